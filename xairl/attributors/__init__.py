@@ -1,0 +1,23 @@
+"""Attribution methods behind one interface; :func:`explain` is the entry point."""
+from __future__ import annotations
+
+from ..explanation import Explanation
+from ..policy import Policy
+from .base import Attributor, Options
+
+
+def explain(policy: Policy, states, background=None, method: str = "deep_shap", options=None) -> Explanation:
+    """Explain a policy's decisions on ``states``.
+
+    :param policy: an :class:`xairl.Policy` (see :func:`xairl.TorchPolicy`).
+    :param states: array-like (n, n_features) or one state (n_features,).
+    :param background: typical states the contributions are measured against; default: the policy's sampler.
+    :param method: a registered attributor name (``xairl attributors`` lists them).
+    :param options: dict of the method's options (validated; unknown keys are an error).
+    """
+    from ..plugins import get_attributor
+
+    return get_attributor(method)(options).explain(policy, states, background)
+
+
+__all__ = ["Attributor", "Options", "explain"]

@@ -1,0 +1,104 @@
+"""DeepSHAP: DeepLIFT rescale-rule multipliers averaged over a background, batched over all (state, background) pairs.
+
+Every pair is one row of a doubled batch ``[x_pairs; r_pairs]``. A forward hook on each elementwise nonlinearity
+replaces its gradient with the rescale ratio Δout/Δin of its own call (so a module used twice is handled per call),
+and one backward pass per action gives the multipliers. Linear layers keep their exact gradients. This gives the
+values of shap.DeepExplainer and captum's DeepLiftShap.
+"""
+from __future__ import annotations
+
+import numpy as np
+import torch
+from pydantic import Field
+
+from ..errors import UnsupportedModelError
+from .base import Attributor, Options
+
+#: layers whose gradient already is the DeepLIFT multiplier (linear in eval mode)
+LINEAR = (torch.nn.Linear, torch.nn.Identity, torch.nn.Flatten, torch.nn.Unflatten, torch.nn.Dropout,
+          torch.nn.AlphaDropout, torch.nn.BatchNorm1d)
+#: elementwise nonlinearities handled with the rescale rule
+NONLINEAR = (torch.nn.ReLU, torch.nn.LeakyReLU, torch.nn.ELU, torch.nn.SiLU, torch.nn.GELU, torch.nn.Tanh,
+             torch.nn.Sigmoid, torch.nn.Softplus, torch.nn.ReLU6, torch.nn.Hardtanh, torch.nn.SELU, torch.nn.CELU,
+             torch.nn.Mish, torch.nn.Softsign, torch.nn.Tanhshrink)
+CONTAINERS = (torch.nn.Sequential, torch.nn.ModuleList, torch.nn.ModuleDict)
+EPS = 1e-6  # below this |Δin| the local gradient is used, as shap does
+
+
+class DeepShapOptions(Options):
+    max_pairs: int = Field(65_536, ge=1, description="(state, background) pairs per batch; bounds memory")
+    check_additivity: bool = Field(True, description="refuse results whose contributions do not add up")
+
+
+def _rescale_hook(module, inputs, output):
+    """Keep the output's value but give it the gradient Δout/Δin (pairs are rows i and i + P)."""
+    inp = inputs[0]
+    p = inp.shape[0] // 2
+    with torch.enable_grad():
+        leaf = inp.detach().requires_grad_(True)
+        local = torch.autograd.grad(module.forward(leaf).sum(), leaf)[0]
+    d_in = inp[:p].detach() - inp[p:].detach()
+    ratio = (output[:p].detach() - output[p:].detach()) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
+    small = d_in.abs() < EPS
+    ratio = torch.cat([torch.where(small, local[:p], ratio), torch.where(small, local[p:], ratio)])
+    return output.detach() + (inp - inp.detach()) * ratio
+
+
+def check_supported(module: torch.nn.Module) -> list[torch.nn.Module]:
+    """The nonlinear layers of ``module``; raises for any leaf layer whose multipliers we cannot compute."""
+    nonlinear = []
+    for name, sub in module.named_modules():
+        if isinstance(sub, NONLINEAR):
+            nonlinear.append(sub)
+        elif isinstance(sub, LINEAR) or isinstance(sub, CONTAINERS):
+            continue
+        elif not any(True for _ in sub.children()):
+            raise UnsupportedModelError(
+                f"deep_shap does not support layer '{name or type(sub).__name__}' ({type(sub).__name__}); "
+                "use method='kernel_shap' or 'exact' for this network."
+            )
+    return nonlinear
+
+
+class DeepShap(Attributor):
+    """DeepSHAP (DeepLIFT rescale rule averaged over background states), all actions in one pass."""
+
+    name = "deep_shap"
+    Options = DeepShapOptions
+
+    def _attribute(self, policy, x, bg):
+        module = policy.module
+        for layer in check_supported(module):
+            self._add_hook(layer.register_forward_hook(_rescale_hook))
+        dev = policy.device
+        xt = torch.as_tensor(x, device=dev)
+        bt = torch.as_tensor(bg, device=dev)
+        n, f = xt.shape
+        b = len(bt)
+        per = max(1, self.options.max_pairs // b)
+        values = np.empty((n, f, policy.n_actions))
+        outputs = np.empty((n, policy.n_actions))
+        for s in range(0, n, per):
+            xs = xt[s:s + per]
+            m = len(xs)
+            xp = xs[:, None, :].expand(m, b, f).reshape(m * b, f)
+            rp = bt[None, :, :].expand(m, b, f).reshape(m * b, f)
+            rows = torch.cat([xp, rp]).requires_grad_(True)
+            out = module(rows)
+            delta = (xp - rp).reshape(m, b, f)
+            outputs[s:s + m] = out[: m * b : b].detach().double().cpu().numpy()
+            base = out[m * b:].detach().double().mean(dim=0).cpu().numpy()
+            for a in range(policy.n_actions):
+                grad = torch.autograd.grad(out[: m * b, a].sum(), rows, retain_graph=a + 1 < policy.n_actions)[0]
+                contrib = (grad[: m * b].reshape(m, b, f) * delta).double().mean(dim=1)
+                values[s:s + m, :, a] = contrib.cpu().numpy()
+        if self.options.check_additivity:
+            gap = np.abs(base + values.sum(axis=1) - outputs).max()
+            scale = max(1.0, float(np.abs(base).max()))
+            if gap > 1e-3 * scale:
+                raise UnsupportedModelError(
+                    f"deep_shap values do not add up to the output (gap {gap:.3g}): the network likely uses functional "
+                    "nonlinearities (torch.relu, F.softmax, ...) that deep_shap cannot see; make them nn modules or "
+                    "use method='kernel_shap' or 'exact'."
+                )
+        return values, base, {}

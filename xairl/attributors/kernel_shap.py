@@ -1,0 +1,43 @@
+"""KernelSHAP through shap.KernelExplainer: model-agnostic, sampled coalitions, seeded."""
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+import torch
+from pydantic import Field
+
+from .base import Attributor, Options
+
+
+class KernelShapOptions(Options):
+    nsamples: int | Literal["auto"] = Field("auto", description="coalitions evaluated per state; 'auto' = 2F + 2048")
+    l1_reg: bool | float | str = Field(False, description="shap's feature selection; False keeps every feature")
+    seed: int = Field(0, description="seed of the coalition sampler")
+
+
+class KernelShap(Attributor):
+    """KernelSHAP (Lundberg & Lee) via the shap package; all actions at once."""
+
+    name = "kernel_shap"
+    Options = KernelShapOptions
+
+    def _attribute(self, policy, x, bg):
+        import shap
+
+        dev = policy.device
+
+        def f(rows: np.ndarray) -> np.ndarray:
+            t = torch.as_tensor(np.asarray(rows, dtype=np.float32), device=dev)
+            return self._forward(policy, t, 65_536).numpy()
+
+        explainer = shap.KernelExplainer(f, bg)
+        # shap samples coalitions from numpy's global generator: seed it here and put the caller's state back
+        saved = np.random.get_state()
+        np.random.seed(self.options.seed)
+        try:
+            sv = explainer.shap_values(x, nsamples=self.options.nsamples, l1_reg=self.options.l1_reg, silent=True)
+        finally:
+            np.random.set_state(saved)
+        values = np.stack(sv, axis=-1) if isinstance(sv, list) else np.asarray(sv)
+        return values, np.asarray(explainer.expected_value, dtype=np.float64), {}

@@ -1,0 +1,28 @@
+"""Exception types a user can cause. Each message is one line that says what is wrong and what to do."""
+
+
+class XairlError(Exception):
+    """Base class of every error xairl raises on purpose; the CLI prints it as one line and exits with status 2."""
+
+
+class InputError(XairlError, ValueError):
+    """States, background or files that cannot be explained as given (shape, NaN, non-numeric cells, ...)."""
+
+
+class UnknownNameError(XairlError, LookupError):
+    """A policy, attributor, narrator or command name that no plugin registered."""
+
+    def __str__(self) -> str:  # LookupError would quote the message like a dict key
+        return str(self.args[0]) if self.args else ""
+
+
+class PluginError(XairlError):
+    """A plugin that registers something twice or fails to load."""
+
+
+class UnsupportedModelError(XairlError):
+    """A network that an attributor cannot explain correctly (it says which layer and what to use instead)."""
+
+
+class CheckpointError(XairlError):
+    """A checkpoint that is missing, corrupt or does not match the architecture."""

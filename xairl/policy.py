@@ -1,0 +1,112 @@
+"""Policy: a trained torch network mapping a batch of states to one score per action, with names and metadata."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+import torch
+
+from .errors import InputError
+from .inputs import as_states
+
+
+@dataclass(frozen=True)
+class FeatureInfo:
+    """What a feature means, for plots and narration.
+
+    :param unit: e.g. "dBm", "m"; empty when unitless.
+    :param description: a plain-language phrase ("the serving cell's reference signal power").
+    :param low: how to describe a low value ("weak signal"); ``high`` likewise.
+    """
+
+    unit: str = ""
+    description: str = ""
+    low: str = "low"
+    high: str = "high"
+
+
+@dataclass
+class Policy:
+    """A decision maker with a torch module scoring every action (Q-values or logits).
+
+    :param module: maps a float tensor (batch, n_features) to (batch, n_actions).
+    :param feature_names: one unique name per input column.
+    :param action_names: one unique name per output column.
+    :param features: optional :class:`FeatureInfo` per feature name.
+    :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}``.
+    :param background_sampler: optional ``f(n, seed) -> array (n, n_features)`` of typical states.
+    :param name: how the policy is called in reports.
+    """
+
+    module: torch.nn.Module
+    feature_names: Sequence[str]
+    action_names: Sequence[str]
+    features: Mapping[str, FeatureInfo] = field(default_factory=dict)
+    groups: Mapping[str, Sequence[str]] = field(default_factory=dict)
+    background_sampler: Callable[[int, int], np.ndarray] | None = None
+    name: str = "policy"
+
+    def __post_init__(self) -> None:
+        self.feature_names = [str(f) for f in self.feature_names]
+        self.action_names = [str(a) for a in self.action_names]
+        for what, names in (("feature_names", self.feature_names), ("action_names", self.action_names)):
+            if not names:
+                raise InputError(f"{what} is empty; name every input column and every action.")
+            if len(set(names)) != len(names):
+                dup = sorted({n for n in names if names.count(n) > 1})
+                raise InputError(f"{what} has duplicates ({', '.join(dup)}); names must be unique.")
+        unknown = sorted(set(self.features) - set(self.feature_names))
+        unknown += sorted({f for g in self.groups.values() for f in g} - set(self.feature_names))
+        if unknown:
+            raise InputError(f"metadata names unknown feature(s) {', '.join(unknown)}; use names from feature_names.")
+        if not isinstance(self.module, torch.nn.Module):
+            raise InputError(f"module must be a torch.nn.Module, got {type(self.module).__name__}.")
+
+    @property
+    def n_features(self) -> int:
+        return len(self.feature_names)
+
+    @property
+    def n_actions(self) -> int:
+        return len(self.action_names)
+
+    @property
+    def device(self) -> torch.device:
+        p = next(self.module.parameters(), None)
+        return p.device if p is not None else torch.device("cpu")
+
+    def check_states(self, states, what: str = "states") -> np.ndarray:
+        """Validated float32 array (n, n_features); raises :class:`InputError` with a one-line reason."""
+        return as_states(states, self.n_features, what)
+
+    def scores(self, states) -> np.ndarray:
+        """Scores (n, n_actions) of the module in eval mode, without gradients."""
+        x = torch.as_tensor(self.check_states(states), device=self.device)
+        was_training = self.module.training
+        self.module.eval()
+        try:
+            with torch.no_grad():
+                out = self.module(x)
+        finally:
+            self.module.train(was_training)
+        out = out.detach().cpu().numpy().astype(np.float64)
+        if out.ndim != 2 or out.shape[1] != self.n_actions:
+            raise InputError(
+                f"the module returned shape {tuple(out.shape)} but {self.n_actions} actions are named; "
+                "it must map (batch, n_features) to (batch, n_actions)."
+            )
+        return out
+
+    def act(self, states) -> np.ndarray:
+        """Index of the highest-scoring action per state."""
+        return self.scores(states).argmax(axis=1)
+
+    def background(self, n: int = 100, seed: int = 0) -> np.ndarray:
+        """`n` typical states from the policy's sampler; raises when it has none."""
+        if self.background_sampler is None:
+            raise InputError(f"policy '{self.name}' has no background sampler; pass background states explicitly.")
+        return self.check_states(self.background_sampler(n, seed), "background")
+
+
+TorchPolicy = Policy  # the name users of plain torch networks (CleanRL style) look for
