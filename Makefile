@@ -1,5 +1,7 @@
 # The README's two commands: `make demo` and `make test`. Both set everything up first; re-running is fast
 # because set-up is redone only when a pyproject or this Makefile changes.
+SHELL := /bin/bash
+.SHELLFLAGS := -o pipefail -ec
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
@@ -7,7 +9,8 @@ PIP := $(PY) -m pip --disable-pip-version-check -q
 STAMP := $(VENV)/.xairl-setup
 PLUGINS := $(wildcard plugins/*/pyproject.toml)
 # pip's find-links on this machine print a warning per unknown folder; keep the set-up output readable
-QUIET := 2>&1 | grep -v "^WARNING: Location" || true
+# (pipefail keeps pip's own failure; grep's "nothing left to print" is not one)
+QUIET := 2>&1 | { grep -v "^WARNING: Location" || true; }
 
 .PHONY: setup demo test bench clean
 

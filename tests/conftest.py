@@ -1,0 +1,51 @@
+import numpy as np
+import pytest
+import torch
+
+from xairl import plugins
+
+
+@pytest.fixture(autouse=True)
+def user_path(tmp_path, monkeypatch):
+    """Every test gets its own empty user folder (prompts, feedback store, model cache)."""
+    path = tmp_path / "xairl-user"
+    path.mkdir()
+    monkeypatch.setenv("XAIRL_USER_PATH", str(path))
+    return path
+
+
+@pytest.fixture(autouse=True)
+def fresh_plugins():
+    """Each test starts from a fresh plugin manager and empty registries."""
+    plugins.reset()
+    yield
+    plugins.reset()
+
+
+def mlp(sizes, act=torch.nn.ReLU, seed=0):
+    torch.manual_seed(seed)
+    layers = []
+    for i, (a, b) in enumerate(zip(sizes[:-1], sizes[1:])):
+        layers.append(torch.nn.Linear(a, b))
+        if i < len(sizes) - 2:
+            layers.append(act())
+    return torch.nn.Sequential(*layers).eval()
+
+
+class ReusedActivations(torch.nn.Module):
+    """A plain forward() network that calls one ReLU module twice (a known pitfall) and mixes nonlinearities."""
+
+    def __init__(self, f=6, h=12, a=3):
+        super().__init__()
+        torch.manual_seed(1)
+        self.l1, self.l2, self.l3 = torch.nn.Linear(f, h), torch.nn.Linear(h, h), torch.nn.Linear(h, a)
+        self.act = torch.nn.ReLU()
+        self.squash = torch.nn.Tanh()
+
+    def forward(self, x):
+        return self.l3(self.squash(self.act(self.l2(self.act(self.l1(x))))))
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(0)
