@@ -1,0 +1,104 @@
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import xairl
+from xairl.cli import main
+from xairl.toy import FEATURES, toy_policy
+
+
+def run(capsys, *argv):
+    rc = main(list(argv))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def test_help_does_not_import_heavy_libraries():
+    code = ("import sys\nfrom xairl.cli import main\ntry:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+            "print([m for m in ('torch', 'shap', 'transformers', 'captum') if m in sys.modules])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert "explain" in out and out.strip().endswith("[]")
+
+
+def test_plugins_and_attributors(capsys):
+    rc, out, _ = run(capsys, "plugins")
+    assert rc == 0 and "xairl" in out and "deep_shap" in out and "toy" in out
+    rc, out, _ = run(capsys, "attributors", "--json")
+    rows = {r["name"]: r for r in json.loads(out)}
+    assert set(rows) >= {"deep_shap", "exact", "kernel_shap", "integrated_gradients"}
+    assert "n_steps" in rows["integrated_gradients"]["options"]["properties"]
+    assert rows["exact"]["options"]["additionalProperties"] is False
+
+
+def test_explain_csv_jsonl_matches_api(tmp_path, capsys):
+    policy = toy_policy()
+    states = policy.background(3, seed=9)
+    csv = tmp_path / "s.csv"
+    csv.write_text(",".join(FEATURES) + "\n" + "\n".join(",".join(map(repr, r.tolist())) for r in states) + "\n")
+    bg = tmp_path / "bg.npy"
+    np.save(bg, policy.background(20))
+    rc, out, err = run(capsys, "explain", "--states", str(csv), "--background", str(bg), "--method", "exact",
+                       "--format", "jsonl")
+    assert rc == 0, err
+    recs = [json.loads(line) for line in out.splitlines()]
+    ref = xairl.explain(policy, states, background=np.load(bg), method="exact")
+    assert len(recs) == 3
+    for i, rec in enumerate(recs):
+        assert rec["chosen"] == ref.action_names[ref.chosen[i]]
+        for j, f in enumerate(FEATURES):
+            assert rec["values"][f][rec["chosen"]] == pytest.approx(ref.values[i, j, ref.chosen[i]], abs=1e-9)
+
+
+def test_explain_table_and_options(capsys):
+    rc, out, err = run(capsys, "explain", "--n", "2", "--method", "integrated_gradients", "-o", "n_steps=16",
+                       "-o", "method=riemann_left", "--top", "2")
+    assert rc == 0, err
+    assert out.count("chose") == 2 and "integrated_gradients" in out
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["explain", "--method", "shapley"], "unknown attributor 'shapley'"),
+    (["explain", "--policy", "nope"], "unknown policy 'nope'"),
+    (["explain", "-o", "foo=1"], "foo: unknown option"),
+    (["explain", "-o", "novalue"], "is not key=value"),
+    (["explain", "--method", "exact", "-o", "max_rows=-3"], "max_rows"),
+    (["explain", "--states", "/nonexistent.csv"], "no such file"),
+])
+def test_user_errors_are_one_line_exit_2(capsys, argv, match):
+    rc, out, err = run(capsys, *argv)
+    assert rc == 2
+    assert match in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+@pytest.mark.parametrize("content, match", [
+    ("battery,distance\n1,2\n", "missing column"),
+    (",".join(FEATURES) + "\n1,2,nan,4,5\n", "NaN/inf"),
+    (",".join(FEATURES) + "\n1,2,three,4,5\n", "'three' is not a number"),
+])
+def test_bad_state_files(tmp_path, capsys, content, match):
+    p = tmp_path / "s.csv"
+    p.write_text(content)
+    rc, _, err = run(capsys, "explain", "--states", str(p))
+    assert rc == 2 and match in err and "Traceback" not in err
+
+
+def test_background_of_wrong_width(tmp_path, capsys):
+    bg = tmp_path / "bg.npy"
+    np.save(bg, np.zeros((4, 3)))
+    rc, _, err = run(capsys, "explain", "--background", str(bg))
+    assert rc == 2 and "has 3 features but the policy expects 5" in err
+
+
+def test_installed_script_smoke():
+    exe = shutil.which("xairl", path=str(Path(sys.executable).parent)) or shutil.which("xairl")
+    assert exe, "the console script `xairl` is not installed"
+    res = subprocess.run([exe, "explain", "--n", "1", "--format", "jsonl"], capture_output=True, text=True,
+                         env={**os.environ, "XAIRL_DEBUG": ""}, timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert json.loads(res.stdout)["method"] == "deep_shap"

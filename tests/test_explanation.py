@@ -1,0 +1,57 @@
+import numpy as np
+import pytest
+
+import xairl
+from xairl.errors import InputError
+from xairl.toy import toy_policy
+
+
+@pytest.fixture(scope="module")
+def exp():
+    policy = toy_policy()
+    return xairl.explain(policy, policy.background(8, seed=1), background=policy.background(30), method="exact")
+
+
+def test_for_chosen_and_margin(exp):
+    idx = np.arange(8)
+    chosen, runner = exp.chosen, exp.runner_up
+    assert (chosen == exp.outputs.argmax(1)).all()
+    assert (exp.outputs[idx, runner] <= exp.outputs[idx, chosen]).all() and (runner != chosen).all()
+    np.testing.assert_array_equal(exp.for_chosen(), exp.values[idx, :, chosen])
+    # the margin's contributions add up to the Q-gap minus the gap of the base values
+    q_gap = exp.outputs[idx, chosen] - exp.outputs[idx, runner]
+    base_gap = exp.base_values[idx, chosen] - exp.base_values[idx, runner]
+    np.testing.assert_allclose(exp.margin().sum(axis=1), q_gap - base_gap, atol=1e-5)
+
+
+def test_grouped_sums_members_and_keeps_additivity(exp):
+    g = exp.grouped({"motion": ["speed", "wind"]})
+    assert g.feature_names == ("battery", "distance", "motion", "obstacle")
+    j = exp.feature_names.index
+    np.testing.assert_allclose(g.values[:, 2], exp.values[:, j("speed")] + exp.values[:, j("wind")])
+    np.testing.assert_allclose(g.additivity_gap, exp.additivity_gap, atol=1e-9)
+    with pytest.raises(InputError, match="unknown feature 'nope'"):
+        exp.grouped({"g": ["nope"]})
+    with pytest.raises(InputError, match="must not overlap"):
+        exp.grouped({"a": ["speed"], "b": ["speed", "wind"]})
+
+
+def test_json_round_trip(exp):
+    back = xairl.Explanation.from_json(exp.to_json())
+    np.testing.assert_array_equal(back.values, exp.values)
+    np.testing.assert_array_equal(back.states, exp.states)
+    assert back.feature_names == exp.feature_names and back.method == "exact"
+    assert back.options == dict(exp.options)
+
+
+def test_records_are_one_per_state(exp):
+    recs = exp.records()
+    assert len(recs) == 8
+    r = recs[3]
+    assert r.chosen == exp.action_names[exp.chosen[3]]
+    assert r.values["battery"][r.chosen] == pytest.approx(exp.values[3, 0, exp.chosen[3]])
+
+
+def test_explanation_is_read_only(exp):
+    with pytest.raises(ValueError):
+        exp.values[0, 0, 0] = 1.0
