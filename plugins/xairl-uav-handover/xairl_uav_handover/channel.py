@@ -1,0 +1,67 @@
+"""3GPP TR 36.777 Annex B air-to-ground channel for aerial UEs: LoS probability, path loss, shadow-fading sigma.
+
+All functions are vectorised over numpy arrays. Heights and distances in metres, carrier frequency in GHz.
+Scenarios: UMa-AV (h 22.5-300 m), UMi-AV (22.5-300 m), RMa-AV (10-300 m).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+SCENARIOS = ("UMa-AV", "UMi-AV", "RMa-AV")
+#: (min exclusive, max inclusive) UAV height the model is defined for
+HEIGHT_RANGE = {"UMa-AV": (22.5, 300.0), "UMi-AV": (22.5, 300.0), "RMa-AV": (10.0, 300.0)}
+
+
+def _los_from_d1_p1(d2d, d1, p1):
+    d2d = np.maximum(d2d, 1e-9)
+    p = d1 / d2d + np.exp(-d2d / p1) * (1.0 - d1 / d2d)
+    return np.where(d2d <= d1, 1.0, p)
+
+
+def los_probability(scenario: str, h, d2d):
+    """P_LOS for a UAV at height ``h`` and horizontal distance ``d2d`` (TR 36.777 Table B-1)."""
+    h, d2d = np.asarray(h, dtype=float), np.asarray(d2d, dtype=float)
+    lg = np.log10(h)
+    if scenario == "UMa-AV":  # LoS certain above 100 m
+        p = _los_from_d1_p1(d2d, np.maximum(460 * lg - 700, 18.0), 4300 * lg - 3800)
+        return np.where(h > 100, 1.0, p)
+    if scenario == "UMi-AV":
+        return _los_from_d1_p1(d2d, np.maximum(294.05 * lg - 432.94, 18.0), 233.98 * lg - 0.95)
+    if scenario == "RMa-AV":  # LoS certain above 40 m
+        p = _los_from_d1_p1(d2d, np.maximum(1350.8 * lg - 1602, 18.0), np.maximum(15021 * lg - 16053, 1000.0))
+        return np.where(h > 40, 1.0, p)
+    raise ValueError(f"unknown scenario '{scenario}'; use one of {', '.join(SCENARIOS)}")
+
+
+def path_loss(scenario: str, h, d3d, fc_ghz: float, los):
+    """Path loss in dB (TR 36.777 Table B-2); ``los`` selects the LoS or NLoS formula per element."""
+    h, d3d = np.asarray(h, dtype=float), np.maximum(np.asarray(d3d, dtype=float), 1.0)
+    lg_h, lg_d = np.log10(h), np.log10(d3d)
+    if scenario == "UMa-AV":
+        pl_los = 28.0 + 22.0 * lg_d + 20.0 * np.log10(fc_ghz)
+        pl_nlos = -17.5 + (46.0 - 7.0 * lg_h) * lg_d + 20.0 * np.log10(40.0 * np.pi * fc_ghz / 3.0)
+    elif scenario == "UMi-AV":
+        fspl = 32.45 + 20.0 * np.log10(fc_ghz) + 20.0 * lg_d
+        pl_los = np.maximum(fspl, 30.9 + (22.25 - 0.5 * lg_h) * lg_d + 20.0 * np.log10(fc_ghz))
+        pl_nlos = np.maximum(pl_los, 32.4 + (43.2 - 7.6 * lg_h) * lg_d + 20.0 * np.log10(fc_ghz))
+    elif scenario == "RMa-AV":
+        fspl_term = 20.0 * np.log10(40.0 * np.pi * fc_ghz / 3.0)
+        pl_los = np.maximum(23.9 - 1.8 * lg_h, 20.0) * lg_d + fspl_term
+        pl_nlos = np.maximum(pl_los, -12.0 + (35.0 - 5.3 * lg_h) * lg_d + fspl_term)
+    else:
+        raise ValueError(f"unknown scenario '{scenario}'; use one of {', '.join(SCENARIOS)}")
+    return np.where(los, pl_los, pl_nlos)
+
+
+def shadow_sigma(scenario: str, h, los):
+    """Shadow-fading standard deviation in dB (TR 36.777 Table B-3)."""
+    h = np.asarray(h, dtype=float)
+    if scenario == "UMa-AV":
+        s_los, s_nlos = 4.64 * np.exp(-0.0066 * h), 6.0
+    elif scenario == "UMi-AV":
+        s_los, s_nlos = np.maximum(5.0 * np.exp(-0.01 * h), 2.0), 8.0
+    elif scenario == "RMa-AV":
+        s_los, s_nlos = 4.2 * np.exp(-0.0046 * h), 6.0
+    else:
+        raise ValueError(f"unknown scenario '{scenario}'; use one of {', '.join(SCENARIOS)}")
+    return np.where(los, s_los, s_nlos)

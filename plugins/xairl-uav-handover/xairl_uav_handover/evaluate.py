@@ -1,0 +1,68 @@
+"""Run controllers on the same held-out flights and summarise them as the paper's Table I."""
+from __future__ import annotations
+
+import numpy as np
+
+from .config import SimConfig
+from .simulator import Simulator
+
+#: seeds of evaluation flights start here; training flights use seeds below it (see train.py)
+HELD_OUT_SEED = 1_000_000
+#: the paper's Table I (median per flight): handovers, ping-pong %
+PAPER = {"CHM": (75, 40), "SA-MRO": (32, 27), "DQN": (12, 14)}
+
+
+def run_flights(controller, config: SimConfig, n_flights: int, seed: int) -> dict[str, np.ndarray]:
+    """Fly ``n_flights`` (all at once) under ``controller``; per-flight metrics as arrays of shape (n_flights,)."""
+    sim = Simulator(config, n_uavs=n_flights, seed=HELD_OUT_SEED + seed)
+    controller.reset(sim)
+    keys = ("handover", "pingpong", "available", "queue_bits", "lost_bits", "rsrp_violation", "rsrq_violation")
+    tot = {k: np.zeros(n_flights) for k in keys}
+    while not sim.done:
+        info = sim.step(controller(sim))
+        for key in keys:
+            tot[key] += getattr(info, key)
+    n = sim.n_steps
+    return {
+        "handovers": tot["handover"],
+        "pingpongs": tot["pingpong"],
+        "service_availability_pct": 100 * tot["available"] / n,
+        "mean_buffer_kbit": tot["queue_bits"] / n / 1e3,
+        "lost_data_kbit": tot["lost_bits"] / 1e3,
+        "rsrp_violation_pct": 100 * tot["rsrp_violation"] / n,
+        "rsrq_violation_pct": 100 * tot["rsrq_violation"] / n,
+    }
+
+
+def summarise(m: dict[str, np.ndarray]) -> dict[str, float]:
+    """Table I row: medians per flight for handovers and ping-pong share (as the paper), pooled ping-pong share
+    (all ping-pongs / all handovers), and means per flight for the rest."""
+    pp_share = 100 * m["pingpongs"] / np.maximum(m["handovers"], 1)
+    row = {"handovers_median": float(np.median(m["handovers"])),
+           "pingpong_pct_median": float(np.median(pp_share)),
+           "pingpong_pct_pooled": float(100 * m["pingpongs"].sum() / max(m["handovers"].sum(), 1))}
+    for key in ("service_availability_pct", "mean_buffer_kbit", "lost_data_kbit", "rsrp_violation_pct",
+                "rsrq_violation_pct"):
+        row[f"{key}_mean"] = float(np.mean(m[key]))
+    return row
+
+
+def table_one(controllers, config: SimConfig, n_flights: int, seed: int) -> dict[str, dict[str, float]]:
+    """{policy name: Table I row} with every controller flying the same held-out flights."""
+    return {c.name: summarise(run_flights(c, config, n_flights, seed)) for c in controllers}
+
+
+def format_table(rows: dict[str, dict[str, float]], config: SimConfig, n_flights: int) -> str:
+    cols = [("handovers_median", "HO/flight", "{:.1f}"), ("pingpong_pct_median", "PP % (med)", "{:.1f}"),
+            ("pingpong_pct_pooled", "PP % (pool)", "{:.1f}"), ("service_availability_pct_mean", "SA %", "{:.2f}"),
+            ("mean_buffer_kbit_mean", "buffer kbit", "{:.2f}"), ("lost_data_kbit_mean", "lost kbit", "{:.1f}"),
+            ("rsrp_violation_pct_mean", "RSRP<thr %", "{:.1f}"), ("rsrq_violation_pct_mean", "RSRQ<thr %", "{:.1f}")]
+    f = config.flight
+    lines = [f"Table I on {n_flights} held-out flights of {f.duration_s:g} s (dt {f.dt_s * 1000:g} ms); ping-pong: "
+             f"back to the previous BS within {config.handover.min_time_of_stay_s:g} s (minimum time of stay)",
+             f"{'policy':<8}" + "".join(f"{name:>13}" for _, name, _ in cols) + f"{'paper HO / PP %':>18}"]
+    for policy, row in rows.items():
+        paper = PAPER.get(policy)
+        lines.append(f"{policy:<8}" + "".join(f"{fmt.format(row[key]):>13}" for key, _, fmt in cols)
+                     + (f"{paper[0]:>12} / {paper[1]}" if paper else ""))
+    return "\n".join(lines)
