@@ -1,0 +1,105 @@
+"""Plugin registration, checkpoints, the pretrained DQN, training smoke test and the `xairl uav` commands."""
+import json
+
+import numpy as np
+import pytest
+import torch
+
+import xairl
+from xairl import plugins
+from xairl.cli import main
+from xairl.errors import CheckpointError
+from xairl_uav_handover.baselines import CHM, SAMRO
+from xairl_uav_handover.config import SimConfig
+from xairl_uav_handover.evaluate import table_one
+from xairl_uav_handover.features import FEATURES
+from xairl_uav_handover.policy import DQNController, build_qnet, load_checkpoint, save_checkpoint, uav_policy
+
+
+def test_registered_through_entry_point():
+    assert plugins.registry("policy").entry("uav-dqn").plugin == "uav-handover"
+    assert plugins.registry("command").entry("uav").plugin == "uav-handover"
+    assert any(p == "uav-handover" and path.endswith("prompts") for p, path in plugins.prompt_dirs())
+
+
+def test_pretrained_policy_metadata_and_background():
+    policy = plugins.get_policy("uav-dqn")
+    assert tuple(policy.feature_names) == FEATURES and policy.groups["position"] == ("x", "y", "z")
+    assert policy.features["rsrp_0"].unit == "dBm"
+    bg = policy.background(16, seed=1)
+    assert bg.shape == (16, 13) and np.isfinite(bg).all()
+
+
+def test_pretrained_dqn_deep_shap_matches_shap():
+    import shap
+
+    policy = uav_policy()
+    bg, x = policy.background(40, seed=1), policy.background(10, seed=2)
+    ours = xairl.explain(policy, x, background=bg, method="deep_shap")
+    ref = np.asarray(shap.DeepExplainer(policy.module, torch.as_tensor(bg)).shap_values(
+        torch.as_tensor(x), check_additivity=False))
+    np.testing.assert_allclose(ours.values, ref, rtol=0, atol=1e-5)
+    assert ours.additivity_gap.max() < 1e-4
+
+
+def test_pretrained_dqn_meets_table_one_targets():
+    """The committed checkpoint against the issue's targets on 100 held-out flights."""
+    net, meta = load_checkpoint(xairl_uav_handover_ckpt())
+    cfg = SimConfig.model_validate(meta["sim_config"])
+    rows = table_one([CHM(), SAMRO(), DQNController(net)], cfg, 100, seed=0)
+    chm, sa, dqn = rows["CHM"], rows["SA-MRO"], rows["DQN"]
+    assert chm["handovers_median"] > sa["handovers_median"] > dqn["handovers_median"]
+    assert chm["pingpong_pct_pooled"] > sa["pingpong_pct_pooled"] > dqn["pingpong_pct_pooled"]
+    assert dqn["handovers_median"] <= 0.2 * chm["handovers_median"]
+    assert dqn["pingpong_pct_median"] <= 14 and dqn["pingpong_pct_pooled"] <= 14
+    assert dqn["service_availability_pct_mean"] >= 0.95 * chm["service_availability_pct_mean"]
+
+
+def xairl_uav_handover_ckpt():
+    from xairl_uav_handover.policy import DEFAULT_CHECKPOINT
+
+    return DEFAULT_CHECKPOINT
+
+
+def test_corrupt_and_mismatched_checkpoints(tmp_path):
+    bad = tmp_path / "bad.safetensors"
+    bad.write_bytes(b"\x00garbage" * 10)
+    with pytest.raises(CheckpointError, match="not a readable safetensors"):
+        load_checkpoint(bad)
+    with pytest.raises(CheckpointError, match="no such checkpoint"):
+        load_checkpoint(tmp_path / "missing.safetensors")
+    other = tmp_path / "other.safetensors"
+    save_checkpoint(build_qnet(np.zeros(13), np.ones(13), hidden=(8,)), other, {"hidden": [64, 64]})
+    with pytest.raises(CheckpointError, match="does not match"):
+        load_checkpoint(other)
+
+
+def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
+    ckpt = tmp_path / "tiny.safetensors"
+    assert main(["uav", "train", "--episodes", "1", "--flights", "2", "--duration", "3", "--seed", "4",
+                 "--no-progress", "--out", str(ckpt)]) == 0
+    net, meta = load_checkpoint(ckpt)
+    assert meta["seed"] == 4 and meta["train_config"]["episodes"] == 1 and len(meta["history"]) == 1
+    capsys.readouterr()
+    assert main(["uav", "evaluate", "--checkpoint", str(ckpt), "--flights", "3", "--duration", "2",
+                 "--min-stay", "0.5", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["flights"] == 3 and report["min_time_of_stay_s"] == 0.5
+    assert set(report["policies"]) == {"CHM", "SA-MRO", "DQN"}
+    for row in report["policies"].values():
+        assert set(row) == {"handovers_median", "pingpong_pct_median", "pingpong_pct_pooled",
+                            "service_availability_pct_mean", "mean_buffer_kbit_mean", "lost_data_kbit_mean",
+                            "rsrp_violation_pct_mean", "rsrq_violation_pct_mean"}
+    assert main(["uav", "evaluate", "--checkpoint", str(ckpt), "--flights", "2", "--duration", "2"]) == 0
+    assert "within 1 s" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["uav", "evaluate", "--duration", "-1"], "flight.duration_s"),
+    (["uav", "evaluate", "--checkpoint", "/nope.safetensors"], "no such checkpoint"),
+    (["uav", "train", "--episodes", "0"], "at least 1"),
+])
+def test_uav_command_errors_are_one_line(capsys, argv, match):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert match in err and err.count("\n") == 1
