@@ -28,8 +28,8 @@ $(STAMP): pyproject.toml Makefile $(PLUGINS)
 	touch $(STAMP)
 
 demo: setup
-	$(VENV)/bin/xairl explain --policy toy --n 3
-	$(VENV)/bin/xairl explain --policy toy --n 2 --method exact
+	$(VENV)/bin/xairl uav evaluate --flights 100 --seed 0
+	$(VENV)/bin/xairl explain --policy uav-dqn --n 3 --top 5
 
 test: setup
 	$(PY) -m pytest
