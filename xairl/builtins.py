@@ -17,3 +17,10 @@ def register_attributors(register):
 @hookimpl
 def register_policies(register):
     register("toy", "xairl.toy:toy_policy", "a tiny seeded 5-feature, 3-action MLP for trying xairl out")
+
+
+@hookimpl
+def register_narrators(register):
+    register("template", "xairl.narrators.template:TemplateNarrator", "deterministic: the first phrasing of each sentence")
+    register("local_lm", "xairl.narrators.local_lm:LocalLMNarrator",
+             "a small local language model (SmolLM2-135M by default) words the facts; verified, template fallback")

@@ -23,6 +23,8 @@ class Explanation:
     :param states: (n_states, n_features) the explained inputs (None after :meth:`grouped`).
     :param method: attributor name; ``options`` the validated options it ran with.
     :param extras: method-specific diagnostics (e.g. IG's convergence delta).
+    :param background_quantiles: (3, n_features) 25th, 50th and 75th percentiles of the background, so that a
+        value can be called low, typical or high.
     """
 
     values: np.ndarray
@@ -34,6 +36,7 @@ class Explanation:
     method: str
     options: Mapping[str, Any] = field(default_factory=dict)
     extras: Mapping[str, Any] = field(default_factory=dict)
+    background_quantiles: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n, f, a = self.values.shape
@@ -104,7 +107,8 @@ class Explanation:
                 names.append(g)
                 idx = [self.feature_names.index(m) for m in groups[g]]
                 cols.append(self.values[:, idx, :].sum(axis=1))
-        return replace(self, values=np.stack(cols, axis=1), feature_names=tuple(names), states=None)
+        return replace(self, values=np.stack(cols, axis=1), feature_names=tuple(names), states=None,
+                       background_quantiles=None)
 
     def records(self) -> list["StateRecord"]:
         """One :class:`StateRecord` per explained state (the JSON-lines form)."""
@@ -148,6 +152,7 @@ class ExplanationRecord(BaseModel):
     method: str
     options: dict[str, Any] = {}
     extras: dict[str, Any] = {}
+    background_quantiles: list[list[float]] | None = None
 
     @classmethod
     def from_explanation(cls, e: Explanation) -> "ExplanationRecord":
@@ -161,6 +166,7 @@ class ExplanationRecord(BaseModel):
             method=e.method,
             options=dict(e.options),
             extras={k: np.asarray(v).tolist() for k, v in e.extras.items()},
+            background_quantiles=None if e.background_quantiles is None else e.background_quantiles.tolist(),
         )
 
     def to_explanation(self) -> Explanation:
@@ -176,6 +182,7 @@ class ExplanationRecord(BaseModel):
             method=self.method,
             options=self.options,
             extras={k: np.asarray(v) for k, v in self.extras.items()},
+            background_quantiles=None if self.background_quantiles is None else np.asarray(self.background_quantiles),
         )
 
 

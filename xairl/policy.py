@@ -18,12 +18,14 @@ class FeatureInfo:
     :param unit: e.g. "dBm", "m"; empty when unitless.
     :param description: a plain-language phrase ("the serving cell's reference signal power").
     :param low: how to describe a low value ("weak signal"); ``high`` likewise.
+    :param aliases: other names a text may use for the feature (the verifier recognises them).
     """
 
     unit: str = ""
     description: str = ""
     low: str = "low"
     high: str = "high"
+    aliases: tuple[str, ...] = ()
 
 
 @dataclass
@@ -37,6 +39,9 @@ class Policy:
     :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}``.
     :param background_sampler: optional ``f(n, seed) -> array (n, n_features)`` of typical states.
     :param name: how the policy is called in reports.
+    :param action_aliases: other names of each action in text, e.g. ``{"stay": ["keep the serving BS"]}``.
+    :param facts_hook: optional ``f(state, chosen, runner_up) -> {"extras": {...}, "comparisons": [...]}`` adding
+        domain facts; each comparison is ``{"text": ..., "value": float, "unit": ...}`` (see xairl.narrators.facts).
     """
 
     module: torch.nn.Module
@@ -46,6 +51,8 @@ class Policy:
     groups: Mapping[str, Sequence[str]] = field(default_factory=dict)
     background_sampler: Callable[[int, int], np.ndarray] | None = None
     name: str = "policy"
+    action_aliases: Mapping[str, Sequence[str]] = field(default_factory=dict)
+    facts_hook: Callable[[np.ndarray, int, int], dict] | None = None
 
     def __post_init__(self) -> None:
         self.feature_names = [str(f) for f in self.feature_names]

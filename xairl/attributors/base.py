@@ -86,6 +86,7 @@ class Attributor:
             method=self.name,
             options=self.options.model_dump(),
             extras=extras,
+            background_quantiles=np.percentile(bg, [25, 50, 75], axis=0).astype(np.float64),
         )
 
     def _attribute(self, policy: Policy, x: np.ndarray, bg: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:

@@ -9,8 +9,12 @@ GROUPS = {"position": ("x", "y", "z"), "rsrp": ("rsrp_0", "rsrp_1", "rsrp_2", "r
           "rsrq": ("rsrq_0", "rsrq_1", "rsrq_2", "rsrq_3")}
 
 
-def _cand(k: int) -> str:
-    return "the serving BS" if k == 0 else f"candidate BS {k} (the {['', 'strongest', 'second strongest', 'third strongest'][k]} neighbour)"
+_WHO = ("the serving BS", "the strongest neighbour", "the second strongest neighbour", "the third strongest neighbour")
+
+
+def _signal(kind: str, k: int, unit: str, low: str, high: str) -> FeatureInfo:
+    aliases = (f"{kind} of candidate {k}", f"candidate {k}'s {kind}") if k else (f"serving {kind}",)
+    return FeatureInfo(unit, f"{_WHO[k]}'s {kind}", low, high, aliases)
 
 
 FEATURE_INFO = {
@@ -19,6 +23,25 @@ FEATURE_INFO = {
     "z": FeatureInfo("m", "the UAV's altitude", "low altitude", "high altitude"),
     "buffer_queue_size": FeatureInfo("bit", "the uplink buffer queue", "nearly empty buffer", "nearly full buffer"),
     "serving_bs": FeatureInfo("", "the serving BS's id", "low id", "high id"),
-    **{f"rsrp_{k}": FeatureInfo("dBm", f"the RSRP of {_cand(k)}", "weak signal", "strong signal") for k in range(4)},
-    **{f"rsrq_{k}": FeatureInfo("dB", f"the RSRQ of {_cand(k)}", "poor quality", "good quality") for k in range(4)},
+    **{f"rsrp_{k}": _signal("RSRP", k, "dBm", "weak signal", "strong signal") for k in range(4)},
+    **{f"rsrq_{k}": _signal("RSRQ", k, "dB", "poor quality", "good quality") for k in range(4)},
 }
+ACTION_ALIASES = {"stay": ("keep the serving BS", "staying"),
+                  **{a: (f"hand over to candidate {k}", f"a handover to candidate {k}")
+                     for k, a in enumerate(ACTIONS) if k}}
+
+
+def handover_facts(state, chosen: int, runner_up: int) -> dict:
+    """Domain facts for narration: stay or hand over, from which BS to which candidate, and how the target (or the
+    runner-up candidate, when the UAV stays) compares with the serving BS in RSRP. (Its RSRQ differs by exactly
+    the same dB: both cells' RSRQ share one RSSI, so an RSRQ comparison would only repeat it.)"""
+    s = dict(zip(FEATURES, (float(v) for v in state)))
+    k = chosen if chosen else runner_up
+    extras = {"decision": "hand over" if chosen else "stay", "serving_bs": int(round(s["serving_bs"])),
+              "target_candidate": int(chosen), "compared_candidate": int(k)}
+    comparisons = []
+    if k:
+        diff = s[f"rsrp_{k}"] - s["rsrp_0"]
+        comparisons.append({"text": f"{_WHO[k]}'s RSRP was {abs(diff):.1f} dB {'above' if diff >= 0 else 'below'} "
+                                    "the serving BS's RSRP", "value": round(abs(diff), 1), "unit": "dB"})
+    return {"extras": extras, "comparisons": comparisons}

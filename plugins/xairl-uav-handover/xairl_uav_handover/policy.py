@@ -16,7 +16,7 @@ from xairl.errors import CheckpointError
 from xairl.policy import Policy
 
 from .config import SimConfig
-from .features import ACTIONS, FEATURE_INFO, FEATURES, GROUPS
+from .features import ACTION_ALIASES, ACTIONS, FEATURE_INFO, FEATURES, GROUPS, handover_facts
 from .simulator import Simulator
 
 DEFAULT_CHECKPOINT = Path(__file__).parent / "checkpoints" / "uav-dqn.safetensors"
@@ -88,7 +88,8 @@ def uav_policy(path: str | Path | None = None) -> Policy:
     net, meta = load_checkpoint(path or DEFAULT_CHECKPOINT)
     config = SimConfig.model_validate(meta["sim_config"]) if "sim_config" in meta else SimConfig()
     return Policy(net, FEATURES, ACTIONS, features=FEATURE_INFO, groups=GROUPS,
-                  background_sampler=lambda n, seed: background_states(n, seed, config), name="uav-dqn")
+                  background_sampler=lambda n, seed: background_states(n, seed, config), name="uav-dqn",
+                  action_aliases=ACTION_ALIASES, facts_hook=handover_facts)
 
 
 class DQNController:

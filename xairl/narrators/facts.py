@@ -1,0 +1,162 @@
+"""Facts computed by code from an Explanation: the only source of numbers, names and directions in a narrative."""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..explanation import Explanation
+from ..policy import FeatureInfo, Policy
+
+
+def fmt(x: float, signed: bool = False) -> str:
+    """How every number is written: 0 decimals from 100, 1 from 10, else 2 (3 significant digits below 0.01)."""
+    a = abs(x)
+    if float(x).is_integer() and a < 1e6:  # ids, counts
+        s = f"{x:.0f}"
+    elif a >= 100:
+        s = f"{x:.0f}"
+    elif a >= 10:
+        s = f"{x:.1f}"
+    elif a >= 0.01 or a == 0:
+        s = f"{x:.2f}"
+    else:
+        s = f"{x:.3g}"
+    if s.startswith("-") and float(s) == 0:
+        s = s[1:]
+    return ("+" + s) if signed and not s.startswith("-") else s
+
+
+@dataclass(frozen=True)
+class FeatureFact:
+    """One feature's part in a decision. ``direction`` is 'toward' (raises the target score) or 'against'."""
+
+    name: str
+    label: str
+    value: float
+    unit: str
+    contribution: float
+    share: float
+    direction: str
+    level: str
+    level_text: str
+    rank: int
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """A domain fact from the policy's plugin, e.g. 'candidate 1's RSRP is 4.2 dB above the serving BS's'."""
+
+    text: str
+    value: float
+    unit: str = ""
+
+
+@dataclass(frozen=True)
+class DecisionFacts:
+    index: int
+    action: str
+    runner_up: str
+    score: float
+    runner_up_score: float
+    q_margin: float
+    base_value: float
+    method: str
+    additivity_gap: float
+    top: tuple[FeatureFact, ...]
+    margin_top: tuple[FeatureFact, ...]
+    comparisons: tuple[Comparison, ...] = ()
+    extras: dict[str, Any] = field(default_factory=dict)
+
+    def context(self) -> dict[str, Any]:
+        """Variables a decision template sees."""
+        return asdict(self) | {"k": len(self.top)}
+
+
+@dataclass(frozen=True)
+class GlobalFacts:
+    """Over a set of states: features ranked by mean |contribution| to the chosen action, and the direction in
+    which high values of each push (correlation of value and contribution)."""
+
+    n_states: int
+    method: str
+    ranking: tuple[dict, ...]
+
+    def context(self) -> dict[str, Any]:
+        return asdict(self) | {"k": len(self.ranking)}
+
+
+def _info(policy: Policy | None, name: str) -> FeatureInfo:
+    return (policy.features.get(name) if policy else None) or FeatureInfo()
+
+
+def _level(exp: Explanation, j: int, value: float, info: FeatureInfo) -> tuple[str, str]:
+    q = exp.background_quantiles
+    if q is None:
+        return "unknown", "unknown"
+    if value < q[0, j]:
+        return "low", info.low
+    if value > q[2, j]:
+        return "high", info.high
+    return "typical", "typical"
+
+
+def _feature_facts(exp, i, contrib, policy, k) -> tuple[FeatureFact, ...]:
+    total = float(np.abs(contrib).sum()) or 1.0
+    order = np.argsort(-np.abs(contrib), kind="stable")
+    out = []
+    for rank, j in enumerate(order[:k], start=1):
+        name = exp.feature_names[j]
+        info = _info(policy, name)
+        value = float(exp.states[i, j]) if exp.states is not None else float("nan")
+        level, level_text = _level(exp, j, value, info)
+        c = float(contrib[j])
+        out.append(FeatureFact(name, info.description or name, value, info.unit, c,
+                               100.0 * abs(c) / total, "toward" if c >= 0 else "against", level, level_text, rank))
+    return tuple(out)
+
+
+def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = None, k: int = 3) -> DecisionFacts:
+    """Facts about state ``index``: the action, runner-up, Q-gap, top-``k`` features for the chosen action and
+    for the margin against the runner-up, and the policy plugin's own comparisons."""
+    n = len(exp.values)
+    if not 0 <= index < n:
+        raise InputError(f"index {index} is out of range: the explanation has {n} state(s).")
+    if exp.states is None:
+        raise InputError("this explanation has no states (it was grouped); narrate the ungrouped explanation.")
+    c, r = int(exp.chosen[index]), int(exp.runner_up[index])
+    extras: dict[str, Any] = {}
+    comparisons: tuple[Comparison, ...] = ()
+    if policy is not None and policy.facts_hook is not None:
+        hooked = policy.facts_hook(np.asarray(exp.states[index]), c, r) or {}
+        extras = dict(hooked.get("extras", {}))
+        comparisons = tuple(Comparison(str(x["text"]), float(x["value"]), str(x.get("unit", "")))
+                            for x in hooked.get("comparisons", ()))
+    return DecisionFacts(
+        index=index, action=exp.action_names[c], runner_up=exp.action_names[r],
+        score=float(exp.outputs[index, c]), runner_up_score=float(exp.outputs[index, r]),
+        q_margin=float(exp.outputs[index, c] - exp.outputs[index, r]), base_value=float(exp.base_values[index, c]),
+        method=exp.method, additivity_gap=float(exp.additivity_gap[index, c]),
+        top=_feature_facts(exp, index, exp.for_chosen()[index], policy, k),
+        margin_top=_feature_facts(exp, index, exp.margin()[index], policy, k),
+        comparisons=comparisons, extras=extras,
+    )
+
+
+def global_facts(exp: Explanation, policy: Policy | None = None, k: int = 5) -> GlobalFacts:
+    """Ranking by mean |contribution to the chosen action| and the direction of effect of high values."""
+    contrib = exp.for_chosen()
+    mean_abs = np.abs(contrib).mean(axis=0)
+    ranking = []
+    for rank, j in enumerate(np.argsort(-mean_abs, kind="stable")[:k], start=1):
+        name = exp.feature_names[j]
+        info = _info(policy, name)
+        effect = "mixed"
+        if exp.states is not None and len(contrib) > 2 and np.std(exp.states[:, j]) > 0 and np.std(contrib[:, j]) > 0:
+            rho = float(np.corrcoef(exp.states[:, j], contrib[:, j])[0, 1])
+            effect = "toward" if rho > 0.3 else "against" if rho < -0.3 else "mixed"
+        ranking.append({"name": name, "label": info.description or name, "unit": info.unit, "rank": rank,
+                        "mean_abs": float(mean_abs[j]), "high_values": effect})
+    return GlobalFacts(len(contrib), exp.method, tuple(ranking))

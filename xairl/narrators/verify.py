@@ -1,0 +1,238 @@
+"""Read any text back against an Explanation: numbers, feature names, directions, ranks and actions.
+
+Each claim found is verified, contradicted or unsupported; a text is ``ok`` only when every claim is verified.
+How claims are tied to features: the text is split into clauses (sentences, then ';'); numbers, direction words
+and rank words belong to the nearest feature mention in their clause (preferring the one before them). Feature and
+action mentions are masked before numbers are read, so digits inside names ('rsrp_1') are not numbers.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..explanation import Explanation
+from ..policy import Policy
+from .facts import decision_facts, global_facts
+
+POSITIVE = ("toward", "towards", "supports", "supported", "supporting", "raises", "raised", "raising", "increases",
+            "increased", "pushes up", "pushed up", "in favour of", "in favor of", "favours", "favoured", "favors",
+            "favored")
+NEGATIVE = ("against", "opposes", "opposed", "opposing", "lowers", "lowered", "lowering", "decreases", "decreased",
+            "pushes down", "pushed down", "reduces", "reduced", "away from")
+ORDINALS = {"most important": 1, "main": 1, "biggest": 1, "largest": 1, "strongest": 1, "first": 1, "top": 1,
+            "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4, "fifth": 5, "5th": 5}
+_ORD = "|".join(sorted(map(re.escape, ORDINALS), key=len, reverse=True))
+RANK_RE = re.compile(rf"\b(?:({_ORD})(?:\s+most\s+important|\s+largest|\s+biggest|\s+strongest)?\s+"
+                     r"(feature|factor|driver|reason|contributor|influence)(s?)\b|(mattered|matters|counted) most)")
+CHOICE_RE = re.compile(r"\b(chose|chooses|choose|picked|picks|selected|selects|decided on|decided to|preferred|"
+                       r"prefers|opted for)\s*$")
+CHOSEN_AFTER_RE = re.compile(r"^\s+(was|is|got)\s+(chosen|picked|selected|preferred)")
+NUMBER_RE = re.compile(r"(?<![\w.])([+\-\u2212]?\d+(?:\.\d+)?)(\s*%)?")
+IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
+MARGIN_WORDS = re.compile(r"\b(rather than|instead of|runner-up|runner up)\b")
+
+
+@dataclass(frozen=True)
+class Claim:
+    kind: str       # number | feature | direction | rank | action
+    text: str
+    status: str     # verified | contradicted | unsupported
+    detail: str = ""
+
+
+@dataclass(frozen=True)
+class Verification:
+    claims: tuple[Claim, ...]
+
+    @property
+    def ok(self) -> bool:
+        return all(c.status == "verified" for c in self.claims)
+
+    def problems(self) -> list[Claim]:
+        return [c for c in self.claims if c.status != "verified"]
+
+
+@dataclass
+class _Feature:
+    values: list[float] = field(default_factory=list)      # numbers that must keep their sign
+    contribs: dict[str, float] = field(default_factory=dict)  # context -> contribution (sign or magnitude)
+    shares: list[float] = field(default_factory=list)
+    ranks: dict[str, int] = field(default_factory=dict)       # context -> rank
+
+
+@dataclass
+class FactBook:
+    """Everything a text may claim about one decision (or, with ``index=None``, about all states)."""
+
+    features: dict[str, _Feature]
+    surfaces: list[tuple[str, str, str]]  # (lowercase surface, kind, key)
+    numbers: list[float]
+    chosen: str | None
+    runner_up: str | None
+    global_view: bool = False
+
+
+def _surfaces(exp: Explanation, policy: Policy | None) -> list[tuple[str, str, str]]:
+    out = []
+    for f in exp.feature_names:
+        info = policy.features.get(f) if policy else None
+        names = {f, f.replace("_", " ")} | ({info.description, *info.aliases} if info else set())
+        out += [(n.lower(), "feature", f) for n in names if n]
+    for a in exp.action_names:
+        names = {a, a.replace("_", " "), *(policy.action_aliases.get(a, ()) if policy else ())}
+        out += [(n.lower(), "action", a) for n in names if n]
+    return sorted(set(out), key=lambda s: -len(s[0]))
+
+
+def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None) -> FactBook:
+    feats = {f: _Feature() for f in exp.feature_names}
+    if index is None:
+        g = global_facts(exp, policy, k=len(exp.feature_names))
+        for r in g.ranking:
+            e = feats[r["name"]]
+            e.values.append(r["mean_abs"])
+            e.ranks["chosen"] = e.ranks["margin"] = r["rank"]
+            if r["high_values"] != "mixed":
+                e.contribs["chosen"] = e.contribs["margin"] = 1.0 if r["high_values"] == "toward" else -1.0
+        return FactBook(feats, _surfaces(exp, policy), [g.n_states], None, None, global_view=True)
+    d = decision_facts(exp, index, policy, k=len(exp.feature_names))
+    for ctx, facts in (("chosen", d.top), ("margin", d.margin_top)):
+        for ff in facts:
+            e = feats[ff.name]
+            e.values = [ff.value]
+            e.contribs[ctx] = ff.contribution
+            e.shares.append(ff.share)
+            e.ranks[ctx] = ff.rank
+    numbers = [d.score, d.runner_up_score, d.q_margin, d.base_value, d.additivity_gap]
+    numbers += [c.value for c in d.comparisons]
+    numbers += [float(v) for v in d.extras.values() if isinstance(v, (int, float)) and not isinstance(v, bool)]
+    return FactBook(feats, _surfaces(exp, policy), numbers, d.action, d.runner_up)
+
+
+def _matches(written: str, value: float, magnitude_ok: bool = False) -> bool:
+    s = written.replace("\u2212", "-")
+    x = float(s)
+    decimals = len(s.split(".")[1]) if "." in s else 0
+    tol = 0.5 * 10 ** -decimals + 1e-9 + 1e-6 * abs(value)
+    if abs(x - value) <= tol:
+        return True
+    return magnitude_ok and s[0] not in "+-" and abs(x - abs(value)) <= tol
+
+
+def _mentions(clause: str, book: FactBook) -> tuple[list[tuple[int, int, str, str]], str]:
+    """Known feature/action mentions (start, end, kind, key) and the clause with them masked."""
+    low = clause.lower()
+    taken = [False] * len(clause)
+    found = []
+    for surface, kind, key in book.surfaces:
+        for m in re.finditer(rf"(?<![\w]){re.escape(surface)}(?![\w])", low):
+            if not any(taken[m.start():m.end()]):
+                found.append((m.start(), m.end(), kind, key))
+                taken[m.start():m.end()] = [True] * (m.end() - m.start())
+    masked = "".join("\0" if t else ch for ch, t in zip(clause, taken))
+    return sorted(found), masked
+
+
+def _nearest(pos: int, feats: list[tuple[int, int, str, str]]) -> str | None:
+    before = [f for f in feats if f[1] <= pos]
+    if before:
+        return before[-1][3]
+    after = [f for f in feats if f[0] >= pos]
+    return after[0][3] if after else None
+
+
+def verify(text: str, explanation: Explanation, index: int | None = 0, policy: Policy | None = None) -> Verification:
+    """Check every claim of ``text`` against the explanation of state ``index`` (``None``: the global view).
+
+    :param policy: optional, for feature descriptions/aliases and domain facts the text may cite.
+    """
+    book = fact_book(explanation, index, policy)
+    claims: list[Claim] = []
+    for sentence in re.split(r"(?<=[.!?])\s+", text.strip()):
+        sent_feats, sent_masked = _mentions(sentence, book)
+        actions = [m for m in sent_feats if m[2] == "action"]
+        margin_sentence = bool(MARGIN_WORDS.search(sentence.lower())) or any(
+            m[3] == book.runner_up for m in actions)
+        for start, end, _, key in actions:
+            claims.append(_check_action(sentence, start, end, key, book))
+        offset = 0
+        for clause in sentence.split(";"):
+            _check_clause(clause, book, margin_sentence, claims)
+            offset += len(clause) + 1
+        for ident in IDENT_RE.findall(sent_masked):
+            claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
+    return Verification(tuple(claims))
+
+
+def _check_action(sentence: str, start: int, end: int, key: str, book: FactBook) -> Claim:
+    text = sentence[start:end]
+    if book.global_view:
+        return Claim("action", text, "unsupported", "a global summary names no particular action")
+    is_choice = bool(CHOICE_RE.search(sentence[:start])) or bool(CHOSEN_AFTER_RE.match(sentence[end:]))
+    if key == book.chosen:
+        return Claim("action", text, "verified", "the chosen action")
+    if is_choice:
+        return Claim("action", text, "contradicted", f"the policy chose {book.chosen}, not {key}")
+    if key == book.runner_up:
+        return Claim("action", text, "verified", "the runner-up action")
+    return Claim("action", text, "contradicted", f"only {book.chosen} (chosen) and {book.runner_up} (runner-up) "
+                                                 "are explained here")
+
+
+def _check_clause(clause: str, book: FactBook, margin_sentence: bool, claims: list[Claim]) -> None:
+    found, masked = _mentions(clause, book)
+    feats = [m for m in found if m[2] == "feature"]
+    ctx_default = "margin" if margin_sentence else "chosen"
+    matched_ctx: dict[str, str] = {}
+    for start, end, _, key in feats:
+        claims.append(Claim("feature", clause[start:end], "verified", key))
+    for m in NUMBER_RE.finditer(masked):
+        written, pct = m.group(1), bool(m.group(2))
+        key = _nearest(m.start(), feats)
+        status, detail = "unsupported", "matches no fact of this explanation"
+        if key is not None:
+            e = book.features[key]
+            for ctx, c in e.contribs.items():
+                if not pct and _matches(written, c, magnitude_ok=True):
+                    status, detail = "verified", f"{key}: contribution ({ctx})"
+                    matched_ctx.setdefault(key, ctx)
+                    break
+            else:
+                if any(_matches(written, v) for v in (e.shares if pct else e.values)):
+                    status, detail = "verified", f"{key}: {'share' if pct else 'value'}"
+            if status != "verified":
+                status, detail = "contradicted", f"{written} is not a value, contribution or share of {key}"
+        if status != "verified" and not pct and any(_matches(written, v) for v in book.numbers):
+            status, detail = "verified", "a decision-level fact"
+        claims.append(Claim("number", m.group(0).strip(), status, detail))
+    low = masked.lower()
+    for words, polarity in ((POSITIVE, 1), (NEGATIVE, -1)):
+        for w in words:
+            for m in re.finditer(rf"\b{re.escape(w)}\b", low):
+                key = _nearest(m.start(), feats)
+                if key is None:
+                    continue
+                ctx = matched_ctx.get(key, ctx_default)
+                c = book.features[key].contribs.get(ctx)
+                if c is None or c == 0:
+                    claims.append(Claim("direction", w, "unsupported", f"no sign known for {key} ({ctx})"))
+                elif np.sign(c) == polarity:
+                    claims.append(Claim("direction", w, "verified", f"{key} {ctx} contribution {c:+.3g}"))
+                else:
+                    claims.append(Claim("direction", w, "contradicted", f"{key} pushes the other way ({c:+.3g})"))
+    for m in RANK_RE.finditer(low):
+        rank = ORDINALS.get(m.group(1), 1) if m.group(1) else 1
+        plural = bool(m.group(3))
+        after = [f for f in feats if f[0] >= m.end()]
+        targets = [f[3] for f in after] if plural else [_nearest(m.start(), feats)] if feats else []
+        if not targets or targets == [None]:
+            claims.append(Claim("rank", m.group(0), "unsupported", "names no feature"))
+            continue
+        ctx = "margin" if margin_sentence else "chosen"
+        for key in targets:
+            actual = book.features[key].ranks.get(ctx)
+            limit_ok = actual is not None and (actual <= len(targets) if plural else actual == rank)
+            claims.append(Claim("rank", f"{m.group(0)}: {key}", "verified" if limit_ok else "contradicted",
+                                f"{key} ranks {actual} ({ctx})"))
