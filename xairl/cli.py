@@ -75,6 +75,8 @@ def cmd_explain(args) -> int:
     bg = read_states(args.background, policy.feature_names) if args.background else policy.background(
         args.background_size, seed=args.seed)
     exp = explain(policy, states, background=bg, method=args.method, options=options.model_dump())
+    if args.narrate:
+        return _print_narratives(args, exp, policy, bg)
     if args.format == "jsonl":
         for rec in exp.records():
             print(rec.model_dump_json())
@@ -89,6 +91,87 @@ def cmd_explain(args) -> int:
             print(f"    {f:<24} = {exp.states[i, j]:>10.4g}   contribution {chosen[i, j]:+.4f}")
         print(f"    base {exp.base_values[i, exp.chosen[i]]:.4f}, additivity gap "
               f"{exp.additivity_gap[i, exp.chosen[i]]:.2e} ({exp.method})")
+    return 0
+
+
+def _print_narratives(args, exp, policy, bg) -> int:
+    from .feedback import FeedbackStore
+    from .narrators import narrate
+
+    store = None if args.no_record else FeedbackStore(args.feedback_db)
+    options = _parse_options(args.narrator_option)
+    if args.examples_from_feedback and store is not None:
+        options.setdefault("examples", store.examples())
+    for i in range(len(exp.values)):
+        n = narrate(exp, i, narrator=args.narrator, template=args.template, policy=policy, background=bg,
+                    options=options, prompt_dirs=args.prompts, store=store)
+        if args.format == "jsonl":
+            print(json.dumps({"index": i, "text": n.text, "verified": n.verified, "confidence": n.confidence,
+                              "components": n.components, "source": n.source, "template": n.template}))
+            continue
+        mark = "verified" if n.verified else "NOT VERIFIED"
+        parts = ", ".join(f"{k} {v:.2f}" for k, v in n.components.items() if v is not None)
+        print(f"state {i} [{mark}, confidence {n.confidence:.2f}: {parts}; {n.source}]\n    {n.text}")
+    return 0
+
+
+def cmd_prompts(args) -> int:
+    from . import prompts
+
+    if args.action == "list":
+        for name, path in sorted(prompts.available(args.prompts).items()):
+            tpl = prompts.parse(path)
+            print(f"{name:<18} {tpl.spec.kind:<9} {path}\n    {tpl.spec.description}")
+        return 0
+    if not args.target:
+        raise InputError(f"`xairl prompts {args.action}` needs a template {'name' if args.action == 'show' else 'path'}.")
+    if args.action == "show":
+        tpl = prompts.load(args.target, args.prompts)
+        print(f"# {tpl.path}")
+        print(tpl.path.read_text(), end="")
+        return 0
+    problems = prompts.check(args.target)
+    for p in problems:
+        print(p)
+    print(f"{args.target}: {'ok' if not problems else f'{len(problems)} problem(s)'}")
+    return 0 if not problems else 1
+
+
+def cmd_review(args) -> int:
+    from .feedback import FeedbackStore
+
+    store = FeedbackStore(args.db)
+    if args.export:
+        with open(args.export, "w") as fh:
+            n = store.export_corrections(fh)
+        print(f"wrote {n} correction(s) to {args.export}")
+        return 0
+    pending = store.records("pending")
+    print(f"{len(pending)} narrative(s) to review in {store.path}")
+    for r in pending:
+        bad = [c for c in r.claims if c["status"] != "verified"]
+        print(f"\n#{r.id} [{r.template}, {r.source}, confidence {r.confidence:.2f}, "
+              f"{'verified' if r.verified else f'{len(bad)} unverified claim(s)'}]\n    {r.text}")
+        while True:
+            try:
+                answer = input("[a]ccept  [r]eject  [c]orrect  [s]kip  [q]uit > ").strip().lower()[:1]
+            except EOFError:
+                return 0
+            if answer == "q":
+                return 0
+            if answer == "s":
+                break
+            if answer in ("a", "r"):
+                store.review(r.id, "accepted" if answer == "a" else "rejected")
+                break
+            if answer == "c":
+                try:
+                    text = input("corrected text > ").strip()
+                except EOFError:
+                    return 0
+                if text:
+                    store.review(r.id, "corrected", text)
+                    break
     return 0
 
 
@@ -114,7 +197,26 @@ def build_parser() -> argparse.ArgumentParser:
                    help="an option of the method, validated against its schema; repeatable")
     p.add_argument("--format", choices=("table", "jsonl"), default="table", help="output format")
     p.add_argument("--top", type=int, default=5, help="features shown per state in the table")
+    p.add_argument("--narrate", action="store_true", help="explain each decision in words, checked against the numbers")
+    p.add_argument("--narrator", default="template", help="template (default) or local_lm")
+    p.add_argument("--template", default=None, help="template name or .yaml path (default explain_action)")
+    p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder, searched first")
+    p.add_argument("-n", "--narrator-option", action="append", default=[], metavar="KEY=VALUE",
+                   help="a narrator option, e.g. -n mode=rewrite or -n model=PATH")
+    p.add_argument("--feedback-db", default=None, help="SQLite store of shown narratives (default: in the user dir)")
+    p.add_argument("--no-record", action="store_true", help="do not record the narratives for review")
+    p.add_argument("--examples-from-feedback", action="store_true",
+                   help="give the local LM the operators' latest accepted or corrected narratives as examples")
     p.set_defaults(run=cmd_explain)
+    p = sub.add_parser("prompts", help="list, show or check prompt templates")
+    p.add_argument("action", choices=("list", "show", "check"))
+    p.add_argument("target", nargs="?", help="template name (show) or .yaml path (check)")
+    p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder")
+    p.set_defaults(run=cmd_prompts)
+    p = sub.add_parser("review", help="accept, reject or correct recorded narratives in the terminal")
+    p.add_argument("--db", default=None, help="feedback store (default: in the user dir)")
+    p.add_argument("--export", metavar="FILE", help="write the corrections as JSON lines instead of reviewing")
+    p.set_defaults(run=cmd_review)
     commands = plugins.registry("command")
     for name in commands.names():
         entry = commands.entry(name)
