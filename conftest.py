@@ -1,4 +1,6 @@
 """Fixtures for every test folder (core and plugins)."""
+import os
+
 import pytest
 
 from xairl import plugins
@@ -19,3 +21,16 @@ def fresh_plugins():
     plugins.reset()
     yield
     plugins.reset()
+
+
+@pytest.fixture(autouse=True, scope="session")
+def model_cache(tmp_path_factory):
+    """One converted copy of the local language model per test session (the conversion takes ~15 s)."""
+    path = tmp_path_factory.mktemp("models")
+    old = os.environ.get("XAIRL_MODEL_CACHE")
+    os.environ["XAIRL_MODEL_CACHE"] = str(path)
+    yield path
+    if old is None:
+        os.environ.pop("XAIRL_MODEL_CACHE", None)
+    else:
+        os.environ["XAIRL_MODEL_CACHE"] = old

@@ -72,6 +72,7 @@ class FactBook:
     chosen: str | None
     runner_up: str | None
     global_view: bool = False
+    by_unit: dict[str, list[float]] = field(default_factory=dict)  # domain comparisons, by their unit
 
 
 def _surfaces(exp: Explanation, policy: Policy | None) -> list[tuple[str, str, str]]:
@@ -108,7 +109,11 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     numbers = [d.score, d.runner_up_score, d.q_margin, d.base_value, d.additivity_gap]
     numbers += [c.value for c in d.comparisons]
     numbers += [float(v) for v in d.extras.values() if isinstance(v, (int, float)) and not isinstance(v, bool)]
-    return FactBook(feats, _surfaces(exp, policy), numbers, d.action, d.runner_up)
+    by_unit: dict[str, list[float]] = {}
+    for c in d.comparisons:
+        if c.unit:
+            by_unit.setdefault(c.unit, []).append(c.value)
+    return FactBook(feats, _surfaces(exp, policy), numbers, d.action, d.runner_up, by_unit=by_unit)
 
 
 def _matches(written: str, value: float, magnitude_ok: bool = False) -> bool:
@@ -181,6 +186,49 @@ def _check_action(sentence: str, start: int, end: int, key: str, book: FactBook)
                                                  "are explained here")
 
 
+def _feature_number(written: str, pct: bool, before: str, e: _Feature, key: str) -> tuple[str, str, str | None]:
+    """A number tied to a feature, read by its form: 'N%' is a share; '+N' or 'by N' a contribution (by N may
+    drop the sign); any other number is the feature's value, or a contribution written with its minus sign."""
+    if pct:
+        if any(_matches(written, v) for v in e.shares):
+            return "verified", f"{key}: share", None
+        return "contradicted", f"{written}% is not the share of {key}", None
+    by = bool(re.search(r"\bby\s*$", before))
+    signed = written[0] in "+-\u2212"
+    if written[0] == "+" or by:
+        for ctx, c in e.contribs.items():
+            if _matches(written, c, magnitude_ok=by):
+                return "verified", f"{key}: contribution ({ctx})", ctx
+        return "contradicted", f"{written} is not a contribution of {key}", None
+    if any(_matches(written, v) for v in e.values):
+        return "verified", f"{key}: value", None
+    if signed:
+        for ctx, c in e.contribs.items():
+            if _matches(written, c):
+                return "verified", f"{key}: contribution ({ctx})", ctx
+    return "contradicted", f"{written} is not the value or a contribution of {key}", None
+
+
+def _free_slots(book: FactBook, before: str, after: str) -> list[float]:
+    """Which decision-level quantity a number stands for, from the words around it."""
+    if book.global_view or len(book.numbers) < 3:
+        return book.numbers
+    unit = re.match(r"\s*([a-zA-Z]+)\b", after)
+    units = {u.lower(): v for u, v in book.by_unit.items()}
+    if unit and unit.group(1).lower() in units:  # '4.2 dB': only a domain fact in dB may back it
+        return units[unit.group(1).lower()]
+    score, runner, margin = book.numbers[:3]
+    if re.match(r"\s*(higher|above|more|ahead)\b", after) or re.search(r"margin( of)?\s*$", before):
+        return [margin]
+    if re.search(r"\bvs\.?\s*$|\bversus\s*$", before):
+        return [runner]
+    if re.match(r"\s*(vs\.?|versus)\s", after):
+        return [score]
+    if re.search(r"\bscor(e|ed|ing)\b[^0-9]*$", before) and not re.search(r"(higher|above|margin)", before):
+        return [score]
+    return book.numbers
+
+
 def _check_clause(clause: str, book: FactBook, margin_sentence: bool, claims: list[Claim]) -> None:
     found, masked = _mentions(clause, book)
     feats = [m for m in found if m[2] == "feature"]
@@ -190,22 +238,20 @@ def _check_clause(clause: str, book: FactBook, margin_sentence: bool, claims: li
         claims.append(Claim("feature", clause[start:end], "verified", key))
     for m in NUMBER_RE.finditer(masked):
         written, pct = m.group(1), bool(m.group(2))
+        before = masked[max(0, m.start() - 24):m.start()].lower()
+        after = masked[m.end():m.end() + 12].lower()
         key = _nearest(m.start(), feats)
         status, detail = "unsupported", "matches no fact of this explanation"
         if key is not None:
-            e = book.features[key]
-            for ctx, c in e.contribs.items():
-                if not pct and _matches(written, c, magnitude_ok=True):
-                    status, detail = "verified", f"{key}: contribution ({ctx})"
-                    matched_ctx.setdefault(key, ctx)
-                    break
-            else:
-                if any(_matches(written, v) for v in (e.shares if pct else e.values)):
-                    status, detail = "verified", f"{key}: {'share' if pct else 'value'}"
-            if status != "verified":
-                status, detail = "contradicted", f"{written} is not a value, contribution or share of {key}"
-        if status != "verified" and not pct and any(_matches(written, v) for v in book.numbers):
-            status, detail = "verified", "a decision-level fact"
+            status, detail, ctx = _feature_number(written, pct, before, book.features[key], key)
+            if ctx:
+                matched_ctx.setdefault(key, ctx)
+        if status != "verified" and not pct:
+            wanted = _free_slots(book, before, after)
+            if any(_matches(written, v) for v in wanted):
+                status, detail = "verified", "a decision-level fact"
+            elif key is None and wanted is not book.numbers:
+                status, detail = "contradicted", f"{written} is not the quantity the text names"
         claims.append(Claim("number", m.group(0).strip(), status, detail))
     low = masked.lower()
     for words, polarity in ((POSITIVE, 1), (NEGATIVE, -1)):

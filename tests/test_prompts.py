@@ -1,0 +1,74 @@
+"""Templates: lookup order, sandbox, `xairl prompts` and check with line numbers."""
+import pytest
+
+import xairl
+from xairl import prompts
+from xairl.cli import main
+from xairl.errors import UnknownNameError
+from xairl.prompts import TemplateError
+from xairl.toy import toy_policy
+
+GOOD = 'name: explain_action\nkind: decision\nsentences:\n  - ["Custom: the policy chose {{ action }}."]\n'
+
+
+def test_builtins_are_found_and_clean():
+    found = prompts.available()
+    assert {"explain_action", "why_not", "global_summary"} <= set(found)
+    for path in found.values():
+        assert prompts.check(path) == []
+
+
+def test_user_dir_overrides_builtin_and_explicit_dir_overrides_user(user_path, tmp_path):
+    (user_path / "prompts").mkdir()
+    (user_path / "prompts" / "explain_action.yaml").write_text(GOOD)
+    assert prompts.load("explain_action").path.parent == user_path / "prompts"
+    extra = tmp_path / "mine"
+    extra.mkdir()
+    (extra / "explain_action.yaml").write_text(GOOD.replace("Custom", "Mine"))
+    assert prompts.load("explain_action", [extra]).path.parent == extra
+    p = toy_policy()
+    e = xairl.explain(p, p.background(1))
+    assert xairl.narrate(e, 0, prompt_dirs=[extra]).text.startswith("Mine: the policy chose")
+
+
+def test_unknown_template():
+    with pytest.raises(UnknownNameError, match="unknown template 'nope'; known: .*explain_action"):
+        prompts.load("nope")
+
+
+@pytest.mark.parametrize("body, expected", [
+    ('name: t\nsentences:\n  - ["{{ action }"]\n', ":3: syntax error"),
+    ('name: t\nsentences:\n  - ["ok {{ actoin }}"]\n', ":3: unknown variable 'actoin'"),
+    ('name: t\nsentences:\n  - |\n    line one\n    {{ "".__class__ }}\n', ":5: sandbox violation: access to '__class__'"),
+    ('name: t\nsentences:\n  - ["{{ top.__globals__ }}"]\n', "sandbox violation"),
+    ('name: t\nsentences: [\n', "YAML error"),
+    ('name: t\nsentence: ["x"]\n', "sentence: unknown option"),
+    ('name: t\nkind: global\nsentences:\n  - ["{{ action }}"]\n', "unknown variable 'action'"),
+])
+def test_check_reports_problems_with_lines(tmp_path, body, expected):
+    path = tmp_path / "t.yaml"
+    path.write_text(body)
+    problems = prompts.check(path)
+    assert problems and any(expected in p for p in problems), problems
+    assert all(str(path) in p for p in problems)
+
+
+def test_sandbox_refuses_escape_at_render_time(tmp_path):
+    path = tmp_path / "evil.yaml"
+    path.write_text('name: evil\nsentences:\n  - ["{{ action.__class__.__mro__ }}"]\n')
+    p = toy_policy()
+    e = xairl.explain(p, p.background(1))
+    with pytest.raises(TemplateError, match="refused by the sandbox"):
+        xairl.narrate(e, 0, template=str(path))
+
+
+def test_prompts_cli(capsys, tmp_path):
+    assert main(["prompts", "list"]) == 0
+    assert "why_not" in capsys.readouterr().out
+    assert main(["prompts", "show", "why_not"]) == 0
+    assert "margin_top" in capsys.readouterr().out
+    bad = tmp_path / "bad.yaml"
+    bad.write_text('name: bad\nsentences:\n  - ["{{ nope }}"]\n')
+    assert main(["prompts", "check", str(bad)]) == 1
+    assert "unknown variable 'nope'" in capsys.readouterr().out
+    assert main(["prompts", "show"]) == 2

@@ -1,0 +1,96 @@
+"""A corpus for testing verifiers: true narratives made wrong in one way each, and paraphrases that stay true.
+
+Wrong: a number changed beyond rounding, a direction flipped, a rank swapped, a feature that is not in the
+explanation, the wrong action named as chosen. True: another phrasing of the template, coarser rounding, direction
+synonyms, clauses reordered.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from .verify import NUMBER_RE
+
+FLIPS = {"toward": "against", "against": "toward"}
+SYNONYMS = {"toward": "in favour of", "against": "against"}
+
+
+@dataclass(frozen=True)
+class Case:
+    kind: str
+    text: str
+    index: int
+    should_pass: bool
+
+
+def _numbers(text: str) -> list[re.Match]:
+    # leave numbers inside identifiers and names alone: they are not claims
+    return [m for m in NUMBER_RE.finditer(text) if not re.search(r"[A-Za-z_]$", text[:m.start()])
+            and not text[max(0, m.start() - 3):m.start()].endswith("BS ")
+            and not text[max(0, m.start() - 10):m.start()].endswith("candidate ")]
+
+
+def wrong(text: str, index: int, action: str, other_actions: list[str]) -> list[Case]:
+    out = []
+    for m in _numbers(text)[:4]:
+        s = m.group(1)
+        decimals = len(s.split(".")[1]) if "." in s else 0
+        bumped = float(s) * 1.5 + (1.0 if abs(float(s)) < 1 else 0) + 10 ** -decimals * 7
+        new = f"{bumped:+.{decimals}f}" if s[0] == "+" else f"{bumped:.{decimals}f}"
+        out.append(Case("wrong number", text[:m.start(1)] + new + text[m.end(1):], index, False))
+    for w, flip in FLIPS.items():
+        for m in list(re.finditer(rf"\b{w}\b", text))[:2]:
+            out.append(Case("flipped direction", text[:m.start()] + flip + text[m.end():], index, False))
+    if "The most important feature" in text:
+        out.append(Case("swapped rank", text.replace("The most important feature", "The second most important "
+                                                      "feature", 1), index, False))
+    if "mattered most" in text:
+        out.append(Case("swapped rank", text.replace("mattered most", "was the third most important factor", 1),
+                        index, False))
+    out.append(Case("unknown feature", re.sub(r"^(.*?)(\()", r"\1(battery_temperature 41, ", text, count=1)
+                    if "(" in text else text + " The wind_speed pushed toward it by +0.20.", index, False))
+    for m in re.finditer(rf"\b(chose|picked) {re.escape(action)}\b", text):
+        for other in other_actions[:2]:
+            out.append(Case("wrong action", text[:m.start()] + f"{m.group(1)} {other}" + text[m.end():], index,
+                            False))
+        break
+    return out
+
+
+def paraphrases(text: str, variants: list[str], index: int) -> list[Case]:
+    out = [Case("other phrasing", v, index, True) for v in variants if v != text]
+    coarse = text
+    for m in reversed([m for m in _numbers(text) if "." in m.group(1) and len(m.group(1).split(".")[1]) == 2]):
+        s = m.group(1)
+        x = float(s)
+        if abs(x) >= 0.1 and s[-1] != "5":  # one decimal fewer; a trailing 5 would round ambiguously
+            coarse = coarse[:m.start(1)] + (f"{x:+.1f}" if s[0] == "+" else f"{x:.1f}") + coarse[m.end(1):]
+    if coarse != text:
+        out.append(Case("coarser rounding", coarse, index, True))
+    if " toward " in text:
+        out.append(Case("direction synonym", text.replace(" pushed toward ", " pushed in favour of "), index, True))
+    if " against " in text:
+        out.append(Case("direction synonym", text.replace(" pushed against ", " worked against "), index, True))
+    parts = text.rstrip(".").split("; ")
+    if len(parts) >= 2 and parts[0].count(".") == 0:
+        out.append(Case("clauses reordered", "; ".join(parts[1:] + parts[:1]) + ".", index, True))
+    return out
+
+
+def corpus(explanation, policy, templates=("explain_action", "why_not"), indices=range(10)) -> list[Case]:
+    """Mutations and paraphrases of every sentence of the given templates for the given states."""
+    from .. import prompts
+    from .facts import decision_facts
+
+    cases: list[Case] = []
+    for name in templates:
+        tpl = prompts.load(name)
+        for i in indices:
+            d = decision_facts(explanation, i, policy)
+            others = [a for a in explanation.action_names if a != d.action]
+            for variants in tpl.render_variants(d.context()):
+                if not variants[0]:
+                    continue
+                cases += wrong(variants[0], i, d.action, others)
+                cases += paraphrases(variants[0], variants, i)
+    return cases
