@@ -30,6 +30,7 @@ $(STAMP): pyproject.toml Makefile $(PLUGINS)
 demo: setup
 	$(VENV)/bin/xairl uav evaluate --flights 100 --seed 0
 	$(VENV)/bin/xairl explain --policy uav-dqn --n 3 --top 5
+	$(VENV)/bin/xairl explain --policy uav-dqn --n 3 --narrate --template handover --no-record
 
 test: setup
 	$(PY) -m pytest
