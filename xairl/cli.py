@@ -59,8 +59,31 @@ def cmd_attributors(args) -> int:
     return 0
 
 
+def cmd_report(args) -> int:
+    from .report import ReportRequest, write_report
+
+    builder = plugins.registry("report").load(args.plugin)
+    method = plugins.get_attributor(args.method)
+    from pathlib import Path
+
+    req = ReportRequest(out=Path(args.out or "xairl-report"), method=args.method, options=method(_parse_options(args.option)).options.model_dump(),
+                        narrate=args.narrate, narrator=args.narrator,
+                        narrator_options=_parse_options(args.narrator_option), template=args.template,
+                        prompt_dirs=args.prompts, real=args.real, seed=args.seed, n_states=args.n or 500)
+    req.out.mkdir(parents=True, exist_ok=True)
+    path = write_report(req, builder(req))
+    print(f"report: {path.resolve()}")
+    return 0
+
+
 def cmd_explain(args) -> int:
     import numpy as np
+
+    if args.plugin:
+        return cmd_report(args)
+    if args.real or args.out:
+        raise InputError("--real and --out go with --plugin NAME (a plugin's report); see `xairl plugins`.")
+    args.n = args.n or 5
 
     from .attributors import explain
     from .inputs import read_states
@@ -190,7 +213,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "default: --n states from the policy's sampler")
     p.add_argument("--background", help="background states file (default: the policy's sampler)")
     p.add_argument("--background-size", type=int, default=100, help="background states drawn from the sampler")
-    p.add_argument("--n", type=int, default=5, help="states to sample when --states is not given")
+    p.add_argument("--n", type=int, default=None, help="states to sample when --states is not given (default 5; "
+                   "500 per dataset in a report)")
+    p.add_argument("--plugin", help="write a plugin's report (e.g. uav-handover) into --out instead of printing")
+    p.add_argument("--out", default=None, help="report folder (with --plugin; default xairl-report)")
+    p.add_argument("--real", help="with --plugin: a folder of real flight data for the report")
     p.add_argument("--seed", type=int, default=0, help="seed of the sampled states and background")
     p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
     p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",

@@ -110,14 +110,16 @@ class Explanation:
         return replace(self, values=np.stack(cols, axis=1), feature_names=tuple(names), states=None,
                        background_quantiles=None)
 
-    def records(self) -> list["StateRecord"]:
-        """One :class:`StateRecord` per explained state (the JSON-lines form)."""
+    def records(self, dataset: str | None = None) -> list["StateRecord"]:
+        """One :class:`StateRecord` per explained state (the JSON-lines form); ``dataset`` labels where the states
+        came from (e.g. 'simulated', 'real')."""
         gap, chosen, runner = self.additivity_gap, self.chosen, self.runner_up
         acts = self.action_names
         out = []
         for i in range(len(self.values)):
             out.append(StateRecord(
                 index=i,
+                dataset=dataset,
                 method=self.method,
                 state=None if self.states is None else dict(zip(self.feature_names, self.states[i].tolist())),
                 chosen=acts[chosen[i]],
@@ -192,6 +194,7 @@ class StateRecord(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     index: int
+    dataset: str | None = None
     method: str
     state: dict[str, float] | None
     chosen: str

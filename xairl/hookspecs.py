@@ -52,3 +52,12 @@ def register_commands(register):
         ``argparse`` sub-parser and sets ``parser.set_defaults(run=fn)`` where ``fn(args) -> int`` does the work.
         Keep the plugin module light: ``xairl --help`` imports it, so import torch inside ``fn``.
     """
+
+
+@hookspec
+def register_reports(register):
+    """Register report builders for ``xairl explain --plugin NAME --out DIR``.
+
+    :param register: ``register(name, builder, description="")``; ``builder(request)`` (or the ``"module:attr"``
+        naming it) takes a :class:`xairl.report.ReportRequest` and returns a :class:`xairl.report.ReportContent`.
+    """

@@ -108,11 +108,12 @@ _HOOKS = {
     "attributor": ("register_attributors", "attributors"),
     "narrator": ("register_narrators", "plugins"),
     "command": ("register_commands", "--help"),
+    "report": ("register_reports", "plugins"),
 }
 
 
 def registry(kind: str) -> Registry:
-    """The registry of ``kind``: 'policy', 'attributor', 'narrator' or 'command'."""
+    """The registry of ``kind``: 'policy', 'attributor', 'narrator', 'command' or 'report'."""
     if kind not in _registries:
         hook, cmd = _HOOKS[kind]
         _registries[kind] = Registry(kind, hook, cmd)
@@ -143,7 +144,7 @@ def summary() -> dict[str, dict[str, list[str]]]:
     out: dict[str, dict[str, list[str]]] = {}
     for name, _ in get_plugin_manager().list_name_plugin():
         out.setdefault(name, {})
-    for kind in ("policy", "attributor", "narrator", "command"):
+    for kind in ("policy", "attributor", "narrator", "command", "report"):
         for e in registry(kind).entries.values():
             out.setdefault(e.plugin, {}).setdefault(kind, []).append(e.name)
     for plugin, path in prompt_dirs():

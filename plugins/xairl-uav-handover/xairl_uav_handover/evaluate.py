@@ -66,3 +66,17 @@ def format_table(rows: dict[str, dict[str, float]], config: SimConfig, n_flights
         lines.append(f"{policy:<8}" + "".join(f"{fmt.format(row[key]):>13}" for key, _, fmt in cols)
                      + (f"{paper[0]:>12} / {paper[1]}" if paper else ""))
     return "\n".join(lines)
+
+
+def chm_rate_by_altitude(altitudes, config: SimConfig, n_flights: int = 40, duration_s: float = 60.0,
+                         seed: int = 0) -> np.ndarray:
+    """Conventional handovers per minute for flights held at each altitude (simulator)."""
+    from .baselines import CHM
+
+    rates = []
+    for h in altitudes:
+        data = config.model_dump()
+        data["flight"].update(altitude_m=(h, h), duration_s=duration_s)
+        m = run_flights(CHM(), SimConfig.model_validate(data), n_flights, seed)
+        rates.append(float(np.mean(m["handovers"])) / (duration_s / 60.0))
+    return np.array(rates)

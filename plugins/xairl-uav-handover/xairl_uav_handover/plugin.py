@@ -22,3 +22,9 @@ def register_prompt_dirs(register):
 @hookimpl
 def register_commands(register):
     register("uav", "xairl_uav_handover.cli:configure", "UAV handover: train the DQN, evaluate Table I")
+
+
+@hookimpl
+def register_reports(register):
+    register("uav-handover", "xairl_uav_handover.report:build",
+             "Table I, real-flight replay, handover rate vs altitude, SHAP figures and narrated handovers")

@@ -1,0 +1,221 @@
+"""Real UAV flights from drive-test exports (Nemo "Exported Measurements", like ../shared/data/ukm-uav-lte/raw).
+
+Rows are events; rows with the same Time form one time step (forward-filled over two steps for the sparse neighbour
+lists and SNR). The last lines are a footer and are dropped (any row whose Time does not parse). The number of
+detected-cell slots varies, so columns are selected by name. Altitude is the nominal height in the file name.
+
+:func:`replay` flies a policy along a real trajectory in closed loop: the policy's serving cell is measured when it
+is the network's serving cell or in the detected list (else the UAV falls back to the strongest measured cell, a
+forced handover). The buffer is not in the data: the real link quality (RS SNR of the network's serving cell,
+shifted by the RSRP difference when the policy serves elsewhere) drives the plugin's buffer model.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from xairl.errors import InputError
+
+from .buffer import buffer_step, service_bits
+from .config import SimConfig
+
+REF_LAT, REF_LON = 2.9228, 101.7715  # centre of the UKM campaign area: local metres are measured from here
+PCI, RSRP, RSRQ = "Physical cell identity (LTE pcell)", "RSRP (LTE pcell)", "RSRQ (LTE pcell)"
+REQUIRED = ("Time", "Latitude", "Longitude", PCI, RSRP, RSRQ, "RS SNR")
+PAD_RSRP, PAD_RSRQ = -140.0, -30.0  # an empty candidate slot reads as a cell far below any measured one
+TIME_RE = r"^\d{1,2}:\d{2}:\d{2}(\.\d+)?$"
+
+
+@dataclass
+class RealFlight:
+    name: str
+    altitude_m: float
+    t: np.ndarray          # seconds since the first sample
+    xy: np.ndarray         # (n, 2) local metres east/north of REF
+    pci: np.ndarray        # (n,) serving PCI
+    rsrp: np.ndarray
+    rsrq: np.ndarray
+    snr: np.ndarray
+    nb_pci: np.ndarray     # (n, slots) detected cells, NaN where empty
+    nb_rsrp: np.ndarray
+    nb_rsrq: np.ndarray
+
+    @property
+    def observed_handovers(self) -> int:
+        return int((np.diff(self.pci) != 0).sum())
+
+
+def load_flight(path: str | Path) -> RealFlight:
+    """One export file; a malformed one raises :class:`InputError` naming the file and the column."""
+    import pandas as pd
+
+    path = Path(path)
+    alt = re.match(r"(\d+(?:\.\d+)?)m", path.stem)
+    if not alt:
+        raise InputError(f"{path}: the nominal altitude is read from the file name (e.g. 100m.csv); rename it.")
+    try:
+        df = pd.read_csv(path, low_memory=False, dtype={"Time": str})
+    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        raise InputError(f"{path}: cannot read it as CSV ({str(exc).splitlines()[0]}).") from None
+    missing = [c for c in REQUIRED if c not in df.columns]
+    if missing:
+        raise InputError(f"{path}: missing column '{missing[0]}'" + (f" (and {len(missing) - 1} more)" if
+                                                                      len(missing) > 1 else "") + ".")
+    df["Time"] = df["Time"].astype(str).str.strip()
+    df = df[df["Time"].str.match(TIME_RE)]
+    if df.empty:
+        raise InputError(f"{path}: no rows with a parseable Time (H:MM:SS.mmm); the file looks truncated.")
+    slots = sorted(int(m.group(1)) for c in df.columns if (m := re.match(r"Physical cell identity \(LTE detected\) - "
+                                                                          r"(\d+)$", c)))
+    nb_cols = [f"{k} (LTE detected) - {s}" for s in slots for k in ("Physical cell identity", "RSRP", "RSRQ")]
+    numeric = ["Latitude", "Longitude", PCI, RSRP, RSRQ, "RS SNR"] + [c for c in nb_cols if c in df.columns]
+    for c in numeric:
+        df[c] = pd.to_numeric(df[c], errors="coerce")
+    hms = df["Time"].str.split(":", expand=True).astype(float)
+    df["_t"] = hms[0] * 3600 + hms[1] * 60 + hms[2]
+    g = df.groupby("_t", sort=True).first()
+    fill = ["Latitude", "Longitude", "RS SNR"] + [c for c in nb_cols if c in g.columns]
+    g[fill] = g[fill].ffill(limit=2)
+    g = g[g[PCI].notna() & g[RSRP].notna() & g[RSRQ].notna() & g["Latitude"].notna()]
+    if len(g) < 2:
+        raise InputError(f"{path}: fewer than 2 time steps with a serving cell ('{PCI}').")
+    for col, lo, hi, unit in ((RSRP, -160, -20, "dBm"), (RSRQ, -40, 0, "dB"), ("Latitude", -90, 90, "deg"),
+                              ("Longitude", -180, 180, "deg")):
+        med = float(g[col].median())
+        if not lo <= med <= hi:
+            raise InputError(f"{path}: column '{col}' has median {med:g}, outside {lo}..{hi} {unit}; wrong units?")
+    t = g.index.to_numpy(dtype=float)
+    t = np.where(t < t[0], t + 86400, t) - t[0]  # a flight over midnight
+    lat, lon = g["Latitude"].to_numpy(), g["Longitude"].to_numpy()
+    xy = np.stack([(lon - REF_LON) * 111_320.0 * np.cos(np.radians(REF_LAT)), (lat - REF_LAT) * 110_574.0], 1)
+
+    def nb(kind):
+        cols = [f"{kind} (LTE detected) - {s}" for s in slots]
+        return np.stack([g[c].to_numpy(dtype=float) if c in g.columns else np.full(len(g), np.nan) for c in cols],
+                        1) if cols else np.full((len(g), 0), np.nan)
+
+    snr = g["RS SNR"].to_numpy(dtype=float)
+    snr = np.where(np.isnan(snr), np.nanmedian(snr) if np.isfinite(snr).any() else 0.0, snr)
+    return RealFlight(path.name, float(alt.group(1)), t, xy, g[PCI].to_numpy(dtype=float), g[RSRP].to_numpy(float),
+                      g[RSRQ].to_numpy(float), snr, nb("Physical cell identity"), nb("RSRP"), nb("RSRQ"))
+
+
+def load_folder(folder: str | Path) -> tuple[list[RealFlight], list[str]]:
+    """Every *.csv under ``folder``: (flights that loaded, one-line reasons for the files that did not)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputError(f"{folder}: no such folder of flight exports.")
+    flights, bad = [], []
+    for f in sorted(folder.rglob("*.csv")):
+        try:
+            flights.append(load_flight(f))
+        except InputError as exc:
+            bad.append(str(exc))
+    if not flights:
+        raise InputError(f"{folder}: no loadable flight export ({len(bad)} bad file(s)); first: "
+                         f"{bad[0] if bad else 'no *.csv files'}")
+    return flights, bad
+
+
+@dataclass
+class Replay:
+    states: np.ndarray      # (n, 13) the policy's view at each step
+    serving: np.ndarray     # (n,) PCI served by the policy after each decision
+    handovers: int
+    pingpongs: int
+    forced: int             # the policy's cell vanished from the measurements
+    mean_buffer_kbit: float
+    lost_kbit: float
+
+
+def _measured(f: RealFlight, i: int) -> dict[float, tuple[float, float]]:
+    cells = {f.pci[i]: (f.rsrp[i], f.rsrq[i])}
+    for p, r, q in zip(f.nb_pci[i], f.nb_rsrp[i], f.nb_rsrq[i]):
+        if np.isfinite(p) and np.isfinite(r) and np.isfinite(q) and p not in cells:
+            cells[p] = (r, q)
+    return cells
+
+
+def replay(f: RealFlight, decide, config: SimConfig | None = None, seed: int = 0,
+           min_stay_s: float | None = None) -> Replay:
+    """Fly ``decide(state (13,), candidates) -> action`` along the real flight (see the module doc); ``decide=None``
+    follows the network's own serving cell (the observed decisions). Ping-pong: back to the previous cell within
+    ``min_stay_s`` (default: the config's minimum time of stay)."""
+    cfg = config or SimConfig()
+    window = cfg.handover.min_time_of_stay_s if min_stay_s is None else min_stay_s
+    rng = np.random.default_rng(seed)
+    ids = {p: k for k, p in enumerate(sorted(set(f.pci.tolist())))}
+    serving, q = f.pci[0], 0.0
+    prev, entered = serving, 0.0
+    states, path = [], []
+    ho = pp = forced = 0
+    qs, lost_total = [], 0.0
+    b, h = cfg.buffer, cfg.handover
+    for i in range(len(f.t)):
+        cells = _measured(f, i)
+        if decide is None and f.pci[i] != serving:  # the network handed over between the samples
+            ho += 1
+            pp += int(f.pci[i] == prev and f.t[i] - entered < window)
+            prev, entered, serving = serving, f.t[i], f.pci[i]
+        if serving not in cells:
+            serving, forced = max(cells, key=lambda p: cells[p][0]), forced + 1
+        cand = [serving] + sorted((p for p in cells if p != serving), key=lambda p: -cells[p][0])[:3]
+        rsrp = [cells[p][0] for p in cand] + [PAD_RSRP] * (4 - len(cand))
+        rsrq = [cells[p][1] for p in cand] + [PAD_RSRQ] * (4 - len(cand))
+        state = np.array([f.xy[i, 0], f.xy[i, 1], f.altitude_m, q, min(ids.get(serving, 0), 18), *rsrp, *rsrq],
+                         dtype=np.float32)
+        states.append(state)
+        if decide is None:
+            target = serving
+        else:
+            a = int(decide(state, cand))
+            target = cand[a] if a < len(cand) else serving
+        handed = target != serving or (decide is None and i > 0 and f.pci[i] != f.pci[i - 1])
+        if target != serving:
+            ho += 1
+            pp += int(target == prev and f.t[i] - entered < window)
+            prev, entered, serving = serving, f.t[i], target
+        path.append(serving)
+        dt = float(np.clip(f.t[i + 1] - f.t[i], 0, 5)) if i + 1 < len(f.t) else 0.0
+        rsrp_now = _measured(f, i).get(serving, (f.rsrp[i], 0))[0]
+        sinr = f.snr[i] + (rsrp_now - f.rsrp[i])
+        served = service_bits(sinr, b.rb_per_uav, b.rb_bandwidth_hz, max(dt - (h.interruption_s if handed else 0), 0))
+        arrivals = rng.poisson(b.packet_rate_hz * dt) * b.data_packet_bits + handed * b.control_packet_bits
+        q, lost = buffer_step(q, arrivals, served, b.q_max_bits)
+        q, lost = float(q), float(lost)
+        qs.append(q)
+        lost_total += lost
+    return Replay(np.array(states), np.array(path), ho, pp, forced, float(np.mean(qs)) / 1e3, lost_total / 1e3)
+
+
+def baltaci_rate_by_altitude(folder: str | Path) -> tuple[np.ndarray, np.ndarray, int]:
+    """Handovers per minute per modem in 10 m height bins from the Baltaci et al. IMC'22 handover events.
+
+    Returns (bin lower edges, rate, events used). Time per bin comes from ``altitude-bin-durations.csv`` (seconds
+    per campaign day, most likely), counted once per operator that flew that day.
+    """
+    import pandas as pd
+
+    folder = Path(folder)
+    try:
+        ev = pd.read_csv(folder / "handovers.csv")
+        dur = pd.read_csv(folder / "altitude-bin-durations.csv")
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{folder}: cannot read the handover events ({str(exc).splitlines()[0]}).") from None
+    for col in ("flight_ts", "relative_height"):
+        if col not in ev.columns:
+            raise InputError(f"{folder / 'handovers.csv'}: missing column '{col}'.")
+    ev = ev.dropna(subset=["relative_height"])
+    ev["day"] = ev["flight_ts"].str.rsplit("-", n=1).str[0]
+    ev["bin"] = (ev["relative_height"] // 10 * 10).clip(upper=120)
+    operators = ev.groupby("day")["flight_ts"].nunique()
+    bins = dur["Altitude"].to_numpy(dtype=float)
+    modem_s = np.zeros(len(bins))
+    for day in operators.index:
+        if day in dur.columns:
+            modem_s += dur[day].to_numpy(dtype=float) * operators[day]
+    counts = ev[ev["day"].isin(dur.columns)].groupby("bin").size().reindex(bins, fill_value=0).to_numpy()
+    return bins, counts / np.maximum(modem_s / 60.0, 1e-9), int(counts.sum())

@@ -1,0 +1,147 @@
+"""``xairl explain --plugin NAME --out DIR``: explanations, figures, narrated decisions, one self-contained HTML.
+
+A plugin's report builder (hook ``register_reports``) supplies the policy, the datasets to explain, a background,
+and its own tables and figures; this module does the rest the same way for every plugin.
+"""
+from __future__ import annotations
+
+import base64
+import html
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .explanation import Explanation, StateRecord
+from .policy import Policy
+
+
+@dataclass
+class ReportRequest:
+    out: Path
+    method: str = "deep_shap"
+    options: dict = field(default_factory=dict)
+    narrate: bool = True
+    narrator: str = "template"
+    narrator_options: dict = field(default_factory=dict)
+    template: str | None = None
+    prompt_dirs: list = field(default_factory=list)
+    real: str | None = None
+    seed: int = 0
+    n_states: int = 500
+    n_narrated: int = 6
+    progress: bool = True
+
+
+@dataclass
+class ReportContent:
+    title: str
+    policy: Policy
+    background: np.ndarray
+    datasets: list[tuple[str, np.ndarray]]   # (label, states); the first is the reference for feature order
+    tables: list[tuple[str, str]] = field(default_factory=list)   # (title, html table)
+    figures: list[tuple[str, Path]] = field(default_factory=list)  # (caption, png)
+    notes: list[str] = field(default_factory=list)
+    settings: dict = field(default_factory=dict)
+    template: str = "explain_action"
+
+
+def table_html(header: list[str], rows: list[list]) -> str:
+    def cell(v):
+        return f"{v:.2f}" if isinstance(v, float) else html.escape(str(v))
+
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td>{cell(v)}</td>" for v in r) + "</tr>" for r in rows)
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def _interesting(exp: Explanation) -> int:
+    """A decision worth a waterfall: the first whose action is not the most common one, else the closest call."""
+    common = np.bincount(exp.chosen).argmax()
+    rare = np.flatnonzero(exp.chosen != common)
+    if len(rare):
+        return int(rare[0])
+    gap = exp.outputs[np.arange(len(exp.values)), exp.chosen] - exp.outputs[np.arange(len(exp.values)), exp.runner_up]
+    return int(np.argmin(gap))
+
+
+def write_report(req: ReportRequest, content: ReportContent) -> Path:
+    """Write explanations.jsonl (+ its JSON schema), PNG figures and report.html into ``req.out``."""
+    from tqdm import tqdm
+
+    from . import plots
+    from .attributors import explain
+    from .narrators import narrate
+
+    t0 = time.time()
+    out = Path(req.out)
+    out.mkdir(parents=True, exist_ok=True)
+    exps: list[tuple[str, Explanation]] = []
+    for label, states in tqdm(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress):
+        exps.append((label, explain(content.policy, states, background=content.background, method=req.method,
+                                    options=req.options)))
+    with open(out / "explanations.jsonl", "w") as fh:
+        for label, exp in exps:
+            for rec in exp.records(dataset=label):
+                fh.write(rec.model_dump_json() + "\n")
+    (out / "explanations.schema.json").write_text(json.dumps(StateRecord.model_json_schema(), indent=2))
+    ref_label, ref = exps[0]
+    pick = _interesting(ref)
+    figures = [(f"SHAP values of the chosen action's Q-value, {' vs '.join(l for l, _ in exps)} (same feature "
+                f"order, by {ref_label} importance)", plots.beeswarms(exps, out / "beeswarm.png")),
+               ("Global importance: mean |contribution|", plots.importance_bars(exps, out / "importance.png")),
+               (f"One decision ({ref_label} state {pick}: {ref.action_names[ref.chosen[pick]]})",
+                plots.waterfall(ref, pick, out / "waterfall.png"))]
+    figures += content.figures
+    narratives = []
+    if req.narrate:
+        idx = [pick] + [i for i in range(len(ref.values)) if i != pick][: max(req.n_narrated - 1, 0)]
+        for i in tqdm(idx, desc=f"narrating ({req.narrator})", disable=not req.progress):
+            narratives.append(narrate(ref, i, narrator=req.narrator, template=req.template or content.template,
+                                      policy=content.policy, background=content.background,
+                                      options=req.narrator_options, prompt_dirs=req.prompt_dirs))
+        summary = narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs)
+        narratives.append(summary)
+    settings = {"method": req.method, "options": req.options, "narrator": req.narrator, "seed": req.seed,
+                "background states": len(content.background), "report seconds": round(time.time() - t0, 1),
+                **content.settings}
+    path = out / "report.html"
+    path.write_text(_html(content, exps, figures, narratives, settings))
+    return path
+
+
+def _img(path: Path) -> str:
+    return "data:image/png;base64," + base64.b64encode(Path(path).read_bytes()).decode()
+
+
+def _html(content, exps, figures, narratives, settings) -> str:
+    parts = [f"<h1>{html.escape(content.title)}</h1>"]
+    parts.append("<h2>Settings</h2>" + table_html(["setting", "value"], [[k, json.dumps(v) if isinstance(v, (dict, list))
+                                                                         else v] for k, v in settings.items()]))
+    for title, table in content.tables:
+        parts.append(f"<h2>{html.escape(title)}</h2>{table}")
+    parts.append("<h2>Explanations</h2><p>" + ", ".join(f"{html.escape(l)}: {len(e.values)} states, largest "
+                                                       f"additivity gap {e.additivity_gap.max():.1e}" for l, e in exps)
+                 + "</p>")
+    for caption, png in figures:
+        parts.append(f"<figure><img src='{_img(png)}' alt='{html.escape(caption)}'><figcaption>"
+                     f"{html.escape(caption)}</figcaption></figure>")
+    if narratives:
+        parts.append("<h2>Narrated decisions</h2>")
+        for n in narratives:
+            mark = "<span class=ok>&#10003; verified</span>" if n.verified else "<span class=bad>&#10007; NOT verified</span>"
+            comp = ", ".join(f"{k} {v:.2f}" for k, v in n.components.items() if v is not None)
+            where = "all states" if n.index is None else f"state {n.index}"
+            parts.append(f"<div class=narr><p>{html.escape(n.text)}</p><p class=meta>{mark} &middot; confidence "
+                         f"{n.confidence:.2f} ({html.escape(comp)}) &middot; {where} &middot; template "
+                         f"{html.escape(n.template)} &middot; {html.escape(n.source)}</p></div>")
+    if content.notes:
+        parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in content.notes) + "</ul>")
+    style = ("body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}table{border-collapse:collapse;"
+             "margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}"
+             "img{max-width:100%}.narr{border-left:4px solid #8ab;padding:0 1em;margin:1em 0}.meta{color:#555;"
+             "font-size:90%}.ok{color:#070;font-weight:bold}.bad{color:#b00;font-weight:bold}")
+    return (f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(content.title)}</title>"
+            f"<style>{style}</style></head><body>{''.join(parts)}</body></html>")
