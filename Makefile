@@ -27,10 +27,12 @@ $(STAMP): pyproject.toml Makefile $(PLUGINS)
 	$(PY) -c "import torch, shap, captum, xairl; assert torch.__version__.startswith('2.13.0'), torch.__version__"
 	touch $(STAMP)
 
+REAL := ../shared/data/ukm-uav-lte/raw
+
 demo: setup
-	$(VENV)/bin/xairl uav evaluate --flights 100 --seed 0
-	$(VENV)/bin/xairl explain --policy uav-dqn --n 3 --top 5
-	$(VENV)/bin/xairl explain --policy uav-dqn --n 3 --narrate --template handover --no-record
+	@# the main job: Table I, SHAP on simulated (and, when ../shared/data is there, real) flights, narrated decisions
+	$(VENV)/bin/xairl explain --plugin uav-handover --narrate --out out/report $(if $(wildcard $(REAL)),--real $(REAL))
+	$(VENV)/bin/xairl explain --policy uav-dqn --n 2 --narrate --template handover --no-record
 
 test: setup
 	$(PY) -m pytest

@@ -105,7 +105,7 @@ def write_report(req: ReportRequest, content: ReportContent) -> Path:
         summary = narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs)
         narratives.append(summary)
     settings = {"method": req.method, "options": req.options, "narrator": req.narrator, "seed": req.seed,
-                "background states": len(content.background), "report seconds": round(time.time() - t0, 1),
+                "background states": len(content.background), "seconds to explain, plot and narrate": round(time.time() - t0, 1),
                 **content.settings}
     path = out / "report.html"
     path.write_text(_html(content, exps, figures, narratives, settings))

@@ -1,0 +1,105 @@
+"""Real flight data (../shared/data, never committed) and the report. Skips cleanly where the data is absent."""
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from xairl.cli import main
+from xairl.errors import InputError
+from xairl.explanation import StateRecord
+from xairl_uav_handover.real_data import baltaci_rate_by_altitude, load_flight, load_folder, replay
+
+DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
+UKM = DATA / "ukm-uav-lte" / "raw"
+BALTACI = DATA / "baltaci-imc22-handovers"
+needs_data = pytest.mark.skipif(not UKM.is_dir(), reason="../shared/data/ukm-uav-lte is not here")
+
+
+@needs_data
+def test_load_one_flight():
+    f = load_flight(UKM / "100m.csv")
+    assert f.altitude_m == 100 and len(f.t) > 1000 and (np.diff(f.t) > 0).all()
+    assert -98 <= f.rsrp.min() and f.rsrp.max() <= -50
+    assert np.abs(f.xy).max() < 2000  # local metres around the campus
+    assert f.observed_handovers == int((np.diff(f.pci) != 0).sum()) > 10
+    o = replay(f, None)
+    assert o.handovers == f.observed_handovers and o.states.shape == (len(f.t), 13)
+    assert (o.states[:, 5] == f.rsrp).all(), "candidate 0 is the network's serving cell"
+    assert (np.diff(o.states[:, 6:9], axis=1) <= 0).all(), "neighbours sorted by RSRP"
+
+
+@needs_data
+def test_malformed_files_name_file_and_column(tmp_path):
+    src = (UKM / "100m.csv").read_text().splitlines()
+    (tmp_path / "20m.csv").write_text("\n".join(src[:1]) + "\n")  # truncated: a header and nothing else
+    header = src[0].split(",")
+    k = header.index("RS SNR")
+    (tmp_path / "30m.csv").write_text("\n".join(",".join(c for i, c in enumerate(line.split(",")) if i != k)
+                                                for line in src[:400]))
+    j = header.index("RSRP (LTE pcell)")
+    rows = [line.split(",") for line in src[1:400]]
+    for r in rows:
+        if len(r) > j and r[j]:
+            r[j] = str(float(r[j]) * -1000)  # wrong units
+    (tmp_path / "40m.csv").write_text("\n".join([src[0]] + [",".join(r) for r in rows]))
+    (tmp_path / "noheight.csv").write_text("\n".join(src[:400]))
+    shutil.copy(UKM / "25m.csv", tmp_path / "25m.csv")
+    for name, match in (("20m.csv", "no rows with a parseable Time"), ("30m.csv", "missing column 'RS SNR'"),
+                        ("40m.csv", r"'RSRP \(LTE pcell\)' has median .* wrong units"),
+                        ("noheight.csv", "altitude is read from the file name")):
+        with pytest.raises(InputError, match=match) as info:
+            load_flight(tmp_path / name)
+        assert name in str(info.value)
+    flights, bad = load_folder(tmp_path)
+    assert [f.name for f in flights] == ["25m.csv"] and len(bad) == 4
+
+
+@pytest.mark.skipif(not BALTACI.is_dir(), reason="../shared/data/baltaci-imc22-handovers is not here")
+def test_baltaci_rates():
+    bins, rate, n = baltaci_rate_by_altitude(BALTACI)
+    assert list(bins) == list(range(0, 130, 10)) and n > 2000 and (rate >= 0).all() and rate.sum() > 0
+
+
+def test_report_without_real_data(tmp_path, capsys):
+    out = tmp_path / "rep"
+    assert main(["explain", "--plugin", "uav-handover", "--n", "40", "--narrate", "--out", str(out)]) == 0
+    html = (out / "report.html").read_text()
+    assert "Table I" in html and html.count("data:image/png;base64,") >= 3
+    assert "&#10003; verified" in html and "confidence" in html
+    lines = (out / "explanations.jsonl").read_text().splitlines()
+    assert len(lines) == 40
+    rec = StateRecord.model_validate_json(lines[0])
+    assert rec.dataset == "simulated" and set(rec.values) >= {"buffer_queue_size", "rsrp_0"}
+    schema = json.loads((out / "explanations.schema.json").read_text())
+    assert "values" in schema["properties"]
+
+
+@needs_data
+def test_report_with_real_data(tmp_path):
+    real = tmp_path / "data" / "ukm"
+    real.mkdir(parents=True)
+    for name in ("25m.csv", "100m.csv"):
+        shutil.copy(UKM / name, real / name)
+    shutil.copytree(BALTACI, tmp_path / "data" / "baltaci-imc22-handovers")
+    out = tmp_path / "rep"
+    assert main(["explain", "--plugin", "uav-handover", "--n", "30", "--real", str(real), "--out", str(out)]) == 0
+    html = (out / "report.html").read_text()
+    assert "Real flights: 2 loaded" in html and "network (observed)" in html and "Baltaci" in html
+    datasets = {json.loads(x)["dataset"] for x in (out / "explanations.jsonl").read_text().splitlines()}
+    assert datasets == {"simulated", "real"}
+
+
+@pytest.mark.skipif(not shutil.which("chromium"), reason="chromium is not installed")
+def test_report_renders_in_headless_chromium(tmp_path):
+    import subprocess
+
+    out = tmp_path / "rep"
+    assert main(["explain", "--plugin", "uav-handover", "--n", "20", "--out", str(out)]) == 0
+    shot = tmp_path / "shot.png"
+    subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+                    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                    f"--user-data-dir={tmp_path / 'profile'}", f"--screenshot={shot}", "--window-size=1200,2000",
+                    (out / "report.html").as_uri()], check=True, capture_output=True, timeout=120)
+    assert shot.stat().st_size > 20_000
