@@ -14,6 +14,7 @@ _LAZY = {
     "Explanation": "xairl.explanation",
     "Policy": "xairl.policy",
     "TorchPolicy": "xairl.policy",
+    "from_sb3": "xairl.policy",
     "FeatureInfo": "xairl.policy",
     "narrate": "xairl.narrators",
     "verify": "xairl.narrators",

@@ -117,3 +117,36 @@ class Policy:
 
 
 TorchPolicy = Policy  # the name users of plain torch networks (CleanRL style) look for
+
+
+class _SB3ActorLogits(torch.nn.Module):
+    """An SB3 actor-critic policy seen as states -> action logits (features extractor, actor MLP, action net)."""
+
+    def __init__(self, policy):
+        super().__init__()
+        self.policy = policy
+
+    def forward(self, x):
+        p = self.policy
+        extractor = getattr(p, "pi_features_extractor", None) or p.features_extractor
+        return p.action_net(p.mlp_extractor.forward_actor(extractor(x)))
+
+
+def from_sb3(model, feature_names=None, action_names=None, **kwargs) -> Policy:
+    """A Stable-Baselines3 model (DQN: Q-values; PPO/A2C: action logits) with discrete actions and a flat Box
+    observation, as a :class:`Policy`. Names default to ``obs_0..`` and ``action_0..``."""
+    obs, act = model.observation_space, model.action_space
+    if not hasattr(act, "n"):
+        raise InputError(f"xairl explains discrete actions; this model's action space is {act}.")
+    if len(getattr(obs, "shape", ()) or ()) != 1:
+        raise InputError(f"xairl needs a flat Box observation; this model's observation space is {obs}.")
+    policy = model.policy
+    if hasattr(policy, "q_net"):
+        module = policy.q_net
+    elif hasattr(policy, "action_net"):
+        module = _SB3ActorLogits(policy)
+    else:
+        raise InputError(f"unsupported SB3 policy {type(policy).__name__}: expected DQN (q_net) or actor-critic.")
+    n_obs, n_act = obs.shape[0], int(act.n)
+    return Policy(module.eval(), feature_names or [f"obs_{i}" for i in range(n_obs)],
+                  action_names or [f"action_{i}" for i in range(n_act)], **kwargs)

@@ -1,0 +1,81 @@
+"""deep_shap vs shap.DeepExplainer vs captum DeepLiftShap: time (median of repeats) and agreement of the values.
+
+Models: the reference UAV DQN (13-13-64-64-4) and a wider MLP (32-256-256-8); 100 background states; all actions.
+Goal (issue 6): >= 50x shap.DeepExplainer on the reference DQN.
+Run: .venv/bin/python benchmarks/bench_deep_shap.py [--sizes 1000,10000] [--device cpu|cuda] [--repeats 3]
+"""
+import argparse
+import os
+import platform
+import time
+
+import numpy as np
+import torch
+
+import xairl
+
+
+def models(device):
+    from xairl_uav_handover.policy import uav_policy
+
+    uav = uav_policy()
+    torch.manual_seed(0)
+    wide = torch.nn.Sequential(torch.nn.Linear(32, 256), torch.nn.ReLU(), torch.nn.Linear(256, 256), torch.nn.ReLU(),
+                               torch.nn.Linear(256, 8)).eval()
+    r = np.random.default_rng(0)
+    wide_policy = xairl.TorchPolicy(wide, [f"f{i}" for i in range(32)], [f"a{i}" for i in range(8)],
+                                    background_sampler=lambda n, s: np.random.default_rng(s).normal(size=(n, 32)))
+    for p in (uav, wide_policy):
+        p.module.to(device)
+    del r
+    return {"uav-dqn 13-64-64-4": uav, "mlp 32-256-256-8": wide_policy}
+
+
+def timed(fn, repeats):
+    times, out = [], None
+    for _ in range(repeats):
+        if torch.cuda.is_available():
+            torch.cuda.synchronize()
+        t0 = time.perf_counter()
+        out = fn()
+        if torch.cuda.is_available():
+            torch.cuda.synchronize()
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times)), out
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sizes", default="1000,10000")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--peer-repeats", type=int, default=1)
+    ap.add_argument("--device", default="cuda" if torch.cuda.is_available() else "cpu")
+    args = ap.parse_args()
+    import captum
+    import shap
+    from captum.attr import DeepLiftShap
+
+    dev = torch.device(args.device)
+    gpu = torch.cuda.get_device_name(0) if dev.type == "cuda" else "none"
+    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, GPU {gpu}; torch {torch.__version__}, "
+          f"shap {shap.__version__}, captum {captum.__version__}; device {dev}")
+    print(f"{'model':<20}{'states':>7}{'xairl s':>9}{'shap s':>9}{'captum s':>10}{'x shap':>9}{'x captum':>10}"
+          f"{'max|diff| shap':>16}{'captum':>10}")
+    for name, policy in models(dev).items():
+        bg = torch.as_tensor(policy.background(100, seed=1), device=dev)
+        for n in (int(s) for s in args.sizes.split(",")):
+            x = torch.as_tensor(policy.background(n, seed=2), device=dev)
+            t_ours, ours = timed(lambda: xairl.explain(policy, x, background=bg, method="deep_shap").values,
+                                 args.repeats)
+            net = policy.module
+            t_shap, sv = timed(lambda: np.asarray(shap.DeepExplainer(net, bg).shap_values(x, check_additivity=False)),
+                               args.peer_repeats)
+            dls = DeepLiftShap(net)
+            t_cap, cv = timed(lambda: np.stack([dls.attribute(x, baselines=bg, target=k).detach().cpu().numpy()
+                                                for k in range(policy.n_actions)], axis=-1), args.peer_repeats)
+            print(f"{name:<20}{n:>7}{t_ours:>9.2f}{t_shap:>9.2f}{t_cap:>10.2f}{t_shap / t_ours:>8.1f}x"
+                  f"{t_cap / t_ours:>9.1f}x{np.abs(ours - sv).max():>16.1e}{np.abs(ours - cv).max():>10.1e}")
+
+
+if __name__ == "__main__":
+    main()

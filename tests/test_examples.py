@@ -1,0 +1,48 @@
+"""Every example runs with a tiny budget (CleanRL-style subprocess smoke tests)."""
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+EX = ROOT / "examples"
+
+
+def run(args, env=None, timeout=300):
+    res = subprocess.run([sys.executable, *args], capture_output=True, text=True, timeout=timeout, cwd=ROOT,
+                         env={**os.environ, **(env or {})})
+    assert res.returncode == 0, res.stderr[-2000:]
+    return res.stdout
+
+
+def test_sb3_cartpole():
+    out = run([str(EX / "sb3_cartpole.py"), "--timesteps", "300"])
+    assert out.count("The policy chose push_") == 5 and "additivity gap" in out
+
+
+def test_cleanrl_style():
+    out = run([str(EX / "cleanrl_style.py"), "--steps", "300"])
+    assert "rather than" in out and "global: Over 3 states" in out
+
+
+def test_custom_prompt():
+    out = run([str(EX / "custom_prompt" / "run.py")])
+    assert "explain_action.yaml ok" in out and "one_liner.yaml ok" in out
+    assert "explain_action: Chose " in out and "[verified=True]" in out and ", mainly because of" in out
+
+
+def test_my_plugin_installs_and_registers(tmp_path):
+    """pip installs the example plugin into its own folder; the entry point makes xairl find it."""
+    target = tmp_path / "site"
+    subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation", "--target",
+                    str(target), str(EX / "my_plugin")], check=True, capture_output=True, timeout=300)
+    env = {"PYTHONPATH": str(target)}
+    out = run(["-m", "xairl.cli", "plugins"], env)
+    assert "my-plugin" in out and "thermostat" in out and "prompt directory" in out
+    out = run(["-m", "xairl.cli", "thermostat", "--temperature", "15"], env)
+    assert out.startswith("The thermostat chose heat: the room temperature (15 degC, cold) pushed toward it by +")
+    out = run(["-m", "xairl.cli", "explain", "--policy", "thermostat", "--n", "2", "--narrate", "--no-record",
+               "--template", "thermostat"], env)
+    assert out.count("[verified") == 2
