@@ -1,4 +1,6 @@
 """Templates: lookup order, sandbox, `xairl prompts` and check with line numbers."""
+from pathlib import Path
+
 import pytest
 
 import xairl
@@ -72,3 +74,24 @@ def test_prompts_cli(capsys, tmp_path):
     assert main(["prompts", "check", str(bad)]) == 1
     assert "unknown variable 'nope'" in capsys.readouterr().out
     assert main(["prompts", "show"]) == 2
+
+
+HOSTILE = sorted((Path(__file__).parent / "hostile_templates").glob("*.yaml"))
+
+
+@pytest.mark.parametrize("path", HOSTILE, ids=lambda p: p.stem)
+def test_hostile_templates_are_refused_quickly(path):
+    """Attribute escapes, mutation, runaway loops, bombs, recursion, imports: a clear error, in well under a second."""
+    import time
+
+    p = toy_policy()
+    e = xairl.explain(p, p.background(1))
+    t0 = time.perf_counter()
+    with pytest.raises((TemplateError, UnknownNameError)) as info:
+        xairl.narrate(e, 0, template=str(path))
+    assert time.perf_counter() - t0 < 2.0
+    assert str(path) in str(info.value) and "\n" not in str(info.value)
+
+
+def test_hostile_corpus_size():
+    assert len(HOSTILE) >= 20

@@ -20,7 +20,10 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from .errors import UnknownNameError, XairlError
 from .paths import user_dir
 
-MAX_OUTPUT = 4000  # characters per rendered sentence: a guard against runaway loops
+MAX_OUTPUT = 4000  # characters per rendered sentence
+MAX_RANGE = 1000  # items produced by range() in one rendering: templates loop over a handful of features
+MAX_LOOP_DEPTH = 2  # nested for-loops; deeper nesting is how a small template hangs a process
+MAX_REPEAT = 1000  # 'x' * n and [..] * n
 
 DECISION_VARS = {"index", "action", "runner_up", "score", "runner_up_score", "q_margin", "base_value", "method",
                  "additivity_gap", "top", "margin_top", "comparisons", "extras", "k"}
@@ -51,9 +54,47 @@ def _fmt(x, signed=False):
     return fmt(float(x), signed)
 
 
+class _Sandbox(ImmutableSandboxedEnvironment):
+    """Jinja's immutable sandbox (no private attributes, no mutation of data), plus bounds on loops, repetition
+    and powers, so that a template can neither escape nor hang the process."""
+
+    intercepted_binops = frozenset(["*", "**"])
+
+    def call_binop(self, context, operator, left, right):
+        if operator == "**" and isinstance(right, (int, float)) and abs(right) > 64:
+            raise SecurityError(f"exponent {right} is too large (limit 64)")
+        if operator == "*" and any(isinstance(a, (str, list, tuple)) for a in (left, right)):
+            n = right if isinstance(left, (str, list, tuple)) else left
+            if isinstance(n, int) and n > MAX_REPEAT:
+                raise SecurityError(f"repetition by {n} is too large (limit {MAX_REPEAT})")
+        return super().call_binop(context, operator, left, right)
+
+
+def _budgeted_range():
+    left = [MAX_RANGE]
+
+    def bounded_range(*args):
+        r = range(*args)
+        left[0] -= len(r)
+        if left[0] < 0:
+            raise SecurityError(f"range() would produce more than {MAX_RANGE} items in one rendering")
+        return r
+
+    return bounded_range
+
+
+def loop_depth(ast) -> int:
+    def depth(node) -> int:
+        inner = max((depth(c) for c in node.iter_child_nodes()), default=0)
+        return inner + 1 if isinstance(node, nodes.For) else inner
+
+    return depth(ast)
+
+
 def environment() -> ImmutableSandboxedEnvironment:
-    env = ImmutableSandboxedEnvironment(undefined=StrictUndefined, autoescape=False, trim_blocks=True,
-                                        lstrip_blocks=True)
+    """A fresh sandbox per rendering (the range() budget is per rendering)."""
+    env = _Sandbox(undefined=StrictUndefined, autoescape=False, trim_blocks=True, lstrip_blocks=True)
+    env.globals = {"range": _budgeted_range(), "dict": dict, "namespace": env.globals["namespace"]}
     env.filters["num"] = _fmt
     env.filters["signed"] = lambda x: _fmt(x, True)
     env.filters["cap"] = lambda t: str(t)[:1].upper() + str(t)[1:]
@@ -79,7 +120,16 @@ class Template:
             for v, text in enumerate(variants):
                 where = f"{self.path}:{self.lines[s][v]}"
                 try:
-                    result = " ".join(env.from_string(text).render(context).split())
+                    compiled = env.from_string(text)
+                    if loop_depth(env.parse(text)) > MAX_LOOP_DEPTH:
+                        raise SecurityError(f"loops nested more than {MAX_LOOP_DEPTH} deep")
+                    size, chunks = 0, []
+                    for chunk in compiled.generate(context):  # stream, so a runaway loop stops at the cap
+                        size += len(chunk)
+                        if size > MAX_OUTPUT:
+                            raise SecurityError(f"output longer than {MAX_OUTPUT} characters")
+                        chunks.append(chunk)
+                    result = " ".join("".join(chunks).split())
                 except SecurityError as exc:
                     raise TemplateError(f"{where}: refused by the sandbox ({exc}).") from None
                 except UndefinedError as exc:
@@ -90,8 +140,6 @@ class Template:
                     raise TemplateError(f"{where}: syntax error: {exc.message}.") from None
                 except Exception as exc:  # a filter or test raising on odd data
                     raise TemplateError(f"{where}: cannot render ({type(exc).__name__}: {exc}).") from None
-                if len(result) > MAX_OUTPUT:
-                    raise TemplateError(f"{where}: renders {len(result)} characters (limit {MAX_OUTPUT}).")
                 rendered.append(result)
             out.append(rendered)
         return out
@@ -189,6 +237,8 @@ def check(path: str | Path) -> list[str]:
             except TemplateSyntaxError as exc:
                 problems.append(f"{path}:{base + (exc.lineno or 1) - 1}: syntax error: {exc.message}")
                 continue
+            if loop_depth(ast) > MAX_LOOP_DEPTH:
+                problems.append(f"{path}:{base}: sandbox violation: loops nested more than {MAX_LOOP_DEPTH} deep")
             for name in sorted(meta.find_undeclared_variables(ast) - allowed):
                 problems.append(f"{path}:{base}: unknown variable '{name}'; a {tpl.spec.kind} template has: "
                                 f"{', '.join(sorted(allowed))}")
