@@ -90,3 +90,21 @@ def test_unverified_text_has_zero_confidence(toy, tmp_path):
     lie.write_text('name: lie\nkind: decision\nsentences:\n  - ["The policy chose {{ runner_up }}."]\n')
     n = xairl.narrate(exp, 0, policy=policy, template=str(lie))
     assert not n.verified and n.confidence == 0.0
+
+
+def test_names_and_descriptions_cannot_smuggle_claims():
+    """A feature description or action name carrying claims is not trusted as a name: its claims get checked."""
+    net = torch.nn.Linear(2, 2)
+    with torch.no_grad():
+        net.weight.copy_(torch.tensor([[1.0, 0.0], [0.0, 1.0]]))
+        net.bias.zero_()
+    hostile = xairl.FeatureInfo("", "speed, the most important feature, pushing toward go by +9.99")
+    policy = xairl.TorchPolicy(net, ["speed", "load"], ["go", "stop"], features={"speed": hostile},
+                               action_aliases={"stop": ["stop, which raises go by 12.5%"]})
+    bg = np.zeros((10, 2))
+    exp = xairl.explain(policy, [[0.1, 2.0]], background=bg, method="exact")  # load dominates, stop is chosen
+    n = xairl.narrate(exp, 0, policy=policy)
+    assert not n.verified and n.confidence == 0.0
+    text = "The policy chose stop. speed, the most important feature, pushing toward go by +9.99."
+    problems = xairl.verify(text, exp, 0, policy).problems()
+    assert any(c.kind == "number" for c in problems) and any(c.kind == "rank" for c in problems)

@@ -75,6 +75,16 @@ class FactBook:
     by_unit: dict[str, list[float]] = field(default_factory=dict)  # domain comparisons, by their unit
 
 
+_CLAIMY = re.compile(r"[+\-\u2212]\d|\d\.\d|%|\b(" + "|".join(map(re.escape, POSITIVE + NEGATIVE)) + r")\b|"
+                    + RANK_RE.pattern, re.IGNORECASE)
+
+
+def clean_surface(text: str) -> bool:
+    """May this name or description hide its words from the verifier? Not if it carries claims itself (a signed or
+    decimal number, a percentage, a direction or rank word): text from data files or plugins cannot smuggle claims."""
+    return not _CLAIMY.search(text)
+
+
 def _surfaces(exp: Explanation, policy: Policy | None) -> list[tuple[str, str, str]]:
     out = []
     for f in exp.feature_names:
@@ -84,7 +94,7 @@ def _surfaces(exp: Explanation, policy: Policy | None) -> list[tuple[str, str, s
     for a in exp.action_names:
         names = {a, a.replace("_", " "), *(policy.action_aliases.get(a, ()) if policy else ())}
         out += [(n.lower(), "action", a) for n in names if n]
-    return sorted(set(out), key=lambda s: -len(s[0]))
+    return sorted({o for o in out if clean_surface(o[0])}, key=lambda s: -len(s[0]))
 
 
 def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None) -> FactBook:
