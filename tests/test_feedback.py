@@ -50,14 +50,33 @@ def _writer(path, n, text):
 def test_concurrent_writers_lose_nothing(tmp_path):
     path = tmp_path / "fb.sqlite"
     FeedbackStore(path)
-    procs = [mp.get_context("spawn").Process(target=_writer, args=(path, 150, f"p{k}")) for k in range(4)]
+    procs = [mp.get_context("spawn").Process(target=_writer, args=(path, 1000, f"p{k}")) for k in range(8)]
     for p in procs:
         p.start()
     for p in procs:
         p.join(120)
         assert p.exitcode == 0
     texts = [r.text for r in FeedbackStore(path).records()]
-    assert len(texts) == 600 and len(set(texts)) == 600
+    assert len(texts) == 8000 and len(set(texts)) == 8000
+
+
+def test_writer_killed_mid_run_leaves_store_readable(tmp_path):
+    import os
+    import signal
+    import time
+
+    path = tmp_path / "fb.sqlite"
+    FeedbackStore(path)
+    p = mp.get_context("spawn").Process(target=_writer, args=(path, 1_000_000, "victim"))
+    p.start()
+    deadline = time.time() + 60
+    while time.time() < deadline and len(FeedbackStore(path).records()) < 50:
+        time.sleep(0.2)
+    os.kill(p.pid, signal.SIGKILL)
+    p.join()
+    rows = FeedbackStore(path).records()
+    assert len(rows) >= 50 and [r.text for r in rows] == [f"victim {i}" for i in range(len(rows))]
+    assert sqlite3.connect(path).execute("PRAGMA integrity_check").fetchone()[0] == "ok"
 
 
 def test_interrupted_write_leaves_store_readable(tmp_path, narrative):
