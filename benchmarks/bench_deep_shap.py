@@ -50,6 +50,8 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--peer-repeats", type=int, default=1)
     ap.add_argument("--device", default="cuda" if torch.cuda.is_available() else "cpu")
+    ap.add_argument("--peer-max", type=int, default=10000, help="largest size at which shap and captum are timed")
+    ap.add_argument("--models", default="uav,mlp", help="which models: uav, mlp")
     args = ap.parse_args()
     import captum
     import shap
@@ -62,11 +64,16 @@ def main():
     print(f"{'model':<20}{'states':>7}{'xairl s':>9}{'shap s':>9}{'captum s':>10}{'x shap':>9}{'x captum':>10}"
           f"{'max|diff| shap':>16}{'captum':>10}")
     for name, policy in models(dev).items():
+        if name.split()[0].split("-")[0] not in args.models:
+            continue
         bg = torch.as_tensor(policy.background(100, seed=1), device=dev)
         for n in (int(s) for s in args.sizes.split(",")):
             x = torch.as_tensor(policy.background(n, seed=2), device=dev)
             t_ours, ours = timed(lambda: xairl.explain(policy, x, background=bg, method="deep_shap").values,
                                  args.repeats)
+            if n > args.peer_max:
+                print(f"{name:<20}{n:>7}{t_ours:>9.2f}{'-':>9}{'-':>10}   (peers not timed above --peer-max)")
+                continue
             net = policy.module
             t_shap, sv = timed(lambda: np.asarray(shap.DeepExplainer(net, bg).shap_values(x, check_additivity=False)),
                                args.peer_repeats)

@@ -1,8 +1,9 @@
 """Read any text back against an Explanation: numbers, feature names, directions, ranks and actions.
 
 Each claim found is verified, contradicted or unsupported; a text is ``ok`` only when every claim is verified.
-How claims are tied to features: the text is split into clauses (sentences, then ';'); numbers, direction words
-and rank words belong to the nearest feature mention in their clause (preferring the one before them). Feature and
+How claims are tied to features: the text is split into clauses (sentences, then ';'); a number belongs to the
+feature named last before it in its clause, unless words around it name a decision-level quantity ("margin of",
+"above", "vs", "score"); direction and rank words belong to the nearest feature mention (preferring the one before). Feature and
 action mentions are masked before numbers are read, so digits inside names ('rsrp_1') are not numbers.
 """
 from __future__ import annotations
@@ -196,9 +197,11 @@ def _check_action(sentence: str, start: int, end: int, key: str, book: FactBook)
                                                  "are explained here")
 
 
-def _feature_number(written: str, pct: bool, before: str, e: _Feature, key: str) -> tuple[str, str, str | None]:
+def _feature_number(written: str, pct: bool, before: str, e: _Feature, key: str,
+                    ctx: str) -> tuple[str, str, str | None]:
     """A number tied to a feature, read by its form: 'N%' is a share; '+N' or 'by N' a contribution (by N may
-    drop the sign); any other number is the feature's value, or a contribution written with its minus sign."""
+    drop the sign) to the sentence's context (the chosen action, or the margin over the runner-up); any other
+    number is the feature's value, or a contribution written with its minus sign."""
     if pct:
         if any(_matches(written, v) for v in e.shares):
             return "verified", f"{key}: share", None
@@ -206,27 +209,28 @@ def _feature_number(written: str, pct: bool, before: str, e: _Feature, key: str)
     by = bool(re.search(r"\bby\s*$", before))
     signed = written[0] in "+-\u2212"
     if written[0] == "+" or by:
-        for ctx, c in e.contribs.items():
-            if _matches(written, c, magnitude_ok=by):
-                return "verified", f"{key}: contribution ({ctx})", ctx
-        return "contradicted", f"{written} is not a contribution of {key}", None
+        c = e.contribs.get(ctx)
+        if c is not None and _matches(written, c, magnitude_ok=by):
+            return "verified", f"{key}: contribution ({ctx})", ctx
+        return "contradicted", f"{written} is not the contribution of {key} ({ctx})", "final"
     if any(_matches(written, v) for v in e.values):
         return "verified", f"{key}: value", None
-    if signed:
-        for ctx, c in e.contribs.items():
-            if _matches(written, c):
-                return "verified", f"{key}: contribution ({ctx})", ctx
+    if signed and ctx in e.contribs and _matches(written, e.contribs[ctx]):
+        return "verified", f"{key}: contribution ({ctx})", ctx
     return "contradicted", f"{written} is not the value or a contribution of {key}", None
 
 
-def _free_slots(book: FactBook, before: str, after: str) -> list[float]:
-    """Which decision-level quantity a number stands for, from the words around it."""
-    if book.global_view or len(book.numbers) < 3:
-        return book.numbers
+def _unit_slots(book: FactBook, after: str) -> list[float]:
     unit = re.match(r"\s*([a-zA-Z]+)\b", after)
     units = {u.lower(): v for u, v in book.by_unit.items()}
-    if unit and unit.group(1).lower() in units:  # '4.2 dB': only a domain fact in dB may back it
-        return units[unit.group(1).lower()]
+    return units.get(unit.group(1).lower(), []) if unit else []
+
+
+def _cue_slots(book: FactBook, before: str, after: str) -> list[float] | None:
+    """The decision-level quantity that the words around a number name (Q-margin, runner-up score, score), or
+    None when they name none. These cues win over feature attachment."""
+    if book.global_view or len(book.numbers) < 3:
+        return None
     score, runner, margin = book.numbers[:3]
     if re.match(r"\s*(higher|above|more|ahead)\b", after) or re.search(r"margin( of)?\s*$", before):
         return [margin]
@@ -236,7 +240,12 @@ def _free_slots(book: FactBook, before: str, after: str) -> list[float]:
         return [score]
     if re.search(r"\bscor(e|ed|ing)\b[^0-9]*$", before) and not re.search(r"(higher|above|margin)", before):
         return [score]
-    return book.numbers
+    return None
+
+
+def _free_slots(book: FactBook, before: str, after: str) -> list[float]:
+    """What a number tied to no feature may stand for: a comparison in its unit, else any decision-level fact."""
+    return _unit_slots(book, after) or book.numbers
 
 
 def _check_clause(clause: str, book: FactBook, margin_sentence: bool, claims: list[Claim]) -> None:
@@ -250,18 +259,26 @@ def _check_clause(clause: str, book: FactBook, margin_sentence: bool, claims: li
         written, pct = m.group(1), bool(m.group(2))
         before = masked[max(0, m.start() - 24):m.start()].lower()
         after = masked[m.end():m.end() + 12].lower()
-        key = _nearest(m.start(), feats)
+        before_feats = [f for f in feats if f[1] <= m.start()]
+        key = before_feats[-1][3] if before_feats else None  # a number describes a feature named before it
         status, detail = "unsupported", "matches no fact of this explanation"
+        final = False
+        cue = _cue_slots(book, before, after)
+        if cue is not None:  # "margin of 4.9", "5.4 above", "vs -11.8", "score -6.4": a decision-level quantity
+            ok = any(_matches(written, v) for v in cue)
+            claims.append(Claim("number", m.group(0).strip(), "verified" if ok else "contradicted",
+                                "decision-level quantity named by the words around it"))
+            continue
         if key is not None:
-            status, detail, ctx = _feature_number(written, pct, before, book.features[key], key)
-            if ctx:
+            status, detail, ctx = _feature_number(written, pct, before, book.features[key], key, ctx_default)
+            final = ctx == "final"  # written as a contribution: no other fact may stand in for it
+            if ctx and not final:
                 matched_ctx.setdefault(key, ctx)
-        if status != "verified" and not pct:
-            wanted = _free_slots(book, before, after)
+        if status != "verified" and not pct and not final:
+            # a number tied to a feature may stand only for a domain comparison in the unit written after it
+            wanted = _free_slots(book, before, after) if key is None else _unit_slots(book, after)
             if any(_matches(written, v) for v in wanted):
                 status, detail = "verified", "a decision-level fact"
-            elif key is None and wanted is not book.numbers:
-                status, detail = "contradicted", f"{written} is not the quantity the text names"
         claims.append(Claim("number", m.group(0).strip(), status, detail))
     low = masked.lower()
     for words, polarity in ((POSITIVE, 1), (NEGATIVE, -1)):
