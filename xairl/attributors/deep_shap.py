@@ -60,6 +60,64 @@ def check_supported(module: torch.nn.Module) -> list[torch.nn.Module]:
     return nonlinear
 
 
+def chain(module: torch.nn.Module) -> list[torch.nn.Module] | None:
+    """The layers of a pure Sequential chain (nested Sequentials flattened), or None when the network is not one."""
+    if not isinstance(module, torch.nn.Sequential):
+        return None
+    out: list[torch.nn.Module] = []
+    for layer in module:
+        if isinstance(layer, torch.nn.Sequential):
+            inner = chain(layer)
+            if inner is None:
+                return None
+            out += inner
+        elif isinstance(layer, (torch.nn.Linear, torch.nn.BatchNorm1d, torch.nn.Identity, torch.nn.Dropout,
+                                torch.nn.AlphaDropout)) or isinstance(layer, NONLINEAR):
+            out.append(layer)
+        else:
+            return None
+    return out
+
+
+def _local_grad(layer, h):
+    with torch.enable_grad():
+        leaf = h.detach().requires_grad_(True)
+        return torch.autograd.grad(layer.forward(leaf).sum(), leaf)[0]
+
+
+def chain_multipliers(layers, xs: torch.Tensor, bg: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Rescale-rule multipliers of every output w.r.t. the input for every (state, background) pair, by explicit
+    back-propagation through the chain: (states * background, actions, features), plus the outputs of the states
+    and of the background. The forward passes run on the states and the background once each (a pair's rows are
+    broadcast from them); no autograd work on the background half, all actions in one sweep."""
+    hx, hr = xs, bg
+    m, b = len(xs), len(bg)
+    steps = []
+    with torch.no_grad():
+        for layer in layers:
+            if isinstance(layer, NONLINEAR):
+                ox, orr = layer(hx), layer(hr)
+                d = (hx[:, None, :] - hr[None, :, :]).reshape(m * b, -1)
+                ratio = (ox[:, None, :] - orr[None, :, :]).reshape(m * b, -1).div_(d)
+                small = d.abs_() < EPS  # rare: patch those with the local gradient
+                if small.any():
+                    local = _local_grad(layer, hx)[:, None, :].expand(m, b, -1).reshape(m * b, -1)
+                    ratio = torch.where(small, local, ratio)
+                steps.append(("scale", ratio))
+                hx, hr = ox, orr
+            elif isinstance(layer, torch.nn.Linear):
+                steps.append(("matmul", layer.weight))
+                hx, hr = layer(hx), layer(hr)
+            elif isinstance(layer, torch.nn.BatchNorm1d):  # eval mode: an affine map per feature
+                steps.append(("scale", (layer.weight if layer.affine else 1.0)
+                              / torch.sqrt(layer.running_var + layer.eps)))
+                hx, hr = layer(hx), layer(hr)
+        mult = torch.eye(hx.shape[1], dtype=hx.dtype, device=hx.device)[None]  # (1, actions, width)
+        for kind, t in reversed(steps):
+            mult = mult @ t if kind == "matmul" else mult * (t[:, None, :] if t.dim() == 2 else t)
+    return mult.expand(m * b, -1, -1), hx, hr
+
+
 class DeepShap(Attributor):
     """DeepSHAP (DeepLIFT rescale rule averaged over background states), all actions in one pass."""
 
@@ -68,6 +126,9 @@ class DeepShap(Attributor):
 
     def _attribute(self, policy, x, bg):
         module = policy.module
+        layers = chain(module)
+        if layers is not None:
+            return self._attribute_chain(policy, layers, x, bg)
         for layer in check_supported(module):
             self._add_hook(layer.register_forward_hook(_rescale_hook))
         dev = policy.device
@@ -101,4 +162,25 @@ class DeepShap(Attributor):
                     "nonlinearities (torch.relu, F.softmax, ...) that deep_shap cannot see; make them nn modules or "
                     "use method='kernel_shap' or 'exact'."
                 )
+        return values, base, {}
+
+    def _attribute_chain(self, policy, layers, x, bg):
+        dev = policy.device
+        xt, bt = torch.as_tensor(x, device=dev), torch.as_tensor(bg, device=dev)
+        n, f = xt.shape
+        b, a = len(bt), policy.n_actions
+        widest = max([f] + [getattr(layer, "out_features", 0) for layer in layers])
+        per = max(1, min(self.options.max_pairs, 2 ** 24 // (a * widest)) // b)  # bounds the multiplier tensor
+        values = np.empty((n, f, a))
+        outputs = np.empty((n, a))
+        base = None
+        for s in range(0, n, per):
+            xs = xt[s:s + per]
+            m = len(xs)
+            mult, ox, orr = chain_multipliers(layers, xs, bt)
+            delta = (xs[:, None, :] - bt[None, :, :]).reshape(m * b, 1, f)
+            contrib = (mult * delta).reshape(m, b, a, f).mean(dim=1).double()
+            values[s:s + m] = contrib.transpose(1, 2).cpu().numpy()
+            outputs[s:s + m] = ox.double().cpu().numpy()
+            base = orr.double().mean(dim=0).cpu().numpy()
         return values, base, {}
