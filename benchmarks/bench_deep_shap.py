@@ -22,12 +22,10 @@ def models(device):
     torch.manual_seed(0)
     wide = torch.nn.Sequential(torch.nn.Linear(32, 256), torch.nn.ReLU(), torch.nn.Linear(256, 256), torch.nn.ReLU(),
                                torch.nn.Linear(256, 8)).eval()
-    r = np.random.default_rng(0)
     wide_policy = xairl.TorchPolicy(wide, [f"f{i}" for i in range(32)], [f"a{i}" for i in range(8)],
                                     background_sampler=lambda n, s: np.random.default_rng(s).normal(size=(n, 32)))
     for p in (uav, wide_policy):
         p.module.to(device)
-    del r
     return {"uav-dqn 13-64-64-4": uav, "mlp 32-256-256-8": wide_policy}
 
 

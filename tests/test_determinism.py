@@ -1,5 +1,4 @@
 """Seeded runs give bit-identical explanations and narratives, also across processes."""
-import hashlib
 import subprocess
 import sys
 

