@@ -30,17 +30,24 @@ class DeepShapOptions(Options):
     check_additivity: bool = Field(True, description="refuse results whose contributions do not add up")
 
 
+def _local_grad(layer, h):
+    with torch.enable_grad():
+        leaf = h.detach().requires_grad_(True)
+        return torch.autograd.grad(layer.forward(leaf).sum(), leaf)[0]
+
+
 def _rescale_hook(module, inputs, output):
     """Keep the output's value but give it the gradient Δout/Δin (pairs are rows i and i + P)."""
     inp = inputs[0]
     p = inp.shape[0] // 2
-    with torch.enable_grad():
-        leaf = inp.detach().requires_grad_(True)
-        local = torch.autograd.grad(module.forward(leaf).sum(), leaf)[0]
     d_in = inp[:p].detach() - inp[p:].detach()
     ratio = (output[:p].detach() - output[p:].detach()) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
     small = d_in.abs() < EPS
-    ratio = torch.cat([torch.where(small, local[:p], ratio), torch.where(small, local[p:], ratio)])
+    if small.any():  # rare: there the local gradient stands in for the ratio, per half as shap does
+        local = _local_grad(module, inp)
+        ratio = torch.cat([torch.where(small, local[:p], ratio), torch.where(small, local[p:], ratio)])
+    else:
+        ratio = torch.cat([ratio, ratio])
     return output.detach() + (inp - inp.detach()) * ratio
 
 
@@ -77,12 +84,6 @@ def chain(module: torch.nn.Module) -> list[torch.nn.Module] | None:
         else:
             return None
     return out
-
-
-def _local_grad(layer, h):
-    with torch.enable_grad():
-        leaf = h.detach().requires_grad_(True)
-        return torch.autograd.grad(layer.forward(leaf).sum(), leaf)[0]
 
 
 def chain_multipliers(layers, xs: torch.Tensor, bg: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
