@@ -173,10 +173,8 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
             m[3] == book.runner_up for m in actions)
         for start, end, _, key in actions:
             claims.append(_check_action(sentence, start, end, key, book))
-        offset = 0
         for clause in sentence.split(";"):
             _check_clause(clause, book, margin_sentence, claims)
-            offset += len(clause) + 1
         for ident in IDENT_RE.findall(sent_masked):
             claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
     return Verification(tuple(claims))

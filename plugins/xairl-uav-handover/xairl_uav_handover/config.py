@@ -44,6 +44,11 @@ class FlightConfig(_Strict):
     dt_s: float = Field(0.04, gt=0, le=1, description="simulation step; TTT and time of stay are multiples of it")
     turn_every_s: float = Field(30.0, gt=0, description="mean time between random heading changes")
 
+    @property
+    def n_steps(self) -> int:
+        """Simulation steps in one flight."""
+        return int(round(self.duration_s / self.dt_s))
+
 
 class BufferConfig(_Strict):
     packet_rate_hz: float = Field(300.0, ge=0, description="Poisson arrival rate of data packets")

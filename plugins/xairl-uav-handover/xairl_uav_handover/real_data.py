@@ -125,10 +125,14 @@ class Replay:
     states: np.ndarray      # (n, 13) the policy's view at each step
     serving: np.ndarray     # (n,) PCI served by the policy after each decision
     handovers: int
-    pingpongs: int
+    returns: np.ndarray     # for each handover back to the previous cell: the seconds spent in between
     forced: int             # the policy's cell vanished from the measurements
     mean_buffer_kbit: float
     lost_kbit: float
+
+    def pingpongs(self, window_s: float) -> int:
+        """Handovers back to the previous cell within ``window_s`` (the minimum time of stay)."""
+        return int((self.returns < window_s).sum())
 
 
 def _measured(f: RealFlight, i: int) -> dict[float, tuple[float, float]]:
@@ -139,26 +143,26 @@ def _measured(f: RealFlight, i: int) -> dict[float, tuple[float, float]]:
     return cells
 
 
-def replay(f: RealFlight, decide, config: SimConfig | None = None, seed: int = 0,
-           min_stay_s: float | None = None) -> Replay:
+def replay(f: RealFlight, decide, config: SimConfig | None = None, seed: int = 0) -> Replay:
     """Fly ``decide(state (13,), candidates) -> action`` along the real flight (see the module doc); ``decide=None``
-    follows the network's own serving cell (the observed decisions). Ping-pong: back to the previous cell within
-    ``min_stay_s`` (default: the config's minimum time of stay)."""
+    follows the network's own serving cell (the observed decisions). Ping-pongs are counted afterwards, for any
+    window, with :meth:`Replay.pingpongs`."""
     cfg = config or SimConfig()
-    window = cfg.handover.min_time_of_stay_s if min_stay_s is None else min_stay_s
     rng = np.random.default_rng(seed)
     ids = {p: k for k, p in enumerate(sorted(set(f.pci.tolist())))}
     serving, q = f.pci[0], 0.0
     prev, entered = serving, 0.0
     states, path = [], []
-    ho = pp = forced = 0
+    ho = forced = 0
+    returns: list[float] = []
     qs, lost_total = [], 0.0
     b, h = cfg.buffer, cfg.handover
     for i in range(len(f.t)):
         cells = _measured(f, i)
         if decide is None and f.pci[i] != serving:  # the network handed over between the samples
             ho += 1
-            pp += int(f.pci[i] == prev and f.t[i] - entered < window)
+            if f.pci[i] == prev:
+                returns.append(f.t[i] - entered)
             prev, entered, serving = serving, f.t[i], f.pci[i]
         if serving not in cells:
             serving, forced = max(cells, key=lambda p: cells[p][0]), forced + 1
@@ -176,11 +180,12 @@ def replay(f: RealFlight, decide, config: SimConfig | None = None, seed: int = 0
         handed = target != serving or (decide is None and i > 0 and f.pci[i] != f.pci[i - 1])
         if target != serving:
             ho += 1
-            pp += int(target == prev and f.t[i] - entered < window)
+            if target == prev:
+                returns.append(f.t[i] - entered)
             prev, entered, serving = serving, f.t[i], target
         path.append(serving)
         dt = float(np.clip(f.t[i + 1] - f.t[i], 0, 5)) if i + 1 < len(f.t) else 0.0
-        rsrp_now = _measured(f, i).get(serving, (f.rsrp[i], 0))[0]
+        rsrp_now = cells.get(serving, (f.rsrp[i], 0))[0]
         sinr = f.snr[i] + (rsrp_now - f.rsrp[i])
         served = service_bits(sinr, b.rb_per_uav, b.rb_bandwidth_hz, max(dt - (h.interruption_s if handed else 0), 0))
         arrivals = rng.poisson(b.packet_rate_hz * dt) * b.data_packet_bits + handed * b.control_packet_bits
@@ -188,7 +193,7 @@ def replay(f: RealFlight, decide, config: SimConfig | None = None, seed: int = 0
         q, lost = float(q), float(lost)
         qs.append(q)
         lost_total += lost
-    return Replay(np.array(states), np.array(path), ho, pp, forced, float(np.mean(qs)) / 1e3, lost_total / 1e3)
+    return Replay(np.array(states), np.array(path), ho, np.array(returns), forced, float(np.mean(qs)) / 1e3, lost_total / 1e3)
 
 
 def baltaci_rate_by_altitude(folder: str | Path) -> tuple[np.ndarray, np.ndarray, int]:

@@ -54,11 +54,11 @@ def build(req: ReportRequest) -> ReportContent:
         real_states = []
         for f in tqdm(flights, desc="replaying real flights", disable=not req.progress):
             for name, decide in zip(stats, (None, dqn, _a3)):
-                runs = [replay(f, decide, cfg, seed=req.seed, min_stay_s=w) for w in PP_WINDOWS]
-                stats[name].append((runs[0].handovers, *(r.pingpongs for r in runs), runs[0].forced,
-                                    runs[0].mean_buffer_kbit, f.t[-1] / 60))
+                run = replay(f, decide, cfg, seed=req.seed)
+                stats[name].append((run.handovers, *(run.pingpongs(w) for w in PP_WINDOWS), run.forced,
+                                    run.mean_buffer_kbit, f.t[-1] / 60))
                 if decide is None:
-                    real_states.append(runs[0].states)
+                    real_states.append(run.states)
         states = np.concatenate(real_states)
         pick = np.random.default_rng(req.seed).choice(len(states), size=min(req.n_states, len(states)), replace=False)
         content.datasets.append(("real", states[np.sort(pick)]))

@@ -67,7 +67,7 @@ class Simulator:
         self.bs_xy = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
         self.K, self.N = n_uavs, len(self.bs_xy)
         self.dt = cfg.flight.dt_s
-        self.n_steps = int(round(cfg.flight.duration_s / self.dt))
+        self.n_steps = cfg.flight.n_steps
         self.radius = (cfg.layout.rings + 0.5) * cfg.layout.isd_m * np.sqrt(3) / 2  # inside the outer ring
         r = self.radius * np.sqrt(rng.uniform(0, 1, n_uavs))
         phi = rng.uniform(0, 2 * np.pi, n_uavs)

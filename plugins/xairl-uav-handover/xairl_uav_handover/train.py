@@ -58,7 +58,7 @@ def train(tc: TrainConfig, sim_cfg: SimConfig | None = None, progress: bool = Tr
     rew_buf = np.zeros(tc.replay_size, np.float32)
     done_buf = np.zeros(tc.replay_size, np.float32)
     size = ptr = updates = 0
-    decisions_per_ep = int(np.ceil(Simulator(sim_cfg).n_steps / sim_cfg.decision_every))
+    decisions_per_ep = int(np.ceil(sim_cfg.flight.n_steps / sim_cfg.decision_every))
     total = tc.episodes * decisions_per_ep
     history = []
     bar = tqdm(total=total, desc="training DQN", unit="dec", disable=not progress)
