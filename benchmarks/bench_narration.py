@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 import xairl
-from xairl.narrators.mutations import corpus
+from xairl.testing import corpus
 from xairl_uav_handover.policy import uav_policy
 
 COLD = ("import time; t = time.perf_counter(); import xairl; from xairl_uav_handover.policy import uav_policy; "

@@ -1,8 +1,15 @@
-"""Helpers shared by the core tests."""
+"""Helpers shared by the core tests. The core is tested alone: no installed plugin is loaded."""
 import numpy as np
 import pytest
 import torch
 
+from xairl import plugins
+
+
+@pytest.fixture(autouse=True)
+def core_only(monkeypatch):
+    """Load no entry-point plugin (the reference plugin may be installed): a test that needs one selects it."""
+    monkeypatch.setenv(plugins.LOAD_ENV, "")
 
 
 def mlp(sizes, act=torch.nn.ReLU, seed=0):

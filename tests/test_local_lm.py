@@ -4,6 +4,7 @@ import pytest
 import xairl
 from xairl.errors import InputError
 from xairl.narrators import local_lm
+from xairl.narrators.base import first_phrasings
 from xairl.narrators.facts import decision_facts
 from xairl import prompts
 from xairl.toy import toy_policy
@@ -38,16 +39,22 @@ def test_choose_mode_picks_template_phrasings_and_verifies(toy):
         assert rest == ""
 
 
-def test_rewrite_mode_is_verified_or_falls_back(toy):
+def test_rewrite_mode_shows_the_model_text_only_when_it_verifies(toy):
+    """The model's own rewrite (composed again here, greedy so deterministic) is shown exactly when the verifier
+    accepts it; otherwise the template is shown and the rewrite is kept as ``rejected``."""
     policy, exp = toy
-    template_text = xairl.narrate(exp, 1, policy=policy, template="why_not").text
-    n = xairl.narrate(exp, 1, narrator="local_lm", policy=policy, template="why_not",
-                      options={"mode": "rewrite", "max_new_tokens": 96})
-    assert n.verified
-    if n.source.startswith("template (fallback"):
-        assert n.text == template_text
+    options = {"mode": "rewrite", "max_new_tokens": 96}
+    facts = decision_facts(exp, 1, policy)
+    variants = prompts.load("why_not").render_variants(facts.context())
+    template_text = first_phrasings(variants)
+    own = local_lm.LocalLMNarrator(options)._compose(variants, facts.context())
+    assert own and own != template_text  # the model wrote text of its own
+    n = xairl.narrate(exp, 1, narrator="local_lm", policy=policy, template="why_not", options=options)
+    if xairl.verify(own, exp, 1, policy).ok:
+        assert (n.source, n.text, n.rejected) == ("local_lm", own, None)
     else:
-        assert n.source == "local_lm" and n.text != ""
+        assert n.source.startswith("template (fallback: local_lm") and n.rejected == own
+        assert n.text == template_text and n.verified
 
 
 def test_examples_and_seeded_runs_are_deterministic(toy):
@@ -59,6 +66,8 @@ def test_examples_and_seeded_runs_are_deterministic(toy):
 
 def test_bad_model_options(tmp_path):
     with pytest.raises(InputError, match="not a transformers model folder"):
-        local_lm.LocalLMNarrator(model=str(tmp_path))
+        local_lm.LocalLMNarrator({"model": str(tmp_path)})
     with pytest.raises(InputError, match="mode"):
-        local_lm.LocalLMNarrator(mode="dream")
+        local_lm.LocalLMNarrator({"mode": "dream"})
+    with pytest.raises(InputError, match="unknown option; options: model, mode"):
+        xairl.narrate(None, 0, narrator="local_lm", options={"temperature": 0.7})

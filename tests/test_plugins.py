@@ -50,6 +50,7 @@ def test_entry_point_plugin_is_discovered(tmp_path, monkeypatch):
     (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: fake-xairl-plugin\nVersion: 0.1\n")
     (dist / "entry_points.txt").write_text("[xairl]\nfake = fake_xairl_plugin\n")
     monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setenv(plugins.LOAD_ENV, "fake")
     plugins.reset()
     assert "fake-policy" in plugins.registry("policy").names()
     assert plugins.registry("policy").entry("fake-policy").plugin == "fake"
@@ -57,6 +58,64 @@ def test_entry_point_plugin_is_discovered(tmp_path, monkeypatch):
     from xairl.cli import main
     assert main(["fake", "--word", "yo"]) == 0
     assert plugins.summary()["fake"] == {"policy": ["fake-policy"], "command": ["fake"]}
+
+
+def _install(tmp_path, monkeypatch, name: str, code: str) -> None:
+    """A real distribution on sys.path whose entry point ``name`` in group 'xairl' is the module ``code``."""
+    mod = f"{name.replace('-', '_')}_plugin"
+    (tmp_path / f"{mod}.py").write_text(textwrap.dedent(code))
+    dist = tmp_path / f"{mod}-0.1.dist-info"
+    dist.mkdir()
+    (dist / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {mod}\nVersion: 0.1\n")
+    (dist / "entry_points.txt").write_text(f"[xairl]\n{name} = {mod}\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, mod, raising=False)  # a module of that name imported by an earlier test
+
+
+GOOD = """
+    import xairl
+
+    @xairl.hookimpl
+    def register_policies(register):
+        register("good-policy", "xairl.toy:toy_policy", "borrowed toy")
+"""
+
+
+@pytest.mark.parametrize("broken, error", [
+    ("raise RuntimeError('boom at import')", "fails to load (RuntimeError: boom at import)"),
+    ("import xairl\n@xairl.hookimpl\ndef register_policies(register):\n    register('half', 'x:y')\n"
+     "    raise KeyError('oops')\n", "failed in register_policies (KeyError"),
+    ("import xairl\n@xairl.hookimpl\ndef register_everything(register):\n    pass\n", "implements an unknown hook"),
+])
+def test_a_broken_plugin_is_reported_and_breaks_nothing_else(tmp_path, monkeypatch, capsys, broken, error):
+    from xairl.cli import main
+
+    _install(tmp_path, monkeypatch, "good", GOOD)
+    _install(tmp_path, monkeypatch, "broken", broken)
+    monkeypatch.setenv(plugins.LOAD_ENV, "good,broken")
+    plugins.reset()
+    assert main(["explain", "--policy", "good-policy", "--n", "1", "--method", "exact"]) == 0
+    assert "half" not in plugins.registry("policy").names()  # a hook that failed half-way registers nothing
+    capsys.readouterr()
+    assert main(["plugins"]) == 0
+    out = capsys.readouterr().out
+    assert "good\n  policy: good-policy" in out and f"broken\n  LEFT OUT: {error}" in out
+    with pytest.raises(UnknownNameError, match=r"left out: broken \(see `xairl plugins`\)"):
+        plugins.get_policy("nope")
+
+
+def test_plugins_are_selected_by_environment(tmp_path, monkeypatch):
+    _install(tmp_path, monkeypatch, "good", GOOD)
+    monkeypatch.delenv(plugins.LOAD_ENV)
+    plugins.reset()
+    assert "good-policy" in plugins.registry("policy").names()  # unset: every installed plugin
+    monkeypatch.setenv(plugins.LOAD_ENV, "")
+    plugins.reset()
+    assert plugins.registry("policy").names() == ["toy"]  # empty: the built-ins only
+    monkeypatch.setenv(plugins.LOAD_ENV, "good, missing")
+    plugins.reset()
+    assert "good-policy" in plugins.registry("policy").names()
+    assert plugins.failures() == {"missing": f"is named in ${plugins.LOAD_ENV} but not installed"}
 
 
 def test_import_is_lazy():

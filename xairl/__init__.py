@@ -8,26 +8,47 @@ import importlib
 
 from .hookspecs import hookimpl, hookspec
 
+#: public name -> module. This is the whole surface a plugin author needs; everything else is internal.
 _LAZY = {
-    "explain": "xairl.attributors",
-    "Attributor": "xairl.attributors",
-    "Explanation": "xairl.explanation",
+    # policies and results
     "Policy": "xairl.policy",
     "TorchPolicy": "xairl.policy",
     "from_sb3": "xairl.policy",
     "FeatureInfo": "xairl.policy",
+    "Explanation": "xairl.explanation",
+    # attribution
+    "explain": "xairl.attributors",
+    "Attributor": "xairl.attributors",
+    # options (attributors, narrators, reports and plugins' own settings)
+    "Options": "xairl.options",
+    "parse_options": "xairl.options",
+    # narration: facts (the template variables), narrators, verification
     "narrate": "xairl.narrators",
     "verify": "xairl.narrators",
     "Narrative": "xairl.narrators",
+    "Narrator": "xairl.narrators",
     "Verification": "xairl.narrators",
+    "DecisionFacts": "xairl.narrators.facts",
+    "GlobalFacts": "xairl.narrators.facts",
+    "FeatureFact": "xairl.narrators.facts",
+    "Comparison": "xairl.narrators.facts",
+    "DomainFacts": "xairl.narrators.facts",
+    # reports
+    "Report": "xairl.report",
+    "ReportRequest": "xairl.report",
+    "ReportContent": "xairl.report",
+    "table_html": "xairl.report",
+    # registries
     "get_policy": "xairl.plugins",
     "get_attributor": "xairl.plugins",
+    # errors a user can cause, and the one-line message of a pydantic validation error
     "XairlError": "xairl.errors",
     "InputError": "xairl.errors",
     "UnknownNameError": "xairl.errors",
     "PluginError": "xairl.errors",
     "UnsupportedModelError": "xairl.errors",
     "CheckpointError": "xairl.errors",
+    "validation_message": "xairl.errors",
 }
 
 __all__ = sorted([*_LAZY, "hookimpl", "hookspec"])

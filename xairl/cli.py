@@ -29,12 +29,18 @@ def _parse_options(pairs: Sequence[str]) -> dict:
 
 
 def cmd_plugins(args) -> int:
-    for plugin, kinds in sorted(plugins.summary().items()):
+    summary, failed = plugins.summary(), plugins.failures()
+    for plugin in sorted(set(summary) | set(failed)):
         print(plugin)
-        for kind, names in sorted(kinds.items()):
+        if plugin in failed:
+            print(f"  LEFT OUT: {failed[plugin]}")
+            continue
+        for kind, names in sorted(summary[plugin].items()):
             print(f"  {kind}: {', '.join(sorted(names))}")
-        if not kinds:
+        if not summary[plugin]:
             print("  (registers nothing)")
+    if os.environ.get(plugins.LOAD_ENV) is not None:
+        print(f"(only the plugins named in ${plugins.LOAD_ENV} were loaded)")
     return 0
 
 
@@ -64,26 +70,21 @@ def cmd_report(args) -> int:
 
     from .report import ReportRequest, write_report
 
-    builder = plugins.registry("report").load(args.plugin)
-    options = plugins.get_attributor(args.method)(_parse_options(args.option)).options.model_dump()
-    req = ReportRequest(out=Path(args.out or "xairl-report"), method=args.method, options=options,
-                        narrate=args.narrate, narrator=args.narrator,
-                        narrator_options=_parse_options(args.narrator_option), template=args.template,
-                        prompt_dirs=args.prompts, real=args.real, seed=args.seed, n_states=args.n or 500)
+    report = plugins.registry("report").load(args.plugin)(_parse_options(args.option))
+    if args.n < 1:
+        raise InputError("--n must be at least 1 state per dataset.")
+    method_options = plugins.get_attributor(args.method)(_parse_options(args.method_option)).options.model_dump()
+    req = ReportRequest(out=Path(args.out), method=args.method, options=method_options, narrate=args.narrate,
+                        narrator=args.narrator, narrator_options=_parse_options(args.narrator_option),
+                        template=args.template, prompt_dirs=args.prompts, seed=args.seed, n_states=args.n)
     req.out.mkdir(parents=True, exist_ok=True)
-    path = write_report(req, builder(req))
+    path = write_report(req, report.build(req))
     print(f"report: {path.resolve()}")
     return 0
 
 
 def cmd_explain(args) -> int:
     import numpy as np
-
-    if args.plugin:
-        return cmd_report(args)
-    if args.real or args.out:
-        raise InputError("--real and --out go with --plugin NAME (a plugin's report); see `xairl plugins`.")
-    args.n = args.n or 5
 
     from .attributors import explain
     from .inputs import read_states
@@ -198,6 +199,15 @@ def cmd_review(args) -> int:
     return 0
 
 
+def _narration_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--narrate", action="store_true", help="explain decisions in words, checked against the numbers")
+    p.add_argument("--narrator", default="template", help="template (default), local_lm, or a plugin's narrator")
+    p.add_argument("--template", default=None, help="template name or .yaml path (default explain_action)")
+    p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder, searched first")
+    p.add_argument("-n", "--narrator-option", action="append", default=[], metavar="KEY=VALUE",
+                   help="a narrator option, e.g. -n mode=rewrite or -n model=PATH")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="xairl", description="Explain what a reinforcement-learning policy decided "
                                      "and why.")
@@ -213,28 +223,31 @@ def build_parser() -> argparse.ArgumentParser:
                    "default: --n states from the policy's sampler")
     p.add_argument("--background", help="background states file (default: the policy's sampler)")
     p.add_argument("--background-size", type=int, default=100, help="background states drawn from the sampler")
-    p.add_argument("--n", type=int, default=None, help="states to sample when --states is not given (default 5; "
-                   "500 per dataset in a report)")
-    p.add_argument("--plugin", help="write a plugin's report (e.g. uav-handover) into --out instead of printing")
-    p.add_argument("--out", default=None, help="report folder (with --plugin; default xairl-report)")
-    p.add_argument("--real", help="with --plugin: a folder of real flight data for the report")
+    p.add_argument("--n", type=int, default=5, help="states to sample when --states is not given")
     p.add_argument("--seed", type=int, default=0, help="seed of the sampled states and background")
     p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
     p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",
                    help="an option of the method, validated against its schema; repeatable")
     p.add_argument("--format", choices=("table", "jsonl"), default="table", help="output format")
     p.add_argument("--top", type=int, default=5, help="features shown per state in the table")
-    p.add_argument("--narrate", action="store_true", help="explain each decision in words, checked against the numbers")
-    p.add_argument("--narrator", default="template", help="template (default) or local_lm")
-    p.add_argument("--template", default=None, help="template name or .yaml path (default explain_action)")
-    p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder, searched first")
-    p.add_argument("-n", "--narrator-option", action="append", default=[], metavar="KEY=VALUE",
-                   help="a narrator option, e.g. -n mode=rewrite or -n model=PATH")
+    _narration_arguments(p)
     p.add_argument("--feedback-db", default=None, help="SQLite store of shown narratives (default: in the user dir)")
     p.add_argument("--no-record", action="store_true", help="do not record the narratives for review")
     p.add_argument("--examples-from-feedback", action="store_true",
                    help="give the local LM the operators' latest accepted or corrected narratives as examples")
     p.set_defaults(run=cmd_explain)
+    p = sub.add_parser("report", help="write a plugin's report (HTML, JSONL, figures) into a folder")
+    p.add_argument("--plugin", required=True, help="the report's name (see `xairl plugins`), e.g. uav-handover")
+    p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",
+                   help="an option of the plugin's report, validated against its schema (e.g. -o real=PATH)")
+    p.add_argument("--out", default="xairl-report", help="report folder (default xairl-report)")
+    p.add_argument("--n", type=int, default=500, help="states explained per dataset")
+    p.add_argument("--seed", type=int, default=0, help="seed of everything the report samples")
+    p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
+    p.add_argument("-m", "--method-option", action="append", default=[], metavar="KEY=VALUE",
+                   help="an option of the attribution method; repeatable")
+    _narration_arguments(p)
+    p.set_defaults(run=cmd_report)
     p = sub.add_parser("prompts", help="list, show or check prompt templates")
     p.add_argument("action", choices=("list", "show", "check"))
     p.add_argument("target", nargs="?", help="template name (show) or .yaml path (check)")

@@ -26,3 +26,16 @@ class UnsupportedModelError(XairlError):
 
 class CheckpointError(XairlError):
     """A checkpoint that is missing, corrupt or does not match the architecture."""
+
+
+def validation_message(exc, what: str) -> str:
+    """One line naming each bad field of a pydantic ``ValidationError``: ``invalid {what} (field: reason; ...).``
+
+    Plugins use it to turn a settings model's error into an :class:`InputError` message.
+    """
+    parts = []
+    for err in exc.errors():
+        loc = ".".join(str(p) for p in err["loc"]) or "value"
+        msg = "unknown option" if err["type"] == "extra_forbidden" else err["msg"]
+        parts.append(f"{loc}: {msg}")
+    return f"invalid {what} ({'; '.join(parts)})."

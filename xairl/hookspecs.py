@@ -32,7 +32,8 @@ def register_attributors(register):
 def register_narrators(register):
     """Register narrators that turn an Explanation into words.
 
-    :param register: ``register(name, cls, description="")``.
+    :param register: ``register(name, cls, description="")``; ``cls`` (or the ``"module:attr"`` naming it) is an
+        :class:`xairl.Narrator` subclass with an ``Options`` model and a ``_compose`` method.
     """
 
 
@@ -56,8 +57,9 @@ def register_commands(register):
 
 @hookspec
 def register_reports(register):
-    """Register report builders for ``xairl explain --plugin NAME --out DIR``.
+    """Register reports for ``xairl report --plugin NAME --out DIR``.
 
-    :param register: ``register(name, builder, description="")``; ``builder(request)`` (or the ``"module:attr"``
-        naming it) takes a :class:`xairl.report.ReportRequest` and returns a :class:`xairl.report.ReportContent`.
+    :param register: ``register(name, cls, description="")``; ``cls`` (or the ``"module:attr"`` naming it) is an
+        :class:`xairl.Report` subclass: its ``Options`` model declares the report's own settings
+        (``-o key=value``) and ``build(request)`` returns an :class:`xairl.ReportContent`.
     """

@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
+import os
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -12,26 +14,59 @@ from .errors import PluginError, UnknownNameError
 
 DEFAULT_PLUGINS = ("xairl.builtins",)
 BUILTIN_NAME = "xairl"
+#: comma-separated entry-point names to load (like simonw/llm's LLM_LOAD_PLUGINS); "" loads none; unset loads all
+LOAD_ENV = "XAIRL_LOAD_PLUGINS"
 
 _pm: pluggy.PluginManager | None = None
 _registries: dict[str, "Registry"] = {}
+_failures: dict[str, str] = {}
+
+
+def _selected() -> set[str] | None:
+    raw = os.environ.get(LOAD_ENV)
+    return None if raw is None else {n.strip() for n in raw.split(",") if n.strip()}
+
+
+def _load_entry_points(pm: pluggy.PluginManager) -> None:
+    """Register every selected entry point of group ``xairl``; one that fails is recorded, not raised."""
+    wanted = _selected()
+    seen: set[str] = set()
+    for ep in importlib.metadata.entry_points(group="xairl"):
+        if ep.name in seen or (wanted is not None and ep.name not in wanted):
+            continue
+        seen.add(ep.name)
+        try:
+            plugin = ep.load()
+            pm.register(plugin, name=ep.name)
+        except Exception as exc:  # a broken plugin must not take the other plugins and commands down
+            _failures[ep.name] = f"fails to load ({type(exc).__name__}: {exc}); reinstall or fix it"
+            continue
+        try:
+            pm.check_pending()
+        except pluggy.PluginValidationError as exc:
+            pm.unregister(plugin)
+            _failures[ep.name] = f"implements an unknown hook ({exc}); update it for this xairl"
+    for name in sorted((wanted or set()) - seen):
+        _failures[name] = f"is named in ${LOAD_ENV} but not installed"
 
 
 def get_plugin_manager() -> pluggy.PluginManager:
-    """The process-wide plugin manager: entry points of group ``xairl``, then the built-ins."""
+    """The process-wide plugin manager: the selected entry points of group ``xairl``, then the built-ins."""
     global _pm
     if _pm is None:
         pm = pluggy.PluginManager("xairl")
         pm.add_hookspecs(hookspecs)
-        try:
-            pm.load_setuptools_entrypoints("xairl")
-        except Exception as exc:  # a broken third-party plugin must not take the CLI down silently
-            raise PluginError(f"a plugin failed to load ({type(exc).__name__}: {exc}); uninstall or fix it.") from exc
+        _load_entry_points(pm)
         for modname in DEFAULT_PLUGINS:
             pm.register(importlib.import_module(modname), name=BUILTIN_NAME if modname == DEFAULT_PLUGINS[0] else modname)
-        pm.check_pending()
         _pm = pm
     return _pm
+
+
+def failures() -> dict[str, str]:
+    """{plugin: why it was left out}: plugins that failed to load or to register, and selected ones not installed."""
+    get_plugin_manager()
+    return dict(_failures)
 
 
 def reset(pm: pluggy.PluginManager | None = None) -> None:
@@ -39,6 +74,7 @@ def reset(pm: pluggy.PluginManager | None = None) -> None:
     global _pm
     _pm = pm
     _registries.clear()
+    _failures.clear()
 
 
 def resolve(target: Any) -> Any:
@@ -77,18 +113,26 @@ class Registry:
         self.entries: dict[str, Entry] = {}
         pm = get_plugin_manager()
         for impl in getattr(pm.hook, hook).get_hookimpls():
-            impl.function(register=self._register_for(impl.plugin_name))
+            self._collect(impl.plugin_name, impl.function)
 
-    def _register_for(self, plugin: str) -> Callable:
+    def _collect(self, plugin: str, hook_function: Callable) -> None:
+        """Call one plugin's hook; keep its entries only when the whole call succeeds."""
+        new: list[Entry] = []
+
         def register(name, target, description: str = ""):
-            name = str(name)
-            if name in self.entries:
-                first = self.entries[name].plugin
-                raise PluginError(f"{self.kind} '{name}' is registered by both '{first}' and '{plugin}'; "
-                                  "uninstall one of them or rename it in the plugin.")
-            self.entries[name] = Entry(name, plugin, target, description)
+            new.append(Entry(str(name), plugin, target, description))
 
-        return register
+        try:
+            hook_function(register=register)
+        except Exception as exc:  # the plugin's own bug: leave it out, keep the others working
+            _failures[plugin] = f"failed in {self.hook} ({type(exc).__name__}: {exc}); fix or uninstall it"
+            return
+        for entry in new:
+            if entry.name in self.entries:
+                first = self.entries[entry.name].plugin
+                raise PluginError(f"{self.kind} '{entry.name}' is registered by both '{first}' and '{plugin}'; "
+                                  "uninstall one of them or rename it in the plugin.")
+            self.entries[entry.name] = entry
 
     def names(self) -> list[str]:
         return sorted(self.entries)
@@ -96,7 +140,9 @@ class Registry:
     def entry(self, name: str) -> Entry:
         if name not in self.entries:
             known = ", ".join(self.names()) or "none"
-            raise UnknownNameError(f"unknown {self.kind} '{name}'; known: {known} (see `xairl {self.list_command}`).")
+            broken = f"; left out: {', '.join(sorted(_failures))} (see `xairl plugins`)" if _failures else ""
+            raise UnknownNameError(f"unknown {self.kind} '{name}'; known: {known} (see `xairl {self.list_command}`)"
+                                   f"{broken}.")
         return self.entries[name]
 
     def load(self, name: str) -> Any:
@@ -124,7 +170,13 @@ def prompt_dirs() -> list[tuple[str, str]]:
     """(plugin, folder) pairs registered through ``register_prompt_dirs``, in registration order."""
     dirs: list[tuple[str, str]] = []
     for impl in get_plugin_manager().hook.register_prompt_dirs.get_hookimpls():
-        impl.function(register=lambda path, p=impl.plugin_name: dirs.append((p, str(path))))
+        mine: list[tuple[str, str]] = []
+        try:
+            impl.function(register=lambda path, p=impl.plugin_name: mine.append((p, str(path))))
+        except Exception as exc:  # as in Registry._collect: the plugin is left out, the others keep working
+            _failures[impl.plugin_name] = f"failed in register_prompt_dirs ({type(exc).__name__}: {exc})"
+            continue
+        dirs += mine
     return dirs
 
 

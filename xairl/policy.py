@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 import torch
@@ -40,8 +40,8 @@ class Policy:
     :param background_sampler: optional ``f(n, seed) -> array (n, n_features)`` of typical states.
     :param name: how the policy is called in reports.
     :param action_aliases: other names of each action in text, e.g. ``{"stay": ["keep the serving BS"]}``.
-    :param facts_hook: optional ``f(state, chosen, runner_up) -> {"extras": {...}, "comparisons": [...]}`` adding
-        domain facts; each comparison is ``{"text": ..., "value": float, "unit": ...}`` (see xairl.narrators.facts).
+    :param facts_hook: optional ``f(state, chosen, runner_up) -> xairl.DomainFacts`` adding domain facts that
+        templates may cite and the verifier accepts (``chosen`` and ``runner_up`` are action indices).
     """
 
     module: torch.nn.Module
@@ -52,7 +52,7 @@ class Policy:
     background_sampler: Callable[[int, int], np.ndarray] | None = None
     name: str = "policy"
     action_aliases: Mapping[str, Sequence[str]] = field(default_factory=dict)
-    facts_hook: Callable[[np.ndarray, int, int], dict] | None = None
+    facts_hook: Callable[[np.ndarray, int, int], Any] | None = None
 
     def __post_init__(self) -> None:
         self.feature_names = [str(f) for f in self.feature_names]

@@ -17,7 +17,7 @@ from jinja2 import StrictUndefined, TemplateSyntaxError, UndefinedError, meta, n
 from jinja2.sandbox import ImmutableSandboxedEnvironment, SecurityError
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from .errors import UnknownNameError, XairlError
+from .errors import UnknownNameError, XairlError, validation_message
 from .paths import user_dir
 
 MAX_OUTPUT = 4000  # characters per rendered sentence
@@ -144,10 +144,6 @@ class Template:
             out.append(rendered)
         return out
 
-    def render(self, context: dict) -> str:
-        """The first variant of each sentence, joined: the deterministic rendering."""
-        return " ".join(s[0] for s in self.render_variants(context) if s[0])
-
 
 def builtin_dir() -> Path:
     installed = Path(__file__).parent / "prompts"  # inside the wheel
@@ -212,8 +208,6 @@ def parse(path: Path) -> Template:
     try:
         spec = TemplateSpec.model_validate(data)
     except ValidationError as exc:
-        from .attributors.base import validation_message
-
         raise TemplateError(f"{path}: {validation_message(exc, 'template')}") from None
     return Template(spec, path, lines or [[0] * len(s) for s in spec.sentences])
 

@@ -1,7 +1,8 @@
-"""``xairl explain --plugin NAME --out DIR``: explanations, figures, narrated decisions, one self-contained HTML.
+"""``xairl report --plugin NAME --out DIR``: explanations, figures, narrated decisions, one self-contained HTML.
 
-A plugin's report builder (hook ``register_reports``) supplies the policy, the datasets to explain, a background,
-and its own tables and figures; this module does the rest the same way for every plugin.
+A plugin's :class:`Report` (hook ``register_reports``) declares its own options and supplies the policy, the
+datasets to explain, a background, and its own tables and figures (:class:`ReportContent`); this module does the
+rest the same way for every plugin (:func:`write_report`).
 """
 from __future__ import annotations
 
@@ -11,15 +12,24 @@ import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
 from .explanation import Explanation, StateRecord
+from .options import Options, parse_options
 from .policy import Policy
 
 
 @dataclass
 class ReportRequest:
+    """What the user asked of any report (the plugin's own settings are its :attr:`Report.Options`).
+
+    :param out: the folder written. ``method`` and ``options``: the attributor and its validated options.
+    :param narrate: narrate ``n_narrated`` decisions and a global summary with ``narrator`` and ``template``.
+    :param seed: seed of everything the plugin samples; ``n_states``: states per dataset.
+    """
+
     out: Path
     method: str = "deep_shap"
     options: dict = field(default_factory=dict)
@@ -28,7 +38,6 @@ class ReportRequest:
     narrator_options: dict = field(default_factory=dict)
     template: str | None = None
     prompt_dirs: list = field(default_factory=list)
-    real: str | None = None
     seed: int = 0
     n_states: int = 500
     n_narrated: int = 6
@@ -37,6 +46,14 @@ class ReportRequest:
 
 @dataclass
 class ReportContent:
+    """What a plugin's report supplies: the policy, a background, the datasets to explain, and its own parts.
+
+    :param datasets: (label, states) pairs; the first is the reference for feature order and narrated decisions.
+    :param tables: (title, HTML) pairs, e.g. from :func:`table_html`; ``figures`` (caption, PNG path) pairs.
+    :param notes: sentences listed at the end; ``settings`` extra rows of the settings table.
+    :param template: the decision template narrated by default.
+    """
+
     title: str
     policy: Policy
     background: np.ndarray
@@ -48,7 +65,26 @@ class ReportContent:
     template: str = "explain_action"
 
 
+class Report:
+    """A plugin's report: subclasses set ``Options`` (their own settings, ``xairl report -o key=value``) and
+    implement :meth:`build`. Registered through the ``register_reports`` hook.
+
+    :param options: a dict or an instance of ``Options``; unknown keys are an error.
+    """
+
+    name: ClassVar[str] = ""
+    Options: ClassVar[type[Options]] = Options
+
+    def __init__(self, options: dict | Options | None = None):
+        self.options = parse_options(self.Options, options, f"{self.name or 'report'} report options")
+
+    def build(self, request: ReportRequest) -> ReportContent:
+        """The plugin's content for ``request`` (figures it draws go into ``request.out``)."""
+        raise NotImplementedError
+
+
 def table_html(header: list[str], rows: list[list]) -> str:
+    """An HTML table; floats with two decimals, everything else escaped."""
     def cell(v):
         return f"{v:.2f}" if isinstance(v, float) else html.escape(str(v))
 

@@ -8,27 +8,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 import torch
-from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..errors import InputError
 from ..explanation import Explanation
+from ..options import Options, parse_options
 from ..policy import Policy
-
-
-class Options(BaseModel):
-    """Base of every attributor's options: unknown keys are an error."""
-
-    model_config = ConfigDict(extra="forbid")
-
-
-def validation_message(exc: ValidationError, what: str) -> str:
-    """One line naming each bad field, from a pydantic error."""
-    parts = []
-    for err in exc.errors():
-        loc = ".".join(str(p) for p in err["loc"]) or "value"
-        msg = "unknown option" if err["type"] == "extra_forbidden" else err["msg"]
-        parts.append(f"{loc}: {msg}")
-    return f"invalid {what} ({'; '.join(parts)})."
 
 
 class Attributor:
@@ -39,18 +23,9 @@ class Attributor:
 
     name: ClassVar[str] = ""
     Options: ClassVar[type[Options]] = Options
-    #: the Shapley efficiency property holds, so the additivity gap must be ~0
-    exact_additivity: ClassVar[bool] = True
 
     def __init__(self, options: dict | Options | None = None):
-        if isinstance(options, self.Options):
-            self.options = options
-        else:
-            try:
-                self.options = self.Options.model_validate(dict(options or {}))
-            except ValidationError as exc:
-                known = ", ".join(self.Options.model_fields) or "none"
-                raise InputError(f"{validation_message(exc, self.name + ' options')[:-1]}; options: {known}.") from None
+        self.options = parse_options(self.Options, options, f"{self.name} options")
         self._handles: list[Any] = []
 
     def explain(self, policy: Policy, states, background=None) -> Explanation:
@@ -90,7 +65,11 @@ class Attributor:
         )
 
     def _attribute(self, policy: Policy, x: np.ndarray, bg: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
-        """Return values (n, f, a), base values (n, a) or (a,), and a dict of diagnostics."""
+        """The subclass's method: contributions of ``x`` (n, f) against ``bg`` (m, f), module already in eval mode.
+
+        :returns: values (n, f, a), base values (n, a) or (a,), and a dict of diagnostics (kept as
+            ``Explanation.extras``). Register torch hooks with :meth:`_add_hook` so they are always removed.
+        """
         raise NotImplementedError
 
     def _add_hook(self, handle) -> None:

@@ -23,7 +23,6 @@ class IntegratedGradients(Attributor):
 
     name = "integrated_gradients"
     Options = IntegratedGradientsOptions
-    exact_additivity = False
 
     def _attribute(self, policy, x, bg):
         from captum.attr import IntegratedGradients as CaptumIG

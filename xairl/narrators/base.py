@@ -1,37 +1,29 @@
-"""Narrative (the result), the narrator interface, and the confidence score.
+"""Narrative (the result) and the Narrator interface.
 
-Confidence, in [0, 1], is ``verification x weighted mean of the measured components``:
-
-- ``verification``: 1 when every claim of the shown text was verified, else 0 (an unverified text has no confidence);
-- ``additivity`` (weight 0.2): 1 / (1 + gap / (1e-3 * max(1, |score|))): 1 when contributions add up to the score;
-- ``margin`` (0.3): 1 - exp(-q_margin / tau), tau = the mean |contribution| per feature: a Q-gap smaller than a
-  typical single feature's effect is a near tie;
-- ``agreement`` (0.25): (1 + Spearman rho) / 2 between the |contributions| of this method and a second one
-  (integrated gradients, or deep_shap when the first is integrated gradients) on the same state;
-- ``stability`` (0.25): mean of (1 + rho) / 2 between the contributions with the full background and with two
-  half-size resamples of it.
-``agreement`` and ``stability`` need the policy and the background; without them they are left out and the
-weights of the others are renormalised. Every component is shown on the Narrative.
+:meth:`Narrator.narrate` does the shared work for every narrator: facts by code, the template rendered in its
+sandbox, the subclass's :meth:`Narrator._compose` for the words, the verifier, the template fallback when the
+words fail verification, and the confidence score (xairl.narrators.confidence).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import Any, ClassVar, Iterable
 
-import numpy as np
-
+from ..errors import InputError
 from ..explanation import Explanation
+from ..options import Options, parse_options
 from ..policy import Policy
-from .verify import Claim
-
-WEIGHTS = {"additivity": 0.2, "margin": 0.3, "agreement": 0.25, "stability": 0.25}
+from .confidence import confidence
+from .facts import decision_facts, global_facts
+from .verify import Claim, verify
 
 
 @dataclass(frozen=True)
 class Narrative:
     """Words for one decision (or the global view), checked against the numbers.
 
-    :param source: 'template', 'local_lm', or 'template (fallback: ...)' when the model's text failed verification.
+    :param source: the narrator's name, or 'template (fallback: ...)' when its text failed verification.
+    :param rejected: the narrator's own text when it failed verification and the template's was shown instead.
     """
 
     text: str
@@ -42,62 +34,71 @@ class Narrative:
     source: str
     template: str
     index: int | None
+    rejected: str | None = None
     extras: dict = field(default_factory=dict)
 
 
+def first_phrasings(variants: list[list[str]]) -> str:
+    """The deterministic text: the first phrasing of every sentence."""
+    return " ".join(s[0] for s in variants if s and s[0])
+
+
 class Narrator:
-    """Turns facts rendered by a template into text. Subclasses implement :meth:`compose`."""
+    """Turns an Explanation into words that are checked against its numbers.
+
+    Subclasses set ``name``, optionally an ``Options`` model (pydantic, derived from :class:`xairl.Options`), and
+    implement :meth:`_compose`. :meth:`narrate` is the public method and is not overridden.
+
+    :param options: a dict or an instance of the subclass's ``Options`` model; unknown keys are an error.
+    """
 
     name: ClassVar[str] = ""
+    Options: ClassVar[type[Options]] = Options
 
-    def compose(self, variants: list[list[str]], context: dict) -> str:
+    def __init__(self, options: dict | Options | None = None):
+        self.options = parse_options(self.Options, options, f"{self.name} narrator options")
+
+    def narrate(self, explanation: Explanation, index: int | None = 0, template: str | None = None,
+                policy: Policy | None = None, background=None, prompt_dirs: Iterable[str] = (), k: int = 3,
+                robustness: bool = True) -> Narrative:
+        """Words for decision ``index`` (``None``: a global summary over all states), verified, with confidence.
+
+        :param template: template name or .yaml path; default 'explain_action' (or 'global_summary').
+        :param policy: gives feature descriptions, domain facts, and (with ``background``) the robustness parts of
+            the confidence.
+        :param k: how many features the facts list.
+        :param robustness: measure agreement and stability (three extra explanations of the state).
+        """
+        from .. import prompts
+
+        tpl = prompts.load(template or ("global_summary" if index is None else "explain_action"), prompt_dirs)
+        if (tpl.spec.kind == "global") != (index is None):
+            raise InputError(f"template '{tpl.name}' is a {tpl.spec.kind} template; use "
+                             f"{'index=None' if tpl.spec.kind == 'global' else 'a state index'} with it.")
+        facts = global_facts(explanation, policy, k=max(k, 3)) if index is None else decision_facts(
+            explanation, index, policy, k)
+        context = facts.context()
+        variants = tpl.render_variants(context)
+        text, source, rejected = self._compose(variants, context), self.name, None
+        check = verify(text, explanation, index, policy)
+        if not check.ok and text != first_phrasings(variants):
+            problem = check.problems()[0]
+            rejected, text = text, first_phrasings(variants)
+            check = verify(text, explanation, index, policy)
+            source = f"template (fallback: {self.name} text failed verification: {problem.text!r} {problem.status})"
+        score, comp = confidence(explanation, index, check.ok, policy, background, robustness)
+        return Narrative(text=text, claims=check.claims, verified=check.ok, confidence=score, components=comp,
+                         source=source, template=tpl.name, index=index, rejected=rejected,
+                         extras={"method": explanation.method})
+
+    def _compose(self, variants: list[list[str]], context: dict[str, Any]) -> str:
+        """The subclass's words.
+
+        :param variants: one list per sentence of the template; each lists phrasings that state the same facts
+            (the first is the template author's default; an empty string means the sentence is left out).
+        :param context: the template variables (:meth:`DecisionFacts.context` or :meth:`GlobalFacts.context`),
+            for narrators that word the facts themselves.
+        :returns: the text to verify. Anything may be returned: a text that fails verification is replaced by
+            the template's first phrasings and reported as a fallback.
+        """
         raise NotImplementedError
-
-
-def _spearman(a: np.ndarray, b: np.ndarray) -> float:
-    ra, rb = np.argsort(np.argsort(a)), np.argsort(np.argsort(b))
-    if ra.std() == 0 or rb.std() == 0:
-        return 0.0
-    return float(np.corrcoef(ra, rb)[0, 1])
-
-
-def confidence(exp: Explanation, index: int | None, verified: bool, policy: Policy | None = None,
-               background=None, seed: int = 0) -> tuple[float, dict[str, float | None]]:
-    """The confidence of a narrative and its components (formula in the module doc)."""
-    comp: dict[str, float | None] = {"verification": 1.0 if verified else 0.0}
-    if index is None:  # a global summary: only verification and additivity apply
-        gap = float(exp.additivity_gap.max())
-        comp.update(additivity=1 / (1 + gap / (1e-3 * max(1.0, float(np.abs(exp.outputs).max())))), margin=None,
-                    agreement=None, stability=None)
-    else:
-        c = int(exp.chosen[index])
-        contrib = exp.values[index, :, c]
-        score = float(exp.outputs[index, c])
-        comp["additivity"] = 1 / (1 + float(exp.additivity_gap[index, c]) / (1e-3 * max(1.0, abs(score))))
-        tau = float(np.abs(contrib).mean()) or 1e-12
-        q_margin = float(exp.outputs[index, c] - exp.outputs[index, exp.runner_up[index]])
-        comp["margin"] = float(1 - np.exp(-q_margin / tau))
-        comp["agreement"] = comp["stability"] = None
-        if policy is not None and background is not None:
-            from ..attributors import explain
-
-            bg = policy.check_states(background, "background")
-            state = exp.states[index:index + 1]
-            second = "deep_shap" if exp.method == "integrated_gradients" else "integrated_gradients"
-            try:
-                other = explain(policy, state, background=bg, method=second).values[0, :, c]
-                comp["agreement"] = (1 + _spearman(np.abs(contrib), np.abs(other))) / 2
-            except Exception:  # the second method may not support this network; then it is simply not measured
-                comp["agreement"] = None
-            rng = np.random.default_rng(seed)
-            rhos = []
-            for _ in range(2):
-                half = bg[rng.choice(len(bg), size=max(1, len(bg) // 2), replace=False)]
-                again = explain(policy, state, background=half, method=exp.method,
-                                options=dict(exp.options)).values[0, :, c]
-                rhos.append((1 + _spearman(contrib, again)) / 2)
-            comp["stability"] = float(np.mean(rhos))
-    measured = {k: v for k, v in comp.items() if k in WEIGHTS and v is not None}
-    total = sum(WEIGHTS[k] for k in measured)
-    score = comp["verification"] * sum(WEIGHTS[k] * v for k, v in measured.items()) / total
-    return float(np.clip(score, 0.0, 1.0)), comp

@@ -2,11 +2,11 @@
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, PluginError
 from ..explanation import Explanation
 from ..policy import FeatureInfo, Policy
 
@@ -31,7 +31,16 @@ def fmt(x: float, signed: bool = False) -> str:
 
 @dataclass(frozen=True)
 class FeatureFact:
-    """One feature's part in a decision. ``direction`` is 'toward' (raises the target score) or 'against'."""
+    """One feature's part in a decision.
+
+    :param name: the feature's name; ``label`` its description (or the name); ``unit`` its unit.
+    :param value: the feature's value in the state; ``contribution`` its signed contribution.
+    :param share: |contribution| as a percentage of the sum of |contributions|.
+    :param direction: 'toward' (raises the target score) or 'against'.
+    :param level: 'low', 'typical' or 'high' against the background quartiles ('unknown' without them);
+        ``level_text`` the feature's own words for it (``FeatureInfo.low`` / ``high``).
+    :param rank: 1 for the largest |contribution|.
+    """
 
     name: str
     label: str
@@ -47,7 +56,13 @@ class FeatureFact:
 
 @dataclass(frozen=True)
 class Comparison:
-    """A domain fact from the policy's plugin, e.g. 'candidate 1's RSRP is 4.2 dB above the serving BS's'."""
+    """A domain fact from the policy's plugin, e.g. 'the strongest neighbour's RSRP was 4.2 dB above the serving
+    BS's RSRP'. The verifier accepts ``value`` where a text writes it followed by ``unit``.
+
+    :param text: the fact in words, ready for a template (``{{ comparisons[0].text }}``).
+    :param value: the number the text states (rounded as written in ``text``).
+    :param unit: the unit written after the number ("dB"); empty when unitless.
+    """
 
     text: str
     value: float
@@ -55,7 +70,33 @@ class Comparison:
 
 
 @dataclass(frozen=True)
+class DomainFacts:
+    """What a policy's ``facts_hook`` returns: domain facts a template may use besides the attribution.
+
+    :param extras: named values for templates (``{{ extras.serving_bs }}``); numbers among them may be cited.
+    :param comparisons: :class:`Comparison` facts, each with its value and unit.
+    """
+
+    extras: Mapping[str, Any] = field(default_factory=dict)
+    comparisons: tuple[Comparison, ...] = ()
+
+
+@dataclass(frozen=True)
 class DecisionFacts:
+    """Facts about one decision: the variables every decision template sees (``context()``), the template-variable
+    contract of narrators and prompt authors.
+
+    :param index: the state's index in the Explanation.
+    :param action: the chosen action's name; ``runner_up`` the second-best action's name.
+    :param score: the chosen action's score (Q-value or logit); ``runner_up_score`` the runner-up's.
+    :param q_margin: ``score - runner_up_score``.
+    :param base_value: the chosen action's expected score over the background.
+    :param method: the attributor's name; ``additivity_gap`` |base + sum of contributions - score|.
+    :param top: the ``k`` largest :class:`FeatureFact` by |contribution| to the chosen action's score.
+    :param margin_top: the same for the margin over the runner-up (why this action and not that one).
+    :param comparisons: the plugin's :class:`Comparison` facts; ``extras`` its named values (``DomainFacts``).
+    """
+
     index: int
     action: str
     runner_up: str
@@ -68,23 +109,29 @@ class DecisionFacts:
     top: tuple[FeatureFact, ...]
     margin_top: tuple[FeatureFact, ...]
     comparisons: tuple[Comparison, ...] = ()
-    extras: dict[str, Any] = field(default_factory=dict)
+    extras: Mapping[str, Any] = field(default_factory=dict)
 
     def context(self) -> dict[str, Any]:
-        """Variables a decision template sees."""
-        return asdict(self) | {"k": len(self.top)}
+        """Variables a decision template sees: every field (feature facts as dicts) and ``k``."""
+        return asdict(self) | {"extras": dict(self.extras), "k": len(self.top)}
 
 
 @dataclass(frozen=True)
 class GlobalFacts:
-    """Over a set of states: features ranked by mean |contribution| to the chosen action, and the direction in
-    which high values of each push (correlation of value and contribution)."""
+    """Over a set of states: the variables every global template sees (``context()``).
+
+    :param n_states: how many states were explained; ``method`` the attributor.
+    :param ranking: features by mean |contribution| to the chosen action, each a dict with ``name``, ``label``,
+        ``unit``, ``rank``, ``mean_abs`` and ``high_values`` ('toward', 'against' or 'mixed': the direction in which
+        high values push, from the correlation of value and contribution).
+    """
 
     n_states: int
     method: str
     ranking: tuple[dict, ...]
 
     def context(self) -> dict[str, Any]:
+        """Variables a global template sees: every field and ``k``."""
         return asdict(self) | {"k": len(self.ranking)}
 
 
@@ -127,13 +174,7 @@ def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = Non
     if exp.states is None:
         raise InputError("this explanation has no states (it was grouped); narrate the ungrouped explanation.")
     c, r = int(exp.chosen[index]), int(exp.runner_up[index])
-    extras: dict[str, Any] = {}
-    comparisons: tuple[Comparison, ...] = ()
-    if policy is not None and policy.facts_hook is not None:
-        hooked = policy.facts_hook(np.asarray(exp.states[index]), c, r) or {}
-        extras = dict(hooked.get("extras", {}))
-        comparisons = tuple(Comparison(str(x["text"]), float(x["value"]), str(x.get("unit", "")))
-                            for x in hooked.get("comparisons", ()))
+    domain = _domain_facts(policy, np.asarray(exp.states[index]), c, r)
     return DecisionFacts(
         index=index, action=exp.action_names[c], runner_up=exp.action_names[r],
         score=float(exp.outputs[index, c]), runner_up_score=float(exp.outputs[index, r]),
@@ -141,8 +182,21 @@ def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = Non
         method=exp.method, additivity_gap=float(exp.additivity_gap[index, c]),
         top=_feature_facts(exp, index, exp.for_chosen()[index], policy, k),
         margin_top=_feature_facts(exp, index, exp.margin()[index], policy, k),
-        comparisons=comparisons, extras=extras,
+        comparisons=tuple(domain.comparisons), extras=dict(domain.extras),
     )
+
+
+def _domain_facts(policy: Policy | None, state: np.ndarray, chosen: int, runner_up: int) -> DomainFacts:
+    """The policy plugin's ``facts_hook`` output, checked for its type."""
+    if policy is None or policy.facts_hook is None:
+        return DomainFacts()
+    out = policy.facts_hook(state, chosen, runner_up)
+    if out is None:
+        return DomainFacts()
+    if not isinstance(out, DomainFacts) or not all(isinstance(c, Comparison) for c in out.comparisons):
+        raise PluginError(f"policy '{policy.name}': facts_hook returned {type(out).__name__}; it must return "
+                          "xairl.DomainFacts(extras={...}, comparisons=(xairl.Comparison(...), ...)) or None.")
+    return out
 
 
 def global_facts(exp: Explanation, policy: Policy | None = None, k: int = 5) -> GlobalFacts:

@@ -21,19 +21,20 @@ import shutil
 from pathlib import Path
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import Field
 
 from ..errors import InputError, XairlError
+from ..options import Options
 from ..paths import model_cache_dir
-from .base import Narrator
+from .base import Narrator, first_phrasings
 
 SYSTEM = ("You write short, factual explanations of an automated controller's decisions for the engineers who "
           "operate it. Keep every number, name and direction exactly as given.")
 _LOADED: dict[str, tuple] = {}
 
 
-class LocalLMOptions(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class LocalLMOptions(Options):
+    """Options of the ``local_lm`` narrator (``-n key=value`` on the CLI)."""
 
     model: str | None = Field(None, description="transformers model folder or .gguf file; default SmolLM2-135M")
     mode: Literal["choose", "rewrite"] = Field("choose", description="pick among phrasings, or rewrite freely")
@@ -108,14 +109,10 @@ class LocalLMNarrator(Narrator):
     """Words the facts with a local causal language model (see the module doc for the two modes)."""
 
     name = "local_lm"
+    Options = LocalLMOptions
 
-    def __init__(self, **options):
-        try:
-            self.options = LocalLMOptions.model_validate(options)
-        except ValidationError as exc:
-            from ..attributors.base import validation_message
-
-            raise InputError(validation_message(exc, "local_lm options")) from None
+    def __init__(self, options: dict | LocalLMOptions | None = None):
+        super().__init__(options)
         self.model, self.tok = load_model(self.options.model)
 
     def _prefix(self, user: str) -> list[int]:
@@ -128,13 +125,13 @@ class LocalLMNarrator(Narrator):
             return list(ids["input_ids"] if isinstance(ids, dict) or hasattr(ids, "keys") else ids)
         return self.tok("\n".join(m["content"] for m in msgs) + "\n")["input_ids"]
 
-    def compose(self, variants: list[list[str]], context: dict) -> str:
+    def _compose(self, variants: list[list[str]], context: dict) -> str:
         import torch
 
         if self.options.threads:
             torch.set_num_threads(self.options.threads)
         if self.options.mode == "rewrite":
-            return self._rewrite(" ".join(s[0] for s in variants if s[0]))
+            return self._rewrite(first_phrasings(variants))
         prefix = self._prefix("Explain the decision.")
         chosen: list[str] = []
         for options in variants:

@@ -1,17 +1,13 @@
-"""The deterministic narrator: the first phrasing of every sentence. Always available, instant."""
+"""The deterministic narrator: the first phrasing of every sentence. Always available, instant; no options."""
 from __future__ import annotations
 
-from .base import Narrator
+from .base import Narrator, first_phrasings
 
 
 class TemplateNarrator(Narrator):
+    """The template author's first phrasing of every sentence."""
+
     name = "template"
 
-    def __init__(self, **options):
-        if options:
-            from ..errors import InputError
-
-            raise InputError(f"the template narrator takes no options (got {', '.join(options)}).")
-
-    def compose(self, variants: list[list[str]], context: dict) -> str:
-        return " ".join(s[0] for s in variants if s[0])
+    def _compose(self, variants: list[list[str]], context: dict) -> str:
+        return first_phrasings(variants)

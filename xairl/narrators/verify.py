@@ -137,7 +137,7 @@ def _matches(written: str, value: float, magnitude_ok: bool = False) -> bool:
     return magnitude_ok and s[0] not in "+-" and abs(x - abs(value)) <= tol
 
 
-def _mentions(clause: str, book: FactBook) -> tuple[list[tuple[int, int, str, str]], str]:
+def _mentions(clause: str, book: FactBook) -> tuple[list["Mention"], str]:
     """Known feature/action mentions (start, end, kind, key) and the clause with them masked."""
     low = clause.lower()
     taken = [False] * len(clause)
@@ -151,7 +151,7 @@ def _mentions(clause: str, book: FactBook) -> tuple[list[tuple[int, int, str, st
     return sorted(found), masked
 
 
-def _nearest(pos: int, feats: list[tuple[int, int, str, str]]) -> str | None:
+def _nearest(pos: int, feats: list["Mention"]) -> str | None:
     before = [f for f in feats if f[1] <= pos]
     if before:
         return before[-1][3]
@@ -241,44 +241,60 @@ def _cue_slots(book: FactBook, before: str, after: str) -> list[float] | None:
     return None
 
 
-def _free_slots(book: FactBook, before: str, after: str) -> list[float]:
+def _free_slots(book: FactBook, after: str) -> list[float]:
     """What a number tied to no feature may stand for: a comparison in its unit, else any decision-level fact."""
     return _unit_slots(book, after) or book.numbers
 
 
+Mention = tuple[int, int, str, str]  # (start, end, kind, key) of a feature or action named in a clause
+
+
 def _check_clause(clause: str, book: FactBook, margin_sentence: bool, claims: list[Claim]) -> None:
+    """Every claim of one clause: the features it names, then its numbers, directions and ranks."""
     found, masked = _mentions(clause, book)
     feats = [m for m in found if m[2] == "feature"]
     ctx_default = "margin" if margin_sentence else "chosen"
-    matched_ctx: dict[str, str] = {}
-    for start, end, _, key in feats:
-        claims.append(Claim("feature", clause[start:end], "verified", key))
+    claims += [Claim("feature", clause[start:end], "verified", key) for start, end, _, key in feats]
+    matched_ctx: dict[str, str] = {}  # feature -> the context its numbers were verified in (directions follow it)
     for m in NUMBER_RE.finditer(masked):
-        written, pct = m.group(1), bool(m.group(2))
-        before = masked[max(0, m.start() - 24):m.start()].lower()
-        after = masked[m.end():m.end() + 12].lower()
-        before_feats = [f for f in feats if f[1] <= m.start()]
-        key = before_feats[-1][3] if before_feats else None  # a number describes a feature named before it
-        status, detail = "unsupported", "matches no fact of this explanation"
-        final = False
-        cue = _cue_slots(book, before, after)
-        if cue is not None:  # "margin of 4.9", "5.4 above", "vs -11.8", "score -6.4": a decision-level quantity
-            ok = any(_matches(written, v) for v in cue)
-            claims.append(Claim("number", m.group(0).strip(), "verified" if ok else "contradicted",
-                                "decision-level quantity named by the words around it"))
-            continue
-        if key is not None:
-            status, detail, ctx = _feature_number(written, pct, before, book.features[key], key, ctx_default)
-            final = ctx == "final"  # written as a contribution: no other fact may stand in for it
-            if ctx and not final:
-                matched_ctx.setdefault(key, ctx)
-        if status != "verified" and not pct and not final:
-            # a number tied to a feature may stand only for a domain comparison in the unit written after it
-            wanted = _free_slots(book, before, after) if key is None else _unit_slots(book, after)
-            if any(_matches(written, v) for v in wanted):
-                status, detail = "verified", "a decision-level fact"
-        claims.append(Claim("number", m.group(0).strip(), status, detail))
-    low = masked.lower()
+        claims.append(_check_number(m, masked, feats, book, ctx_default, matched_ctx))
+    claims += _check_directions(masked.lower(), feats, book, matched_ctx, ctx_default)
+    claims += _check_ranks(masked.lower(), feats, book, ctx_default)
+
+
+def _check_number(m: re.Match, masked: str, feats: list[Mention], book: FactBook, ctx_default: str,
+                  matched_ctx: dict[str, str]) -> Claim:
+    """A number: a decision-level quantity when the words around it say so, else a fact of the feature named
+    before it, else (unless written as a contribution or share) a domain comparison or decision-level fact."""
+    written, pct = m.group(1), bool(m.group(2))
+    text = m.group(0).strip()
+    before = masked[max(0, m.start() - 24):m.start()].lower()
+    after = masked[m.end():m.end() + 12].lower()
+    cue = _cue_slots(book, before, after)
+    if cue is not None:  # "margin of 4.9", "5.4 above", "vs -11.8", "score -6.4"
+        ok = any(_matches(written, v) for v in cue)
+        return Claim("number", text, "verified" if ok else "contradicted",
+                     "decision-level quantity named by the words around it")
+    before_feats = [f for f in feats if f[1] <= m.start()]
+    key = before_feats[-1][3] if before_feats else None
+    status, detail, final = "unsupported", "matches no fact of this explanation", False
+    if key is not None:
+        status, detail, ctx = _feature_number(written, pct, before, book.features[key], key, ctx_default)
+        final = ctx == "final"  # written as a contribution: no other fact may stand in for it
+        if ctx and not final:
+            matched_ctx.setdefault(key, ctx)
+    if status != "verified" and not pct and not final:
+        # a number tied to a feature may stand only for a domain comparison in the unit written after it
+        wanted = _free_slots(book, after) if key is None else _unit_slots(book, after)
+        if any(_matches(written, v) for v in wanted):
+            status, detail = "verified", "a decision-level fact"
+    return Claim("number", text, status, detail)
+
+
+def _check_directions(low: str, feats: list[Mention], book: FactBook, matched_ctx: dict[str, str],
+                      ctx_default: str) -> list[Claim]:
+    """Direction words against the sign of the nearest feature's contribution (in the context its numbers used)."""
+    out = []
     for words, polarity in ((POSITIVE, 1), (NEGATIVE, -1)):
         for w in words:
             for m in re.finditer(rf"\b{re.escape(w)}\b", low):
@@ -288,22 +304,28 @@ def _check_clause(clause: str, book: FactBook, margin_sentence: bool, claims: li
                 ctx = matched_ctx.get(key, ctx_default)
                 c = book.features[key].contribs.get(ctx)
                 if c is None or c == 0:
-                    claims.append(Claim("direction", w, "unsupported", f"no sign known for {key} ({ctx})"))
+                    out.append(Claim("direction", w, "unsupported", f"no sign known for {key} ({ctx})"))
                 elif np.sign(c) == polarity:
-                    claims.append(Claim("direction", w, "verified", f"{key} {ctx} contribution {c:+.3g}"))
+                    out.append(Claim("direction", w, "verified", f"{key} {ctx} contribution {c:+.3g}"))
                 else:
-                    claims.append(Claim("direction", w, "contradicted", f"{key} pushes the other way ({c:+.3g})"))
+                    out.append(Claim("direction", w, "contradicted", f"{key} pushes the other way ({c:+.3g})"))
+    return out
+
+
+def _check_ranks(low: str, feats: list[Mention], book: FactBook, ctx: str) -> list[Claim]:
+    """Rank words ('most important', 'second factor', 'the top features were ...') against the ranking."""
+    out = []
     for m in RANK_RE.finditer(low):
         rank = ORDINALS.get(m.group(1), 1) if m.group(1) else 1
         plural = bool(m.group(3))
         after = [f for f in feats if f[0] >= m.end()]
         targets = [f[3] for f in after] if plural else [_nearest(m.start(), feats)] if feats else []
         if not targets or targets == [None]:
-            claims.append(Claim("rank", m.group(0), "unsupported", "names no feature"))
+            out.append(Claim("rank", m.group(0), "unsupported", "names no feature"))
             continue
-        ctx = "margin" if margin_sentence else "chosen"
         for key in targets:
             actual = book.features[key].ranks.get(ctx)
             limit_ok = actual is not None and (actual <= len(targets) if plural else actual == rank)
-            claims.append(Claim("rank", f"{m.group(0)}: {key}", "verified" if limit_ok else "contradicted",
-                                f"{key} ranks {actual} ({ctx})"))
+            out.append(Claim("rank", f"{m.group(0)}: {key}", "verified" if limit_ok else "contradicted",
+                             f"{key} ranks {actual} ({ctx})"))
+    return out

@@ -5,7 +5,7 @@ import pytest
 
 import xairl
 from xairl import prompts
-from xairl.narrators.mutations import corpus
+from xairl.testing import corpus
 from xairl_uav_handover.features import handover_facts
 from xairl_uav_handover.policy import uav_policy
 

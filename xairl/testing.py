@@ -1,38 +1,44 @@
-"""A corpus for testing verifiers: true narratives made wrong in one way each, and paraphrases that stay true.
+"""Test helpers for plugin authors: a corpus that checks the verifier against your templates.
 
-Wrong: a number changed beyond rounding, a direction flipped, a rank swapped, a feature that is not in the
-explanation, the wrong action named as chosen. True: another phrasing of the template, coarser rounding, direction
-synonyms, clauses reordered.
+:func:`corpus` renders your templates for real decisions and makes each sentence wrong in one way (a number
+changed beyond rounding, a direction flipped, a rank swapped, a feature that is not in the explanation, the wrong
+action named as chosen) and right in other ways (another phrasing of the template, coarser rounding, direction
+synonyms, clauses reordered). A plugin's tests assert that every wrong case fails ``xairl.verify`` and every right
+one passes. ``label_words`` is the plugin's vocabulary of words followed by an identifier, not a quantity
+(the UAV plugin passes ``("BS", "candidate")``: "BS 15" is a cell id), so those numbers are not mutated.
 """
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
 
-from .verify import NUMBER_RE
+from .narrators.verify import NUMBER_RE
 
 FLIPS = {"toward": "against", "against": "toward"}
-SYNONYMS = {"toward": "in favour of", "against": "against"}
 
 
 @dataclass(frozen=True)
 class Case:
+    """One text for the verifier: ``should_pass`` says whether it is true of decision ``index``."""
+
     kind: str
     text: str
     index: int
     should_pass: bool
 
 
-def _numbers(text: str) -> list[re.Match]:
-    # leave numbers inside identifiers and names alone: they are not claims
+def _numbers(text: str, label_words: tuple[str, ...]) -> list[re.Match]:
+    """Numbers that are claims: not inside identifiers and names, not right after a label word ("BS 15")."""
+    label = re.compile(rf"\b({'|'.join(map(re.escape, label_words))})\s$") if label_words else None
     return [m for m in NUMBER_RE.finditer(text) if not re.search(r"[A-Za-z_]$", text[:m.start()])
-            and not text[max(0, m.start() - 3):m.start()].endswith("BS ")
-            and not text[max(0, m.start() - 10):m.start()].endswith("candidate ")]
+            and not (label and label.search(text[:m.start()]))]
 
 
-def wrong(text: str, index: int, action: str, other_actions: list[str]) -> list[Case]:
+def wrong(text: str, index: int, action: str, other_actions: list[str], label_words: tuple[str, ...] = ()
+          ) -> list[Case]:
+    """Copies of a true ``text`` made wrong in one way each."""
     out = []
-    for m in _numbers(text)[:4]:
+    for m in _numbers(text, label_words)[:4]:
         s = m.group(1)
         decimals = len(s.split(".")[1]) if "." in s else 0
         bumped = float(s) * 1.5 + (1.0 if abs(float(s)) < 1 else 0) + 10 ** -decimals * 7
@@ -57,10 +63,11 @@ def wrong(text: str, index: int, action: str, other_actions: list[str]) -> list[
     return out
 
 
-def paraphrases(text: str, variants: list[str], index: int) -> list[Case]:
+def paraphrases(text: str, variants: list[str], index: int, label_words: tuple[str, ...] = ()) -> list[Case]:
+    """Rewordings of a true ``text`` that stay true."""
     out = [Case("other phrasing", v, index, True) for v in variants if v != text]
     coarse = text
-    for m in reversed([m for m in _numbers(text) if "." in m.group(1) and len(m.group(1).split(".")[1]) == 2]):
+    for m in reversed([m for m in _numbers(text, label_words) if "." in m.group(1) and len(m.group(1).split(".")[1]) == 2]):
         s = m.group(1)
         x = float(s)
         if abs(x) >= 0.1 and s[-1] != "5":  # one decimal fewer; a trailing 5 would round ambiguously
@@ -77,10 +84,14 @@ def paraphrases(text: str, variants: list[str], index: int) -> list[Case]:
     return out
 
 
-def corpus(explanation, policy, templates=("explain_action", "why_not"), indices=range(10)) -> list[Case]:
-    """Mutations and paraphrases of every sentence of the given templates for the given states."""
-    from .. import prompts
-    from .facts import decision_facts
+def corpus(explanation, policy, templates=("explain_action", "why_not"), indices=range(10),
+           label_words: tuple[str, ...] = ()) -> list[Case]:
+    """Mutations and paraphrases of every sentence of the given templates for the given states.
+
+    :param label_words: words after which a number is an identifier, not a claim (see the module doc).
+    """
+    from . import prompts
+    from .narrators.facts import decision_facts
 
     cases: list[Case] = []
     for name in templates:
@@ -91,6 +102,6 @@ def corpus(explanation, policy, templates=("explain_action", "why_not"), indices
             for variants in tpl.render_variants(d.context()):
                 if not variants[0]:
                     continue
-                cases += wrong(variants[0], i, d.action, others)
-                cases += paraphrases(variants[0], variants, i)
+                cases += wrong(variants[0], i, d.action, others, label_words)
+                cases += paraphrases(variants[0], variants, i, label_words)
     return cases
