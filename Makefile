@@ -31,14 +31,14 @@ REAL := ../shared/data/ukm-uav-lte/raw
 
 demo: setup
 	@# the main job: Table I, SHAP on simulated (and, when ../shared/data is there, real) flights, narrated decisions
-	$(VENV)/bin/xairl explain --plugin uav-handover --narrate --out out/report $(if $(wildcard $(REAL)),--real $(REAL))
+	$(VENV)/bin/xairl report --plugin uav-handover --narrate --out out/report $(if $(wildcard $(REAL)),-o real=$(REAL))
 	$(VENV)/bin/xairl explain --policy uav-dqn --n 2 --narrate --template handover --no-record
 
 test: setup
 	$(PY) -m pytest
 
 bench: setup
-	@for b in benchmarks/*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
+	@for b in benchmarks/*.py plugins/*/benchmarks/*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
 
 clean:
 	rm -rf $(VENV) build *.egg-info

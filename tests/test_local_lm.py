@@ -69,5 +69,5 @@ def test_bad_model_options(tmp_path):
         local_lm.LocalLMNarrator({"model": str(tmp_path)})
     with pytest.raises(InputError, match="mode"):
         local_lm.LocalLMNarrator({"mode": "dream"})
-    with pytest.raises(InputError, match="unknown option; options: model, mode"):
+    with pytest.raises(InputError, match=r"temperature: unknown option\); options: model, mode"):
         xairl.narrate(None, 0, narrator="local_lm", options={"temperature": 0.7})

@@ -10,7 +10,6 @@ from xairl import plugins
 from xairl.cli import main
 from xairl.errors import CheckpointError
 from xairl_uav_handover.baselines import CHM, SAMRO
-from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.evaluate import table_one
 from xairl_uav_handover.features import FEATURES
 from xairl_uav_handover.policy import DQNController, build_qnet, load_checkpoint, save_checkpoint, uav_policy
@@ -44,21 +43,14 @@ def test_pretrained_dqn_deep_shap_matches_shap():
 
 def test_pretrained_dqn_meets_table_one_targets():
     """The committed checkpoint against the issue's targets on 100 held-out flights."""
-    net, meta = load_checkpoint(xairl_uav_handover_ckpt())
-    cfg = SimConfig.model_validate(meta["sim_config"])
-    rows = table_one([CHM(), SAMRO(), DQNController(net)], cfg, 100, seed=0)
+    ckpt = load_checkpoint()
+    rows = table_one([CHM(), SAMRO(), DQNController(ckpt.net)], ckpt.sim_config, 100, seed=0)
     chm, sa, dqn = rows["CHM"], rows["SA-MRO"], rows["DQN"]
     assert chm["handovers_median"] > sa["handovers_median"] > dqn["handovers_median"]
     assert chm["pingpong_pct_pooled"] > sa["pingpong_pct_pooled"] > dqn["pingpong_pct_pooled"]
     assert dqn["handovers_median"] <= 0.2 * chm["handovers_median"]
     assert dqn["pingpong_pct_median"] <= 14 and dqn["pingpong_pct_pooled"] <= 14
     assert dqn["service_availability_pct_mean"] >= 0.95 * chm["service_availability_pct_mean"]
-
-
-def xairl_uav_handover_ckpt():
-    from xairl_uav_handover.policy import DEFAULT_CHECKPOINT
-
-    return DEFAULT_CHECKPOINT
 
 
 def test_corrupt_and_mismatched_checkpoints(tmp_path):
@@ -78,7 +70,7 @@ def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
     ckpt = tmp_path / "tiny.safetensors"
     assert main(["uav", "train", "--episodes", "1", "--flights", "2", "--duration", "3", "--seed", "4",
                  "--no-progress", "--out", str(ckpt)]) == 0
-    net, meta = load_checkpoint(ckpt)
+    meta = load_checkpoint(ckpt).meta
     assert meta["seed"] == 4 and meta["train_config"]["episodes"] == 1 and len(meta["history"]) == 1
     capsys.readouterr()
     assert main(["uav", "evaluate", "--checkpoint", str(ckpt), "--flights", "3", "--duration", "2",

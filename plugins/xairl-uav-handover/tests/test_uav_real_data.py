@@ -64,7 +64,7 @@ def test_baltaci_rates():
 
 def test_report_without_real_data(tmp_path, capsys):
     out = tmp_path / "rep"
-    assert main(["explain", "--plugin", "uav-handover", "--n", "40", "--narrate", "--out", str(out)]) == 0
+    assert main(["report", "--plugin", "uav-handover", "--n", "40", "-o", "flights=20", "--narrate", "--out", str(out)]) == 0
     html = (out / "report.html").read_text()
     assert "Table I" in html and html.count("data:image/png;base64,") >= 3
     assert "&#10003; verified" in html and "confidence" in html
@@ -84,7 +84,8 @@ def test_report_with_real_data(tmp_path):
         shutil.copy(UKM / name, real / name)
     shutil.copytree(BALTACI, tmp_path / "data" / "baltaci-imc22-handovers")
     out = tmp_path / "rep"
-    assert main(["explain", "--plugin", "uav-handover", "--n", "30", "--real", str(real), "--out", str(out)]) == 0
+    assert main(["report", "--plugin", "uav-handover", "--n", "30", "-o", f"real={real}", "-o", "flights=20", "--out",
+                 str(out)]) == 0
     html = (out / "report.html").read_text()
     assert "Real flights: 2 loaded" in html and "network (observed)" in html and "Baltaci" in html
     datasets = {json.loads(x)["dataset"] for x in (out / "explanations.jsonl").read_text().splitlines()}
@@ -96,7 +97,7 @@ def test_report_renders_in_headless_chromium(tmp_path):
     import subprocess
 
     out = tmp_path / "rep"
-    assert main(["explain", "--plugin", "uav-handover", "--n", "20", "--out", str(out)]) == 0
+    assert main(["report", "--plugin", "uav-handover", "--n", "20", "-o", "flights=20", "--out", str(out)]) == 0
     shot = tmp_path / "shot.png"
     subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
                     "--disable-background-networking", "--disable-component-update", "--disable-sync",

@@ -4,9 +4,9 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 from pydantic import ValidationError
 
-from xairl_uav_handover.baselines import CHM, SAMRO, A3Trigger
+from xairl_uav_handover.baselines import CHM, SAMRO, A3Trigger, CHMOnSamples
 from xairl_uav_handover.config import CHMConfig, SimConfig
-from xairl_uav_handover.env import UAVHandoverEnv
+from xairl_uav_handover.env import HandoverVecEnv, UAVHandoverEnv
 from xairl_uav_handover.features import ACTIONS, FEATURES
 from xairl_uav_handover.simulator import Simulator, hex_layout
 
@@ -87,15 +87,48 @@ def test_chm_timer_restarts_when_condition_breaks():
     assert out.index(1) == 8
 
 
+def test_a3_on_time_stamps_fires_at_the_first_sample_after_ttt():
+    """Irregular samples (a real flight): the condition starts at 1.0 s; 160 ms later has passed at 2.3 s."""
+    a3 = A3Trigger(1, 2)
+    times = [0.0, 1.0, 2.3, 3.6]
+    gains = [0.0, 3.0, 3.0, 3.0]
+    out = [a3.targets(np.array([[-80.0, -80.0 + g]]), np.array([0]), 2.0, 0.16, now=t)[0] for t, g in zip(times, gains)]
+    assert out == [0, 0, 1, 0]  # fired at 2.3 s; then the timers start again
+
+
+def test_chm_on_samples_uses_the_same_trigger():
+    state = np.zeros(13, dtype=np.float32)
+    chm = CHMOnSamples(cells=[101.0, 202.0, 303.0])
+    state[5:9] = [-80, -76, -90, -140]  # candidate 1 (cell 202) 4 dB above the serving cell 101
+    assert chm(state, [101.0, 202.0, 303.0], 0.0) == 0  # the condition just started
+    assert chm(state, [101.0, 202.0, 303.0], 1.3) == 1  # held for 1.3 s >= 160 ms
+
+
+def test_vector_env_steps_flights_together():
+    env = HandoverVecEnv(SimConfig(**SHORT), n_flights=4)
+    obs, info = env.reset(seed=3)
+    assert obs.shape == (4, 13) and info["candidates"].shape == (4, 4) and env.action_space.shape == (4,)
+    steps, truncated = 0, np.zeros(4, bool)
+    while not truncated.all():
+        obs, reward, terminated, truncated, info = env.step(np.zeros(4, int))
+        steps += 1
+        assert reward.shape == (4,) and not terminated.any() and (info["handover"] == 0).all()
+    assert steps == int(np.ceil(env.sim.n_steps / env.decision_every))
+    again, _ = env.reset(seed=3)
+    np.testing.assert_array_equal(again, HandoverVecEnv(SimConfig(**SHORT), n_flights=4).reset(seed=3)[0])
+
+
 def test_chm_and_samro_behaviour_on_flights():
     cfg = SimConfig(**{"flight": {"duration_s": 30.0}})
     counts = {}
     for ctl in (CHM(), SAMRO()):
-        sim = Simulator(cfg, n_uavs=20, seed=2)
-        ctl.reset(sim)
-        hos = 0
-        while not sim.done:
-            hos += sim.step(ctl(sim)).handover.sum()
+        env = HandoverVecEnv(cfg, n_flights=20, decision_every=1)
+        env.reset(seed=2)
+        ctl.reset(env)
+        hos, truncated = 0, np.zeros(20, bool)
+        while not truncated.all():
+            *_, truncated, info = env.step(ctl(env))
+            hos += info["handover"].sum()
         counts[ctl.name] = hos
     assert counts["CHM"] > counts["SA-MRO"] > 0
     assert (ctl.margin > 2.0).mean() > 0.5  # service was fine, so SA-MRO raised most margins

@@ -1,4 +1,9 @@
-"""Rule-based handover controllers. A controller maps the simulator's current measurements to target BS ids.
+"""Rule-based handover controllers. A controller acts through :class:`env.HandoverVecEnv`: ``reset(env)``, then
+``controller(env)`` returns one action per flight (the index of the candidate to serve; 0 = stay).
+
+The UE measures the serving BS and the strongest neighbours (the env's 4 candidates), so A3 sees those cells only:
+a neighbour that drops out of the strongest three starts its time-to-trigger again, as in a real measurement
+report. :class:`A3Trigger` runs on time stamps, so the same rule also runs on real flights' irregular samples.
 
 - :class:`CHM`: the conventional A3 handover: hand over to the strongest neighbour once its RSRP has exceeded the
   serving RSRP by ``offset_db`` continuously for ``ttt_s`` (TR 36.777 Table A.2.1-1: 2 dB, 160 ms).
@@ -15,61 +20,84 @@ from __future__ import annotations
 import numpy as np
 
 from .config import CHMConfig, SAMROConfig
-from .simulator import Simulator
+from .features import RSRP
 
 #: 3GPP TS 36.331 timeToTrigger values, seconds
 TTT_VALUES = np.array([0, 40, 64, 80, 100, 128, 160, 256, 320, 480, 512, 640, 1024, 1280, 2560, 5120]) / 1000.0
 
 
 class A3Trigger:
-    """Per-(UAV, BS) A3 timers: a neighbour wins once Mn > Ms + offset has held for TTT (the condition is checked
-    at every step; holding from t0 through t0 + TTT triggers at t0 + TTT)."""
+    """Per-(UAV, cell) A3 timers: a neighbour wins once Mn > Ms + offset has held for TTT. The condition is checked
+    at every measurement; holding from t0 through t0 + TTT triggers at the first measurement at or after t0 + TTT.
+    Cells with RSRP -inf are not measured (the condition does not hold for them).
 
-    def __init__(self, k: int, n: int, dt: float):
-        self.since = np.full((k, n), -1, dtype=np.int64)  # step at which the condition started, -1 = not holding
+    :param k: UAVs; ``n`` cells; ``dt``: seconds between measurements when :meth:`targets` is given no time.
+    """
+
+    def __init__(self, k: int, n: int, dt: float = 0.0):
+        self.since = np.full((k, n), np.nan)  # time at which the condition started to hold, NaN = not holding
         self.dt = dt
         self.t = 0
 
-    def targets(self, rsrp: np.ndarray, serving: np.ndarray, offset_db, ttt_s) -> np.ndarray:
+    def targets(self, rsrp: np.ndarray, serving: np.ndarray, offset_db, ttt_s, now: float | None = None) -> np.ndarray:
+        """Target cell per UAV (the serving one when no neighbour fired) for measurements ``rsrp`` (k, n) at time
+        ``now`` (default: measurement count x dt)."""
+        now = self.t * self.dt if now is None else float(now)
         k = np.arange(len(serving))
         ms = rsrp[k, serving][:, None]
         cond = rsrp > ms + np.asarray(offset_db, dtype=float).reshape(-1, 1)
         cond[k, serving] = False
-        self.since = np.where(cond, np.where(self.since < 0, self.t, self.since), -1)
-        held = (self.t - self.since) * self.dt >= np.asarray(ttt_s, dtype=float).reshape(-1, 1) - 1e-9
-        fired = cond & held
+        self.since = np.where(cond, np.where(np.isnan(self.since), now, self.since), np.nan)
+        fired = cond & (now - self.since >= np.asarray(ttt_s, dtype=float).reshape(-1, 1) - 1e-9)
         best = np.where(fired, rsrp, -np.inf).argmax(axis=1)
         target = np.where(fired.any(axis=1), best, serving)
-        self.since[target != serving] = -1  # after a handover every timer starts again
+        self.since[target != serving] = np.nan  # after a handover every timer starts again
         self.t += 1
         return target
 
 
+def _candidate_rsrp(env) -> np.ndarray:
+    """The simulator's RSRP with every cell but the env's candidates unmeasured (-inf)."""
+    sim, cand = env.sim, env.candidates
+    rows = np.arange(sim.K)[:, None]
+    rsrp = np.full_like(sim.rsrp, -np.inf)
+    rsrp[rows, cand] = sim.rsrp[rows, cand]
+    return rsrp
+
+
+def _action_of(env, target: np.ndarray) -> np.ndarray:
+    """Index of each flight's target BS among its candidates (A3 targets are always candidates)."""
+    return (env.candidates == target[:, None]).argmax(axis=1)
+
+
 class CHM:
-    """Conventional A3 handover with fixed offset and time-to-trigger."""
+    """Conventional A3 handover with fixed offset and time-to-trigger, acting at every measurement."""
 
     name = "CHM"
+    decision_every = 1
 
     def __init__(self, config: CHMConfig | None = None):
         self.cfg = config or CHMConfig()
 
-    def reset(self, sim: Simulator) -> None:
-        self.a3 = A3Trigger(sim.K, sim.N, sim.dt)
+    def reset(self, env) -> None:
+        self.a3 = A3Trigger(env.sim.K, env.sim.N, env.sim.dt)
 
-    def __call__(self, sim: Simulator) -> np.ndarray:
-        return self.a3.targets(sim.rsrp, sim.serving, self.cfg.offset_db, self.cfg.ttt_s)
+    def __call__(self, env) -> np.ndarray:
+        return _action_of(env, self.a3.targets(_candidate_rsrp(env), env.sim.serving, self.cfg.offset_db,
+                                               self.cfg.ttt_s))
 
 
 class SAMRO:
     """A3 handover whose margin and TTT adapt per UAV to measured service availability (rule in the module doc)."""
 
     name = "SA-MRO"
+    decision_every = 1
 
     def __init__(self, config: SAMROConfig | None = None):
         self.cfg = config or SAMROConfig()
 
-    def reset(self, sim: Simulator) -> None:
-        c = self.cfg
+    def reset(self, env) -> None:
+        sim, c = env.sim, self.cfg
         self.a3 = A3Trigger(sim.K, sim.N, sim.dt)
         self.margin = np.full(sim.K, c.offset_db)
         self.ttt_idx = np.full(sim.K, int(np.abs(TTT_VALUES - c.ttt_s).argmin()))
@@ -78,7 +106,8 @@ class SAMRO:
         self.hos = np.zeros(sim.K)
         self.n = 0
 
-    def __call__(self, sim: Simulator) -> np.ndarray:
+    def __call__(self, env) -> np.ndarray:
+        sim = env.sim
         if sim.last is not None:
             self.avail += sim.last.radio_ok
             self.hos += sim.last.handover
@@ -91,4 +120,29 @@ class SAMRO:
                                   *c.margin_range_db)
             self.ttt_idx = np.clip(self.ttt_idx - poor + wasted, 0, len(TTT_VALUES) - 1)
             self.avail[:], self.hos[:], self.n = 0, 0, 0
-        return self.a3.targets(sim.rsrp, sim.serving, self.margin, TTT_VALUES[self.ttt_idx])
+        return _action_of(env, self.a3.targets(_candidate_rsrp(env), sim.serving, self.margin,
+                                               TTT_VALUES[self.ttt_idx]))
+
+
+class CHMOnSamples:
+    """CHM on measurement samples at arbitrary times (a real flight's ~1.3 s samples): the same :class:`A3Trigger`
+    over the candidates' RSRP, keyed by cell id. Called as ``chm(state, candidates, t) -> action``.
+
+    :param cells: every cell id the flight may measure (its columns in the trigger).
+    """
+
+    name = "CHM"
+
+    def __init__(self, cells, config: CHMConfig | None = None):
+        self.cfg = config or CHMConfig()
+        self.cells = list(cells)
+        self.col = {c: j for j, c in enumerate(self.cells)}
+        self.a3 = A3Trigger(1, len(self.cells))
+
+    def __call__(self, state, candidates, t: float) -> int:
+        rsrp = np.full((1, len(self.cells)), -np.inf)
+        for k, cell in enumerate(candidates):
+            rsrp[0, self.col[cell]] = state[RSRP][k]
+        serving = np.array([self.col[candidates[0]]])
+        target = self.a3.targets(rsrp, serving, self.cfg.offset_db, self.cfg.ttt_s, now=t)[0]
+        return list(candidates).index(self.cells[target])

@@ -26,8 +26,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def _sim_config(base, duration=None, min_stay=None):
-    from xairl.errors import InputError
     from pydantic import ValidationError
+    from xairl import InputError, validation_message
 
     from .config import SimConfig
 
@@ -39,15 +39,13 @@ def _sim_config(base, duration=None, min_stay=None):
     try:
         return SimConfig.model_validate(data)
     except ValidationError as exc:
-        from xairl.attributors.base import validation_message
-
         raise InputError(validation_message(exc, "UAV simulator settings")) from None
 
 
 def run_train(args) -> int:
     import time
 
-    from xairl.errors import InputError
+    from xairl import InputError
 
     from .policy import save_checkpoint
     from .train import TrainConfig, train
@@ -68,19 +66,17 @@ def run_train(args) -> int:
 
 
 def run_evaluate(args) -> int:
-    from xairl.errors import InputError
+    from xairl import InputError
 
     from .baselines import CHM, SAMRO
     from .evaluate import format_table, table_one
-    from .policy import DQNController, load_checkpoint, DEFAULT_CHECKPOINT
-    from .config import SimConfig
+    from .policy import DQNController, load_checkpoint
 
     if args.flights < 1:
         raise InputError("--flights must be at least 1.")
-    net, meta = load_checkpoint(args.checkpoint or DEFAULT_CHECKPOINT)
-    base = SimConfig.model_validate(meta["sim_config"]) if "sim_config" in meta else None
-    cfg = _sim_config(base, args.duration, args.min_stay)
-    rows = table_one([CHM(), SAMRO(), DQNController(net)], cfg, args.flights, args.seed)
+    ckpt = load_checkpoint(args.checkpoint)
+    cfg = _sim_config(ckpt.sim_config, args.duration, args.min_stay)
+    rows = table_one([CHM(), SAMRO(), DQNController(ckpt.net)], cfg, args.flights, args.seed)
     if args.json:
         print(json.dumps({"flights": args.flights, "seed": args.seed,
                           "min_time_of_stay_s": cfg.handover.min_time_of_stay_s, "policies": rows}, indent=2))

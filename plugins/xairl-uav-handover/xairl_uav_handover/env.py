@@ -1,57 +1,94 @@
-"""Gymnasium environment: one UAV flight; each step is one handover decision among the 4 candidates."""
+"""Gymnasium environments: the one thing that training and evaluation step through.
+
+:class:`HandoverVecEnv` flies K flights at once (a ``gymnasium.vector.VectorEnv``); each step is one handover
+decision per flight among its 4 candidates (0 = stay), held for ``decision_every`` simulator steps. All flights
+of one vector end together, after the flight's duration (truncation, no autoreset: call ``reset`` again).
+:class:`UAVHandoverEnv` is the single-flight ``gymnasium.Env`` for tools that want one (``check_env`` passes).
+
+Reward per flight and decision (the paper's four terms, weights in ``RewardConfig``):
+``-w_handover*[handover] - mean over the steps of (w_buffer*q/q_max + w_rsrp*[RSRP<thr] + w_rsrq*[RSRQ<thr])``.
+``info`` carries, per flight, the sums over the decision's simulator steps of :data:`METRICS`, and the candidate
+BS ids (``info["candidates"]``, (K, 4)).
+"""
 from __future__ import annotations
 
 import gymnasium as gym
 import numpy as np
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import batch_space
 
 from .config import SimConfig
 from .features import ACTIONS, FEATURES
 from .simulator import Simulator
 
+#: per-flight quantities summed over each decision's simulator steps (StepInfo fields)
+METRICS = ("handover", "pingpong", "available", "queue_bits", "lost_bits", "rsrp_violation", "rsrq_violation")
 
-def decision_step(sim: Simulator, actions: np.ndarray, candidates: np.ndarray) -> tuple[np.ndarray, dict]:
-    """Apply one decision per UAV (index into its candidates), then run ``decision_every`` simulator steps.
 
-    Reward per UAV (the paper's four terms, weights in ``RewardConfig``):
-    ``-w_handover*[handover] - mean over the steps of (w_buffer*q/q_max + w_rsrp*[RSRP<thr] + w_rsrq*[RSRQ<thr])``.
+class HandoverVecEnv(gym.vector.VectorEnv):
+    """K UAV flights stepped at once, one handover decision per flight and step.
+
+    :param config: the simulator's settings.
+    :param n_flights: flights flown in parallel (``num_envs``).
+    :param decision_every: simulator steps per decision (default ``config.decision_every``; 1 for rule-based
+        controllers that act at every measurement).
     """
-    cfg = sim.cfg
-    w, q_max = cfg.reward, cfg.buffer.q_max_bits
-    target = candidates[np.arange(sim.K), np.asarray(actions, dtype=np.int64)]
-    cost = np.zeros(sim.K)
-    sums = {"handover": np.zeros(sim.K), "pingpong": np.zeros(sim.K), "available": np.zeros(sim.K)}
-    n = 0
-    for _ in range(cfg.decision_every):
-        if sim.done:
-            break
-        info = sim.step(target if n == 0 else sim.serving)
-        cost += w.w_buffer * info.queue_bits / q_max + w.w_rsrp * info.rsrp_violation + w.w_rsrq * info.rsrq_violation
-        for key in sums:
-            sums[key] += getattr(info, key)
-        n += 1
-    reward = -w.w_handover * sums["handover"] - cost / max(n, 1)
-    return reward, sums
+
+    metadata = {"autoreset_mode": AutoresetMode.DISABLED}
+
+    def __init__(self, config: SimConfig | None = None, n_flights: int = 1, decision_every: int | None = None):
+        self.cfg = config or SimConfig()
+        self.num_envs = n_flights
+        self.decision_every = decision_every or self.cfg.decision_every
+        self.single_observation_space = gym.spaces.Box(-np.inf, np.inf, shape=(len(FEATURES),), dtype=np.float32)
+        self.single_action_space = gym.spaces.Discrete(len(ACTIONS))
+        self.observation_space = batch_space(self.single_observation_space, n_flights)
+        self.action_space = batch_space(self.single_action_space, n_flights)
+        self.sim: Simulator | None = None
+        self.obs: np.ndarray | None = None  # the latest observation (K, 13)
+        self.candidates: np.ndarray | None = None  # the latest candidate BS ids (K, 4)
+
+    def reset(self, *, seed: int | None = None, options=None):
+        """New flights; every random draw of the episode comes from ``seed``."""
+        self.sim = Simulator(self.cfg, n_uavs=self.num_envs, seed=0 if seed is None else seed)
+        self.obs, self.candidates = self.sim.observe()
+        return self.obs, {"candidates": self.candidates}
+
+    def step(self, actions):
+        """Hand over each flight to its candidate ``actions[k]`` (0 = stay) and fly ``decision_every`` steps."""
+        sim, w = self.sim, self.cfg.reward
+        target = self.candidates[np.arange(sim.K), np.asarray(actions, dtype=np.int64)]
+        sums = {key: np.zeros(sim.K) for key in METRICS}
+        cost = np.zeros(sim.K)
+        n = 0
+        while n < self.decision_every and not sim.done:
+            info = sim.step(target if n == 0 else sim.serving)
+            cost += (w.w_buffer * info.queue_bits / self.cfg.buffer.q_max_bits + w.w_rsrp * info.rsrp_violation
+                     + w.w_rsrq * info.rsrq_violation)
+            for key in METRICS:
+                sums[key] += getattr(info, key)
+            n += 1
+        reward = -w.w_handover * sums["handover"] - cost / max(n, 1)
+        self.obs, self.candidates = sim.observe()
+        ended = np.full(sim.K, sim.done)
+        return self.obs, reward, np.zeros(sim.K, dtype=bool), ended, sums | {"candidates": self.candidates}
 
 
 class UAVHandoverEnv(gym.Env):
-    """Observation: the 13 features of :data:`FEATURES`; action: :data:`ACTIONS` (0 = stay)."""
+    """One flight as a ``gymnasium.Env``: observation :data:`FEATURES`, action :data:`ACTIONS` (0 = stay)."""
 
     metadata = {"render_modes": []}
 
     def __init__(self, config: SimConfig | None = None):
-        self.cfg = config or SimConfig()
-        self.observation_space = gym.spaces.Box(-np.inf, np.inf, shape=(len(FEATURES),), dtype=np.float32)
-        self.action_space = gym.spaces.Discrete(len(ACTIONS))
-        self.sim: Simulator | None = None
+        self.vec = HandoverVecEnv(config, n_flights=1)
+        self.observation_space = self.vec.single_observation_space
+        self.action_space = self.vec.single_action_space
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
-        self.sim = Simulator(self.cfg, n_uavs=1, seed=int(self.np_random.integers(2 ** 31)))
-        obs, self._cand = self.sim.observe()
-        return obs[0], {"candidates": self._cand[0]}
+        obs, info = self.vec.reset(seed=int(self.np_random.integers(2 ** 31)))
+        return obs[0], {"candidates": info["candidates"][0]}
 
     def step(self, action):
-        reward, sums = decision_step(self.sim, np.array([action]), self._cand)
-        obs, self._cand = self.sim.observe()
-        info = {k: float(v[0]) for k, v in sums.items()} | {"candidates": self._cand[0]}
-        return obs[0], float(reward[0]), False, self.sim.done, info
+        obs, reward, terminated, truncated, info = self.vec.step(np.array([action]))
+        return obs[0], float(reward[0]), bool(terminated[0]), bool(truncated[0]), {k: v[0] for k, v in info.items()}

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .config import SimConfig
-from .simulator import Simulator
+from .env import METRICS, HandoverVecEnv
 
 #: seeds of evaluation flights start here; training flights use seeds below it (see train.py)
 HELD_OUT_SEED = 1_000_000
@@ -13,16 +13,19 @@ PAPER = {"CHM": (75, 40), "SA-MRO": (32, 27), "DQN": (12, 14)}
 
 
 def run_flights(controller, config: SimConfig, n_flights: int, seed: int) -> dict[str, np.ndarray]:
-    """Fly ``n_flights`` (all at once) under ``controller``; per-flight metrics as arrays of shape (n_flights,)."""
-    sim = Simulator(config, n_uavs=n_flights, seed=HELD_OUT_SEED + seed)
-    controller.reset(sim)
-    keys = ("handover", "pingpong", "available", "queue_bits", "lost_bits", "rsrp_violation", "rsrq_violation")
-    tot = {k: np.zeros(n_flights) for k in keys}
-    while not sim.done:
-        info = sim.step(controller(sim))
-        for key in keys:
-            tot[key] += getattr(info, key)
-    n = sim.n_steps
+    """Fly ``n_flights`` held-out flights (all at once, through :class:`HandoverVecEnv`) under ``controller``;
+    per-flight metrics as arrays of shape (n_flights,)."""
+    env = HandoverVecEnv(config, n_flights, decision_every=controller.decision_every)
+    env.reset(seed=HELD_OUT_SEED + seed)
+    controller.reset(env)
+    tot = {k: np.zeros(n_flights) for k in METRICS}
+    ended = False
+    while not ended:
+        *_, truncated, info = env.step(controller(env))
+        for key in METRICS:
+            tot[key] += info[key]
+        ended = bool(truncated.all())
+    n = env.sim.n_steps
     return {
         "handovers": tot["handover"],
         "pingpongs": tot["pingpong"],

@@ -1,10 +1,34 @@
-"""The DQN's state layout (as in the paper) and what each feature means, for plots and narration."""
-from xairl.policy import FeatureInfo
+"""The DQN's state layout (as in the paper) and what each feature means, for plots and narration.
 
+:func:`state_rows` is the one place that lays a state out; the simulator, the real-flight replay and the report
+all build or read states through it and the column slices below.
+"""
+import numpy as np
+
+from xairl import Comparison, DomainFacts, FeatureInfo
+
+N_CANDIDATES = 4  # candidate 0 is the serving BS (stay); 1..3 the strongest other BSs
 FEATURES = ("x", "y", "z", "buffer_queue_size", "serving_bs",
-            "rsrp_0", "rsrp_1", "rsrp_2", "rsrp_3", "rsrq_0", "rsrq_1", "rsrq_2", "rsrq_3")
+            *(f"rsrp_{k}" for k in range(N_CANDIDATES)), *(f"rsrq_{k}" for k in range(N_CANDIDATES)))
+POSITION, BUFFER, SERVING = slice(0, 3), 3, 4
+RSRP, RSRQ = slice(5, 5 + N_CANDIDATES), slice(5 + N_CANDIDATES, 5 + 2 * N_CANDIDATES)
 #: action k: associate with candidate k; candidate 0 is the serving BS, so action 0 is "stay"
-ACTIONS = ("stay", "handover_to_candidate_1", "handover_to_candidate_2", "handover_to_candidate_3")
+ACTIONS = ("stay", *(f"handover_to_candidate_{k}" for k in range(1, N_CANDIDATES)))
+#: words followed by an identifier in this plugin's narratives ("BS 15", "candidate 2"), not by a quantity
+LABEL_WORDS = ("BS", "candidate")
+
+
+def state_rows(position, queue_bits, serving_id, rsrp, rsrq) -> np.ndarray:
+    """States (K, 13) float32 in :data:`FEATURES` order.
+
+    :param position: (K, 3) x, y, z in metres; ``queue_bits`` (K,); ``serving_id`` (K,) the serving BS's id.
+    :param rsrp: (K, 4) dBm of the candidates (serving first); ``rsrq`` (K, 4) dB.
+    """
+    position = np.asarray(position, dtype=float).reshape(-1, 3)
+    k = len(position)
+    return np.concatenate([position, np.reshape(queue_bits, (k, 1)), np.reshape(serving_id, (k, 1)),
+                           np.reshape(rsrp, (k, N_CANDIDATES)), np.reshape(rsrq, (k, N_CANDIDATES))],
+                          axis=1).astype(np.float32)
 GROUPS = {"position": ("x", "y", "z"), "rsrp": ("rsrp_0", "rsrp_1", "rsrp_2", "rsrp_3"),
           "rsrq": ("rsrq_0", "rsrq_1", "rsrq_2", "rsrq_3")}
 
@@ -31,7 +55,7 @@ ACTION_ALIASES = {"stay": ("keep the serving BS", "staying"),
                      for k, a in enumerate(ACTIONS) if k}}
 
 
-def handover_facts(state, chosen: int, runner_up: int) -> dict:
+def handover_facts(state, chosen: int, runner_up: int) -> DomainFacts:
     """Domain facts for narration: stay or hand over, from which BS to which candidate, and how the target (or the
     runner-up candidate, when the UAV stays) compares with the serving BS in RSRP. (Its RSRQ differs by exactly
     the same dB: both cells' RSRQ share one RSSI, so an RSRQ comparison would only repeat it.)"""
@@ -42,6 +66,6 @@ def handover_facts(state, chosen: int, runner_up: int) -> dict:
     comparisons = []
     if k:
         diff = s[f"rsrp_{k}"] - s["rsrp_0"]
-        comparisons.append({"text": f"{_WHO[k]}'s RSRP was {abs(diff):.1f} dB {'above' if diff >= 0 else 'below'} "
-                                    "the serving BS's RSRP", "value": round(abs(diff), 1), "unit": "dB"})
-    return {"extras": extras, "comparisons": comparisons}
+        comparisons.append(Comparison(f"{_WHO[k]}'s RSRP was {abs(diff):.1f} dB {'above' if diff >= 0 else 'below'} "
+                                      "the serving BS's RSRP", round(abs(diff), 1), "dB"))
+    return DomainFacts(extras, tuple(comparisons))

@@ -26,5 +26,5 @@ def register_commands(register):
 
 @hookimpl
 def register_reports(register):
-    register("uav-handover", "xairl_uav_handover.report:build",
-             "Table I, real-flight replay, handover rate vs altitude, SHAP figures and narrated handovers")
+    register("uav-handover", "xairl_uav_handover.report:UAVReport",
+             "Table I, real-flight replay (-o real=PATH), handover rate vs altitude, SHAP figures, narrated handovers")

@@ -7,17 +7,17 @@ the features' own units.
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import torch
 
-from xairl.errors import CheckpointError
-from xairl.policy import Policy
+from xairl import CheckpointError, Policy
 
 from .config import SimConfig
+from .env import HandoverVecEnv
 from .features import ACTION_ALIASES, ACTIONS, FEATURE_INFO, FEATURES, GROUPS, handover_facts
-from .simulator import Simulator
 
 DEFAULT_CHECKPOINT = Path(__file__).parent / "checkpoints" / "uav-dqn.safetensors"
 
@@ -46,12 +46,23 @@ def save_checkpoint(net: torch.nn.Module, path: str | Path, meta: dict) -> None:
               metadata={"xairl": json.dumps(meta)})
 
 
-def load_checkpoint(path: str | Path) -> tuple[torch.nn.Sequential, dict]:
-    """Network and metadata from a safetensors file; any mismatch is a :class:`CheckpointError`."""
+@dataclass(frozen=True)
+class Checkpoint:
+    """A loaded checkpoint: the Q-network, its metadata, and the simulator settings it was trained with."""
+
+    path: Path
+    net: torch.nn.Sequential
+    meta: dict
+    sim_config: SimConfig
+
+
+def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
+    """Network and metadata from a safetensors file (default: the plugin's pretrained DQN); any mismatch is a
+    :class:`CheckpointError`."""
     from safetensors import SafetensorError
     from safetensors.torch import load_file, safe_open
 
-    path = Path(path)
+    path = Path(path or DEFAULT_CHECKPOINT)
     if not path.is_file():
         raise CheckpointError(f"{path}: no such checkpoint; train one with `xairl uav train --out {path}`.")
     try:
@@ -68,45 +79,47 @@ def load_checkpoint(path: str | Path) -> tuple[torch.nn.Sequential, dict]:
     except RuntimeError as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise CheckpointError(f"{path}: does not match the UAV DQN architecture (hidden={hidden}): {first}")
-    return net.eval(), meta
+    try:
+        config = SimConfig.model_validate(meta.get("sim_config", {}))
+    except ValueError as exc:
+        raise CheckpointError(f"{path}: its simulator settings are invalid ({str(exc).splitlines()[0]}).") from None
+    return Checkpoint(path, net.eval(), meta, config)
 
 
 def background_states(n: int, seed: int = 0, config: SimConfig | None = None) -> np.ndarray:
     """``n`` states the policy meets in flight: ``n`` simulated UAVs after 10 s under conventional handover."""
     from .baselines import CHM
 
-    sim = Simulator(config, n_uavs=n, seed=seed)
+    env = HandoverVecEnv(config, n_flights=n, decision_every=1)
+    obs, _ = env.reset(seed=seed)
     chm = CHM()
-    chm.reset(sim)
-    for _ in range(int(round(10.0 / sim.dt))):
-        sim.step(chm(sim))
-    return sim.observe()[0]
+    chm.reset(env)
+    for _ in range(int(round(10.0 / env.sim.dt))):
+        obs = env.step(chm(env))[0]
+    return obs
 
 
-def uav_policy(path: str | Path | None = None) -> Policy:
+def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
     """The trained handover DQN as an xairl Policy (the plugin's ``uav-dqn``)."""
-    net, meta = load_checkpoint(path or DEFAULT_CHECKPOINT)
-    config = SimConfig.model_validate(meta["sim_config"]) if "sim_config" in meta else SimConfig()
-    return Policy(net, FEATURES, ACTIONS, features=FEATURE_INFO, groups=GROUPS,
+    ckpt = checkpoint if isinstance(checkpoint, Checkpoint) else load_checkpoint(checkpoint)
+    config = ckpt.sim_config
+    return Policy(ckpt.net, FEATURES, ACTIONS, features=FEATURE_INFO, groups=GROUPS,
                   background_sampler=lambda n, seed: background_states(n, seed, config), name="uav-dqn",
                   action_aliases=ACTION_ALIASES, facts_hook=handover_facts)
 
 
 class DQNController:
-    """Acts greedily with a Q-network every ``decision_every`` steps and stays in between."""
+    """Acts greedily with a Q-network, one decision per env step (every ``decision_every`` simulator steps)."""
 
     name = "DQN"
+    decision_every = None  # the simulator config's
 
     def __init__(self, net: torch.nn.Module):
         self.net = net.eval()
 
-    def reset(self, sim: Simulator) -> None:
-        self.every = sim.cfg.decision_every
+    def reset(self, env) -> None:
+        pass
 
-    def __call__(self, sim: Simulator) -> np.ndarray:
-        if sim.t % self.every:
-            return sim.serving
-        obs, cand = sim.observe()
+    def __call__(self, env) -> np.ndarray:
         with torch.no_grad():
-            act = self.net(torch.as_tensor(obs)).argmax(dim=1).numpy()
-        return cand[np.arange(sim.K), act]
+            return self.net(torch.as_tensor(env.obs)).argmax(dim=1).numpy()

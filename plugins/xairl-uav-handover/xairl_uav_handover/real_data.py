@@ -17,10 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from xairl.errors import InputError
+from xairl import InputError
 
 from .buffer import buffer_step, service_bits
 from .config import SimConfig
+from .features import N_CANDIDATES, state_rows
+from .simulator import n_sites
 
 REF_LAT, REF_LON = 2.9228, 101.7715  # centre of the UKM campaign area: local metres are measured from here
 PCI, RSRP, RSRQ = "Physical cell identity (LTE pcell)", "RSRP (LTE pcell)", "RSRQ (LTE pcell)"
@@ -47,46 +49,20 @@ class RealFlight:
     def observed_handovers(self) -> int:
         return int((np.diff(self.pci) != 0).sum())
 
+    @property
+    def cells(self) -> list[float]:
+        """Every cell measured on the flight (serving or detected), sorted."""
+        return sorted(set(self.pci.tolist()) | {p for p in self.nb_pci.ravel().tolist() if np.isfinite(p)})
+
 
 def load_flight(path: str | Path) -> RealFlight:
     """One export file; a malformed one raises :class:`InputError` naming the file and the column."""
-    import pandas as pd
-
     path = Path(path)
     alt = re.match(r"(\d+(?:\.\d+)?)m", path.stem)
     if not alt:
         raise InputError(f"{path}: the nominal altitude is read from the file name (e.g. 100m.csv); rename it.")
-    try:
-        df = pd.read_csv(path, low_memory=False, dtype={"Time": str})
-    except (OSError, ValueError, pd.errors.ParserError) as exc:
-        raise InputError(f"{path}: cannot read it as CSV ({str(exc).splitlines()[0]}).") from None
-    missing = [c for c in REQUIRED if c not in df.columns]
-    if missing:
-        raise InputError(f"{path}: missing column '{missing[0]}'" + (f" (and {len(missing) - 1} more)" if
-                                                                      len(missing) > 1 else "") + ".")
-    df["Time"] = df["Time"].astype(str).str.strip()
-    df = df[df["Time"].str.match(TIME_RE)]
-    if df.empty:
-        raise InputError(f"{path}: no rows with a parseable Time (H:MM:SS.mmm); the file looks truncated.")
-    slots = sorted(int(m.group(1)) for c in df.columns if (m := re.match(r"Physical cell identity \(LTE detected\) - "
-                                                                          r"(\d+)$", c)))
-    nb_cols = [f"{k} (LTE detected) - {s}" for s in slots for k in ("Physical cell identity", "RSRP", "RSRQ")]
-    numeric = ["Latitude", "Longitude", PCI, RSRP, RSRQ, "RS SNR"] + [c for c in nb_cols if c in df.columns]
-    for c in numeric:
-        df[c] = pd.to_numeric(df[c], errors="coerce")
-    hms = df["Time"].str.split(":", expand=True).astype(float)
-    df["_t"] = hms[0] * 3600 + hms[1] * 60 + hms[2]
-    g = df.groupby("_t", sort=True).first()
-    fill = ["Latitude", "Longitude", "RS SNR"] + [c for c in nb_cols if c in g.columns]
-    g[fill] = g[fill].ffill(limit=2)
-    g = g[g[PCI].notna() & g[RSRP].notna() & g[RSRQ].notna() & g["Latitude"].notna()]
-    if len(g) < 2:
-        raise InputError(f"{path}: fewer than 2 time steps with a serving cell ('{PCI}').")
-    for col, lo, hi, unit in ((RSRP, -160, -20, "dBm"), (RSRQ, -40, 0, "dB"), ("Latitude", -90, 90, "deg"),
-                              ("Longitude", -180, 180, "deg")):
-        med = float(g[col].median())
-        if not lo <= med <= hi:
-            raise InputError(f"{path}: column '{col}' has median {med:g}, outside {lo}..{hi} {unit}; wrong units?")
+    df, slots = _read_export(path)
+    g = _time_steps(df, slots, path)
     t = g.index.to_numpy(dtype=float)
     t = np.where(t < t[0], t + 86400, t) - t[0]  # a flight over midnight
     lat, lon = g["Latitude"].to_numpy(), g["Longitude"].to_numpy()
@@ -101,6 +77,53 @@ def load_flight(path: str | Path) -> RealFlight:
     snr = np.where(np.isnan(snr), np.nanmedian(snr) if np.isfinite(snr).any() else 0.0, snr)
     return RealFlight(path.name, float(alt.group(1)), t, xy, g[PCI].to_numpy(dtype=float), g[RSRP].to_numpy(float),
                       g[RSRQ].to_numpy(float), snr, nb("Physical cell identity"), nb("RSRP"), nb("RSRQ"))
+
+
+def _read_export(path: Path):
+    """The export's event rows with a parseable Time, numeric columns as numbers, and its detected-cell slots."""
+    import pandas as pd
+
+    try:
+        df = pd.read_csv(path, low_memory=False, dtype={"Time": str})
+    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        raise InputError(f"{path}: cannot read it as CSV ({str(exc).splitlines()[0]}).") from None
+    missing = [c for c in REQUIRED if c not in df.columns]
+    if missing:
+        raise InputError(f"{path}: missing column '{missing[0]}'" + (f" (and {len(missing) - 1} more)" if
+                                                                      len(missing) > 1 else "") + ".")
+    df["Time"] = df["Time"].astype(str).str.strip()
+    df = df[df["Time"].str.match(TIME_RE)].copy()
+    if df.empty:
+        raise InputError(f"{path}: no rows with a parseable Time (H:MM:SS.mmm); the file looks truncated.")
+    slots = sorted(int(m.group(1)) for c in df.columns if (m := re.match(r"Physical cell identity \(LTE detected\) - "
+                                                                          r"(\d+)$", c)))
+    for c in ["Latitude", "Longitude", PCI, RSRP, RSRQ, "RS SNR", *_neighbour_columns(slots, df.columns)]:
+        df[c] = pd.to_numeric(df[c], errors="coerce")
+    return df, slots
+
+
+def _neighbour_columns(slots: list[int], present) -> list[str]:
+    return [c for s in slots for k in ("Physical cell identity", "RSRP", "RSRQ")
+            if (c := f"{k} (LTE detected) - {s}") in present]
+
+
+def _time_steps(df, slots: list[int], path: Path):
+    """One row per time stamp (sparse columns forward-filled over two steps), with a serving cell and a position,
+    in plausible units."""
+    hms = df["Time"].str.split(":", expand=True).astype(float)
+    df["_t"] = hms[0] * 3600 + hms[1] * 60 + hms[2]
+    g = df.groupby("_t", sort=True).first()
+    fill = ["Latitude", "Longitude", "RS SNR", *_neighbour_columns(slots, g.columns)]
+    g[fill] = g[fill].ffill(limit=2)
+    g = g[g[PCI].notna() & g[RSRP].notna() & g[RSRQ].notna() & g["Latitude"].notna()]
+    if len(g) < 2:
+        raise InputError(f"{path}: fewer than 2 time steps with a serving cell ('{PCI}').")
+    for col, lo, hi, unit in ((RSRP, -160, -20, "dBm"), (RSRQ, -40, 0, "dB"), ("Latitude", -90, 90, "deg"),
+                              ("Longitude", -180, 180, "deg")):
+        med = float(g[col].median())
+        if not lo <= med <= hi:
+            raise InputError(f"{path}: column '{col}' has median {med:g}, outside {lo}..{hi} {unit}; wrong units?")
+    return g
 
 
 def load_folder(folder: str | Path) -> tuple[list[RealFlight], list[str]]:
@@ -143,57 +166,66 @@ def _measured(f: RealFlight, i: int) -> dict[float, tuple[float, float]]:
     return cells
 
 
+class _Service:
+    """The plugin's buffer model driven by the real link quality along the flight (see the module doc)."""
+
+    def __init__(self, cfg: SimConfig, seed: int):
+        self.b, self.h, self.rng = cfg.buffer, cfg.handover, np.random.default_rng(seed)
+        self.q, self.queues, self.lost = 0.0, [], 0.0
+
+    def step(self, sinr_db: float, dt: float, handed: bool) -> None:
+        b = self.b
+        served = service_bits(sinr_db, b.rb_per_uav, b.rb_bandwidth_hz,
+                              max(dt - (self.h.interruption_s if handed else 0), 0))
+        arrivals = self.rng.poisson(b.packet_rate_hz * dt) * b.data_packet_bits + handed * b.control_packet_bits
+        q, lost = buffer_step(self.q, arrivals, served, b.q_max_bits)
+        self.q = float(q)
+        self.queues.append(self.q)
+        self.lost += float(lost)
+
+
 def replay(f: RealFlight, decide, config: SimConfig | None = None, seed: int = 0) -> Replay:
-    """Fly ``decide(state (13,), candidates) -> action`` along the real flight (see the module doc); ``decide=None``
-    follows the network's own serving cell (the observed decisions). Ping-pongs are counted afterwards, for any
-    window, with :meth:`Replay.pingpongs`."""
+    """Fly ``decide(state (13,), candidates, t) -> action`` along the real flight (see the module doc);
+    ``decide=None`` follows the network's own serving cell (the observed decisions). Ping-pongs are counted
+    afterwards, for any window, with :meth:`Replay.pingpongs`."""
     cfg = config or SimConfig()
-    rng = np.random.default_rng(seed)
     ids = {p: k for k, p in enumerate(sorted(set(f.pci.tolist())))}
-    serving, q = f.pci[0], 0.0
-    prev, entered = serving, 0.0
-    states, path = [], []
-    ho = forced = 0
-    returns: list[float] = []
-    qs, lost_total = [], 0.0
-    b, h = cfg.buffer, cfg.handover
+    max_id = n_sites(cfg.layout) - 1  # the simulator's ids: a real flight's cells are ranked into that range
+    service = _Service(cfg, seed)
+    serving = prev = f.pci[0]
+    entered, ho, forced = 0.0, 0, 0
+    states, path, returns = [], [], []
+
+    def hand_over(target, t):
+        nonlocal serving, prev, entered, ho
+        ho += 1
+        if target == prev:
+            returns.append(t - entered)
+        prev, entered, serving = serving, t, target
+
     for i in range(len(f.t)):
         cells = _measured(f, i)
         if decide is None and f.pci[i] != serving:  # the network handed over between the samples
-            ho += 1
-            if f.pci[i] == prev:
-                returns.append(f.t[i] - entered)
-            prev, entered, serving = serving, f.t[i], f.pci[i]
+            hand_over(f.pci[i], f.t[i])
         if serving not in cells:
             serving, forced = max(cells, key=lambda p: cells[p][0]), forced + 1
-        cand = [serving] + sorted((p for p in cells if p != serving), key=lambda p: -cells[p][0])[:3]
-        rsrp = [cells[p][0] for p in cand] + [PAD_RSRP] * (4 - len(cand))
-        rsrq = [cells[p][1] for p in cand] + [PAD_RSRQ] * (4 - len(cand))
-        state = np.array([f.xy[i, 0], f.xy[i, 1], f.altitude_m, q, min(ids.get(serving, 0), 18), *rsrp, *rsrq],
-                         dtype=np.float32)
+        cand = [serving] + sorted((p for p in cells if p != serving), key=lambda p: -cells[p][0])[:N_CANDIDATES - 1]
+        pad = N_CANDIDATES - len(cand)
+        state = state_rows([*f.xy[i], f.altitude_m], service.q, min(ids.get(serving, 0), max_id),
+                           [cells[p][0] for p in cand] + [PAD_RSRP] * pad,
+                           [cells[p][1] for p in cand] + [PAD_RSRQ] * pad)[0]
         states.append(state)
-        if decide is None:
-            target = serving
-        else:
-            a = int(decide(state, cand))
-            target = cand[a] if a < len(cand) else serving
+        a = 0 if decide is None else int(decide(state, cand, float(f.t[i])))
+        target = cand[a] if a < len(cand) else serving  # a padded candidate slot: stay
         handed = target != serving or (decide is None and i > 0 and f.pci[i] != f.pci[i - 1])
         if target != serving:
-            ho += 1
-            if target == prev:
-                returns.append(f.t[i] - entered)
-            prev, entered, serving = serving, f.t[i], target
+            hand_over(target, f.t[i])
         path.append(serving)
         dt = float(np.clip(f.t[i + 1] - f.t[i], 0, 5)) if i + 1 < len(f.t) else 0.0
         rsrp_now = cells.get(serving, (f.rsrp[i], 0))[0]
-        sinr = f.snr[i] + (rsrp_now - f.rsrp[i])
-        served = service_bits(sinr, b.rb_per_uav, b.rb_bandwidth_hz, max(dt - (h.interruption_s if handed else 0), 0))
-        arrivals = rng.poisson(b.packet_rate_hz * dt) * b.data_packet_bits + handed * b.control_packet_bits
-        q, lost = buffer_step(q, arrivals, served, b.q_max_bits)
-        q, lost = float(q), float(lost)
-        qs.append(q)
-        lost_total += lost
-    return Replay(np.array(states), np.array(path), ho, np.array(returns), forced, float(np.mean(qs)) / 1e3, lost_total / 1e3)
+        service.step(f.snr[i] + (rsrp_now - f.rsrp[i]), dt, handed)
+    return Replay(np.array(states), np.array(path), ho, np.array(returns), forced,
+                  float(np.mean(service.queues)) / 1e3, service.lost / 1e3)
 
 
 def baltaci_rate_by_altitude(folder: str | Path) -> tuple[np.ndarray, np.ndarray, int]:

@@ -19,9 +19,13 @@ from scipy.special import ndtr
 
 from .buffer import buffer_step, service_bits
 from .channel import los_probability, path_loss, shadow_sigma
-from .config import SimConfig
+from .config import LayoutConfig, SimConfig
+from .features import N_CANDIDATES, state_rows
 
-N_CANDIDATES = 4  # candidate 0 is the serving BS (stay); 1..3 the strongest other BSs
+
+def n_sites(layout: LayoutConfig) -> int:
+    """Sites of the hexagonal grid: the centre plus 6 r sites in ring r."""
+    return 1 + 3 * layout.rings * (layout.rings + 1)
 
 
 def hex_layout(isd: float, rings: int) -> np.ndarray:
@@ -127,9 +131,7 @@ class Simulator:
         """Features (K, 13) in :data:`features.FEATURES` order, and the candidate BS ids (K, 4)."""
         cand = self.candidates()
         rows = np.arange(self.K)[:, None]
-        feats = np.concatenate([self.pos, self.q[:, None], self.serving[:, None].astype(float),
-                                self.rsrp[rows, cand], self.rsrq[rows, cand]], axis=1)
-        return feats.astype(np.float32), cand
+        return state_rows(self.pos, self.q, self.serving, self.rsrp[rows, cand], self.rsrq[rows, cand]), cand
 
     def step(self, target: np.ndarray) -> StepInfo:
         """Associate every UAV with ``target`` (BS ids, (K,)), then advance one dt."""

@@ -1,7 +1,11 @@
-"""DQN training, CleanRL style: one short file, many flights in parallel, replay, target network, tqdm.
+"""DQN training, CleanRL style: one short file; the vectorised env, SB3's replay buffer, a named schedule, an update.
 
-Experience replay; target network copied every ``target_every`` gradient steps; epsilon-greedy decaying linearly
-from ``eps_start`` to ``eps_end`` over ``eps_fraction`` of training; learning rate lr0 / (1 + eta * episode).
+Many flights fly in parallel through :class:`env.HandoverVecEnv`; transitions go into Stable-Baselines3's
+``ReplayBuffer`` (one row per flight and decision); epsilon-greedy exploration decays linearly
+(:func:`linear_schedule`) from ``eps_start`` to ``eps_end`` over ``eps_fraction`` of training; the learning rate is
+lr0 / (1 + eta * episode) (:func:`learning_rate`); the target network is copied every ``target_every`` updates
+(:func:`dqn_update` is one gradient step). The end of a flight is terminal (no bootstrap), as in the paper's
+episodic set-up.
 """
 from __future__ import annotations
 
@@ -9,17 +13,17 @@ import time
 
 import numpy as np
 import torch
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
+
+from xairl import Options
 
 from .config import SimConfig
-from .env import decision_step
-from .features import ACTIONS, FEATURES
+from .env import HandoverVecEnv
 from .policy import background_states, build_qnet
-from .simulator import Simulator
 
 
-class TrainConfig(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+class TrainConfig(Options, frozen=True):
+    """Every setting of a training run (stored in the checkpoint's metadata)."""
 
     episodes: int = Field(40, ge=1, description="training episodes; each flies n_flights flights at once")
     n_flights: int = Field(64, ge=1)
@@ -38,67 +42,77 @@ class TrainConfig(BaseModel):
     seed: int = 0
 
 
+def linear_schedule(start: float, end: float, duration: float, t: float) -> float:
+    """``start`` moving linearly to ``end`` over ``duration`` steps, then ``end`` (CleanRL's schedule)."""
+    return start + (end - start) * min(t / duration, 1.0)
+
+
+def learning_rate(tc: TrainConfig, episode: int) -> float:
+    """lr0 / (1 + eta * episode), the paper's decaying learning rate."""
+    return tc.lr0 / (1 + tc.eta * episode)
+
+
+def dqn_update(q: torch.nn.Module, target: torch.nn.Module, opt: torch.optim.Optimizer, batch, gamma: float) -> float:
+    """One gradient step on the Huber TD error of a replay batch; returns the loss."""
+    with torch.no_grad():
+        next_q = target(batch.next_observations).max(dim=1).values
+        y = batch.rewards.flatten() + gamma * next_q * (1 - batch.dones.flatten())
+    qa = q(batch.observations).gather(1, batch.actions.long()).flatten()
+    loss = torch.nn.functional.smooth_l1_loss(qa, y)
+    opt.zero_grad()
+    loss.backward()
+    torch.nn.utils.clip_grad_norm_(q.parameters(), 10.0)
+    opt.step()
+    return float(loss)
+
+
+def _networks(tc: TrainConfig, sim_cfg: SimConfig):
+    """Q-network and target network, standardising inputs with statistics of states met in flight."""
+    bg = background_states(2048, seed=tc.seed + 10_000, config=sim_cfg)
+    mean, std = bg.mean(axis=0), np.maximum(bg.std(axis=0), 1e-3)
+    q, target = build_qnet(mean, std, tc.hidden), build_qnet(mean, std, tc.hidden)
+    target.load_state_dict(q.state_dict())
+    return q, target
+
+
 def train(tc: TrainConfig, sim_cfg: SimConfig | None = None, progress: bool = True):
-    """Train a Q-network; returns (network, history list of per-episode dicts)."""
+    """Train a Q-network; returns (network, history: one dict per episode)."""
+    from stable_baselines3.common.buffers import ReplayBuffer
+    from stable_baselines3.common.utils import set_random_seed
     from tqdm import tqdm
 
     sim_cfg = sim_cfg or SimConfig()
+    set_random_seed(tc.seed)  # python, numpy (the replay buffer samples with it) and torch
     rng = np.random.default_rng(tc.seed)
-    torch.manual_seed(tc.seed)
-    bg = background_states(2048, seed=tc.seed + 10_000, config=sim_cfg)
-    mean, std = bg.mean(axis=0), np.maximum(bg.std(axis=0), 1e-3)
-    q = build_qnet(mean, std, tc.hidden)
-    target = build_qnet(mean, std, tc.hidden)
-    target.load_state_dict(q.state_dict())
+    q, target = _networks(tc, sim_cfg)
     opt = torch.optim.Adam([p for p in q.parameters() if p.requires_grad], lr=tc.lr0)
-    f = len(FEATURES)
-    obs_buf = np.zeros((tc.replay_size, f), np.float32)
-    next_buf = np.zeros((tc.replay_size, f), np.float32)
-    act_buf = np.zeros(tc.replay_size, np.int64)
-    rew_buf = np.zeros(tc.replay_size, np.float32)
-    done_buf = np.zeros(tc.replay_size, np.float32)
-    size = ptr = updates = 0
-    decisions_per_ep = int(np.ceil(sim_cfg.flight.n_steps / sim_cfg.decision_every))
-    total = tc.episodes * decisions_per_ep
+    env = HandoverVecEnv(sim_cfg, tc.n_flights)
+    rb = ReplayBuffer(max(tc.replay_size // tc.n_flights, 1) * tc.n_flights, env.single_observation_space,
+                      env.single_action_space, device="cpu", n_envs=tc.n_flights, handle_timeout_termination=False)
+    total = tc.episodes * int(np.ceil(sim_cfg.flight.n_steps / env.decision_every))
+    step = updates = 0
     history = []
     bar = tqdm(total=total, desc="training DQN", unit="dec", disable=not progress)
-    step = 0
     for ep in range(tc.episodes):
         for g in opt.param_groups:
-            g["lr"] = tc.lr0 / (1 + tc.eta * ep)
-        sim = Simulator(sim_cfg, n_uavs=tc.n_flights, seed=tc.seed * 100_003 + ep)
-        obs, cand = sim.observe()
-        ep_ret, ep_ho, t0 = np.zeros(tc.n_flights), np.zeros(tc.n_flights), time.time()
-        while not sim.done:
-            eps = max(tc.eps_end, tc.eps_start - (tc.eps_start - tc.eps_end) * step / (tc.eps_fraction * total))
+            g["lr"] = learning_rate(tc, ep)
+        obs, _ = env.reset(seed=tc.seed * 100_003 + ep)
+        ep_ret, ep_ho, t0, ended = np.zeros(tc.n_flights), np.zeros(tc.n_flights), time.time(), False
+        while not ended:
+            eps = linear_schedule(tc.eps_start, tc.eps_end, tc.eps_fraction * total, step)
             with torch.no_grad():
-                greedy = q(torch.as_tensor(obs)).argmax(dim=1).numpy()
+                act = q(torch.as_tensor(obs)).argmax(dim=1).numpy()
             explore = rng.uniform(size=tc.n_flights) < eps
-            act = np.where(explore, rng.integers(len(ACTIONS), size=tc.n_flights), greedy)
-            reward, sums = decision_step(sim, act, cand)
-            nxt, cand = sim.observe()
-            idx = (ptr + np.arange(tc.n_flights)) % tc.replay_size
-            obs_buf[idx], next_buf[idx], act_buf[idx], rew_buf[idx] = obs, nxt, act, reward
-            done_buf[idx] = float(sim.done)
-            ptr, size = (ptr + tc.n_flights) % tc.replay_size, min(size + tc.n_flights, tc.replay_size)
-            obs = nxt
-            ep_ret += reward
-            ep_ho += sums["handover"]
-            step += 1
+            act = np.where(explore, rng.integers(env.single_action_space.n, size=tc.n_flights), act)
+            nxt, reward, _, truncated, info = env.step(act)
+            ended = bool(truncated.all())
+            rb.add(obs, nxt, act, reward, truncated, [{}] * tc.n_flights)
+            obs, ep_ret, ep_ho, step = nxt, ep_ret + reward, ep_ho + info["handover"], step + 1
             bar.update(1)
-            if size < max(tc.learning_starts, tc.batch_size):
+            if rb.size() * tc.n_flights < max(tc.learning_starts, tc.batch_size):
                 continue
             for _ in range(tc.updates_per_decision):
-                b = rng.integers(size, size=tc.batch_size)
-                with torch.no_grad():
-                    nq = target(torch.as_tensor(next_buf[b])).max(dim=1).values
-                    y = torch.as_tensor(rew_buf[b]) + tc.gamma * nq * (1 - torch.as_tensor(done_buf[b]))
-                qa = q(torch.as_tensor(obs_buf[b])).gather(1, torch.as_tensor(act_buf[b])[:, None])[:, 0]
-                loss = torch.nn.functional.smooth_l1_loss(qa, y)
-                opt.zero_grad()
-                loss.backward()
-                torch.nn.utils.clip_grad_norm_(q.parameters(), 10.0)
-                opt.step()
+                dqn_update(q, target, opt, rb.sample(tc.batch_size), tc.gamma)
                 updates += 1
                 if updates % tc.target_every == 0:
                     target.load_state_dict(q.state_dict())
