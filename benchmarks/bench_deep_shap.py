@@ -1,8 +1,10 @@
 """deep_shap vs shap.DeepExplainer vs captum DeepLiftShap: time (median of repeats) and agreement of the values.
 
-Models: the reference UAV DQN (13-13-64-64-4) and a wider MLP (32-256-256-8); 100 background states; all actions.
+Models: an MLP of the reference DQN's shape (13-64-64-4), a wider MLP (32-256-256-8), and any registered policy
+named with --policy (e.g. --policy uav-dqn, the reference plugin's trained DQN); 100 background states; all actions.
 Goal (issue 6): >= 50x shap.DeepExplainer on the reference DQN.
 Run: .venv/bin/python benchmarks/bench_deep_shap.py [--sizes 1000,10000] [--device cpu|cuda] [--repeats 3]
+     [--policy uav-dqn]
 """
 import argparse
 import os
@@ -15,18 +17,25 @@ import torch
 import xairl
 
 
-def models(device):
-    from xairl_uav_handover.policy import uav_policy
-
-    uav = uav_policy()
+def mlp_policy(sizes):
+    """A seeded ReLU MLP with a standard-normal background."""
     torch.manual_seed(0)
-    wide = torch.nn.Sequential(torch.nn.Linear(32, 256), torch.nn.ReLU(), torch.nn.Linear(256, 256), torch.nn.ReLU(),
-                               torch.nn.Linear(256, 8)).eval()
-    wide_policy = xairl.TorchPolicy(wide, [f"f{i}" for i in range(32)], [f"a{i}" for i in range(8)],
-                                    background_sampler=lambda n, s: np.random.default_rng(s).normal(size=(n, 32)))
-    for p in (uav, wide_policy):
+    layers = []
+    for i, (a, b) in enumerate(zip(sizes[:-1], sizes[1:])):
+        layers += [torch.nn.Linear(a, b)] + ([torch.nn.ReLU()] if i < len(sizes) - 2 else [])
+    f, a = sizes[0], sizes[-1]
+    return xairl.TorchPolicy(torch.nn.Sequential(*layers).eval(), [f"f{i}" for i in range(f)],
+                             [f"a{i}" for i in range(a)],
+                             background_sampler=lambda n, s: np.random.default_rng(s).normal(size=(n, f)))
+
+
+def models(device, policy_name=None):
+    found = {"mlp 13-64-64-4": mlp_policy((13, 64, 64, 4)), "mlp 32-256-256-8": mlp_policy((32, 256, 256, 8))}
+    if policy_name:
+        found[policy_name] = xairl.get_policy(policy_name)
+    for p in found.values():
         p.module.to(device)
-    return {"uav-dqn 13-64-64-4": uav, "mlp 32-256-256-8": wide_policy}
+    return found
 
 
 def timed(fn, repeats):
@@ -49,7 +58,7 @@ def main():
     ap.add_argument("--peer-repeats", type=int, default=1)
     ap.add_argument("--device", default="cuda" if torch.cuda.is_available() else "cpu")
     ap.add_argument("--peer-max", type=int, default=10000, help="largest size at which shap and captum are timed")
-    ap.add_argument("--models", default="uav,mlp", help="which models: uav, mlp")
+    ap.add_argument("--policy", default=None, help="also a registered policy, e.g. uav-dqn")
     args = ap.parse_args()
     import captum
     import shap
@@ -61,9 +70,7 @@ def main():
           f"shap {shap.__version__}, captum {captum.__version__}; device {dev}")
     print(f"{'model':<20}{'states':>7}{'xairl s':>9}{'shap s':>9}{'captum s':>10}{'x shap':>9}{'x captum':>10}"
           f"{'max|diff| shap':>16}{'captum':>10}")
-    for name, policy in models(dev).items():
-        if name.split()[0].split("-")[0] not in args.models:
-            continue
+    for name, policy in models(dev, args.policy).items():
         bg = torch.as_tensor(policy.background(100, seed=1), device=dev)
         for n in (int(s) for s in args.sizes.split(",")):
             x = torch.as_tensor(policy.background(n, seed=2), device=dev)

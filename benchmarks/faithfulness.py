@@ -1,15 +1,16 @@
-"""Faithfulness of deep_shap to exact Shapley values on the reference DQN (13 features: exact is ground truth).
+"""Faithfulness of deep_shap to exact Shapley values on a registered policy with <= 16 features (exact is ground
+truth); default: the reference plugin's uav-dqn (13 features) when installed, else the toy.
 
 Per state, for the chosen action: Spearman correlation of the two feature rankings, agreement of the top feature,
 overlap of the top 3, and max |difference|.
-Run: .venv/bin/python benchmarks/faithfulness.py [--states 100]
+Run: .venv/bin/python benchmarks/faithfulness.py [--states 100] [--policy NAME]
 """
 import argparse
 
 import numpy as np
 
 import xairl
-from xairl_uav_handover.policy import uav_policy
+import xairl.plugins
 
 
 def spearman(a, b):
@@ -20,8 +21,11 @@ def spearman(a, b):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--states", type=int, default=100)
-    n = ap.parse_args().states
-    p = uav_policy()
+    ap.add_argument("--policy", default=None, help="registered policy (default uav-dqn if installed, else toy)")
+    args = ap.parse_args()
+    n = args.states
+    name = args.policy or ("uav-dqn" if "uav-dqn" in xairl.plugins.registry("policy").names() else "toy")
+    p = xairl.get_policy(name)
     bg, x = p.background(50, seed=1), p.background(n, seed=3)
     deep = xairl.explain(p, x, background=bg, method="deep_shap")
     exact = xairl.explain(p, x, background=bg, method="exact")
@@ -32,7 +36,7 @@ def main():
     top3 = np.mean([len(set(np.argsort(-np.abs(d[i]))[:3]) & set(np.argsort(-np.abs(e[i]))[:3])) / 3
                     for i in range(n)])
     glob = spearman(np.abs(d).mean(0), np.abs(e).mean(0))
-    print(f"reference DQN, {n} states, 50 background, chosen action: Spearman of |contribution| rankings median "
+    print(f"{name}, {n} states, 50 background, chosen action: Spearman of |contribution| rankings median "
           f"{np.median(rho):.3f} (mean {np.mean(rho):.3f}, min {np.min(rho):.3f}); signed values median "
           f"{np.median(rho_signed):.3f}; same top feature {100 * top1:.0f} %; top-3 overlap {100 * top3:.0f} %; "
           f"global importance ranking Spearman {glob:.3f}; max |deep_shap - exact| {np.abs(d - e).max():.3f} "

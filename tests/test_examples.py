@@ -37,11 +37,18 @@ def test_my_plugin_installs_and_registers(tmp_path):
     target = tmp_path / "site"
     subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation", "--target",
                     str(target), str(EX / "my_plugin")], check=True, capture_output=True, timeout=300)
-    env = {"PYTHONPATH": str(target)}
+    env = {"PYTHONPATH": str(target), "XAIRL_LOAD_PLUGINS": "my-plugin"}
     out = run(["-m", "xairl.cli", "plugins"], env)
-    assert "my-plugin" in out and "thermostat" in out and "prompt directory" in out
+    assert ("my-plugin\n  attributor: occlusion\n  command: thermostat\n  narrator: shortest\n  policy: thermostat\n"
+            "  prompt directory: ") in out
     out = run(["-m", "xairl.cli", "thermostat", "--temperature", "15"], env)
     assert out.startswith("The thermostat chose heat: the room temperature (15 degC, cold) pushed toward it by +")
     out = run(["-m", "xairl.cli", "explain", "--policy", "thermostat", "--n", "2", "--narrate", "--no-record",
                "--template", "thermostat"], env)
     assert out.count("[verified") == 2
+    # the plugin's attributor and narrator, with options validated against their own models
+    out = run(["-m", "xairl.cli", "explain", "--policy", "thermostat", "--method", "occlusion", "-o", "max_rows=64",
+               "--n", "2", "--narrate", "--narrator", "shortest", "-n", "max_sentences=1", "--no-record"], env)
+    assert out.count("[verified") == 2 and out.count("; shortest]") == 2
+    for line in out.splitlines()[1::2]:  # one sentence per narrative
+        assert line.strip().count(". ") == 0 and line.strip().endswith(".")

@@ -1,30 +1,30 @@
-"""A minimal xairl plugin. Installed with pip, found through the entry point group ``xairl``.
+"""A minimal third-party xairl plugin: a policy, an attribution method, a narrator, a prompt folder, a command.
 
-Everything heavy is named by ``"module:attr"`` strings or imported inside functions, so ``xairl --help`` stays fast.
+Installed with pip, found through the entry point group ``xairl``. The hooks below only name their targets
+(``"module:attr"`` strings) or define light functions, so ``xairl --help`` imports neither torch nor this
+plugin's heavy parts. Everything it uses comes from ``import xairl`` (the public surface), nothing private.
 """
 from pathlib import Path
 
 import xairl
 
 
-def thermostat_policy():
-    """A hand-written 2-feature Q-network: heat when cold, idle when warm."""
-    import torch
-
-    net = torch.nn.Linear(2, 2)
-    with torch.no_grad():
-        net.weight.copy_(torch.tensor([[-1.0, 0.2], [1.0, -0.2]]))  # columns: temperature, occupancy
-        net.bias.copy_(torch.tensor([20.0, -20.0]))
-    return xairl.Policy(net, ["temperature", "occupancy"], ["heat", "idle"],
-                        features={"temperature": xairl.FeatureInfo("degC", "the room temperature", "cold", "warm")},
-                        background_sampler=lambda n, seed: __import__("numpy").random.default_rng(seed).normal(
-                            [20.0, 1.0], [3.0, 1.0], size=(n, 2)),
-                        name="thermostat")
+@xairl.hookimpl
+def register_policies(register):
+    register("thermostat", "my_xairl_plugin.thermostat:thermostat_policy",
+             "heat or idle, from temperature and occupancy")
 
 
 @xairl.hookimpl
-def register_policies(register):
-    register("thermostat", "my_xairl_plugin:thermostat_policy", "heat or idle, from temperature and occupancy")
+def register_attributors(register):
+    register("occlusion", "my_xairl_plugin.occlusion:Occlusion",
+             "occlusion: score drop when one feature is replaced by background values (not additive)")
+
+
+@xairl.hookimpl
+def register_narrators(register):
+    register("shortest", "my_xairl_plugin.shortest:ShortestNarrator",
+             "the shortest phrasing of each sentence, at most max_sentences sentences")
 
 
 @xairl.hookimpl
@@ -39,6 +39,8 @@ def register_commands(register):
         parser.set_defaults(run=run)
 
     def run(args):
+        from .thermostat import thermostat_policy
+
         policy = thermostat_policy()
         exp = xairl.explain(policy, [[args.temperature, 1.0]], method="exact")
         print(xairl.narrate(exp, 0, policy=policy, template="thermostat").text)

@@ -63,7 +63,7 @@ def dqn_update(q: torch.nn.Module, target: torch.nn.Module, opt: torch.optim.Opt
     loss.backward()
     torch.nn.utils.clip_grad_norm_(q.parameters(), 10.0)
     opt.step()
-    return float(loss)
+    return float(loss.detach())
 
 
 def _networks(tc: TrainConfig, sim_cfg: SimConfig):

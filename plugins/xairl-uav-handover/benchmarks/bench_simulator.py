@@ -1,6 +1,7 @@
-"""UAV-steps per second of the vectorised TR 36.777 simulator (goal: >= 200k/s on 2 cores), under CHM control.
+"""UAV-steps per second of the vectorised TR 36.777 simulator (goal: >= 200k/s on 2 cores), under CHM control,
+stepped through the vectorised Gymnasium env as training and evaluation do.
 
-Run: .venv/bin/python benchmarks/bench_simulator.py
+Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/bench_simulator.py
 """
 import os
 import platform
@@ -10,7 +11,7 @@ import numpy as np
 
 from xairl_uav_handover.baselines import CHM
 from xairl_uav_handover.config import SimConfig
-from xairl_uav_handover.simulator import Simulator
+from xairl_uav_handover.env import HandoverVecEnv
 
 GOAL = 200_000
 
@@ -18,12 +19,13 @@ GOAL = 200_000
 def rate(n_uavs: int, steps: int, repeats: int = 3) -> float:
     times = []
     for r in range(repeats):
-        sim = Simulator(SimConfig(), n_uavs=n_uavs, seed=r)
+        env = HandoverVecEnv(SimConfig(), n_flights=n_uavs, decision_every=1)
+        env.reset(seed=r)
         chm = CHM()
-        chm.reset(sim)
+        chm.reset(env)
         t0 = time.perf_counter()
         for _ in range(steps):
-            sim.step(chm(sim))
+            env.step(chm(env))
         times.append(time.perf_counter() - t0)
     return n_uavs * steps / float(np.median(times))
 
