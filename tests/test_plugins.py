@@ -124,3 +124,61 @@ def test_import_is_lazy():
             "if m in sys.modules]; print(heavy)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"
+
+
+REPORT = """
+    import numpy as np
+    from pydantic import Field
+    import xairl
+
+    class TinyOptions(xairl.Options):
+        rows: int = Field(1, ge=1, description="rows of the plugin's own table")
+
+    class TinyReport(xairl.Report):
+        name = "tiny"
+        Options = TinyOptions
+
+        def build(self, request):
+            policy = xairl.get_policy("toy")
+            table = xairl.table_html(["k", "square"], [[k, k * k] for k in range(self.options.rows)])
+            return xairl.ReportContent(title="tiny report", policy=policy, background=policy.background(20),
+                                       datasets=[("sampled", policy.background(request.n_states, seed=1))],
+                                       tables=[("squares", table)])
+
+    @xairl.hookimpl
+    def register_reports(register):
+        register("tiny", "tiny_plugin:TinyReport", "a report with one option")
+"""
+
+
+def test_a_plugin_report_declares_its_own_options(tmp_path, monkeypatch, capsys):
+    from xairl.cli import main
+
+    _install(tmp_path, monkeypatch, "tiny", REPORT)
+    monkeypatch.setenv(plugins.LOAD_ENV, "tiny")
+    plugins.reset()
+    out = tmp_path / "rep"
+    assert main(["report", "--plugin", "tiny", "-o", "rows=3", "--n", "4", "--method", "exact", "--out", str(out)]) == 0
+    html = (out / "report.html").read_text()
+    assert "tiny report" in html and "<td>2</td><td>4</td>" in html and "<td>3</td><td>9</td>" not in html
+    assert len((out / "explanations.jsonl").read_text().splitlines()) == 4
+    capsys.readouterr()
+    assert main(["report", "--plugin", "tiny", "-o", "colour=red", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "colour: unknown option" in err and "options: rows" in err
+    assert main(["report", "--plugin", "nope", "--out", str(out)]) == 2
+    assert "unknown report 'nope'; known: tiny" in capsys.readouterr().err
+
+
+def test_facts_hook_must_return_domain_facts():
+    from xairl.toy import toy_policy
+
+    policy = toy_policy()
+    exp = xairl.explain(policy, policy.background(1, seed=2), background=policy.background(20), method="exact")
+    policy.facts_hook = lambda state, chosen, runner_up: xairl.DomainFacts(
+        {"note": 7}, (xairl.Comparison("the gap was 1.5 m", 1.5, "m"),))
+    assert xairl.verify("The gap was 1.5 m.", exp, 0, policy).ok
+    assert not xairl.verify("The gap was 2.5 m.", exp, 0, policy).ok
+    policy.facts_hook = lambda state, chosen, runner_up: {"extras": {}, "comparisons": []}
+    with pytest.raises(PluginError, match="facts_hook returned dict; it must return xairl.DomainFacts"):
+        xairl.narrate(exp, 0, policy=policy)

@@ -217,7 +217,25 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("attributors", help="list attribution methods and their options")
     p.add_argument("--json", action="store_true", help="print names and JSON schemas of the options")
     p.set_defaults(run=cmd_attributors)
-    p = sub.add_parser("explain", help="explain a registered policy's decisions on states from a file")
+    _explain_parser(sub.add_parser("explain", help="explain a registered policy's decisions on states from a file"))
+    _report_parser(sub.add_parser("report", help="write a plugin's report (HTML, JSONL, figures) into a folder"))
+    p = sub.add_parser("prompts", help="list, show or check prompt templates")
+    p.add_argument("action", choices=("list", "show", "check"))
+    p.add_argument("target", nargs="?", help="template name (show) or .yaml path (check)")
+    p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder")
+    p.set_defaults(run=cmd_prompts)
+    p = sub.add_parser("review", help="accept, reject or correct recorded narratives in the terminal")
+    p.add_argument("--db", default=None, help="feedback store (default: in the user dir)")
+    p.add_argument("--export", metavar="FILE", help="write the corrections as JSON lines instead of reviewing")
+    p.set_defaults(run=cmd_review)
+    commands = plugins.registry("command")
+    for name in commands.names():
+        entry = commands.entry(name)
+        entry.load()(sub.add_parser(name, help=entry.description))
+    return parser
+
+
+def _explain_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--policy", default="toy", help="registered policy name (see `xairl plugins`); default: toy")
     p.add_argument("--states", help="states to explain: .csv with a header naming the features, .npy or .json; "
                    "default: --n states from the policy's sampler")
@@ -236,7 +254,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--examples-from-feedback", action="store_true",
                    help="give the local LM the operators' latest accepted or corrected narratives as examples")
     p.set_defaults(run=cmd_explain)
-    p = sub.add_parser("report", help="write a plugin's report (HTML, JSONL, figures) into a folder")
+
+
+def _report_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--plugin", required=True, help="the report's name (see `xairl plugins`), e.g. uav-handover")
     p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",
                    help="an option of the plugin's report, validated against its schema (e.g. -o real=PATH)")
@@ -248,20 +268,6 @@ def build_parser() -> argparse.ArgumentParser:
                    help="an option of the attribution method; repeatable")
     _narration_arguments(p)
     p.set_defaults(run=cmd_report)
-    p = sub.add_parser("prompts", help="list, show or check prompt templates")
-    p.add_argument("action", choices=("list", "show", "check"))
-    p.add_argument("target", nargs="?", help="template name (show) or .yaml path (check)")
-    p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder")
-    p.set_defaults(run=cmd_prompts)
-    p = sub.add_parser("review", help="accept, reject or correct recorded narratives in the terminal")
-    p.add_argument("--db", default=None, help="feedback store (default: in the user dir)")
-    p.add_argument("--export", metavar="FILE", help="write the corrections as JSON lines instead of reviewing")
-    p.set_defaults(run=cmd_review)
-    commands = plugins.registry("command")
-    for name in commands.names():
-        entry = commands.entry(name)
-        entry.load()(sub.add_parser(name, help=entry.description))
-    return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
