@@ -76,7 +76,8 @@ def cmd_report(args) -> int:
     method_options = plugins.get_attributor(args.method)(_parse_options(args.method_option)).options.model_dump()
     req = ReportRequest(out=Path(args.out), method=args.method, options=method_options, narrate=args.narrate,
                         narrator=args.narrator, narrator_options=_parse_options(args.narrator_option),
-                        template=args.template, prompt_dirs=args.prompts, seed=args.seed, n_states=args.n)
+                        template=args.template, prompt_dirs=args.prompts, seed=args.seed, n_states=args.n,
+                        robustness=not args.no_robustness)
     req.out.mkdir(parents=True, exist_ok=True)
     path = write_report(req, report.build(req))
     print(f"report: {path.resolve()}")
@@ -128,6 +129,7 @@ def _print_narratives(args, exp, policy, bg) -> int:
         options.setdefault("examples", store.examples())
     for i in range(len(exp.values)):
         n = narrate(exp, i, narrator=args.narrator, template=args.template, policy=policy, background=bg,
+                    robustness=not args.no_robustness,
                     options=options, prompt_dirs=args.prompts, store=store)
         if args.format == "jsonl":
             print(json.dumps({"index": i, "text": n.text, "verified": n.verified, "confidence": n.confidence,
@@ -206,6 +208,8 @@ def _narration_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder, searched first")
     p.add_argument("-n", "--narrator-option", action="append", default=[], metavar="KEY=VALUE",
                    help="a narrator option, e.g. -n mode=rewrite or -n model=PATH")
+    p.add_argument("--no-robustness", action="store_true", help="confidence without the agreement and stability "
+                   "components (saves three extra explanations per narrated state)")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -26,7 +26,8 @@ class ReportRequest:
     """What the user asked of any report (the plugin's own settings are its :attr:`Report.Options`).
 
     :param out: the folder written. ``method`` and ``options``: the attributor and its validated options.
-    :param narrate: narrate ``n_narrated`` decisions and a global summary with ``narrator`` and ``template``.
+    :param narrate: narrate ``n_narrated`` decisions and a global summary with ``narrator`` and ``template``;
+        ``robustness``: include the confidence's agreement and stability (three extra explanations per decision).
     :param seed: seed of everything the plugin samples; ``n_states``: states per dataset.
     """
 
@@ -41,6 +42,7 @@ class ReportRequest:
     seed: int = 0
     n_states: int = 500
     n_narrated: int = 6
+    robustness: bool = True
     progress: bool = True
 
 
@@ -137,7 +139,8 @@ def write_report(req: ReportRequest, content: ReportContent) -> Path:
         for i in tqdm(idx, desc=f"narrating ({req.narrator})", disable=not req.progress):
             narratives.append(narrate(ref, i, narrator=req.narrator, template=req.template or content.template,
                                       policy=content.policy, background=content.background,
-                                      options=req.narrator_options, prompt_dirs=req.prompt_dirs))
+                                      options=req.narrator_options, prompt_dirs=req.prompt_dirs,
+                                      robustness=req.robustness))
         summary = narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs)
         narratives.append(summary)
     settings = {"method": req.method, "options": req.options, "narrator": req.narrator, "seed": req.seed,

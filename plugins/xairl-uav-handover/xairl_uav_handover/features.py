@@ -1,7 +1,7 @@
 """The DQN's state layout (as in the paper) and what each feature means, for plots and narration.
 
-:func:`state_rows` is the one place that lays a state out; the simulator, the real-flight replay and the report
-all build or read states through it and the column slices below.
+:func:`state_rows` is the one place that lays a state out; the simulator and the real-flight replay build states
+through it, and code that reads a state uses :data:`FEATURES` or the column slice below.
 """
 import numpy as np
 
@@ -10,8 +10,7 @@ from xairl import Comparison, DomainFacts, FeatureInfo
 N_CANDIDATES = 4  # candidate 0 is the serving BS (stay); 1..3 the strongest other BSs
 FEATURES = ("x", "y", "z", "buffer_queue_size", "serving_bs",
             *(f"rsrp_{k}" for k in range(N_CANDIDATES)), *(f"rsrq_{k}" for k in range(N_CANDIDATES)))
-POSITION, BUFFER, SERVING = slice(0, 3), 3, 4
-RSRP, RSRQ = slice(5, 5 + N_CANDIDATES), slice(5 + N_CANDIDATES, 5 + 2 * N_CANDIDATES)
+RSRP = slice(5, 5 + N_CANDIDATES)  # the candidates' RSRP columns, serving BS first
 #: action k: associate with candidate k; candidate 0 is the serving BS, so action 0 is "stay"
 ACTIONS = ("stay", *(f"handover_to_candidate_{k}" for k in range(1, N_CANDIDATES)))
 #: words followed by an identifier in this plugin's narratives ("BS 15", "candidate 2"), not by a quantity
