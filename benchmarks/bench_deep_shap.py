@@ -59,6 +59,7 @@ def main():
     ap.add_argument("--device", default="cuda" if torch.cuda.is_available() else "cpu")
     ap.add_argument("--peer-max", type=int, default=10000, help="largest size at which shap and captum are timed")
     ap.add_argument("--policy", default=None, help="also a registered policy, e.g. uav-dqn")
+    ap.add_argument("--models", default="", help="comma-separated names to run (default all), e.g. uav-dqn")
     args = ap.parse_args()
     import captum
     import shap
@@ -70,7 +71,10 @@ def main():
           f"shap {shap.__version__}, captum {captum.__version__}; device {dev}")
     print(f"{'model':<20}{'states':>7}{'xairl s':>9}{'shap s':>9}{'captum s':>10}{'x shap':>9}{'x captum':>10}"
           f"{'max|diff| shap':>16}{'captum':>10}")
+    wanted = {m for m in args.models.split(",") if m}
     for name, policy in models(dev, args.policy).items():
+        if wanted and name not in wanted:
+            continue
         bg = torch.as_tensor(policy.background(100, seed=1), device=dev)
         for n in (int(s) for s in args.sizes.split(",")):
             x = torch.as_tensor(policy.background(n, seed=2), device=dev)

@@ -16,6 +16,7 @@ _LAZY = {
     "from_sb3": "xairl.policy",
     "FeatureInfo": "xairl.policy",
     "Explanation": "xairl.explanation",
+    "StateRecord": "xairl.explanation",
     # attribution
     "explain": "xairl.attributors",
     "Attributor": "xairl.attributors",

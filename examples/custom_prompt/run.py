@@ -6,12 +6,11 @@ from pathlib import Path
 
 import xairl
 from xairl import prompts
-from xairl.toy import toy_policy
 
 here = Path(__file__).parent / "prompts"
 for path in sorted(here.glob("*.yaml")):
     print(path.name, "ok" if not prompts.check(path) else prompts.check(path))
-policy = toy_policy()
+policy = xairl.get_policy("toy")
 exp = xairl.explain(policy, policy.background(2, seed=4))
 for name in ("explain_action", "one_liner"):
     n = xairl.narrate(exp, 0, template=name, policy=policy, prompt_dirs=[here])

@@ -8,7 +8,7 @@ import torch
 import xairl
 from xairl import plugins
 from xairl.cli import main
-from xairl.errors import CheckpointError
+from xairl import CheckpointError
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.evaluate import table_one
 from xairl_uav_handover.features import FEATURES

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from xairl.cli import main
-from xairl.errors import InputError
-from xairl.explanation import StateRecord
+from xairl import InputError
+from xairl import StateRecord
 from xairl_uav_handover.real_data import baltaci_rate_by_altitude, load_flight, load_folder, replay
 
 DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
