@@ -17,16 +17,27 @@ ACTIONS = ("stay", *(f"handover_to_candidate_{k}" for k in range(1, N_CANDIDATES
 LABEL_WORDS = ("BS", "candidate")
 
 
-def state_rows(position, queue_bits, serving_id, rsrp, rsrq) -> np.ndarray:
-    """States (K, 13) float32 in :data:`FEATURES` order.
+def state_rows(position, queue_bits, serving_id, rsrp, rsrq, observation) -> np.ndarray:
+    """States (K, 13) float32 in :data:`FEATURES` order, as the UE reports them (``ObservationConfig``): x, y
+    quantised to ``position_grid_m`` when it is set; an empty candidate slot (NaN) reported at the detection limit.
 
-    :param position: (K, 3) x, y, z in metres; ``queue_bits`` (K,); ``serving_id`` (K,) the serving BS's id.
-    :param rsrp: (K, 4) dBm of the candidates (serving first); ``rsrq`` (K, 4) dB.
+    :param position: (K, 3) x, y, z in metres: x east and y north of the centre of the area the UAVs fly in (the
+        grid's centre site in simulation, the campaign area's centre for real flights); ``queue_bits`` (K,);
+        ``serving_id`` (K,) the serving BS's id.
+    :param rsrp: (K, 4) dBm of the candidates (serving first), NaN where no neighbour is measured; ``rsrq`` (K, 4) dB.
     """
-    position = np.asarray(position, dtype=float).reshape(-1, 3)
+    position = np.array(position, dtype=float).reshape(-1, 3)
     k = len(position)
-    return np.concatenate([position, np.reshape(queue_bits, (k, 1)), np.reshape(serving_id, (k, 1)),
-                           np.reshape(rsrp, (k, N_CANDIDATES)), np.reshape(rsrq, (k, N_CANDIDATES))],
+    if observation.position_grid_m > 0:
+        position[:, :2] = np.round(position[:, :2] / observation.position_grid_m) * observation.position_grid_m
+    rsrp = np.array(rsrp, dtype=float).reshape(k, N_CANDIDATES)
+    rsrq = np.array(rsrq, dtype=float).reshape(k, N_CANDIDATES)
+    empty = np.isnan(rsrp) | np.isnan(rsrq)
+    limit = observation.detection_rsrq_db
+    # both cells' RSRQ share one RSSI, so RSRP differs by the RSRQ difference: the slot sits exactly at the limit
+    rsrp = np.where(empty, rsrp[:, :1] + limit - rsrq[:, :1], rsrp)
+    rsrq = np.where(empty, limit, rsrq)
+    return np.concatenate([position, np.reshape(queue_bits, (k, 1)), np.reshape(serving_id, (k, 1)), rsrp, rsrq],
                           axis=1).astype(np.float32)
 GROUPS = {"position": ("x", "y", "z"), "rsrp": ("rsrp_0", "rsrp_1", "rsrp_2", "rsrp_3"),
           "rsrq": ("rsrq_0", "rsrq_1", "rsrq_2", "rsrq_3")}

@@ -108,6 +108,23 @@ def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
                   action_aliases=ACTION_ALIASES, facts_hook=handover_facts)
 
 
+def dqn_decision_states(ckpt: Checkpoint, n: int, seed: int = 0, epsilon: float = 0.0) -> np.ndarray:
+    """``n`` states at which the DQN decided, sampled from 64 held-out flights it flew itself; with ``epsilon``,
+    that share of its decisions is random (0.5: the mix of exploration and greedy steps that training sees)."""
+    env = HandoverVecEnv(ckpt.sim_config, n_flights=64)
+    obs, _ = env.reset(seed=2_000_000 + seed)
+    rng = np.random.default_rng(seed)
+    seen, truncated = [], np.zeros(64, bool)
+    while not truncated.all():
+        seen.append(obs)
+        with torch.no_grad():
+            act = ckpt.net(torch.as_tensor(obs)).argmax(dim=1).numpy()
+        act = np.where(rng.uniform(size=64) < epsilon, rng.integers(len(ACTIONS), size=64), act)
+        obs, _, _, truncated, _ = env.step(act)
+    states = np.concatenate(seen)
+    return states[np.random.default_rng(seed).choice(len(states), size=min(n, len(states)), replace=False)]
+
+
 class DQNController:
     """Acts greedily with a Q-network, one decision per env step (every ``decision_every`` simulator steps)."""
 
