@@ -9,7 +9,8 @@ import pytest
 from xairl.cli import main
 from xairl import InputError
 from xairl import StateRecord
-from xairl_uav_handover.real_data import baltaci_rate_by_altitude, load_flight, load_folder, replay
+from xairl_uav_handover.real_data import (agreement, baltaci_rate_by_altitude, chm_handovers, load_flight,
+                                          load_folder, walk)
 
 DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
 UKM = DATA / "ukm-uav-lte" / "raw"
@@ -24,10 +25,26 @@ def test_load_one_flight():
     assert -98 <= f.rsrp.min() and f.rsrp.max() <= -50
     assert np.abs(f.xy).max() < 2000  # local metres around the campus
     assert f.observed_handovers == int((np.diff(f.pci) != 0).sum()) > 10
-    o = replay(f, None)
-    assert o.handovers == f.observed_handovers and o.states.shape == (len(f.t), 13)
-    assert (o.states[:, 5] == f.rsrp).all(), "candidate 0 is the network's serving cell"
-    assert (np.diff(o.states[:, 6:9], axis=1) <= 0).all(), "neighbours sorted by RSRP"
+    w = walk(f)
+    assert w.states.shape == (len(f.t), 13) and (w.serving == f.pci).all()
+    assert int((w.next_serving != w.serving).sum()) == f.observed_handovers
+    assert (w.states[:, 5] == f.rsrp).all(), "candidate 0 is the network's serving cell"
+    for state, cand in zip(w.states, w.candidates):
+        assert (np.diff(state[6:5 + len(cand)]) <= 0).all(), "measured neighbours sorted by RSRP"
+        assert (state[9 + len(cand):] == -24.0).all(), "empty slots at the detection limit"
+    assert 0 < (w.queue_bits > 0).mean() < 1 and w.queue_bits.max() <= 2e6
+
+
+@needs_data
+def test_open_loop_agreement_on_known_deciders():
+    w = walk(load_flight(UKM / "100m.csv"))
+    stay = agreement([w], lambda _w: (lambda s, c, t: 0))
+    assert (stay.proposals, stay.stay_agreement, stay.handover_agreement) == (0, 1.0, 0.0)
+    assert stay.network_handovers == int((w.next_serving != w.serving).sum())
+    follow = dict(zip(w.t.tolist(), w.next_serving.tolist()))  # an oracle that does what the network did next
+    oracle = agreement([w], lambda _w: (lambda s, c, t: c.index(follow[t]) if follow[t] in c else 0))
+    assert oracle.stay_agreement == 1.0 and oracle.target_agreement == oracle.handover_agreement > 0.5
+    assert chm_handovers(load_flight(UKM / "100m.csv")) > 0
 
 
 @needs_data
@@ -87,7 +104,9 @@ def test_report_with_real_data(tmp_path):
     assert main(["report", "--plugin", "uav-handover", "--n", "30", "-o", f"real={real}", "-o", "flights=20", "--out",
                  str(out)]) == 0
     html = (out / "report.html").read_text()
-    assert "Real flights: 2 loaded" in html and "network (observed)" in html and "Baltaci" in html
+    assert "Calibration: handovers per minute by altitude band (2 real flights" in html and "Baltaci" in html
+    assert "Open-loop agreement with the live network" in html and "Spearman rank correlation real vs simulated" in html
+    assert "finding (buffer first, position second)" in html
     datasets = {json.loads(x)["dataset"] for x in (out / "explanations.jsonl").read_text().splitlines()}
     assert datasets == {"simulated", "real"}
 
