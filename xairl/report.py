@@ -12,7 +12,7 @@ import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import ClassVar
+from typing import Callable, ClassVar
 
 import numpy as np
 
@@ -54,6 +54,9 @@ class ReportContent:
     :param tables: (title, HTML) pairs, e.g. from :func:`table_html`; ``figures`` (caption, PNG path) pairs.
     :param notes: sentences listed at the end; ``settings`` extra rows of the settings table.
     :param template: the decision template narrated by default.
+    :param commentary: optional ``f({label: Explanation}) -> [sentence, ...]``, called once the datasets are
+        explained: the plugin's reading of the explanations (e.g. which of a paper's findings hold), listed first
+        among the notes.
     """
 
     title: str
@@ -65,6 +68,7 @@ class ReportContent:
     notes: list[str] = field(default_factory=list)
     settings: dict = field(default_factory=dict)
     template: str = "explain_action"
+    commentary: Callable[[dict[str, Explanation]], list[str]] | None = None
 
 
 class Report:
@@ -93,6 +97,23 @@ def table_html(header: list[str], rows: list[list]) -> str:
     head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
     body = "".join("<tr>" + "".join(f"<td>{cell(v)}</td>" for v in r) + "</tr>" for r in rows)
     return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def importance_table(exps: list[tuple[str, Explanation]]) -> tuple[str, str]:
+    """Each feature's rank by mean |contribution to the chosen action| per dataset, and the Spearman rank
+    correlation of every dataset's global importance with the first's."""
+    from scipy.stats import spearmanr
+
+    imp = [np.abs(e.for_chosen()).mean(axis=0) for _, e in exps]
+    ranks = [np.argsort(np.argsort(-v)) + 1 for v in imp]
+    names = exps[0][1].feature_names
+    rows = [[f, *[int(r[j]) for r in ranks], *[float(v[j]) for v in imp]] for j, f in
+            sorted(enumerate(names), key=lambda t: ranks[0][t[0]])]
+    rhos = [float(spearmanr(imp[0], v).statistic) for v in imp[1:]]
+    title = "Global importance by dataset" + "".join(f"; Spearman rank correlation {label} vs {exps[0][0]}: {rho:.2f}"
+                                                    for (label, _), rho in zip(exps[1:], rhos))
+    header = ["feature", *[f"rank ({label})" for label, _ in exps], *[f"mean |contribution| ({label})" for label, _ in exps]]
+    return title, table_html(header, rows)
 
 
 def _interesting(exp: Explanation) -> int:
@@ -132,7 +153,13 @@ def write_report(req: ReportRequest, content: ReportContent) -> Path:
                ("Global importance: mean |contribution|", plots.importance_bars(exps, out / "importance.png")),
                (f"One decision ({ref_label} state {pick}: {ref.action_names[ref.chosen[pick]]})",
                 plots.waterfall(ref, pick, out / "waterfall.png"))]
+    groups = dict(content.policy.groups)
+    if groups:
+        figures.append((f"Global importance by group ({'; '.join(g + ' = ' + ', '.join(m) for g, m in groups.items())})",
+                        plots.importance_bars([(l, e.grouped(groups)) for l, e in exps], out / "importance_groups.png")))
     figures += content.figures
+    tables = list(content.tables) + ([importance_table(exps)] if len(exps) > 1 else [])
+    notes = (content.commentary({label: e for label, e in exps}) if content.commentary else []) + content.notes
     narratives = []
     if req.narrate:
         idx = [pick] + [i for i in range(len(ref.values)) if i != pick][: max(req.n_narrated - 1, 0)]
@@ -141,13 +168,14 @@ def write_report(req: ReportRequest, content: ReportContent) -> Path:
                                       policy=content.policy, background=content.background,
                                       options=req.narrator_options, prompt_dirs=req.prompt_dirs,
                                       robustness=req.robustness))
-        summary = narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs)
-        narratives.append(summary)
+        narratives.append(narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs))
+        if groups:  # the groups narrated as one reason each
+            narratives.append(narrate(ref.grouped(groups), None, policy=content.policy, prompt_dirs=req.prompt_dirs))
     settings = {"method": req.method, "options": req.options, "narrator": req.narrator, "seed": req.seed,
                 "background states": len(content.background), "seconds to explain, plot and narrate": round(time.time() - t0, 1),
                 **content.settings}
     path = out / "report.html"
-    path.write_text(_html(content, exps, figures, narratives, settings))
+    path.write_text(_html(content.title, tables, notes, exps, figures, narratives, settings))
     return path
 
 
@@ -155,12 +183,12 @@ def _img(path: Path) -> str:
     return "data:image/png;base64," + base64.b64encode(Path(path).read_bytes()).decode()
 
 
-def _html(content, exps, figures, narratives, settings) -> str:
-    parts = [f"<h1>{html.escape(content.title)}</h1>"]
+def _html(title, tables, notes, exps, figures, narratives, settings) -> str:
+    parts = [f"<h1>{html.escape(title)}</h1>"]
     parts.append("<h2>Settings</h2>" + table_html(["setting", "value"], [[k, json.dumps(v) if isinstance(v, (dict, list))
                                                                          else v] for k, v in settings.items()]))
-    for title, table in content.tables:
-        parts.append(f"<h2>{html.escape(title)}</h2>{table}")
+    for heading, table in tables:
+        parts.append(f"<h2>{html.escape(heading)}</h2>{table}")
     parts.append("<h2>Explanations</h2><p>" + ", ".join(f"{html.escape(l)}: {len(e.values)} states, largest "
                                                        f"additivity gap {e.additivity_gap.max():.1e}" for l, e in exps)
                  + "</p>")
@@ -176,11 +204,11 @@ def _html(content, exps, figures, narratives, settings) -> str:
             parts.append(f"<div class=narr><p>{html.escape(n.text)}</p><p class=meta>{mark} &middot; confidence "
                          f"{n.confidence:.2f} ({html.escape(comp)}) &middot; {where} &middot; template "
                          f"{html.escape(n.template)} &middot; {html.escape(n.source)}</p></div>")
-    if content.notes:
-        parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in content.notes) + "</ul>")
+    if notes:
+        parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in notes) + "</ul>")
     style = ("body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}table{border-collapse:collapse;"
              "margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}"
              "img{max-width:100%}.narr{border-left:4px solid #8ab;padding:0 1em;margin:1em 0}.meta{color:#555;"
              "font-size:90%}.ok{color:#070;font-weight:bold}.bad{color:#b00;font-weight:bold}")
-    return (f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(content.title)}</title>"
+    return (f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
             f"<style>{style}</style></head><body>{''.join(parts)}</body></html>")

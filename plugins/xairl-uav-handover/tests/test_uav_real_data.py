@@ -68,6 +68,7 @@ def test_report_without_real_data(tmp_path, capsys):
     html = (out / "report.html").read_text()
     assert "Table I" in html and html.count("data:image/png;base64,") >= 3
     assert "&#10003; verified" in html and "confidence" in html
+    assert "Over 40 states, the most important features were position (mean |contribution|" in html  # the group
     lines = (out / "explanations.jsonl").read_text().splitlines()
     assert len(lines) == 40
     rec = StateRecord.model_validate_json(lines[0])
@@ -88,6 +89,8 @@ def test_report_with_real_data(tmp_path):
                  str(out)]) == 0
     html = (out / "report.html").read_text()
     assert "Real flights: 2 loaded" in html and "network (observed)" in html and "Baltaci" in html
+    assert "Spearman rank correlation real vs simulated" in html and "Global importance by group (position = x, y, z" in html
+    assert html.count("finding (buffer first, position second)") == 2  # one statement per dataset
     datasets = {json.loads(x)["dataset"] for x in (out / "explanations.jsonl").read_text().splitlines()}
     assert datasets == {"simulated", "real"}
 

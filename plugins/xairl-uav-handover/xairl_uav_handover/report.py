@@ -9,10 +9,11 @@ from pathlib import Path
 import numpy as np
 from pydantic import Field
 
-from xairl import Options, Report, ReportContent, ReportRequest, table_html
+from xairl import Explanation, Options, Report, ReportContent, ReportRequest, table_html
 
 from .baselines import CHM, SAMRO, CHMOnSamples
 from .evaluate import PAPER, chm_rate_by_altitude, table_one
+from .features import GROUPS
 from .policy import Checkpoint, DQNController, background_states, load_checkpoint, uav_policy
 
 PP_WINDOWS = (1.0, 5.0)
@@ -87,7 +88,7 @@ class UAVReport(Report):
             tables=[self._table_one(ckpt, req.seed)],
             settings={"checkpoint": ckpt.path.name, "training command": ckpt.meta.get("command"),
                       "simulated states": req.n_states, "real data": self.options.real or "not given (-o real=PATH)"},
-            template="handover",
+            template="handover", commentary=findings,
             notes=["Simulated states: UAVs after 10 s of flight under conventional handover (TR 36.777 UMa-AV).",
                    "Contributions are to the chosen action's Q-value; the background is 100 simulated states."])
         if self.options.real:
@@ -125,6 +126,21 @@ class UAVReport(Report):
                                + (f", {len(bad)} skipped" if bad else ""), _table(rows)))
         content.notes += [f"skipped file: {b}" for b in bad] + _real_notes(rows)
         content.figures.append(_altitude_figure(req.out, self.options.real, cfg, flights, req.seed))
+
+
+def findings(exps: dict[str, Explanation]) -> list[str]:
+    """Which of the paper's findings hold here, read off the explanations (mean |contribution to the margin|)."""
+    out = []
+    for label, exp in exps.items():
+        grouped = exp.grouped({"position": GROUPS["position"]})
+        imp = np.abs(grouped.margin()).mean(axis=0)
+        order = [grouped.feature_names[j] for j in np.argsort(-imp)]
+        buf, pos = order.index("buffer_queue_size") + 1, order.index("position") + 1
+        holds = "holds" if buf == 1 and pos == 2 else "does not hold"
+        out.append(f"Paper's Figure 2 finding (buffer first, position second) {holds} on the {label} states: by mean "
+                   f"|contribution to the margin over the runner-up| the buffer ranks {buf} and position (x, y, z) "
+                   f"{pos}; the top three are {', '.join(order[:3])}.")
+    return out
 
 
 def _real_notes(rows: list[ReplayRow]) -> list[str]:
