@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from xairl.cli import main
-from xairl import InputError
-from xairl import StateRecord
-from xairl_uav_handover.real_data import baltaci_rate_by_altitude, load_flight, load_folder, replay
+from xairl import InputError, StateRecord
+from xairl_uav_handover.config import CHMConfig
+from xairl_uav_handover.real_data import baltaci_rate_by_altitude, chm_handovers, load_flight, load_folder, replay
 
 DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
 UKM = DATA / "ukm-uav-lte" / "raw"
@@ -28,6 +28,14 @@ def test_load_one_flight():
     assert o.handovers == f.observed_handovers and o.states.shape == (len(f.t), 13)
     assert (o.states[:, 5] == f.rsrp).all(), "candidate 0 is the network's serving cell"
     assert (np.diff(o.states[:, 6:9], axis=1) <= 0).all(), "neighbours sorted by RSRP"
+
+
+@needs_data
+def test_chm_replayed_on_real_measurements():
+    f = load_flight(UKM / "100m.csv")
+    n = chm_handovers(f)
+    assert 0 < n < len(f.t) / 2  # A3 needs two consecutive samples 2 dB above the serving cell
+    assert chm_handovers(f, CHMConfig(offset_db=6.0)) < n  # a larger offset hands over less
 
 
 @needs_data
@@ -89,6 +97,7 @@ def test_report_with_real_data(tmp_path):
                  str(out)]) == 0
     html = (out / "report.html").read_text()
     assert "Real flights: 2 loaded" in html and "network (observed)" in html and "Baltaci" in html
+    assert "Handover dynamics by altitude band" in html and "<td>20-60 m</td><td>1</td>" in html and "<td>100-160 m</td><td>1</td>" in html
     assert "Spearman rank correlation real vs simulated" in html and "Global importance by group (position = x, y, z" in html
     assert html.count("finding (buffer first, position second)") == 2  # one statement per dataset
     datasets = {json.loads(x)["dataset"] for x in (out / "explanations.jsonl").read_text().splitlines()}

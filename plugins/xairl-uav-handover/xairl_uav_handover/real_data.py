@@ -228,6 +228,32 @@ def replay(f: RealFlight, decide, config: SimConfig | None = None, seed: int = 0
                   float(np.mean(service.queues)) / 1e3, service.lost / 1e3)
 
 
+def chm_handovers(f: RealFlight, config=None) -> int:
+    """Handovers of CHM flying its own serving cell along the real measurements (closed loop): the simulator's A3
+    trigger on the samples' time stamps; a cell that is no longer measured is left for the strongest one measured
+    (a handover too). The rate to compare with simulated CHM."""
+    from .baselines import A3Trigger
+    from .config import CHMConfig
+
+    cfg = config or CHMConfig()
+    cells = sorted(set(f.pci.tolist()) | {p for p in f.nb_pci.ravel().tolist() if np.isfinite(p)})
+    col = {c: j for j, c in enumerate(cells)}
+    a3 = A3Trigger(1, len(cells))
+    serving, handovers = f.pci[0], 0
+    for i in range(len(f.t)):
+        measured = _measured(f, i)
+        if serving not in measured:
+            serving, handovers = max(measured, key=lambda p: measured[p][0]), handovers + 1
+            a3.since[:] = np.nan
+        rsrp = np.full((1, len(cells)), -np.inf)
+        for p, (r, _) in measured.items():
+            rsrp[0, col[p]] = r
+        target = cells[a3.targets(rsrp, np.array([col[serving]]), cfg.offset_db, cfg.ttt_s, now=float(f.t[i]))[0]]
+        if target != serving:
+            serving, handovers = target, handovers + 1
+    return handovers
+
+
 def baltaci_rate_by_altitude(folder: str | Path) -> tuple[np.ndarray, np.ndarray, int]:
     """Handovers per minute per modem in 10 m height bins from the Baltaci et al. IMC'22 handover events.
 
