@@ -142,8 +142,10 @@ REPORT = """
             policy = xairl.get_policy("toy")
             table = xairl.table_html(["k", "square"], [[k, k * k] for k in range(self.options.rows)])
             return xairl.ReportContent(title="tiny report", policy=policy, background=policy.background(20),
-                                       datasets=[("sampled", policy.background(request.n_states, seed=1))],
-                                       tables=[("squares", table)])
+                                       datasets=[("sampled", policy.background(request.n_states, seed=1)),
+                                                 ("again", policy.background(request.n_states, seed=1))],
+                                       tables=[("squares", table)],
+                                       commentary=lambda exps: [f"read {', '.join(exps)}"])
 
     @xairl.hookimpl
     def register_reports(register):
@@ -161,7 +163,9 @@ def test_a_plugin_report_declares_its_own_options(tmp_path, monkeypatch, capsys)
     assert main(["report", "--plugin", "tiny", "-o", "rows=3", "--n", "4", "--method", "exact", "--out", str(out)]) == 0
     html = (out / "report.html").read_text()
     assert "tiny report" in html and "<td>2</td><td>4</td>" in html and "<td>3</td><td>9</td>" not in html
-    assert len((out / "explanations.jsonl").read_text().splitlines()) == 4
+    assert len((out / "explanations.jsonl").read_text().splitlines()) == 8
+    # two identical datasets: the same ranks, a rank correlation of exactly 1; the commentary saw both
+    assert "Spearman rank correlation again vs sampled: 1.00" in html and "<li>read sampled, again</li>" in html
     capsys.readouterr()
     assert main(["report", "--plugin", "tiny", "-o", "colour=red", "--out", str(out)]) == 2
     err = capsys.readouterr().err

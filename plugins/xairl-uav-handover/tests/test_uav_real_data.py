@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from xairl.cli import main
-from xairl import InputError
-from xairl import StateRecord
+from xairl import InputError, StateRecord
+from xairl_uav_handover.config import CHMConfig
 from xairl_uav_handover.real_data import (agreement, baltaci_rate_by_altitude, chm_handovers, load_flight,
                                           load_folder, walk)
 
@@ -45,6 +45,14 @@ def test_open_loop_agreement_on_known_deciders():
     oracle = agreement([w], lambda _w: (lambda s, c, t: c.index(follow[t]) if follow[t] in c else 0))
     assert oracle.stay_agreement == 1.0 and oracle.target_agreement == oracle.handover_agreement > 0.5
     assert chm_handovers(load_flight(UKM / "100m.csv")) > 0
+
+
+@needs_data
+def test_chm_replayed_on_real_measurements():
+    f = load_flight(UKM / "100m.csv")
+    n = chm_handovers(f)
+    assert 0 < n < len(f.t) / 2  # A3 needs two consecutive samples 2 dB above the serving cell
+    assert chm_handovers(f, CHMConfig(offset_db=6.0)) < n  # a larger offset hands over less
 
 
 @needs_data
