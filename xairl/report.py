@@ -132,7 +132,6 @@ def write_report(req: ReportRequest, content: ReportContent) -> Path:
 
     from . import plots
     from .attributors import explain
-    from .narrators import narrate
 
     t0 = time.time()
     out = Path(req.out)
@@ -160,23 +159,32 @@ def write_report(req: ReportRequest, content: ReportContent) -> Path:
     figures += content.figures
     tables = list(content.tables) + ([importance_table(exps)] if len(exps) > 1 else [])
     notes = (content.commentary({label: e for label, e in exps}) if content.commentary else []) + content.notes
-    narratives = []
-    if req.narrate:
-        idx = [pick] + [i for i in range(len(ref.values)) if i != pick][: max(req.n_narrated - 1, 0)]
-        for i in tqdm(idx, desc=f"narrating ({req.narrator})", disable=not req.progress):
-            narratives.append(narrate(ref, i, narrator=req.narrator, template=req.template or content.template,
-                                      policy=content.policy, background=content.background,
-                                      options=req.narrator_options, prompt_dirs=req.prompt_dirs,
-                                      robustness=req.robustness))
-        narratives.append(narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs))
-        if groups:  # the groups narrated as one reason each
-            narratives.append(narrate(ref.grouped(groups), None, policy=content.policy, prompt_dirs=req.prompt_dirs))
+    narratives = _narratives(req, content, ref, pick) if req.narrate else []
     settings = {"method": req.method, "options": req.options, "narrator": req.narrator, "seed": req.seed,
                 "background states": len(content.background), "seconds to explain, plot and narrate": round(time.time() - t0, 1),
                 **content.settings}
     path = out / "report.html"
     path.write_text(_html(content.title, tables, notes, exps, figures, narratives, settings))
     return path
+
+
+def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, pick: int) -> list:
+    """Narrated decisions of the reference dataset (``pick`` first), its global summary and, with groups, the
+    summary with each group as one reason."""
+    from tqdm import tqdm
+
+    from .narrators import narrate
+
+    idx = [pick] + [i for i in range(len(ref.values)) if i != pick][: max(req.n_narrated - 1, 0)]
+    out = [narrate(ref, i, narrator=req.narrator, template=req.template or content.template, policy=content.policy,
+                   background=content.background, options=req.narrator_options, prompt_dirs=req.prompt_dirs,
+                   robustness=req.robustness)
+           for i in tqdm(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)]
+    out.append(narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs))
+    if content.policy.groups:
+        out.append(narrate(ref.grouped(dict(content.policy.groups)), None, policy=content.policy,
+                           prompt_dirs=req.prompt_dirs))
+    return out
 
 
 def _img(path: Path) -> str:
