@@ -153,6 +153,11 @@ class Replay:
     mean_buffer_kbit: float
     lost_kbit: float
 
+    @property
+    def changes(self) -> int:
+        """Every change of serving cell: the policy's handovers and the forced ones."""
+        return self.handovers + self.forced
+
     def pingpongs(self, window_s: float) -> int:
         """Handovers back to the previous cell within ``window_s`` (the minimum time of stay)."""
         return int((self.returns < window_s).sum())
@@ -228,30 +233,12 @@ def replay(f: RealFlight, decide, config: SimConfig | None = None, seed: int = 0
                   float(np.mean(service.queues)) / 1e3, service.lost / 1e3)
 
 
-def chm_handovers(f: RealFlight, config=None) -> int:
-    """Handovers of CHM flying its own serving cell along the real measurements (closed loop): the simulator's A3
-    trigger on the samples' time stamps; a cell that is no longer measured is left for the strongest one measured
-    (a handover too). The rate to compare with simulated CHM."""
-    from .baselines import A3Trigger
-    from .config import CHMConfig
+def chm_handovers(f: RealFlight, config=None, sim_config: SimConfig | None = None) -> int:
+    """Changes of serving cell (forced ones included) of CHM flown closed-loop along the real measurements by
+    :func:`replay` (A3 on the samples' time stamps): the count to compare with simulated CHM."""
+    from .baselines import CHMOnSamples
 
-    cfg = config or CHMConfig()
-    cells = sorted(set(f.pci.tolist()) | {p for p in f.nb_pci.ravel().tolist() if np.isfinite(p)})
-    col = {c: j for j, c in enumerate(cells)}
-    a3 = A3Trigger(1, len(cells))
-    serving, handovers = f.pci[0], 0
-    for i in range(len(f.t)):
-        measured = _measured(f, i)
-        if serving not in measured:
-            serving, handovers = max(measured, key=lambda p: measured[p][0]), handovers + 1
-            a3.since[:] = np.nan
-        rsrp = np.full((1, len(cells)), -np.inf)
-        for p, (r, _) in measured.items():
-            rsrp[0, col[p]] = r
-        target = cells[a3.targets(rsrp, np.array([col[serving]]), cfg.offset_db, cfg.ttt_s, now=float(f.t[i]))[0]]
-        if target != serving:
-            serving, handovers = target, handovers + 1
-    return handovers
+    return replay(f, CHMOnSamples(f.cells, config), sim_config).changes
 
 
 def baltaci_rate_by_altitude(folder: str | Path) -> tuple[np.ndarray, np.ndarray, int]:

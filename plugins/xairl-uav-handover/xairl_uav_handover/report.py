@@ -84,17 +84,16 @@ class BandRow:
               "CHM simulated HO/min", "simulated / real CHM"]
 
 
-def band_rows(flights, cfg, seed: int) -> list[BandRow]:
-    from .real_data import chm_handovers
-
+def band_rows(flights, chm_runs: list, cfg, seed: int) -> list[BandRow]:
+    """One row per altitude band with flights; ``chm_runs``: CHM's closed-loop replay of each flight."""
     rows = []
     for lo, hi in BANDS:
-        inside = [f for f in flights if lo <= f.altitude_m < hi]
+        inside = [(f, run) for f, run in zip(flights, chm_runs) if lo <= f.altitude_m < hi]
         if not inside:
             continue
-        minutes = sum(f.t[-1] / 60 for f in inside)
-        live = sum(f.observed_handovers for f in inside) / minutes
-        real = sum(chm_handovers(f) for f in inside) / minutes
+        minutes = sum(f.t[-1] / 60 for f, _ in inside)
+        live = sum(f.observed_handovers for f, _ in inside) / minutes
+        real = sum(run.changes for _, run in inside) / minutes
         sim = float(np.mean(chm_rate_by_altitude(np.linspace(max(lo, 50.0), hi, 3), cfg, seed=seed)))
         rows.append(BandRow(f"{lo:g}-{hi:g} m", len(inside), live, real, sim, sim / max(real, 1e-9)))
     return rows
@@ -158,7 +157,7 @@ class UAVReport(Report):
                                + (f", {len(bad)} skipped" if bad else ""), _table(rows)))
         content.tables.append(("Handover dynamics by altitude band: the live network, CHM replayed (closed loop) on "
                                "the real measurements, and CHM in the simulator (not yet calibrated: issue 11)",
-                               _table(band_rows(flights, ckpt.sim_config, req.seed))))
+                               _table(band_rows(flights, runs["CHM (A3 2 dB)"], cfg, req.seed))))
         content.notes += [f"skipped file: {b}" for b in bad] + _real_notes(rows)
         content.figures.append(_altitude_figure(req.out, self.options.real, cfg, flights, req.seed))
 
