@@ -23,7 +23,7 @@ from xairl import InputError
 
 from .buffer import buffer_step
 from .config import SimConfig
-from .features import N_CANDIDATES, state_rows
+from .features import FEATURES, N_CANDIDATES, RSRP, state_rows
 from .simulator import hex_layout, n_sites
 from .uplink import capacity_bps, interference_mw, rsrp_offset_db, sinr_db
 
@@ -194,6 +194,12 @@ class UplinkBuffer:
             self.q, self.lost = float(q), self.lost + float(lost)
 
 
+def _candidates(cells: dict, serving, cfg: SimConfig) -> list:
+    """The serving cell, then up to 3 neighbours measured above the detection limit, strongest RSRP first."""
+    detected = [p for p in cells if p != serving and cells[p][1] >= cfg.observation.detection_rsrq_db]
+    return [serving] + sorted(detected, key=lambda p: -cells[p][0])[:N_CANDIDATES - 1]
+
+
 def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
     """The network's own path along ``f`` with the state a policy would see at each sample (see the module doc)."""
     cfg = config or SimConfig()
@@ -204,8 +210,7 @@ def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
     for i in range(len(f.t)):
         cells = _measured(f, i)
         serving = f.pci[i]
-        detected = [p for p in cells if p != serving and cells[p][1] >= cfg.observation.detection_rsrq_db]
-        cand = [serving] + sorted(detected, key=lambda p: -cells[p][0])[:N_CANDIDATES - 1]
+        cand = _candidates(cells, serving, cfg)
         pad = [np.nan] * (N_CANDIDATES - len(cand))
         states.append(state_rows([*f.xy[i], f.altitude_m], link.q, min(ids[serving], max_id),
                                  [cells[p][0] for p in cand] + pad, [cells[p][1] for p in cand] + pad,
@@ -217,30 +222,26 @@ def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
     return Walk(f.t, np.array(states), cands, np.append(f.pci[1:], f.pci[-1]), np.array(queues), link.lost)
 
 
-def chm_handovers(f: RealFlight, config=None) -> int:
-    """Handovers of CHM flying its own serving cell along the real measurements (closed loop): the simulator's A3
-    trigger on the samples' time stamps; a cell that is no longer measured is left for the strongest one measured
-    (a handover too). The rate to compare with simulated CHM."""
-    from .baselines import A3Trigger
-    from .config import CHMConfig
+def chm_handovers(f: RealFlight, config=None, sim_config: SimConfig | None = None) -> int:
+    """Changes of serving cell of CHM flown closed-loop along the real measurements: A3 (:class:`CHMOnSamples`) on
+    the samples' time stamps over CHM's own serving cell and its measured neighbours; a serving cell that is no
+    longer measured is left for the strongest one measured (counted too). The count to compare with simulated CHM."""
+    from .baselines import CHMOnSamples
 
-    cfg = config or CHMConfig()
-    cells = sorted(set(f.pci.tolist()) | {p for p in f.nb_pci.ravel().tolist() if np.isfinite(p)})
-    col = {c: j for j, c in enumerate(cells)}
-    a3 = A3Trigger(1, len(cells))
-    serving, handovers = f.pci[0], 0
+    cfg = sim_config or SimConfig()
+    chm = CHMOnSamples(f.cells, config)
+    serving, changes = f.pci[0], 0
     for i in range(len(f.t)):
-        measured = _measured(f, i)
-        if serving not in measured:
-            serving, handovers = max(measured, key=lambda p: measured[p][0]), handovers + 1
-            a3.since[:] = np.nan
-        rsrp = np.full((1, len(cells)), -np.inf)
-        for p, (r, _) in measured.items():
-            rsrp[0, col[p]] = r
-        target = cells[a3.targets(rsrp, np.array([col[serving]]), cfg.offset_db, cfg.ttt_s, now=float(f.t[i]))[0]]
+        cells = _measured(f, i)
+        if serving not in cells:
+            serving, changes = max(cells, key=lambda p: cells[p][0]), changes + 1
+        cand = _candidates(cells, serving, cfg)
+        state = np.full(len(FEATURES), np.nan)
+        state[RSRP.start:RSRP.start + len(cand)] = [cells[p][0] for p in cand]
+        target = cand[chm(state, cand, float(f.t[i]))]
         if target != serving:
-            serving, handovers = target, handovers + 1
-    return handovers
+            serving, changes = target, changes + 1
+    return changes
 
 
 @dataclass

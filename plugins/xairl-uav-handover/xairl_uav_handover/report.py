@@ -138,11 +138,12 @@ class UAVReport(Report):
     def _add_real_flights(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest) -> None:
         from tqdm import tqdm
 
-        from .real_data import load_folder, walk
+        from .real_data import chm_handovers, load_folder, walk
 
         flights, bad = load_folder(self.options.real)
         cfg = ckpt.sim_config
         walks = [walk(f, cfg, seed=req.seed) for f in tqdm(flights, desc="real flights", disable=not req.progress)]
+        chm_real = [chm_handovers(f, sim_config=cfg) for f in flights]
         states = np.concatenate([w.states for w in walks])
         pick = np.random.default_rng(req.seed).choice(len(states), size=min(req.n_states, len(states)), replace=False)
         content.datasets.append(("real", states[np.sort(pick)]))
@@ -150,7 +151,7 @@ class UAVReport(Report):
         queue = np.concatenate([w.queue_bits for w in walks])
         where = f"{len(flights)} real flights from {self.options.real}" + (f" ({len(bad)} skipped)" if bad else "")
         content.tables += [
-            (f"Calibration: handovers per minute by altitude band ({where})", _table(band_rows(flights, cfg, req.seed))),
+            (f"Calibration: handovers per minute by altitude band ({where})", _table(band_rows(flights, chm_real, cfg, req.seed))),
             (f"Real states in the training distribution: buffer full in {100 * np.mean(queue >= cfg.buffer.q_max_bits):.1f} "
              f"% of real states, non-empty in {100 * np.mean(queue > 0):.1f} %; any feature outside the simulated "
              f"0.5-99.5 % range in {100 * outside(states, sim_ref).any(axis=1).mean():.1f} % of real states",
@@ -158,7 +159,7 @@ class UAVReport(Report):
             (f"Open-loop agreement with the live network's decisions ({where})",
              _table(agreement_rows(walks, ckpt, cfg)))]
         content.notes += [f"skipped file: {b}" for b in bad] + REAL_NOTES
-        content.figures.append(_altitude_figure(req.out, self.options.real, cfg, flights, req.seed))
+        content.figures.append(_altitude_figure(req.out, self.options.real, cfg, flights, chm_real, req.seed))
 
 
 REAL_NOTES = [
@@ -174,17 +175,16 @@ REAL_NOTES = [
     "the network hands over."]
 
 
-def band_rows(flights, cfg, seed: int) -> list[BandRow]:
-    from .real_data import chm_handovers
-
+def band_rows(flights, chm_real: list[int], cfg, seed: int) -> list[BandRow]:
+    """One row per altitude band with flights; ``chm_real``: CHM's closed-loop handovers on each flight."""
     rows = []
     for lo, hi in BANDS:
-        inside = [f for f in flights if lo <= f.altitude_m < hi]
+        inside = [(f, n) for f, n in zip(flights, chm_real) if lo <= f.altitude_m < hi]
         if not inside:
             continue
-        minutes = sum(f.t[-1] / 60 for f in inside)
-        live = sum(f.observed_handovers for f in inside) / minutes
-        real = sum(chm_handovers(f) for f in inside) / minutes
+        minutes = sum(f.t[-1] / 60 for f, _ in inside)
+        live = sum(f.observed_handovers for f, _ in inside) / minutes
+        real = sum(n for _, n in inside) / minutes
         sim = float(np.mean(chm_rate_by_altitude(np.linspace(max(lo, 23.0), hi, 3), cfg, seed=seed)))
         rows.append(BandRow(f"{lo:g}-{hi:g} m", len(inside), live, real, sim, sim / max(real, 1e-9)))
     return rows
@@ -238,21 +238,21 @@ def findings(exps: dict[str, Explanation]) -> list[str]:
     return out
 
 
-def _altitude_figure(out: Path, real: str, cfg, flights, seed: int) -> tuple[str, Path]:
+def _altitude_figure(out: Path, real: str, cfg, flights, chm_real: list[int], seed: int) -> tuple[str, Path]:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .real_data import baltaci_rate_by_altitude, chm_handovers
+    from .real_data import baltaci_rate_by_altitude
 
     alts = np.arange(30, 161, 20)
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
     ax.plot(alts, chm_rate_by_altitude(alts, cfg, seed=seed), "o-", label="simulator, CHM (A3 2 dB / 160 ms)")
-    long = [f for f in flights if f.t[-1] > 60]
-    ax.plot([f.altitude_m for f in long], [chm_handovers(f) / (f.t[-1] / 60) for f in long], "x",
+    long = [(f, n) for f, n in zip(flights, chm_real) if f.t[-1] > 60]
+    ax.plot([f.altitude_m for f, _ in long], [n / (f.t[-1] / 60) for f, n in long], "x",
             label="CHM on the UKM measurements")
-    ax.plot([f.altitude_m for f in long], [f.observed_handovers / (f.t[-1] / 60) for f in long], "s",
+    ax.plot([f.altitude_m for f, _ in long], [f.observed_handovers / (f.t[-1] / 60) for f, _ in long], "s",
             label="UKM flights, live network (nominal height)")
     baltaci = next((p / "baltaci-imc22-handovers" for p in Path(real).resolve().parents
                     if (p / "baltaci-imc22-handovers" / "handovers.csv").is_file()), None)
