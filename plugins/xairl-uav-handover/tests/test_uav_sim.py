@@ -7,7 +7,7 @@ from pydantic import ValidationError
 from xairl_uav_handover.baselines import CHM, SAMRO, A3Trigger, CHMOnSamples
 from xairl_uav_handover.config import CHMConfig, SimConfig
 from xairl_uav_handover.env import HandoverVecEnv, UAVHandoverEnv
-from xairl_uav_handover.features import ACTIONS, FEATURES
+from xairl_uav_handover.features import ACTIONS, FEATURES, RSRQ, available_actions
 from xairl_uav_handover.simulator import Simulator, hex_layout
 
 SHORT = {"flight": {"duration_s": 4.0}}
@@ -30,6 +30,26 @@ def test_observation_layout():
     assert (np.diff(rsrp[:, 1:], axis=1) <= 0).all(), "neighbour candidates are sorted by RSRP"
     assert (obs[:, 4] == sim.serving).all()
     np.testing.assert_allclose(obs[:, 5], sim.rsrp[np.arange(8), sim.serving], rtol=1e-5)
+
+
+def test_empty_slots_are_masked_actions():
+    """Few neighbours are measured at low height; their empty slots read at the detection limit and are exactly
+    the masked handovers, in simulated states and in the masked greedy choice."""
+    import torch
+
+    from xairl_uav_handover.policy import greedy
+
+    cfg = SimConfig(flight={"altitude_m": (23.0, 30.0)})
+    obs, cand = Simulator(cfg, n_uavs=200, seed=2).observe()
+    mask = available_actions(obs, cfg.observation)
+    np.testing.assert_array_equal(mask, cand >= 0)
+    assert (~mask).any() and mask[:, 0].all()
+    assert (obs[:, RSRQ][~mask] == cfg.observation.detection_rsrq_db).all()
+    net = torch.nn.Linear(len(FEATURES), len(ACTIONS))
+    with torch.no_grad():
+        net.weight.zero_(), net.bias.copy_(torch.tensor([0.0, 1.0, 2.0, 3.0]))  # prefers the highest slot
+    expected = np.where(mask, np.arange(4), -1).argmax(axis=1)
+    np.testing.assert_array_equal(greedy(net, obs, cfg), expected)
 
 
 def test_same_seed_same_flight():

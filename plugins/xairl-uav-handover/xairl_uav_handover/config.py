@@ -88,7 +88,7 @@ class BufferConfig(_Strict):
 class ObservationConfig(_Strict):
     """What the UE reports, as in LTE (TS 36.331): RSRP/RSRQ averaged over each measurement period, then layer-3
     filtered F_n = (1 - a) F_(n-1) + a M_n with a = 1/2^(k/4); neighbours count as measured only while their
-    filtered RSRQ reaches the detection threshold. An empty candidate slot is reported at the detection limit (RSRQ
+    filtered RSRQ is above the detection threshold. An empty candidate slot is reported at the detection limit (RSRQ
     at the threshold, RSRP as much below the serving cell's as that RSRQ is), in simulation and real data alike."""
 
     measurement_period_s: float = Field(0.2, gt=0, le=2, description="L1 measurement period")

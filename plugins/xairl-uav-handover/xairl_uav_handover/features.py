@@ -11,6 +11,7 @@ N_CANDIDATES = 4  # candidate 0 is the serving BS (stay); 1..3 the strongest oth
 FEATURES = ("x", "y", "z", "buffer_queue_size", "serving_bs",
             *(f"rsrp_{k}" for k in range(N_CANDIDATES)), *(f"rsrq_{k}" for k in range(N_CANDIDATES)))
 RSRP = slice(5, 5 + N_CANDIDATES)  # the candidates' RSRP columns, serving BS first
+RSRQ = slice(5 + N_CANDIDATES, 5 + 2 * N_CANDIDATES)  # and their RSRQ columns
 #: action k: associate with candidate k; candidate 0 is the serving BS, so action 0 is "stay"
 ACTIONS = ("stay", *(f"handover_to_candidate_{k}" for k in range(1, N_CANDIDATES)))
 #: words followed by an identifier in this plugin's narratives ("BS 15", "candidate 2"), not by a quantity
@@ -39,6 +40,17 @@ def state_rows(position, queue_bits, serving_id, rsrp, rsrq, observation) -> np.
     rsrq = np.where(empty, limit, rsrq)
     return np.concatenate([position, np.reshape(queue_bits, (k, 1)), np.reshape(serving_id, (k, 1)), rsrp, rsrq],
                           axis=1).astype(np.float32)
+
+
+def available_actions(states, observation) -> np.ndarray:
+    """Bool (n, 4): stay is always available, a handover only to a measured candidate (an empty slot reads exactly
+    at the detection limit; a measured neighbour is strictly above it)."""
+    rsrq = np.asarray(states, dtype=np.float32).reshape(-1, len(FEATURES))[:, RSRQ]
+    mask = rsrq > np.float32(observation.detection_rsrq_db)
+    mask[:, 0] = True
+    return mask
+
+
 GROUPS = {"position": ("x", "y", "z"), "rsrp": ("rsrp_0", "rsrp_1", "rsrp_2", "rsrp_3"),
           "rsrq": ("rsrq_0", "rsrq_1", "rsrq_2", "rsrq_3")}
 

@@ -196,7 +196,7 @@ class UplinkBuffer:
 
 def _candidates(cells: dict, serving, cfg: SimConfig) -> list:
     """The serving cell, then up to 3 neighbours measured above the detection limit, strongest RSRP first."""
-    detected = [p for p in cells if p != serving and cells[p][1] >= cfg.observation.detection_rsrq_db]
+    detected = [p for p in cells if p != serving and cells[p][1] > cfg.observation.detection_rsrq_db]
     return [serving] + sorted(detected, key=lambda p: -cells[p][0])[:N_CANDIDATES - 1]
 
 

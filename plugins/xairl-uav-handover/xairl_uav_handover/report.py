@@ -16,7 +16,8 @@ from xairl import Explanation, Options, Report, ReportContent, ReportRequest, ta
 from .baselines import CHM, SAMRO, CHMOnSamples, SAMROOnSamples
 from .evaluate import PAPER, chm_rate_by_altitude, table_one
 from .features import FEATURES, GROUPS
-from .policy import Checkpoint, DQNController, background_states, dqn_decision_states, load_checkpoint, uav_policy
+from .policy import (Checkpoint, DQNController, background_states, dqn_decision_states, greedy, load_checkpoint,
+                     uav_policy)
 
 BANDS = ((20.0, 60.0), (60.0, 100.0), (100.0, 160.0))
 
@@ -203,12 +204,10 @@ def quantile_rows(sim: np.ndarray, real: np.ndarray) -> list[QuantileRow]:
 
 
 def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
-    import torch
-
     from .real_data import agreement
 
     def dqn(_walk):
-        return lambda s, c, t: int(ckpt.net(torch.as_tensor(s)[None]).argmax())
+        return lambda s, c, t: int(greedy(ckpt.net, s[None], cfg)[0])
 
     def cells(w):
         return sorted({c for cand in w.candidates for c in cand})
@@ -216,8 +215,7 @@ def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
     rows = []
     for name, make in (("DQN", dqn), ("CHM (A3 2 dB, 160 ms)", lambda w: CHMOnSamples(cells(w))),
                        ("SA-MRO", lambda w: SAMROOnSamples(cells(w), cfg))):
-        with torch.no_grad():
-            a = agreement(walks, make)
+        a = agreement(walks, make)
         rows.append(AgreementRow(name, a.proposals_per_min, a.network_handovers / a.minutes,
                                  100 * a.stay_agreement, 100 * a.handover_agreement, 100 * a.target_agreement))
     return rows

@@ -146,7 +146,7 @@ class Simulator:
         """(K, 4) BS ids: the serving BS, then the strongest measured neighbours by reported RSRP; -1 for a slot
         with no measured neighbour."""
         k = np.arange(self.K)
-        masked = np.where(self.meas_rsrq >= self.cfg.observation.detection_rsrq_db, self.meas_rsrp, -np.inf)
+        masked = np.where(self.meas_rsrq > self.cfg.observation.detection_rsrq_db, self.meas_rsrp, -np.inf)
         masked[k, self.serving] = -np.inf
         top = np.argsort(-masked, axis=1)[:, : N_CANDIDATES - 1]
         top = np.where(np.isfinite(np.take_along_axis(masked, top, axis=1)), top, -1)
