@@ -3,20 +3,24 @@ and the rank of buffer_queue_size by mean |contribution to the margin| (deep_sha
 
 Targets (issue 11): CHM > SA-MRO > DQN in handovers; DQN handovers <= 0.2 x CHM; buffer non-empty in >= 30 % of
 simulated decision states; buffer_queue_size in the top 2 features for every seed.
-Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reproduce.py --checkpoints A.safetensors B C
-     [--flights 200] [--states 400] [--json OUT]
-Train the checkpoints first: xairl uav train --episodes 40 --seed S --out seedS.safetensors (S = 0, 1, 2)
+Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reproduce.py [--seeds 0 1 2] [--episodes 40]
+     [--flights 200] [--states 400] [--json OUT]      trains one DQN per seed (the simulator's defaults), then measures
+or:  ... reproduce.py --checkpoints A.safetensors B.safetensors C.safetensors   measures existing checkpoints
 """
 import argparse
 import json
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import xairl
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.evaluate import table_one
 from xairl_uav_handover.features import FEATURES
+from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.policy import (DQNController, background_states, dqn_decision_states, load_checkpoint,
                                        uav_policy)
+from xairl_uav_handover.train import TrainConfig, train_checkpoint
 
 KEYS = ("handovers_median", "pingpong_pct_median", "pingpong_pct_pooled", "pingpong_pct_mean",
         "service_availability_pct_mean", "lost_data_kbit_mean", "mean_buffer_kbit_mean", "buffer_nonempty_pct_mean")
@@ -30,16 +34,30 @@ def margin_ranking(ckpt, n_states: int, seed: int) -> list[str]:
     return [FEATURES[j] for j in np.argsort(-importance)]
 
 
+def train_seeds(seeds: list[int], episodes: int, folder: Path) -> list[str]:
+    """One checkpoint per training seed, as ``xairl uav train --episodes E --seed S`` writes it."""
+    paths = [str(folder / f"seed{seed}.safetensors") for seed in seeds]
+    for seed, path in zip(seeds, paths):
+        train_checkpoint(TrainConfig(episodes=episodes, seed=seed), SimConfig(), path, progress=False)
+    return paths
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--checkpoints", nargs="+", required=True)
+    ap.add_argument("--checkpoints", nargs="+", default=None, help="measure these instead of training")
+    ap.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2], help="training seeds")
+    ap.add_argument("--episodes", type=int, default=40, help="training episodes per seed")
+    ap.add_argument("--out-dir", default=None, help="keep the trained checkpoints here (default: a temp dir)")
     ap.add_argument("--flights", type=int, default=200)
     ap.add_argument("--states", type=int, default=400)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--json", default=None, help="also write the per-seed results here")
     args = ap.parse_args()
+    folder = Path(args.out_dir or tempfile.mkdtemp(prefix="xairl-reproduce-"))
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = args.checkpoints or train_seeds(args.seeds, args.episodes, folder)
     per_seed = []
-    for path in args.checkpoints:
+    for path in paths:
         ckpt = load_checkpoint(path)
         rows = table_one([CHM(), SAMRO(), DQNController(ckpt.net)], ckpt.sim_config, args.flights, args.seed)
         ranking = margin_ranking(ckpt, args.states, args.seed)

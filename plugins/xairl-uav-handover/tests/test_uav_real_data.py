@@ -9,8 +9,10 @@ import pytest
 from xairl.cli import main
 from xairl import InputError, StateRecord
 from xairl_uav_handover.config import CHMConfig
+from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint
 from xairl_uav_handover.real_data import (agreement, baltaci_rate_by_altitude, chm_handovers, load_flight,
                                           load_folder, walk)
+from xairl_uav_handover.report import band_rows, outside
 
 DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
 UKM = DATA / "ukm-uav-lte" / "raw"
@@ -53,6 +55,26 @@ def test_chm_replayed_on_real_measurements():
     n = chm_handovers(f)
     assert 0 < n < len(f.t) / 2  # A3 needs two consecutive samples 2 dB above the serving cell
     assert chm_handovers(f, CHMConfig(offset_db=6.0)) < n  # a larger offset hands over less
+
+
+@needs_data
+def test_calibration_targets_on_the_real_flights():
+    """Issue 11's calibration, on all 29 UKM flights against the committed checkpoint's simulator (small simulated
+    samples): simulated CHM within 2x of CHM on the real measurements in every altitude band; the modelled real
+    buffer full in < 20 % of real states yet used; few real states outside the simulated training distribution (the
+    target is 5 %; the 20 m flight, 2.2 % of the states, lies below the channel model's 22.5 m floor)."""
+    ckpt = load_checkpoint()
+    cfg = ckpt.sim_config
+    flights, _ = load_folder(UKM)
+    rows = band_rows(flights, [chm_handovers(f, sim_config=cfg) for f in flights], cfg, seed=0)
+    assert [r.band for r in rows] == ["20-60 m", "60-100 m", "100-160 m"]
+    assert all(0.5 <= r.sim_over_real <= 2.0 for r in rows), [round(r.sim_over_real, 2) for r in rows]
+    walks = [walk(f, cfg) for f in flights]
+    q = np.concatenate([w.queue_bits for w in walks])
+    assert np.mean(q >= cfg.buffer.q_max_bits) < 0.2 and np.mean(q > 0) > 0.1
+    real = np.concatenate([w.states for w in walks])
+    sim = dqn_decision_states(ckpt, 5000, seed=2, epsilon=0.5, n_flights=256)
+    assert outside(real, sim).any(axis=1).mean() < 0.06
 
 
 @needs_data

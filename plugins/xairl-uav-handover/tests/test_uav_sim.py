@@ -142,18 +142,20 @@ def test_vector_env_steps_flights_together():
 
 
 def test_chm_and_samro_behaviour_on_flights():
-    cfg = SimConfig(**{"flight": {"duration_s": 60.0}})
-    counts = {}
+    """Table I compares medians: SA-MRO raises its margin where service is fine (most flights) and hands over less
+    there; where the link cannot carry the video it lowers the margin and may hand over more than CHM."""
+    cfg = SimConfig()
+    medians = {}
     for ctl in (CHM(), SAMRO()):
         env = HandoverVecEnv(cfg, n_flights=20, decision_every=1)
         env.reset(seed=2)
         ctl.reset(env)
-        hos, truncated = 0, np.zeros(20, bool)
+        hos, truncated = np.zeros(20), np.zeros(20, bool)
         while not truncated.all():
             *_, truncated, info = env.step(ctl(env))
-            hos += info["handover"].sum()
-        counts[ctl.name] = hos
-    assert counts["CHM"] > counts["SA-MRO"] > 0
+            hos += info["handover"]
+        medians[ctl.name] = np.median(hos)
+    assert medians["CHM"] > medians["SA-MRO"] > 0
     assert (ctl.margin > 2.0).mean() > 0.5  # service was fine, so SA-MRO raised most margins
 
 

@@ -122,17 +122,19 @@ def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
                   action_mask=lambda x: available_actions(x, config.observation))
 
 
-def dqn_decision_states(ckpt: Checkpoint, n: int, seed: int = 0, epsilon: float = 0.0) -> np.ndarray:
-    """``n`` states at which the DQN decided, sampled from 64 held-out flights it flew itself; with ``epsilon``,
-    that share of its decisions is random (0.5: the mix of exploration and greedy steps that training sees)."""
-    env = HandoverVecEnv(ckpt.sim_config, n_flights=64)
+def dqn_decision_states(ckpt: Checkpoint, n: int, seed: int = 0, epsilon: float = 0.0,
+                        n_flights: int = 64) -> np.ndarray:
+    """``n`` states at which the DQN decided, sampled from ``n_flights`` held-out flights it flew itself; with
+    ``epsilon``, that share of its decisions is random (0.5: the mix of exploration and greedy steps that training
+    sees). Flights draw their height uniformly, so a few hundred cover the altitude range to its percentiles."""
+    env = HandoverVecEnv(ckpt.sim_config, n_flights=n_flights)
     obs, _ = env.reset(seed=2_000_000 + seed)
     rng = np.random.default_rng(seed)
-    seen, truncated = [], np.zeros(64, bool)
+    seen, truncated = [], np.zeros(n_flights, bool)
     while not truncated.all():
         seen.append(obs)
         act = greedy(ckpt.net, obs, ckpt.sim_config)
-        act = np.where(rng.uniform(size=64) < epsilon, random_available(rng, obs, ckpt.sim_config), act)
+        act = np.where(rng.uniform(size=n_flights) < epsilon, random_available(rng, obs, ckpt.sim_config), act)
         obs, _, _, truncated, _ = env.step(act)
     states = np.concatenate(seen)
     return states[np.random.default_rng(seed).choice(len(states), size=min(n, len(states)), replace=False)]

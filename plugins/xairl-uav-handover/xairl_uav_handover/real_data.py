@@ -23,7 +23,8 @@ from xairl import InputError
 
 from .buffer import buffer_step
 from .config import SimConfig
-from .features import FEATURES, N_CANDIDATES, RSRP, state_rows
+from .features import FEATURES, N_CANDIDATES, state_rows
+from .features import RSRP as RSRP_COLUMNS
 from .simulator import hex_layout, n_sites
 from .uplink import capacity_bps, interference_mw, rsrp_offset_db, sinr_db
 
@@ -237,7 +238,7 @@ def chm_handovers(f: RealFlight, config=None, sim_config: SimConfig | None = Non
             serving, changes = max(cells, key=lambda p: cells[p][0]), changes + 1
         cand = _candidates(cells, serving, cfg)
         state = np.full(len(FEATURES), np.nan)
-        state[RSRP.start:RSRP.start + len(cand)] = [cells[p][0] for p in cand]
+        state[RSRP_COLUMNS.start:RSRP_COLUMNS.start + len(cand)] = [cells[p][0] for p in cand]
         target = cand[chm(state, cand, float(f.t[i]))]
         if target != serving:
             serving, changes = target, changes + 1

@@ -148,7 +148,7 @@ class UAVReport(Report):
         states = np.concatenate([w.states for w in walks])
         pick = np.random.default_rng(req.seed).choice(len(states), size=min(req.n_states, len(states)), replace=False)
         content.datasets.append(("real", states[np.sort(pick)]))
-        sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5)
+        sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=256)
         queue = np.concatenate([w.queue_bits for w in walks])
         where = f"{len(flights)} real flights from {self.options.real}" + (f" ({len(bad)} skipped)" if bad else "")
         content.tables += [

@@ -128,3 +128,18 @@ def train(tc: TrainConfig, sim_cfg: SimConfig | None = None, progress: bool = Tr
         bar.set_postfix(ho=history[-1]["median_handovers"], ret=round(history[-1]["mean_return"], 1))
     bar.close()
     return q.eval(), history
+
+
+def train_checkpoint(tc: TrainConfig, sim_cfg: SimConfig, out, progress: bool = True) -> float:
+    """Train and write a checkpoint whose metadata holds both configs, the history, the seed, the wall time and the
+    command that re-runs it; returns the seconds spent training."""
+    from .policy import save_checkpoint
+
+    t0 = time.time()
+    net, history = train(tc, sim_cfg, progress=progress)
+    seconds = round(time.time() - t0, 1)
+    save_checkpoint(net, out, {"hidden": list(tc.hidden), "train_config": tc.model_dump(),
+                               "sim_config": sim_cfg.model_dump(), "seed": tc.seed, "train_seconds": seconds,
+                               "history": history, "command": f"xairl uav train --episodes {tc.episodes} --flights "
+                                                              f"{tc.n_flights} --seed {tc.seed}"})
+    return seconds
