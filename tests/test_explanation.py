@@ -55,3 +55,30 @@ def test_records_are_one_per_state(exp):
 def test_explanation_is_read_only(exp):
     with pytest.raises(ValueError):
         exp.values[0, 0, 0] = 1.0
+
+
+def test_action_mask_restricts_chosen_and_runner_up():
+    """A policy's action_mask: acting and the explained decision use available actions only; scores of every
+    action are still explained, and the mask survives grouping and JSON."""
+    from dataclasses import replace
+
+    policy = toy_policy()
+    states = policy.background(12, seed=3)
+    scores = policy.scores(states)
+    best = scores.argmax(1)
+    masked = replace(policy, action_mask=lambda x: np.arange(policy.n_actions)[None, :] != best[: len(x), None])
+    exp = xairl.explain(masked, states, background=policy.background(30), method="exact")
+    allowed = np.where(exp.available, scores, -np.inf)
+    np.testing.assert_array_equal(masked.act(states), allowed.argmax(1))
+    np.testing.assert_array_equal(exp.chosen, allowed.argmax(1))
+    assert (exp.chosen != best).all() and (exp.runner_up != best).all() and (exp.runner_up != exp.chosen).all()
+    assert np.abs(exp.additivity_gap).max() < 1e-5  # every action, the masked one too, is explained
+    back = xairl.Explanation.from_json(exp.to_json())
+    np.testing.assert_array_equal(back.runner_up, exp.runner_up)
+    np.testing.assert_array_equal(exp.grouped({"motion": ["speed", "wind"]}).chosen, exp.chosen)
+    only = replace(policy, action_mask=lambda x: np.eye(policy.n_actions, dtype=bool)[np.zeros(len(x), int)])
+    one = xairl.explain(only, states[:2], background=policy.background(30), method="exact")
+    assert (one.chosen == 0).all() and (one.runner_up == 0).all() and not one.margin().any()
+    bad = replace(policy, action_mask=lambda x: np.zeros((len(x), policy.n_actions), bool))
+    with pytest.raises(InputError, match="at least one available action"):
+        bad.act(states)

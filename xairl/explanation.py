@@ -25,6 +25,8 @@ class Explanation:
     :param extras: method-specific diagnostics (e.g. IG's convergence delta).
     :param background_quantiles: (3, n_features) 25th, 50th and 75th percentiles of the background, so that a
         value can be called low, typical or high.
+    :param available: (n_states, n_actions) bool, the actions available in each state (the policy's
+        ``action_mask``); None: all. The chosen action and the runner-up are taken among available ones.
     """
 
     values: np.ndarray
@@ -37,6 +39,7 @@ class Explanation:
     options: Mapping[str, Any] = field(default_factory=dict)
     extras: Mapping[str, Any] = field(default_factory=dict)
     background_quantiles: np.ndarray | None = None
+    available: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n, f, a = self.values.shape
@@ -46,28 +49,39 @@ class Explanation:
         ):
             if arr.shape != shape:
                 raise InputError(f"Explanation.{name} has shape {arr.shape}, expected {shape}.")
+        if self.available is not None and self.available.shape != (n, a):
+            raise InputError(f"Explanation.available has shape {self.available.shape}, expected {(n, a)}.")
         if self.states is not None and self.states.shape != (n, f):
             raise InputError(f"Explanation.states has shape {self.states.shape}, expected {(n, f)}.")
         if len(self.feature_names) != f or len(self.action_names) != a:
             raise InputError("Explanation names do not match the values' shape.")
-        for arr in (self.values, self.base_values, self.outputs):
-            arr.setflags(write=False)
+        for arr in (self.values, self.base_values, self.outputs, self.available):
+            if arr is not None:
+                arr.setflags(write=False)
 
     @property
     def shape(self) -> tuple[int, int, int]:
         return self.values.shape
 
+    def _ranked(self) -> np.ndarray:
+        """Actions per state, best available first (unavailable ones last)."""
+        scores = self.outputs if self.available is None else np.where(self.available, self.outputs, -np.inf)
+        return np.argsort(-scores, axis=1, kind="stable")
+
     @property
     def chosen(self) -> np.ndarray:
-        """Index of the best-scoring action per state."""
-        return self.outputs.argmax(axis=1)
+        """Index of the best-scoring available action per state."""
+        return self._ranked()[:, 0]
 
     @property
     def runner_up(self) -> np.ndarray:
-        """Index of the second-best action per state (the chosen one again when there is a single action)."""
-        if self.outputs.shape[1] < 2:
-            return self.chosen
-        return np.argsort(-self.outputs, axis=1, kind="stable")[:, 1]
+        """Index of the second-best available action per state (the chosen one again when it is the only one)."""
+        ranked = self._ranked()
+        if ranked.shape[1] < 2:
+            return ranked[:, 0]
+        if self.available is None:
+            return ranked[:, 1]
+        return np.where(self.available.sum(axis=1) < 2, ranked[:, 0], ranked[:, 1])
 
     @property
     def additivity_gap(self) -> np.ndarray:
@@ -155,6 +169,7 @@ class ExplanationRecord(BaseModel):
     options: dict[str, Any] = {}
     extras: dict[str, Any] = {}
     background_quantiles: list[list[float]] | None = None
+    available: list[list[bool]] | None = None
 
     @classmethod
     def from_explanation(cls, e: Explanation) -> "ExplanationRecord":
@@ -169,6 +184,7 @@ class ExplanationRecord(BaseModel):
             options=dict(e.options),
             extras={k: np.asarray(v).tolist() for k, v in e.extras.items()},
             background_quantiles=None if e.background_quantiles is None else e.background_quantiles.tolist(),
+            available=None if e.available is None else e.available.tolist(),
         )
 
     def to_explanation(self) -> Explanation:
@@ -185,6 +201,7 @@ class ExplanationRecord(BaseModel):
             options=self.options,
             extras={k: np.asarray(v) for k, v in self.extras.items()},
             background_quantiles=None if self.background_quantiles is None else np.asarray(self.background_quantiles),
+            available=None if self.available is None else np.asarray(self.available, dtype=bool),
         )
 
 

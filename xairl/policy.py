@@ -42,6 +42,9 @@ class Policy:
     :param action_aliases: other names of each action in text, e.g. ``{"stay": ["keep the serving BS"]}``.
     :param facts_hook: optional ``f(state, chosen, runner_up) -> xairl.DomainFacts`` adding domain facts that
         templates may cite and the verifier accepts (``chosen`` and ``runner_up`` are action indices).
+    :param action_mask: optional ``f(states (n, n_features)) -> bool (n, n_actions)``, True where an action is
+        available in that state (invalid-action masking, as in MaskablePPO). The policy acts, and explanations take
+        the chosen action and the runner-up, among available actions only; their scores are still explained.
     """
 
     module: torch.nn.Module
@@ -53,6 +56,7 @@ class Policy:
     name: str = "policy"
     action_aliases: Mapping[str, Sequence[str]] = field(default_factory=dict)
     facts_hook: Callable[[np.ndarray, int, int], Any] | None = None
+    action_mask: Callable[[np.ndarray], np.ndarray] | None = None
 
     def __post_init__(self) -> None:
         self.feature_names = [str(f) for f in self.feature_names]
@@ -105,9 +109,20 @@ class Policy:
             )
         return out
 
+    def available(self, states) -> np.ndarray:
+        """Bool (n, n_actions): the actions available in each state (all of them without an ``action_mask``)."""
+        x = self.check_states(states)
+        if self.action_mask is None:
+            return np.ones((len(x), self.n_actions), dtype=bool)
+        mask = np.asarray(self.action_mask(x), dtype=bool)
+        if mask.shape != (len(x), self.n_actions) or not mask.any(axis=1).all():
+            raise InputError(f"policy '{self.name}': action_mask must return a bool array {(len(x), self.n_actions)} "
+                             "with at least one available action per state.")
+        return mask
+
     def act(self, states) -> np.ndarray:
-        """Index of the highest-scoring action per state."""
-        return self.scores(states).argmax(axis=1)
+        """Index of the highest-scoring available action per state."""
+        return np.where(self.available(states), self.scores(states), -np.inf).argmax(axis=1)
 
     def background(self, n: int = 100, seed: int = 0) -> np.ndarray:
         """`n` typical states from the policy's sampler; raises when it has none."""

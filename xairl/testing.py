@@ -89,6 +89,8 @@ def corpus(explanation, policy, templates=("explain_action", "why_not"), indices
     """Mutations and paraphrases of every sentence of the given templates for the given states.
 
     :param label_words: words after which a number is an identifier, not a claim (see the module doc).
+    States where the chosen action was the only available one (an ``action_mask``) have no runner-up, so the
+    ``why_not`` template is skipped there.
     """
     from . import prompts
     from .narrators.facts import decision_facts
@@ -98,6 +100,8 @@ def corpus(explanation, policy, templates=("explain_action", "why_not"), indices
         tpl = prompts.load(name)
         for i in indices:
             d = decision_facts(explanation, i, policy)
+            if name == "why_not" and d.runner_up == d.action:
+                continue
             others = [a for a in explanation.action_names if a != d.action]
             for variants in tpl.render_variants(d.context()):
                 if not variants[0]:

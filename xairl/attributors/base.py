@@ -62,6 +62,7 @@ class Attributor:
             options=self.options.model_dump(),
             extras=extras,
             background_quantiles=np.percentile(bg, [25, 50, 75], axis=0).astype(np.float64),
+            available=None if policy.action_mask is None else policy.available(x),
         )
 
     def _attribute(self, policy: Policy, x: np.ndarray, bg: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:

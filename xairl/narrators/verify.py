@@ -124,7 +124,8 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     for c in d.comparisons:
         if c.unit:
             by_unit.setdefault(c.unit, []).append(c.value)
-    return FactBook(feats, _surfaces(exp, policy), numbers, d.action, d.runner_up, by_unit=by_unit)
+    runner_up = None if d.runner_up == d.action else d.runner_up  # a single available action: no alternative
+    return FactBook(feats, _surfaces(exp, policy), numbers, d.action, runner_up, by_unit=by_unit)
 
 
 def _matches(written: str, value: float, magnitude_ok: bool = False) -> bool:
@@ -191,8 +192,8 @@ def _check_action(sentence: str, start: int, end: int, key: str, book: FactBook)
         return Claim("action", text, "contradicted", f"the policy chose {book.chosen}, not {key}")
     if key == book.runner_up:
         return Claim("action", text, "verified", "the runner-up action")
-    return Claim("action", text, "contradicted", f"only {book.chosen} (chosen) and {book.runner_up} (runner-up) "
-                                                 "are explained here")
+    others = f" and {book.runner_up} (runner-up)" if book.runner_up else " (no other action was available)"
+    return Claim("action", text, "contradicted", f"only {book.chosen} (chosen){others} is explained here")
 
 
 def _feature_number(written: str, pct: bool, before: str, e: _Feature, key: str,

@@ -2,8 +2,11 @@
 import numpy as np
 import pytest
 
-from xairl_uav_handover.buffer import buffer_step, service_bits
+from xairl_uav_handover import uplink
+from xairl_uav_handover.buffer import buffer_step
 from xairl_uav_handover.channel import SCENARIOS, los_probability, path_loss, shadow_sigma
+from xairl_uav_handover.config import SimConfig
+from xairl_uav_handover.simulator import hex_layout
 
 
 def test_uma_oracle_values():
@@ -35,10 +38,23 @@ def test_unknown_scenario():
         path_loss("XYZ", 50, 100, 2.0, True)
 
 
-def test_service_is_shannon_rate():
-    # SINR 0 dB -> log2(2) = 1 bit/s/Hz: W_s |B| dt = 180 kHz * 6 * 0.04 s
-    assert service_bits(0.0, 6, 180e3, 0.04) == pytest.approx(43_200.0)
-    assert service_bits(10 * np.log10(3), 1, 1.0, 1.0) == pytest.approx(2.0)
+def test_capacity_is_shannon_rate():
+    cfg = SimConfig.model_validate({"buffer": {"rb_per_uav": 6}})
+    # SINR 0 dB -> log2(2) = 1 bit/s/Hz: W_s |B| = 180 kHz * 6
+    assert uplink.capacity_bps(cfg, 0.0) == pytest.approx(1_080_000.0)
+    assert uplink.capacity_bps(cfg, 10 * np.log10(3)) == pytest.approx(2 * 1_080_000.0)
+
+
+def test_uplink_interference_rises_with_height_and_matches_the_link_budget():
+    cfg = SimConfig()
+    layout = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
+    i = uplink.interference_mw(cfg, layout, np.array([30.0, 60.0, 100.0, 150.0]))[:, 0]
+    assert (np.diff(i) > 0).all()  # more cells in line of sight as the UAV climbs (TR 36.777)
+    # no interference: SINR is the link budget, P_ue + G - PL - noise over the UAV's resource blocks
+    quiet = SimConfig.model_validate({"radio": {"ul_activity": 0.0}})
+    noise = -174 + 10 * np.log10(50 * 180e3) + 5.0
+    assert uplink.sinr_db(quiet, 100.0, 0.0) == pytest.approx(23.0 - 19.0 - 100.0 - noise)
+    assert uplink.sinr_db(cfg, 100.0, i[0]) < uplink.sinr_db(quiet, 100.0, 0.0)
 
 
 def test_buffer_recursion_by_hand():

@@ -9,7 +9,10 @@ import pytest
 from xairl.cli import main
 from xairl import InputError, StateRecord
 from xairl_uav_handover.config import CHMConfig
-from xairl_uav_handover.real_data import baltaci_rate_by_altitude, chm_handovers, load_flight, load_folder, replay
+from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint
+from xairl_uav_handover.real_data import (agreement, baltaci_rate_by_altitude, chm_handovers, load_flight,
+                                          load_folder, walk)
+from xairl_uav_handover.report import band_rows, outside
 
 DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
 UKM = DATA / "ukm-uav-lte" / "raw"
@@ -24,10 +27,26 @@ def test_load_one_flight():
     assert -98 <= f.rsrp.min() and f.rsrp.max() <= -50
     assert np.abs(f.xy).max() < 2000  # local metres around the campus
     assert f.observed_handovers == int((np.diff(f.pci) != 0).sum()) > 10
-    o = replay(f, None)
-    assert o.handovers == f.observed_handovers and o.states.shape == (len(f.t), 13)
-    assert (o.states[:, 5] == f.rsrp).all(), "candidate 0 is the network's serving cell"
-    assert (np.diff(o.states[:, 6:9], axis=1) <= 0).all(), "neighbours sorted by RSRP"
+    w = walk(f)
+    assert w.states.shape == (len(f.t), 13) and (w.serving == f.pci).all()
+    assert int((w.next_serving != w.serving).sum()) == f.observed_handovers
+    assert (w.states[:, 5] == f.rsrp).all(), "candidate 0 is the network's serving cell"
+    for state, cand in zip(w.states, w.candidates):
+        assert (np.diff(state[6:5 + len(cand)]) <= 0).all(), "measured neighbours sorted by RSRP"
+        assert (state[9 + len(cand):] == -24.0).all(), "empty slots at the detection limit"
+    assert 0 < (w.queue_bits > 0).mean() < 1 and w.queue_bits.max() <= 2e6
+
+
+@needs_data
+def test_open_loop_agreement_on_known_deciders():
+    w = walk(load_flight(UKM / "100m.csv"))
+    stay = agreement([w], lambda _w: (lambda s, c, t: 0))
+    assert (stay.proposals, stay.stay_agreement, stay.handover_agreement) == (0, 1.0, 0.0)
+    assert stay.network_handovers == int((w.next_serving != w.serving).sum())
+    follow = dict(zip(w.t.tolist(), w.next_serving.tolist()))  # an oracle that does what the network did next
+    oracle = agreement([w], lambda _w: (lambda s, c, t: c.index(follow[t]) if follow[t] in c else 0))
+    assert oracle.stay_agreement == 1.0 and oracle.target_agreement == oracle.handover_agreement > 0.5
+    assert chm_handovers(load_flight(UKM / "100m.csv")) > 0
 
 
 @needs_data
@@ -36,6 +55,26 @@ def test_chm_replayed_on_real_measurements():
     n = chm_handovers(f)
     assert 0 < n < len(f.t) / 2  # A3 needs two consecutive samples 2 dB above the serving cell
     assert chm_handovers(f, CHMConfig(offset_db=6.0)) < n  # a larger offset hands over less
+
+
+@needs_data
+def test_calibration_targets_on_the_real_flights():
+    """Issue 11's calibration, on all 29 UKM flights against the committed checkpoint's simulator (small simulated
+    samples): simulated CHM within 2x of CHM on the real measurements in every altitude band; the modelled real
+    buffer full in < 20 % of real states yet used; few real states outside the simulated training distribution (the
+    target is 5 %; the 20 m flight, 2.2 % of the states, lies below the channel model's 22.5 m floor)."""
+    ckpt = load_checkpoint()
+    cfg = ckpt.sim_config
+    flights, _ = load_folder(UKM)
+    rows = band_rows(flights, [chm_handovers(f, sim_config=cfg) for f in flights], cfg, seed=0)
+    assert [r.band for r in rows] == ["20-60 m", "60-100 m", "100-160 m"]
+    assert all(0.5 <= r.sim_over_real <= 2.0 for r in rows), [round(r.sim_over_real, 2) for r in rows]
+    walks = [walk(f, cfg) for f in flights]
+    q = np.concatenate([w.queue_bits for w in walks])
+    assert np.mean(q >= cfg.buffer.q_max_bits) < 0.2 and np.mean(q > 0) > 0.1
+    real = np.concatenate([w.states for w in walks])
+    sim = dqn_decision_states(ckpt, 5000, seed=2, epsilon=0.5, n_flights=256)
+    assert outside(real, sim).any(axis=1).mean() < 0.06
 
 
 @needs_data
@@ -76,7 +115,6 @@ def test_report_without_real_data(tmp_path, capsys):
     html = (out / "report.html").read_text()
     assert "Table I" in html and html.count("data:image/png;base64,") >= 3
     assert "&#10003; verified" in html and "confidence" in html
-    assert "Over 40 states, the most important features were position (mean |contribution|" in html  # the group
     lines = (out / "explanations.jsonl").read_text().splitlines()
     assert len(lines) == 40
     rec = StateRecord.model_validate_json(lines[0])
@@ -96,10 +134,9 @@ def test_report_with_real_data(tmp_path):
     assert main(["report", "--plugin", "uav-handover", "--n", "30", "-o", f"real={real}", "-o", "flights=20", "--out",
                  str(out)]) == 0
     html = (out / "report.html").read_text()
-    assert "Real flights: 2 loaded" in html and "network (observed)" in html and "Baltaci" in html
-    assert "Handover dynamics by altitude band" in html and "<td>20-60 m</td><td>1</td>" in html and "<td>100-160 m</td><td>1</td>" in html
-    assert "Spearman rank correlation real vs simulated" in html and "Global importance by group (position = x, y, z" in html
-    assert html.count("finding (buffer first, position second)") == 2  # one statement per dataset
+    assert "Calibration: handovers per minute by altitude band (2 real flights" in html and "Baltaci" in html
+    assert "Open-loop agreement with the live network" in html and "Spearman rank correlation real vs simulated" in html
+    assert "finding (buffer first, position second)" in html
     datasets = {json.loads(x)["dataset"] for x in (out / "explanations.jsonl").read_text().splitlines()}
     assert datasets == {"simulated", "real"}
 

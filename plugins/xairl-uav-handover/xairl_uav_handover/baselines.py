@@ -57,11 +57,12 @@ class A3Trigger:
 
 
 def _candidate_rsrp(env) -> np.ndarray:
-    """The simulator's RSRP with every cell but the env's candidates unmeasured (-inf)."""
+    """The reported RSRP of the env's measured candidates; every other cell unmeasured (-inf)."""
     sim, cand = env.sim, env.candidates
-    rows = np.arange(sim.K)[:, None]
-    rsrp = np.full_like(sim.rsrp, -np.inf)
-    rsrp[rows, cand] = sim.rsrp[rows, cand]
+    rows = np.broadcast_to(np.arange(sim.K)[:, None], cand.shape)
+    rsrp = np.full_like(sim.meas_rsrp, -np.inf)
+    ok = cand >= 0
+    rsrp[rows[ok], cand[ok]] = sim.meas_rsrp[rows[ok], cand[ok]]
     return rsrp
 
 
@@ -126,7 +127,8 @@ class SAMRO:
 
 class CHMOnSamples:
     """CHM on measurement samples at arbitrary times (a real flight's ~1.3 s samples): the same :class:`A3Trigger`
-    over the candidates' RSRP, keyed by cell id. Called as ``chm(state, candidates, t) -> action``.
+    over the candidates' RSRP, keyed by cell id. Called as ``chm(state, candidates, t) -> action``; open loop, so
+    when the serving cell changes (the network handed over) every timer starts again.
 
     :param cells: every cell id the flight may measure (its columns in the trigger).
     """
@@ -138,11 +140,59 @@ class CHMOnSamples:
         self.cells = list(cells)
         self.col = {c: j for j, c in enumerate(self.cells)}
         self.a3 = A3Trigger(1, len(self.cells))
+        self.serving = None
+
+    def _margin_ttt(self, state, network_handed: bool, t: float) -> tuple[float, float]:
+        return self.cfg.offset_db, self.cfg.ttt_s
 
     def __call__(self, state, candidates, t: float) -> int:
+        network_handed = self.serving is not None and candidates[0] != self.serving
+        if candidates[0] != self.serving:
+            self.a3.since[:] = np.nan
+            self.serving = candidates[0]
         rsrp = np.full((1, len(self.cells)), -np.inf)
         for k, cell in enumerate(candidates):
             rsrp[0, self.col[cell]] = state[RSRP][k]
-        serving = np.array([self.col[candidates[0]]])
-        target = self.a3.targets(rsrp, serving, self.cfg.offset_db, self.cfg.ttt_s, now=t)[0]
+        margin, ttt = self._margin_ttt(state, network_handed, t)
+        target = self.a3.targets(rsrp, np.array([self.col[candidates[0]]]), margin, ttt, now=t)[0]
         return list(candidates).index(self.cells[target])
+
+
+class SAMROOnSamples(CHMOnSamples):
+    """SA-MRO on real samples: the rule of :class:`SAMRO`, with radio availability from the uplink model at the
+    sample's serving RSRP and altitude, and the network's own handovers counted in the window."""
+
+    name = "SA-MRO"
+
+    def __init__(self, cells, sim_config, config: SAMROConfig | None = None):
+        super().__init__(cells, None)
+        self.sa, self.sim_cfg = config or SAMROConfig(), sim_config
+        self.margin = self.sa.offset_db
+        self.ttt_idx = int(np.abs(TTT_VALUES - self.sa.ttt_s).argmin())
+        self.window: list[tuple[bool, bool]] = []  # (radio ok, handed over) per sample
+        self.window_start: float | None = None
+        self.interference: dict[float, float] = {}
+
+    def _radio_ok(self, state) -> bool:
+        from .simulator import hex_layout
+        from .uplink import interference_mw, rsrp_offset_db, sinr_db
+
+        cfg, h = self.sim_cfg, float(state[2])
+        if h not in self.interference:
+            layout = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
+            self.interference[h] = float(interference_mw(cfg, layout, np.array([h]))[0, 0])
+        sinr = sinr_db(cfg, rsrp_offset_db(cfg) - float(state[RSRP][0]), self.interference[h])
+        return bool(sinr >= cfg.handover.sinr_min_db)
+
+    def _margin_ttt(self, state, network_handed: bool, t: float) -> tuple[float, float]:
+        self.window.append((self._radio_ok(state), network_handed))
+        self.window_start = t if self.window_start is None else self.window_start
+        if t - self.window_start >= self.sa.window_s:
+            ok = np.array(self.window)
+            poor = ok[:, 0].mean() < self.sa.target_availability
+            wasted = not poor and ok[:, 1].any()
+            step = self.sa.margin_step_db
+            self.margin = float(np.clip(self.margin - step * poor + step * wasted, *self.sa.margin_range_db))
+            self.ttt_idx = int(np.clip(self.ttt_idx - poor + wasted, 0, len(TTT_VALUES) - 1))
+            self.window, self.window_start = [], None
+        return self.margin, TTT_VALUES[self.ttt_idx]

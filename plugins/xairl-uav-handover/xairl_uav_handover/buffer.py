@@ -1,12 +1,10 @@
-"""The UAV's uplink buffer: Poisson data arrivals, control packets at handovers, Shannon-rate service, overflow."""
+"""The UAV's uplink buffer: arrivals (video packets, control packets at handovers), service, overflow.
+
+The service rate is the uplink capacity (uplink.py).
+"""
 from __future__ import annotations
 
 import numpy as np
-
-
-def service_bits(sinr_db, rb_per_uav: int, rb_bandwidth_hz: float, dt_s: float):
-    """Bits served in one step: s = W_s |B| log2(1 + SINR) dt."""
-    return rb_bandwidth_hz * rb_per_uav * np.log2(1.0 + 10.0 ** (np.asarray(sinr_db) / 10.0)) * dt_s
 
 
 def buffer_step(q, arrivals_bits, served_bits, q_max: float):

@@ -43,24 +43,14 @@ def _sim_config(base, duration=None, min_stay=None):
 
 
 def run_train(args) -> int:
-    import time
-
     from xairl import InputError
 
-    from .policy import save_checkpoint
-    from .train import TrainConfig, train
+    from .train import TrainConfig, train_checkpoint
 
     if args.episodes < 1 or args.flights < 1:
         raise InputError("--episodes and --flights must be at least 1.")
-    sim_cfg = _sim_config(None, args.duration)
     tc = TrainConfig(episodes=args.episodes, n_flights=args.flights, seed=args.seed)
-    t0 = time.time()
-    net, history = train(tc, sim_cfg, progress=not args.no_progress)
-    seconds = round(time.time() - t0, 1)
-    meta = {"hidden": list(tc.hidden), "train_config": tc.model_dump(), "sim_config": sim_cfg.model_dump(),
-            "seed": args.seed, "train_seconds": seconds, "history": history,
-            "command": f"xairl uav train --episodes {args.episodes} --flights {args.flights} --seed {args.seed}"}
-    save_checkpoint(net, args.out, meta)
+    seconds = train_checkpoint(tc, _sim_config(None, args.duration), args.out, progress=not args.no_progress)
     print(f"trained {args.episodes} episodes in {seconds} s; wrote {args.out}")
     return 0
 

@@ -5,8 +5,9 @@ decision per flight among its 4 candidates (0 = stay), held for ``decision_every
 of one vector end together, after the flight's duration (truncation, no autoreset: call ``reset`` again).
 :class:`UAVHandoverEnv` is the single-flight ``gymnasium.Env`` for tools that want one (``check_env`` passes).
 
-Reward per flight and decision (the paper's four terms, weights in ``RewardConfig``):
-``-w_handover*[handover] - mean over the steps of (w_buffer*q/q_max + w_rsrp*[RSRP<thr] + w_rsrq*[RSRQ<thr])``.
+Reward per flight and decision (the paper's four terms, weights in ``RewardConfig``, q in Mbit):
+``-w_handover*[handover] + mean over the steps of (w_buffer/(1 + q) - w_rsrp*[RSRP<thr] - w_rsrq*[RSRQ<thr])``.
+An action naming an empty candidate slot (fewer neighbours measured) keeps the serving BS.
 ``info`` carries, per flight, the sums over the decision's simulator steps of :data:`METRICS`, and the candidate
 BS ids (``info["candidates"]``, (K, 4)).
 """
@@ -58,17 +59,18 @@ class HandoverVecEnv(gym.vector.VectorEnv):
         """Hand over each flight to its candidate ``actions[k]`` (0 = stay) and fly ``decision_every`` steps."""
         sim, w = self.sim, self.cfg.reward
         target = self.candidates[np.arange(sim.K), np.asarray(actions, dtype=np.int64)]
+        target = np.where(target < 0, sim.serving, target)
         sums = {key: np.zeros(sim.K) for key in METRICS}
-        cost = np.zeros(sim.K)
+        gain = np.zeros(sim.K)
         n = 0
         while n < self.decision_every and not sim.done:
             info = sim.step(target if n == 0 else sim.serving)
-            cost += (w.w_buffer * info.queue_bits / self.cfg.buffer.q_max_bits + w.w_rsrp * info.rsrp_violation
-                     + w.w_rsrq * info.rsrq_violation)
+            gain += (w.w_buffer / (1 + info.queue_bits / 1e6) - w.w_rsrp * info.rsrp_violation
+                     - w.w_rsrq * info.rsrq_violation)
             for key in METRICS:
                 sums[key] += getattr(info, key)
             n += 1
-        reward = -w.w_handover * sums["handover"] - cost / max(n, 1)
+        reward = -w.w_handover * sums["handover"] + gain / max(n, 1)
         self.obs, self.candidates = sim.observe()
         ended = np.full(sim.K, sim.done)
         return self.obs, reward, np.zeros(sim.K, dtype=bool), ended, sums | {"candidates": self.candidates}

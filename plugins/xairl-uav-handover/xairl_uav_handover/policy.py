@@ -17,7 +17,7 @@ from xairl import CheckpointError, Policy
 
 from .config import SimConfig
 from .env import HandoverVecEnv
-from .features import ACTION_ALIASES, ACTIONS, FEATURE_INFO, FEATURES, GROUPS, handover_facts
+from .features import ACTION_ALIASES, ACTIONS, FEATURE_INFO, FEATURES, GROUPS, available_actions, handover_facts
 
 DEFAULT_CHECKPOINT = Path(__file__).parent / "checkpoints" / "uav-dqn.safetensors"
 
@@ -86,6 +86,19 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
     return Checkpoint(path, net.eval(), meta, config)
 
 
+def greedy(net: torch.nn.Module, obs: np.ndarray, config: SimConfig) -> np.ndarray:
+    """The best available action per state: a handover only to a measured candidate (invalid-action masking)."""
+    with torch.no_grad():
+        q = net(torch.as_tensor(obs, dtype=torch.float32)).numpy()
+    return np.where(available_actions(obs, config.observation), q, -np.inf).argmax(axis=1)
+
+
+def random_available(rng: np.random.Generator, obs: np.ndarray, config: SimConfig) -> np.ndarray:
+    """A uniformly random available action per state (exploration)."""
+    mask = available_actions(obs, config.observation)
+    return (rng.uniform(size=mask.shape) * mask).argmax(axis=1)
+
+
 def background_states(n: int, seed: int = 0, config: SimConfig | None = None) -> np.ndarray:
     """``n`` states the policy meets in flight: ``n`` simulated UAVs after 10 s under conventional handover."""
     from .baselines import CHM
@@ -105,11 +118,31 @@ def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
     config = ckpt.sim_config
     return Policy(ckpt.net, FEATURES, ACTIONS, features=FEATURE_INFO, groups=GROUPS,
                   background_sampler=lambda n, seed: background_states(n, seed, config), name="uav-dqn",
-                  action_aliases=ACTION_ALIASES, facts_hook=handover_facts)
+                  action_aliases=ACTION_ALIASES, facts_hook=handover_facts,
+                  action_mask=lambda x: available_actions(x, config.observation))
+
+
+def dqn_decision_states(ckpt: Checkpoint, n: int, seed: int = 0, epsilon: float = 0.0,
+                        n_flights: int = 64) -> np.ndarray:
+    """``n`` states at which the DQN decided, sampled from ``n_flights`` held-out flights it flew itself; with
+    ``epsilon``, that share of its decisions is random (0.5: the mix of exploration and greedy steps that training
+    sees). Flights draw their height uniformly, so a few hundred cover the altitude range to its percentiles."""
+    env = HandoverVecEnv(ckpt.sim_config, n_flights=n_flights)
+    obs, _ = env.reset(seed=2_000_000 + seed)
+    rng = np.random.default_rng(seed)
+    seen, truncated = [], np.zeros(n_flights, bool)
+    while not truncated.all():
+        seen.append(obs)
+        act = greedy(ckpt.net, obs, ckpt.sim_config)
+        act = np.where(rng.uniform(size=n_flights) < epsilon, random_available(rng, obs, ckpt.sim_config), act)
+        obs, _, _, truncated, _ = env.step(act)
+    states = np.concatenate(seen)
+    return states[np.random.default_rng(seed).choice(len(states), size=min(n, len(states)), replace=False)]
 
 
 class DQNController:
-    """Acts greedily with a Q-network, one decision per env step (every ``decision_every`` simulator steps)."""
+    """Acts greedily among available actions with a Q-network, one decision per env step (every
+    ``decision_every`` simulator steps)."""
 
     name = "DQN"
     decision_every = None  # the simulator config's
@@ -121,5 +154,4 @@ class DQNController:
         pass
 
     def __call__(self, env) -> np.ndarray:
-        with torch.no_grad():
-            return self.net(torch.as_tensor(env.obs)).argmax(dim=1).numpy()
+        return greedy(self.net, env.obs, env.cfg)

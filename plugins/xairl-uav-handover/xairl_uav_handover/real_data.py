@@ -4,10 +4,12 @@ Rows are events; rows with the same Time form one time step (forward-filled over
 lists and SNR). The last lines are a footer and are dropped (any row whose Time does not parse). The number of
 detected-cell slots varies, so columns are selected by name. Altitude is the nominal height in the file name.
 
-:func:`replay` flies a policy along a real trajectory in closed loop: the policy's serving cell is measured when it
-is the network's serving cell or in the detected list (else the UAV falls back to the strongest measured cell, a
-forced handover). The buffer is not in the data: the real link quality (RS SNR of the network's serving cell,
-shifted by the RSRP difference when the policy serves elsewhere) drives the plugin's buffer model.
+:func:`walk` follows the network's own decisions along a real flight and gives, at each sample, the state a policy
+would see (the same layout, detection limit and position frame as in simulation), its candidate cells and what the
+network did next; :func:`agreement` compares a policy's proposals with those decisions (open loop: the policy never
+steers, so every instant is a fair comparison). The buffer is not in the data: the simulator's uplink model
+(uplink.py), driven by the measured serving RSRP at the flight's altitude, fills it, sub-stepped at the simulator's
+time step between samples.
 """
 from __future__ import annotations
 
@@ -19,15 +21,16 @@ import numpy as np
 
 from xairl import InputError
 
-from .buffer import buffer_step, service_bits
+from .buffer import buffer_step
 from .config import SimConfig
-from .features import N_CANDIDATES, state_rows
-from .simulator import n_sites
+from .features import FEATURES, N_CANDIDATES, state_rows
+from .features import RSRP as RSRP_COLUMNS
+from .simulator import hex_layout, n_sites
+from .uplink import capacity_bps, interference_mw, rsrp_offset_db, sinr_db
 
 REF_LAT, REF_LON = 2.9228, 101.7715  # centre of the UKM campaign area: local metres are measured from here
 PCI, RSRP, RSRQ = "Physical cell identity (LTE pcell)", "RSRP (LTE pcell)", "RSRQ (LTE pcell)"
 REQUIRED = ("Time", "Latitude", "Longitude", PCI, RSRP, RSRQ, "RS SNR")
-PAD_RSRP, PAD_RSRQ = -140.0, -30.0  # an empty candidate slot reads as a cell far below any measured one
 TIME_RE = r"^\d{1,2}:\d{2}:\d{2}(\.\d+)?$"
 
 
@@ -144,23 +147,19 @@ def load_folder(folder: str | Path) -> tuple[list[RealFlight], list[str]]:
 
 
 @dataclass
-class Replay:
-    states: np.ndarray      # (n, 13) the policy's view at each step
-    serving: np.ndarray     # (n,) PCI served by the policy after each decision
-    handovers: int
-    returns: np.ndarray     # for each handover back to the previous cell: the seconds spent in between
-    forced: int             # the policy's cell vanished from the measurements
-    mean_buffer_kbit: float
-    lost_kbit: float
+class Walk:
+    """A real flight as the network flew it, seen as a policy would see it at each sample."""
+
+    t: np.ndarray              # (n,) seconds
+    states: np.ndarray         # (n, 13)
+    candidates: list[list]     # per sample: the serving PCI, then up to 3 measured neighbours by RSRP
+    next_serving: np.ndarray   # (n,) the network's serving PCI at the next sample (its decision); last: itself
+    queue_bits: np.ndarray     # (n,) the modelled uplink buffer
+    lost_bits: float
 
     @property
-    def changes(self) -> int:
-        """Every change of serving cell: the policy's handovers and the forced ones."""
-        return self.handovers + self.forced
-
-    def pingpongs(self, window_s: float) -> int:
-        """Handovers back to the previous cell within ``window_s`` (the minimum time of stay)."""
-        return int((self.returns < window_s).sum())
+    def serving(self) -> np.ndarray:
+        return np.array([c[0] for c in self.candidates])
 
 
 def _measured(f: RealFlight, i: int) -> dict[float, tuple[float, float]]:
@@ -171,74 +170,116 @@ def _measured(f: RealFlight, i: int) -> dict[float, tuple[float, float]]:
     return cells
 
 
-class _Service:
-    """The plugin's buffer model driven by the real link quality along the flight (see the module doc)."""
+class UplinkBuffer:
+    """The simulator's buffer and uplink model on a real flight: SINR from the measured serving RSRP (path loss =
+    RSRP offset - RSRP) with the aerial interference at the flight's altitude, sub-stepped at the sim's dt."""
 
-    def __init__(self, cfg: SimConfig, seed: int):
-        self.b, self.h, self.rng = cfg.buffer, cfg.handover, np.random.default_rng(seed)
-        self.q, self.queues, self.lost = 0.0, [], 0.0
+    def __init__(self, cfg: SimConfig, altitude_m: float, seed: int = 0):
+        self.cfg, self.rng, self.q, self.lost = cfg, np.random.default_rng(seed), 0.0, 0.0
+        layout = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
+        self.interference = float(interference_mw(cfg, layout, np.array([altitude_m]))[0, 0])  # the centre cell
 
-    def step(self, sinr_db: float, dt: float, handed: bool) -> None:
-        b = self.b
-        served = service_bits(sinr_db, b.rb_per_uav, b.rb_bandwidth_hz,
-                              max(dt - (self.h.interruption_s if handed else 0), 0))
-        arrivals = self.rng.poisson(b.packet_rate_hz * dt) * b.data_packet_bits + handed * b.control_packet_bits
-        q, lost = buffer_step(self.q, arrivals, served, b.q_max_bits)
-        self.q = float(q)
-        self.queues.append(self.q)
-        self.lost += float(lost)
+    def sinr_db(self, rsrp_dbm: float) -> float:
+        return float(sinr_db(self.cfg, rsrp_offset_db(self.cfg) - rsrp_dbm, self.interference))
+
+    def advance(self, rsrp_dbm: float, seconds: float, handed: bool) -> None:
+        """Serve the buffer for ``seconds`` at the link of a serving cell measured at ``rsrp_dbm``."""
+        b, dt = self.cfg.buffer, self.cfg.flight.dt_s
+        rate = float(capacity_bps(self.cfg, self.sinr_db(rsrp_dbm)))
+        interrupt = self.cfg.handover.interruption_s if handed else 0.0
+        for k in range(int(round(seconds / dt))):
+            arrivals = self.rng.poisson(b.packet_rate_hz * dt) * b.data_packet_bits
+            arrivals += b.control_packet_bits if handed and k == 0 else 0.0
+            served = rate * dt if k * dt >= interrupt else 0.0
+            q, lost = buffer_step(self.q, arrivals, served, b.q_max_bits)
+            self.q, self.lost = float(q), self.lost + float(lost)
 
 
-def replay(f: RealFlight, decide, config: SimConfig | None = None, seed: int = 0) -> Replay:
-    """Fly ``decide(state (13,), candidates, t) -> action`` along the real flight (see the module doc);
-    ``decide=None`` follows the network's own serving cell (the observed decisions). Ping-pongs are counted
-    afterwards, for any window, with :meth:`Replay.pingpongs`."""
+def _candidates(cells: dict, serving, cfg: SimConfig) -> list:
+    """The serving cell, then up to 3 neighbours measured above the detection limit, strongest RSRP first."""
+    detected = [p for p in cells if p != serving and cells[p][1] > cfg.observation.detection_rsrq_db]
+    return [serving] + sorted(detected, key=lambda p: -cells[p][0])[:N_CANDIDATES - 1]
+
+
+def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
+    """The network's own path along ``f`` with the state a policy would see at each sample (see the module doc)."""
     cfg = config or SimConfig()
     ids = {p: k for k, p in enumerate(sorted(set(f.pci.tolist())))}
     max_id = n_sites(cfg.layout) - 1  # the simulator's ids: a real flight's cells are ranked into that range
-    service = _Service(cfg, seed)
-    serving = prev = f.pci[0]
-    entered, ho, forced = 0.0, 0, 0
-    states, path, returns = [], [], []
-
-    def hand_over(target, t):
-        nonlocal serving, prev, entered, ho
-        ho += 1
-        if target == prev:
-            returns.append(t - entered)
-        prev, entered, serving = serving, t, target
-
+    link = UplinkBuffer(cfg, f.altitude_m, seed)
+    states, cands, queues = [], [], []
     for i in range(len(f.t)):
         cells = _measured(f, i)
-        if decide is None and f.pci[i] != serving:  # the network handed over between the samples
-            hand_over(f.pci[i], f.t[i])
-        if serving not in cells:
-            serving, forced = max(cells, key=lambda p: cells[p][0]), forced + 1
-        cand = [serving] + sorted((p for p in cells if p != serving), key=lambda p: -cells[p][0])[:N_CANDIDATES - 1]
-        pad = N_CANDIDATES - len(cand)
-        state = state_rows([*f.xy[i], f.altitude_m], service.q, min(ids.get(serving, 0), max_id),
-                           [cells[p][0] for p in cand] + [PAD_RSRP] * pad,
-                           [cells[p][1] for p in cand] + [PAD_RSRQ] * pad)[0]
-        states.append(state)
-        a = 0 if decide is None else int(decide(state, cand, float(f.t[i])))
-        target = cand[a] if a < len(cand) else serving  # a padded candidate slot: stay
-        handed = target != serving or (decide is None and i > 0 and f.pci[i] != f.pci[i - 1])
-        if target != serving:
-            hand_over(target, f.t[i])
-        path.append(serving)
-        dt = float(np.clip(f.t[i + 1] - f.t[i], 0, 5)) if i + 1 < len(f.t) else 0.0
-        rsrp_now = cells.get(serving, (f.rsrp[i], 0))[0]
-        service.step(f.snr[i] + (rsrp_now - f.rsrp[i]), dt, handed)
-    return Replay(np.array(states), np.array(path), ho, np.array(returns), forced,
-                  float(np.mean(service.queues)) / 1e3, service.lost / 1e3)
+        serving = f.pci[i]
+        cand = _candidates(cells, serving, cfg)
+        pad = [np.nan] * (N_CANDIDATES - len(cand))
+        states.append(state_rows([*f.xy[i], f.altitude_m], link.q, min(ids[serving], max_id),
+                                 [cells[p][0] for p in cand] + pad, [cells[p][1] for p in cand] + pad,
+                                 cfg.observation)[0])
+        cands.append(cand)
+        queues.append(link.q)
+        if i + 1 < len(f.t):
+            link.advance(f.rsrp[i], float(np.clip(f.t[i + 1] - f.t[i], 0, 5)), f.pci[i + 1] != serving)
+    return Walk(f.t, np.array(states), cands, np.append(f.pci[1:], f.pci[-1]), np.array(queues), link.lost)
 
 
 def chm_handovers(f: RealFlight, config=None, sim_config: SimConfig | None = None) -> int:
-    """Changes of serving cell (forced ones included) of CHM flown closed-loop along the real measurements by
-    :func:`replay` (A3 on the samples' time stamps): the count to compare with simulated CHM."""
+    """Changes of serving cell of CHM flown closed-loop along the real measurements: A3 (:class:`CHMOnSamples`) on
+    the samples' time stamps over CHM's own serving cell and its measured neighbours; a serving cell that is no
+    longer measured is left for the strongest one measured (counted too). The count to compare with simulated CHM."""
     from .baselines import CHMOnSamples
 
-    return replay(f, CHMOnSamples(f.cells, config), sim_config).changes
+    cfg = sim_config or SimConfig()
+    chm = CHMOnSamples(f.cells, config)
+    serving, changes = f.pci[0], 0
+    for i in range(len(f.t)):
+        cells = _measured(f, i)
+        if serving not in cells:
+            serving, changes = max(cells, key=lambda p: cells[p][0]), changes + 1
+        cand = _candidates(cells, serving, cfg)
+        state = np.full(len(FEATURES), np.nan)
+        state[RSRP_COLUMNS.start:RSRP_COLUMNS.start + len(cand)] = [cells[p][0] for p in cand]
+        target = cand[chm(state, cand, float(f.t[i]))]
+        if target != serving:
+            serving, changes = target, changes + 1
+    return changes
+
+
+@dataclass
+class Agreement:
+    """A policy's proposals against the network's decisions at the same instants (open loop)."""
+
+    instants: int
+    network_handovers: int
+    proposals: int              # instants at which the policy proposed a handover
+    stay_agreement: float       # share of the network's stays where the policy also stayed
+    handover_agreement: float   # share of the network's handovers where the policy proposed one
+    target_agreement: float     # share of the network's handovers where the policy proposed the same cell
+    minutes: float
+
+    @property
+    def proposals_per_min(self) -> float:
+        return self.proposals / max(self.minutes, 1e-9)
+
+
+def agreement(walks: list[Walk], make_decider) -> Agreement:
+    """Open-loop agreement over flights: ``make_decider(walk)`` returns ``decide(state, candidates, t) -> action``
+    (a fresh one per flight, for rules with timers)."""
+    n = ho = prop = stay_ok = ho_ok = target_ok = 0
+    minutes = 0.0
+    for w in walks:
+        decide = make_decider(w)
+        minutes += (w.t[-1] - w.t[0]) / 60
+        for i in range(len(w.t) - 1):
+            cand = w.candidates[i]
+            a = int(decide(w.states[i], cand, float(w.t[i])))
+            target = cand[a] if a < len(cand) else cand[0]
+            net_ho = w.next_serving[i] != cand[0]
+            n, ho, prop = n + 1, ho + net_ho, prop + (target != cand[0])
+            stay_ok += (not net_ho) and target == cand[0]
+            ho_ok += net_ho and target != cand[0]
+            target_ok += net_ho and target == w.next_serving[i]
+    return Agreement(n, ho, prop, stay_ok / max(n - ho, 1), ho_ok / max(ho, 1), target_ok / max(ho, 1), minutes)
 
 
 def baltaci_rate_by_altitude(folder: str | Path) -> tuple[np.ndarray, np.ndarray, int]:

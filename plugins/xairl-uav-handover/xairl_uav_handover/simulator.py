@@ -8,7 +8,10 @@ latents that follow an AR(1) process with correlation exp(-distance moved / shad
 is sigma(LoS state) times one latent; the link is LoS while Phi(other latent) < P_LOS(h, d2D), so the LoS
 probability of TR 36.777 holds at every point and the state does not flicker from step to step. A third latent,
 correlated in time (fading_corr_s) and scaled by fading_db, is the fast-fading residual that layer-3 filtering
-leaves in measured RSRP; it is what makes an A3 handover with a small offset ping-pong at height.
+is left in each 40 ms sample. What the UE reports (``meas_rsrp``, ``meas_rsrq``: what controllers and observations
+see) is the L1 average over each measurement period, layer-3 filtered (``ObservationConfig``); neighbours count as
+measured only above the detection threshold. The uplink (SINR with aerial co-channel interference, capacity) is in
+uplink.py.
 """
 from __future__ import annotations
 
@@ -17,10 +20,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtr
 
-from .buffer import buffer_step, service_bits
+from .buffer import buffer_step
 from .channel import los_probability, path_loss, shadow_sigma
 from .config import LayoutConfig, SimConfig
 from .features import N_CANDIDATES, state_rows
+from .uplink import capacity_bps, interference_mw, rsrp_offset_db, sinr_db
 
 
 def n_sites(layout: LayoutConfig) -> int:
@@ -82,13 +86,19 @@ class Simulator:
         self.g_los = rng.standard_normal((n_uavs, self.N))
         self.g_fast = rng.standard_normal((n_uavs, self.N))
         self._rho_fast = np.exp(-self.dt / cfg.channel.fading_corr_s)
-        rad = cfg.radio
-        self._rsrp_offset = rad.bs_tx_power_dbm - 10 * np.log10(12 * rad.n_rb) + rad.bs_antenna_gain_db
-        bw = rad.n_rb * 180e3
-        self._dl_noise_mw = 10 ** ((-174 + 10 * np.log10(bw) + rad.ue_noise_figure_db) / 10)
-        self._ul_noise_db = -174 + 10 * np.log10(bw) + rad.bs_noise_figure_db + rad.ul_interference_db
+        rad, obs = cfg.radio, cfg.observation
+        self._rsrp_offset = rsrp_offset_db(cfg)
+        self._dl_noise_mw = 10 ** ((-174 + 10 * np.log10(rad.n_rb * 180e3) + rad.ue_noise_figure_db) / 10)
+        self._ul_interference = interference_mw(cfg, self.bs_xy, self.pos[:, 2])
+        # domain randomisation per flight (RadioConfig): cell load and antenna gain deviation
+        self._load = rng.uniform(*rad.load_range, (n_uavs, 1))
+        self._gain = rng.uniform(-rad.gain_spread_db, rad.gain_spread_db, (n_uavs, 1))
+        self._meas_every = max(1, int(round(obs.measurement_period_s / self.dt)))
+        self._l3_a = 1.0 / 2 ** (obs.l3_filter_k / 4)
         self._measure()
-        self.serving = self.rsrp.argmax(axis=1)
+        self.meas_rsrp, self.meas_rsrq = self.rsrp.copy(), self.rsrq.copy()  # what the UE reports
+        self._acc = [np.zeros_like(self.rsrp), np.zeros_like(self.rsrq), 0]
+        self.serving = self.meas_rsrp.argmax(axis=1)
         self.prev_serving = self.serving.copy()
         self.entered = np.zeros(n_uavs, dtype=np.int64)
         self.interrupt = np.zeros(n_uavs, dtype=np.int64)
@@ -104,34 +114,52 @@ class Simulator:
         los = ndtr(self.g_los) < los_probability(c.scenario, h, d2d)
         self.loss_db = (path_loss(c.scenario, h, d3d, c.carrier_ghz, los) + shadow_sigma(c.scenario, h, los)
                         * self.g_shadow + c.fading_db * self.g_fast)
-        self.rsrp = self._rsrp_offset - self.loss_db
+        self.rsrp = self._rsrp_offset + self._gain - self.loss_db
         rsrp_mw = 10 ** (self.rsrp / 10)
         n_re = 12 * self.cfg.radio.n_rb
-        rssi = n_re * self.cfg.radio.load * rsrp_mw.sum(axis=1, keepdims=True) + self._dl_noise_mw
+        rssi = n_re * self._load * rsrp_mw.sum(axis=1, keepdims=True) + self._dl_noise_mw
         self.rsrq = 10 * np.log10(self.cfg.radio.n_rb * rsrp_mw / rssi)
+
+    def _report(self) -> None:
+        """Average the samples of each measurement period, then layer-3 filter them into the reported values."""
+        acc = self._acc
+        acc[0] += self.rsrp
+        acc[1] += self.rsrq
+        acc[2] += 1
+        if acc[2] == self._meas_every:
+            a = self._l3_a
+            self.meas_rsrp = (1 - a) * self.meas_rsrp + a * acc[0] / acc[2]
+            self.meas_rsrq = (1 - a) * self.meas_rsrq + a * acc[1] / acc[2]
+            self._acc = [np.zeros_like(self.rsrp), np.zeros_like(self.rsrq), 0]
 
     @property
     def done(self) -> bool:
         return self.t >= self.n_steps
 
     def ul_sinr_db(self) -> np.ndarray:
-        """Uplink SINR of each UAV at its serving BS."""
-        rad = self.cfg.radio
-        loss = self.loss_db[np.arange(self.K), self.serving]
-        return rad.ue_tx_power_dbm + rad.bs_antenna_gain_db - loss - self._ul_noise_db
+        """Uplink SINR of each UAV at its serving BS (uplink.py)."""
+        k = np.arange(self.K)
+        loss = self.loss_db[k, self.serving] - self._gain[:, 0]  # the same antenna both ways
+        return sinr_db(self.cfg, loss, self._ul_interference[k, self.serving])
 
     def candidates(self) -> np.ndarray:
-        """(K, 4) BS ids: the serving BS, then the three strongest others by RSRP."""
-        masked = self.rsrp.copy()
-        masked[np.arange(self.K), self.serving] = -np.inf
+        """(K, 4) BS ids: the serving BS, then the strongest measured neighbours by reported RSRP; -1 for a slot
+        with no measured neighbour."""
+        k = np.arange(self.K)
+        masked = np.where(self.meas_rsrq > self.cfg.observation.detection_rsrq_db, self.meas_rsrp, -np.inf)
+        masked[k, self.serving] = -np.inf
         top = np.argsort(-masked, axis=1)[:, : N_CANDIDATES - 1]
+        top = np.where(np.isfinite(np.take_along_axis(masked, top, axis=1)), top, -1)
         return np.concatenate([self.serving[:, None], top], axis=1)
 
     def observe(self) -> tuple[np.ndarray, np.ndarray]:
-        """Features (K, 13) in :data:`features.FEATURES` order, and the candidate BS ids (K, 4)."""
+        """Features (K, 13) in :data:`features.FEATURES` order, and the candidate BS ids (K, 4; -1: none)."""
         cand = self.candidates()
         rows = np.arange(self.K)[:, None]
-        return state_rows(self.pos, self.q, self.serving, self.rsrp[rows, cand], self.rsrq[rows, cand]), cand
+        missing = cand < 0
+        rsrp = np.where(missing, np.nan, self.meas_rsrp[rows, cand])
+        rsrq = np.where(missing, np.nan, self.meas_rsrq[rows, cand])
+        return state_rows(self.pos, self.q, self.serving, rsrp, rsrq, self.cfg.observation), cand
 
     def step(self, target: np.ndarray) -> StepInfo:
         """Associate every UAV with ``target`` (BS ids, (K,)), then advance one dt."""
@@ -148,7 +176,7 @@ class Simulator:
         b = cfg.buffer
         sinr = self.ul_sinr_db()
         serving_now = self.interrupt == 0
-        served = service_bits(sinr, b.rb_per_uav, b.rb_bandwidth_hz, self.dt) * serving_now
+        served = capacity_bps(cfg, sinr) * self.dt * serving_now
         arrivals = self.rng.poisson(b.packet_rate_hz * self.dt, self.K) * b.data_packet_bits
         arrivals = arrivals + ho * b.control_packet_bits
         self.q, lost = buffer_step(self.q, arrivals, served, b.q_max_bits)
@@ -156,10 +184,11 @@ class Simulator:
         hc = cfg.handover
         radio_ok = sinr >= hc.sinr_min_db
         info = StepInfo(ho, pingpong, serving_now & radio_ok, radio_ok,
-                        self.rsrp[k, self.serving] < hc.rsrp_threshold_dbm,
-                        self.rsrq[k, self.serving] < hc.rsrq_threshold_db, self.q.copy(), lost, sinr)
+                        self.meas_rsrp[k, self.serving] < hc.rsrp_threshold_dbm,
+                        self.meas_rsrq[k, self.serving] < hc.rsrq_threshold_db, self.q.copy(), lost, sinr)
         self._move()
         self._measure()
+        self._report()
         self.t += 1
         self.last = info
         return info

@@ -4,7 +4,8 @@ Many flights fly in parallel through :class:`env.HandoverVecEnv`; transitions go
 ``ReplayBuffer`` (one row per flight and decision); epsilon-greedy exploration decays linearly
 (:func:`linear_schedule`) from ``eps_start`` to ``eps_end`` over ``eps_fraction`` of training; the learning rate is
 lr0 / (1 + eta * episode) (:func:`learning_rate`); the target network is copied every ``target_every`` updates
-(:func:`dqn_update` is one gradient step). The end of a flight is terminal (no bootstrap), as in the paper's
+(:func:`dqn_update` is one gradient step). Actions are masked to the measured candidates when acting, exploring and
+bootstrapping (a handover to an empty slot is no action at all). The end of a flight is terminal (no bootstrap), as in the paper's
 episodic set-up.
 """
 from __future__ import annotations
@@ -19,7 +20,8 @@ from xairl import Options
 
 from .config import SimConfig
 from .env import HandoverVecEnv
-from .policy import background_states, build_qnet
+from .features import available_actions
+from .policy import background_states, build_qnet, greedy, random_available
 
 
 class TrainConfig(Options, frozen=True):
@@ -52,10 +54,15 @@ def learning_rate(tc: TrainConfig, episode: int) -> float:
     return tc.lr0 / (1 + tc.eta * episode)
 
 
-def dqn_update(q: torch.nn.Module, target: torch.nn.Module, opt: torch.optim.Optimizer, batch, gamma: float) -> float:
-    """One gradient step on the Huber TD error of a replay batch; returns the loss."""
+def dqn_update(q: torch.nn.Module, target: torch.nn.Module, opt: torch.optim.Optimizer, batch, gamma: float,
+               next_available: torch.Tensor | None = None) -> float:
+    """One gradient step on the Huber TD error of a replay batch; returns the loss. ``next_available`` (batch,
+    actions) bool restricts the bootstrap max to the actions available in the next state."""
     with torch.no_grad():
-        next_q = target(batch.next_observations).max(dim=1).values
+        next_q = target(batch.next_observations)
+        if next_available is not None:
+            next_q = next_q.masked_fill(~next_available, -torch.inf)
+        next_q = next_q.max(dim=1).values
         y = batch.rewards.flatten() + gamma * next_q * (1 - batch.dones.flatten())
     qa = q(batch.observations).gather(1, batch.actions.long()).flatten()
     loss = torch.nn.functional.smooth_l1_loss(qa, y)
@@ -100,10 +107,8 @@ def train(tc: TrainConfig, sim_cfg: SimConfig | None = None, progress: bool = Tr
         ep_ret, ep_ho, t0, ended = np.zeros(tc.n_flights), np.zeros(tc.n_flights), time.time(), False
         while not ended:
             eps = linear_schedule(tc.eps_start, tc.eps_end, tc.eps_fraction * total, step)
-            with torch.no_grad():
-                act = q(torch.as_tensor(obs)).argmax(dim=1).numpy()
             explore = rng.uniform(size=tc.n_flights) < eps
-            act = np.where(explore, rng.integers(env.single_action_space.n, size=tc.n_flights), act)
+            act = np.where(explore, random_available(rng, obs, sim_cfg), greedy(q, obs, sim_cfg))
             nxt, reward, _, truncated, info = env.step(act)
             ended = bool(truncated.all())
             rb.add(obs, nxt, act, reward, truncated, [{}] * tc.n_flights)
@@ -112,7 +117,9 @@ def train(tc: TrainConfig, sim_cfg: SimConfig | None = None, progress: bool = Tr
             if rb.size() * tc.n_flights < max(tc.learning_starts, tc.batch_size):
                 continue
             for _ in range(tc.updates_per_decision):
-                dqn_update(q, target, opt, rb.sample(tc.batch_size), tc.gamma)
+                batch = rb.sample(tc.batch_size)
+                nxt_ok = torch.as_tensor(available_actions(batch.next_observations.numpy(), sim_cfg.observation))
+                dqn_update(q, target, opt, batch, tc.gamma, nxt_ok)
                 updates += 1
                 if updates % tc.target_every == 0:
                     target.load_state_dict(q.state_dict())
@@ -121,3 +128,18 @@ def train(tc: TrainConfig, sim_cfg: SimConfig | None = None, progress: bool = Tr
         bar.set_postfix(ho=history[-1]["median_handovers"], ret=round(history[-1]["mean_return"], 1))
     bar.close()
     return q.eval(), history
+
+
+def train_checkpoint(tc: TrainConfig, sim_cfg: SimConfig, out, progress: bool = True) -> float:
+    """Train and write a checkpoint whose metadata holds both configs, the history, the seed, the wall time and the
+    command that re-runs it; returns the seconds spent training."""
+    from .policy import save_checkpoint
+
+    t0 = time.time()
+    net, history = train(tc, sim_cfg, progress=progress)
+    seconds = round(time.time() - t0, 1)
+    save_checkpoint(net, out, {"hidden": list(tc.hidden), "train_config": tc.model_dump(),
+                               "sim_config": sim_cfg.model_dump(), "seed": tc.seed, "train_seconds": seconds,
+                               "history": history, "command": f"xairl uav train --episodes {tc.episodes} --flights "
+                                                              f"{tc.n_flights} --seed {tc.seed}"})
+    return seconds
