@@ -161,6 +161,11 @@ class Walk:
     def serving(self) -> np.ndarray:
         return np.array([c[0] for c in self.candidates])
 
+    @property
+    def cells(self) -> list:
+        """Every cell the walk's candidates name (the columns of an A3 trigger on it)."""
+        return sorted({c for cand in self.candidates for c in cand})
+
 
 def _measured(f: RealFlight, i: int) -> dict[float, tuple[float, float]]:
     cells = {f.pci[i]: (f.rsrp[i], f.rsrq[i])}

@@ -209,12 +209,9 @@ def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
     def dqn(_walk):
         return lambda s, c, t: int(greedy(ckpt.net, s[None], cfg)[0])
 
-    def cells(w):
-        return sorted({c for cand in w.candidates for c in cand})
-
     rows = []
-    for name, make in (("DQN", dqn), ("CHM (A3 2 dB, 160 ms)", lambda w: CHMOnSamples(cells(w))),
-                       ("SA-MRO", lambda w: SAMROOnSamples(cells(w), cfg))):
+    for name, make in (("DQN", dqn), ("CHM (A3 2 dB, 160 ms)", lambda w: CHMOnSamples(w.cells)),
+                       ("SA-MRO", lambda w: SAMROOnSamples(w.cells, cfg))):
         a = agreement(walks, make)
         rows.append(AgreementRow(name, a.proposals_per_min, a.network_handovers / a.minutes,
                                  100 * a.stay_agreement, 100 * a.handover_agreement, 100 * a.target_agreement))
