@@ -83,7 +83,8 @@ class Attributor:
         if self.gap_of_change:
             scale, what = float(np.abs(outputs - base).max()), "the explained change"
         else:
-            scale, what = max(float(np.abs(outputs).max()), float(np.abs(base).max())), "the output scale"
+            # float32 rounding is absolute below 1: the scale does not fall under it
+            scale, what = max(float(np.abs(outputs).max()), float(np.abs(base).max()), 1.0), "the output scale"
         scale = max(scale, 1e-6)
         if gap > self.tolerance * scale:
             raise UnsupportedModelError(

@@ -210,7 +210,8 @@ class DeepShap(Attributor):
             delta = (xp - rp).reshape(m, b, f)
             base = out[m * b:].detach().double().mean(dim=0).cpu().numpy()
             for j in range(a):
-                grad = torch.autograd.grad(out[: m * b, j].sum(), rows, retain_graph=j + 1 < a)[0]
+                # both halves get the output gradient, as in shap: the max-pool rule mixes them
+                grad = torch.autograd.grad(out[:, j].sum(), rows, retain_graph=j + 1 < a)[0]
                 contrib = (grad[: m * b].reshape(m, b, f) * delta).double().mean(dim=1)
                 values[s:s + m, :, j] = contrib.cpu().numpy()
         return values, base, {}
