@@ -153,3 +153,34 @@ def test_value_head_needs_an_actor_critic():
         xairl.from_sb3(build("DQN", "MlpPolicy", "CartPole-v1", None), head="value")
     with pytest.raises(InputError, match="use head='q'"):
         xairl.from_sb3(build("SAC", "MlpPolicy", "Pendulum-v1", None), head="value")
+
+
+@pytest.mark.parametrize("algo, obs, act, head", [
+    ("PPO", "CartPole-v1", None, "value"),
+    ("TD3", spaces.Box(-1, 1, (6,), np.float32), spaces.Box(-2, 3, (2,), np.float32), "policy"),
+])
+def test_narration_of_a_value_head_and_a_2d_actor_verifies(algo, obs, act, head):
+    model = build(algo, "MlpPolicy", obs, act)
+    policy = xairl.from_sb3(model, head=head)
+    x = states(model.observation_space, 24)
+    e = xairl.explain(policy, x[:2], background=x[2:])
+    n = xairl.narrate(e, 0, policy=policy, robustness=False)
+    assert n.verified and n.template == "explain_output" and "chose" not in n.text and "above" not in n.text
+    if head == "value":
+        assert n.text.startswith(f"The value estimate was {xairl_fmt(e.outputs[0, 0])}")
+        assert n.components["margin"] is None
+    else:  # each action dimension is narrated on its own, nothing is chosen among them
+        assert [s for s in n.text.split(". ") if "was set to" in s][1].startswith("Action_1 was set to")
+    # a wrong number in the same words is caught (a continuous action: against its own dimension)
+    view, text = (e, n.text) if head == "value" else (e.output_slice(0), n.text.split(" Action_1")[0])
+    assert xairl.verify(text, view, 0, policy).ok
+    first = next(c for c in n.claims if c.kind == "number" and "+" in c.text)
+    assert not xairl.verify(text.replace(first.text, "+9.99", 1), view, 0, policy).ok
+    with pytest.raises(InputError, match="narrates actions outputs; this policy's output is"):
+        xairl.narrate(e, 0, template="why_not")
+
+
+def xairl_fmt(v):
+    from xairl.narrators.facts import fmt
+
+    return fmt(float(v))

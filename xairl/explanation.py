@@ -148,6 +148,15 @@ class Explanation:
         return replace(self, values=np.stack(cols, axis=1), feature_names=tuple(out_names), states=None,
                        background_quantiles=None, observation=None)
 
+    def output_slice(self, j: int) -> "Explanation":
+        """The explanation of output ``j`` alone (one dimension of a continuous action, narrated on its own)."""
+        if not 0 <= j < self.values.shape[2]:
+            raise InputError(f"output {j} is out of range: the explanation has {self.values.shape[2]} output(s).")
+        cut = slice(j, j + 1)
+        return replace(self, values=self.values[:, :, cut], base_values=self.base_values[:, cut],
+                       outputs=self.outputs[:, cut], action_names=(self.action_names[j],),
+                       available=None if self.available is None else self.available[:, cut])
+
     def groups_by_part(self) -> dict[str, np.ndarray]:
         """Column indices of each input part (the keys of a dict observation, the inputs of a multi-input module),
         for :meth:`grouped`."""
