@@ -123,18 +123,19 @@ def check_supported(module: torch.nn.Module, suggest: str = "") -> list[tuple[to
     return rules
 
 
-def _only_child(module: torch.nn.Module, x: np.ndarray) -> torch.nn.Module:
+def _only_child(policy, x: np.ndarray) -> torch.nn.Module:
     """The Sequential inside a wrapper module (CleanRL's ``QNetwork.network``) when the wrapper has that one child
-    and gives its outputs on these states (checked), else the module itself."""
+    and gives its outputs on these states (checked), else the policy's module itself."""
+    module = policy.module
     if isinstance(module, torch.nn.Sequential):
         return module
     children = list(module.children())
     if len(children) != 1 or not isinstance(children[0], torch.nn.Sequential) or \
             any(True for _ in module.parameters(recurse=False)) or any(True for _ in module.buffers(recurse=False)):
         return module
-    t = torch.as_tensor(x[:256], device=next(iter(children[0].parameters()), torch.empty(0)).device)
+    t = torch.as_tensor(x[:256], device=policy.device)
     with torch.no_grad():
-        same = torch.equal(module(t), children[0](t))
+        same = torch.equal(policy.network(t), children[0](t))
     return children[0] if same else module
 
 
@@ -201,7 +202,7 @@ class DeepShap(Attributor):
                   "operations nn modules")
 
     def _attribute(self, policy, x, bg):
-        layers = chain(_only_child(policy.module, x)) if policy.observation.kind == "flat" else None
+        layers = chain(_only_child(policy, x)) if policy.observation.kind == "flat" else None
         if layers is not None:
             return self._attribute_chain(policy, layers, x, bg)
         module = policy.network
