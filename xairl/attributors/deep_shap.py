@@ -52,9 +52,23 @@ def _local_grad(layer, h):
         return torch.autograd.grad(layer.forward(leaf).sum(), leaf)[0]
 
 
+def _rescale_multiplier(layer, inp, out):
+    """Rescale rule of an elementwise layer: the multiplier Δout/Δin per element (pairs are rows i and i + P), the
+    local gradient where |Δin| is tiny, as shap does. Computed once per forward call, used by every output's
+    backward pass."""
+    p = len(inp) // 2
+    d_in = inp[:p] - inp[p:]
+    ratio = (out[:p] - out[p:]) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
+    small = d_in.abs() < EPS
+    ratio = torch.cat([ratio, ratio])
+    if small.any():
+        ratio = torch.where(torch.cat([small, small]), _local_grad(layer, inp), ratio)
+    return ratio
+
+
 def _rescale(layer, inp, out, g):
-    """Rescale rule: the multiplier Δout/Δin per element (pairs are rows i and i + P); the local gradient where
-    |Δin| is tiny, as shap does."""
+    """Rescale rule for a layer that mixes elements (Softmax, LogSoftmax), per element as shap applies it; the
+    true local Jacobian where |Δin| is tiny."""
     p = len(inp) // 2
     d_in = inp[:p] - inp[p:]
     ratio = (out[:p] - out[p:]) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
@@ -78,16 +92,22 @@ def _maxpool(layer, inp, out, g):
 
 
 class _Rule(torch.autograd.Function):
-    """Identity on the layer's output in the forward pass; the DeepLIFT rule in the backward pass."""
+    """Identity on the layer's output in the forward pass; the DeepLIFT rule in the backward pass: a multiplier
+    computed once (elementwise layers), or a rule applied to each output's gradient."""
 
     @staticmethod
     def forward(ctx, inp, out, layer, rule):
-        ctx.save_for_backward(inp, out)
+        if rule is _rescale_multiplier:
+            ctx.save_for_backward(_rescale_multiplier(layer, inp, out))
+        else:
+            ctx.save_for_backward(inp, out)
         ctx.layer, ctx.rule = layer, rule
         return out.clone()
 
     @staticmethod
     def backward(ctx, g):
+        if ctx.rule is _rescale_multiplier:
+            return g * ctx.saved_tensors[0], None, None, None
         inp, out = ctx.saved_tensors
         return ctx.rule(ctx.layer, inp, out, g), None, None, None
 
@@ -107,7 +127,9 @@ def check_supported(module: torch.nn.Module, suggest: str = "") -> list[tuple[to
     attribute ``xairl_linear = True``; the additivity check still guards the claim."""
     rules = []
     for name, sub in module.named_modules():
-        if isinstance(sub, NONLINEAR + SOFTMAX):
+        if isinstance(sub, NONLINEAR):
+            rules.append((sub, _rescale_multiplier))
+        elif isinstance(sub, SOFTMAX):
             rules.append((sub, _rescale))
         elif isinstance(sub, MAXPOOL):
             if sub.return_indices:
