@@ -82,9 +82,8 @@ class Policy:
         if self.feature_names is None:
             self.feature_names = self.observation.feature_names()
         self.network = PolicyNetwork(self.module, self.observation, self.name)
-        if self.action_names is None:
-            n = self.network(torch.zeros(1, self.observation.n_features, device=self.device)).shape[1] \
-                if self.output != "value" else 1
+        if self.action_names is None:  # count the outputs on one all-zero state
+            n = 1 if self.output == "value" else self.scores(np.zeros((1, self.observation.n_features))).shape[1]
             self.action_names = ["value"] if self.output == "value" else [f"action_{i}" for i in range(n)]
         self.feature_names = [str(f) for f in self.feature_names]
         self.action_names = [str(a) for a in self.action_names]
@@ -135,7 +134,7 @@ class Policy:
         finally:
             self.module.train(was_training)
         out = out.detach().cpu().numpy().astype(np.float64)
-        if out.shape[1] != self.n_actions:
+        if self.action_names is not None and out.shape[1] != self.n_actions:
             raise InputError(
                 f"the module returned shape {tuple(out.shape)} but {self.n_actions} outputs are named; "
                 f"it must map {self.observation.describe()} to (batch, {self.n_actions})."
