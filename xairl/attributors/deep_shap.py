@@ -235,7 +235,7 @@ class DeepShap(Attributor):
         bt = torch.as_tensor(bg, device=dev)
         n, f = xt.shape
         b, a = len(bt), policy.n_actions
-        per = max(1, min(self.options.max_pairs, max(1, 2 ** 24 // f)) // b)  # bounds the doubled batch
+        per = max(1, min(self.options.max_pairs, max(1, 2 ** 22 // f)) // b)  # bounds the doubled batch
         values = np.empty((n, f, a))
         base = None
         for s in range(0, n, per):
@@ -250,7 +250,7 @@ class DeepShap(Attributor):
             for j in range(a):
                 # both halves get the output gradient, as in shap: the max-pool rule mixes them
                 grad = torch.autograd.grad(out[:, j].sum(), rows, retain_graph=j + 1 < a)[0]
-                contrib = (grad[: m * b].reshape(m, b, f) * delta).double().mean(dim=1)
+                contrib = (grad[: m * b].reshape(m, b, f) * delta).mean(dim=1).double()
                 values[s:s + m, :, j] = contrib.cpu().numpy()
         return values, base, {}
 
