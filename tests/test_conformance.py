@@ -89,7 +89,8 @@ def test_hooks_and_mode_restored_after_error(method, data):
     net = Exploding(fuse=2)  # call 1 is the policy's own scoring; call 2 is inside the attributor
     net.train()
     policy = xairl.TorchPolicy(net, [f"f{i}" for i in range(5)], ["a", "b", "c"])
-    with pytest.raises(RuntimeError, match="injected failure"):
+    # the user's exception comes out as one xairl line naming the module and the input's shape
+    with pytest.raises(xairl.InputError, match=r"module Exploding raised RuntimeError \(injected failure\) on input \("):
         xairl.explain(policy, x, background=bg, method=method, options=SMALL.get(method, {}))
     assert net.calls >= 2
     assert hook_count(net) == 0

@@ -26,6 +26,27 @@ def test_cleanrl_style():
     assert "rather than" in out and "global: Over 3 states" in out
 
 
+def test_atari_cnn_and_its_cli_with_nothing_installed(tmp_path):
+    out = run([str(EX / "atari_cnn.py"), "--out", str(tmp_path / "ex")])
+    assert "strongest patches: ['patch[" in out and (tmp_path / "ex" / "image.png").stat().st_size > 5000
+    xairl = str(Path(sys.executable).with_name("xairl"))
+    res = subprocess.run([xairl, "explain", "--policy", f"{EX / 'atari_cnn.py'}:make_policy", "--policy-arg", "seed=1",
+                          "--states", str(tmp_path / "ex" / "states.npy"), "--background",
+                          str(tmp_path / "ex" / "background.npy"), "--out", str(tmp_path / "rep")],
+                         capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr[-2000:]
+    for name in ("explanations.jsonl", "report.html", "beeswarm.png", "image.png"):
+        assert (tmp_path / "rep" / name).stat().st_size > 0, name
+    first = (tmp_path / "rep" / "explanations.jsonl").read_text().splitlines()[0]
+    assert '"chosen":"' in first and '"obs[3,83,83]"' in first
+
+
+def test_continuous_actor():
+    out = run([str(EX / "continuous_actor.py"), "--timesteps", "200"])
+    assert "[continuous, verified=True" in out and "Torque was set to" in out
+    assert "[value, verified=True" in out and "The Q estimate was" in out and "chose" not in out
+
+
 def test_custom_prompt():
     out = run([str(EX / "custom_prompt" / "run.py")])
     assert "explain_action.yaml ok" in out and "one_liner.yaml ok" in out

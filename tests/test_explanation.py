@@ -82,3 +82,20 @@ def test_action_mask_restricts_chosen_and_runner_up():
     bad = replace(policy, action_mask=lambda x: np.zeros((len(x), policy.n_actions), bool))
     with pytest.raises(InputError, match="at least one available action"):
         bad.act(states)
+
+
+def test_patches_group_an_image_and_keep_additivity():
+    groups = xairl.patches((4, 84, 84), 6)
+    assert len(groups) == 196 and all(len(g) == 4 * 36 for g in groups.values())
+    assert sorted(np.concatenate(list(groups.values()))) == list(range(4 * 84 * 84))
+    rng = np.random.default_rng(0)
+    f = 4 * 84 * 84
+    e = xairl.Explanation(values=rng.normal(size=(2, f, 3)), base_values=np.zeros((2, 3)), outputs=np.zeros((2, 3)),
+                          states=rng.normal(size=(2, f)), feature_names=tuple(f"p{i}" for i in range(f)),
+                          action_names=("a", "b", "c"), method="test")
+    g = e.grouped(groups)
+    assert g.feature_names[0] == "patch[0,0]" and g.values.shape == (2, 196, 3)
+    np.testing.assert_allclose(g.values.sum(axis=1), e.values.sum(axis=1))
+    np.testing.assert_allclose(g.values[:, 0], e.values[:, groups["patch[0,0]"]].sum(axis=1))
+    with pytest.raises(xairl.InputError, match="groups must not overlap"):
+        e.grouped({"x": [0, 1], "y": [1, 2]})

@@ -1,33 +1,186 @@
-"""xairl.from_sb3 on real Stable-Baselines3 models (a few gradient steps, no mocks)."""
+"""xairl.from_sb3 on real Stable-Baselines3 models of every algorithm and policy kind (built untrained with small
+buffers, a few gradient steps where cheap; no mocks). Each Policy's outputs are compared here with SB3's own."""
 import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+from gymnasium import spaces
 
 import xairl
 from xairl.errors import InputError
 
+IMAGE = spaces.Box(0, 255, (4, 84, 84), np.uint8)  # Atari frames after SB3's VecFrameStack + transpose
+DICT = spaces.Dict({"image": spaces.Box(0, 255, (3, 36, 36), np.uint8), "vec": spaces.Box(-1, 1, (5,), np.float32),
+                    "mode": spaces.Discrete(3)})
 
-def test_ppo_logits_match_the_sb3_policy():
-    from stable_baselines3 import PPO
 
-    env = gym.make("CartPole-v1")
-    model = PPO("MlpPolicy", env, n_steps=32, batch_size=32, n_epochs=1, seed=0).learn(32)
-    policy = xairl.from_sb3(model)
-    assert policy.feature_names == ["obs_0", "obs_1", "obs_2", "obs_3"] and policy.n_actions == 2
-    obs = np.stack([env.reset(seed=s)[0] for s in range(12)])
+class SpaceEnv(gym.Env):
+    """Random observations of a given space: enough to build and briefly train any SB3 algorithm."""
+
+    def __init__(self, obs, act):
+        self.observation_space, self.action_space = obs, act
+
+    def reset(self, seed=None, options=None):
+        super().reset(seed=seed)
+        return self.observation_space.sample(), {}
+
+    def step(self, action):
+        return self.observation_space.sample(), float(self.np_random.normal()), False, \
+            bool(self.np_random.random() < 0.1), {}
+
+
+def states(space, n, seed=1):
+    space.seed(seed)
+    raw = [space.sample() for _ in range(n)]
+    return {k: np.stack([r[k] for r in raw]) for k in space.spaces} if isinstance(space, spaces.Dict) \
+        else np.stack(raw)
+
+
+def sb3_outputs(model, head, obs):
+    """What SB3 itself computes for ``obs`` (the reference for each head)."""
+    p = model.policy
     with torch.no_grad():
-        dist = model.policy.get_distribution(torch.as_tensor(obs))
-    # torch's Categorical keeps normalised logits (log-probabilities); ours are the raw action-net outputs
-    ours = torch.log_softmax(torch.as_tensor(policy.scores(obs)), dim=1).numpy()
-    np.testing.assert_allclose(ours, dist.distribution.logits.numpy(), atol=1e-5)
-    exp = xairl.explain(policy, obs[:3], background=obs[3:], method="deep_shap")
-    assert exp.additivity_gap.max() < 1e-4
+        t, _ = p.obs_to_tensor(obs)
+        if head == "q-values":
+            return p.q_net(t).numpy()
+        if head == "log-probs":
+            return p.get_distribution(t).distribution.logits.numpy()
+        if head == "value":
+            return p.predict_values(t).numpy()
+        if head == "q":
+            act = p.actor(t, deterministic=True) if hasattr(p.actor, "latent_pi") else p.actor(t)
+            return p.critic.q1_forward(t, act).numpy()
+    return np.asarray(model.predict(obs, deterministic=True)[0], dtype=np.float64)
 
 
-def test_continuous_actions_are_refused():
-    from stable_baselines3 import PPO
+def build(algo, policy_kind, obs, act, **kw):
+    import stable_baselines3 as sb3
 
-    model = PPO("MlpPolicy", gym.make("Pendulum-v1"), n_steps=16, batch_size=16, seed=0)
-    with pytest.raises(InputError, match="discrete actions"):
+    cls = getattr(sb3, algo)
+    if algo in ("DQN", "SAC", "TD3", "DDPG"):
+        kw.setdefault("buffer_size", 200)
+        kw.setdefault("learning_starts", 16)
+    else:
+        kw.setdefault("n_steps", 16)
+        if algo == "PPO":
+            kw.setdefault("batch_size", 16)
+    return cls(policy_kind, SpaceEnv(obs, act) if not isinstance(obs, str) else gym.make(obs), seed=0, **kw)
+
+
+CASES = [  # algorithm, policy, observation, action space, head, reference, output kind, train steps
+    ("DQN", "MlpPolicy", "CartPole-v1", None, "policy", "q-values", "actions", 64),
+    ("DQN", "CnnPolicy", IMAGE, spaces.Discrete(6), "policy", "q-values", "actions", 0),
+    ("DQN", "MultiInputPolicy", DICT, spaces.Discrete(4), "policy", "q-values", "actions", 32),
+    ("PPO", "MlpPolicy", "CartPole-v1", None, "policy", "log-probs", "actions", 32),
+    ("PPO", "MlpPolicy", "CartPole-v1", None, "value", "value", "value", 0),
+    ("PPO", "MlpPolicy", "Pendulum-v1", None, "policy", "predict", "continuous", 32),
+    ("A2C", "MlpPolicy", spaces.Box(-1, 1, (6,), np.float32), spaces.Box(-2, 3, (2,), np.float32), "policy",
+     "predict", "continuous", 16),
+    ("A2C", "MultiInputPolicy", DICT, spaces.Discrete(3), "value", "value", "value", 0),
+    ("SAC", "MlpPolicy", "Pendulum-v1", None, "policy", "predict", "continuous", 32),
+    ("SAC", "MlpPolicy", "Pendulum-v1", None, "q", "q", "value", 0),
+    ("TD3", "MlpPolicy", spaces.Box(-1, 1, (6,), np.float32), spaces.Box(-2, 3, (2,), np.float32), "policy",
+     "predict", "continuous", 32),
+    ("DDPG", "MlpPolicy", "Pendulum-v1", None, "q", "q", "value", 0),
+]
+
+
+@pytest.mark.parametrize("algo, kind, obs, act, head, ref, output, steps", CASES,
+                         ids=[f"{c[0]}-{c[1]}-{c[4]}" for c in CASES])
+def test_from_sb3_equals_sb3(algo, kind, obs, act, head, ref, output, steps):
+    model = build(algo, kind, obs, act)
+    if steps:
+        model.learn(steps)
+    policy = xairl.from_sb3(model, head=head)
+    assert policy.output == output
+    x = states(model.observation_space, 12)
+    ours = policy.scores(x)
+    if ref == "log-probs":  # torch's Categorical keeps normalised logits
+        ours = torch.log_softmax(torch.as_tensor(ours), dim=1).numpy()
+    np.testing.assert_allclose(ours, sb3_outputs(model, ref, x).reshape(ours.shape), rtol=0, atol=1e-6)
+    if output == "actions":
+        np.testing.assert_array_equal(policy.act(x), model.predict(x, deterministic=True)[0])
+    e = xairl.explain(policy, {k: v[:2] for k, v in x.items()} if isinstance(x, dict) else x[:2],
+                      background={k: v[2:] for k, v in x.items()} if isinstance(x, dict) else x[2:])
+    assert e.output == output and e.values.shape == (2, policy.n_features, policy.n_actions)
+    assert e.additivity_gap.max() <= 1e-5 * max(1.0, np.abs(e.outputs).max())
+
+
+def test_image_feature_names_and_image_view():
+    model = build("DQN", "CnnPolicy", IMAGE, spaces.Discrete(6))
+    policy = xairl.from_sb3(model)
+    assert policy.feature_names[0] == "obs[0,0,0]" and policy.n_features == 4 * 84 * 84
+    x = states(IMAGE, 3)
+    e = xairl.explain(policy, x[:1], background=x[1:])
+    assert e.image().shape == (1, 4, 84, 84)
+    np.testing.assert_allclose(e.image(0).sum(axis=(1, 2, 3)) + e.base_values[:, 0], e.outputs[:, 0], atol=1e-4)
+
+
+def test_dict_observation_one_hot_and_groups():
+    model = build("DQN", "MultiInputPolicy", DICT, spaces.Discrete(4))
+    policy = xairl.from_sb3(model)
+    assert [f for f in policy.feature_names if f.startswith("mode")] == ["mode=0", "mode=1", "mode=2"]
+    x = states(DICT, 6)
+    e = xairl.explain(policy, {k: v[:2] for k, v in x.items()}, background={k: v[2:] for k, v in x.items()})
+    g = e.grouped(e.groups_by_part())
+    assert g.feature_names == ("image", "mode", "vec")  # SB3 sorts Dict keys
+    np.testing.assert_allclose(g.values.sum(axis=1), e.values.sum(axis=1), atol=1e-9)
+    with pytest.raises(InputError, match=r"states\['mode'\] must hold one integer in 0..2"):
+        policy.scores({**x, "mode": np.full(6, 7)})
+
+
+def test_multidiscrete_is_explained_one_branch_at_a_time():
+    model = build("PPO", "MlpPolicy", spaces.Box(-1, 1, (4,), np.float32), spaces.MultiDiscrete([3, 2]))
+    with pytest.raises(InputError, match="pick one with branch=0..1"):
         xairl.from_sb3(model)
+    x = states(model.observation_space, 8)
+    for b, n in ((0, 3), (1, 2)):
+        policy = xairl.from_sb3(model, branch=b)
+        assert policy.action_names == [f"action_{b}={i}" for i in range(n)]
+        np.testing.assert_array_equal(policy.act(x), model.predict(x, deterministic=True)[0][:, b])
+
+
+def test_recurrent_policies_are_refused():
+    from sb3_contrib import RecurrentPPO
+
+    model = RecurrentPPO("MlpLstmPolicy", gym.make("CartPole-v1"), n_steps=16, batch_size=16, seed=0)
+    with pytest.raises(InputError, match="recurrent: its action depends on the LSTM's hidden state"):
+        xairl.from_sb3(model)
+
+
+def test_value_head_needs_an_actor_critic():
+    with pytest.raises(InputError, match="head='value' is for actor-critics"):
+        xairl.from_sb3(build("DQN", "MlpPolicy", "CartPole-v1", None), head="value")
+    with pytest.raises(InputError, match="use head='q'"):
+        xairl.from_sb3(build("SAC", "MlpPolicy", "Pendulum-v1", None), head="value")
+
+
+@pytest.mark.parametrize("algo, obs, act, head", [
+    ("PPO", "CartPole-v1", None, "value"),
+    ("TD3", spaces.Box(-1, 1, (6,), np.float32), spaces.Box(-2, 3, (2,), np.float32), "policy"),
+])
+def test_narration_of_a_value_head_and_a_2d_actor_verifies(algo, obs, act, head):
+    model = build(algo, "MlpPolicy", obs, act)
+    policy = xairl.from_sb3(model, head=head)
+    x = states(model.observation_space, 24)
+    e = xairl.explain(policy, x[:2], background=x[2:])
+    n = xairl.narrate(e, 0, policy=policy, robustness=False)
+    assert n.verified and n.template == "explain_output" and "chose" not in n.text and "above" not in n.text
+    if head == "value":
+        assert n.text.startswith(f"The value estimate was {xairl_fmt(e.outputs[0, 0])}")
+        assert n.components["margin"] is None
+    else:  # each action dimension is narrated on its own, nothing is chosen among them
+        assert [s for s in n.text.split(". ") if "was set to" in s][1].startswith("Action_1 was set to")
+    # a wrong number in the same words is caught (a continuous action: against its own dimension)
+    view, text = (e, n.text) if head == "value" else (e.output_slice(0), n.text.split(" Action_1")[0])
+    assert xairl.verify(text, view, 0, policy).ok
+    first = next(c for c in n.claims if c.kind == "number" and "+" in c.text)
+    assert not xairl.verify(text.replace(first.text, "+9.99", 1), view, 0, policy).ok
+    with pytest.raises(InputError, match="narrates actions outputs; this policy's output is"):
+        xairl.narrate(e, 0, template="why_not")
+
+
+def xairl_fmt(v):
+    from xairl.narrators.facts import fmt
+
+    return fmt(float(v))

@@ -13,7 +13,9 @@ _LAZY = {
     # policies and results
     "Policy": "xairl.policy",
     "TorchPolicy": "xairl.policy",
-    "from_sb3": "xairl.policy",
+    "from_sb3": "xairl.sb3",
+    "Observation": "xairl.observation",
+    "patches": "xairl.observation",
     "FeatureInfo": "xairl.policy",
     "Explanation": "xairl.explanation",
     "StateRecord": "xairl.explanation",

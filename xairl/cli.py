@@ -90,32 +90,66 @@ def cmd_explain(args) -> int:
     from .attributors import explain
     from .inputs import read_states
 
-    policy = plugins.get_policy(args.policy)
+    policy = plugins.load_policy(args.policy, _parse_options(args.policy_arg), _state_shape(args.states))
     method = plugins.get_attributor(args.method)  # unknown names fail before any file is read
     options = method(_parse_options(args.option)).options
     if args.states:
-        states = read_states(args.states, policy.feature_names)
+        states = read_states(args.states, policy.feature_names, policy.observation)
     else:
         states = policy.background(args.n, seed=args.seed + 1)
-    bg = read_states(args.background, policy.feature_names) if args.background else policy.background(
-        args.background_size, seed=args.seed)
+    bg = read_states(args.background, policy.feature_names, policy.observation) if args.background else \
+        policy.background(args.background_size, seed=args.seed)
     exp = explain(policy, states, background=bg, method=args.method, options=options.model_dump())
+    if args.out:
+        return _write_report(args, exp, policy, bg)
     if args.narrate:
         return _print_narratives(args, exp, policy, bg)
     if args.format == "jsonl":
         for rec in exp.records():
             print(rec.model_dump_json())
         return 0
-    chosen = exp.for_chosen()
+    decides = exp.output == "actions"
     for i, rec in enumerate(exp.records()):
-        order = np.argsort(-np.abs(chosen[i]))[: args.top]
         scores = ", ".join(f"{a}={v:.3f}" for a, v in rec.scores.items())
-        print(f"state {i}: chose {rec.chosen} (runner-up {rec.runner_up}); scores {scores}")
-        for j in order:
-            f = exp.feature_names[j]
-            print(f"    {f:<24} = {exp.states[i, j]:>10.4g}   contribution {chosen[i, j]:+.4f}")
-        print(f"    base {exp.base_values[i, exp.chosen[i]]:.4f}, additivity gap "
-              f"{exp.additivity_gap[i, exp.chosen[i]]:.2e} ({exp.method})")
+        print(f"state {i}: chose {rec.chosen} (runner-up {rec.runner_up}); scores {scores}" if decides else
+              f"state {i}: {exp.output} {scores}")
+        for a in ([int(exp.chosen[i])] if decides else range(exp.values.shape[2])):
+            contrib = exp.values[i, :, a]
+            if not decides:
+                print(f"  {exp.action_names[a]}:")
+            for j in np.argsort(-np.abs(contrib))[: args.top]:
+                print(f"    {exp.feature_names[j]:<24} = {exp.states[i, j]:>10.4g}   contribution {contrib[j]:+.4f}")
+            print(f"    base {exp.base_values[i, a]:.4f}, additivity gap {exp.additivity_gap[i, a]:.2e} ({exp.method})")
+    return 0
+
+
+def _state_shape(path):
+    """The shape of one state in a .npy file (what a bare torch module given as --policy takes), else None."""
+    import numpy as np
+
+    if not path or not str(path).lower().endswith(".npy"):
+        return None
+    try:
+        shape = np.load(path, mmap_mode="r", allow_pickle=False).shape
+    except (OSError, ValueError):
+        return None  # read_states reports the problem with the file
+    return shape[1:] if len(shape) > 1 else shape
+
+
+def _write_report(args, exp, policy, bg) -> int:
+    """explanations.jsonl, figures and report.html for any policy (``--out DIR``)."""
+    from pathlib import Path
+
+    from .report import ReportContent, ReportRequest, write_report
+
+    req = ReportRequest(out=Path(args.out), method=args.method, options=dict(exp.options), narrate=args.narrate,
+                        narrator=args.narrator, narrator_options=_parse_options(args.narrator_option),
+                        template=args.template, prompt_dirs=args.prompts, seed=args.seed, n_states=len(exp.values),
+                        robustness=not args.no_robustness, progress=False)
+    content = ReportContent(title=f"xairl: {policy.name}", policy=policy, background=bg,
+                            datasets=[("states", exp.states)])
+    path = write_report(req, content, explained={"states": exp})
+    print(f"report: {path.resolve()}")
     return 0
 
 
@@ -240,8 +274,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _explain_parser(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--policy", default="toy", help="registered policy name (see `xairl plugins`); default: toy")
-    p.add_argument("--states", help="states to explain: .csv with a header naming the features, .npy or .json; "
+    p.add_argument("--policy", default="toy", help="registered policy name (see `xairl plugins`), or with nothing "
+                   "installed package.module:attr or path/file.py:attr (a Policy, a torch module, or a function "
+                   "returning one); default: toy")
+    p.add_argument("--policy-arg", action="append", default=[], metavar="KEY=VALUE",
+                   help="argument of a module:attr policy function, e.g. --policy-arg checkpoint=my_q.pt")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="write explanations.jsonl, figures and report.html into DIR instead of printing")
+    p.add_argument("--states", help="states to explain: .csv with a header naming the features, .npy (n, *obs_shape), .npz (dict "
+                   "observations) or .json; "
                    "default: --n states from the policy's sampler")
     p.add_argument("--background", help="background states file (default: the policy's sampler)")
     p.add_argument("--background-size", type=int, default=100, help="background states drawn from the sampler")

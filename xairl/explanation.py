@@ -27,6 +27,10 @@ class Explanation:
         value can be called low, typical or high.
     :param available: (n_states, n_actions) bool, the actions available in each state (the policy's
         ``action_mask``); None: all. The chosen action and the runner-up are taken among available ones.
+    :param output: what the outputs are (``Policy.output``): 'actions' (discrete scores: a chosen action and a
+        runner-up), 'continuous' (action dimensions, each explained on its own) or 'value' (one output).
+    :param observation: the policy's input structure (``Observation.to_dict()``), so that values can be viewed as
+        images (:meth:`image`); None for flat states.
     """
 
     values: np.ndarray
@@ -40,6 +44,8 @@ class Explanation:
     extras: Mapping[str, Any] = field(default_factory=dict)
     background_quantiles: np.ndarray | None = None
     available: np.ndarray | None = None
+    output: str = "actions"
+    observation: Mapping[str, Any] | None = None
 
     def __post_init__(self) -> None:
         n, f, a = self.values.shape
@@ -70,7 +76,7 @@ class Explanation:
 
     @property
     def chosen(self) -> np.ndarray:
-        """Index of the best-scoring available action per state."""
+        """Index of the best-scoring available action per state (meaningful for discrete actions; 0 for a value)."""
         return self._ranked()[:, 0]
 
     @property
@@ -97,38 +103,90 @@ class Explanation:
         idx = np.arange(len(self.values))
         return self.values[idx, :, self.chosen] - self.values[idx, :, self.runner_up]
 
-    def grouped(self, groups: Mapping[str, Sequence[str]]) -> "Explanation":
+    def grouped(self, groups: Mapping[str, Sequence[str] | np.ndarray]) -> "Explanation":
         """Sum the contributions of each group into one feature named after it; other features stay as they are.
 
-        Groups must not overlap. The result keeps outputs and base values, so additivity is unchanged.
+        :param groups: group name -> member feature names, or member column indices (e.g. from
+            :func:`xairl.patches` for image patches, or :meth:`groups_by_part` for dict keys). Groups must not
+            overlap. The result keeps outputs and base values, so additivity is unchanged.
         """
-        seen: dict[str, str] = {}
-        for g, members in groups.items():
-            for m in members:
-                if m not in self.feature_names:
-                    raise InputError(f"group '{g}' names unknown feature '{m}'; known: {', '.join(self.feature_names)}.")
-                if m in seen:
-                    raise InputError(f"feature '{m}' is in groups '{seen[m]}' and '{g}'; groups must not overlap.")
-                seen[m] = g
-        names: list[str] = []
-        cols: list[np.ndarray] = []
-        for i, f in enumerate(self.feature_names):
-            g = seen.get(f)
-            if g is None:
-                names.append(f)
-                cols.append(self.values[:, i, :])
-            elif g not in names:
-                names.append(g)
-                idx = [self.feature_names.index(m) for m in groups[g]]
-                cols.append(self.values[:, idx, :].sum(axis=1))
-        return replace(self, values=np.stack(cols, axis=1), feature_names=tuple(names), states=None,
-                       background_quantiles=None)
+        index = {f: i for i, f in enumerate(self.feature_names)}
+        owner = np.full(len(self.feature_names), -1)
+        names = list(groups)
+        for k, (g, members) in enumerate(groups.items()):
+            members = np.asarray(members)
+            if members.dtype.kind in "iu":
+                idx = members.astype(int)
+                if idx.size and (idx.min() < 0 or idx.max() >= len(owner)):
+                    raise InputError(f"group '{g}' has column indices outside 0..{len(owner) - 1}.")
+            else:
+                unknown = [m for m in members.tolist() if m not in index]
+                if unknown:
+                    raise InputError(f"group '{g}' names unknown feature '{unknown[0]}'; known: "
+                                     f"{', '.join(self.feature_names[:20])}{' ...' if len(index) > 20 else ''}.")
+                idx = np.array([index[m] for m in members.tolist()], dtype=int)
+            clash = idx[owner[idx] >= 0]
+            if clash.size:
+                raise InputError(f"feature '{self.feature_names[clash[0]]}' is in groups '{names[owner[clash[0]]]}' "
+                                 f"and '{g}'; groups must not overlap.")
+            owner[idx] = k
+        # one column per group (at its first member's place) and per ungrouped feature, in feature order
+        order, out_names, seen = [], [], set()
+        for i in range(len(owner)):
+            k = int(owner[i])
+            if k < 0:
+                order.append(("f", i))
+                out_names.append(self.feature_names[i])
+            elif k not in seen:
+                seen.add(k)
+                order.append(("g", k))
+                out_names.append(names[k])
+        sums = np.zeros((len(self.values), len(names), self.values.shape[2]))
+        grouped = owner >= 0
+        np.add.at(sums.transpose(1, 0, 2), owner[grouped], self.values[:, grouped, :].transpose(1, 0, 2))
+        cols = [self.values[:, i, :] if kind == "f" else sums[:, i, :] for kind, i in order]
+        return replace(self, values=np.stack(cols, axis=1), feature_names=tuple(out_names), states=None,
+                       background_quantiles=None, observation=None)
+
+    def output_slice(self, j: int) -> "Explanation":
+        """The explanation of output ``j`` alone (one dimension of a continuous action, narrated on its own)."""
+        if not 0 <= j < self.values.shape[2]:
+            raise InputError(f"output {j} is out of range: the explanation has {self.values.shape[2]} output(s).")
+        cut = slice(j, j + 1)
+        return replace(self, values=self.values[:, :, cut], base_values=self.base_values[:, cut],
+                       outputs=self.outputs[:, cut], action_names=(self.action_names[j],),
+                       available=None if self.available is None else self.available[:, cut])
+
+    def groups_by_part(self) -> dict[str, np.ndarray]:
+        """Column indices of each input part (the keys of a dict observation, the inputs of a multi-input module),
+        for :meth:`grouped`."""
+        from .observation import Observation
+
+        if self.observation is None:
+            return {}
+        return {k: np.arange(s.start, s.stop) for k, s in Observation.from_dict(self.observation).slices().items()}
+
+    def image(self, action: int | str | None = None) -> np.ndarray:
+        """Contributions as images: (n_states, *image_shape) for one output (default: the chosen action for
+        discrete actions, else output 0)."""
+        from .observation import Observation
+
+        shape = None if self.observation is None else Observation.from_dict(self.observation).image_shape()
+        if shape is None:
+            raise InputError("this explanation is not of an image observation; give the policy observation=(C, H, W).")
+        n = len(self.values)
+        if action is None:
+            a = self.chosen if self.output == "actions" else np.zeros(n, dtype=int)
+        else:
+            a = np.full(n, self.action_names.index(action) if isinstance(action, str) else int(action))
+        return self.values[np.arange(n), :, a].reshape(n, *shape)
 
     def records(self, dataset: str | None = None) -> list["StateRecord"]:
         """One :class:`StateRecord` per explained state (the JSON-lines form); ``dataset`` labels where the states
         came from (e.g. 'simulated', 'real')."""
         gap, chosen, runner = self.additivity_gap, self.chosen, self.runner_up
         acts = self.action_names
+        decides = self.output == "actions"  # continuous dimensions and values have nothing chosen
         out = []
         for i in range(len(self.values)):
             out.append(StateRecord(
@@ -136,8 +194,9 @@ class Explanation:
                 dataset=dataset,
                 method=self.method,
                 state=None if self.states is None else dict(zip(self.feature_names, self.states[i].tolist())),
-                chosen=acts[chosen[i]],
-                runner_up=acts[runner[i]],
+                output=self.output,
+                chosen=acts[chosen[i]] if decides else None,
+                runner_up=acts[runner[i]] if decides else None,
                 scores=dict(zip(acts, self.outputs[i].tolist())),
                 base_values=dict(zip(acts, self.base_values[i].tolist())),
                 values={f: dict(zip(acts, self.values[i, j].tolist())) for j, f in enumerate(self.feature_names)},
@@ -170,6 +229,8 @@ class ExplanationRecord(BaseModel):
     extras: dict[str, Any] = {}
     background_quantiles: list[list[float]] | None = None
     available: list[list[bool]] | None = None
+    output: str = "actions"
+    observation: dict[str, Any] | None = None
 
     @classmethod
     def from_explanation(cls, e: Explanation) -> "ExplanationRecord":
@@ -185,6 +246,8 @@ class ExplanationRecord(BaseModel):
             extras={k: np.asarray(v).tolist() for k, v in e.extras.items()},
             background_quantiles=None if e.background_quantiles is None else e.background_quantiles.tolist(),
             available=None if e.available is None else e.available.tolist(),
+            output=e.output,
+            observation=None if e.observation is None else dict(e.observation),
         )
 
     def to_explanation(self) -> Explanation:
@@ -202,6 +265,8 @@ class ExplanationRecord(BaseModel):
             extras={k: np.asarray(v) for k, v in self.extras.items()},
             background_quantiles=None if self.background_quantiles is None else np.asarray(self.background_quantiles),
             available=None if self.available is None else np.asarray(self.available, dtype=bool),
+            output=self.output,
+            observation=self.observation,
         )
 
 
@@ -214,8 +279,9 @@ class StateRecord(BaseModel):
     dataset: str | None = None
     method: str
     state: dict[str, float] | None
-    chosen: str
-    runner_up: str
+    output: str = "actions"
+    chosen: str | None
+    runner_up: str | None
     scores: dict[str, float]
     base_values: dict[str, float]
     values: dict[str, dict[str, float]]

@@ -9,6 +9,7 @@ from typing import Sequence
 import numpy as np
 
 from .errors import InputError
+from .observation import Observation
 
 
 def as_states(data, n_features: int, what: str = "states") -> np.ndarray:
@@ -18,38 +19,20 @@ def as_states(data, n_features: int, what: str = "states") -> np.ndarray:
     :param n_features: width the policy expects.
     :param what: name used in error messages ("states", "background").
     """
-    if hasattr(data, "detach"):  # a torch tensor, without importing torch here
-        data = data.detach().cpu().numpy()
-    try:
-        arr = np.asarray(data, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{what} must be numeric; could not convert ({exc}).") from None
-    if arr.ndim == 1 and arr.size == n_features:
-        arr = arr[None, :]
-    if arr.ndim != 2:
-        raise InputError(f"{what} must be a 2-D array (n, {n_features}); got shape {arr.shape}.")
-    if arr.shape[0] == 0:
-        raise InputError(f"{what} is empty: give at least one row of {n_features} features.")
-    if arr.shape[1] != n_features:
-        raise InputError(
-            f"{what} has {arr.shape[1]} features but the policy expects {n_features}; check the column order/count."
-        )
-    arr = arr.astype(np.float32)  # check after the cast: values beyond float32's range become inf here
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
-        raise InputError(
-            f"{what} contain {int(bad.sum())} NaN/inf value(s), first at row {r}, column {c}; clean or drop them."
-        )
-    return arr
+    return Observation.flat(n_features).flatten(data, what)
 
 
-def read_states(path: str | Path, feature_names: Sequence[str]) -> np.ndarray:
-    """Read states from .npy, .csv (header row naming the features, any order) or .json (list of rows or of objects).
+def read_states(path: str | Path, feature_names: Sequence[str], observation: Observation | None = None
+                ) -> np.ndarray:
+    """Read states from .npy (any shape the observation takes), .npz (one array per key of a dict observation, or
+    ``arr_0, arr_1, ...`` for several inputs), .csv (header row naming the features, any order) or .json (list of
+    rows or of objects).
 
     :param path: file to read.
     :param feature_names: the policy's features; CSV/JSON objects are reordered to match them.
+    :param observation: the policy's observation (default: flat with these features).
     """
+    observation = observation or Observation.flat(len(feature_names))
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such file; give a .csv, .npy or .json file of states.")
@@ -57,19 +40,27 @@ def read_states(path: str | Path, feature_names: Sequence[str]) -> np.ndarray:
     try:
         if suffix == ".npy":
             data = np.load(path, allow_pickle=False)
+        elif suffix == ".npz":
+            with np.load(path, allow_pickle=False) as z:
+                data = {k: z[k] for k in z.files}
+            if observation.kind == "tuple":
+                data = [data.get(f"arr_{i}") for i in range(len(observation.parts))]
+                if any(d is None for d in data):
+                    raise InputError(f"the policy takes {len(observation.parts)} inputs; save them with "
+                                     "np.savez(path, x0, x1, ...).")
         elif suffix == ".csv":
             data = _read_csv(path, feature_names)
         elif suffix == ".json":
             data = _read_json(path, feature_names)
         else:
-            raise InputError(f"{path}: unknown file type '{suffix}'; use .csv, .npy or .json.")
+            raise InputError(f"{path}: unknown file type '{suffix}'; use .csv, .npy, .npz or .json.")
     except InputError as exc:
         msg = str(exc)
         raise InputError(msg if msg.startswith(str(path)) else f"{path}: {msg}") from None
     except (ValueError, OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: cannot read it ({exc}).") from None
     try:
-        return as_states(data, len(feature_names))
+        return observation.flatten(data)
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
 

@@ -10,7 +10,7 @@ from typing import Any, Callable
 import pluggy
 
 from . import hookspecs
-from .errors import PluginError, UnknownNameError
+from .errors import InputError, PluginError, UnknownNameError, XairlError
 
 DEFAULT_PLUGINS = ("xairl.builtins",)
 BUILTIN_NAME = "xairl"
@@ -184,6 +184,65 @@ def get_policy(name: str):
     """Build the registered policy ``name`` (loads its checkpoint)."""
     factory = registry("policy").load(name)
     return factory() if callable(factory) else factory
+
+
+def load_policy(spec: str, kwargs: dict | None = None, observation=None):
+    """A policy by registered name, or without any plugin: ``package.module:attr`` or ``path/to/file.py:attr``.
+
+    ``attr`` is an :class:`xairl.Policy`, a torch module, or a callable returning either, called with ``kwargs``
+    (``xairl explain --policy-arg key=value``). A bare torch module becomes a Policy whose observation is
+    ``observation`` (the shape of one state, taken from the states file by the CLI).
+    """
+    import importlib
+    import importlib.util
+    from pathlib import Path
+
+    kwargs = dict(kwargs or {})
+    if ":" not in spec:
+        if kwargs:
+            raise InputError(f"--policy-arg is for a module:attr policy; '{spec}' is a registered name.")
+        return get_policy(spec)
+    where, _, attr = spec.rpartition(":")
+    try:
+        if where.endswith(".py"):
+            path = Path(where)
+            if not path.is_file():
+                raise InputError(f"{where}: no such file; give --policy path/to/file.py:attr or package.module:attr.")
+            mod_spec = importlib.util.spec_from_file_location(path.stem, path)
+            module = importlib.util.module_from_spec(mod_spec)
+            mod_spec.loader.exec_module(module)
+        else:
+            module = importlib.import_module(where)
+    except XairlError:
+        raise
+    except Exception as exc:  # the user's module: one line, no traceback
+        raise InputError(f"cannot import '{where}' ({type(exc).__name__}: {' '.join(str(exc).split())[:200]}).") from None
+    if not hasattr(module, attr):
+        raise UnknownNameError(f"'{where}' has no attribute '{attr}'.")
+    obj = getattr(module, attr)
+    import torch
+
+    from .policy import Policy
+
+    if callable(obj) and not isinstance(obj, (Policy, torch.nn.Module)):
+        try:
+            obj = obj(**kwargs)
+        except XairlError:
+            raise
+        except Exception as exc:
+            raise InputError(f"{spec}({', '.join(f'{k}={v!r}' for k, v in kwargs.items())}) raised "
+                             f"{type(exc).__name__}: {' '.join(str(exc).split())[:200]}.") from None
+    elif kwargs:
+        raise InputError(f"{spec} is not callable; --policy-arg needs a function that builds the policy.")
+    if isinstance(obj, torch.nn.Module):
+        if observation is None:
+            raise InputError(f"{spec} is a bare torch module: give --states so that its input shape is known, or "
+                             "return an xairl.Policy.")
+        obj = Policy(obj.eval(), observation=tuple(observation), name=attr)
+    if not isinstance(obj, Policy):
+        raise InputError(f"{spec} gave a {type(obj).__name__}; it must be an xairl.Policy, a torch module, or a "
+                         "function returning one.")
+    return obj
 
 
 def get_attributor(name: str):

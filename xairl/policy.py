@@ -1,14 +1,15 @@
-"""Policy: a trained torch network mapping a batch of states to one score per action, with names and metadata."""
+"""Policy: a trained torch network mapping a batch of states to its outputs (action scores, continuous actions or a
+value), with names, metadata and the structure of its input."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Literal, Mapping, Sequence
 
 import numpy as np
 import torch
 
-from .errors import InputError
-from .inputs import as_states
+from .errors import InputError, XairlError
+from .observation import Observation
 
 
 @dataclass(frozen=True)
@@ -28,16 +29,28 @@ class FeatureInfo:
     aliases: tuple[str, ...] = ()
 
 
+#: what a policy's outputs are: scores of discrete actions (the highest available one is taken; a runner-up exists),
+#: the dimensions of a continuous action (each explained on its own; nothing is chosen among them), or one value
+OUTPUT_KINDS = ("actions", "continuous", "value")
+
+
 @dataclass
 class Policy:
-    """A decision maker with a torch module scoring every action (Q-values or logits).
+    """A decision maker: a torch module and what its inputs and outputs mean.
 
-    :param module: maps a float tensor (batch, n_features) to (batch, n_actions).
-    :param feature_names: one unique name per input column.
-    :param action_names: one unique name per output column.
+    :param module: maps a batch of states to (batch, n_outputs) (a (batch,) output is read as one column). Its
+        input is one tensor (batch, *shape), a dict of tensors, or several tensors, as ``observation`` says.
+    :param feature_names: one unique name per flat input column; default: generated from ``observation``
+        (``obs_0..``, ``frame[c,h,w]``, ``key[i]``, ``key=v`` for a categorical key).
+    :param action_names: one unique name per output column; default: ``action_0..`` (``value`` for a value).
+    :param observation: the input's structure: an :class:`xairl.Observation`, or a shape tuple ``(4, 84, 84)``,
+        a dict of shapes ``{"image": (3, 64, 64), "speed": (1,)}`` or a list of shapes (several inputs). Default:
+        flat, one column per feature name.
+    :param output: 'actions' (discrete action scores: Q-values or logits), 'continuous' (one column per action
+        dimension) or 'value' (one column: V(s), Q(s, a) or any regressor).
     :param features: optional :class:`FeatureInfo` per feature name.
     :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}``.
-    :param background_sampler: optional ``f(n, seed) -> array (n, n_features)`` of typical states.
+    :param background_sampler: optional ``f(n, seed) -> states`` of typical states (any form ``observation`` takes).
     :param name: how the policy is called in reports.
     :param action_aliases: other names of each action in text, e.g. ``{"stay": ["keep the serving BS"]}``.
     :param facts_hook: optional ``f(state, chosen, runner_up) -> xairl.DomainFacts`` adding domain facts that
@@ -48,31 +61,48 @@ class Policy:
     """
 
     module: torch.nn.Module
-    feature_names: Sequence[str]
-    action_names: Sequence[str]
+    feature_names: Sequence[str] | None = None
+    action_names: Sequence[str] | None = None
     features: Mapping[str, FeatureInfo] = field(default_factory=dict)
     groups: Mapping[str, Sequence[str]] = field(default_factory=dict)
-    background_sampler: Callable[[int, int], np.ndarray] | None = None
+    background_sampler: Callable[[int, int], Any] | None = None
     name: str = "policy"
     action_aliases: Mapping[str, Sequence[str]] = field(default_factory=dict)
     facts_hook: Callable[[np.ndarray, int, int], Any] | None = None
     action_mask: Callable[[np.ndarray], np.ndarray] | None = None
+    observation: Any = None
+    output: Literal["actions", "continuous", "value"] = "actions"
 
     def __post_init__(self) -> None:
+        if not isinstance(self.module, torch.nn.Module):
+            raise InputError(f"module must be a torch.nn.Module, got {type(self.module).__name__}.")
+        if self.output not in OUTPUT_KINDS:
+            raise InputError(f"output '{self.output}' is unknown; use one of {', '.join(OUTPUT_KINDS)}.")
+        self.observation = _observation(self.observation, self.feature_names)
+        if self.feature_names is None:
+            self.feature_names = self.observation.feature_names()
+        self.network = PolicyNetwork(self.module, self.observation, self.name)
+        if self.action_names is None:  # count the outputs on one all-zero state
+            n = 1 if self.output == "value" else self.scores(np.zeros((1, self.observation.n_features))).shape[1]
+            self.action_names = ["value"] if self.output == "value" else [f"action_{i}" for i in range(n)]
         self.feature_names = [str(f) for f in self.feature_names]
         self.action_names = [str(a) for a in self.action_names]
         for what, names in (("feature_names", self.feature_names), ("action_names", self.action_names)):
             if not names:
-                raise InputError(f"{what} is empty; name every input column and every action.")
+                raise InputError(f"{what} is empty; name every input column and every output.")
             if len(set(names)) != len(names):
                 dup = sorted({n for n in names if names.count(n) > 1})
                 raise InputError(f"{what} has duplicates ({', '.join(dup)}); names must be unique.")
-        unknown = sorted(set(self.features) - set(self.feature_names))
-        unknown += sorted({f for g in self.groups.values() for f in g} - set(self.feature_names))
+        if len(self.feature_names) != self.observation.n_features:
+            raise InputError(f"{len(self.feature_names)} feature names for an observation of "
+                             f"{self.observation.n_features} columns {self.observation.describe()}; name each column.")
+        if self.output == "value" and len(self.action_names) != 1:
+            raise InputError("a 'value' policy has one output; give one name in action_names (e.g. ['value']).")
+        names = set(self.feature_names)
+        unknown = sorted(set(self.features) - names) + sorted({f for g in self.groups.values() for f in g} - names)
         if unknown:
-            raise InputError(f"metadata names unknown feature(s) {', '.join(unknown)}; use names from feature_names.")
-        if not isinstance(self.module, torch.nn.Module):
-            raise InputError(f"module must be a torch.nn.Module, got {type(self.module).__name__}.")
+            raise InputError(f"metadata names unknown feature(s) {', '.join(unknown[:5])}; use names from "
+                             "feature_names.")
 
     @property
     def n_features(self) -> int:
@@ -80,6 +110,7 @@ class Policy:
 
     @property
     def n_actions(self) -> int:
+        """Number of output columns (actions, action dimensions, or 1 for a value)."""
         return len(self.action_names)
 
     @property
@@ -88,24 +119,25 @@ class Policy:
         return p.device if p is not None else torch.device("cpu")
 
     def check_states(self, states, what: str = "states") -> np.ndarray:
-        """Validated float32 array (n, n_features); raises :class:`InputError` with a one-line reason."""
-        return as_states(states, self.n_features, what)
+        """States in any form the observation takes -> validated float32 (n, n_features); raises
+        :class:`InputError` with a one-line reason."""
+        return self.observation.flatten(states, what)
 
     def scores(self, states) -> np.ndarray:
-        """Scores (n, n_actions) of the module in eval mode, without gradients."""
+        """Outputs (n, n_actions) of the module in eval mode, without gradients."""
         x = torch.as_tensor(self.check_states(states), device=self.device)
         was_training = self.module.training
         self.module.eval()
         try:
             with torch.no_grad():
-                out = self.module(x)
+                out = self.network(x)
         finally:
             self.module.train(was_training)
         out = out.detach().cpu().numpy().astype(np.float64)
-        if out.ndim != 2 or out.shape[1] != self.n_actions:
+        if self.action_names is not None and out.shape[1] != self.n_actions:
             raise InputError(
-                f"the module returned shape {tuple(out.shape)} but {self.n_actions} actions are named; "
-                "it must map (batch, n_features) to (batch, n_actions)."
+                f"the module returned shape {tuple(out.shape)} but {self.n_actions} outputs are named; "
+                f"it must map {self.observation.describe()} to (batch, {self.n_actions})."
             )
         return out
 
@@ -114,6 +146,8 @@ class Policy:
         x = self.check_states(states)
         if self.action_mask is None:
             return np.ones((len(x), self.n_actions), dtype=bool)
+        if self.output != "actions":
+            raise InputError(f"policy '{self.name}': an action_mask needs discrete actions (output='actions').")
         mask = np.asarray(self.action_mask(x), dtype=bool)
         if mask.shape != (len(x), self.n_actions) or not mask.any(axis=1).all():
             raise InputError(f"policy '{self.name}': action_mask must return a bool array {(len(x), self.n_actions)} "
@@ -121,7 +155,10 @@ class Policy:
         return mask
 
     def act(self, states) -> np.ndarray:
-        """Index of the highest-scoring available action per state."""
+        """Index of the highest-scoring available action per state (discrete actions only)."""
+        if self.output != "actions":
+            raise InputError(f"policy '{self.name}' outputs {self.output}, not discrete actions: nothing is chosen; "
+                             "use scores().")
         return np.where(self.available(states), self.scores(states), -np.inf).argmax(axis=1)
 
     def background(self, n: int = 100, seed: int = 0) -> np.ndarray:
@@ -134,34 +171,64 @@ class Policy:
 TorchPolicy = Policy  # the name users of plain torch networks (CleanRL style) look for
 
 
-class _SB3ActorLogits(torch.nn.Module):
-    """An SB3 actor-critic policy seen as states -> action logits (features extractor, actor MLP, action net)."""
+class PolicyNetwork(torch.nn.Module):
+    """The module as every attributor sees it: flat rows (n, F) -> outputs (n, n_outputs).
 
-    def __init__(self, policy):
+    It unflattens the rows into what the module takes (a view and a split: linear, so attributions see through
+    it), calls the module, reads a (n,) output as one column, and turns an exception raised inside the user's
+    module into one line that names the module and the input's shape.
+    """
+
+    def __init__(self, module: torch.nn.Module, observation: Observation, policy_name: str):
         super().__init__()
-        self.policy = policy
+        self.module = module
+        self.observation = observation
+        self.policy_name = policy_name
 
-    def forward(self, x):
-        p = self.policy
-        extractor = getattr(p, "pi_features_extractor", None) or p.features_extractor
-        return p.action_net(p.mlp_extractor.forward_actor(extractor(x)))
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        inp = self.observation.unflatten(x)
+        try:
+            out = self.module(*inp) if isinstance(inp, tuple) else self.module(inp)
+        except XairlError:
+            raise
+        except Exception as exc:  # the user's code: say where, in one line, without its traceback
+            detail = " ".join(str(exc).split())[:300]
+            shape = tuple(x.shape[:1]) + tuple(inp.shape[1:]) if isinstance(inp, torch.Tensor) else \
+                f"{self.observation.describe().replace('(n', f'({len(x)}')}"
+            raise InputError(f"policy '{self.policy_name}': its module {type(self.module).__name__} raised "
+                             f"{type(exc).__name__} ({detail}) on input {shape}; check that it takes "
+                             f"{self.observation.describe()}.") from None
+        if not isinstance(out, torch.Tensor):
+            raise InputError(f"policy '{self.policy_name}': its module {type(self.module).__name__} returned a "
+                             f"{type(out).__name__}, not a tensor; wrap it so that it returns one (batch, n_outputs) "
+                             "tensor (e.g. the logits or Q-values only).")
+        if out.dim() == 1 and len(out) == len(x):
+            out = out[:, None]
+        if out.dim() != 2 or len(out) != len(x):
+            raise InputError(f"policy '{self.policy_name}': the module returned shape {tuple(out.shape)} for "
+                             f"{len(x)} states; it must return (batch, n_outputs).")
+        return out
 
 
-def from_sb3(model, feature_names=None, action_names=None, **kwargs) -> Policy:
-    """A Stable-Baselines3 model (DQN: Q-values; PPO/A2C: action logits) with discrete actions and a flat Box
-    observation, as a :class:`Policy`. Names default to ``obs_0..`` and ``action_0..``."""
-    obs, act = model.observation_space, model.action_space
-    if not hasattr(act, "n"):
-        raise InputError(f"xairl explains discrete actions; this model's action space is {act}.")
-    if len(getattr(obs, "shape", ()) or ()) != 1:
-        raise InputError(f"xairl needs a flat Box observation; this model's observation space is {obs}.")
-    policy = model.policy
-    if hasattr(policy, "q_net"):
-        module = policy.q_net
-    elif hasattr(policy, "action_net"):
-        module = _SB3ActorLogits(policy)
-    else:
-        raise InputError(f"unsupported SB3 policy {type(policy).__name__}: expected DQN (q_net) or actor-critic.")
-    n_obs, n_act = obs.shape[0], int(act.n)
-    return Policy(module.eval(), feature_names or [f"obs_{i}" for i in range(n_obs)],
-                  action_names or [f"action_{i}" for i in range(n_act)], **kwargs)
+def _observation(obs, feature_names) -> Observation:
+    if isinstance(obs, Observation):
+        return obs
+    if obs is None:
+        if feature_names is None:
+            raise InputError("give feature_names or an observation shape, e.g. observation=(4, 84, 84).")
+        return Observation.flat(len(list(feature_names)))
+    if isinstance(obs, Mapping):
+        return Observation.dict(obs)
+    if isinstance(obs, (list, tuple)) and obs and all(isinstance(s, (list, tuple)) for s in obs):
+        return Observation.several(obs)
+    if isinstance(obs, (list, tuple, int)):
+        shape = (obs,) if isinstance(obs, int) else tuple(obs)
+        return Observation.flat(shape[0]) if len(shape) == 1 else Observation.array(shape)
+    raise InputError(f"observation must be a shape, a dict of shapes or a list of shapes; got {type(obs).__name__}.")
+
+
+def __getattr__(name: str):  # from_sb3 lives in xairl.sb3; this keeps ``from xairl.policy import from_sb3``
+    if name == "from_sb3":
+        from .sb3 import from_sb3
+        return from_sb3
+    raise AttributeError(name)

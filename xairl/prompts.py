@@ -26,7 +26,7 @@ MAX_LOOP_DEPTH = 2  # nested for-loops; deeper nesting is how a small template h
 MAX_REPEAT = 1000  # 'x' * n and [..] * n
 
 DECISION_VARS = {"index", "action", "runner_up", "score", "runner_up_score", "q_margin", "base_value", "method",
-                 "additivity_gap", "top", "margin_top", "comparisons", "extras", "k"}
+                 "additivity_gap", "top", "margin_top", "comparisons", "extras", "k", "output"}
 GLOBAL_VARS = {"n_states", "method", "ranking", "k"}
 
 
@@ -40,6 +40,9 @@ class TemplateSpec(BaseModel):
     name: str
     kind: Literal["decision", "global"] = "decision"
     description: str = ""
+    #: the output kinds this template narrates (``Policy.output``): a choice among discrete actions needs words
+    #: other than a value estimate or the dimensions of a continuous action
+    outputs: list[Literal["actions", "continuous", "value"]] = ["actions", "continuous", "value"]
     sentences: list[list[str]] = Field(min_length=1)
 
     @field_validator("sentences", mode="before")

@@ -122,12 +122,18 @@ def _interesting(exp: Explanation) -> int:
     rare = np.flatnonzero(exp.chosen != common)
     if len(rare):
         return int(rare[0])
+    if exp.output != "actions":
+        return 0
     gap = exp.outputs[np.arange(len(exp.values)), exp.chosen] - exp.outputs[np.arange(len(exp.values)), exp.runner_up]
     return int(np.argmin(gap))
 
 
-def write_report(req: ReportRequest, content: ReportContent) -> Path:
-    """Write explanations.jsonl (+ its JSON schema), PNG figures and report.html into ``req.out``."""
+def write_report(req: ReportRequest, content: ReportContent, explained: dict[str, Explanation] | None = None
+                 ) -> Path:
+    """Write explanations.jsonl (+ its JSON schema), PNG figures and report.html into ``req.out``.
+
+    :param explained: explanations already computed, by dataset label (the others are explained here).
+    """
     from tqdm import tqdm
 
     from . import plots
@@ -137,9 +143,10 @@ def write_report(req: ReportRequest, content: ReportContent) -> Path:
     out = Path(req.out)
     out.mkdir(parents=True, exist_ok=True)
     exps: list[tuple[str, Explanation]] = []
+    explained = explained or {}
     for label, states in tqdm(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress):
-        exps.append((label, explain(content.policy, states, background=content.background, method=req.method,
-                                    options=req.options)))
+        exps.append((label, explained.get(label) or explain(content.policy, states, background=content.background,
+                                                            method=req.method, options=req.options)))
     with open(out / "explanations.jsonl", "w") as fh:
         for label, exp in exps:
             for rec in exp.records(dataset=label):
@@ -147,11 +154,19 @@ def write_report(req: ReportRequest, content: ReportContent) -> Path:
     (out / "explanations.schema.json").write_text(json.dumps(StateRecord.model_json_schema(), indent=2))
     ref_label, ref = exps[0]
     pick = _interesting(ref)
-    figures = [(f"SHAP values of the chosen action's Q-value, {' vs '.join(l for l, _ in exps)} (same feature "
-                f"order, by {ref_label} importance)", plots.beeswarms(exps, out / "beeswarm.png")),
-               ("Global importance: mean |contribution|", plots.importance_bars(exps, out / "importance.png")),
-               (f"One decision ({ref_label} state {pick}: {ref.action_names[ref.chosen[pick]]})",
-                plots.waterfall(ref, pick, out / "waterfall.png"))]
+    # images and dicts are plotted by patch / by key (thousands of pixels are no beeswarm); the image plot shows
+    # the pixels themselves
+    shown = [(label, plots.readable(e)) for label, e in exps]
+    target = "the chosen action's score" if ref.output == "actions" else f"output {ref.action_names[0]}"
+    figures = [(f"SHAP values of {target}, {' vs '.join(l for l, _ in exps)} (same feature "
+                f"order, by {ref_label} importance)", plots.beeswarms(shown, out / "beeswarm.png")),
+               ("Global importance: mean |contribution|", plots.importance_bars(shown, out / "importance.png")),
+               (f"One {'decision' if ref.output == 'actions' else 'state'} ({ref_label} state {pick}"
+                f"{': ' + ref.action_names[ref.chosen[pick]] if ref.output == 'actions' else ''})",
+                plots.waterfall(shown[0][1], pick, out / "waterfall.png"))]
+    if ref.observation is not None and plots.image_shape(ref) is not None:
+        figures.append((f"Contributions over the frame, per output ({ref_label} state {pick}; red raises the "
+                        "output, blue lowers it; summed over channels)", plots.images(ref, pick, out / "image.png")))
     groups = dict(content.policy.groups)
     if groups:
         figures.append((f"Global importance by group ({'; '.join(g + ' = ' + ', '.join(m) for g, m in groups.items())})",

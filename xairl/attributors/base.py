@@ -9,7 +9,7 @@ from typing import Any, ClassVar
 import numpy as np
 import torch
 
-from ..errors import InputError
+from ..errors import InputError, UnsupportedModelError
 from ..explanation import Explanation
 from ..options import Options, parse_options
 from ..policy import Policy
@@ -23,6 +23,12 @@ class Attributor:
 
     name: ClassVar[str] = ""
     Options: ClassVar[type[Options]] = Options
+    #: largest additivity gap accepted, relative to the output scale (max |output| and |base value|), or with
+    #: ``gap_of_change`` to the largest change the contributions explain (max |output - base value|)
+    tolerance: ClassVar[float] = 1e-4
+    gap_of_change: ClassVar[bool] = False
+    #: why a result over the tolerance happens with this method (the refusal says it)
+    gap_reason: ClassVar[str] = "the network is not what this method assumes"
 
     def __init__(self, options: dict | Options | None = None):
         self.options = parse_options(self.Options, options, f"{self.name} options")
@@ -40,8 +46,8 @@ class Attributor:
         x = policy.check_states(states)
         bg = policy.background() if background is None else policy.check_states(background, "background")
         outputs = policy.scores(x)
-        module = policy.module
-        was_training = module.training
+        module = policy.network
+        was_training = policy.module.training  # the user's flag; the wrapper's own means nothing
         module.eval()
         try:
             values, base, extras = self._attribute(policy, x, bg)
@@ -51,9 +57,13 @@ class Attributor:
             self._handles.clear()
             module.train(was_training)
         n, f, a = len(x), policy.n_features, policy.n_actions
+        values = np.asarray(values, dtype=np.float64).reshape(n, f, a)
+        base = np.broadcast_to(np.asarray(base, dtype=np.float64), (n, a))
+        if getattr(self.options, "check_additivity", True):
+            self._check_additivity(policy, values, base, outputs)
         return Explanation(
-            values=np.asarray(values, dtype=np.float64).reshape(n, f, a),
-            base_values=np.broadcast_to(np.asarray(base, dtype=np.float64), (n, a)).copy(),
+            values=values,
+            base_values=base.copy(),
             outputs=outputs,
             states=x.astype(np.float64),
             feature_names=tuple(policy.feature_names),
@@ -63,7 +73,23 @@ class Attributor:
             extras=extras,
             background_quantiles=np.percentile(bg, [25, 50, 75], axis=0).astype(np.float64),
             available=None if policy.action_mask is None else policy.available(x),
+            output=policy.output,
+            observation=policy.observation.to_dict(),
         )
+
+    def _check_additivity(self, policy: Policy, values, base, outputs) -> None:
+        """Refuse a result whose contributions do not add up to output - base value (no silent wrong answer)."""
+        gap = float(np.abs(base + values.sum(axis=1) - outputs).max())
+        if self.gap_of_change:
+            scale, what = float(np.abs(outputs - base).max()), "the explained change"
+        else:
+            # float32 rounding is absolute below 1: the scale does not fall under it
+            scale, what = max(float(np.abs(outputs).max()), float(np.abs(base).max()), 1.0), "the output scale"
+        scale = max(scale, 1e-6)
+        if gap > self.tolerance * scale:
+            raise UnsupportedModelError(
+                f"{self.name} contributions do not add up to the output (gap {gap:.3g}, {what} {scale:.3g}, "
+                f"tolerance {self.tolerance:g} of it): {self.gap_reason}; otherwise {alternatives(policy, self.name)}")
 
     def _attribute(self, policy: Policy, x: np.ndarray, bg: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
         """The subclass's method: contributions of ``x`` (n, f) against ``bg`` (m, f), module already in eval mode.
@@ -81,5 +107,16 @@ class Attributor:
     def _forward(policy: Policy, rows: torch.Tensor, chunk: int) -> torch.Tensor:
         """Scores of many rows in chunks, without gradients (float64 on the CPU)."""
         with torch.no_grad():
-            parts = [policy.module(rows[i:i + chunk]).double().cpu() for i in range(0, len(rows), chunk)]
+            parts = [policy.network(rows[i:i + chunk]).double().cpu() for i in range(0, len(rows), chunk)]
         return torch.cat(parts)
+
+
+def alternatives(policy: Policy, exclude: str) -> str:
+    """What to use instead of method ``exclude``: only methods that accept this network."""
+    from ..attributors.exact import MAX_FEATURES
+
+    options = [m for m in ("deep_shap", "integrated_gradients", "kernel_shap") if m != exclude]
+    if policy.n_features <= MAX_FEATURES and exclude != "exact":
+        options.append("exact")
+    hint = " (kernel_shap: model-agnostic but sampled; give it a small background)" if policy.n_features > 64 else ""
+    return f"use method={' or '.join(repr(o) for o in options)}{hint}."

@@ -1,9 +1,12 @@
-"""DeepSHAP: DeepLIFT rescale-rule multipliers averaged over a background, batched over all (state, background) pairs.
+"""DeepSHAP: DeepLIFT multipliers averaged over a background, batched over all (state, background) pairs.
 
-Every pair is one row of a doubled batch ``[x_pairs; r_pairs]``. A forward hook on each elementwise nonlinearity
-replaces its gradient with the rescale ratio Δout/Δin of its own call (so a module used twice is handled per call),
-and one backward pass per action gives the multipliers. Linear layers keep their exact gradients. This gives the
-values of shap.DeepExplainer and captum's DeepLiftShap.
+Every pair is one row of a doubled batch ``[x_pairs; r_pairs]``. A forward hook on each nonlinear layer ties its
+output to its input through a custom backward (:class:`_Rule`) that gives the DeepLIFT multiplier of its own call
+(so a module used twice is handled per call): the rescale rule Δout/Δin for elementwise layers (and Softmax /
+LogSoftmax as a final layer), the max-pool rule shap uses for MaxPool. Linear layers (Linear, Conv, ConvTranspose,
+average pooling, BatchNorm in eval mode, reshapes) keep their exact gradients. One backward pass per output gives
+the multipliers. This gives the values of shap.DeepExplainer and captum's DeepLiftShap. A pure Sequential MLP on
+flat states takes a faster path (:func:`chain_multipliers`).
 """
 from __future__ import annotations
 
@@ -12,16 +15,22 @@ import torch
 from pydantic import Field
 
 from ..errors import UnsupportedModelError
-from .base import Attributor, Options
+from .base import Attributor, Options, alternatives
 
+nn = torch.nn
 #: layers whose gradient already is the DeepLIFT multiplier (linear in eval mode)
-LINEAR = (torch.nn.Linear, torch.nn.Identity, torch.nn.Flatten, torch.nn.Unflatten, torch.nn.Dropout,
-          torch.nn.AlphaDropout, torch.nn.BatchNorm1d)
+LINEAR = (nn.Linear, nn.Identity, nn.Flatten, nn.Unflatten, nn.Dropout, nn.Dropout1d, nn.Dropout2d, nn.Dropout3d,
+          nn.AlphaDropout, nn.BatchNorm1d, nn.BatchNorm2d, nn.BatchNorm3d, nn.Conv1d, nn.Conv2d, nn.Conv3d,
+          nn.ConvTranspose1d, nn.ConvTranspose2d, nn.ConvTranspose3d, nn.AvgPool1d, nn.AvgPool2d, nn.AvgPool3d,
+          nn.AdaptiveAvgPool1d, nn.AdaptiveAvgPool2d, nn.AdaptiveAvgPool3d, nn.ZeroPad1d, nn.ZeroPad2d,
+          nn.ZeroPad3d, nn.ConstantPad1d, nn.ConstantPad2d, nn.ConstantPad3d)
 #: elementwise nonlinearities handled with the rescale rule
-NONLINEAR = (torch.nn.ReLU, torch.nn.LeakyReLU, torch.nn.ELU, torch.nn.SiLU, torch.nn.GELU, torch.nn.Tanh,
-             torch.nn.Sigmoid, torch.nn.Softplus, torch.nn.ReLU6, torch.nn.Hardtanh, torch.nn.SELU, torch.nn.CELU,
-             torch.nn.Mish, torch.nn.Softsign, torch.nn.Tanhshrink)
-CONTAINERS = (torch.nn.Sequential, torch.nn.ModuleList, torch.nn.ModuleDict)
+NONLINEAR = (nn.ReLU, nn.LeakyReLU, nn.ELU, nn.SiLU, nn.GELU, nn.Tanh, nn.Sigmoid, nn.Softplus, nn.ReLU6,
+             nn.Hardtanh, nn.SELU, nn.CELU, nn.Mish, nn.Softsign, nn.Tanhshrink)
+#: the rescale rule per element, as shap applies it; additive only as the network's final layer (checked)
+SOFTMAX = (nn.Softmax, nn.LogSoftmax)
+MAXPOOL = (nn.MaxPool1d, nn.MaxPool2d, nn.MaxPool3d)
+CONTAINERS = (nn.Sequential, nn.ModuleList, nn.ModuleDict)
 EPS = 1e-6  # below this |Δin| the local gradient is used, as shap does
 
 
@@ -30,41 +39,126 @@ class DeepShapOptions(Options):
     check_additivity: bool = Field(True, description="refuse results whose contributions do not add up")
 
 
+def _vjp(layer, h, g):
+    """g times the layer's local Jacobian at h (its own forward, without our hooks)."""
+    with torch.enable_grad():
+        leaf = h.detach().requires_grad_(True)
+        return torch.autograd.grad(layer.forward(leaf), leaf, g)[0]
+
+
 def _local_grad(layer, h):
     with torch.enable_grad():
         leaf = h.detach().requires_grad_(True)
         return torch.autograd.grad(layer.forward(leaf).sum(), leaf)[0]
 
 
-def _rescale_hook(module, inputs, output):
-    """Keep the output's value but give it the gradient Δout/Δin (pairs are rows i and i + P)."""
-    inp = inputs[0]
-    p = inp.shape[0] // 2
-    d_in = inp[:p].detach() - inp[p:].detach()
-    ratio = (output[:p].detach() - output[p:].detach()) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
+def _rescale_multiplier(layer, inp, out):
+    """Rescale rule of an elementwise layer: the multiplier Δout/Δin per element (pairs are rows i and i + P), the
+    local gradient where |Δin| is tiny, as shap does. Computed once per forward call, used by every output's
+    backward pass."""
+    p = len(inp) // 2
+    d_in = inp[:p] - inp[p:]
+    ratio = (out[:p] - out[p:]) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
     small = d_in.abs() < EPS
-    if small.any():  # rare: there the local gradient stands in for the ratio, per half as shap does
-        local = _local_grad(module, inp)
-        ratio = torch.cat([torch.where(small, local[:p], ratio), torch.where(small, local[p:], ratio)])
-    else:
-        ratio = torch.cat([ratio, ratio])
-    return output.detach() + (inp - inp.detach()) * ratio
+    ratio = torch.cat([ratio, ratio])
+    if small.any():
+        ratio = torch.where(torch.cat([small, small]), _local_grad(layer, inp), ratio)
+    return ratio
 
 
-def check_supported(module: torch.nn.Module) -> list[torch.nn.Module]:
-    """The nonlinear layers of ``module``; raises for any leaf layer whose multipliers we cannot compute."""
-    nonlinear = []
+def _rescale(layer, inp, out, g):
+    """Rescale rule for a layer that mixes elements (Softmax, LogSoftmax), per element as shap applies it; the
+    true local Jacobian where |Δin| is tiny."""
+    p = len(inp) // 2
+    d_in = inp[:p] - inp[p:]
+    ratio = (out[:p] - out[p:]) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
+    grad = g * torch.cat([ratio, ratio])
+    small = d_in.abs() < EPS
+    if small.any():
+        grad = torch.where(torch.cat([small, small]), _vjp(layer, inp, g), grad)
+    return grad
+
+
+def _maxpool(layer, inp, out, g):
+    """DeepLIFT's max-pool rule as shap implements it: the change of each window's max is split between the
+    state's and the reference's arg-max positions, then divided by Δin there."""
+    p = len(inp) // 2
+    y, r = out[:p], out[p:]
+    cross = torch.max(y, r)
+    routed = _vjp(layer, inp, g * torch.cat([cross - r, y - cross]))  # the pooling's own routing to the arg-max
+    d_in = inp[:p] - inp[p:]
+    m = torch.where(d_in.abs() < 1e-7, torch.zeros_like(d_in), (routed[:p] + routed[p:]) / d_in)
+    return torch.cat([m, m])
+
+
+class _Rule(torch.autograd.Function):
+    """Identity on the layer's output in the forward pass; the DeepLIFT rule in the backward pass: a multiplier
+    computed once (elementwise layers), or a rule applied to each output's gradient."""
+
+    @staticmethod
+    def forward(ctx, inp, out, layer, rule):
+        if rule is _rescale_multiplier:
+            ctx.save_for_backward(_rescale_multiplier(layer, inp, out))
+        else:
+            ctx.save_for_backward(inp, out)
+        ctx.layer, ctx.rule = layer, rule
+        return out.clone()
+
+    @staticmethod
+    def backward(ctx, g):
+        if ctx.rule is _rescale_multiplier:
+            return g * ctx.saved_tensors[0], None, None, None
+        inp, out = ctx.saved_tensors
+        return ctx.rule(ctx.layer, inp, out, g), None, None, None
+
+
+def _hook(rule):
+    def hook(module, inputs, output):
+        if not isinstance(output, torch.Tensor) or not inputs or not isinstance(inputs[0], torch.Tensor):
+            return None
+        return _Rule.apply(inputs[0], output, module, rule)
+    return hook
+
+
+def check_supported(module: torch.nn.Module, suggest: str = "") -> list[tuple[torch.nn.Module, object]]:
+    """(layer, rule) for the nonlinear layers of ``module``; raises for any leaf layer without a DeepLIFT rule.
+
+    A user module whose forward is affine in its input (a scaling, a reshape, a column slice) may set the class
+    attribute ``xairl_linear = True``; the additivity check still guards the claim."""
+    rules = []
     for name, sub in module.named_modules():
         if isinstance(sub, NONLINEAR):
-            nonlinear.append(sub)
-        elif isinstance(sub, LINEAR) or isinstance(sub, CONTAINERS):
-            continue
+            rules.append((sub, _rescale_multiplier))
+        elif isinstance(sub, SOFTMAX):
+            rules.append((sub, _rescale))
+        elif isinstance(sub, MAXPOOL):
+            if sub.return_indices:
+                raise UnsupportedModelError(f"deep_shap does not support '{name}' (MaxPool with return_indices); "
+                                            f"{suggest}")
+            rules.append((sub, _maxpool))
+        elif isinstance(sub, LINEAR + CONTAINERS) or getattr(sub, "xairl_linear", False):
+            continue  # a module may declare itself linear (an affine map, a reshape): its gradient is its multiplier
         elif not any(True for _ in sub.children()):
             raise UnsupportedModelError(
-                f"deep_shap does not support layer '{name or type(sub).__name__}' ({type(sub).__name__}); "
-                "use method='kernel_shap' or 'exact' for this network."
+                f"deep_shap does not support layer '{name or type(sub).__name__}' ({type(sub).__name__}); {suggest}"
             )
-    return nonlinear
+    return rules
+
+
+def _only_child(policy, x: np.ndarray) -> torch.nn.Module:
+    """The Sequential inside a wrapper module (CleanRL's ``QNetwork.network``) when the wrapper has that one child
+    and gives its outputs on these states (checked), else the policy's module itself."""
+    module = policy.module
+    if isinstance(module, torch.nn.Sequential):
+        return module
+    children = list(module.children())
+    if len(children) != 1 or not isinstance(children[0], torch.nn.Sequential) or \
+            any(True for _ in module.parameters(recurse=False)) or any(True for _ in module.buffers(recurse=False)):
+        return module
+    t = torch.as_tensor(x[:256], device=policy.device)
+    with torch.no_grad():
+        same = torch.equal(policy.network(t), children[0](t))
+    return children[0] if same else module
 
 
 def chain(module: torch.nn.Module) -> list[torch.nn.Module] | None:
@@ -124,22 +218,26 @@ class DeepShap(Attributor):
 
     name = "deep_shap"
     Options = DeepShapOptions
+    tolerance = 1e-5  # float32 rounding stays near 1e-6 of the output scale on the networks we test
+    gap_reason = ("the network computes something deep_shap cannot see: a functional nonlinearity (torch.tanh, "
+                  "F.relu, ...), a product of two activations, or a softmax before the last layer; make such "
+                  "operations nn modules")
 
     def _attribute(self, policy, x, bg):
-        module = policy.module
-        layers = chain(module)
+        layers = chain(_only_child(policy, x)) if policy.observation.kind == "flat" else None
         if layers is not None:
             return self._attribute_chain(policy, layers, x, bg)
-        for layer in check_supported(module):
-            self._add_hook(layer.register_forward_hook(_rescale_hook))
+        module = policy.network
+        for layer, rule in check_supported(module, alternatives(policy, self.name)):
+            self._add_hook(layer.register_forward_hook(_hook(rule)))
         dev = policy.device
         xt = torch.as_tensor(x, device=dev)
         bt = torch.as_tensor(bg, device=dev)
         n, f = xt.shape
-        b = len(bt)
-        per = max(1, self.options.max_pairs // b)
-        values = np.empty((n, f, policy.n_actions))
-        outputs = np.empty((n, policy.n_actions))
+        b, a = len(bt), policy.n_actions
+        per = max(1, min(self.options.max_pairs, max(1, 2 ** 22 // f)) // b)  # bounds the doubled batch
+        values = np.empty((n, f, a))
+        base = None
         for s in range(0, n, per):
             xs = xt[s:s + per]
             m = len(xs)
@@ -148,21 +246,12 @@ class DeepShap(Attributor):
             rows = torch.cat([xp, rp]).requires_grad_(True)
             out = module(rows)
             delta = (xp - rp).reshape(m, b, f)
-            outputs[s:s + m] = out[: m * b : b].detach().double().cpu().numpy()
             base = out[m * b:].detach().double().mean(dim=0).cpu().numpy()
-            for a in range(policy.n_actions):
-                grad = torch.autograd.grad(out[: m * b, a].sum(), rows, retain_graph=a + 1 < policy.n_actions)[0]
-                contrib = (grad[: m * b].reshape(m, b, f) * delta).double().mean(dim=1)
-                values[s:s + m, :, a] = contrib.cpu().numpy()
-        if self.options.check_additivity:
-            gap = np.abs(base + values.sum(axis=1) - outputs).max()
-            scale = max(1.0, float(np.abs(base).max()))
-            if gap > 1e-3 * scale:
-                raise UnsupportedModelError(
-                    f"deep_shap values do not add up to the output (gap {gap:.3g}): the network likely uses functional "
-                    "nonlinearities (torch.relu, F.softmax, ...) that deep_shap cannot see; make them nn modules or "
-                    "use method='kernel_shap' or 'exact'."
-                )
+            for j in range(a):
+                # both halves get the output gradient, as in shap: the max-pool rule mixes them
+                grad = torch.autograd.grad(out[:, j].sum(), rows, retain_graph=j + 1 < a)[0]
+                contrib = (grad[: m * b].reshape(m, b, f) * delta).mean(dim=1).double()
+                values[s:s + m, :, j] = contrib.cpu().numpy()
         return values, base, {}
 
     def _attribute_chain(self, policy, layers, x, bg):

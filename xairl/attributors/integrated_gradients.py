@@ -23,6 +23,11 @@ class IntegratedGradients(Attributor):
 
     name = "integrated_gradients"
     Options = IntegratedGradientsOptions
+    tolerance = 0.1  # of the change explained: a coarse quadrature stays well under it, zero gradients do not
+    gap_of_change = True
+    gap_reason = ("the path integral did not converge: the network is not differentiable along the path from the "
+                  "baseline (one-hot or integer inputs, argmax, embedding lookups, steps) or needs more n_steps; "
+                  "raise n_steps")
 
     def _attribute(self, policy, x, bg):
         from captum.attr import IntegratedGradients as CaptumIG
@@ -31,7 +36,7 @@ class IntegratedGradients(Attributor):
         xt = torch.as_tensor(x, device=dev)
         ref = bg.mean(axis=0) if self.options.baseline == "mean" else np.zeros(x.shape[1], dtype=np.float32)
         baseline = torch.as_tensor(ref, device=dev)[None, :].expand_as(xt).contiguous()
-        ig = CaptumIG(policy.module)
+        ig = CaptumIG(policy.network)
         values = np.empty((len(x), x.shape[1], policy.n_actions))
         delta = np.empty((len(x), policy.n_actions))
         for a in range(policy.n_actions):

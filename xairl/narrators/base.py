@@ -9,6 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Iterable
 
+import numpy as np
+
 from ..errors import InputError
 from ..explanation import Explanation
 from ..options import Options, parse_options
@@ -71,10 +73,39 @@ class Narrator:
         """
         from .. import prompts
 
-        tpl = prompts.load(template or ("global_summary" if index is None else "explain_action"), prompt_dirs)
+        default = "global_summary" if index is None else \
+            "explain_action" if explanation.output == "actions" else "explain_output"
+        tpl = prompts.load(template or default, prompt_dirs)
         if (tpl.spec.kind == "global") != (index is None):
             raise InputError(f"template '{tpl.name}' is a {tpl.spec.kind} template; use "
                              f"{'index=None' if tpl.spec.kind == 'global' else 'a state index'} with it.")
+        if index is not None and explanation.output not in tpl.spec.outputs:
+            raise InputError(f"template '{tpl.name}' narrates {' or '.join(tpl.spec.outputs)} outputs; this policy's "
+                             f"output is {explanation.output}: use template '{default}'.")
+        # a continuous action: each dimension is its own output, narrated and verified on its own
+        views = [explanation.output_slice(j) for j in range(explanation.values.shape[2])] \
+            if index is not None and explanation.output == "continuous" else [explanation]
+        texts, claims, ok, sources, rejected, scores, comps = [], [], True, [], [], [], []
+        for j, view in enumerate(views):
+            text, check, source, bad = self._words(view, index, tpl, policy, k)
+            texts.append(text)
+            claims += check.claims
+            ok &= check.ok
+            sources.append(source)
+            rejected += [bad] if bad else []
+            score, comp = confidence(explanation, index, check.ok, policy, background, robustness,
+                                     output=j if len(views) > 1 else None)
+            scores.append(score)
+            comps.append(comp)
+        worst = int(np.argmin(scores))  # a continuous action is as trustworthy as its least trustworthy dimension
+        return Narrative(text=" ".join(texts), claims=tuple(claims), verified=ok, confidence=scores[worst],
+                         components=comps[worst], source=next((s for s in sources if s != self.name), self.name),
+                         template=tpl.name, index=index, rejected=" ".join(rejected) or None,
+                         extras={"method": explanation.method})
+
+    def _words(self, explanation: Explanation, index: int | None, tpl, policy: Policy | None, k: int):
+        """(text, verification, source, rejected text) for one explanation: the subclass's words, verified, or the
+        template's first phrasings when they fail."""
         facts = global_facts(explanation, policy, k=max(k, 3)) if index is None else decision_facts(
             explanation, index, policy, k)
         context = facts.context()
@@ -86,10 +117,7 @@ class Narrator:
             rejected, text = text, first_phrasings(variants)
             check = verify(text, explanation, index, policy)
             source = f"template (fallback: {self.name} text failed verification: {problem.text!r} {problem.status})"
-        score, comp = confidence(explanation, index, check.ok, policy, background, robustness)
-        return Narrative(text=text, claims=check.claims, verified=check.ok, confidence=score, components=comp,
-                         source=source, template=tpl.name, index=index, rejected=rejected,
-                         extras={"method": explanation.method})
+        return text, check, source, rejected
 
     def _compose(self, variants: list[list[str]], context: dict[str, Any]) -> str:
         """The subclass's words.

@@ -3,7 +3,7 @@
 - ``verification``: 1 when every claim of the shown text was verified, else 0 (an unverified text has no confidence);
 - ``additivity`` (weight 0.2): 1 / (1 + gap / (1e-3 * max(1, |score|))): 1 when contributions add up to the score;
 - ``margin`` (0.3): 1 - exp(-q_margin / tau), tau = the mean |contribution| per feature: a Q-gap smaller than a
-  typical single feature's effect is a near tie;
+  typical single feature's effect is a near tie (discrete actions only: a value or a continuous action has none);
 - ``agreement`` (0.25): (1 + Spearman rho) / 2 between the |contributions| of this method and a second one
   (integrated gradients, or deep_shap when the first is integrated gradients) on the same state;
 - ``stability`` (0.25): mean of (1 + rho) / 2 between the contributions with the full background and with two
@@ -35,12 +35,11 @@ def _additivity(gap: float, score: float) -> float:
     return 1 / (1 + gap / (1e-3 * max(1.0, abs(score))))
 
 
-def _agreement(exp: Explanation, index: int, policy: Policy, bg: np.ndarray) -> float | None:
-    """Rank agreement of |contributions| with a second method; None when that method refuses this network."""
+def _agreement(exp: Explanation, index: int, policy: Policy, bg: np.ndarray, c: int) -> float | None:
+    """Rank agreement of |contributions| to output ``c`` with a second method; None when it refuses this network."""
     from ..attributors import explain
     from ..errors import XairlError
 
-    c = int(exp.chosen[index])
     second = "deep_shap" if exp.method == "integrated_gradients" else "integrated_gradients"
     try:
         other = explain(policy, exp.states[index:index + 1], background=bg, method=second).values[0, :, c]
@@ -49,11 +48,11 @@ def _agreement(exp: Explanation, index: int, policy: Policy, bg: np.ndarray) -> 
     return (1 + _spearman(np.abs(exp.values[index, :, c]), np.abs(other))) / 2
 
 
-def _stability(exp: Explanation, index: int, policy: Policy, bg: np.ndarray, seed: int) -> float:
-    """Mean rank agreement of the contributions with those from two half-size resamples of the background."""
+def _stability(exp: Explanation, index: int, policy: Policy, bg: np.ndarray, seed: int, c: int) -> float:
+    """Mean rank agreement of the contributions to output ``c`` with those from two half-size resamples of the
+    background."""
     from ..attributors import explain
 
-    c = int(exp.chosen[index])
     rng = np.random.default_rng(seed)
     rhos = []
     for _ in range(2):
@@ -65,28 +64,34 @@ def _stability(exp: Explanation, index: int, policy: Policy, bg: np.ndarray, see
 
 
 def components(exp: Explanation, index: int | None, verified: bool, policy: Policy | None = None,
-               background=None, robustness: bool = True, seed: int = 0) -> dict[str, float | None]:
-    """Every component of the confidence (None where not measured); see the module doc."""
+               background=None, robustness: bool = True, seed: int = 0, output: int | None = None
+               ) -> dict[str, float | None]:
+    """Every component of the confidence (None where not measured); see the module doc.
+
+    :param output: the output narrated when nothing is chosen (a value, one dimension of a continuous action);
+        there the margin does not apply. Default: the chosen action."""
     comp: dict[str, float | None] = {"verification": 1.0 if verified else 0.0, "additivity": None,
                                      "margin": None, "agreement": None, "stability": None}
     if index is None:  # a global summary: only verification and additivity apply
         comp["additivity"] = _additivity(float(exp.additivity_gap.max()), float(np.abs(exp.outputs).max()))
         return comp
-    c, r = int(exp.chosen[index]), int(exp.runner_up[index])
+    c, r = int(exp.chosen[index]) if output is None else output, int(exp.runner_up[index])
     comp["additivity"] = _additivity(float(exp.additivity_gap[index, c]), float(exp.outputs[index, c]))
-    tau = float(np.abs(exp.values[index, :, c]).mean()) or 1e-12
-    comp["margin"] = float(1 - np.exp(-float(exp.outputs[index, c] - exp.outputs[index, r]) / tau))
+    if exp.output == "actions":
+        tau = float(np.abs(exp.values[index, :, c]).mean()) or 1e-12
+        comp["margin"] = float(1 - np.exp(-float(exp.outputs[index, c] - exp.outputs[index, r]) / tau))
     if robustness and policy is not None and background is not None and exp.states is not None:
         bg = policy.check_states(background, "background")
-        comp["agreement"] = _agreement(exp, index, policy, bg)
-        comp["stability"] = _stability(exp, index, policy, bg, seed)
+        comp["agreement"] = _agreement(exp, index, policy, bg, c)
+        comp["stability"] = _stability(exp, index, policy, bg, seed, c)
     return comp
 
 
 def confidence(exp: Explanation, index: int | None, verified: bool, policy: Policy | None = None,
-               background=None, robustness: bool = True, seed: int = 0) -> tuple[float, dict[str, float | None]]:
+               background=None, robustness: bool = True, seed: int = 0, output: int | None = None
+               ) -> tuple[float, dict[str, float | None]]:
     """The confidence of a narrative and its components (formula and cost in the module doc)."""
-    comp = components(exp, index, verified, policy, background, robustness, seed)
+    comp = components(exp, index, verified, policy, background, robustness, seed, output)
     measured = {k: v for k, v in comp.items() if k in WEIGHTS and v is not None}
     score = comp["verification"] * sum(WEIGHTS[k] * v for k, v in measured.items()) / sum(WEIGHTS[k] for k in measured)
     return float(np.clip(score, 0.0, 1.0)), comp

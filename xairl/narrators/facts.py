@@ -95,6 +95,9 @@ class DecisionFacts:
     :param top: the ``k`` largest :class:`FeatureFact` by |contribution| to the chosen action's score.
     :param margin_top: the same for the margin over the runner-up (why this action and not that one).
     :param comparisons: the plugin's :class:`Comparison` facts; ``extras`` its named values (``DomainFacts``).
+    :param output: the policy's output kind. For 'value' and 'continuous' (one dimension at a time) nothing is
+        chosen: ``action`` names the output, ``score`` is its value, ``runner_up`` is ``action`` again and
+        ``margin_top`` is empty.
     """
 
     index: int
@@ -110,6 +113,7 @@ class DecisionFacts:
     margin_top: tuple[FeatureFact, ...]
     comparisons: tuple[Comparison, ...] = ()
     extras: Mapping[str, Any] = field(default_factory=dict)
+    output: str = "actions"
 
     def context(self) -> dict[str, Any]:
         """Variables a decision template sees: every field (feature facts as dicts) and ``k``."""
@@ -173,6 +177,9 @@ def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = Non
         raise InputError(f"index {index} is out of range: the explanation has {n} state(s).")
     if exp.states is None:
         raise InputError("this explanation has no states (it was grouped); narrate the ungrouped explanation.")
+    if exp.output != "actions" and exp.values.shape[2] != 1:
+        raise InputError(f"this explanation has {exp.values.shape[2]} {exp.output} outputs; narrate one at a time "
+                         "(Explanation.output_slice(j)).")
     c, r = int(exp.chosen[index]), int(exp.runner_up[index])
     domain = _domain_facts(policy, np.asarray(exp.states[index]), c, r)
     return DecisionFacts(
@@ -181,8 +188,8 @@ def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = Non
         q_margin=float(exp.outputs[index, c] - exp.outputs[index, r]), base_value=float(exp.base_values[index, c]),
         method=exp.method, additivity_gap=float(exp.additivity_gap[index, c]),
         top=_feature_facts(exp, index, exp.for_chosen()[index], policy, k),
-        margin_top=_feature_facts(exp, index, exp.margin()[index], policy, k),
-        comparisons=tuple(domain.comparisons), extras=dict(domain.extras),
+        margin_top=_feature_facts(exp, index, exp.margin()[index], policy, k) if exp.output == "actions" else (),
+        comparisons=tuple(domain.comparisons), extras=dict(domain.extras), output=exp.output,
     )
 
 

@@ -1,0 +1,235 @@
+"""What a policy's states look like (one flat vector, an image, a dict of arrays, several inputs) and the one flat
+(n, F) feature matrix every attributor works on.
+
+Data flows one way: user states -> :meth:`Observation.flatten` -> (n, F) float32 -> attributors, which call the
+policy's network through :meth:`Observation.unflatten` (a view and a split, both linear, so every attribution
+method sees through them).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from itertools import product
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from .errors import InputError
+
+KINDS = ("flat", "array", "dict", "tuple")
+
+
+@dataclass(frozen=True)
+class Part:
+    """One input of the module.
+
+    :param key: the dict key (or 'input{i}' for a tuple part, 'obs' for a single array).
+    :param shape: the shape of one state of this part, e.g. (4, 84, 84); ``()`` for a scalar.
+    :param categories: for a discrete input given as integers: how many values it takes (it is explained as that
+        many one-hot columns ``key=v``); ``None`` for numbers used as they are.
+    """
+
+    key: str
+    shape: tuple[int, ...]
+    categories: int | None = None
+
+    @property
+    def size(self) -> int:
+        """Columns this part takes in the flat feature matrix."""
+        return self.categories if self.categories else int(np.prod(self.shape, dtype=np.int64))
+
+    def names(self, single: bool) -> list[str]:
+        if self.categories:
+            return [f"{self.key}={v}" for v in range(self.categories)]
+        if not self.shape:
+            return [self.key]
+        if single and len(self.shape) == 1:
+            return [f"{self.key}_{i}" for i in range(self.shape[0])]
+        return [f"{self.key}[{','.join(map(str, ix))}]" for ix in product(*(range(s) for s in self.shape))]
+
+
+@dataclass(frozen=True)
+class Observation:
+    """The structure of a policy's input.
+
+    :param kind: 'flat' (one vector per state), 'array' (one array per state, e.g. an image (C, H, W)), 'dict'
+        (a dict of arrays: Dict observations) or 'tuple' (the module takes several tensors).
+    :param parts: the inputs in flat-column order.
+    """
+
+    kind: str
+    parts: tuple[Part, ...]
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise InputError(f"observation kind '{self.kind}' is unknown; use one of {', '.join(KINDS)}.")
+
+    # ---- constructors -------------------------------------------------------------------------------------
+    @classmethod
+    def flat(cls, n_features: int) -> "Observation":
+        return cls("flat", (Part("obs", (int(n_features),)),))
+
+    @classmethod
+    def array(cls, shape: Sequence[int], key: str = "obs") -> "Observation":
+        """States of shape ``(n, *shape)``, e.g. frames (n, 4, 84, 84)."""
+        return cls("array", (Part(key, tuple(int(s) for s in shape)),))
+
+    @classmethod
+    def dict(cls, shapes: Mapping[str, Sequence[int] | int], categories: Mapping[str, int] | None = None
+             ) -> "Observation":
+        """A dict of arrays; ``categories`` names the keys holding integer categories (one-hot encoded)."""
+        categories = dict(categories or {})
+        parts = []
+        for key, shape in shapes.items():
+            shape = (shape,) if isinstance(shape, int) else tuple(int(s) for s in shape)
+            parts.append(Part(str(key), shape, categories.get(key)))
+        return cls("dict", tuple(parts))
+
+    @classmethod
+    def several(cls, shapes: Sequence[Sequence[int]]) -> "Observation":
+        """Several inputs, passed to the module as positional tensors ``module(x0, x1, ...)``."""
+        return cls("tuple", tuple(Part(f"input{i}", tuple(int(s) for s in sh)) for i, sh in enumerate(shapes)))
+
+    # ---- the flat view --------------------------------------------------------------------------------------
+    @property
+    def n_features(self) -> int:
+        return sum(p.size for p in self.parts)
+
+    def feature_names(self) -> list[str]:
+        single = len(self.parts) == 1
+        if self.kind == "flat":
+            return [f"obs_{i}" for i in range(self.n_features)]
+        return [n for p in self.parts for n in p.names(single and self.kind == "array")]
+
+    def slices(self) -> dict[str, slice]:
+        """Columns of each part in the flat matrix."""
+        out, start = {}, 0
+        for p in self.parts:
+            out[p.key] = slice(start, start + p.size)
+            start += p.size
+        return out
+
+    def describe(self) -> str:
+        if self.kind in ("flat", "array"):
+            return f"(n, {', '.join(map(str, self.parts[0].shape))})"
+        return "{" + ", ".join(f"{p.key}: (n, {', '.join(map(str, p.shape))})" for p in self.parts) + "}" \
+            if self.kind == "dict" else "(" + ", ".join(f"(n, {', '.join(map(str, p.shape))})" for p in self.parts) + ")"
+
+    def flatten(self, states: Any, what: str = "states") -> np.ndarray:
+        """States in any form this observation accepts -> a checked float32 matrix (n, n_features).
+
+        Accepted: the flat matrix itself (n, F) or one flat row (F,); for 'array' also (n, *shape) or one state
+        (*shape); for 'dict' a mapping of key -> (n, *shape) (integers for categorical keys); for 'tuple' a
+        sequence of arrays, one per input.
+        """
+        if self.kind == "dict" and len(self.parts) == 1 and not isinstance(states, Mapping):
+            states = {self.parts[0].key: states}  # one categorical input (a Discrete observation)
+        if isinstance(states, Mapping):
+            if self.kind != "dict":
+                raise InputError(f"{what}: got a dict but this policy takes {self.describe()}; pass an array.")
+            return _finite(np.concatenate(self._columns(states, what), axis=1), what)
+        if isinstance(states, (tuple, list)) and self.kind == "tuple" and len(states) == len(self.parts) and \
+                all(hasattr(s, "shape") for s in states):
+            return _finite(np.concatenate(self._columns(dict(zip([p.key for p in self.parts], states)), what),
+                                          axis=1), what)
+        arr = _numeric(states, what)
+        f = self.n_features
+        if self.kind == "array":
+            shape = self.parts[0].shape
+            if arr.shape == shape:
+                arr = arr[None]
+            if arr.ndim == len(shape) + 1 and arr.shape[1:] == shape:
+                arr = arr.reshape(len(arr), -1)
+        if arr.ndim == 1 and arr.size == f:
+            arr = arr[None, :]
+        if arr.ndim != 2:
+            shape = "a 2-D array (n, %d)" % f if self.kind == "flat" else f"{self.describe()} or a flat (n, {f}) array"
+            raise InputError(f"{what} must be {shape}; got shape {arr.shape}.")
+        if arr.shape[0] == 0:
+            raise InputError(f"{what} is empty: give at least one state.")
+        if arr.shape[1] != f:
+            raise InputError(f"{what} has {arr.shape[1]} features but the policy expects {f}"
+                             f"{' as ' + self.describe() if self.kind != 'flat' else ''}; check the column order/count.")
+        return _finite(arr, what)
+
+    def _columns(self, states: Mapping, what: str) -> list[np.ndarray]:
+        missing = [p.key for p in self.parts if p.key not in states]
+        if missing:
+            raise InputError(f"{what} lack key(s) {', '.join(missing)}; the policy takes {self.describe()}.")
+        cols, n = [], None
+        for p in self.parts:
+            a = _numeric(states[p.key], f"{what}['{p.key}']")
+            if p.categories:
+                a = a.reshape(len(a), -1) if a.ndim > 1 else a[:, None]
+                if a.shape[1] != 1 or not np.all((a == np.round(a)) & (a >= 0) & (a < p.categories)):
+                    raise InputError(f"{what}['{p.key}'] must hold one integer in 0..{p.categories - 1} per state.")
+                a = np.eye(p.categories, dtype=np.float64)[a[:, 0].astype(int)]
+            else:
+                if a.shape == p.shape:
+                    a = a[None]
+                if a.shape[1:] != p.shape:
+                    raise InputError(f"{what}['{p.key}'] has shape {a.shape}; expected (n, "
+                                     f"{', '.join(map(str, p.shape))}).")
+                a = a.reshape(len(a), -1)
+            if n is not None and len(a) != n:
+                raise InputError(f"{what}: the parts have different numbers of states ({n} and {len(a)}).")
+            n = len(a)
+            cols.append(a)
+        return cols
+
+    def unflatten(self, x):
+        """A torch (n, F) tensor -> what the module takes: one tensor, a dict of tensors, or a tuple of them."""
+        if self.kind == "flat":
+            return x
+        out = {p.key: x[:, s].reshape(len(x), *(p.shape if not p.categories else (p.categories,)))
+               for p, s in zip(self.parts, self.slices().values())}
+        if self.kind == "array":
+            return out[self.parts[0].key]
+        return out if self.kind == "dict" else tuple(out.values())
+
+    def image_shape(self) -> tuple[int, ...] | None:
+        """(C, H, W) or (H, W) of an image observation; None for other kinds."""
+        if self.kind == "array" and len(self.parts[0].shape) in (2, 3):
+            return self.parts[0].shape
+        return None
+
+    def to_dict(self) -> dict:
+        return {"kind": self.kind, "parts": [{"key": p.key, "shape": list(p.shape), "categories": p.categories}
+                                             for p in self.parts]}
+
+    @classmethod
+    def from_dict(cls, d: Mapping) -> "Observation":
+        return cls(d["kind"], tuple(Part(p["key"], tuple(p["shape"]), p.get("categories")) for p in d["parts"]))
+
+
+def patches(shape: Sequence[int], size: int | Sequence[int], prefix: str = "patch") -> dict[str, np.ndarray]:
+    """Groups of an image's flat columns: one group per ``size`` x ``size`` patch over all channels.
+
+    :param shape: the image, (C, H, W) or (H, W); patches at the edges are smaller when ``size`` does not divide.
+    :returns: ``{"patch[r,c]": column indices}`` in row-major patch order, for :meth:`Explanation.grouped`.
+    """
+    shape = tuple(int(s) for s in shape)
+    c, h, w = (1, *shape) if len(shape) == 2 else shape
+    ph, pw = (size, size) if isinstance(size, int) else tuple(size)
+    idx = np.arange(c * h * w).reshape(c, h, w)
+    return {f"{prefix}[{r // ph},{q // pw}]": idx[:, r:r + ph, q:q + pw].ravel()
+            for r in range(0, h, ph) for q in range(0, w, pw)}
+
+
+def _numeric(data, what: str) -> np.ndarray:
+    if hasattr(data, "detach"):  # a torch tensor, without importing torch here
+        data = data.detach().cpu().numpy()
+    try:
+        return np.asarray(data, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{what} must be numeric; could not convert ({exc}).") from None
+
+
+def _finite(arr: np.ndarray, what: str) -> np.ndarray:
+    arr = arr.astype(np.float32)  # check after the cast: values beyond float32's range become inf here
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise InputError(
+            f"{what} contain {int(bad.sum())} NaN/inf value(s), first at row {r}, column {c}; clean or drop them."
+        )
+    return arr
