@@ -281,8 +281,8 @@ def _explain_parser(p: argparse.ArgumentParser) -> None:
                    help="argument of a module:attr policy function, e.g. --policy-arg checkpoint=my_q.pt")
     p.add_argument("--out", default=None, metavar="DIR",
                    help="write explanations.jsonl, figures and report.html into DIR instead of printing")
-    p.add_argument("--states", help="states to explain: .csv with a header naming the features, .npy (n, *obs_shape), .npz (dict "
-                   "observations) or .json; "
+    p.add_argument("--states", help="states to explain: .csv with a header naming the features, .npy "
+                   "(n, *obs_shape), .npz (dict observations) or .json; "
                    "default: --n states from the policy's sampler")
     p.add_argument("--background", help="background states file (default: the policy's sampler)")
     p.add_argument("--background-size", type=int, default=100, help="background states drawn from the sampler")

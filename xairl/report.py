@@ -53,7 +53,8 @@ class ReportContent:
     :param datasets: (label, states) pairs; the first is the reference for feature order and narrated decisions.
     :param tables: (title, HTML) pairs, e.g. from :func:`table_html`; ``figures`` (caption, PNG path) pairs.
     :param notes: sentences listed at the end; ``settings`` extra rows of the settings table.
-    :param template: the decision template narrated by default.
+    :param template: the decision template narrated by default (None: 'explain_action' for discrete actions,
+        'explain_output' for a value or a continuous action).
     :param commentary: optional ``f({label: Explanation}) -> [sentence, ...]``, called once the datasets are
         explained: the plugin's reading of the explanations (e.g. which of a paper's findings hold), listed first
         among the notes.
@@ -67,7 +68,7 @@ class ReportContent:
     figures: list[tuple[str, Path]] = field(default_factory=list)  # (caption, png)
     notes: list[str] = field(default_factory=list)
     settings: dict = field(default_factory=dict)
-    template: str = "explain_action"
+    template: str | None = None  # None: the default for the policy's output kind
     commentary: Callable[[dict[str, Explanation]], list[str]] | None = None
 
 
