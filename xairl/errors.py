@@ -28,6 +28,11 @@ class CheckpointError(XairlError):
     """A checkpoint that is missing, corrupt or does not match the architecture."""
 
 
+def one_line(exc: BaseException, limit: int = 300) -> str:
+    """``TypeName: message`` of an exception raised in user code, on one line and at most ``limit`` characters."""
+    return f"{type(exc).__name__}: {' '.join(str(exc).split())[:limit]}"
+
+
 def validation_message(exc, what: str) -> str:
     """One line naming each bad field of a pydantic ``ValidationError``: ``invalid {what} (field: reason; ...).``
 

@@ -90,6 +90,19 @@ class Explanation:
         return np.where(self.available.sum(axis=1) < 2, ranked[:, 0], ranked[:, 1])
 
     @property
+    def focus(self) -> np.ndarray:
+        """Index per state of the output a one-output view shows (plots, images): the chosen action for discrete
+        actions, else the first output."""
+        return self.chosen if self.output == "actions" else np.zeros(len(self.values), dtype=int)
+
+    @property
+    def image_shape(self) -> tuple[int, ...] | None:
+        """(C, H, W) or (H, W) when the states are images, else None."""
+        from .observation import Observation
+
+        return None if self.observation is None else Observation.from_dict(self.observation).image_shape()
+
+    @property
     def additivity_gap(self) -> np.ndarray:
         """|base + sum of contributions − output| per state and action."""
         return np.abs(self.base_values + self.values.sum(axis=1) - self.outputs)
@@ -169,14 +182,12 @@ class Explanation:
     def image(self, action: int | str | None = None) -> np.ndarray:
         """Contributions as images: (n_states, *image_shape) for one output (default: the chosen action for
         discrete actions, else output 0)."""
-        from .observation import Observation
-
-        shape = None if self.observation is None else Observation.from_dict(self.observation).image_shape()
+        shape = self.image_shape
         if shape is None:
             raise InputError("this explanation is not of an image observation; give the policy observation=(C, H, W).")
         n = len(self.values)
         if action is None:
-            a = self.chosen if self.output == "actions" else np.zeros(n, dtype=int)
+            a = self.focus
         else:
             a = np.full(n, self.action_names.index(action) if isinstance(action, str) else int(action))
         return self.values[np.arange(n), :, a].reshape(n, *shape)

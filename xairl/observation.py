@@ -109,10 +109,13 @@ class Observation:
         return out
 
     def describe(self) -> str:
+        """The states' form in messages: ``(n, 4, 84, 84)``, ``{image: (n, 3, 8, 8), v: (n, 5)}``, ``((n, 4), (n, 2))``."""
+        shapes = [f"(n, {', '.join(map(str, p.shape))})" for p in self.parts]
         if self.kind in ("flat", "array"):
-            return f"(n, {', '.join(map(str, self.parts[0].shape))})"
-        return "{" + ", ".join(f"{p.key}: (n, {', '.join(map(str, p.shape))})" for p in self.parts) + "}" \
-            if self.kind == "dict" else "(" + ", ".join(f"(n, {', '.join(map(str, p.shape))})" for p in self.parts) + ")"
+            return shapes[0]
+        if self.kind == "dict":
+            return "{" + ", ".join(f"{p.key}: {s}" for p, s in zip(self.parts, shapes)) + "}"
+        return "(" + ", ".join(shapes) + ")"
 
     def flatten(self, states: Any, what: str = "states") -> np.ndarray:
         """States in any form this observation accepts -> a checked float32 matrix (n, n_features).

@@ -22,19 +22,13 @@ def _plt():
 MAX_SHOWN = 40
 
 
-def image_shape(exp: Explanation):
-    from .observation import Observation
-
-    return None if exp.observation is None else Observation.from_dict(exp.observation).image_shape()
-
-
 def readable(exp: Explanation) -> Explanation:
     """An explanation a beeswarm can show: images grouped into at most ~100 patches, dicts by key."""
     from .observation import patches
 
     if exp.values.shape[1] <= MAX_SHOWN or exp.observation is None:
         return exp
-    shape = image_shape(exp)
+    shape = exp.image_shape
     if shape is not None:
         side = max(1, int(np.ceil(max(shape[-2:]) / 10)))
         return exp.grouped(patches(shape, side))
@@ -45,7 +39,7 @@ def readable(exp: Explanation) -> Explanation:
 def images(exp: Explanation, index: int, path: Path) -> Path:
     """The state's frame (mean over channels) and, per output, its contributions summed over channels."""
     plt = _plt()
-    shape = image_shape(exp)
+    shape = exp.image_shape
     frame = exp.states[index].reshape(shape)
     frame = frame.mean(axis=0) if len(shape) == 3 else frame
     heat = [exp.image(a)[index] for a in range(exp.values.shape[2])]
@@ -68,14 +62,9 @@ def images(exp: Explanation, index: int, path: Path) -> Path:
     return path
 
 
-def _target(exp: Explanation) -> np.ndarray:
-    """The output each state's plots show: the chosen action, or the first output where nothing is chosen."""
-    return exp.chosen if exp.output == "actions" else np.zeros(len(exp.values), dtype=int)
-
-
 def contributions(exp: Explanation) -> np.ndarray:
     """(n_states, n_features) contributions to the plotted output of each state."""
-    return exp.values[np.arange(len(exp.values)), :, _target(exp)]
+    return exp.values[np.arange(len(exp.values)), :, exp.focus]
 
 
 def importance_order(exp: Explanation) -> np.ndarray:
@@ -123,7 +112,7 @@ def waterfall(exp: Explanation, index: int, path: Path, title: str = "", shown: 
     """From the base value to the output of state ``index``: the ``shown`` largest contributions as steps, the
     rest as one step."""
     plt = _plt()
-    a = int(_target(exp)[index])
+    a = int(exp.focus[index])
     c = exp.values[index, :, a]
     order = np.argsort(-np.abs(c), kind="stable")
     top, rest = order[:shown], order[shown:]

@@ -10,7 +10,7 @@ from typing import Any, Callable
 import pluggy
 
 from . import hookspecs
-from .errors import InputError, PluginError, UnknownNameError, XairlError
+from .errors import InputError, PluginError, UnknownNameError, XairlError, one_line
 
 DEFAULT_PLUGINS = ("xairl.builtins",)
 BUILTIN_NAME = "xairl"
@@ -216,7 +216,7 @@ def load_policy(spec: str, kwargs: dict | None = None, observation=None):
     except XairlError:
         raise
     except Exception as exc:  # the user's module: one line, no traceback
-        raise InputError(f"cannot import '{where}' ({type(exc).__name__}: {' '.join(str(exc).split())[:200]}).") from None
+        raise InputError(f"cannot import '{where}' ({one_line(exc, 200)}).") from None
     if not hasattr(module, attr):
         raise UnknownNameError(f"'{where}' has no attribute '{attr}'.")
     obj = getattr(module, attr)
@@ -231,7 +231,7 @@ def load_policy(spec: str, kwargs: dict | None = None, observation=None):
             raise
         except Exception as exc:
             raise InputError(f"{spec}({', '.join(f'{k}={v!r}' for k, v in kwargs.items())}) raised "
-                             f"{type(exc).__name__}: {' '.join(str(exc).split())[:200]}.") from None
+                             f"{one_line(exc, 200)}.") from None
     elif kwargs:
         raise InputError(f"{spec} is not callable; --policy-arg needs a function that builds the policy.")
     if isinstance(obj, torch.nn.Module):

@@ -165,7 +165,7 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
                (f"One {'decision' if ref.output == 'actions' else 'state'} ({ref_label} state {pick}"
                 f"{': ' + ref.action_names[ref.chosen[pick]] if ref.output == 'actions' else ''})",
                 plots.waterfall(shown[0][1], pick, out / "waterfall.png"))]
-    if ref.observation is not None and plots.image_shape(ref) is not None:
+    if ref.image_shape is not None:
         figures.append((f"Contributions over the frame, per output ({ref_label} state {pick}; red raises the "
                         "output, blue lowers it; summed over channels)", plots.images(ref, pick, out / "image.png")))
     groups = dict(content.policy.groups)

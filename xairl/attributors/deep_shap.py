@@ -47,36 +47,31 @@ def _vjp(layer, h, g):
 
 
 def _local_grad(layer, h):
-    with torch.enable_grad():
-        leaf = h.detach().requires_grad_(True)
-        return torch.autograd.grad(layer.forward(leaf).sum(), leaf)[0]
+    """The derivative of an elementwise layer at h."""
+    return _vjp(layer, h, torch.ones_like(h))
 
 
-def _rescale_multiplier(layer, inp, out):
-    """Rescale rule of an elementwise layer: the multiplier Δout/Δin per element (pairs are rows i and i + P), the
-    local gradient where |Δin| is tiny, as shap does. Computed once per forward call, used by every output's
-    backward pass."""
+def _ratio(inp, out):
+    """Δout/Δin per element for both halves of each pair (rows i and i + P), and where |Δin| is too small for it."""
     p = len(inp) // 2
     d_in = inp[:p] - inp[p:]
     ratio = (out[:p] - out[p:]) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
     small = d_in.abs() < EPS
-    ratio = torch.cat([ratio, ratio])
-    if small.any():
-        ratio = torch.where(torch.cat([small, small]), _local_grad(layer, inp), ratio)
-    return ratio
+    return torch.cat([ratio, ratio]), torch.cat([small, small])
+
+
+def _rescale_multiplier(layer, inp, out):
+    """Rescale rule of an elementwise layer: the multiplier Δout/Δin per element, the local gradient where |Δin| is
+    tiny, as shap does. Computed once per forward call, used by every output's backward pass."""
+    ratio, small = _ratio(inp, out)
+    return torch.where(small, _local_grad(layer, inp), ratio) if small.any() else ratio
 
 
 def _rescale(layer, inp, out, g):
     """Rescale rule for a layer that mixes elements (Softmax, LogSoftmax), per element as shap applies it; the
     true local Jacobian where |Δin| is tiny."""
-    p = len(inp) // 2
-    d_in = inp[:p] - inp[p:]
-    ratio = (out[:p] - out[p:]) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
-    grad = g * torch.cat([ratio, ratio])
-    small = d_in.abs() < EPS
-    if small.any():
-        grad = torch.where(torch.cat([small, small]), _vjp(layer, inp, g), grad)
-    return grad
+    ratio, small = _ratio(inp, out)
+    return torch.where(small, _vjp(layer, inp, g), g * ratio) if small.any() else g * ratio
 
 
 def _maxpool(layer, inp, out, g):
