@@ -31,6 +31,8 @@ class Explanation:
         runner-up), 'continuous' (action dimensions, each explained on its own) or 'value' (one output).
     :param observation: the policy's input structure (``Observation.to_dict()``), so that values can be viewed as
         images (:meth:`image`); None for flat states.
+    :param categories: feature name -> the label of each integer code, for categorical features
+        (``FeatureInfo.categories``); :attr:`value_labels` reads the states through it.
     """
 
     values: np.ndarray
@@ -46,6 +48,7 @@ class Explanation:
     available: np.ndarray | None = None
     output: str = "actions"
     observation: Mapping[str, Any] | None = None
+    categories: Mapping[str, Sequence[str]] | None = None
 
     def __post_init__(self) -> None:
         n, f, a = self.values.shape
@@ -101,6 +104,20 @@ class Explanation:
         from .observation import Observation
 
         return None if self.observation is None else Observation.from_dict(self.observation).image_shape()
+
+    @property
+    def value_labels(self) -> np.ndarray | None:
+        """(n_states, n_features) object array: the label of each categorical feature's value, None elsewhere
+        (None altogether when there are no states or no categorical features)."""
+        if self.states is None or not self.categories:
+            return None
+        out = np.full(self.states.shape, None, dtype=object)
+        for j, f in enumerate(self.feature_names):
+            labels = self.categories.get(f)
+            if labels:
+                codes = np.round(self.states[:, j]).astype(int)
+                out[:, j] = [labels[c] if 0 <= c < len(labels) else None for c in codes]
+        return out
 
     @property
     def additivity_gap(self) -> np.ndarray:
@@ -242,6 +259,7 @@ class ExplanationRecord(BaseModel):
     available: list[list[bool]] | None = None
     output: str = "actions"
     observation: dict[str, Any] | None = None
+    categories: dict[str, list[str]] | None = None
 
     @classmethod
     def from_explanation(cls, e: Explanation) -> "ExplanationRecord":
@@ -259,6 +277,7 @@ class ExplanationRecord(BaseModel):
             available=None if e.available is None else e.available.tolist(),
             output=e.output,
             observation=None if e.observation is None else dict(e.observation),
+            categories=None if not e.categories else {k: list(v) for k, v in e.categories.items()},
         )
 
     def to_explanation(self) -> Explanation:
@@ -278,6 +297,7 @@ class ExplanationRecord(BaseModel):
             available=None if self.available is None else np.asarray(self.available, dtype=bool),
             output=self.output,
             observation=self.observation,
+            categories=self.categories,
         )
 
 

@@ -20,6 +20,8 @@ class FeatureInfo:
     :param description: a plain-language phrase ("the serving cell's reference signal power").
     :param low: how to describe a low value ("weak signal"); ``high`` likewise.
     :param aliases: other names a text may use for the feature (the verifier recognises them).
+    :param categories: for a categorical feature given as integer codes, the label of each code (code k is
+        ``categories[k]``): narratives name the label ("odor: foul") and the verifier checks it.
     """
 
     unit: str = ""
@@ -27,6 +29,7 @@ class FeatureInfo:
     low: str = "low"
     high: str = "high"
     aliases: tuple[str, ...] = ()
+    categories: tuple[str, ...] = ()
 
 
 #: what a policy's outputs are: scores of discrete actions (the highest available one is taken; a runner-up exists),

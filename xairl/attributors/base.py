@@ -75,6 +75,7 @@ class Attributor:
             available=None if policy.action_mask is None else policy.available(x),
             output=policy.output,
             observation=policy.observation.to_dict(),
+            categories={f: tuple(i.categories) for f, i in policy.features.items() if i.categories} or None,
         )
 
     def _check_additivity(self, policy: Policy, values, base, outputs) -> None:
