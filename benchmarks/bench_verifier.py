@@ -1,0 +1,132 @@
+"""The verifier on prose it did not write: agreement with hand labels on the held-out narrative corpus.
+
+The corpus (``benchmarks/data/narratives``): 320 narratives about 32 explanations in four domains (house prices and
+credit default, one output each, not RL; the UAV handover DQN; the toy discrete policy), half accurate and half
+with one labelled error, in many voices. Cases 0-3 of each domain are the dev split (the verifier was tuned on it),
+cases 4-7 the test split (frozen before any tuning; report it apart). A narrative counts as agreeing when
+``Verification.ok`` equals its label.
+
+    .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain and error kind, speed
+    .venv/bin/python benchmarks/bench_verifier.py --show test # also every disagreement of the test split
+    .venv/bin/python benchmarks/bench_verifier.py --explingo accuracy_tests.json   # outside corpus, see below
+
+``--explingo``: the hand-labelled narratives of Zytek et al.'s Explingo (github.com/sibyl-dev/Explingo,
+``full-experiment/accuracy_tests.json``; not shipped here): each explanation is rebuilt from its
+(feature, value, contribution) tuples as a one-output Explanation; score 0 is inaccurate, 2 and 4 accurate.
+"""
+from __future__ import annotations
+
+import argparse
+import collections
+import json
+import pathlib
+import re
+import sys
+import time
+
+import numpy as np
+import yaml
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
+import xairl  # noqa: E402
+from tests import narrative_domains as domains  # noqa: E402
+
+DATA = pathlib.Path(__file__).parent / "data" / "narratives"
+
+
+def load_corpus() -> list[dict]:
+    """Every narrative with its case's Explanation, domain, split, label and error kind."""
+    cases = {c["id"]: c for c in json.loads((DATA / "cases.json").read_text())}
+    out = []
+    for domain in domains.DOMAINS:
+        for case_id, items in yaml.safe_load((DATA / f"{domain}.yaml").read_text()).items():
+            case = cases[case_id]
+            exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
+            for item in items:
+                (label, text), = item.items()
+                out.append({"case": case_id, "domain": domain, "split": case["split"], "error": label,
+                            "accurate": label == "ok", "text": text, "explanation": exp})
+    return out
+
+
+def run(items: list[dict], policies: dict) -> list[dict]:
+    for it in items:
+        t = time.perf_counter()
+        res = xairl.verify(it["text"], it["explanation"], 0, policies.get(it["domain"]))
+        it["seconds"] = time.perf_counter() - t
+        it["sentences"] = max(1, len(re.findall(r"[.!?\n](\s|$)", it["text"].strip() + " ")))
+        it["ok"] = res.ok
+        it["result"] = res
+    return items
+
+
+def table(items: list[dict], key) -> list[tuple[str, int, int]]:
+    groups = collections.defaultdict(list)
+    for it in items:
+        groups[key(it)].append(it["ok"] == it["accurate"])
+    return [(k, sum(v), len(v)) for k, v in sorted(groups.items())]
+
+
+def report(items: list[dict], show: str | None) -> None:
+    for split in ("dev", "test"):
+        part = [it for it in items if it["split"] == split]
+        agree = sum(it["ok"] == it["accurate"] for it in part)
+        print(f"\n## {split} split: agreement {agree}/{len(part)} = {100 * agree / len(part):.1f} %")
+        print("| domain | agree | n | % |\n|---|---|---|---|")
+        for k, a, n in table(part, lambda it: it["domain"]):
+            print(f"| {k} | {a} | {n} | {100 * a / n:.0f} |")
+        print("\n| label | agree | n | % |\n|---|---|---|---|")
+        for k, a, n in table(part, lambda it: it["error"]):
+            print(f"| {'accurate' if k == 'ok' else k} | {a} | {n} | {100 * a / n:.0f} |")
+        if show == split:
+            for it in part:
+                if it["ok"] != it["accurate"]:
+                    probs = "; ".join(f"{c.kind} '{c.text}': {c.status} ({c.detail})" for c in it["result"].problems())
+                    print(f"- [{it['case']} {it['error']}] {it['text']!r}\n    -> {probs or 'no problem found'}")
+    per_sentence = sum(it["seconds"] for it in items) / sum(it["sentences"] for it in items)
+    print(f"\nspeed: {1000 * per_sentence:.2f} ms per sentence (mean over {len(items)} narratives)")
+
+
+def explingo_items(path: str) -> list[dict]:
+    """Explingo's labelled narratives, each with a one-output Explanation rebuilt from its tuples."""
+    out = []
+    for row in json.loads(pathlib.Path(path).read_text()):
+        tuples = re.findall(r"\(([^()]*?),\s*([^,()]+?),\s*(-?[\d.]+)\)", row["explanation"])
+        names = [t[0].strip() for t in tuples]
+        raw = [t[1].strip() for t in tuples]
+        contrib = np.array([float(t[2]) for t in tuples])
+        cats = {n: (v,) for n, v in zip(names, raw) if not re.fullmatch(r"-?[\d.]+", v)}
+        states = np.array([[0.0 if n in cats else float(v) for n, v in zip(names, raw)]])
+        exp = xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.zeros((1, 1)),
+                                outputs=np.array([[contrib.sum()]]), states=states, feature_names=tuple(names),
+                                action_names=("prediction",), method="given", output="value",
+                                categories=cats or None)
+        out.append({"case": row["explanation"][:40], "domain": row["context"].split(" predicts ")[-1][:28],
+                    "split": "explingo", "error": row["accuracy_rationalization"],
+                    "accurate": row["accuracy_score"] > 0, "text": row["narrative"], "explanation": exp})
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--show", choices=("dev", "test", "explingo"), help="list the disagreements of a split")
+    ap.add_argument("--explingo", help="path of Explingo's full-experiment/accuracy_tests.json")
+    args = ap.parse_args()
+    if args.explingo:
+        items = run(explingo_items(args.explingo), {})
+        agree = sum(it["ok"] == it["accurate"] for it in items)
+        print(f"## Explingo accuracy_tests (outside): agreement {agree}/{len(items)} = {100 * agree / len(items):.1f} %")
+        print("| label | agree | n |\n|---|---|---|")
+        for k, a, n in table(items, lambda it: ("accurate: " if it["accurate"] else "inaccurate: ") + it["error"]):
+            print(f"| {k} | {a} | {n} |")
+        for it in items:
+            if args.show == "explingo" and it["ok"] != it["accurate"]:
+                probs = "; ".join(f"{c.kind} '{c.text}': {c.status} ({c.detail})" for c in it["result"].problems())
+                print(f"- [{it['error']}] {it['text']!r}\n    -> {probs or 'no problem found'}")
+        return
+    policies = {d: domains.policy(d) for d in domains.DOMAINS}
+    report(run(load_corpus(), policies), args.show)
+
+
+if __name__ == "__main__":
+    main()
