@@ -1,0 +1,298 @@
+"""Read any text back against an Explanation: the verifier.
+
+A small pipeline, one module per step:
+
+1. :mod:`.numbers` normalises the text (Unicode minus, no-break spaces) and reads every number as people write
+   it, with the hedge before it;
+2. :mod:`.names` finds where features (any spelling, words of their name or description), actions (verb forms
+   too) and categorical values are named, and masks them;
+3. this module splits sentences into clauses and binds each number, direction word, rank phrase and
+   'barely matters' phrase to the names around it (a number to the name before it in its clause, or pairwise for
+   'A and B ... by x and y, respectively'; a direction word to the names since the previous one, or to a list that
+   follows it, 'Raising risk: A, B');
+4. :mod:`.checks` checks each claim against :mod:`.book` (values, contributions to the chosen action's score and to
+   the margin over the runner-up, ranks, shares, labels, scores, domain comparisons) and says verified,
+   contradicted or unchecked;
+5. every sentence gets a status (contradicted if any claim is; verified if a claim was checked and none is
+   contradicted; else unchecked), and the text a coverage (share of sentences with a checked claim).
+
+``Verification.ok``: nothing contradicted and coverage >= :data:`MIN_COVERAGE` (0.5). What is and is not checked
+is listed in the README ("What the verifier checks").
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ...explanation import Explanation
+from ...policy import Policy
+from . import checks
+from .book import FactBook, clean_surface, fact_book
+from .checks import CHECKED, Claim
+from .names import Mention, find_mentions, vocabulary
+from .numbers import NUMBER_RE, find_numbers, normalise
+
+MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
+MAX_CHARS = 200_000  # longer texts are cut here (and the cut reported)
+
+__all__ = ["Claim", "Verification", "SentenceCheck", "verify", "clean_surface", "fact_book", "NUMBER_RE",
+           "MIN_COVERAGE"]
+
+
+@dataclass(frozen=True)
+class SentenceCheck:
+    """One sentence: its claims and status (verified / contradicted / unchecked)."""
+
+    text: str
+    claims: tuple[Claim, ...]
+
+    @property
+    def status(self) -> str:
+        if any(c.status == "contradicted" for c in self.claims):
+            return "contradicted"
+        if any(c.status == "verified" and c.kind in CHECKED for c in self.claims):
+            return "verified"
+        return "unchecked"
+
+
+@dataclass(frozen=True)
+class Verification:
+    """The verdict on a text: every claim, every sentence, coverage and status.
+
+    ``ok``: no claim contradicted and at least :data:`MIN_COVERAGE` of the sentences carry a checked claim.
+    """
+
+    sentences: tuple[SentenceCheck, ...]
+    note: str = ""
+
+    @property
+    def claims(self) -> tuple[Claim, ...]:
+        return tuple(c for s in self.sentences for c in s.claims)
+
+    @property
+    def coverage(self) -> float:
+        return sum(s.status != "unchecked" for s in self.sentences) / len(self.sentences) if self.sentences else 0.0
+
+    @property
+    def status(self) -> str:
+        if any(s.status == "contradicted" for s in self.sentences):
+            return "contradicted"
+        return "verified" if self.sentences and self.coverage >= MIN_COVERAGE else "unchecked"
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "verified"
+
+    def problems(self) -> list[Claim]:
+        """Contradicted claims first, then (for a text that is not ok) the sentences left unchecked."""
+        bad = [c for c in self.claims if c.status == "contradicted"]
+        if not bad and not self.ok:
+            bad = [Claim("coverage", s.text, "unchecked", f"no checkable claim (coverage {self.coverage:.0%})")
+                   for s in self.sentences if s.status == "unchecked"] or [
+                Claim("coverage", "", "unchecked", "empty text")]
+        return bad
+
+
+_SENTENCE_RE = re.compile(r"(?<=[.!?])\s+(?=[^a-z0-9])|\n+\s*(?:[-•*]\s*)?")
+_CLAUSE_RE = re.compile(r";|\s(?:while|whereas|but|yet|although|though|however)\b|,\s(?:and\s)?(?=but\b)",
+                        re.IGNORECASE)
+_IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
+_GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:it|this|that|they|these|those|which|everything"
+                              r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
+                              r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total)\b",
+                              re.IGNORECASE)
+
+
+def sentences(text: str) -> list[tuple[int, int]]:
+    """Sentence spans: split after . ! ? before a capital or a sign, and at line breaks and bullets."""
+    spans, start = [], 0
+    for m in _SENTENCE_RE.finditer(text):
+        if text[start:m.start()].strip():
+            spans.append((start, m.start()))
+        start = m.end()
+    if text[start:].strip():
+        spans.append((start, len(text)))
+    return spans
+
+
+def verify(text: str, explanation: Explanation, index: int | None = 0, policy: Policy | None = None) -> Verification:
+    """Check every claim of ``text`` against the explanation of state ``index`` (``None``: the global view).
+
+    :param policy: optional, for feature descriptions, aliases and units, action aliases and domain facts.
+    :returns: a :class:`Verification`; never raises on odd text (empty, very long, another language).
+    """
+    note = ""
+    text = normalise(text if isinstance(text, str) else str(text))
+    if len(text) > MAX_CHARS:
+        text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
+    book = fact_book(explanation, index, policy)
+    vocab = vocabulary(explanation, policy, clean_surface)
+
+    def unit_of(f: str) -> str:
+        info = policy.features.get(f) if policy else None
+        return info.unit if info else ""
+
+    out = [SentenceCheck(text[a:b].strip(), tuple(_check_sentence(text[a:b], book, vocab, unit_of)))
+           for a, b in sentences(text)]
+    return Verification(tuple(out), note)
+
+
+def _context(sentence: str, mentions: list[Mention], book: FactBook) -> str | None:
+    """'margin' when the sentence compares with the runner-up, 'chosen' when it names the chosen action's score,
+    None when it does not say (claims then hold if they hold in either view)."""
+    if not book.runner_up:
+        return "chosen"
+    low = sentence.lower()
+    runner_named = any(m.kind == "action" and checks.resolve_action(m, book) == book.runner_up for m in mentions)
+    if runner_named or re.search(r"\b(rather than|instead of|runner.up|relative to|compared (with|to)|versus|vs\.?|"
+                                 r"margin|lead|edge|advantage|over (going|staying|turning|handing))\b", low):
+        return "margin"
+    if re.search(r"\b(score|q.value|q\(|value of)\b", low) or any(
+            m.kind == "action" and checks.resolve_action(m, book) == book.chosen for m in mentions):
+        return "chosen"
+    return None
+
+
+def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]:
+    mentions, masked = find_mentions(sentence, vocab)
+    ctx = _context(sentence, mentions, book)
+    claims: list[Claim] = [Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys))
+                           for m in mentions if m.kind == "feature"]
+    for m in mentions:
+        c = checks.check_action(sentence, m, book) if m.kind == "action" else \
+            checks.check_label(sentence, m, book) if m.kind == "label" else None
+        if c is not None:
+            claims.append(c)
+    bounds = [0] + [m.end() for m in _CLAUSE_RE.finditer(masked)] + [len(masked)]
+    for a, b in zip(bounds, bounds[1:]):
+        inside = [m for m in mentions if a <= m.start < b]
+        claims += _check_clause(masked, a, b, inside, book, ctx, unit_of)
+    for ident in _IDENT_RE.findall(masked):
+        claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
+    return claims
+
+
+def _names(mentions: list[Mention]) -> list[Mention]:
+    return [m for m in mentions if m.kind in ("feature", "label")]
+
+
+def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
+                  unit_of) -> list[Claim]:
+    out: list[Claim] = []
+    names = _names(mentions)
+    numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not checks.skip_number(n, masked)]
+    # 'A and B ... by x and y, respectively': numbers after the last name pair up with the names in order
+    tail = [n for n in numbers if names and n.start > names[-1].end]
+    paired = {}
+    if len(names) >= 2 and len(tail) == len(names) and (
+            "respectively" in masked[a:b].lower() or checks._CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])):
+        paired = {id(n): m for n, m in zip(tail, names)}
+    actions = [m for m in mentions if m.kind == "action"]
+    scored = {}
+    if not names and len(actions) >= 2 and len(numbers) == len(actions) and numbers[0].start > actions[-1].end:
+        scored = {id(n): m for n, m in zip(numbers, actions)}  # 'turn beat recharge 6.30 to 2.37'
+    for n in numbers:
+        out.append(_bind_number(n, masked, a, mentions, names, paired, scored, book, ctx, unit_of))
+    out += _directions(masked, a, b, mentions, book, ctx)
+    out += _ranks(masked, a, b, mentions, book, ctx)
+    for m in checks.MINOR_RE.finditer(masked, a, b):
+        owner = next((x for x in reversed(names) if x.end <= m.start()), None) or next(
+            (x for x in names if x.start >= m.end()), None)
+        if owner is not None:
+            out.append(checks.check_minor(owner.keys, ctx, book, m.group(0)))
+    return out
+
+
+_SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q\s*=|scored|scores|score of|with a score of|came second at|"
+                        r"second at|score|at|of|was|=)?\s*\(?(?:q\s*=\s*)?$", re.IGNORECASE)
+
+
+def _bind_number(n, masked: str, a: int, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:
+    """Which name a number belongs to, then its check: a pair of a 'respectively' list; an action right before it
+    ('Turn (4.07)', 'staying scored 26.26') or right after it ('7.38 for staying'); a name right after it ('a 7-year
+    credit history'); the name before it in its clause unless a new noun phrase starts between them; else none."""
+    if id(n) in paired:
+        return checks.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of)
+    if id(n) in scored:
+        return checks.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
+    after = masked[n.end:n.end + 24]
+    nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
+    if nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|by)\s+$", masked[n.end:nxt.start]):
+        return checks.action_number(n, checks.resolve_action(nxt, book), masked, book)
+    gap = masked[n.end:nxt.start] if nxt is not None else ""
+    if nxt is not None and nxt.kind != "action" and re.match(r"^[\s-]*(?:[a-z]+[\s-]+)?(?:of\s+)?$", gap,
+                                                               re.IGNORECASE) \
+            and not re.search(r"\b(and|or|but|while|with)\b", gap, re.IGNORECASE):
+        return checks.feature_number(n, nxt.keys, masked, book, ctx, unit_of)
+    prev = next((m for m in reversed(mentions) if m.end <= n.start), None)
+    feature_before = next((m for m in reversed(names) if m.end <= n.start), None)
+    if prev is not None and prev.kind == "action" and (
+            n.sign == "+" or re.match(r"^\s*(over|than|versus|vs)\b", after, re.IGNORECASE) or (
+            feature_before is not None and checks.DIRECTION_RE.search(masked, feature_before.end, prev.start))):
+        prev = feature_before  # '(+2.05)' after 'supported recharging': the feature's contribution
+    if prev is not None and prev.kind == "action":
+        if _SCORE_GAP.match(masked[prev.end:n.start]) or checks._MARGIN_BEFORE.search(masked[prev.end:n.start]):
+            return checks.action_number(n, checks.resolve_action(prev, book), masked, book)
+        prev = next((m for m in reversed(names) if m.end <= n.start), None)
+    if prev is not None and not re.search(r",\s*(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s",
+                                          masked[prev.end:n.start], re.IGNORECASE):
+        return checks.feature_number(n, prev.keys, masked, book, ctx, unit_of)
+    return checks.free_number(n, masked, book)
+
+
+def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None
+                ) -> list[Claim]:
+    out, prev = [], a
+    names = _names(mentions)
+    found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
+    for i, m in enumerate(found):
+        polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
+        subjects = [x for x in names if prev <= x.start < m.start()]
+        if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
+            nxt = found[i + 1].start() if i + 1 < len(found) else b
+            subjects = [x for x in names if m.end() <= x.start < nxt]
+            if not subjects:
+                subject = masked[prev:m.start()]
+                if book.output != "actions" or not re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE):
+                    out += _unknown_subject(subject, m.group(0), mentions)
+        out += checks.check_direction(subjects, polarity, where, m.group(0), book)
+        prev = m.end()
+    return out
+
+
+def _unknown_subject(subject: str, word: str, mentions: list[Mention]) -> list[Claim]:
+    """A direction claimed for something that names no feature ('the swimming pool adds ...'): contradicted when
+    the subject is a noun phrase of its own, not a pronoun or the decision itself."""
+    words = re.findall(r"[A-Za-z]{3,}", subject.replace("\0", " "))
+    if not words or mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")):
+        return []
+    return [Claim("feature", subject.strip(" ,:-\0"), "contradicted",
+                  f"'{word}' is said of something that is not a feature of this model")]
+
+
+def _ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
+    out = []
+    names = _names(mentions)
+    for m in checks.RANK_RE.finditer(masked, a, b):
+        rank, plural, sign = checks.rank_claim(m, masked)
+        if plural:
+            targets = [x for x in names if x.start >= m.end()] or [x for x in names if x.end <= m.start()]
+            k = rank or len(targets)
+            for t in targets:
+                out.append(checks.check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {masked[t.start:t.end]}"))
+            continue
+        before = [x for x in names if x.end <= m.start()]
+        target = before[-1] if before else next((x for x in names if x.start >= m.end()), None)
+        if target is None:
+            continue
+        out.append(checks.check_rank(target.keys, rank, None, sign, ctx, book, m.group(0)))
+        for x in names:  # 'followed by B', 'B second'
+            if x.start >= m.end() and checks._FOLLOWED.search(masked[max(a, x.start - 24):x.start]):
+                rank += 1
+                out.append(checks.check_rank(x.keys, rank, None, sign, ctx, book, f"then {masked[x.start:x.end]}"))
+    for x in names:
+        o = checks._AFTER_ORD.match(masked[x.end:b])
+        if o and not checks.RANK_RE.match(masked[x.end:b].lstrip(" ,(")):
+            out.append(checks.check_rank(x.keys, checks._ORD[o.group("o").lower()], None, 0, ctx, book,
+                                         f"{masked[x.start:x.end]} {o.group('o')}"))
+    return out

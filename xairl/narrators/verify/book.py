@@ -1,0 +1,109 @@
+"""FactBook: everything a text may claim about one decision (or, with ``index=None``, about all states), computed
+from the Explanation alone."""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...explanation import Explanation
+from ...policy import Policy
+from ..facts import decision_facts, global_facts
+
+_CLAIMY = re.compile(r"[+\-\u2212]\d|\d\.\d|%|\b(toward|towards|against|raises|lowers|increases|decreases|pushes|"
+                     r"favours|favors|opposes|most important|main|largest|biggest|strongest|top|first|second|third|"
+                     r"mattered most)\b", re.IGNORECASE)
+
+
+def clean_surface(text: str) -> bool:
+    """May this name or description hide its words from the verifier? Not if it carries claims itself (a signed or
+    decimal number, a percentage, a direction or rank word): text from data files or plugins cannot smuggle claims."""
+    return not _CLAIMY.search(text)
+
+
+@dataclass
+class FeatureFacts:
+    value: float | None = None
+    label: str | None = None                                  # a categorical value's label
+    contribs: dict[str, float] = field(default_factory=dict)  # context ('chosen', 'margin') -> contribution
+    ranks: dict[str, int] = field(default_factory=dict)       # context -> rank by |contribution|
+    signed_ranks: dict[str, int] = field(default_factory=dict)  # context -> rank among contributions of its sign
+    shares: dict[str, float] = field(default_factory=dict)    # context -> % of the sum of |contributions|
+
+
+@dataclass
+class FactBook:
+    features: dict[str, FeatureFacts]
+    output: str                      # 'actions', 'continuous' or 'value'
+    chosen: str | None
+    runner_up: str | None
+    scores: dict[str, float]         # every action's (or the output's) score
+    margin: float | None
+    base: float | None
+    decision_numbers: list[float]    # every decision-level number a text may cite
+    by_unit: dict[str, list[float]] = field(default_factory=dict)
+    global_view: bool = False
+    n_states: int = 1
+
+    @property
+    def contexts(self) -> tuple[str, ...]:
+        return ("chosen", "margin") if self.runner_up else ("chosen",)
+
+
+def _ranks(contrib: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    order = np.argsort(-np.abs(contrib), kind="stable")
+    rank = np.empty(len(contrib), int)
+    rank[order] = np.arange(1, len(contrib) + 1)
+    signed = np.zeros(len(contrib), int)
+    for sgn in (1, -1):
+        idx = [j for j in order if np.sign(contrib[j]) == sgn]
+        for r, j in enumerate(idx, 1):
+            signed[j] = r
+    total = np.abs(contrib).sum() or 1.0
+    return rank, signed, 100 * np.abs(contrib) / total
+
+
+def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None) -> FactBook:
+    feats = {f: FeatureFacts() for f in exp.feature_names}
+    if index is None:
+        g = global_facts(exp, policy, k=len(exp.feature_names))
+        for r in g.ranking:
+            e = feats[r["name"]]
+            e.value = r["mean_abs"]
+            e.ranks["chosen"] = r["rank"]
+            if r["high_values"] != "mixed":
+                e.contribs["chosen"] = 1.0 if r["high_values"] == "toward" else -1.0
+        return FactBook(feats, exp.output, None, None, {}, None, None, [float(g.n_states)], global_view=True,
+                        n_states=g.n_states)
+    d = decision_facts(exp, index, policy, k=len(exp.feature_names))
+    labels = exp.value_labels
+    chosen_i, runner_i = int(exp.chosen[index]), int(exp.runner_up[index])
+    deciding = exp.output == "actions" and runner_i != chosen_i
+    views = {"chosen": exp.values[index, :, chosen_i]}
+    if deciding:
+        views["margin"] = exp.values[index, :, chosen_i] - exp.values[index, :, runner_i]
+    for ctx, contrib in views.items():
+        rank, signed, share = _ranks(contrib)
+        for j, f in enumerate(exp.feature_names):
+            e = feats[f]
+            e.contribs[ctx], e.ranks[ctx], e.signed_ranks[ctx], e.shares[ctx] = (
+                float(contrib[j]), int(rank[j]), int(signed[j]), float(share[j]))
+    for j, f in enumerate(exp.feature_names):
+        if exp.states is not None:
+            feats[f].value = float(exp.states[index, j])
+        if labels is not None and labels[index, j] is not None:
+            feats[f].label = str(labels[index, j])
+    scores = {a: float(exp.outputs[index, k]) for k, a in enumerate(exp.action_names)}
+    base = float(exp.base_values[index, chosen_i])
+    numbers = [d.score, base, d.score - base, d.additivity_gap, *scores.values()]
+    if deciding:
+        numbers += [d.runner_up_score, d.q_margin]
+    numbers += [c.value for c in d.comparisons]
+    numbers += [float(v) for v in d.extras.values() if isinstance(v, (int, float)) and not isinstance(v, bool)]
+    by_unit: dict[str, list[float]] = {}
+    for c in d.comparisons:
+        if c.unit:
+            by_unit.setdefault(c.unit.lower(), []).append(c.value)
+    return FactBook(feats, exp.output, d.action, d.runner_up if deciding else None, scores,
+                    d.q_margin if deciding else None, base, numbers, by_unit)

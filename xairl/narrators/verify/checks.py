@@ -1,0 +1,372 @@
+"""One function per kind of claim. Each takes a clause (or sentence) already read into mentions and numbers and
+returns :class:`Claim`\\ s: verified, contradicted, or unchecked (with the reason)."""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from .book import FactBook
+from .names import Mention
+from .numbers import Number, matches
+
+
+@dataclass(frozen=True)
+class Claim:
+    """kind: number | feature | direction | rank | action | category | magnitude; status: verified | contradicted
+    | unchecked."""
+
+    kind: str
+    text: str
+    status: str
+    detail: str = ""
+
+
+CHECKED = {"number", "direction", "rank", "action", "category", "magnitude"}
+
+_POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|supported|supporting|favou?r(?:s|ed|ing)?|"
+        r"in favou?r of|toward|towards|push(?:es|ed|ing)? (?:\w+ )?up|pull(?:s|ed|ing)? (?:\w+ )?up|"
+        r"nudg\w* (?:\w+ )?up|drives?|driven by|driving|tipped|tips|argu\w* for|counted for|counts for|"
+        r"positive(?:ly)?|more likely|higher|up by")
+_NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ )?down|"
+        r"push(?:es|ed|ing)? (?:\w+ )?down|nudg\w* (?:\w+ )?down|subtract\w*|tak(?:es|ing|e) (?:\w+ )?(?:off|away)|"
+        r"took (?:\w+ )?(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos\w*|negative(?:ly)?|less likely|"
+        r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
+        r"los(?:t|ing)|diminish\w*|penali[sz]\w*")
+DIRECTION_RE = re.compile(rf"\b(?:(?P<pos>{_POS})|(?P<neg>{_NEG}))\b", re.IGNORECASE)
+_NEGATION = re.compile(r"\b(not|n't|never|no longer|neither|nor)\b[^.]{0,12}$", re.IGNORECASE)
+_OUTPUT_WORDS = re.compile(r"^\W*(?:the\s+)?(?:model's\s+|predicted\s+|estimated\s+)?(price|prediction|estimate|risk|"
+                           r"probability|valuation|value|output|score|chance)", re.IGNORECASE)
+
+_ORD = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4, "fifth": 5}
+_COUNT = {"two": 2, "three": 3, "four": 4, "five": 5, "2": 2, "3": 3, "4": 4, "5": 5}
+_NOUN = r"(?:features?|factors?|drivers?|reasons?|contributors?|contributions?|influences?|inputs?|effects?|" \
+        r"positives?|negatives?|boosts?|push(?:es)?|arguments?|concerns?|variables?|predictors?|attributions?|story)"
+_TOPWORD = r"(?:most important|most influential|most significant|most decisive|biggest|largest|strongest|main|top|" \
+           r"primary|key|dominant|leading|greatest|decisive|single biggest|single largest|one big|big)"
+RANK_RE = re.compile(
+    rf"\b(?:(?P<ord>second|third|fourth|fifth|2nd|3rd|4th)(?: most important| most influential| biggest| largest|"
+    rf" strongest)?\s+(?:single\s+)?{_NOUN}"
+    rf"|(?P<because>(?:mostly|mainly|chiefly|largely|primarily) (?:because of|due to|thanks to|on))"
+    rf"|(?:the\s+)?(?P<plural>(?:two|three|four|2|3|4)\s+(?:most important|largest|biggest|strongest|main)|"
+    rf"(?:top|the)[\s-]+(?P<k>two|three|four|2|3|4)(?:\s+most important|\s+largest|\s+biggest)?)\s+{_NOUN}"
+    rf"|(?P<top>{_TOPWORD})(?:\s+single)?\s+(?:risk\s+)?(?P<noun>{_NOUN})"
+    rf"|(?:mattered|matters|counted|counts|weighed) most|dominat\w+|ranks? (?P<rk>first|second|third)"
+    rf"|top[\s-](?P<topk>\d)\b)", re.IGNORECASE)
+_AFTER_ORD = re.compile(r"^\W{0,3}(?:[a-z]+\s+)?(?:was\s+|is\s+|came\s+|a\s+(?:distant|close)\s+)?(?P<o>second|third|fourth)\b",
+                        re.IGNORECASE)
+_FOLLOWED = re.compile(r"\b(?:followed(?: closely)? by|then|next(?: came| was)?|after that|ahead of|second only to)\s*$",
+                       re.IGNORECASE)
+MINOR_RE = re.compile(r"\b(?:barely|hardly|scarcely)\s+(?:\w+\s+)?(?:matter\w*|mov\w*|regist\w*|chang\w*|affect\w*|"
+                      r"counts?|counted)|\b(?:no real|almost no|essentially no|next to no|practically no|virtually no|"
+                      r"little|negligible|minimal|no)\s+(?:\w+\s+)?(?:effect|influence|impact|role|difference)\b|"
+                      r"\bnegligible\b", re.IGNORECASE)
+MINOR_SHARE = 10.0  # % of the sum of |contributions| below which 'barely matters' holds
+
+
+def _keys_of(m: Mention) -> tuple[str, ...]:
+    return m.keys if m.kind in ("feature", "label") else ()
+
+
+def _over_keys(keys: tuple[str, ...], test, what: str, text: str, kind: str) -> Claim:
+    """A claim about a mention that may mean several features: verified when it holds for all of them,
+    contradicted when for none, else unchecked (ambiguous)."""
+    results = [test(k) for k in keys]
+    known = [r for r in results if r is not None]
+    if not known:
+        return Claim(kind, text, "unchecked", f"nothing known to check it against ({what})")
+    if all(r[0] for r in known) and len(known) == len(results):
+        return Claim(kind, text, "verified", known[0][1])
+    if not any(r[0] for r in known):
+        return Claim(kind, text, "contradicted", known[0][1])
+    return Claim(kind, text, "unchecked", f"ambiguous: it may mean {', '.join(keys)}")
+
+
+# -- actions ---------------------------------------------------------------------------------------------------
+_CHOICE_BEFORE = re.compile(r"\b(chose|chooses|choose|picked|picks|selected|selects|decided on|decided to|decides to|"
+                            r"preferred|prefers|opted for|opted to|went for|goes for)\s+(?:to\s+)?$", re.IGNORECASE)
+_CHOICE_AFTER = re.compile(r"^\W{0,3}(?:\([^)]*\)\s*)?(?:was|is|got)?\s*(?:chosen|picked|selected|preferred|the choice)\b|"
+                           r"^\W{0,3}(?:\([^)]*\)\s*)?(?:narrowly\s+|clearly\s+)?(?:won|wins|beat|beats|edged out|"
+                           r"prevailed|came out ahead)\b", re.IGNORECASE)
+_RUNNER_AFTER = re.compile(r"^\W{0,3}(?:\([^)]*\)\s*)?(?:came|was|is|as)?\s*(?:the\s+|a\s+)?(?:close\s+|distant\s+)?"
+                           r"(?:second|runner.up)\b", re.IGNORECASE)
+
+
+def resolve_action(m: Mention, book: FactBook) -> str | None:
+    """The action a mention means: itself, or for a head word shared by several actions the chosen (else the
+    runner-up) one among them."""
+    if len(m.keys) == 1:
+        return m.keys[0]
+    for a in (book.chosen, book.runner_up):
+        if a in m.keys:
+            return a
+    return None
+
+
+def check_action(sentence: str, m: Mention, book: FactBook) -> Claim | None:
+    """A named action: a statement of what was chosen ('chose X', 'X was chosen', 'it recharged', 'X won') must name
+    the chosen action; 'X came second' the runner-up. A plain mention asserts nothing."""
+    text = sentence[m.start:m.end]
+    if book.global_view or book.output != "actions":
+        return None
+    a = resolve_action(m, book)
+    choice = m.form == "past" or bool(_CHOICE_BEFORE.search(sentence[:m.start])) or bool(
+        _CHOICE_AFTER.match(sentence[m.end:]))
+    if _RUNNER_AFTER.match(sentence[m.end:]) and not choice:
+        ok = a is not None and a == book.runner_up
+        return Claim("action", text, "verified" if ok else "contradicted",
+                     f"the runner-up was {book.runner_up}")
+    if choice:
+        if re.search(r"\b(not|n't|instead of|rather than|over)\s*$", sentence[:m.start], re.IGNORECASE):
+            return None
+        ok = a == book.chosen
+        return Claim("action", text, "verified" if ok else "contradicted",
+                     "the chosen action" if ok else f"the policy chose {book.chosen}, not {a or ' / '.join(m.keys)}")
+    return None
+
+
+# -- categorical values ------------------------------------------------------------------------------------------
+def check_label(sentence: str, m: Mention, book: FactBook) -> Claim | None:
+    """A categorical value named ('in CollgCr', 'odor: foul', 'self-employed') must be the state's value."""
+    if re.search(r"\b(not|no|non|rather than|instead of|unlike|than)\W*$", sentence[:m.start], re.IGNORECASE):
+        return None
+    f = m.keys[0]
+    actual = book.features[f].label
+    if actual is None:
+        return None
+    text = sentence[m.start:m.end]
+    ok = actual.lower() == m.label.lower()
+    return Claim("category", text, "verified" if ok else "contradicted",
+                 f"{f} is {actual}" if ok else f"{f} is {actual}, not {m.label}")
+
+
+# -- numbers -----------------------------------------------------------------------------------------------------
+_CONTRIB_BEFORE = re.compile(
+    r"(?:\bby|\badds?|\badded|\badding|contribut\w*|\bworth|\bcosts?|\bcosting|subtract\w*|\boff|\baway|\bcut\w*|"
+    r"knock\w*|lifts?|lower\w*|rais\w*|reduc\w*|increas\w*|decreas\w*|shap(?: value)?(?: of| is| was|:|=)?|"
+    r"contribution(?: of| was| is|:)?|attributions?:?|phi\([^)]*\)\s*=|\|φ\|:?|impact of|effect of|push\w*|"
+    r"another|\banother|drops?|takes|took|loses|gains?|\bby a margin of|\|shap\|:?|"
+    r"edge of|favou?red \w+ by|for \w+ by|\bdown|\bup)\s*(?:\(|about|around|roughly|nearly|almost|"
+    r"approximately|some|only|just|a further|another|over|under)?\s*[+\-]?[$€£]?\s*$", re.IGNORECASE)
+_MARGIN_BEFORE = re.compile(r"\b(margin|lead|edge|gap|advantage|difference)(?: of)?\W*(?:about|around|roughly|only|"
+                            r"just)?\s*$|\b(won|wins|beat\w*|ahead|stayed ahead|led)\s+(?:\w+\s+){0,3}by\s+(?:about|"
+                            r"around|roughly|only|just)?\s*$", re.IGNORECASE)
+_MARGIN_AFTER = re.compile(r"^\s*(?:points?\s+)?(?:above|ahead|higher|more than)\b", re.IGNORECASE)
+_RUNNER_BEFORE = re.compile(r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?[$€£]?\s*$", re.IGNORECASE)
+_SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
+_BASE_AFTER = re.compile(r"^\s*(?:\w+\s+)?(baseline|base value|average|typical|expected|mean)\b", re.IGNORECASE)
+_BASE_WORDS = re.compile(r"\b(baseline|base value|base|average|typical|expected value|mean|on average)\b", re.IGNORECASE)
+_OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability|chance|risk|price|output|final)\b",
+                        re.IGNORECASE)
+_SKIP_AFTER = re.compile(r"^\s*(background|samples?|rows?|states?|draws|features|narratives|coalitions)\b",
+                         re.IGNORECASE)
+_LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state)[\s-]*$", re.IGNORECASE)
+_CHANGE_AFTER = re.compile(r"^\s*(?:\w+\s+){0,2}(above|below|under|over|more|less)\s+(the\s+)?(average|baseline|base|"
+                           r"typical|expected|mean)", re.IGNORECASE)
+_COMPARE_AFTER = re.compile(r"^\s*(?:dB|dBm)?\s*(above|below|stronger|weaker|better|worse|higher|lower|more|less)\b",
+                            re.IGNORECASE)
+
+
+def skip_number(n: Number, masked: str) -> bool:
+    """Numbers that are not claims: list markers ('1.' at a line start), identifiers ('candidate 2', 'top-3'),
+    counts of the method's inputs ('100 background rows')."""
+    before = masked[:n.start]
+    if re.search(r"(^|\n)\s*$", before) and re.match(r"^[.)]\s", masked[n.end:n.end + 2]):
+        return True
+    if re.match(r"^\s+(?:most|largest|biggest|main|top|strongest|key)\b", masked[n.end:]):  # 'the two largest'
+        return True
+    if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):
+        return True  # all three
+    return bool(_LABEL_BEFORE.search(before)) or bool(_SKIP_AFTER.match(masked[n.end:]))
+
+
+def _percent_readings(n: Number, v: float) -> bool:
+    return abs(v) <= 1.0 and matches(Number(n.start, n.end, n.text, n.value, n.unit, n.sign, n.hedge), 100 * v)
+
+
+def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook, ctx: str | None,
+                   unit_of) -> Claim:
+    """A number tied to a feature: its value, its contribution (in the sentence's context, or any context when the
+    sentence does not say), its share, or a percentage of a probability-like contribution. Cue words before it
+    ('by', 'adds', 'SHAP value of') say it is a contribution; the feature's unit after it that it is a value."""
+    before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 16]
+    contrib_cue = bool(_CONTRIB_BEFORE.search(before))
+    contexts = (ctx or "chosen",)  # a number not said to be about the margin is about the chosen action's score
+
+    def test(key):
+        e = book.features[key]
+        unit = unit_of(key).lower()
+        value_cue = bool(unit) and after.strip().lower().startswith(unit.split()[0]) and not contrib_cue
+        cands = []
+        if not contrib_cue and e.value is not None:
+            cands.append(("value", e.value))
+        if not value_cue:
+            cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
+        for what, v in cands:
+            if matches(n, v) or (n.percent and _percent_readings(n, v)):
+                return True, f"{key}: {what}"
+        if n.percent and any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
+            return True, f"{key}: share"
+        shown = ", ".join(f"{w} {v:.4g}" for w, v in cands)
+        return False, f"{n.text} is not {key}'s {shown or 'value'}"
+
+    claim = _over_keys(keys, test, "feature", n.text, "number")
+    if claim.status == "contradicted" and comparison(n, after, book):
+        return Claim("number", n.text, "verified", "a domain comparison in its unit")
+    return claim
+
+
+def comparison(n: Number, after: str, book: FactBook) -> bool:
+    unit = re.match(r"\s*([A-Za-z]+)", after)
+    values = book.by_unit.get(unit.group(1).lower(), []) if unit else []
+    return any(matches(n, v) for v in values)
+
+
+def action_number(n: Number, action: str | None, masked: str, book: FactBook) -> Claim:
+    """A number next to an action: its score, or the margin when the words say so ('won by', 'a lead of')."""
+    before = masked[max(0, n.start - 40):n.start]
+    if _MARGIN_BEFORE.search(before) and book.margin is not None:
+        ok = matches(n, book.margin)
+        return Claim("number", n.text, "verified" if ok else "contradicted", f"the margin is {book.margin:.4g}")
+    if action is None or action not in book.scores:
+        return Claim("number", n.text, "unchecked", "an action that could not be told apart")
+    ok = matches(n, book.scores[action], magnitude_ok=False)
+    return Claim("number", n.text, "verified" if ok else "contradicted", f"{action}'s score is "
+                 f"{book.scores[action]:.4g}")
+
+
+def free_number(n: Number, masked: str, book: FactBook) -> Claim:
+    """A number tied to no name: a decision-level quantity when the words around it name one (margin, runner-up
+    score, prediction, baseline, change from the baseline, a domain comparison in its unit), else any decision-level
+    fact or, when it is a contribution, the one feature whose contribution it is."""
+    before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 30]
+    named = None
+    if _MARGIN_BEFORE.search(before) or _MARGIN_AFTER.match(after):
+        named = ("the margin", [book.margin] if book.margin is not None else [])
+    elif _CHANGE_AFTER.match(after) and book.base is not None:
+        change = book.scores[book.chosen] - book.base
+        ok = matches(n, change) or (n.percent and _percent_readings(n, abs(change)))
+        return Claim("number", n.text, "verified" if ok else "contradicted", f"the change from the baseline is "
+                     f"{change:.4g}")
+    elif (_SCORE_BEFORE.search(before) or re.match(r"^\s*(vs\.?|versus)\s", after)) and book.chosen in book.scores:
+        named = ("the chosen action's score", [book.scores[book.chosen]])
+    elif _RUNNER_BEFORE.search(before) and book.runner_up:
+        named = ("the runner-up's score", [book.scores[book.runner_up]])
+    elif _COMPARE_AFTER.match(after) and book.by_unit:
+        named = ("a comparison", [v for vs in book.by_unit.values() for v in vs])
+    elif _CONTRIB_BEFORE.search(before) and _owner(n, book):
+        return Claim("number", n.text, "verified", f"{_owner(n, book)}'s contribution (the only one it matches)")
+    elif book.output != "actions" and not book.global_view:
+        if _BASE_WORDS.search(before[-12:]) or _BASE_AFTER.match(after):
+            named = ("the baseline", [book.base])
+        elif _OUT_WORDS.search(before):
+            named = ("the prediction", [book.scores[book.chosen]])
+    if named is not None and named[1]:
+        ok = any(matches(n, v, magnitude_ok=False) or (n.percent and _percent_readings(n, v)) for v in named[1])
+        return Claim("number", n.text, "verified" if ok else "contradicted", f"{named[0]} is {named[1][0]:.4g}")
+    if any(matches(n, v) or (n.percent and _percent_readings(n, v)) for v in book.decision_numbers):
+        return Claim("number", n.text, "verified", "a decision-level fact")
+    return Claim("number", n.text, "unchecked", "tied to no feature or quantity of this explanation")
+
+
+def _owner(n: Number, book: FactBook) -> str | None:
+    """The one feature whose contribution (in any view) the number states, if exactly one."""
+    owners = [f for f, e in book.features.items()
+              if any(matches(n, c) or (n.percent and _percent_readings(n, c)) for c in e.contribs.values())]
+    return owners[0] if len(owners) == 1 else None
+
+
+# -- directions --------------------------------------------------------------------------------------------------
+def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: FactBook, ctx: str | None
+                     ) -> tuple[int, str]:
+    """(polarity, context) of a direction word: toward the runner-up ('favoured forward', 'argued for staying')
+    means against the chosen action in the margin."""
+    polarity = 1 if m.group("pos") else -1
+    if _NEGATION.search(masked[max(0, m.start() - 30):m.start()]):
+        polarity = -polarity
+    obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() <= 16), None)
+    if obj is not None and book.runner_up:
+        a = resolve_action(obj, book)
+        if a == book.runner_up:
+            return -polarity, "margin"
+        if a == book.chosen:
+            return polarity, ctx or "chosen"
+    return polarity, ctx or "chosen"
+
+
+def is_frame(masked: str, m: re.Match) -> bool:
+    """'against' that compares ('7.53 against 7.38', 'Against recharge, ...', 'against that') is not a direction."""
+    word = m.group(0).lower()
+    after = masked[m.end():m.end() + 30]
+    if word in ("against", "higher", "up by", "down by") and re.match(r"^\s*(?:a\s+|an\s+|the\s+)?[$€£]?[+\-]?\s*[\d.]", after):
+        return word == "against" or word == "higher"
+    if word == "against" and (re.search(r"(^|[.;:\n]\s*)$", masked[:m.start()]) or re.match(r"^\s*(that|this)\b", after)):
+        return True
+    return word in ("higher",)
+
+
+def check_direction(subjects: list[Mention], polarity: int, ctx: str, word: str, book: FactBook) -> list[Claim]:
+    out = []
+    for s in subjects:
+        def test(key, s=s):
+            c = book.features[key].contribs.get(ctx if ctx in book.features[key].contribs else "chosen")
+            if c is None or c == 0:
+                return None
+            return (np.sign(c) == polarity, f"{key}'s contribution ({ctx}) is {c:+.3g}")
+        out.append(_over_keys(_keys_of(s), test, ctx, word, "direction"))
+    return out
+
+
+# -- ranks and magnitude ------------------------------------------------------------------------------------------
+def rank_claim(m: re.Match, masked: str) -> tuple[int, bool, int]:
+    """(rank or top-k, plural, sign restriction) a rank phrase states."""
+    text = m.group(0).lower()
+    sign = 1 if re.search(r"positive|boost|plus|argument for|push", text) else \
+        -1 if re.search(r"negative|drag|minus", text) else 0
+    if m.group("ord"):
+        return _ORD[m.group("ord").lower()], False, sign
+    if m.group("because"):
+        return 1, False, 0
+    if m.group("rk"):
+        return _ORD[m.group("rk").lower()], False, sign
+    if m.group("topk"):
+        return int(m.group("topk")), True, sign
+    if m.group("plural") or m.group("k"):
+        k = next((v for w, v in _COUNT.items() if re.search(rf"\b{w}\b", text)), 0)
+        return k, True, sign
+    if m.group("noun") and m.group("noun").lower().endswith("s") and m.group("noun").lower() != "story":
+        return 0, True, sign
+    return 1, False, sign
+
+
+def check_rank(keys: tuple[str, ...], rank: int, plural_k: int | None, sign: int, ctx: str | None, book: FactBook,
+               text: str) -> Claim:
+    contexts = (ctx,) if ctx else book.contexts
+
+    def test(key):
+        e = book.features[key]
+        for c in contexts:
+            if c not in e.ranks:
+                continue
+            actual = e.signed_ranks[c] if sign and np.sign(e.contribs.get(c, 0)) == sign else e.ranks[c]
+            if sign and np.sign(e.contribs.get(c, 0)) != sign:
+                continue
+            if (plural_k is not None and actual <= plural_k) or (plural_k is None and actual == rank):
+                return True, f"{key} ranks {actual} ({c})"
+        shown = ", ".join(f"{e.ranks[c]} ({c})" for c in contexts if c in e.ranks)
+        return False, f"{key} ranks {shown}"
+
+    return _over_keys(keys, test, "rank", text, "rank")
+
+
+def check_minor(keys: tuple[str, ...], ctx: str | None, book: FactBook, text: str) -> Claim:
+    contexts = (ctx,) if ctx else book.contexts
+
+    def test(key):
+        shares = [book.features[key].shares[c] for c in contexts if c in book.features[key].shares]
+        if not shares:
+            return None
+        return min(shares) < MINOR_SHARE, f"{key} has {min(shares):.1f} % of the total |contribution|"
+
+    return _over_keys(keys, test, "magnitude", text, "magnitude")

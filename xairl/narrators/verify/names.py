@@ -1,0 +1,183 @@
+"""Where a text names a feature, an action or a categorical value.
+
+A feature is recognised by its name in any spelling (``gill_size``, "gill-size", "gill size", "GillSize"), its
+description, its aliases, and by any run of their words that belongs to that feature alone ("kitchen" for
+``kitchen_quality``). A run shared by several features ("quality" for ``overall_quality`` and ``kitchen_quality``)
+is an *ambiguous* mention: a claim about it counts only when it holds, or fails, for every feature it may mean.
+Actions are recognised by name, alias and verb forms ("recharged", "handing over to candidate 1"); a head word shared
+by several actions ("handover") means the chosen or runner-up one among them. Categorical values are recognised by
+their labels ("CollgCr", "self-employed" and "self-employment"); labels of one or two letters only next to their
+feature's name.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ...explanation import Explanation
+from ...policy import Policy
+
+STOP = {"the", "a", "an", "of", "in", "on", "to", "for", "and", "or", "s", "its", "it", "by", "with", "at", "from",
+        "per", "than", "is", "as", "out", "above", "below", "over", "under", "after", "before", "between", "within",
+        "into", "onto", "about"}
+#: words too generic to name a feature on their own
+GENERIC = {"size", "area", "number", "total", "rate", "ratio", "level", "value", "values", "score", "type", "years",
+           "year", "feature", "count", "amount", "length", "time", "state", "status", "quality", "id", "feet",
+           "square", "sq", "ft", "kb", "m", "db", "dbm", "bit", "bits", "percent", "one", "two", "model", "data",
+           "information", "prediction", "new", "old", "high", "low", "first", "second", "third", "average"}
+_IRREGULAR = {"keep": "kept", "go": "went", "choose": "chose", "hold": "held", "run": "ran", "stay": "stayed"}
+
+
+@dataclass(frozen=True)
+class Mention:
+    """A span naming something: kind 'feature', 'action' or 'label'; ``keys`` the features or actions it may mean
+    (several: ambiguous); ``label`` the categorical value named (kind 'label'); ``form`` 'past' for a verb in the
+    past tense ("recharged": a statement of what was chosen)."""
+
+    start: int
+    end: int
+    kind: str
+    keys: tuple[str, ...]
+    label: str = ""
+    form: str = ""
+
+
+def split_words(name: str) -> list[str]:
+    """'GillSize' / 'gill_size' / 'gill-size' / 'rsrp_1' -> ['gill', 'size'] / ... / ['rsrp', '1']."""
+    spaced = re.sub(r"(?<=[a-z0-9])(?=[A-Z])|[_\-./]+", " ", name)
+    return re.findall(r"[a-z0-9]+", spaced.lower())
+
+
+def stem(word: str) -> str:
+    """A crude English stem, enough for labels ('renting' -> 'rent', 'self-employment' -> 'self employ'); a word
+    left whole is returned as is."""
+    w = word.lower()
+    for suffix in ("ment", "ing", "ed", "es", "s", "e"):
+        if w.endswith(suffix) and not w.endswith("ss") and len(w) - len(suffix) >= 4:
+            return w[: -len(suffix)] + "~"
+    return w
+
+
+@dataclass
+class Vocabulary:
+    """Every surface of an explanation's names, longest first: (regex, kind, keys, label, form)."""
+
+    entries: list[tuple[re.Pattern, str, tuple[str, ...], str, str]]
+    short_labels: dict[str, list[tuple[str, str]]]  # feature -> [(label, label)] of 1-2 characters
+
+
+def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
+    phrases: dict[str, set[str]] = {}
+    exact: dict[str, set[str]] = {}
+    for f in exp.feature_names:
+        info = policy.features.get(f) if policy else None
+        forms = [f, " ".join(split_words(f))] + ([info.description, *info.aliases] if info else [])
+        for form in forms:
+            if form and clean(form):
+                exact.setdefault(_phrase(form), set()).add(f)
+        for form in [f] + ([info.description] if info and info.description else []):
+            if not clean(form):
+                continue
+            owners = set(re.findall(r"(\w+)'s\b", form.lower()))  # 'the applicant's age': not 'applicant'
+            words = [w for w in split_words(form) if w not in STOP]
+            for i in range(len(words)):
+                for j in range(i + 1, len(words) + 1):
+                    run = words[i:j]
+                    if len(run) == 1 and (run[0] in GENERIC or len(run[0]) < 3 or run[0].isdigit() or (
+                            form != f and (run[0] in owners or len(run[0]) < 5) and run[0] not in split_words(f))):
+                        continue
+                    phrases.setdefault(" ".join(run), set()).add(f)
+    entries = []
+    for phrase, keys in {**phrases, **exact}.items():
+        keys = exact.get(phrase, keys)
+        entries.append((phrase, "feature", tuple(sorted(keys)), "", ""))
+    entries += _action_entries(exp, policy, clean)
+    short: dict[str, list[tuple[str, str]]] = {}
+    for f, labels in (exp.categories or {}).items():
+        for label in labels:
+            if len(label) <= 2:
+                short.setdefault(f, []).append((label, label))
+            elif clean(label):
+                entries.append((" ".join(stem(w) for w in split_words(label)), "label", (f,), label, ""))
+    entries.sort(key=lambda e: -len(e[0]))
+    return Vocabulary([(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries], short)
+
+
+def _phrase(text: str) -> str:
+    return " ".join(w for w in re.findall(r"[a-z0-9']+", re.sub(r"(?<=[a-z0-9])(?=[A-Z])|[_\-]+", " ", text).lower())
+                    if w != "the") if text else ""
+
+
+def _pattern(phrase: str, kind: str) -> re.Pattern:
+    """Words in order, separated by spaces, hyphens, underscores or nothing; plural 's' and possessive allowed."""
+    parts = [re.escape(w) for w in phrase.split()]
+    if kind == "label":  # a stem ('~') takes any ending, a whole word a plural
+        body = r"[\s_\-]*".join(p.replace("\\~", "").replace("~", "") + "[a-z]*" if "~" in p else p + "(?:s|es|ing|ed|er|ers)?"
+                                  for p in parts)
+    else:
+        body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+)?|)".join(parts) + r"(?:s|es)?(?:'s|')?\)?"
+    return re.compile(rf"(?<![\w]){body}(?![\w])", re.IGNORECASE)
+
+
+def _inflect(head: str) -> list[tuple[str, str]]:
+    """(surface, form) for an action's head phrase: itself, and the verb forms of its first word."""
+    first, _, rest = head.partition(" ")
+    rest = f" {rest}" if rest else ""
+    base = first[:-1] if first.endswith("e") else first
+    out = [(head, ""), (f"{first}s{rest}", ""), (f"{base}ing{rest}", "")]
+    past = _IRREGULAR.get(first, f"{base}ed")
+    out.append((f"{past}{rest}", "past"))
+    if first == "stay":
+        out.append((f"stayed{rest}", "past"))
+    if first.endswith("over") and len(first) > 4:  # handover -> hand over
+        out += _inflect(f"{first[:-4]} over{rest}")
+    return out
+
+
+def _action_entries(exp: Explanation, policy: Policy | None, clean) -> list:
+    heads: dict[str, set[str]] = {}
+    full: list[tuple[str, str, str]] = []
+    for a in exp.action_names:
+        forms = {a, " ".join(split_words(a)), *(policy.action_aliases.get(a, ()) if policy else ())}
+        for form in forms:
+            if not form or not clean(form):
+                continue
+            phrase = re.sub(r"^(a|an|the)\s+", "", _phrase(form))
+            words = phrase.split()
+            for surface, kind in _inflect(phrase):
+                full.append((surface, a, kind))
+            for extra in (f"go {phrase}", f"goes {phrase}", f"going {phrase}"):
+                full.append((extra, a, ""))
+            full.append((f"went {phrase}", a, "past"))
+            cut = next((i for i, w in enumerate(words) if w == "to" or any(c.isdigit() for c in w)), len(words))
+            if 0 < cut < len(words):
+                heads.setdefault(" ".join(words[:cut]), set()).add(a)
+    out = [(s, "action", (a,), "", form) for s, a, form in full]
+    for head, acts in heads.items():
+        if len(acts) > 1:
+            for surface, form in _inflect(head):
+                out.append((surface, "action", tuple(sorted(acts)), "", form))
+    return out
+
+
+def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
+    """Mentions in ``text`` (longest surface first, no overlaps) and the text with them masked by NUL characters,
+    so that digits inside names ('rsrp_1', 'candidate 2') are not read as numbers."""
+    taken = bytearray(len(text))
+    found: list[Mention] = []
+    for pattern, kind, keys, label, form in vocab.entries:
+        for m in pattern.finditer(text):
+            if not any(taken[m.start():m.end()]):
+                found.append(Mention(m.start(), m.end(), kind, keys, label, form))
+                taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
+    features = [m for m in found if m.kind == "feature"]
+    for f, labels in vocab.short_labels.items():  # 'Y', 'Ex': only right next to their feature
+        near = [m for m in features if f in m.keys]
+        for label, _ in labels:
+            for m in re.finditer(rf"(?<![\w]){re.escape(label)}(?![\w])", text):
+                if any(abs(m.start() - n.end) <= 14 or abs(n.start - m.end()) <= 14 for n in near) \
+                        and not any(taken[m.start():m.end()]):
+                    found.append(Mention(m.start(), m.end(), "label", (f,), label))
+                    taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
+    masked = "".join("\0" if t else ch for ch, t in zip(text, taken))
+    return sorted(found, key=lambda m: m.start), masked

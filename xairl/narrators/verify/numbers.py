@@ -1,0 +1,154 @@
+"""Numbers as people write them: thousands separators, currency, a leading dot, k/M suffixes, percentages and
+points, fractions, scientific notation, Unicode minus, number words, and the hedge words before them.
+
+A :class:`Number` knows what it may stand for (``value`` and ``alternatives``) and how precisely it was written
+(``unit``, one step of its last written digit). :func:`matches` compares it with a fact:
+
+- written plainly: equal after rounding to the written digits, or truncated to them ("6,157" for 6157.86);
+- with a symmetric hedge ("about", "around", "roughly", "approximately", "~", "some", "close to"): within 20 % of the
+  fact, or equal after rounding;
+- "nearly", "almost", "just under", "a bit under": the fact is at most the number and within 20 % of it;
+  "just over", "a little over": at least the number and within 20 %;
+- bounds ("less than", "under", "at most", "more than", "over", "at least"): the fact's magnitude is on that side.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+HEDGE_TOLERANCE = 0.2  # how far a hedged number may be from the fact, relative to the fact
+
+_APPROX = ("about", "around", "roughly", "approximately", "approx.", "approx", "~", "some", "close to", "circa",
+           "ca.", "an estimated", "on the order of")
+_BELOW = ("nearly", "almost", "just under", "a bit under", "a little under", "slightly under", "just shy of",
+          "a bit less than", "slightly less than", "a little less than")
+_ABOVE = ("just over", "a little over", "a bit over", "slightly over", "slightly more than", "a bit more than",
+          "a little more than", "just above")
+_AT_MOST = ("less than", "under", "at most", "up to", "no more than", "below")
+_AT_LEAST = ("more than", "over", "at least", "no less than", "upwards of")
+HEDGES = {**{h: "approx" for h in _APPROX}, **{h: "below" for h in _BELOW}, **{h: "above" for h in _ABOVE},
+          **{h: "at_most" for h in _AT_MOST}, **{h: "at_least" for h in _AT_LEAST}}
+_HEDGE_RE = re.compile(r"(?:^|[\s(])(" + "|".join(sorted(map(re.escape, HEDGES), key=len, reverse=True))
+                       + r")\s*[+\-]?[$€£]?\s*$", re.IGNORECASE)
+
+_NUM_RE = re.compile(
+    r"(?<![\w.,])(?P<sign>[+\-])?\s?(?P<cur>[$€£])?\s?"
+    r"(?P<num>\d{1,3}(?:,\d{3})+(?:\.\d+)?|\d+(?:\.\d+)?|\.\d+)(?!\.\d)(?![\d,]\d)"
+    r"(?P<exp>[eE][+\-]?\d+)?(?!st\b|nd\b|rd\b|th\b)"
+    r"(?:\s?(?P<suffix>k|K|M|bn)\b)?"
+    r"(?P<den>/\d+(?:\.\d+)?)?"
+    r"(?P<pct>\s?(?:%|percent\b|per cent\b|percentage points?\b|pp\b|points?\b))?")
+
+_WORDS = {"zero": 0, "one": 1, "two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8,
+          "nine": 9, "ten": 10, "eleven": 11, "twelve": 12, "thirteen": 13, "fourteen": 14, "fifteen": 15,
+          "sixteen": 16, "seventeen": 17, "eighteen": 18, "nineteen": 19, "twenty": 20, "thirty": 30, "forty": 40,
+          "fifty": 50, "sixty": 60, "seventy": 70, "eighty": 80, "ninety": 90}
+_SCALES = {"hundred": 100, "thousand": 1000, "million": 1_000_000}
+_WORD_RE = re.compile(r"\b(" + "|".join(_WORDS) + r")(?:[\s-](" + "|".join(_WORDS) + r"))?"
+                      r"(?:\s(" + "|".join(_SCALES) + r"))?\b(?P<pct>\s(?:percent\b|percentage points?\b|points?\b))?",
+                      re.IGNORECASE)
+
+#: what the old single regex found; kept for :mod:`xairl.testing`, which mutates template numbers
+NUMBER_RE = re.compile(r"(?<![\w.])([+\-\u2212]?\d+(?:\.\d+)?)(\s*%)?")
+
+
+@dataclass(frozen=True)
+class Number:
+    """One number in a text.
+
+    :param value: what it says (a percentage as written: 43 for "43%"); ``alternatives`` other readings ("3/10"
+        is 3 or 0.3). ``unit``: one step of its last written digit (0.01 for "0.07", 1000 for "12,000" and "12k").
+    :param sign: '+', '-' or '' as written; ``hedge`` the kind of hedge before it (approx/below/above/at_most/
+        at_least) or ''; ``percent`` whether it is a percentage or percentage points.
+    """
+
+    start: int
+    end: int
+    text: str
+    value: float
+    unit: float
+    sign: str = ""
+    hedge: str = ""
+    percent: bool = False
+    currency: str = ""
+    alternatives: tuple[float, ...] = ()
+
+    @property
+    def readings(self) -> tuple[float, ...]:
+        return (self.value, *self.alternatives)
+
+
+def normalise(text: str) -> str:
+    """One spelling of minus signs, spaces and apostrophes (same length, so positions stay valid)."""
+    table = str.maketrans({"\u2212": "-", "\u2012": "-", "\u00a0": " ", "\u202f": " ", "\u2009": " ",
+                           "\u2019": "'", "\u2018": "'"})
+    return text.translate(table)
+
+
+def _step(digits: str, decimals: int) -> float:
+    if decimals:
+        return 10.0 ** -decimals
+    stripped = digits.rstrip("0")
+    return 10.0 ** (len(digits) - len(stripped)) if stripped else 1.0
+
+
+def find_numbers(text: str) -> list[Number]:
+    """Every number in ``text`` (already :func:`normalise`\\ d), digits and number words, left to right."""
+    out = []
+    for m in _NUM_RE.finditer(text):
+        raw = m.group("num")
+        digits = raw.replace(",", "")
+        decimals = len(digits.split(".")[1]) if "." in digits else 0
+        value = float(digits + (m.group("exp") or ""))
+        unit = _step(digits.split(".")[0] if not decimals else digits, decimals)
+        if m.group("exp"):
+            unit *= 10.0 ** int(m.group("exp")[1:])
+        scale = {"k": 1e3, "K": 1e3, "M": 1e6, "bn": 1e9}.get(m.group("suffix") or "", 1.0)
+        value, unit = value * scale, unit * scale
+        alts = ()
+        if m.group("den"):
+            den = float(m.group("den")[1:])
+            if den:
+                alts = (value / den,)
+        sign = (m.group("sign") or "")
+        out.append(Number(m.start(), m.end(), m.group(0).strip(), -value if sign == "-" else value, unit, sign,
+                          _hedge(text[:m.start()]), bool(m.group("pct")), m.group("cur") or "", alts))
+    for m in _WORD_RE.finditer(text):
+        value = _WORDS[m.group(1).lower()] + (_WORDS[m.group(2).lower()] if m.group(2) else 0)
+        scale = _SCALES[m.group(3).lower()] if m.group(3) else 1
+        out.append(Number(m.start(), m.end(), m.group(0), float(value * scale), float(scale),
+                          hedge=_hedge(text[:m.start()]), percent=bool(m.group("pct"))))
+    return sorted(out, key=lambda n: n.start)
+
+
+def _hedge(before: str) -> str:
+    m = _HEDGE_RE.search(before[-30:])
+    return HEDGES[m.group(1).lower()] if m else ""
+
+
+def matches(n: Number, fact: float, magnitude_ok: bool = True) -> bool:
+    """Does ``n`` state ``fact``? ``magnitude_ok``: an unsigned number may state a negative fact's size ("lowered
+    it by 0.4"). A written sign must agree with the fact's."""
+    if n.sign and (fact < 0) != (n.sign == "-") and fact != 0:
+        return False
+    return any(_close(abs(x) if not n.sign else x, fact if n.sign else (abs(fact) if magnitude_ok else fact),
+                      n.unit if x == n.value else n.unit / max(abs(n.value), 1e-12) * abs(x), n.hedge)
+               for x in n.readings)
+
+
+def _close(x: float, fact: float, step: float, hedge: str) -> bool:
+    rounding = 0.55 * step + 1e-9 + 1e-6 * abs(fact)  # 0.55: rounded from an already rounded display
+    exact = abs(x - fact) <= rounding or (abs(x) <= abs(fact) < abs(x) + step and x * fact >= 0)
+    if not hedge:
+        return exact
+    near = exact or abs(x - fact) <= HEDGE_TOLERANCE * abs(fact)
+    a, b = abs(fact), abs(x)
+    if hedge == "approx":
+        return near
+    if hedge == "below":
+        return near and a <= b + rounding
+    if hedge == "above":
+        return near and a >= b - rounding
+    if hedge == "at_most":
+        return a <= b + rounding
+    return a >= b - rounding  # at_least
