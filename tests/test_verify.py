@@ -53,7 +53,8 @@ def test_reads_any_text_not_just_ours(toy):
     bad = good.replace("toward", "@").replace("against", "toward").replace("@", "against")
     assert not xairl.verify(bad, exp, i, policy).ok
     res = xairl.verify("The policy chose nothing in particular.", exp, i, policy)
-    assert res.ok and res.claims == ()  # no claims: nothing to contradict
+    # nothing to contradict, but nothing checked either: a vacuous text is not ok
+    assert not res.ok and res.status == "unchecked" and res.coverage == 0.0
 
 
 def test_global_summary_verifies(toy):

@@ -93,7 +93,8 @@ class Verification:
         return bad
 
 
-_SENTENCE_RE = re.compile(r"(?<=[.!?])\s+(?=[^a-z0-9])|\n+\s*(?:[-•*]\s*)?")
+_SENTENCE_RE = re.compile(r"(?<=[.!?])\s+(?=\S)|\n+\s*(?:[-•*]\s*)?")
+_ABBREVIATION = re.compile(r"(?:^|[\s(])(?:e\.g|i\.e|vs|approx|ca|etc|no|fig|cf)\.$", re.IGNORECASE)
 _CLAUSE_RE = re.compile(r";|\s(?:while|whereas|but|yet|although|though|however)\b|,\s(?:and\s)?(?=but\b)",
                         re.IGNORECASE)
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
@@ -107,6 +108,8 @@ def sentences(text: str) -> list[tuple[int, int]]:
     """Sentence spans: split after . ! ? before a capital or a sign, and at line breaks and bullets."""
     spans, start = [], 0
     for m in _SENTENCE_RE.finditer(text):
+        if _ABBREVIATION.search(text[max(0, m.start() - 8):m.start()]):
+            continue
         if text[start:m.start()].strip():
             spans.append((start, m.start()))
         start = m.end()
@@ -234,7 +237,8 @@ def _bind_number(n, masked: str, a: int, mentions, names, paired, scored, book: 
         if _SCORE_GAP.match(masked[prev.end:n.start]) or checks._MARGIN_BEFORE.search(masked[prev.end:n.start]):
             return checks.action_number(n, checks.resolve_action(prev, book), masked, book)
         prev = next((m for m in reversed(names) if m.end <= n.start), None)
-    if prev is not None and not re.search(r",\s*(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s",
+    if prev is not None and not re.search(r",\s*(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s(?!(?:most|"
+                                          r"second|third|main|largest|biggest|top|strongest)\b)",
                                           masked[prev.end:n.start], re.IGNORECASE):
         return checks.feature_number(n, prev.keys, masked, book, ctx, unit_of)
     return checks.free_number(n, masked, book)

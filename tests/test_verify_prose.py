@@ -1,0 +1,136 @@
+"""The verifier on prose it did not write: each pipeline step on its own, the held-out corpus, bad input."""
+import json
+import pathlib
+import time
+
+import numpy as np
+import pytest
+
+import xairl
+from xairl.narrators.verify.names import find_mentions, vocabulary
+from xairl.narrators.verify.numbers import find_numbers, matches, normalise
+from xairl.narrators.verify.book import clean_surface
+from benchmarks.bench_verifier import load_corpus, run
+from tests import narrative_domains as domains
+
+
+@pytest.mark.parametrize("text,value,unit,hedge", [
+    ("$12,757.84", 12757.84, 0.01, ""), (".9", 0.9, 0.1, ""), ("about $12,000", 12000, 1000, "approx"),
+    ("262KB", 262, 1, ""), ("-4330.84", -4330.84, 0.01, ""), ("~$21k", 21000, 1000, "approx"),
+    ("nearly 2 dB", 2, 1, "below"), ("1.2e-3", 0.0012, 1e-4, ""), ("five thousand dollars", 5000, 1000, ""),
+])
+def test_numbers_as_people_write_them(text, value, unit, hedge):
+    n = find_numbers(normalise(text))[0]
+    assert n.value == pytest.approx(value) and n.unit == pytest.approx(unit) and n.hedge == hedge
+
+
+def test_hedges_widen_the_tolerance_as_documented():
+    def num(t):
+        return find_numbers(normalise(t))[0]
+    assert matches(num("about $12,000"), 12757.84) and matches(num("around 800"), 812)
+    assert matches(num("roughly 0.6"), 0.63) and matches(num("nearly 2 dB"), 1.8)
+    assert not matches(num("about 5,000"), 12757.84) and not matches(num("12,000"), 13757)
+    assert matches(num("6,157"), 6157.86)  # truncated
+    assert not matches(num("nearly 2"), 2.8) and matches(num("less than $500"), -494)
+    assert matches(num("3/10"), 0.3) and matches(num("3/10"), 3)
+    assert matches(num("\u22124.3"), -4.3) and not matches(num("+4.3"), -4.3)
+
+
+def _exp(names=("gill_size", "odor", "cap_diameter"), contrib=(0.11, 0.15, -0.05), states=(1, 0, 7.5),
+         categories={"gill_size": ("broad", "narrow"), "odor": ("foul", "none")}):
+    c = np.array(contrib, float)
+    return xairl.Explanation(values=c.reshape(1, -1, 1), base_values=np.array([[0.3]]),
+                             outputs=np.array([[0.3 + c.sum()]]), states=np.array([states], float),
+                             feature_names=tuple(names), action_names=("poisonous",), method="given",
+                             output="value", categories=categories)
+
+
+def test_name_variants_and_ambiguity():
+    exp = _exp(names=("gill_size", "gill_color", "capDiameter"), categories=None)
+    vocab = vocabulary(exp, None, clean_surface)
+    for text in ("gill-size", "gill size", "GillSize", "gill_size"):
+        (m,), _ = find_mentions(text, vocab)
+        assert m.keys == ("gill_size",), text
+    (m,), _ = find_mentions("the cap diameter", vocab)
+    assert m.keys == ("capDiameter",)
+    (m,), _ = find_mentions("the gill", vocab)
+    assert set(m.keys) == {"gill_size", "gill_color"}  # ambiguous, not guessed
+    res = xairl.verify("The gill raised the prediction by 0.11.", exp, 0)  # true of gill_size only
+    assert [c.status for c in res.claims if c.kind == "number"] == ["unchecked"]
+    assert any("ambiguous" in c.detail for c in res.claims)
+    assert xairl.verify("The gill lowered the prediction.", exp, 0).status == "contradicted"  # false of both
+
+
+def test_categorical_values_are_checked():
+    exp = _exp()
+    assert xairl.verify("The narrow gill size raises the prediction by 0.11.", exp, 0).ok
+    bad = xairl.verify("The broad gill size raises the prediction by 0.11.", exp, 0)
+    assert [c.kind for c in bad.problems()] == ["category"]
+    assert not xairl.verify("odor: none, which adds 0.15.", exp, 0).ok
+    assert xairl.verify("odor: foul, which adds 0.15.", exp, 0).ok
+
+
+def test_contribution_phrasing_single_output_and_directions():
+    exp = _exp()
+    for good in ("The SHAP value of odor is 0.15.", "Its odor has a contribution of 0.15.",
+                 "odor increases the prediction by about 0.15", "Cap diameter decreases the prediction.",
+                 "Cap diameter does not increase the prediction.", "Odor has a positive impact on the prediction."):
+        assert xairl.verify(good, exp, 0).ok, good
+    for bad in ("Odor decreases the prediction.", "Cap diameter pushes the prediction up.",
+                "Odor does not increase the prediction.", "The SHAP value of odor is 0.51."):
+        assert not xairl.verify(bad, exp, 0).ok, bad
+
+
+def test_lists_ranks_and_magnitude():
+    exp = _exp()
+    assert xairl.verify("Odor and gill size raise it by 0.15 and 0.11, respectively.", exp, 0).ok
+    assert not xairl.verify("Odor and gill size raise it by 0.11 and 0.15, respectively.", exp, 0).ok
+    assert xairl.verify("The top two features were odor and gill size.", exp, 0).ok
+    assert not xairl.verify("The top two features were odor and cap diameter.", exp, 0).ok
+    assert xairl.verify("Odor was the most important feature, followed by gill size.", exp, 0).ok
+    assert not xairl.verify("Gill size was the most important feature.", exp, 0).ok
+    assert not xairl.verify("Odor barely matters.", exp, 0).ok
+
+
+def test_sentence_status_and_coverage():
+    exp = _exp()
+    res = xairl.verify("Odor raises the prediction by 0.15. Mushrooms are fascinating. Nature is big.", exp, 0)
+    assert [s.status for s in res.sentences] == ["verified", "unchecked", "unchecked"]
+    assert res.coverage == pytest.approx(1 / 3) and not res.ok and res.status == "unchecked"
+    invented = xairl.verify("The stem height raises the prediction by 0.2.", exp, 0)
+    assert invented.status == "contradicted"
+
+
+@pytest.mark.parametrize("text", ["", " ", "x" * 1_000_000, "Die Geruchsnote erhöht die Vorhersage deutlich.",
+                                  "odor adds 1.5e-1", "odor adds\u00a00.15 \u2212 wait", "\x00\x01"])
+def test_bad_input_gives_a_status_not_an_exception(text):
+    t = time.perf_counter()
+    res = xairl.verify(text, _exp(), 0)
+    assert res.status in ("verified", "contradicted", "unchecked")
+    assert time.perf_counter() - t < 10
+
+
+@pytest.fixture(scope="module")
+def corpus():
+    return run(load_corpus(), {d: domains.policy(d) for d in domains.DOMAINS})
+
+
+def test_held_out_corpus_agreement(corpus):
+    """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
+    for split, floor in (("dev", 0.9), ("test", 0.8)):
+        part = [it for it in corpus if it["split"] == split]
+        agree = sum(it["ok"] == it["accurate"] for it in part) / len(part)
+        assert agree >= floor, (split, agree)
+    assert len(corpus) >= 300 and len({it["domain"] for it in corpus}) == 4
+
+
+def test_exact_restatements_verify_in_every_domain():
+    cases = json.loads((pathlib.Path(__file__).parents[1] / "benchmarks/data/narratives/cases.json").read_text())
+    for case in cases:
+        exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
+        policy = domains.policy(case["domain"])
+        a = int(exp.focus[0])
+        for j, f in enumerate(exp.feature_names):
+            text = f"The SHAP value of feature {f} is {exp.values[0, j, a]:.2f}."
+            res = xairl.verify(text, exp, 0, policy)
+            assert res.ok, (case["id"], text, res.problems())
