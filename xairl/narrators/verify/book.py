@@ -12,8 +12,8 @@ from ...policy import Policy
 from ..facts import decision_facts, global_facts
 
 _CLAIMY = re.compile(r"[+\-\u2212]\d|\d\.\d|%|\b(toward|towards|against|raises|lowers|increases|decreases|pushes|"
-                     r"favours|favors|opposes|most important|main|largest|biggest|strongest|top|first|second|third|"
-                     r"mattered most)\b", re.IGNORECASE)
+                     r"favours|favors|opposes|mattered most)\b|\b(most important|main|largest|biggest|strongest|top|"
+                     r"first|second|third)\s+(feature|factor|driver|reason|contributor|influence)s?\b", re.IGNORECASE)
 
 
 def clean_surface(text: str) -> bool:

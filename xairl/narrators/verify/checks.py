@@ -243,7 +243,7 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 30]
     named = None
     if _MARGIN_BEFORE.search(before) or _MARGIN_AFTER.match(after):
-        named = ("the margin", [book.margin] if book.margin is not None else [])
+        named = ("the margin", [book.margin if book.margin is not None else 0.0])  # one available action: 0
     elif _CHANGE_AFTER.match(after) and book.base is not None:
         change = book.scores[book.chosen] - book.base
         ok = matches(n, change) or (n.percent and _percent_readings(n, abs(change)))
