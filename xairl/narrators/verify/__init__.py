@@ -195,7 +195,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     if not names and len(actions) >= 2 and len(numbers) == len(actions) and numbers[0].start > actions[-1].end:
         scored = {id(n): m for n, m in zip(numbers, actions)}  # 'turn beat recharge 6.30 to 2.37'
     for n in numbers:
-        out.append(_bind_number(n, masked, a, mentions, names, paired, scored, book, ctx, unit_of))
+        out.append(_bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of))
     out += _directions(masked, a, b, mentions, book, ctx)
     out += _ranks(masked, a, b, mentions, book, ctx)
     for m in checks.MINOR_RE.finditer(masked, a, b):
@@ -210,7 +210,7 @@ _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q\s*=|scored|scores|score of|
                         r"second at|score|at|of|was|=)?\s*\(?(?:q\s*=\s*)?$", re.IGNORECASE)
 
 
-def _bind_number(n, masked: str, a: int, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:
+def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:
     """Which name a number belongs to, then its check: a pair of a 'respectively' list; an action right before it
     ('Turn (4.07)', 'staying scored 26.26') or right after it ('7.38 for staying'); a name right after it ('a 7-year
     credit history'); the name before it in its clause unless a new noun phrase starts between them; else none."""

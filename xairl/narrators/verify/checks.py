@@ -3,7 +3,7 @@ returns :class:`Claim`\\ s: verified, contradicted, or unchecked (with the reaso
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -28,7 +28,7 @@ CHECKED = {"number", "direction", "rank", "action", "category", "magnitude"}
 _POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|supported|supporting|favou?r(?:s|ed|ing)?|"
         r"in favou?r of|toward|towards|push(?:es|ed|ing)? (?:\w+ )?up|pull(?:s|ed|ing)? (?:\w+ )?up|"
         r"nudg\w* (?:\w+ )?up|drives?|driven by|driving|tipped|tips|argu\w* for|counted for|counts for|"
-        r"positive(?:ly)?|more likely|higher|up by")
+        r"positive(?:ly)?|more likely|up by")
 _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ )?down|"
         r"push(?:es|ed|ing)? (?:\w+ )?down|nudg\w* (?:\w+ )?down|subtract\w*|tak(?:es|ing|e) (?:\w+ )?(?:off|away)|"
         r"took (?:\w+ )?(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos\w*|negative(?:ly)?|less likely|"
@@ -36,8 +36,6 @@ _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? 
         r"los(?:t|ing)|diminish\w*|penali[sz]\w*")
 DIRECTION_RE = re.compile(rf"\b(?:(?P<pos>{_POS})|(?P<neg>{_NEG}))\b", re.IGNORECASE)
 _NEGATION = re.compile(r"\b(not|n't|never|no longer|neither|nor)\b[^.]{0,12}$", re.IGNORECASE)
-_OUTPUT_WORDS = re.compile(r"^\W*(?:the\s+)?(?:model's\s+|predicted\s+|estimated\s+)?(price|prediction|estimate|risk|"
-                           r"probability|valuation|value|output|score|chance)", re.IGNORECASE)
 
 _ORD = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4, "fifth": 5}
 _COUNT = {"two": 2, "three": 3, "four": 4, "five": 5, "2": 2, "3": 3, "4": 4, "5": 5}
@@ -63,10 +61,6 @@ MINOR_RE = re.compile(r"\b(?:barely|hardly|scarcely)\s+(?:\w+\s+)?(?:matter\w*|m
                       r"little|negligible|minimal|no)\s+(?:\w+\s+)?(?:effect|influence|impact|role|difference)\b|"
                       r"\bnegligible\b", re.IGNORECASE)
 MINOR_SHARE = 10.0  # % of the sum of |contributions| below which 'barely matters' holds
-
-
-def _keys_of(m: Mention) -> tuple[str, ...]:
-    return m.keys if m.kind in ("feature", "label") else ()
 
 
 def _over_keys(keys: tuple[str, ...], test, what: str, text: str, kind: str) -> Claim:
@@ -182,7 +176,7 @@ def skip_number(n: Number, masked: str) -> bool:
 
 
 def _percent_readings(n: Number, v: float) -> bool:
-    return abs(v) <= 1.0 and matches(Number(n.start, n.end, n.text, n.value, n.unit, n.sign, n.hedge), 100 * v)
+    return abs(v) <= 1.0 and matches(replace(n, percent=False, alternatives=()), 100 * v)
 
 
 def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook, ctx: str | None,
@@ -297,25 +291,22 @@ def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: Fa
 
 def is_frame(masked: str, m: re.Match) -> bool:
     """'against' that compares ('7.53 against 7.38', 'Against recharge, ...', 'against that') is not a direction."""
-    word = m.group(0).lower()
+    if m.group(0).lower() != "against":
+        return False
     after = masked[m.end():m.end() + 30]
-    if word in ("against", "higher", "up by", "down by") and re.match(r"^\s*(?:a\s+|an\s+|the\s+)?[$€£]?[+\-]?\s*[\d.]", after):
-        return word == "against" or word == "higher"
-    if word == "against" and (re.search(r"(^|[.;:\n]\s*)$", masked[:m.start()]) or re.match(r"^\s*(that|this)\b", after)):
-        return True
-    return word in ("higher",)
+    return bool(re.match(r"^\s*(?:a\s+|an\s+|the\s+)?[$€£]?[+\-]?\s*[\d.]|^\s*(that|this)\b", after)
+                or re.search(r"(^|[.;:\n]\s*)$", masked[:m.start()]))
 
 
 def check_direction(subjects: list[Mention], polarity: int, ctx: str, word: str, book: FactBook) -> list[Claim]:
     out = []
-    for s in subjects:
-        def test(key, s=s):
-            c = book.features[key].contribs.get(ctx if ctx in book.features[key].contribs else "chosen")
-            if c is None or c == 0:
-                return None
-            return (np.sign(c) == polarity, f"{key}'s contribution ({ctx}) is {c:+.3g}")
-        out.append(_over_keys(_keys_of(s), test, ctx, word, "direction"))
-    return out
+    def test(key):
+        c = book.features[key].contribs.get(ctx if ctx in book.features[key].contribs else "chosen")
+        if c is None or c == 0:
+            return None
+        return np.sign(c) == polarity, f"{key}'s contribution ({ctx}) is {c:+.3g}"
+
+    return [_over_keys(s.keys, test, ctx, word, "direction") for s in subjects]
 
 
 # -- ranks and magnitude ------------------------------------------------------------------------------------------
@@ -347,11 +338,9 @@ def check_rank(keys: tuple[str, ...], rank: int, plural_k: int | None, sign: int
     def test(key):
         e = book.features[key]
         for c in contexts:
-            if c not in e.ranks:
+            if c not in e.ranks or (sign and np.sign(e.contribs[c]) != sign):
                 continue
-            actual = e.signed_ranks[c] if sign and np.sign(e.contribs.get(c, 0)) == sign else e.ranks[c]
-            if sign and np.sign(e.contribs.get(c, 0)) != sign:
-                continue
+            actual = e.signed_ranks[c] if sign else e.ranks[c]
             if (plural_k is not None and actual <= plural_k) or (plural_k is None and actual == rank):
                 return True, f"{key} ranks {actual} ({c})"
         shown = ", ".join(f"{e.ranks[c]} ({c})" for c in contexts if c in e.ranks)

@@ -131,9 +131,9 @@ def matches(n: Number, fact: float, magnitude_ok: bool = True) -> bool:
     it by 0.4"). A written sign must agree with the fact's."""
     if n.sign and (fact < 0) != (n.sign == "-") and fact != 0:
         return False
-    return any(_close(abs(x) if not n.sign else x, fact if n.sign else (abs(fact) if magnitude_ok else fact),
-                      n.unit if x == n.value else n.unit / max(abs(n.value), 1e-12) * abs(x), n.hedge)
-               for x in n.readings)
+    target = fact if n.sign or not magnitude_ok else abs(fact)
+    ratio = n.unit / max(abs(n.value), 1e-12)  # an alternative reading ('3/10' as 0.3) keeps the relative precision
+    return any(_close(x, target, n.unit if x == n.value else ratio * abs(x), n.hedge) for x in n.readings)
 
 
 def _close(x: float, fact: float, step: float, hedge: str) -> bool:
