@@ -22,6 +22,14 @@ class FeatureInfo:
     :param aliases: other names a text may use for the feature (the verifier recognises them).
     :param categories: for a categorical feature given as integer codes, the label of each code (code k is
         ``categories[k]``): narratives name the label ("odor: foul") and the verifier checks it.
+    :param kind: 'numeric' (a quantity: narrated as a reason with a signed push), 'categorical' (a label; its
+        contribution is the effect of having that category), 'identifier' (an id such as a cell id: its code order
+        means nothing, so it is never narrated as a cause, only as context, "while on BS 15") or 'group' (the entry
+        describes a group of ``Policy.groups``, narrated as one reason whose contribution is its members' sum).
+    :param capacity: for a quantity that fills up (a buffer, a queue), its maximum: narratives state the fill as a
+        percentage of it and its level words come from it (below 25 % low, above 75 % high, unless ``thresholds``).
+    :param thresholds: (low below, high above) in the feature's unit, e.g. RSRP (-100, -80) dBm: level words come
+        from them instead of the background's quartiles.
     """
 
     unit: str = ""
@@ -30,6 +38,23 @@ class FeatureInfo:
     high: str = "high"
     aliases: tuple[str, ...] = ()
     categories: tuple[str, ...] = ()
+    kind: Literal["numeric", "categorical", "identifier", "group"] = "numeric"
+    capacity: float | None = None
+    thresholds: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in FEATURE_KINDS:
+            raise InputError(f"FeatureInfo kind '{self.kind}' is unknown; use one of {', '.join(FEATURE_KINDS)}.")
+        if self.categories and self.kind == "numeric":
+            object.__setattr__(self, "kind", "categorical")
+        if self.capacity is not None and not (np.isfinite(self.capacity) and self.capacity > 0):
+            raise InputError(f"FeatureInfo capacity must be a positive number, got {self.capacity}.")
+        if self.thresholds is not None and not (len(self.thresholds) == 2 and self.thresholds[0] <= self.thresholds[1]):
+            raise InputError(f"FeatureInfo thresholds must be (low below, high above) with low <= high, got "
+                             f"{self.thresholds}.")
+
+
+FEATURE_KINDS = ("numeric", "categorical", "identifier", "group")
 
 
 #: what a policy's outputs are: scores of discrete actions (the highest available one is taken; a runner-up exists),
@@ -51,13 +76,17 @@ class Policy:
         flat, one column per feature name.
     :param output: 'actions' (discrete action scores: Q-values or logits), 'continuous' (one column per action
         dimension) or 'value' (one column: V(s), Q(s, a) or any regressor).
-    :param features: optional :class:`FeatureInfo` per feature name.
-    :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}``.
+    :param features: optional :class:`FeatureInfo` per feature name, and per group name for a group narrated as
+        one reason (``kind='group'``).
+    :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}`` (plots show each as one bar).
     :param background_sampler: optional ``f(n, seed) -> states`` of typical states (any form ``observation`` takes).
     :param name: how the policy is called in reports.
     :param action_aliases: other names of each action in text, e.g. ``{"stay": ["keep the serving BS"]}``.
-    :param facts_hook: optional ``f(state, chosen, runner_up) -> xairl.DomainFacts`` adding domain facts that
-        templates may cite and the verifier accepts (``chosen`` and ``runner_up`` are action indices).
+    :param facts_hook: optional ``f(state, chosen, runner_up, history=None) -> xairl.DomainFacts`` adding domain
+        facts that templates may cite and the verifier accepts (``chosen`` and ``runner_up`` are action indices;
+        ``history``, when the caller knows it, the states before this one in the same episode, oldest first, as an
+        array (h, n_features): for facts such as "the neighbour has been stronger for 4 steps"). A hook without a
+        ``history`` parameter is called without it.
     :param action_mask: optional ``f(states (n, n_features)) -> bool (n, n_actions)``, True where an action is
         available in that state (invalid-action masking, as in MaskablePPO). The policy acts, and explanations take
         the chosen action and the runner-up, among available actions only; their scores are still explained.
@@ -102,14 +131,26 @@ class Policy:
         if self.output == "value" and len(self.action_names) != 1:
             raise InputError("a 'value' policy has one output; give one name in action_names (e.g. ['value']).")
         names = set(self.feature_names)
-        unknown = sorted(set(self.features) - names) + sorted({f for g in self.groups.values() for f in g} - names)
+        described = {f for f, i in self.features.items() if i.kind != "group"}
+        unknown = sorted(described - names) + sorted({f for g in self.groups.values() for f in g} - names)
         if unknown:
             raise InputError(f"metadata names unknown feature(s) {', '.join(unknown[:5])}; use names from "
                              "feature_names.")
+        for g, info in self.features.items():
+            if info.kind == "group" and g not in self.groups:
+                raise InputError(f"features['{g}'] has kind 'group' but '{g}' is not in groups; add it to groups.")
+        members = [f for g, i in self.features.items() if i.kind == "group" for f in self.groups[g]]
+        if len(members) != len(set(members)):
+            raise InputError("a feature belongs to two groups narrated as one reason (kind='group'); keep them apart.")
 
     @property
     def n_features(self) -> int:
         return len(self.feature_names)
+
+    @property
+    def reason_groups(self) -> dict[str, tuple[str, ...]]:
+        """Groups narrated as one reason (those described with ``FeatureInfo(kind='group')``)."""
+        return {g: tuple(self.groups[g]) for g, i in self.features.items() if i.kind == "group"}
 
     @property
     def n_actions(self) -> int:

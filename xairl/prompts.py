@@ -26,7 +26,8 @@ MAX_LOOP_DEPTH = 2  # nested for-loops; deeper nesting is how a small template h
 MAX_REPEAT = 1000  # 'x' * n and [..] * n
 
 DECISION_VARS = {"index", "action", "runner_up", "score", "runner_up_score", "q_margin", "base_value", "method",
-                 "additivity_gap", "top", "margin_top", "comparisons", "extras", "k", "output"}
+                 "additivity_gap", "top", "margin_top", "comparisons", "extras", "k", "output", "reasons",
+                 "concession", "base_margin", "identifiers"}
 GLOBAL_VARS = {"n_states", "method", "ranking", "k"}
 
 
@@ -236,7 +237,9 @@ def check(path: str | Path) -> list[str]:
                 continue
             if loop_depth(ast) > MAX_LOOP_DEPTH:
                 problems.append(f"{path}:{base}: sandbox violation: loops nested more than {MAX_LOOP_DEPTH} deep")
-            for name in sorted(meta.find_undeclared_variables(ast) - allowed):
+            assigned = {n.name for a in ast.find_all(nodes.Assign) for n in [a.target, *a.target.find_all(nodes.Name)]
+                        if isinstance(n, nodes.Name)}
+            for name in sorted(meta.find_undeclared_variables(ast) - allowed - assigned):
                 problems.append(f"{path}:{base}: unknown variable '{name}'; a {tpl.spec.kind} template has: "
                                 f"{', '.join(sorted(allowed))}")
             for node in ast.find_all((nodes.Getattr, nodes.Getitem)):
@@ -267,7 +270,11 @@ def sample_context(kind: str) -> dict:
         return GlobalFacts(10, "deep_shap", tuple({"name": f"f{i}", "label": f"feature {i}", "unit": "", "rank": i,
                                                     "mean_abs": 1.0 / i, "high_values": "toward"}
                                                    for i in range(1, 4))).context()
-    feats = tuple(FeatureFact(f"f{i}", f"feature {i}", 1.0, "m", 0.5 / i, 30.0, "toward", "high", "high", i)
-                  for i in range(1, 4))
+    feats = tuple(FeatureFact(f"f{i}", f"feature {i}", 1.0, "m", 0.5 / i, 30.0, "toward", "high", "high", i,
+                              value_text="1.00 m") for i in range(1, 4))
+    against = FeatureFact("f4", "feature 4", 2.0, "m", -0.1, 10.0, "against", "low", "low", 4, value_text="2.00 m")
+    ident = FeatureFact("f5", "feature 5", 15.0, "", 0.0, 0.0, "toward", "unknown", "", 0, "identifier",
+                        value_text="15")
     return DecisionFacts(0, "a", "b", 1.0, 0.5, 0.5, 0.2, "deep_shap", 0.0, feats, feats,
-                         (Comparison("x is 1 dB above y", 1.0, "dB"),), {}).context() | {"extras": _SampleExtras()}
+                         (Comparison("x is 1 dB above y", 1.0, "dB"),), {}, reasons=feats, concession=against,
+                         base_margin=0.1, identifiers=(ident,)).context() | {"extras": _SampleExtras()}

@@ -50,6 +50,8 @@ def wrong(text: str, index: int, action: str, other_actions: list[str], label_wo
     if "The most important feature" in text:
         out.append(Case("swapped rank", text.replace("The most important feature", "The second most important "
                                                       "feature", 1), index, False))
+    if "The biggest push" in text:
+        out.append(Case("swapped rank", text.replace("The biggest push", "The third biggest push", 1), index, False))
     if "mattered most" in text:
         out.append(Case("swapped rank", text.replace("mattered most", "was the third most important factor", 1),
                         index, False))

@@ -1,6 +1,7 @@
 """Facts computed by code from an Explanation: the only source of numbers, names and directions in a narrative."""
 from __future__ import annotations
 
+import inspect
 from dataclasses import asdict, dataclass, field
 from typing import Any, Mapping
 
@@ -31,15 +32,21 @@ def fmt(x: float, signed: bool = False) -> str:
 
 @dataclass(frozen=True)
 class FeatureFact:
-    """One feature's part in a decision.
+    """One reason's part in a decision: a feature, or a group narrated as one reason (``FeatureInfo(kind='group')``).
 
-    :param name: the feature's name; ``label`` its description (or the name); ``unit`` its unit.
-    :param value: the feature's value in the state; ``contribution`` its signed contribution.
-    :param share: |contribution| as a percentage of the sum of |contributions|.
-    :param direction: 'toward' (raises the target score) or 'against'.
-    :param level: 'low', 'typical' or 'high' against the background quartiles ('unknown' without them);
-        ``level_text`` the feature's own words for it (``FeatureInfo.low`` / ``high``).
-    :param rank: 1 for the largest |contribution|.
+    :param name: the feature's (or group's) name; ``label`` its description (or the name); ``unit`` its unit.
+    :param value: the feature's value in the state (NaN for a group); ``contribution`` its signed contribution (a
+        group's: the sum of its members').
+    :param share: |contribution| as a percentage of the sum of |contributions| (features and groups alike).
+    :param direction: 'toward' (raises the target: the chosen score, or the margin over the runner-up) or 'against'.
+    :param level: 'low', 'typical' or 'high': from the feature's capacity or thresholds when it has them, else from
+        the background's quartiles when they are distinct, else 'unknown'; ``level_text`` the feature's own words for
+        it (``FeatureInfo.low`` / ``high``, 'typical' or 'moderate'; empty when unknown).
+    :param rank: 1 for the largest |contribution| among the reasons (identifiers are context, not reasons).
+    :param kind: the feature's ``FeatureInfo.kind``.
+    :param fill: for a feature with a capacity, its value as a percentage of it; else None.
+    :param value_text: the value as a narrative writes it: '-85.3 dBm', '12.0 % full', a category's label, or empty
+        for a group.
     """
 
     name: str
@@ -52,6 +59,9 @@ class FeatureFact:
     level: str
     level_text: str
     rank: int
+    kind: str = "numeric"
+    fill: float | None = None
+    value_text: str = ""
 
 
 @dataclass(frozen=True)
@@ -92,8 +102,16 @@ class DecisionFacts:
     :param q_margin: ``score - runner_up_score``.
     :param base_value: the chosen action's expected score over the background.
     :param method: the attributor's name; ``additivity_gap`` |base + sum of contributions - score|.
-    :param top: the ``k`` largest :class:`FeatureFact` by |contribution| to the chosen action's score.
-    :param margin_top: the same for the margin over the runner-up (why this action and not that one).
+    :param top: the ``k`` largest :class:`FeatureFact` by |contribution| to the chosen action's score (the
+        chosen-score view: what raised or lowered its Q-value or logit).
+    :param margin_top: the same for the margin over the runner-up, ``q_margin``.
+    :param reasons: the decision view, why this action and not the runner-up: up to ``k`` reasons whose
+        contributions to the margin favour the chosen action, largest first (empty when none does, or when
+        nothing was chosen); ``concession`` the reason that favoured the runner-up most (None when none did).
+    :param base_margin: the margin expected over the background (chosen minus runner-up base value): what the
+        margin is when no reason pushes either way.
+    :param identifiers: the identifiers (``FeatureInfo(kind='identifier')``) with their values: context for the words
+        ("while on BS 15"), never a reason.
     :param comparisons: the plugin's :class:`Comparison` facts; ``extras`` its named values (``DomainFacts``).
     :param output: the policy's output kind. For 'value' and 'continuous' (one dimension at a time) nothing is
         chosen: ``action`` names the output, ``score`` is its value, ``runner_up`` is ``action`` again and
@@ -114,6 +132,10 @@ class DecisionFacts:
     comparisons: tuple[Comparison, ...] = ()
     extras: Mapping[str, Any] = field(default_factory=dict)
     output: str = "actions"
+    reasons: tuple[FeatureFact, ...] = ()
+    concession: FeatureFact | None = None
+    base_margin: float = 0.0
+    identifiers: tuple[FeatureFact, ...] = ()
 
     def context(self) -> dict[str, Any]:
         """Variables a decision template sees: every field (feature facts as dicts) and ``k``."""
@@ -143,35 +165,101 @@ def _info(policy: Policy | None, name: str) -> FeatureInfo:
     return (policy.features.get(name) if policy else None) or FeatureInfo()
 
 
-def _level(exp: Explanation, j: int, value: float, info: FeatureInfo) -> tuple[str, str]:
-    q = exp.background_quantiles
-    if q is None:
-        return "unknown", "unknown"
-    if value < q[0, j]:
-        return "low", info.low
-    if value > q[2, j]:
-        return "high", info.high
-    return "typical", "typical"
+@dataclass(frozen=True)
+class Unit:
+    """What a narrative names as one reason: a feature, or a group narrated as one (its members' columns)."""
+
+    name: str
+    columns: tuple[int, ...]
+    info: FeatureInfo
 
 
-def _feature_facts(exp, i, contrib, policy, k) -> tuple[FeatureFact, ...]:
+def units(exp: Explanation, policy: Policy | None) -> list[Unit]:
+    """The narration units of an explanation: each group narrated as one reason, then every feature outside them."""
+    index = {f: j for j, f in enumerate(exp.feature_names)}
+    out, taken = [], set()
+    for g, members in (policy.reason_groups if policy else {}).items():
+        cols = tuple(index[f] for f in members if f in index)
+        if cols and len(cols) == len(members):
+            out.append(Unit(g, cols, _info(policy, g)))
+            taken.update(cols)
+    out += [Unit(f, (j,), _info(policy, f)) for j, f in enumerate(exp.feature_names) if j not in taken]
+    return out
+
+
+def unit_ranks(contrib: np.ndarray, reasons: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(rank by |contribution|, rank among contributions of the same sign, % of the sum of |contributions|) per
+    unit; ranks count ``reasons`` only (identifiers are context, not reasons) and are 0 for the others."""
+    order = [j for j in np.argsort(-np.abs(contrib), kind="stable") if reasons[j]]
+    rank = np.zeros(len(contrib), int)
+    rank[order] = np.arange(1, len(order) + 1)
+    signed = np.zeros(len(contrib), int)
+    for sgn in (1, -1):
+        for r, j in enumerate([j for j in order if np.sign(contrib[j]) == sgn], 1):
+            signed[j] = r
     total = float(np.abs(contrib).sum()) or 1.0
-    order = np.argsort(-np.abs(contrib), kind="stable")
+    return rank, signed, 100 * np.abs(contrib) / total
+
+
+def level(value: float, info: FeatureInfo, quartiles: tuple[float, float] | None) -> tuple[str, str]:
+    """(level, words) of a value: from the feature's thresholds or capacity (a physical range) when it has one,
+    else from the background's quartiles when they are distinct (a degenerate background, e.g. a buffer empty in
+    three states of four, says nothing about 'high'), else unknown."""
+    if info.kind != "numeric" or not np.isfinite(value):
+        return "unknown", ""
+    bounds, middle = info.thresholds, "moderate"
+    if bounds is None and info.capacity is not None:
+        bounds = (0.25 * info.capacity, 0.75 * info.capacity)
+    if bounds is None and quartiles is not None and quartiles[0] < quartiles[1]:
+        bounds, middle = quartiles, "typical"
+    if bounds is None:
+        return "unknown", ""
+    if value < bounds[0]:
+        return "low", info.low
+    if value > bounds[1]:
+        return "high", info.high
+    return "typical", middle
+
+
+def _value_text(value: float, info: FeatureInfo, label: str | None) -> tuple[float | None, str]:
+    if info.kind == "group":
+        return None, ""
+    if label is not None:
+        return None, label
+    if info.capacity is not None:
+        fill = 100.0 * value / info.capacity
+        return fill, f"{fmt(fill)} % full"
+    return None, f"{fmt(value)} {info.unit}".strip()
+
+
+def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy | None) -> list[FeatureFact]:
+    """A :class:`FeatureFact` per narration unit of state ``i`` for ``contrib`` (one value per feature)."""
+    us = units(exp, policy)
+    c = np.array([float(contrib[list(u.columns)].sum()) for u in us])
+    rank, _, share = unit_ranks(c, np.array([u.info.kind != "identifier" for u in us]))
+    q = exp.background_quantiles
+    labels = exp.value_labels
     out = []
-    for rank, j in enumerate(order[:k], start=1):
-        name = exp.feature_names[j]
-        info = _info(policy, name)
-        value = float(exp.states[i, j]) if exp.states is not None else float("nan")
-        level, level_text = _level(exp, j, value, info)
-        c = float(contrib[j])
-        out.append(FeatureFact(name, info.description or name, value, info.unit, c,
-                               100.0 * abs(c) / total, "toward" if c >= 0 else "against", level, level_text, rank))
-    return tuple(out)
+    for n, u in enumerate(us):
+        j = u.columns[0]
+        value = float(exp.states[i, j]) if len(u.columns) == 1 else float("nan")
+        label = None if len(u.columns) > 1 or labels is None or labels[i, j] is None else str(labels[i, j])
+        lvl, words = level(value, u.info, None if q is None or len(u.columns) > 1 else (float(q[0, j]), float(q[2, j])))
+        fill, text = _value_text(value, u.info, label)
+        out.append(FeatureFact(u.name, u.info.description or u.name, value, u.info.unit, float(c[n]), float(share[n]),
+                               "toward" if c[n] >= 0 else "against", lvl, words, int(rank[n]), u.info.kind, fill, text))
+    return out
 
 
-def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = None, k: int = 3) -> DecisionFacts:
-    """Facts about state ``index``: the action, runner-up, Q-gap, top-``k`` features for the chosen action and
-    for the margin against the runner-up, and the policy plugin's own comparisons."""
+def _top(facts: list[FeatureFact], k: int) -> tuple[FeatureFact, ...]:
+    return tuple(sorted((f for f in facts if f.rank), key=lambda f: f.rank)[:k])
+
+
+def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = None, k: int = 3,
+                   history: np.ndarray | None = None) -> DecisionFacts:
+    """Facts about state ``index``: the action, runner-up, Q-gap, top-``k`` reasons for the chosen action's score,
+    for the margin against the runner-up, the reasons that favour the decision and its strongest concession, the
+    identifiers as context, and the policy plugin's own facts (given ``history``, the episode's earlier states)."""
     n = len(exp.values)
     if not 0 <= index < n:
         raise InputError(f"index {index} is out of range: the explanation has {n} state(s).")
@@ -181,23 +269,42 @@ def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = Non
         raise InputError(f"this explanation has {exp.values.shape[2]} {exp.output} outputs; narrate one at a time "
                          "(Explanation.output_slice(j)).")
     c, r = int(exp.chosen[index]), int(exp.runner_up[index])
-    domain = _domain_facts(policy, np.asarray(exp.states[index]), c, r)
+    domain = _domain_facts(policy, np.asarray(exp.states[index]), c, r, history)
+    chosen = _feature_facts(exp, index, exp.for_chosen()[index], policy)
+    deciding = exp.output == "actions" and r != c
+    margin = _feature_facts(exp, index, exp.margin()[index], policy) if deciding else []
+    ranked = _top(margin, len(margin))
     return DecisionFacts(
         index=index, action=exp.action_names[c], runner_up=exp.action_names[r],
         score=float(exp.outputs[index, c]), runner_up_score=float(exp.outputs[index, r]),
         q_margin=float(exp.outputs[index, c] - exp.outputs[index, r]), base_value=float(exp.base_values[index, c]),
         method=exp.method, additivity_gap=float(exp.additivity_gap[index, c]),
-        top=_feature_facts(exp, index, exp.for_chosen()[index], policy, k),
-        margin_top=_feature_facts(exp, index, exp.margin()[index], policy, k) if exp.output == "actions" else (),
+        top=_top(chosen, k), margin_top=_top(margin, k),
         comparisons=tuple(domain.comparisons), extras=dict(domain.extras), output=exp.output,
+        reasons=tuple(f for f in ranked if f.contribution > 0)[:k],
+        concession=next((f for f in ranked if f.contribution < 0), None),
+        base_margin=float(exp.base_values[index, c] - exp.base_values[index, r]) if deciding else 0.0,
+        identifiers=tuple(f for f in chosen if f.kind == "identifier"),
     )
 
 
-def _domain_facts(policy: Policy | None, state: np.ndarray, chosen: int, runner_up: int) -> DomainFacts:
-    """The policy plugin's ``facts_hook`` output, checked for its type."""
+def _takes_history(hook) -> bool:
+    try:
+        params = inspect.signature(hook).parameters
+    except (TypeError, ValueError):
+        return False
+    return "history" in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
+
+
+def _domain_facts(policy: Policy | None, state: np.ndarray, chosen: int, runner_up: int,
+                  history: np.ndarray | None = None) -> DomainFacts:
+    """The policy plugin's ``facts_hook`` output, checked for its type; ``history`` goes to hooks that take it."""
     if policy is None or policy.facts_hook is None:
         return DomainFacts()
-    out = policy.facts_hook(state, chosen, runner_up)
+    if history is not None and len(history) and _takes_history(policy.facts_hook):
+        out = policy.facts_hook(state, chosen, runner_up, history=policy.check_states(history, "history"))
+    else:
+        out = policy.facts_hook(state, chosen, runner_up)
     if out is None:
         return DomainFacts()
     if not isinstance(out, DomainFacts) or not all(isinstance(c, Comparison) for c in out.comparisons):

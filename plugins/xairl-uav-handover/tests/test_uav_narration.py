@@ -1,6 +1,8 @@
 """Narrating the reference DQN: the handover template, domain comparisons, and the verifier's mutation corpus."""
 import collections
 
+import numpy as np
+
 import pytest
 
 import xairl
@@ -29,17 +31,37 @@ def test_handover_facts():
     state = [0, 0, 100, 0, 7, -70, -66, -80, -90, -12, -8, -20, -25]
     f = handover_facts(state, 1, 0)
     assert isinstance(f, xairl.DomainFacts)
-    assert f.extras == {"decision": "hand over", "serving_bs": 7, "target_candidate": 1, "compared_candidate": 1}
+    assert f.extras == {"decision": "hand over", "serving_bs": 7, "target_candidate": 1, "compared_candidate": 1,
+                        "runner_up_candidate": 0, "buffer_fill": 0.0, "buffer_trend": "", "a3_decisions": 1,
+                        "chm": "start its time-to-trigger"}
     assert f.comparisons == (xairl.Comparison("the strongest neighbour's RSRP was 4.0 dB above the serving BS's "
                                               "RSRP", 4.0, "dB"),)
     assert handover_facts(state, 0, 2).comparisons[0].text.startswith("the second strongest neighbour's RSRP "
                                                                       "was 10.0 dB below")
 
 
+def test_handover_facts_with_history():
+    """Given the flight's earlier states: how long the strongest neighbour has met A3, what CHM would do, and the
+    buffer's trend."""
+    now = np.array([0, 0, 100, 5e5, 7, -70, -66, -80, -90, -12, -8, -20, -23], dtype=float)
+    weak = now.copy()
+    weak[6] = -69  # the neighbour only 1 dB above: A3 (2 dB) not met
+    emptier = now.copy()
+    emptier[3] = 2e5
+    f = handover_facts(now, 0, 1, history=np.array([weak, now, emptier]))
+    assert f.extras["a3_decisions"] == 3 and f.extras["chm"] == "hand over to candidate 1"
+    assert f.extras["buffer_fill"] == 25.0 and f.extras["buffer_trend"] == "rising"
+    assert f.comparisons[1] == xairl.Comparison("the strongest neighbour has been more than 2 dB above the serving BS "
+                                                "for 3 consecutive decisions", 3, "consecutive")
+    assert handover_facts(now, 0, 1, history=np.array([now, weak])).extras["chm"] == "start its time-to-trigger"
+    assert handover_facts(weak, 0, 1).extras["chm"] == "stay"
+
+
 def test_mutation_corpus_on_the_reference_policy(uav):
     policy, exp, _ = uav
-    cases = corpus(exp, policy, ("explain_action", "why_not", "handover"), range(40), label_words=LABEL_WORDS)
+    cases = corpus(exp, policy, ("explain_action", "explain_score", "why_not", "handover"), range(40),
+                   label_words=LABEL_WORDS)
     wrongly = [(c.kind, c.text) for c in cases if xairl.verify(c.text, exp, c.index, policy).ok != c.should_pass]
     kinds = collections.Counter(c.kind for c in cases)
-    assert len(cases) > 2500 and len(kinds) >= 8
+    assert len(cases) > 3000 and len(kinds) >= 8
     assert not wrongly, wrongly[:3]

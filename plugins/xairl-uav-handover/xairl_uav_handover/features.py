@@ -56,38 +56,88 @@ GROUPS = {"position": ("x", "y", "z"), "rsrp": ("rsrp_0", "rsrp_1", "rsrp_2", "r
 
 
 _WHO = ("the serving BS", "the strongest neighbour", "the second strongest neighbour", "the third strongest neighbour")
+#: level words: RSRP below the reward's violation threshold (-100 dBm, HandoverConfig) is weak, above -80 dBm
+#: (LTE's usual "excellent" band) strong; RSRQ below the violation threshold (-16 dB) poor, above -10 dB good
+RSRP_LEVELS = (-100.0, -80.0)
+RSRQ_LEVELS = (-16.0, -10.0)
 
 
-def _signal(kind: str, k: int, unit: str, low: str, high: str) -> FeatureInfo:
+def _signal(kind: str, k: int, unit: str, low: str, high: str, levels) -> FeatureInfo:
     aliases = (f"{kind} of candidate {k}", f"candidate {k}'s {kind}") if k else (f"serving {kind}",)
-    return FeatureInfo(unit, f"{_WHO[k]}'s {kind}", low, high, aliases)
+    return FeatureInfo(unit, f"{_WHO[k]}'s {kind}", low, high, aliases, thresholds=levels)
 
 
-FEATURE_INFO = {
-    "x": FeatureInfo("m", "the UAV's east position", "west", "east"),
-    "y": FeatureInfo("m", "the UAV's north position", "south", "north"),
-    "z": FeatureInfo("m", "the UAV's altitude", "low altitude", "high altitude"),
-    "buffer_queue_size": FeatureInfo("bit", "the uplink buffer queue", "nearly empty buffer", "nearly full buffer"),
-    "serving_bs": FeatureInfo("", "the serving BS's id", "low id", "high id"),
-    **{f"rsrp_{k}": _signal("RSRP", k, "dBm", "weak signal", "strong signal") for k in range(4)},
-    **{f"rsrq_{k}": _signal("RSRQ", k, "dB", "poor quality", "good quality") for k in range(4)},
-}
+def feature_info(q_max_bits: float = 2e6) -> dict[str, FeatureInfo]:
+    """What each feature means to an operator; the buffer's capacity is the simulator's ``q_max_bits``."""
+    return {
+        "x": FeatureInfo("m", "the UAV's east position", "west", "east"),
+        "y": FeatureInfo("m", "the UAV's north position", "south", "north"),
+        "z": FeatureInfo("m", "the UAV's altitude", "low altitude", "high altitude"),
+        "position": FeatureInfo("", "the UAV's position", kind="group", aliases=("position (x, y, z)",)),
+        "buffer_queue_size": FeatureInfo("bit", "the uplink buffer", "lightly loaded", "heavily loaded",
+                                         ("the uplink buffer queue", "buffer queue"), capacity=q_max_bits),
+        "serving_bs": FeatureInfo("", "the serving BS's id", kind="identifier"),
+        **{f"rsrp_{k}": _signal("RSRP", k, "dBm", "weak signal", "strong signal", RSRP_LEVELS) for k in range(4)},
+        **{f"rsrq_{k}": _signal("RSRQ", k, "dB", "poor quality", "good quality", RSRQ_LEVELS) for k in range(4)},
+    }
+
+
+FEATURE_INFO = feature_info()
 ACTION_ALIASES = {"stay": ("keep the serving BS", "staying"),
                   **{a: (f"hand over to candidate {k}", f"a handover to candidate {k}")
                      for k, a in enumerate(ACTIONS) if k}}
 
 
-def handover_facts(state, chosen: int, runner_up: int) -> DomainFacts:
-    """Domain facts for narration: stay or hand over, from which BS to which candidate, and how the target (or the
-    runner-up candidate, when the UAV stays) compares with the serving BS in RSRP. (Its RSRQ differs by exactly
-    the same dB: both cells' RSRQ share one RSSI, so an RSRQ comparison would only repeat it.)"""
-    s = dict(zip(FEATURES, (float(v) for v in state)))
-    k = chosen if chosen else runner_up
-    extras = {"decision": "hand over" if chosen else "stay", "serving_bs": int(round(s["serving_bs"])),
-              "target_candidate": int(chosen), "compared_candidate": int(k)}
-    comparisons = []
-    if k:
-        diff = s[f"rsrp_{k}"] - s["rsrp_0"]
-        comparisons.append(Comparison(f"{_WHO[k]}'s RSRP was {abs(diff):.1f} dB {'above' if diff >= 0 else 'below'} "
-                                      "the serving BS's RSRP", round(abs(diff), 1), "dB"))
-    return DomainFacts(extras, tuple(comparisons))
+class HandoverFacts:
+    """The UAV plugin's facts hook: what an operator checks beside the DQN's reasons.
+
+    - the decision in cells: stay or hand over, from which BS, to which candidate; the runner-up's candidate;
+    - how the compared candidate (the target, or the runner-up when the UAV stays) stands against the serving BS in
+      RSRP (its RSRQ differs by exactly the same dB: both cells' RSRQ share one RSSI, so it would only repeat it);
+    - what the conventional A3 rule (CHM: the strongest measured neighbour ``offset_db`` above the serving BS for its time-to-trigger)
+      would do in the same state, and, given the flight's earlier states, for how many consecutive decisions the
+      strongest neighbour has met that condition. A decision period (0.2 s in simulation, a sample in real data)
+      is at least the 160 ms time-to-trigger, so two consecutive decisions meeting it mean CHM hands over; one
+      means its timer is running;
+    - the buffer's fill (% of ``q_max_bits``) and, given history, its trend since the previous decision.
+    """
+
+    def __init__(self, q_max_bits: float = 2e6, offset_db: float = 2.0, detection_rsrq_db: float = -24.0):
+        self.q_max, self.offset, self.detection = q_max_bits, offset_db, detection_rsrq_db
+
+    def __call__(self, state, chosen: int, runner_up: int, history=None) -> DomainFacts:
+        s = dict(zip(FEATURES, (float(v) for v in state)))
+        k = chosen if chosen else runner_up
+        fill = 100.0 * s["buffer_queue_size"] / self.q_max
+        extras = {"decision": "hand over" if chosen else "stay", "serving_bs": int(round(s["serving_bs"])),
+                  "target_candidate": int(chosen), "compared_candidate": int(k), "runner_up_candidate": int(runner_up),
+                  "buffer_fill": fill, "buffer_trend": ""}
+        comparisons = []
+        if k:
+            diff = s[f"rsrp_{k}"] - s["rsrp_0"]
+            comparisons.append(Comparison(f"{_WHO[k]}'s RSRP was {abs(diff):.1f} dB {'above' if diff >= 0 else 'below'} "
+                                          "the serving BS's RSRP", round(abs(diff), 1), "dB"))
+        rows = [state] if history is None else [*np.asarray(history)[-50:], state]
+        held = 0
+        for row in reversed(rows):  # consecutive decisions, ending now, with the strongest neighbour A3-above
+            if row[RSRP][1] > row[RSRP][0] + self.offset and row[RSRQ][1] > self.detection:
+                held += 1
+            else:
+                break
+        extras["a3_decisions"] = held
+        if not held:
+            extras["chm"] = "stay"
+        elif history is None or held == 1:
+            extras["chm"] = "start its time-to-trigger"
+        else:
+            extras["chm"] = "hand over to candidate 1"
+        if history is not None and held:
+            comparisons.append(Comparison(f"the strongest neighbour has been more than {self.offset:g} dB above the "
+                                          f"serving BS for {held} consecutive decisions", held, "consecutive"))
+        if history is not None and len(history):
+            before = 100.0 * float(np.asarray(history)[-1][3]) / self.q_max
+            extras["buffer_trend"] = "rising" if fill > before + 1 else "falling" if fill < before - 1 else "steady"
+        return DomainFacts(extras, tuple(comparisons))
+
+
+handover_facts = HandoverFacts()

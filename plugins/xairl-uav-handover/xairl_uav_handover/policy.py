@@ -17,7 +17,7 @@ from xairl import CheckpointError, Policy
 
 from .config import SimConfig
 from .env import HandoverVecEnv
-from .features import ACTION_ALIASES, ACTIONS, FEATURE_INFO, FEATURES, GROUPS, available_actions, handover_facts
+from .features import ACTION_ALIASES, ACTIONS, FEATURES, GROUPS, HandoverFacts, available_actions, feature_info
 
 DEFAULT_CHECKPOINT = Path(__file__).parent / "checkpoints" / "uav-dqn.safetensors"
 
@@ -116,9 +116,12 @@ def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
     """The trained handover DQN as an xairl Policy (the plugin's ``uav-dqn``)."""
     ckpt = checkpoint if isinstance(checkpoint, Checkpoint) else load_checkpoint(checkpoint)
     config = ckpt.sim_config
-    return Policy(ckpt.net, FEATURES, ACTIONS, features=FEATURE_INFO, groups=GROUPS,
+    from .config import CHMConfig
+
+    facts = HandoverFacts(config.buffer.q_max_bits, CHMConfig().offset_db, config.observation.detection_rsrq_db)
+    return Policy(ckpt.net, FEATURES, ACTIONS, features=feature_info(config.buffer.q_max_bits), groups=GROUPS,
                   background_sampler=lambda n, seed: background_states(n, seed, config), name="uav-dqn",
-                  action_aliases=ACTION_ALIASES, facts_hook=handover_facts,
+                  action_aliases=ACTION_ALIASES, facts_hook=facts,
                   action_mask=lambda x: available_actions(x, config.observation))
 
 

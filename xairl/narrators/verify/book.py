@@ -9,7 +9,7 @@ import numpy as np
 
 from ...explanation import Explanation
 from ...policy import Policy
-from ..facts import decision_facts, global_facts
+from ..facts import decision_facts, global_facts, unit_ranks, units
 
 _CLAIMY = re.compile(r"[+\-\u2212]\d|\d\.\d|%|\b(toward|towards|against|raises|lowers|increases|decreases|pushes|"
                      r"favours|favors|opposes|mattered most)\b|\b(most important|main|largest|biggest|strongest|top|"
@@ -30,6 +30,7 @@ class FeatureFacts:
     ranks: dict[str, int] = field(default_factory=dict)       # context -> rank by |contribution|
     signed_ranks: dict[str, int] = field(default_factory=dict)  # context -> rank among contributions of its sign
     shares: dict[str, float] = field(default_factory=dict)    # context -> % of the sum of |contributions|
+    fill: float | None = None                                 # % of the feature's capacity
 
 
 @dataclass
@@ -51,21 +52,9 @@ class FactBook:
         return ("chosen", "margin") if self.runner_up else ("chosen",)
 
 
-def _ranks(contrib: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    order = np.argsort(-np.abs(contrib), kind="stable")
-    rank = np.empty(len(contrib), int)
-    rank[order] = np.arange(1, len(contrib) + 1)
-    signed = np.zeros(len(contrib), int)
-    for sgn in (1, -1):
-        idx = [j for j in order if np.sign(contrib[j]) == sgn]
-        for r, j in enumerate(idx, 1):
-            signed[j] = r
-    total = np.abs(contrib).sum() or 1.0
-    return rank, signed, 100 * np.abs(contrib) / total
-
-
 def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None) -> FactBook:
-    feats = {f: FeatureFacts() for f in exp.feature_names}
+    us = units(exp, policy)
+    feats = {f: FeatureFacts() for f in exp.feature_names} | {u.name: FeatureFacts() for u in us}
     if index is None:
         g = global_facts(exp, policy, k=len(exp.feature_names))
         for r in g.ranking:
@@ -83,22 +72,32 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     views = {"chosen": exp.values[index, :, chosen_i]}
     if deciding:
         views["margin"] = exp.values[index, :, chosen_i] - exp.values[index, :, runner_i]
+    # ranks and shares among the narration units (groups narrated as one reason, identifiers not ranked); a group's
+    # members are ranked among all features
+    reasons = np.array([u.info.kind != "identifier" for u in us])
     for ctx, contrib in views.items():
-        rank, signed, share = _ranks(contrib)
-        for j, f in enumerate(exp.feature_names):
-            e = feats[f]
-            e.contribs[ctx], e.ranks[ctx], e.signed_ranks[ctx], e.shares[ctx] = (
-                float(contrib[j]), int(rank[j]), int(signed[j]), float(share[j]))
+        for names, c, ok in (([u.name for u in us], np.array([contrib[list(u.columns)].sum() for u in us]), reasons),
+                             (exp.feature_names, contrib, np.ones(len(contrib), bool))):
+            rank, signed, share = unit_ranks(c, ok)
+            for j, f in enumerate(names):
+                e = feats[f]
+                if ctx in e.contribs:  # a feature outside any group: its unit's ranks
+                    continue
+                e.contribs[ctx], e.ranks[ctx], e.signed_ranks[ctx], e.shares[ctx] = (
+                    float(c[j]), int(rank[j]) or None, int(signed[j]) or None, float(share[j]))
     for j, f in enumerate(exp.feature_names):
+        info = policy.features.get(f) if policy else None
         if exp.states is not None:
             feats[f].value = float(exp.states[index, j])
+            if info is not None and info.capacity is not None:
+                feats[f].fill = 100.0 * feats[f].value / info.capacity
         if labels is not None and labels[index, j] is not None:
             feats[f].label = str(labels[index, j])
     scores = {a: float(exp.outputs[index, k]) for k, a in enumerate(exp.action_names)}
     base = float(exp.base_values[index, chosen_i])
     numbers = [d.score, base, d.score - base, d.additivity_gap, *scores.values()]
     if deciding:
-        numbers += [d.runner_up_score, d.q_margin]
+        numbers += [d.runner_up_score, d.q_margin, d.base_margin]
     numbers += [c.value for c in d.comparisons]
     numbers += [float(v) for v in d.extras.values() if isinstance(v, (int, float)) and not isinstance(v, bool)]
     by_unit: dict[str, list[float]] = {}

@@ -188,13 +188,19 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     contrib_cue = bool(_CONTRIB_BEFORE.search(before))
     contexts = (ctx or "chosen",)  # a number not said to be about the margin is about the chosen action's score
 
+    fill_cue = n.percent and re.match(r"\s*(full|of (?:its |the )?capacity)\b", after, re.IGNORECASE)
+
     def test(key):
         e = book.features[key]
+        if fill_cue and e.fill is not None:  # '8 % full': the fill, nothing else
+            return matches(n, e.fill), f"{key}'s fill is {e.fill:.3g} % of its capacity"
         unit = unit_of(key).lower()
         value_cue = bool(unit) and after.strip().lower().startswith(unit.split()[0]) and not contrib_cue
         cands = []
         if not contrib_cue and e.value is not None:
             cands.append(("value", e.value))
+        if n.percent and not contrib_cue and e.fill is not None:
+            cands.append(("fill (% of capacity)", e.fill))
         if not value_cue:
             cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
         for what, v in cands:
@@ -341,6 +347,8 @@ def check_rank(keys: tuple[str, ...], rank: int, plural_k: int | None, sign: int
             if c not in e.ranks or (sign and np.sign(e.contribs[c]) != sign):
                 continue
             actual = e.signed_ranks[c] if sign else e.ranks[c]
+            if actual is None:  # an identifier: context, not a reason
+                continue
             if (plural_k is not None and actual <= plural_k) or (plural_k is None and actual == rank):
                 return True, f"{key} ranks {actual} ({c})"
         shown = ", ".join(f"{e.ranks[c]} ({c})" for c in contexts if c in e.ranks)

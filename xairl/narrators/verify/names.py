@@ -69,7 +69,8 @@ class Vocabulary:
 def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     phrases: dict[str, set[str]] = {}
     exact: dict[str, set[str]] = {}
-    for f in exp.feature_names:
+    groups = [g for g in (policy.reason_groups if policy else {}) if g not in exp.feature_names]
+    for f in [*exp.feature_names, *groups]:
         info = policy.features.get(f) if policy else None
         forms = [f, " ".join(split_words(f))] + ([info.description, *info.aliases] if info else [])
         for form in forms:
