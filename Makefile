@@ -17,6 +17,10 @@ QUIET := 2>&1 | { grep -v "^WARNING: Location" || true; }
 setup: $(STAMP)
 
 $(STAMP): pyproject.toml Makefile $(PLUGINS)
+	@# Debian's Chromium and its driver, for the review page's browser test (no browser downloads)
+	command -v chromium >/dev/null && command -v chromedriver >/dev/null || { apt-get update -qq && \
+		DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium chromium-driver \
+		>/dev/null; } || echo "warning: could not install chromium (needs root and Debian's registry); the browser tests will be skipped"
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	@# torch first and pinned: the CPU build on disk (an open range could pull a multi-GB CUDA build)
 	$(PIP) install torch==2.13.0 $(QUIET)

@@ -201,6 +201,11 @@ def cmd_review(args) -> int:
     from .feedback import FeedbackStore
 
     store = FeedbackStore(args.db)
+    if args.serve:
+        from .review import serve
+
+        serve(store, args.port)
+        return 0
     if args.export:
         with open(args.export, "w") as fh:
             n = store.export_corrections(fh)
@@ -262,8 +267,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("target", nargs="?", help="template name (show) or .yaml path (check)")
     p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder")
     p.set_defaults(run=cmd_prompts)
-    p = sub.add_parser("review", help="accept, reject or correct recorded narratives in the terminal")
+    p = sub.add_parser("review", help="accept, reject or correct recorded narratives in the terminal, or in a local "
+                       "web page with the evidence (--serve)")
     p.add_argument("--db", default=None, help="feedback store (default: in the user dir)")
+    p.add_argument("--serve", action="store_true", help="serve the review page on http://127.0.0.1:PORT/")
+    p.add_argument("--port", type=int, default=8765, help="port of the review page (default 8765)")
     p.add_argument("--export", metavar="FILE", help="write the corrections as JSON lines instead of reviewing")
     p.set_defaults(run=cmd_review)
     commands = plugins.registry("command")

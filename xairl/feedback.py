@@ -29,7 +29,8 @@ CREATE TABLE IF NOT EXISTS narratives (
     confidence REAL NOT NULL,
     status TEXT NOT NULL DEFAULT 'pending' CHECK (status IN ('pending', 'accepted', 'rejected', 'corrected')),
     correction TEXT,
-    reviewed REAL
+    reviewed REAL,
+    evidence TEXT
 )"""
 STATUSES = ("accepted", "rejected", "corrected")
 
@@ -55,6 +56,7 @@ class Record:
     confidence: float
     status: str
     correction: str | None
+    evidence: dict | None = None  # xairl.evidence.evidence(): the state, contributions, sentence statuses
 
 
 class FeedbackStore:
@@ -66,6 +68,8 @@ class FeedbackStore:
         try:
             with self._tx() as db:
                 db.execute(SCHEMA)
+                if "evidence" not in {row[1] for row in db.execute("PRAGMA table_info(narratives)")}:
+                    db.execute("ALTER TABLE narratives ADD COLUMN evidence TEXT")  # a store from before 0.3
         except sqlite3.DatabaseError as exc:
             raise InputError(f"{self.path}: not a usable feedback store ({exc}); move it away or pass another path.")
 
@@ -85,25 +89,32 @@ class FeedbackStore:
         finally:
             db.close()
 
-    def record(self, narrative, policy=None) -> int:
-        """Store a shown :class:`xairl.Narrative`; returns its id."""
+    def record(self, narrative, policy=None, explanation=None) -> int:
+        """Store a shown :class:`xairl.Narrative` (with ``explanation``, its evidence for the review page); returns
+        its id."""
+        from .evidence import evidence
+
+        ev = evidence(explanation, narrative) if explanation is not None else None
         row = (time.time(), getattr(policy, "name", None), model_hash(policy.module) if policy is not None else None,
                narrative.template, narrative.source, narrative.extras.get("method"), narrative.index, narrative.text,
-               json.dumps([c.__dict__ for c in narrative.claims]), int(narrative.verified), narrative.confidence)
+               json.dumps([c.__dict__ for c in narrative.claims]), int(narrative.verified), narrative.confidence,
+               json.dumps(ev) if ev is not None else None)
         with self._tx() as db:
             cur = db.execute("INSERT INTO narratives (created, policy, model_hash, template, source, method, "
-                             "state_index, text, claims, verified, confidence) VALUES (?,?,?,?,?,?,?,?,?,?,?)", row)
+                             "state_index, text, claims, verified, confidence, evidence) "
+                             "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)", row)
             return int(cur.lastrowid)
 
     def records(self, status: str | None = None) -> list[Record]:
         db = sqlite3.connect(self.path, timeout=60)
         try:
-            q = "SELECT id, policy, template, source, text, claims, verified, confidence, status, correction " \
-                "FROM narratives" + (" WHERE status = ?" if status else "") + " ORDER BY id"
+            q = "SELECT id, policy, template, source, text, claims, verified, confidence, status, correction, " \
+                "evidence FROM narratives" + (" WHERE status = ?" if status else "") + " ORDER BY id"
             rows = db.execute(q, (status,) if status else ()).fetchall()
         finally:
             db.close()
-        return [Record(r[0], r[1], r[2], r[3], r[4], json.loads(r[5]), bool(r[6]), r[7], r[8], r[9]) for r in rows]
+        return [Record(r[0], r[1], r[2], r[3], r[4], json.loads(r[5]), bool(r[6]), r[7], r[8], r[9],
+                       json.loads(r[10]) if r[10] else None) for r in rows]
 
     def review(self, record_id: int, status: str, correction: str | None = None) -> None:
         """Mark a narrative accepted, rejected or corrected (with the operator's text)."""

@@ -16,6 +16,7 @@ from typing import Callable, ClassVar
 
 import numpy as np
 
+from .evidence import CARD_STYLE, card_html, evidence
 from .explanation import Explanation, StateRecord
 from .options import Options, parse_options
 from .policy import Policy
@@ -185,8 +186,8 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
 
 
 def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, pick: int) -> list:
-    """Narrated decisions of the reference dataset (``pick`` first), its global summary and, with groups, the
-    summary with each group as one reason."""
+    """(narrative, evidence) for narrated decisions of the reference dataset (``pick`` first), its global summary
+    and, with groups, the summary with each group as one reason."""
     from tqdm import tqdm
 
     from .narrators import narrate
@@ -197,10 +198,12 @@ def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, pi
                    robustness=req.robustness)
            for i in tqdm(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)]
     out.append(narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs))
+    pairs = [(n, evidence(ref, n)) for n in out]
     if content.policy.groups:
-        out.append(narrate(ref.grouped(dict(content.policy.groups)), None, policy=content.policy,
-                           prompt_dirs=req.prompt_dirs))
-    return out
+        grouped = ref.grouped(dict(content.policy.groups))
+        n = narrate(grouped, None, policy=content.policy, prompt_dirs=req.prompt_dirs)
+        pairs.append((n, evidence(grouped, n)))
+    return pairs
 
 
 def _img(path: Path) -> str:
@@ -220,19 +223,19 @@ def _html(title, tables, notes, exps, figures, narratives, settings) -> str:
         parts.append(f"<figure><img src='{_img(png)}' alt='{html.escape(caption)}'><figcaption>"
                      f"{html.escape(caption)}</figcaption></figure>")
     if narratives:
-        parts.append("<h2>Narrated decisions</h2>")
-        for n in narratives:
-            mark = "<span class=ok>&#10003; verified</span>" if n.verified else "<span class=bad>&#10007; NOT verified</span>"
-            comp = ", ".join(f"{k} {v:.2f}" for k, v in n.components.items() if v is not None)
+        parts.append("<h2>Narrated decisions</h2><p class=meta>Each sentence is marked &#10003; verified, &#10007; "
+                     "contradicted or ? unchecked (no claim the verifier could check); the waterfall builds the margin "
+                     "of the chosen action over the runner-up (the score, when nothing is chosen) from its background "
+                     "average, feature by feature.</p>")
+        for n, ev in narratives:
             where = "all states" if n.index is None else f"state {n.index}"
-            parts.append(f"<div class=narr><p>{html.escape(n.text)}</p><p class=meta>{mark} &middot; confidence "
-                         f"{n.confidence:.2f} ({html.escape(comp)}) &middot; {where} &middot; template "
-                         f"{html.escape(n.template)} &middot; {html.escape(n.source)}</p></div>")
+            meta = (f"{where} &middot; template {html.escape(n.template)} &middot; {html.escape(n.source)}"
+                    + ("" if n.verified else " &middot; <span class=bad>NOT verified</span>"))
+            parts.append(card_html(n.text, ev, meta))
     if notes:
         parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in notes) + "</ul>")
     style = ("body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}table{border-collapse:collapse;"
              "margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}"
-             "img{max-width:100%}.narr{border-left:4px solid #8ab;padding:0 1em;margin:1em 0}.meta{color:#555;"
-             "font-size:90%}.ok{color:#070;font-weight:bold}.bad{color:#b00;font-weight:bold}")
+             "img{max-width:100%}.ok{color:#070;font-weight:bold}.bad{color:#b00;font-weight:bold}" + CARD_STYLE)
     return (f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
             f"<style>{style}</style></head><body>{''.join(parts)}</body></html>")

@@ -12,21 +12,23 @@ from .verify import Verification, verify
 
 def narrate(explanation: Explanation, index: int | None = 0, narrator: str = "template", template: str | None = None,
             policy: Policy | None = None, background=None, options: dict | None = None,
-            prompt_dirs: Iterable[str] = (), k: int = 3, store=None, robustness: bool = True) -> Narrative:
+            prompt_dirs: Iterable[str] = (), k: int = 3, store=None, robustness: bool = True,
+            history=None) -> Narrative:
     """Words for decision ``index`` (``None``: a global summary over all states), checked against the numbers.
 
     :param narrator: a registered narrator ('template', 'local_lm', or a plugin's).
     :param options: the narrator's options (e.g. ``{"mode": "rewrite"}`` for local_lm), validated.
-    :param store: a :class:`xairl.feedback.FeedbackStore` that records the shown narrative.
+    :param store: a :class:`xairl.feedback.FeedbackStore` that records the shown narrative, with its evidence
+        (the state, the margin's contributions, the sentences' statuses) for the review page.
 
     The other parameters are those of :meth:`xairl.Narrator.narrate`.
     """
     from ..plugins import registry
 
     writer: Narrator = registry("narrator").load(narrator)(options)
-    narrative = writer.narrate(explanation, index, template, policy, background, prompt_dirs, k, robustness)
+    narrative = writer.narrate(explanation, index, template, policy, background, prompt_dirs, k, robustness, history)
     if store is not None:
-        store.record(narrative, policy=policy)
+        store.record(narrative, policy=policy, explanation=explanation)
     return narrative
 
 

@@ -16,7 +16,7 @@ from ..explanation import Explanation
 from ..options import Options, parse_options
 from ..policy import Policy
 from .confidence import confidence
-from .facts import decision_facts, global_facts
+from .facts import DomainFacts, decision_facts, global_facts
 from .verify import Claim, verify
 
 
@@ -26,6 +26,8 @@ class Narrative:
 
     :param source: the narrator's name, or 'template (fallback: ...)' when its text failed verification.
     :param rejected: the narrator's own text when it failed verification and the template's was shown instead.
+    :param sentences: (sentence, status) per sentence of ``text``: 'verified', 'contradicted' or 'unchecked' (no
+        checkable claim), as the verifier found them; the report and the review page mark each.
     """
 
     text: str
@@ -38,6 +40,7 @@ class Narrative:
     index: int | None
     rejected: str | None = None
     extras: dict = field(default_factory=dict)
+    sentences: tuple[tuple[str, str], ...] = ()
 
 
 def first_phrasings(variants: list[list[str]]) -> str:
@@ -62,7 +65,7 @@ class Narrator:
 
     def narrate(self, explanation: Explanation, index: int | None = 0, template: str | None = None,
                 policy: Policy | None = None, background=None, prompt_dirs: Iterable[str] = (), k: int = 3,
-                robustness: bool = True) -> Narrative:
+                robustness: bool = True, history=None) -> Narrative:
         """Words for decision ``index`` (``None``: a global summary over all states), verified, with confidence.
 
         :param template: template name or .yaml path; default 'explain_action' (or 'global_summary').
@@ -70,6 +73,8 @@ class Narrator:
             the confidence.
         :param k: how many features the facts list.
         :param robustness: measure agreement and stability (three extra explanations of the state).
+        :param history: the states before ``index`` in the same episode (oldest first), for a policy whose
+            ``facts_hook`` states facts over time ("the neighbour has been stronger for 3 decisions").
         """
         from .. import prompts
 
@@ -85,37 +90,41 @@ class Narrator:
         # a continuous action: each dimension is its own output, narrated and verified on its own
         views = [explanation.output_slice(j) for j in range(explanation.values.shape[2])] \
             if index is not None and explanation.output == "continuous" else [explanation]
-        texts, claims, ok, sources, rejected, scores, comps = [], [], True, [], [], [], []
+        texts, claims, ok, sources, rejected, scores, comps, sentences = [], [], True, [], [], [], [], []
         for j, view in enumerate(views):
-            text, check, source, bad = self._words(view, index, tpl, policy, k)
+            text, check, source, bad = self._words(view, index, tpl, policy, k, history)
             texts.append(text)
             claims += check.claims
+            sentences += [(s.text, s.status) for s in check.sentences]
             ok &= check.ok
             sources.append(source)
             rejected += [bad] if bad else []
             score, comp = confidence(explanation, index, check.ok, policy, background, robustness,
-                                     output=j if len(views) > 1 else None)
+                                     output=j if len(views) > 1 else None, coverage=check.coverage)
             scores.append(score)
             comps.append(comp)
         worst = int(np.argmin(scores))  # a continuous action is as trustworthy as its least trustworthy dimension
         return Narrative(text=" ".join(texts), claims=tuple(claims), verified=ok, confidence=scores[worst],
                          components=comps[worst], source=next((s for s in sources if s != self.name), self.name),
                          template=tpl.name, index=index, rejected=" ".join(rejected) or None,
-                         extras={"method": explanation.method})
+                         extras={"method": explanation.method}, sentences=tuple(sentences))
 
-    def _words(self, explanation: Explanation, index: int | None, tpl, policy: Policy | None, k: int):
+    def _words(self, explanation: Explanation, index: int | None, tpl, policy: Policy | None, k: int,
+               history=None):
         """(text, verification, source, rejected text) for one explanation: the subclass's words, verified, or the
         template's first phrasings when they fail."""
         facts = global_facts(explanation, policy, k=max(k, 3)) if index is None else decision_facts(
-            explanation, index, policy, k)
+            explanation, index, policy, k, history)
         context = facts.context()
         variants = tpl.render_variants(context)
         text, source, rejected = self._compose(variants, context), self.name, None
-        check = verify(text, explanation, index, policy)
+        # the domain facts the words were made from (a facts hook given the episode's history states more)
+        domain = DomainFacts(facts.extras, facts.comparisons) if index is not None else None
+        check = verify(text, explanation, index, policy, facts=domain)
         if not check.ok and text != first_phrasings(variants):
             problem = check.problems()[0]
             rejected, text = text, first_phrasings(variants)
-            check = verify(text, explanation, index, policy)
+            check = verify(text, explanation, index, policy, facts=domain)
             source = f"template (fallback: {self.name} text failed verification: {problem.text!r} {problem.status})"
         return text, check, source, rejected
 

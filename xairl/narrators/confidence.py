@@ -21,7 +21,7 @@ import numpy as np
 from ..explanation import Explanation
 from ..policy import Policy
 
-WEIGHTS = {"additivity": 0.2, "margin": 0.3, "agreement": 0.25, "stability": 0.25}
+WEIGHTS = {"coverage": 0.2, "additivity": 0.15, "margin": 0.25, "agreement": 0.2, "stability": 0.2}
 
 
 def _spearman(a: np.ndarray, b: np.ndarray) -> float:
@@ -64,14 +64,15 @@ def _stability(exp: Explanation, index: int, policy: Policy, bg: np.ndarray, see
 
 
 def components(exp: Explanation, index: int | None, verified: bool, policy: Policy | None = None,
-               background=None, robustness: bool = True, seed: int = 0, output: int | None = None
-               ) -> dict[str, float | None]:
+               background=None, robustness: bool = True, seed: int = 0, output: int | None = None,
+               coverage: float | None = None) -> dict[str, float | None]:
     """Every component of the confidence (None where not measured); see the module doc.
 
     :param output: the output narrated when nothing is chosen (a value, one dimension of a continuous action);
-        there the margin does not apply. Default: the chosen action."""
-    comp: dict[str, float | None] = {"verification": 1.0 if verified else 0.0, "additivity": None,
-                                     "margin": None, "agreement": None, "stability": None}
+        there the margin does not apply. Default: the chosen action.
+    :param coverage: the verifier's coverage of the text (:attr:`xairl.Verification.coverage`); None: not known."""
+    comp: dict[str, float | None] = {"verification": 1.0 if verified else 0.0, "coverage": coverage,
+                                     "additivity": None, "margin": None, "agreement": None, "stability": None}
     if index is None:  # a global summary: only verification and additivity apply
         comp["additivity"] = _additivity(float(exp.additivity_gap.max()), float(np.abs(exp.outputs).max()))
         return comp
@@ -88,10 +89,10 @@ def components(exp: Explanation, index: int | None, verified: bool, policy: Poli
 
 
 def confidence(exp: Explanation, index: int | None, verified: bool, policy: Policy | None = None,
-               background=None, robustness: bool = True, seed: int = 0, output: int | None = None
-               ) -> tuple[float, dict[str, float | None]]:
+               background=None, robustness: bool = True, seed: int = 0, output: int | None = None,
+               coverage: float | None = None) -> tuple[float, dict[str, float | None]]:
     """The confidence of a narrative and its components (formula and cost in the module doc)."""
-    comp = components(exp, index, verified, policy, background, robustness, seed, output)
+    comp = components(exp, index, verified, policy, background, robustness, seed, output, coverage)
     measured = {k: v for k, v in comp.items() if k in WEIGHTS and v is not None}
     score = comp["verification"] * sum(WEIGHTS[k] * v for k, v in measured.items()) / sum(WEIGHTS[k] for k in measured)
     return float(np.clip(score, 0.0, 1.0)), comp

@@ -28,6 +28,8 @@ class UAVReportOptions(Options):
     real: str | None = Field(None, description="folder of real flight exports (Nemo CSV), e.g. "
                                                "../shared/data/ukm-uav-lte/raw")
     flights: int = Field(100, ge=1, le=10_000, description="held-out simulated flights for Table I")
+    timelines: int = Field(2, ge=0, le=20, description="simulated flights shown at a glance (timeline and summary; "
+                                                       "with real data, its first flight too)")
 
 
 @dataclass
@@ -125,7 +127,26 @@ class UAVReport(Report):
                    "background is 100 states after 10 s of flight under conventional handover."])
         if self.options.real:
             self._add_real_flights(content, ckpt, req)
+        self._add_timelines(content, ckpt, req)
         return content
+
+    def _add_timelines(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest) -> None:
+        """A few flights at a glance: two simulated, and the first real one when real data is given."""
+        from .flight import explain_flight, narrate_flight, real_flight, simulated_flight, timeline_figure
+
+        lines = [simulated_flight(ckpt, seed=req.seed + s) for s in range(self.options.timelines)]
+        if self.options.real and self.options.timelines:
+            from .real_data import load_folder
+
+            flights, _ = load_folder(self.options.real)
+            lines += [real_flight(flights[0], ckpt, seed=req.seed)] if flights else []
+        for n, tl in enumerate(lines):
+            exp = explain_flight(tl, content.policy, content.background)
+            text, check = narrate_flight(tl, exp, content.policy)
+            mark = "verified" if check.ok else "NOT verified"
+            path = timeline_figure(tl, exp, content.policy, Path(req.out) / f"flight_{n}.png")
+            content.figures.append((f"Flight at a glance: {tl.label}. {text} [{mark}, coverage {check.coverage:.0%}]",
+                                    path))
 
     def _table_one(self, ckpt: Checkpoint, seed: int) -> tuple[str, str]:
         n, cfg = self.options.flights, ckpt.sim_config

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from ...explanation import Explanation
 from ...policy import Policy
 from . import checks
-from .book import FactBook, clean_surface, fact_book
+from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, vocabulary
 from .numbers import NUMBER_RE, find_numbers, normalise
@@ -118,10 +118,13 @@ def sentences(text: str) -> list[tuple[int, int]]:
     return spans
 
 
-def verify(text: str, explanation: Explanation, index: int | None = 0, policy: Policy | None = None) -> Verification:
+def verify(text: str, explanation: Explanation, index: int | None = 0, policy: Policy | None = None,
+           facts=None) -> Verification:
     """Check every claim of ``text`` against the explanation of state ``index`` (``None``: the global view).
 
     :param policy: optional, for feature descriptions, aliases and units, action aliases and domain facts.
+    :param facts: optional :class:`xairl.DomainFacts` beyond the explanation (e.g. a flight's handover counts): its
+        numbers may be cited, each comparison's value followed by its unit.
     :returns: a :class:`Verification`; never raises on odd text (empty, very long, another language).
     """
     note = ""
@@ -129,6 +132,8 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
     if len(text) > MAX_CHARS:
         text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
     book = fact_book(explanation, index, policy)
+    if facts is not None:
+        add_facts(book, facts)
     vocab = vocabulary(explanation, policy, clean_surface)
 
     def unit_of(f: str) -> str:

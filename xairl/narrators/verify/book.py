@@ -9,7 +9,7 @@ import numpy as np
 
 from ...explanation import Explanation
 from ...policy import Policy
-from ..facts import decision_facts, global_facts, unit_ranks, units
+from ..facts import DomainFacts, decision_facts, global_facts, unit_ranks, units
 
 _CLAIMY = re.compile(r"[+\-\u2212]\d|\d\.\d|%|\b(toward|towards|against|raises|lowers|increases|decreases|pushes|"
                      r"favours|favors|opposes|mattered most)\b|\b(most important|main|largest|biggest|strongest|top|"
@@ -98,11 +98,18 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     numbers = [d.score, base, d.score - base, d.additivity_gap, *scores.values()]
     if deciding:
         numbers += [d.runner_up_score, d.q_margin, d.base_margin]
-    numbers += [c.value for c in d.comparisons]
     numbers += [float(v) for v in d.extras.values() if isinstance(v, (int, float)) and not isinstance(v, bool)]
-    by_unit: dict[str, list[float]] = {}
-    for c in d.comparisons:
+    book = FactBook(feats, exp.output, d.action, d.runner_up if deciding else None, scores,
+                    d.q_margin if deciding else None, base, numbers)
+    add_facts(book, DomainFacts(comparisons=d.comparisons))
+    return book
+
+
+def add_facts(book: FactBook, facts: DomainFacts) -> None:
+    """Domain facts a text may cite: numeric extras anywhere, each comparison's value before its unit."""
+    book.decision_numbers += [float(v) for v in facts.extras.values()
+                              if isinstance(v, (int, float)) and not isinstance(v, bool)]
+    book.decision_numbers += [c.value for c in facts.comparisons]
+    for c in facts.comparisons:
         if c.unit:
-            by_unit.setdefault(c.unit.lower(), []).append(c.value)
-    return FactBook(feats, exp.output, d.action, d.runner_up if deciding else None, scores,
-                    d.q_margin if deciding else None, base, numbers, by_unit)
+            book.by_unit.setdefault(c.unit.lower(), []).append(c.value)

@@ -225,6 +225,8 @@ def comparison(n: Number, after: str, book: FactBook) -> bool:
 
 def action_number(n: Number, action: str | None, masked: str, book: FactBook) -> Claim:
     """A number next to an action: its score, or the margin when the words say so ('won by', 'a lead of')."""
+    if book.global_view:  # over many states no single action has a score: a count or another flight-level fact
+        return free_number(n, masked, book)
     before = masked[max(0, n.start - 40):n.start]
     if _MARGIN_BEFORE.search(before) and book.margin is not None:
         ok = matches(n, book.margin)

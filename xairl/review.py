@@ -1,0 +1,113 @@
+"""``xairl review --serve``: operators review recorded narratives in a local web page, with the evidence beside
+each one (the state, the margin's waterfall, each sentence marked verified / contradicted / unchecked, the
+confidence components), and accept, reject or correct it. Verdicts go to the same SQLite store as the terminal
+review.
+
+The server is Python's own (http.server), bound to 127.0.0.1 only; every form carries a token made at start-up, so
+a page from elsewhere open in the same browser cannot post verdicts.
+"""
+from __future__ import annotations
+
+import html
+import secrets
+import threading
+from http import HTTPStatus
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from urllib.parse import parse_qs, urlencode, urlparse
+
+from .errors import InputError
+from .evidence import CARD_STYLE, card_html
+from .feedback import FeedbackStore, Record
+
+HOST = "127.0.0.1"
+
+
+def _item(r: Record, token: str) -> str:
+    meta = (f"#{r.id} &middot; {html.escape(r.policy or '?')} &middot; template {html.escape(r.template or '?')} "
+            f"&middot; {html.escape(r.source or '?')} &middot; <b class=status>{html.escape(r.status)}</b>"
+            + (f" &middot; correction: <i>{html.escape(r.correction)}</i>" if r.correction else ""))
+    form = (f"<form method=post action='/review' class=verdict><input type=hidden name=id value='{r.id}'>"
+            f"<input type=hidden name=token value='{token}'>"
+            f"<button name=status value=accepted class=accept>Accept</button> "
+            f"<button name=status value=rejected class=reject>Reject</button> "
+            f"<textarea name=correction rows=2 cols=70 placeholder='corrected text'></textarea> "
+            f"<button name=status value=corrected class=correct>Correct</button></form>")
+    ev = r.evidence or {"sentences": [], "components": {}, "confidence": r.confidence, "verified": r.verified}
+    return f"<section class=item id='item-{r.id}'>{card_html(r.text, ev, meta, form)}</section>"
+
+
+def page(store: FeedbackStore, token: str, show_all: bool = False, message: str = "") -> str:
+    records = store.records() if show_all else store.records("pending")
+    head = (f"<h1>Narratives to review</h1><p class=meta>{len(records)} {'recorded' if show_all else 'pending'} in "
+            f"{html.escape(str(store.path))} &middot; <a href='/?all=1'>all</a> &middot; <a href='/'>pending</a></p>")
+    note = f"<p class=message>{html.escape(message)}</p>" if message else ""
+    body = "".join(_item(r, token) for r in records) or "<p class=empty>Nothing to review.</p>"
+    style = CARD_STYLE + ("body{font-family:sans-serif;max-width:1100px;margin:1.5em auto;color:#222}"
+                          ".message{background:#e6f4e6;padding:.4em}.verdict{margin-top:.6em}"
+                          "td,th{border:1px solid #ddd;padding:1px 6px}table{border-collapse:collapse}")
+    return (f"<!doctype html><html><head><meta charset='utf-8'><title>xairl review</title><style>{style}</style>"
+            f"</head><body>{head}{note}{body}</body></html>")
+
+
+def make_server(store: FeedbackStore, port: int = 0) -> ThreadingHTTPServer:
+    """A review server for ``store`` on 127.0.0.1 (``port`` 0: any free port; ``server.server_address`` says)."""
+    token = secrets.token_urlsafe(16)
+
+    class Handler(BaseHTTPRequestHandler):
+        def _send(self, status: int, body: str = "", location: str | None = None) -> None:
+            data = body.encode()
+            self.send_response(status)
+            if location:
+                self.send_header("Location", location)
+            self.send_header("Content-Type", "text/html; charset=utf-8")
+            self.send_header("Content-Length", str(len(data)))
+            self.end_headers()
+            self.wfile.write(data)
+
+        def do_GET(self):  # noqa: N802 (http.server's naming)
+            url = urlparse(self.path)
+            if url.path != "/":
+                return self._send(HTTPStatus.NOT_FOUND, "not found")
+            q = parse_qs(url.query)
+            self._send(HTTPStatus.OK, page(store, token, bool(q.get("all")), q.get("msg", [""])[0]))
+
+        def do_POST(self):  # noqa: N802
+            if urlparse(self.path).path != "/review":
+                return self._send(HTTPStatus.NOT_FOUND, "not found")
+            size = min(int(self.headers.get("Content-Length") or 0), 1_000_000)
+            form = {k: v[0] for k, v in parse_qs(self.rfile.read(size).decode("utf-8", "replace")).items()}
+            if not secrets.compare_digest(form.get("token", ""), token):
+                return self._send(HTTPStatus.FORBIDDEN, "this form is not from this review page; reload it")
+            status = form.get("status", "")
+            correction = form.get("correction", "").strip() if status == "corrected" else None
+            try:
+                store.review(int(form.get("id", "-1")), status, correction)
+                msg = f"#{form['id']} {status}"
+            except (InputError, ValueError) as exc:
+                msg = f"not stored: {exc}"
+            self._send(HTTPStatus.SEE_OTHER, location="/?" + urlencode({"msg": msg}))
+
+        def log_message(self, *args):  # quiet: the terminal shows only the address
+            pass
+
+    return ThreadingHTTPServer((HOST, port), Handler)
+
+
+def serve(store: FeedbackStore, port: int = 8765) -> None:
+    """Serve the review page until interrupted."""
+    try:
+        server = make_server(store, port)
+    except OSError as exc:
+        raise InputError(f"cannot listen on {HOST}:{port} ({exc.strerror}); pass another --port.") from None
+    print(f"reviewing {store.path} at http://{HOST}:{server.server_address[1]}/ (Ctrl-C stops)", flush=True)
+    try:
+        server.serve_forever()
+    finally:
+        server.server_close()
+
+
+def serve_in_thread(store: FeedbackStore) -> tuple[ThreadingHTTPServer, str]:
+    """A server on a free port in a daemon thread, and its address (for tests and notebooks)."""
+    server = make_server(store, 0)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    return server, f"http://{HOST}:{server.server_address[1]}/"
