@@ -32,7 +32,7 @@ from xairl.narrators.verify.names import find_mentions, vocabulary
 from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.policy import background_states, greedy, load_checkpoint, uav_policy
 
-REAL = Path(__file__).resolve().parents[3] / "shared" / "data" / "ukm-uav-lte" / "raw"
+REAL = Path(__file__).resolve().parents[4] / "shared" / "data" / "ukm-uav-lte" / "raw"
 DIRECTION = re.compile(r"\b(push\w*|favou?r\w*|toward|against|raised?|lowered?)\b", re.IGNORECASE)
 
 

@@ -124,7 +124,8 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
 
     :param policy: optional, for feature descriptions, aliases and units, action aliases and domain facts.
     :param facts: optional :class:`xairl.DomainFacts` beyond the explanation (e.g. a flight's handover counts): its
-        numbers may be cited, each comparison's value followed by its unit.
+        numbers may be cited, each comparison's value followed by its unit. With ``index=None`` the summary is
+        taken to be made from them: a number that is none of the facts is contradicted, not unchecked.
     :returns: a :class:`Verification`; never raises on odd text (empty, very long, another language).
     """
     note = ""
@@ -134,6 +135,7 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
     book = fact_book(explanation, index, policy)
     if facts is not None:
         add_facts(book, facts)
+        book.closed = index is None  # a summary made from these facts: a number that is none of them is wrong
     vocab = vocabulary(explanation, policy, clean_surface)
 
     def unit_of(f: str) -> str:

@@ -46,6 +46,7 @@ class FactBook:
     by_unit: dict[str, list[float]] = field(default_factory=dict)
     global_view: bool = False
     n_states: int = 1
+    closed: bool = False             # every number must be one of the facts (a summary made from given facts)
 
     @property
     def contexts(self) -> tuple[str, ...]:

@@ -269,6 +269,8 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         return Claim("number", n.text, "verified" if ok else "contradicted", f"{named[0]} is {named[1][0]:.4g}")
     if any(matches(n, v) or (n.percent and _percent_readings(n, v)) for v in book.decision_numbers):
         return Claim("number", n.text, "verified", "a decision-level fact")
+    if book.closed:
+        return Claim("number", n.text, "contradicted", "none of the facts the summary was made from")
     return Claim("number", n.text, "unchecked", "tied to no feature or quantity of this explanation")
 
 
