@@ -80,7 +80,7 @@ def test_confidence_near_tie_below_clear_decision():
     assert tie.verified and clear.verified
     assert tie.components["margin"] < 0.1 < 0.5 < clear.components["margin"]
     assert tie.confidence < clear.confidence
-    assert set(clear.components) == {"verification", "additivity", "margin", "agreement", "stability"}
+    assert set(clear.components) == {"verification", "coverage", "additivity", "margin", "agreement", "stability"}
     assert 0 <= tie.confidence <= 1 and 0 <= clear.confidence <= 1
 
 

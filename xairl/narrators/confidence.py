@@ -78,7 +78,7 @@ def components(exp: Explanation, index: int | None, verified: bool, policy: Poli
         return comp
     c, r = int(exp.chosen[index]) if output is None else output, int(exp.runner_up[index])
     comp["additivity"] = _additivity(float(exp.additivity_gap[index, c]), float(exp.outputs[index, c]))
-    if exp.output == "actions":
+    if exp.output == "actions" and r != c:  # one available action: no choice, so no tie to doubt
         tau = float(np.abs(exp.values[index, :, c]).mean()) or 1e-12
         comp["margin"] = float(1 - np.exp(-float(exp.outputs[index, c] - exp.outputs[index, r]) / tau))
     if robustness and policy is not None and background is not None and exp.states is not None:

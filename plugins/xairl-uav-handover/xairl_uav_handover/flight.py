@@ -130,11 +130,12 @@ def summary(tl: FlightTimeline, exp: Explanation, policy: Policy) -> tuple[str, 
         comparisons.append(Comparison(f"{live} times", live, "times"))
     comparisons += [Comparison(f"{dqn} times", dqn, "times"), Comparison(f"{chm} times", chm, "times"),
                     Comparison(f"{dqn} samples", dqn, "samples")]
-    text = [first, f"It stayed at {len(stays)} of its {len(tl.states)} decisions."]
+    would = "" if tl.closed_loop else " would have"
+    text = [first, f"The DQN{would} stayed at {len(stays)} of its {len(tl.states)} decisions."]
     if top:
         name, n = top[0]
         comparisons.append(Comparison(f"{n} decisions", n, "decisions"))
-        text.append(f"When it stayed, its first reason was most often {name}, in {n} decisions.")
+        text.append(f"For staying, its first reason was most often {name}, in {n} decisions.")
     return " ".join(text), DomainFacts(comparisons=tuple(comparisons))
 
 
