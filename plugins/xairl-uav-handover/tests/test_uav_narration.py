@@ -72,13 +72,13 @@ def test_mutation_corpus_on_the_reference_policy(uav):
 def test_a_flight_at_a_glance(uav, tmp_path):
     """A simulated flight: the DQN's and CHM's handovers on the same flight, a timeline figure, and a summary whose
     every number is verified; a wrong count is caught."""
-    from xairl_uav_handover.flight import explain_flight, narrate_flight, simulated_flight, summary, timeline_figure
+    from xairl_uav_handover.flight import narrate_flight, simulated_flight, summary, timeline_figure
     from xairl_uav_handover.policy import load_checkpoint
 
     policy, _, bg = uav
     tl = simulated_flight(load_checkpoint(), seed=3)
     assert len(tl.states) == 600 and tl.duration_s == pytest.approx(119.8) and len(tl.chm_times) >= 1
-    exp = explain_flight(tl, policy, bg)
+    exp = xairl.explain(policy, tl.states, background=bg)
     text, check = narrate_flight(tl, exp, policy)
     assert check.ok and check.coverage == 1.0
     assert f"handed over {int(tl.dqn_handover.sum())} time" in text and f"handed over {len(tl.chm_times)} time" in text

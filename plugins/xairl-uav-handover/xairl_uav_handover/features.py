@@ -135,7 +135,7 @@ class HandoverFacts:
             comparisons.append(Comparison(f"the strongest neighbour has been more than {self.offset:g} dB above the "
                                           f"serving BS for {held} consecutive decisions", held, "consecutive"))
         if history is not None and len(history):
-            before = 100.0 * float(np.asarray(history)[-1][3]) / self.q_max
+            before = 100.0 * float(np.asarray(history)[-1][FEATURES.index("buffer_queue_size")]) / self.q_max
             extras["buffer_trend"] = "rising" if fill > before + 1 else "falling" if fill < before - 1 else "steady"
         return DomainFacts(extras, tuple(comparisons))
 

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from xairl import Comparison, DomainFacts, Explanation, Policy, explain, verify
+from xairl import Comparison, DomainFacts, Explanation, Policy, verify
 from xairl.narrators.facts import decision_facts, fmt, units
 
 from .features import FEATURES, RSRP
@@ -98,10 +98,6 @@ def real_flight(flight, ckpt: Checkpoint, seed: int = 0) -> FlightTimeline:
     return FlightTimeline(flight.name, np.asarray(w.t, float), w.states, dqn, np.array(chm_times), live, False)
 
 
-def explain_flight(tl: FlightTimeline, policy: Policy, background: np.ndarray) -> Explanation:
-    return explain(policy, tl.states, background=background)
-
-
 def _first_reasons(tl: FlightTimeline, exp: Explanation, policy: Policy) -> list[tuple[int, str | None]]:
     """(chosen action, name of its first reason or None) per decision, with the flight's history."""
     out = []
@@ -123,13 +119,13 @@ def summary(tl: FlightTimeline, exp: Explanation, policy: Policy) -> tuple[str, 
     if tl.closed_loop:
         first = (f"Over {fmt(tl.duration_s)} s the DQN handed over {dqn} {'time' if dqn == 1 else 'times'}, where CHM "
                  f"flying the same flight handed over {chm} {'time' if chm == 1 else 'times'}.")
+        comparisons += [Comparison(f"{dqn} times", dqn, "times"), Comparison(f"{chm} times", chm, "times")]
     else:
         live = len(tl.live_times)
         first = (f"Over {fmt(tl.duration_s)} s of this real flight the DQN would have proposed a handover at {dqn} "
                  f"samples and CHM at {chm}; the live network handed over {live} times.")
-        comparisons.append(Comparison(f"{live} times", live, "times"))
-    comparisons += [Comparison(f"{dqn} times", dqn, "times"), Comparison(f"{chm} times", chm, "times"),
-                    Comparison(f"{dqn} samples", dqn, "samples")]
+        comparisons += [Comparison(f"{dqn} samples", dqn, "samples"), Comparison(f"{chm} samples", chm, "samples"),
+                        Comparison(f"{live} times", live, "times")]
     would = "" if tl.closed_loop else " would have"
     text = [first, f"The DQN{would} stayed at {len(stays)} of its {len(tl.states)} decisions."]
     if top:

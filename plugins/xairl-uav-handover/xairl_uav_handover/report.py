@@ -125,23 +125,20 @@ class UAVReport(Report):
             notes=["Simulated states: the DQN's own decision states on held-out flights (TR 36.777 UMa-AV, the "
                    "calibrated link and load of config.py). Contributions are to the chosen action's Q-value; the "
                    "background is 100 states after 10 s of flight under conventional handover."])
-        if self.options.real:
-            self._add_real_flights(content, ckpt, req)
-        self._add_timelines(content, ckpt, req)
+        flights = self._add_real_flights(content, ckpt, req) if self.options.real else []
+        self._add_timelines(content, ckpt, req, flights[:1])
         return content
 
-    def _add_timelines(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest) -> None:
-        """A few flights at a glance: two simulated, and the first real one when real data is given."""
-        from .flight import explain_flight, narrate_flight, real_flight, simulated_flight, timeline_figure
+    def _add_timelines(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest, real: list) -> None:
+        """A few flights at a glance: ``timelines`` simulated ones, and the ``real`` flights given."""
+        from xairl import explain
+
+        from .flight import narrate_flight, real_flight, simulated_flight, timeline_figure
 
         lines = [simulated_flight(ckpt, seed=req.seed + s) for s in range(self.options.timelines)]
-        if self.options.real and self.options.timelines:
-            from .real_data import load_folder
-
-            flights, _ = load_folder(self.options.real)
-            lines += [real_flight(flights[0], ckpt, seed=req.seed)] if flights else []
+        lines += [real_flight(f, ckpt, seed=req.seed) for f in real] if self.options.timelines else []
         for n, tl in enumerate(lines):
-            exp = explain_flight(tl, content.policy, content.background)
+            exp = explain(content.policy, tl.states, background=content.background)
             text, check = narrate_flight(tl, exp, content.policy)
             mark = "verified" if check.ok else "NOT verified"
             path = timeline_figure(tl, exp, content.policy, Path(req.out) / f"flight_{n}.png")
@@ -157,7 +154,8 @@ class UAVReport(Report):
         return (f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s (ping-pong window "
                 f"{cfg.handover.min_time_of_stay_s:g} s)", _table(rows))
 
-    def _add_real_flights(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest) -> None:
+    def _add_real_flights(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest) -> list:
+        """The calibration and agreement tables against the real flights; returns the flights loaded."""
         from tqdm import tqdm
 
         from .real_data import chm_handovers, load_folder, walk
@@ -182,6 +180,7 @@ class UAVReport(Report):
              _table(agreement_rows(walks, ckpt, cfg)))]
         content.notes += [f"skipped file: {b}" for b in bad] + REAL_NOTES
         content.figures.append(_altitude_figure(req.out, self.options.real, cfg, flights, chm_real, req.seed))
+        return flights
 
 
 REAL_NOTES = [

@@ -99,10 +99,9 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     numbers = [d.score, base, d.score - base, d.additivity_gap, *scores.values()]
     if deciding:
         numbers += [d.runner_up_score, d.q_margin, d.base_margin]
-    numbers += [float(v) for v in d.extras.values() if isinstance(v, (int, float)) and not isinstance(v, bool)]
     book = FactBook(feats, exp.output, d.action, d.runner_up if deciding else None, scores,
                     d.q_margin if deciding else None, base, numbers)
-    add_facts(book, DomainFacts(comparisons=d.comparisons))
+    add_facts(book, DomainFacts(d.extras, d.comparisons))
     return book
 
 
