@@ -100,7 +100,7 @@ _CLAUSE_RE = re.compile(r";|\s(?:while|whereas|but|yet|although|though|however)\
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
 _GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:it|this|that|they|these|those|which|everything"
                               r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
-                              r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total)\b",
+                              r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total)\b(?!'s)",
                               re.IGNORECASE)
 
 
@@ -199,7 +199,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
         paired = {id(n): m for n, m in zip(tail, names)}
     actions = [m for m in mentions if m.kind == "action"]
     scored = {}
-    if not names and len(actions) >= 2 and len(numbers) == len(actions) and numbers[0].start > actions[-1].end:
+    if not names and len(actions) >= 2 and len(numbers) == len(actions) and numbers[0].start >= actions[-1].end:
         scored = {id(n): m for n, m in zip(numbers, actions)}  # 'turn beat recharge 6.30 to 2.37'
     for n in numbers:
         out.append(_bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of))
@@ -257,6 +257,8 @@ def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: Fact
     names = _names(mentions)
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
     for i, m in enumerate(found):
+        if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(masked, m, mentions):
+            continue  # 'a salaried job helps': helps the applicant, so lowers the risk? not a checkable direction
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
         subjects = [x for x in names if prev <= x.start < m.start()]
         if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
@@ -264,8 +266,9 @@ def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: Fact
             subjects = [x for x in names if m.end() <= x.start < nxt]
             if not subjects:
                 subject = masked[prev:m.start()]
+                inside = [x for x in mentions if prev <= x.start < m.start()]
                 if book.output != "actions" or not re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE):
-                    out += _unknown_subject(subject, m.group(0), mentions)
+                    out += _unknown_subject(subject, m.group(0), inside)
         out += checks.check_direction(subjects, polarity, where, m.group(0), book)
         prev = m.end()
     return out

@@ -28,12 +28,13 @@ CHECKED = {"number", "direction", "rank", "action", "category", "magnitude"}
 _POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|supported|supporting|favou?r(?:s|ed|ing)?|"
         r"in favou?r of|toward|towards|push(?:es|ed|ing)? (?:\w+ )?up|pull(?:s|ed|ing)? (?:\w+ )?up|"
         r"nudg\w* (?:\w+ )?up|drives?|driven by|driving|tipped|tips|argu\w* for|counted for|counts for|"
-        r"positive(?:ly)?|more likely|up by")
+        r"positive(?:ly)?|more likely|up by|help(?:s|ed|ing)?")
 _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ )?down|"
         r"push(?:es|ed|ing)? (?:\w+ )?down|nudg\w* (?:\w+ )?down|subtract\w*|tak(?:es|ing|e) (?:\w+ )?(?:off|away)|"
         r"took (?:\w+ )?(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos\w*|negative(?:ly)?|less likely|"
         r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
-        r"los(?:t|ing)|diminish\w*|penali[sz]\w*")
+        r"los(?:t|ing)|diminish\w*|penali[sz]\w*|hurt(?:s|ing)?")
+VALENCE_RE = re.compile(r"^(?:help|hurt)", re.IGNORECASE)  # whose side? a direction only toward a named action
 DIRECTION_RE = re.compile(rf"\b(?:(?P<pos>{_POS})|(?P<neg>{_NEG}))\b", re.IGNORECASE)
 _NEGATION = re.compile(r"\b(not|n't|never|no longer|neither|nor)\b[^.]{0,12}$", re.IGNORECASE)
 
@@ -78,7 +79,8 @@ def _over_keys(keys: tuple[str, ...], test, what: str, text: str, kind: str) -> 
 
 
 # -- actions ---------------------------------------------------------------------------------------------------
-_CHOICE_BEFORE = re.compile(r"\b(chose|chooses|choose|picked|picks|selected|selects|decided on|decided to|decides to|"
+_CHOICE_BEFORE = re.compile(r"(?:[:→]|->|=>|\b(?:made|makes|led|leads) (?:it|the \w+) (?:to )?)\s*$|"
+                            r"\b(chose|chooses|choose|picked|picks|selected|selects|decided on|decided to|decides to|"
                             r"preferred|prefers|opted for|opted to|went for|goes for)\s+(?:to\s+)?$", re.IGNORECASE)
 _CHOICE_AFTER = re.compile(r"^\W{0,3}(?:\([^)]*\)\s*)?(?:was|is|got)?\s*(?:chosen|picked|selected|preferred|the choice)\b|"
                            r"^\W{0,3}(?:\([^)]*\)\s*)?(?:narrowly\s+|clearly\s+)?(?:won|wins|beat|beats|edged out|"
@@ -151,6 +153,8 @@ _RUNNER_BEFORE = re.compile(r"\b(vs\.?|versus|against|compared with|over)\s*(?:a
 _SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
 _BASE_AFTER = re.compile(r"^\s*(?:\w+\s+)?(baseline|base value|average|typical|expected|mean)\b", re.IGNORECASE)
 _BASE_WORDS = re.compile(r"\b(baseline|base value|base|average|typical|expected value|mean|on average)\b", re.IGNORECASE)
+_BASE_BEFORE = re.compile(r"\b(?:baseline|average|typical|mean|expected)\s+(?:prediction|estimate|output|predicted \w+)"
+                          r"\s*(?:of|is|was|:|=)?\s*[$€£]?\s*$", re.IGNORECASE)  # 'the average prediction of $230,061'
 _OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability|chance|risk|price|output|final)\b",
                         re.IGNORECASE)
 _SKIP_AFTER = re.compile(r"^\s*(background|samples?|rows?|states?|draws|features|narratives|coalitions)\b",
@@ -260,7 +264,7 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     elif _CONTRIB_BEFORE.search(before) and _owner(n, book):
         return Claim("number", n.text, "verified", f"{_owner(n, book)}'s contribution (the only one it matches)")
     elif book.output != "actions" and not book.global_view:
-        if _BASE_WORDS.search(before[-12:]) or _BASE_AFTER.match(after):
+        if _BASE_WORDS.search(before[-12:]) or _BASE_AFTER.match(after) or _BASE_BEFORE.search(before):
             named = ("the baseline", [book.base])
         elif _OUT_WORDS.search(before):
             named = ("the prediction", [book.scores[book.chosen]])
@@ -282,6 +286,12 @@ def _owner(n: Number, book: FactBook) -> str | None:
 
 
 # -- directions --------------------------------------------------------------------------------------------------
+def action_object(masked: str, m: re.Match, mentions: list[Mention]) -> Mention | None:
+    """The action a direction word is said of, when one is named right after it ('favoured forward', 'helped the
+    turn decision')."""
+    return next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() <= 16), None)
+
+
 def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: FactBook, ctx: str | None
                      ) -> tuple[int, str]:
     """(polarity, context) of a direction word: toward the runner-up ('favoured forward', 'argued for staying')
@@ -289,7 +299,7 @@ def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: Fa
     polarity = 1 if m.group("pos") else -1
     if _NEGATION.search(masked[max(0, m.start() - 30):m.start()]):
         polarity = -polarity
-    obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() <= 16), None)
+    obj = action_object(masked, m, mentions)
     if obj is not None and book.runner_up:
         a = resolve_action(obj, book)
         if a == book.runner_up:

@@ -24,7 +24,10 @@ STOP = {"the", "a", "an", "of", "in", "on", "to", "for", "and", "or", "s", "its"
 GENERIC = {"size", "area", "number", "total", "rate", "ratio", "level", "value", "values", "score", "type", "years",
            "year", "feature", "count", "amount", "length", "time", "state", "status", "quality", "id", "feet",
            "square", "sq", "ft", "kb", "m", "db", "dbm", "bit", "bits", "percent", "one", "two", "model", "data",
-           "information", "prediction", "new", "old", "high", "low", "first", "second", "third", "average"}
+           "information", "prediction", "new", "old", "high", "low", "first", "second", "third", "average",
+           "strongest", "weakest", "biggest", "largest", "main", "top"}  # rank words say which, not what
+#: participles that name a feature whose words are said the other way round ('year built' -> 'the build year')
+_BASE_FORM = {"built": "build", "sold": "sale", "made": "make", "paid": "pay", "owned": "own", "used": "use"}
 _IRREGULAR = {"keep": "kept", "go": "went", "choose": "chose", "hold": "held", "run": "ran", "stay": "stayed"}
 
 
@@ -64,15 +67,21 @@ class Vocabulary:
 
     entries: list[tuple[re.Pattern, str, tuple[str, ...], str, str]]
     short_labels: dict[str, list[tuple[str, str]]]  # feature -> [(label, label)] of 1-2 characters
+    words: dict[str, frozenset[str]]  # feature -> the words of its name, description and aliases (qualifiers)
 
 
 def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     phrases: dict[str, set[str]] = {}
     exact: dict[str, set[str]] = {}
+    feature_words: dict[str, frozenset[str]] = {}
     groups = [g for g in (policy.reason_groups if policy else {}) if g not in exp.feature_names]
     for f in [*exp.feature_names, *groups]:
         info = policy.features.get(f) if policy else None
         forms = [f, " ".join(split_words(f))] + ([info.description, *info.aliases] if info else [])
+        feature_words[f] = frozenset(w for form in forms if form for w in split_words(form) if w not in STOP)
+        name_words = split_words(f)
+        if len(name_words) == 2 and not any(w.isdigit() for w in name_words):  # 'year built' -> 'build year'
+            forms.append(" ".join(_BASE_FORM.get(w, w) for w in reversed(name_words)))
         for form in forms:
             if form and clean(form):
                 exact.setdefault(_phrase(form), set()).add(f)
@@ -101,7 +110,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
             elif clean(label):
                 entries.append((" ".join(stem(w) for w in split_words(label)), "label", (f,), label, ""))
     entries.sort(key=lambda e: -len(e[0]))
-    return Vocabulary([(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries], short)
+    return Vocabulary([(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries], short,
+                      feature_words)
 
 
 def _phrase(text: str) -> str:
@@ -153,7 +163,10 @@ def _action_entries(exp: Explanation, policy: Policy | None, clean) -> list:
             cut = next((i for i, w in enumerate(words) if w == "to" or any(c.isdigit() for c in w)), len(words))
             if 0 < cut < len(words):
                 heads.setdefault(" ".join(words[:cut]), set()).add(a)
-    out = [(s, "action", (a,), "", form) for s, a, form in full]
+    owners: dict[tuple[str, str], set[str]] = {}
+    for surface, a, form in full:  # a surface that several actions share ('switch cells') is one shared mention
+        owners.setdefault((surface, form), set()).add(a)
+    out = [(s, "action", tuple(sorted(acts)), "", form) for (s, form), acts in owners.items()]
     for head, acts in heads.items():
         if len(acts) > 1:
             for surface, form in _inflect(head):
@@ -180,5 +193,39 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
                         and not any(taken[m.start():m.end()]):
                     found.append(Mention(m.start(), m.end(), "label", (f,), label))
                     taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
+    found = _narrow(text, sorted(found, key=lambda m: m.start), vocab.words)
     masked = "".join("\0" if t else ch for ch, t in zip(text, taken))
-    return sorted(found, key=lambda m: m.start), masked
+    return found, masked
+
+
+_QUALIFIER_STOP = re.compile(r"[,.;:!?()\[\]]|\b(?:the|a|an|and|or|of|with|by|to|was|is|were|are|than|from|while|"
+                             r"for|at|as|on|in|its|their|his|her|that|which)\b", re.IGNORECASE)
+
+
+def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -> list[Mention]:
+    """An ambiguous name narrowed by the words that qualify it in its noun phrase: 'the serving cell's poor RSRQ'
+    means the one RSRQ whose name or description has 'serving'; 'candidate 1's excellent RSRQ' the one of candidate
+    1. Only words that belong to some of the meanings count ('poor', 'cell' do not); mentions inside the qualifier
+    ('serving BS's') become part of the narrowed name. Nothing is guessed: without such words the name stays
+    ambiguous."""
+    out: list[Mention] = []
+    for m in found:
+        if m.kind != "feature" or len(m.keys) < 2:
+            out.append(m)
+            continue
+        start = max(0, m.start - 40)
+        stops = list(_QUALIFIER_STOP.finditer(text, start, m.start))
+        lo = stops[-1].end() if stops else start
+        if not stops and start > 0:
+            lo = text.find(" ", start) + 1
+        known = set().union(*(words.get(k, frozenset()) for k in m.keys))
+        qual = [w for w in split_words(text[lo:m.start]) if w in known]
+        keys = tuple(k for k in m.keys if qual and set(qual) <= words.get(k, frozenset()))
+        if not keys or len(keys) == len(m.keys):
+            out.append(m)
+            continue
+        first = next((i for i in range(len(text[lo:m.start])) if not text[lo + i].isspace()), 0) + lo
+        while out and out[-1].kind == "feature" and out[-1].start >= first:
+            out.pop()  # 'serving BS's' in 'the serving BS's weak RSRP'
+        out.append(Mention(min(first, m.start), m.end, "feature", keys))
+    return out
