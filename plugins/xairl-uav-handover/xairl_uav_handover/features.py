@@ -63,7 +63,8 @@ RSRQ_LEVELS = (-16.0, -10.0)
 
 
 def _signal(kind: str, k: int, unit: str, low: str, high: str, levels) -> FeatureInfo:
-    aliases = (f"{kind} of candidate {k}", f"candidate {k}'s {kind}") if k else (f"serving {kind}",)
+    aliases = (f"{kind} of candidate {k}", f"candidate {k}'s {kind}") if k else (
+        f"serving {kind}", f"the serving cell's {kind}", f"serving cell {kind}")
     return FeatureInfo(unit, f"{_WHO[k]}'s {kind}", low, high, aliases, thresholds=levels)
 
 
@@ -84,7 +85,8 @@ def feature_info(q_max_bits: float = 2e6) -> dict[str, FeatureInfo]:
 
 FEATURE_INFO = feature_info()
 ACTION_ALIASES = {"stay": ("keep the serving BS", "staying"),
-                  **{a: (f"hand over to candidate {k}", f"a handover to candidate {k}")
+                  **{a: (f"hand over to candidate {k}", f"a handover to candidate {k}", f"switch to candidate {k}",
+                         "switch cells", "change cells")  # shared by every handover: the chosen one among them
                      for k, a in enumerate(ACTIONS) if k}}
 
 

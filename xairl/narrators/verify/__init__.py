@@ -176,7 +176,8 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     bounds = [0] + [m.end() for m in _CLAUSE_RE.finditer(masked)] + [len(masked)]
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
-        claims += _check_clause(masked, a, b, inside, book, ctx, unit_of)
+        own = _context(sentence[a:b], inside, book) if len(bounds) > 2 else None  # '..., yet against staying'
+        claims += _check_clause(masked, a, b, inside, book, own or ctx, unit_of)
     for ident in _IDENT_RE.findall(masked):
         claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
     return claims
