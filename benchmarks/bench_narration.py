@@ -24,15 +24,20 @@ COLD = ("import time; t = time.perf_counter(); import xairl; p = xairl.get_polic
 
 
 def run_mode(exp, policy, mode, n_states, template):
-    times, first_try, fallback = [], 0, 0
+    """Latencies, first-try verified count, fallbacks, and the coverage of the model's own text (the share of its
+    sentences with a checked claim, whether it was shown or rejected)."""
+    times, first_try, fallback, coverage = [], 0, 0, []
     for i in range(n_states):
         t0 = time.perf_counter()
         n = xairl.narrate(exp, i, narrator="local_lm", policy=policy, template=template, options={"mode": mode})
         times.append(time.perf_counter() - t0)
         first_try += n.source == "local_lm"
         fallback += n.source.startswith("template (fallback")
+        own = n.text if n.source == "local_lm" else n.rejected
+        if own is not None:
+            coverage.append(xairl.verify(own, exp, i, policy).coverage)
         assert n.verified, n
-    return np.array(times), first_try, fallback
+    return np.array(times), first_try, fallback, np.array(coverage)
 
 
 def main():
@@ -56,10 +61,11 @@ def main():
     print(f"cold start (new process: imports, model load from the cached copy, one narrative): {float(cold[0]):.2f} s"
           f" (goal 5 s: {float(cold[0]) / 5:.2f} of it)")
     for mode, n in (("choose", args.states), ("rewrite", args.rewrite_states)):
-        t, ok, fb = run_mode(exp, policy, mode, n, args.template)
+        t, ok, fb, cov = run_mode(exp, policy, mode, n, args.template)
         print(f"local_lm mode={mode:<8} states {n:>4}: verified on first try {100 * ok / n:5.1f} %, fallback "
-              f"{100 * fb / n:5.1f} %, warm latency median {np.median(t):.2f} s, p90 {np.percentile(t, 90):.2f} s "
-              f"(goal 1.5 s: {np.median(t) / 1.5:.2f} of it)")
+              f"{100 * fb / n:5.1f} %, coverage of the model's text mean {cov.mean() if len(cov) else 0:.2f} "
+              f"(full in {100 * np.mean(cov == 1) if len(cov) else 0:.0f} %), warm latency median {np.median(t):.2f} s, "
+              f"p90 {np.percentile(t, 90):.2f} s (goal 1.5 s: {np.median(t) / 1.5:.2f} of it)")
     verifier_corpus(args.policy, args.template, label_words, min(args.states, 150))
 
 

@@ -55,6 +55,26 @@ def test_explain_csv_jsonl_matches_api(tmp_path, capsys):
             assert rec["values"][f][rec["chosen"]] == pytest.approx(ref.values[i, j, ref.chosen[i]], abs=1e-9)
 
 
+def test_narration_marks_each_sentence(tmp_path, capsys):
+    """A customised template with a sentence that claims nothing checkable: the CLI says so, line by line and in
+    JSONL, and the narrative is shown as verified only while coverage stays above the threshold."""
+    src = (Path(xairl.__file__).parents[1] / "prompts" / "explain_action.yaml").read_text()
+    extra = '  - - "Operators should keep an eye on this state."\n'
+    (tmp_path / "explain_action.yaml").write_text(src.rstrip("\n") + "\n" + extra)
+    args = ("explain", "--n", "1", "--narrate", "--no-record", "--no-robustness", "--prompts", str(tmp_path))
+    rc, out, err = run(capsys, *args)
+    assert rc == 0, err
+    lines = out.splitlines()
+    assert lines[0].startswith("state 0 [verified")
+    assert lines[-1].split() == ["unchecked", "Operators", "should", "keep", "an", "eye", "on", "this", "state."]
+    assert all(line.split()[0] == "verified" for line in lines[1:-1]) and len(lines) >= 3
+    rc, out, err = run(capsys, *args, "--format", "jsonl")
+    rec = json.loads(out)
+    assert [s["status"] for s in rec["sentences"]][-1] == "unchecked"
+    assert rec["text"].endswith("Operators should keep an eye on this state.")
+    assert {s["status"] for s in rec["sentences"][:-1]} == {"verified"}
+
+
 def test_explain_table_and_options(capsys):
     rc, out, err = run(capsys, "explain", "--n", "2", "--method", "integrated_gradients", "-o", "n_steps=16",
                        "-o", "method=riemann_left", "--top", "2")

@@ -167,12 +167,18 @@ def _print_narratives(args, exp, policy, bg) -> int:
                     options=options, prompt_dirs=args.prompts, store=store)
         if args.format == "jsonl":
             print(json.dumps({"index": i, "text": n.text, "verified": n.verified, "confidence": n.confidence,
-                              "components": n.components, "source": n.source, "template": n.template}))
+                              "components": n.components, "source": n.source, "template": n.template,
+                              "sentences": [{"text": t, "status": st} for t, st in n.sentences]}))
             continue
         mark = "verified" if n.verified else "NOT VERIFIED"
         parts = ", ".join(f"{k} {v:.2f}" for k, v in n.components.items() if v is not None)
-        print(f"state {i} [{mark}, confidence {n.confidence:.2f}: {parts}; {n.source}]\n    {n.text}")
+        print(f"state {i} [{mark}, confidence {n.confidence:.2f}: {parts}; {n.source}]")
+        print("\n".join(f"    {_MARKS[status]:<13} {text}" for text, status in n.sentences) or f"    {n.text}")
     return 0
+
+
+#: how each sentence's status is shown: an unchecked sentence is said to be unchecked, never passed as verified
+_MARKS = {"verified": "verified", "contradicted": "CONTRADICTED", "unchecked": "unchecked"}
 
 
 def cmd_prompts(args) -> int:
