@@ -10,6 +10,8 @@ flat states takes a faster path (:func:`chain_multipliers`).
 """
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 import torch
 from pydantic import Field
@@ -51,67 +53,114 @@ def _local_grad(layer, h):
     return _vjp(layer, h, torch.ones_like(h))
 
 
-def _ratio(inp, out):
-    """Δout/Δin per element for both halves of each pair (rows i and i + P), and where |Δin| is too small for it."""
-    p = len(inp) // 2
-    d_in = inp[:p] - inp[p:]
-    ratio = (out[:p] - out[p:]) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
-    small = d_in.abs() < EPS
-    return torch.cat([ratio, ratio]), torch.cat([small, small])
+def _ratio(xi, xo, ri, ro):
+    """Δout/Δin per element of a pair (state side xi/xo, reference side ri/ro), and where |Δin| is too small for it."""
+    d_in = xi - ri
+    ratio = (xo - ro) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
+    return ratio, d_in.abs() < EPS
 
 
-def _rescale_multiplier(layer, inp, out):
+def _rescale_multiplier(layer, xi, xo, ri, ro):
     """Rescale rule of an elementwise layer: the multiplier Δout/Δin per element, the local gradient where |Δin| is
     tiny, as shap does. Computed once per forward call, used by every output's backward pass."""
-    ratio, small = _ratio(inp, out)
-    return torch.where(small, _local_grad(layer, inp), ratio) if small.any() else ratio
+    ratio, small = _ratio(xi, xo, ri, ro)
+    return torch.where(small, _local_grad(layer, xi), ratio) if small.any() else ratio
 
 
-def _rescale(layer, inp, out, g):
+def _rescale(layer, xi, xo, ri, ro, g, g_ref):
     """Rescale rule for a layer that mixes elements (Softmax, LogSoftmax), per element as shap applies it; the
     true local Jacobian where |Δin| is tiny."""
-    ratio, small = _ratio(inp, out)
-    return torch.where(small, _vjp(layer, inp, g), g * ratio) if small.any() else g * ratio
+    ratio, small = _ratio(xi, xo, ri, ro)
+    return torch.where(small, _vjp(layer, xi, g), g * ratio) if small.any() else g * ratio
 
 
-def _maxpool(layer, inp, out, g):
+def _maxpool(layer, xi, xo, ri, ro, g, g_ref):
     """DeepLIFT's max-pool rule as shap implements it: the change of each window's max is split between the
-    state's and the reference's arg-max positions, then divided by Δin there."""
-    p = len(inp) // 2
-    y, r = out[:p], out[p:]
-    cross = torch.max(y, r)
-    routed = _vjp(layer, inp, g * torch.cat([cross - r, y - cross]))  # the pooling's own routing to the arg-max
-    d_in = inp[:p] - inp[p:]
-    m = torch.where(d_in.abs() < 1e-7, torch.zeros_like(d_in), (routed[:p] + routed[p:]) / d_in)
-    return torch.cat([m, m])
+    state's and the reference's arg-max positions (each routed with its own side's gradient), then divided by Δin
+    there. The same multiplier holds for both sides of the pair."""
+    cross = torch.max(xo, ro)
+    routed = _vjp(layer, xi, g * (cross - ro)) + _vjp(layer, ri, g_ref * (xo - cross))
+    d_in = xi - ri
+    return torch.where(d_in.abs() < 1e-7, torch.zeros_like(d_in), routed / d_in)
 
 
 class _Rule(torch.autograd.Function):
-    """Identity on the layer's output in the forward pass; the DeepLIFT rule in the backward pass: a multiplier
-    computed once (elementwise layers), or a rule applied to each output's gradient."""
+    """Identity on the layer's output in the forward pass; the DeepLIFT rule in the backward pass, straight to the
+    layer's input: a multiplier computed once (elementwise layers), or a rule applied to each output's gradient.
+
+    Two layouts. Joint (``ref_in`` is None): the batch is ``[state rows; reference rows]`` and both halves are
+    back-propagated, as shap does (needed when a rule is not the same on both sides, e.g. Softmax's local Jacobian).
+    Split: the batch holds the state side of every pair and ``ref_in``/``ref_out`` the reference side's activations
+    of the same call (from one forward pass of the background); only the state side is back-propagated, with the
+    rules' gradient taken as the same on both sides."""
 
     @staticmethod
-    def forward(ctx, inp, out, layer, rule):
-        if rule is _rescale_multiplier:
-            ctx.save_for_backward(_rescale_multiplier(layer, inp, out))
+    def forward(ctx, inp, out, ref_in, ref_out, layer, rule):
+        joint = ref_in is None
+        if joint:
+            p = len(inp) // 2
+            xi, xo, ri, ro = inp[:p], out[:p], inp[p:], out[p:]
         else:
-            ctx.save_for_backward(inp, out)
-        ctx.layer, ctx.rule = layer, rule
+            xi, xo, ri, ro = inp, out, ref_in, ref_out
+        if rule is _rescale_multiplier:
+            m = _rescale_multiplier(layer, xi, xo, ri, ro)
+            ctx.save_for_backward(torch.cat([m, _rescale_multiplier(layer, ri, ro, xi, xo)]) if joint else m)
+        else:
+            ctx.save_for_backward(xi, xo, ri, ro)
+        ctx.layer, ctx.rule, ctx.joint = layer, rule, joint
         return out.clone()
 
     @staticmethod
     def backward(ctx, g):
         if ctx.rule is _rescale_multiplier:
-            return g * ctx.saved_tensors[0], None, None, None
-        inp, out = ctx.saved_tensors
-        return ctx.rule(ctx.layer, inp, out, g), None, None, None
+            return g * ctx.saved_tensors[0], None, None, None, None, None
+        xi, xo, ri, ro = ctx.saved_tensors
+        if not ctx.joint:
+            return ctx.rule(ctx.layer, xi, xo, ri, ro, g, g), None, None, None, None, None
+        gx, gr = g[:len(xi)], g[len(xi):]
+        return (torch.cat([ctx.rule(ctx.layer, xi, xo, ri, ro, gx, gr), ctx.rule(ctx.layer, ri, ro, xi, xo, gr, gx)]),
+                None, None, None, None, None)
 
 
-def _hook(rule):
+@contextlib.contextmanager
+def _hooked(rules, make_hook):
+    """The forward hook ``make_hook(rule)`` on each nonlinear layer while the block runs; removed whatever happens."""
+    handles = [layer.register_forward_hook(make_hook(rule)) for layer, rule in rules]
+    try:
+        yield
+    finally:
+        for h in handles:
+            h.remove()
+
+
+def _recorder(calls: list):
+    """A forward hook that records (layer, input, output) of each call, in call order."""
+    def hook(module, inputs, output):
+        if isinstance(output, torch.Tensor) and inputs and isinstance(inputs[0], torch.Tensor):
+            calls.append((module, inputs[0].detach(), output.detach()))
+    return hook
+
+
+class _Mismatch(Exception):
+    """The network's calls on the pairs differ from its calls on the background (control flow): use the joint
+    layout."""
+
+
+def _hook(rule, calls=None, pairs=None):
+    """The forward hook of one nonlinear layer. With ``calls`` (the reference side's (input, output) of each call,
+    recorded on the background in call order) and ``pairs`` (a one-element list: how many states the batch pairs
+    with the background), the split layout; else the joint one."""
     def hook(module, inputs, output):
         if not isinstance(output, torch.Tensor) or not inputs or not isinstance(inputs[0], torch.Tensor):
             return None
-        return _Rule.apply(inputs[0], output, module, rule)
+        if calls is None:
+            return _Rule.apply(inputs[0], output, None, None, module, rule)
+        if not calls or calls[0][0] is not module or calls[0][2].shape[1:] != output.shape[1:]:
+            raise _Mismatch()
+        _, ri, ro = calls.pop(0)
+        m = pairs[0]
+        ri, ro = (t.unsqueeze(0).expand(m, *t.shape).reshape(m * t.shape[0], *t.shape[1:]) for t in (ri, ro))
+        return _Rule.apply(inputs[0], output, ri, ro, module, rule)
     return hook
 
 
@@ -222,28 +271,44 @@ class DeepShap(Attributor):
         layers = chain(_only_child(policy, x)) if policy.observation.kind == "flat" else None
         if layers is not None:
             return self._attribute_chain(policy, layers, x, bg)
-        module = policy.network
-        for layer, rule in check_supported(module, alternatives(policy, self.name)):
-            self._add_hook(layer.register_forward_hook(_hook(rule)))
-        dev = policy.device
-        xt = torch.as_tensor(x, device=dev)
-        bt = torch.as_tensor(bg, device=dev)
+        rules = check_supported(policy.network, alternatives(policy, self.name))
+        xt = torch.as_tensor(x, device=policy.device)
+        bt = torch.as_tensor(bg, device=policy.device)
+        if not any(rule is _rescale for _, rule in rules):  # every rule is the same on both sides of a pair
+            try:
+                return self._attribute_pairs(policy.network, rules, xt, bt, policy.n_actions, split=True)
+            except _Mismatch:
+                pass  # the network's calls depend on its input: back-propagate both sides instead
+        return self._attribute_pairs(policy.network, rules, xt, bt, policy.n_actions, split=False)
+
+    def _attribute_pairs(self, module, rules, xt, bt, a, split: bool):
+        """Every (state, background) pair as a row; one forward pass and one backward pass per output. Split: the
+        rows are the state sides, the reference sides' activations come from one pass over the background. Joint:
+        the rows are ``[state sides; reference sides]``."""
         n, f = xt.shape
-        b, a = len(bt), policy.n_actions
-        per = max(1, min(self.options.max_pairs, max(1, 2 ** 22 // f)) // b)  # bounds the doubled batch
+        b = len(bt)
+        per = max(1, min(self.options.max_pairs, max(1, 2 ** 22 // f)) // b)  # bounds the batch
         values = np.empty((n, f, a))
-        base = None
+        calls: list = []
+        if split:
+            with _hooked(rules, lambda rule: _recorder(calls)), torch.no_grad():
+                base = module(bt).double().mean(dim=0).cpu().numpy()
+        pairs = [0]
         for s in range(0, n, per):
             xs = xt[s:s + per]
-            m = len(xs)
+            m = pairs[0] = len(xs)
             xp = xs[:, None, :].expand(m, b, f).reshape(m * b, f)
             rp = bt[None, :, :].expand(m, b, f).reshape(m * b, f)
-            rows = torch.cat([xp, rp]).requires_grad_(True)
-            out = module(rows)
+            rows = (xp if split else torch.cat([xp, rp])).detach().requires_grad_(True)
+            queue = list(calls)
+            with _hooked(rules, (lambda rule: _hook(rule, queue, pairs)) if split else _hook):
+                out = module(rows)
+            if queue:
+                raise _Mismatch()
+            if not split:
+                base = out[m * b:].detach().double().mean(dim=0).cpu().numpy()
             delta = (xp - rp).reshape(m, b, f)
-            base = out[m * b:].detach().double().mean(dim=0).cpu().numpy()
             for j in range(a):
-                # both halves get the output gradient, as in shap: the max-pool rule mixes them
                 grad = torch.autograd.grad(out[:, j].sum(), rows, retain_graph=j + 1 < a)[0]
                 contrib = (grad[: m * b].reshape(m, b, f) * delta).mean(dim=1).double()
                 values[s:s + m, :, j] = contrib.cpu().numpy()
