@@ -3,7 +3,8 @@
 The corpus (``benchmarks/data/narratives``): 320 narratives about 32 explanations in four domains (house prices and
 credit default, one output each, not RL; the UAV handover DQN; the toy discrete policy), half accurate and half
 with one labelled error, in many voices. Cases 0-3 of each domain are the dev split (the verifier was tuned on it),
-cases 4-7 the test split (frozen before any tuning; report it apart). A narrative counts as agreeing when
+cases 4-7 the test split (frozen before any tuning; report it apart); ``dev2/`` 60 more narratives on the dev
+cases in other voices (Q&A, LLM-style prose, shorthand, lists), written after the freeze for tuning. A narrative counts as agreeing when
 ``Verification.ok`` equals its label.
 
     .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain and error kind, speed
@@ -34,18 +35,24 @@ from tests import narrative_domains as domains  # noqa: E402
 DATA = pathlib.Path(__file__).parent / "data" / "narratives"
 
 
+SPLITS = ("dev", "dev2", "test")
+
+
 def load_corpus() -> list[dict]:
-    """Every narrative with its case's Explanation, domain, split, label and error kind."""
+    """Every narrative with its case's Explanation, domain, split, label and error kind. ``dev2`` holds narratives
+    written later, on the dev cases only, in other voices (tuning material like ``dev``)."""
     cases = {c["id"]: c for c in json.loads((DATA / "cases.json").read_text())}
     out = []
     for domain in domains.DOMAINS:
-        for case_id, items in yaml.safe_load((DATA / f"{domain}.yaml").read_text()).items():
-            case = cases[case_id]
-            exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
-            for item in items:
-                (label, text), = item.items()
-                out.append({"case": case_id, "domain": domain, "split": case["split"], "error": label,
-                            "accurate": label == "ok", "text": text, "explanation": exp})
+        for path, later in ((DATA / f"{domain}.yaml", False), (DATA / "dev2" / f"{domain}.yaml", True)):
+            for case_id, items in yaml.safe_load(path.read_text()).items():
+                case = cases[case_id]
+                assert not later or case["split"] == "dev", f"{path}: {case_id} is not a dev case"
+                exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
+                for item in items:
+                    (label, text), = item.items()
+                    out.append({"case": case_id, "domain": domain, "split": "dev2" if later else case["split"],
+                                "error": label, "accurate": label == "ok", "text": text, "explanation": exp})
     return out
 
 
@@ -68,7 +75,7 @@ def table(items: list[dict], key) -> list[tuple[str, int, int]]:
 
 
 def report(items: list[dict], show: str | None) -> None:
-    for split in ("dev", "test"):
+    for split in SPLITS:
         part = [it for it in items if it["split"] == split]
         agree = sum(it["ok"] == it["accurate"] for it in part)
         print(f"\n## {split} split: agreement {agree}/{len(part)} = {100 * agree / len(part):.1f} %")
@@ -109,7 +116,7 @@ def explingo_items(path: str) -> list[dict]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--show", choices=("dev", "test", "explingo"), help="list the disagreements of a split")
+    ap.add_argument("--show", choices=(*SPLITS, "explingo"), help="list the disagreements of a split")
     ap.add_argument("--explingo", help="path of Explingo's full-experiment/accuracy_tests.json")
     args = ap.parse_args()
     if args.explingo:
