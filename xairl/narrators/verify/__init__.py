@@ -95,7 +95,7 @@ class Verification:
 
 _SENTENCE_RE = re.compile(r"(?<=[.!?])\s+(?=\S)|\n+\s*(?:[-•*]\s*)?")
 _ABBREVIATION = re.compile(r"(?:^|[\s(])(?:e\.g|i\.e|vs|approx|ca|etc|no|fig|cf)\.$", re.IGNORECASE)
-_CLAUSE_RE = re.compile(r";|\s(?:while|whereas|but|yet|although|though|however)\b|,\s(?:and\s)?(?=but\b)",
+_CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|however)\b|,\s(?:and\s)?(?=but\b)",
                         re.IGNORECASE)
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
 _GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:it|this|that|they|these|those|which|everything"
@@ -157,6 +157,8 @@ def _context(sentence: str, mentions: list[Mention], book: FactBook) -> str | No
     if runner_named or re.search(r"\b(rather than|instead of|runner.up|relative to|compared (with|to)|versus|vs\.?|"
                                  r"margin|lead|edge|advantage|over (going|staying|turning|handing))\b", low):
         return "margin"
+    if re.search(r"\b(argu\w* (for|against)|in favou?r of|tip(ped|s)? the balance)\b", low):
+        return checks.EITHER  # weighing two options: the margin, or the chosen action's own score
     if re.search(r"\b(score|q.value|q\(|value of)\b", low) or any(
             m.kind == "action" and checks.resolve_action(m, book) == book.chosen for m in mentions):
         return "chosen"
@@ -177,7 +179,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book) if len(bounds) > 2 else None  # '..., yet against staying'
-        claims += _check_clause(masked, a, b, inside, book, own or ctx, unit_of)
+        claims += _check_clause(masked, a, b, inside, book, own or ctx, unit_of, vocab.name_words)
     for ident in _IDENT_RE.findall(masked):
         claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
     return claims
@@ -188,7 +190,7 @@ def _names(mentions: list[Mention]) -> list[Mention]:
 
 
 def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
-                  unit_of) -> list[Claim]:
+                  unit_of, name_words=frozenset()) -> list[Claim]:
     out: list[Claim] = []
     names = _names(mentions)
     numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not checks.skip_number(n, masked)]
@@ -196,7 +198,8 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     tail = [n for n in numbers if names and n.start > names[-1].end]
     paired = {}
     if len(names) >= 2 and len(tail) == len(names) and (
-            "respectively" in masked[a:b].lower() or checks._CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])):
+            "respectively" in masked[a:b].lower() or checks._CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
+            or _PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])):
         paired = {id(n): m for n, m in zip(tail, names)}
     actions = [m for m in mentions if m.kind == "action"]
     scored = {}
@@ -204,7 +207,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
         scored = {id(n): m for n, m in zip(numbers, actions)}  # 'turn beat recharge 6.30 to 2.37'
     for n in numbers:
         out.append(_bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of))
-    out += _directions(masked, a, b, mentions, book, ctx)
+    out += _directions(masked, a, b, mentions, book, ctx, name_words)
     out += _ranks(masked, a, b, mentions, book, ctx)
     for m in checks.MINOR_RE.finditer(masked, a, b):
         owner = next((x for x in reversed(names) if x.end <= m.start()), None) or next(
@@ -231,7 +234,7 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     if nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|by)\s+$", masked[n.end:nxt.start]):
         return checks.action_number(n, checks.resolve_action(nxt, book), masked, book)
     gap = masked[n.end:nxt.start] if nxt is not None else ""
-    if nxt is not None and nxt.kind != "action" and re.match(r"^[\s-]*(?:[a-z]+[\s-]+)?(?:of\s+)?$", gap,
+    if nxt is not None and nxt.kind != "action" and re.match(r"^[\s-]*(?:[a-z]+[\s-]+){0,2}(?:of\s+)?$", gap,
                                                                re.IGNORECASE) \
             and not re.search(r"\b(and|or|but|while|with)\b", gap, re.IGNORECASE):
         return checks.feature_number(n, nxt.keys, masked, book, ctx, unit_of)
@@ -245,15 +248,21 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         if _SCORE_GAP.match(masked[prev.end:n.start]) or checks._MARGIN_BEFORE.search(masked[prev.end:n.start]):
             return checks.action_number(n, checks.resolve_action(prev, book), masked, book)
         prev = next((m for m in reversed(names) if m.end <= n.start), None)
-    if prev is not None and not re.search(r",\s*(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s(?!(?:most|"
+    if prev is not None and not re.search(r"(?:,\s*|\sand\s+)(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s(?!(?:most|"
                                           r"second|third|main|largest|biggest|top|strongest)\b)",
                                           masked[prev.end:n.start], re.IGNORECASE):
         return checks.feature_number(n, prev.keys, masked, book, ctx, unit_of)
     return checks.free_number(n, masked, book)
 
 
-def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None
-                ) -> list[Claim]:
+_PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
+_LINKS = {"but", "and", "also", "yet", "then", "still", "even", "only", "while", "though", "thus", "hence"}
+_EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:but|except(?: for)?|apart from|other than)"
+                     r"\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
+
+
+def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
+                name_words=frozenset()) -> list[Claim]:
     out, prev = [], a
     names = _names(mentions)
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
@@ -268,18 +277,23 @@ def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: Fact
             if not subjects:
                 subject = masked[prev:m.start()]
                 inside = [x for x in mentions if prev <= x.start < m.start()]
-                if book.output != "actions" or not re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE):
-                    out += _unknown_subject(subject, m.group(0), inside)
-        out += checks.check_direction(subjects, polarity, where, m.group(0), book)
+                pronoun = re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE)
+                if i == 0 and (book.output != "actions" or not pronoun):  # ('tipped the balance toward': one claim)
+                    out += _unknown_subject(subject, m.group(0), inside, name_words)
+        flipped = [x for x in subjects if _EXCEPT.search(masked, prev, x.start)]  # 'everything but the kitchen'
+        out += checks.check_direction([x for x in subjects if x not in flipped], polarity, where, m.group(0), book)
+        out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
         prev = m.end()
     return out
 
 
-def _unknown_subject(subject: str, word: str, mentions: list[Mention]) -> list[Claim]:
+def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_words=frozenset()) -> list[Claim]:
     """A direction claimed for something that names no feature ('the swimming pool adds ...'): contradicted when
-    the subject is a noun phrase of its own, not a pronoun or the decision itself."""
-    words = re.findall(r"[A-Za-z]{3,}", subject.replace("\0", " "))
-    if not words or mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")):
+    the subject is a noun phrase of its own, not a pronoun or the decision itself, and has no word of a feature's
+    name (then it may be a vague mention: 'a quality rating of 10/10 adds ...')."""
+    words = [w for w in re.findall(r"[A-Za-z]{3,}", subject.replace("\0", " ")) if w.lower() not in _LINKS]
+    if not words or mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")) or \
+            any(w.lower() in name_words for w in words):
         return []
     return [Claim("feature", subject.strip(" ,:-\0"), "contradicted",
                   f"'{word}' is said of something that is not a feature of this model")]

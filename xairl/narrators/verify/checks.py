@@ -24,6 +24,7 @@ class Claim:
 
 
 CHECKED = {"number", "direction", "rank", "action", "category", "magnitude"}
+EITHER = "either"  # a sentence's view when its words weigh two options without naming the view (margin or score)
 
 _POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|supported|supporting|favou?r(?:s|ed|ing)?|"
         r"in favou?r of|toward|towards|push(?:es|ed|ing)? (?:\w+ )?up|pull(?:s|ed|ing)? (?:\w+ )?up|"
@@ -176,6 +177,8 @@ def skip_number(n: Number, masked: str) -> bool:
         return True
     if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):
         return True  # all three
+    if n.text.lower() == "one" and re.search(r"\b(this|that|the|which|each|every|any|no|a)\s+$", before, re.IGNORECASE):
+        return True  # 'this one': a pronoun
     return bool(_LABEL_BEFORE.search(before)) or bool(_SKIP_AFTER.match(masked[n.end:]))
 
 
@@ -190,7 +193,9 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     ('by', 'adds', 'SHAP value of') say it is a contribution; the feature's unit after it that it is a value."""
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 16]
     contrib_cue = bool(_CONTRIB_BEFORE.search(before))
-    contexts = (ctx or "chosen",)  # a number not said to be about the margin is about the chosen action's score
+    # a number not said to be about the margin is about the chosen action's score; 'either': the words weigh the two
+    # options ('argued against it') without saying which view
+    contexts = book.contexts if ctx == EITHER else (ctx or "chosen",)
 
     fill_cue = n.percent and re.match(r"\s*(full|of (?:its |the )?capacity)\b", after, re.IGNORECASE)
 
@@ -321,10 +326,15 @@ def is_frame(masked: str, m: re.Match) -> bool:
 def check_direction(subjects: list[Mention], polarity: int, ctx: str, word: str, book: FactBook) -> list[Claim]:
     out = []
     def test(key):
-        c = book.features[key].contribs.get(ctx if ctx in book.features[key].contribs else "chosen")
-        if c is None or c == 0:
+        contribs = book.features[key].contribs
+        views = [v for v in book.contexts if v in contribs] if ctx == EITHER else [
+            ctx if ctx in contribs else "chosen"]
+        cs = [(v, contribs.get(v)) for v in views if contribs.get(v)]
+        if not cs:
             return None
-        return np.sign(c) == polarity, f"{key}'s contribution ({ctx}) is {c:+.3g}"
+        ok = [(v, c) for v, c in cs if np.sign(c) == polarity]
+        v, c = (ok or cs)[0]
+        return bool(ok), f"{key}'s contribution ({v}) is {c:+.3g}"
 
     return [_over_keys(s.keys, test, ctx, word, "direction") for s in subjects]
 
@@ -353,7 +363,7 @@ def rank_claim(m: re.Match, masked: str) -> tuple[int, bool, int]:
 
 def check_rank(keys: tuple[str, ...], rank: int, plural_k: int | None, sign: int, ctx: str | None, book: FactBook,
                text: str) -> Claim:
-    contexts = (ctx,) if ctx else book.contexts
+    contexts = (ctx,) if ctx and ctx != EITHER else book.contexts
 
     def test(key):
         e = book.features[key]
@@ -372,7 +382,7 @@ def check_rank(keys: tuple[str, ...], rank: int, plural_k: int | None, sign: int
 
 
 def check_minor(keys: tuple[str, ...], ctx: str | None, book: FactBook, text: str) -> Claim:
-    contexts = (ctx,) if ctx else book.contexts
+    contexts = (ctx,) if ctx and ctx != EITHER else book.contexts
 
     def test(key):
         shares = [book.features[key].shares[c] for c in contexts if c in book.features[key].shares]

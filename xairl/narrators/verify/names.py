@@ -69,6 +69,12 @@ class Vocabulary:
     short_labels: dict[str, list[tuple[str, str]]]  # feature -> [(label, label)] of 1-2 characters
     words: dict[str, frozenset[str]]  # feature -> the words of its name, description and aliases (qualifiers)
 
+    @property
+    def name_words(self) -> frozenset[str]:
+        """Words of the features' own names ('quality' of ``kitchen_quality``): a phrase with one of them may be a
+        vague mention of a feature, not a thing the model lacks."""
+        return frozenset(w for f in self.words for w in split_words(f) if len(w) >= 3 and not w.isdigit())
+
 
 def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     phrases: dict[str, set[str]] = {}
@@ -97,6 +103,14 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
                             form != f and (run[0] in owners or len(run[0]) < 5) and run[0] not in split_words(f))):
                         continue
                     phrases.setdefault(" ".join(run), set()).add(f)
+    shared: dict[str, set[str]] = {}
+    for f in [*exp.feature_names, *groups]:
+        for w in split_words(f):
+            if w in GENERIC and len(w) >= 4:
+                shared.setdefault(w, set()).add(f)
+    for w, keys in shared.items():  # 'quality' of overall_quality and kitchen_quality: named, but not which
+        if len(keys) > 1 and w not in phrases and w not in exact:
+            phrases[w] = keys
     entries = []
     for phrase, keys in {**phrases, **exact}.items():
         keys = exact.get(phrase, keys)
@@ -181,6 +195,8 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
     found: list[Mention] = []
     for pattern, kind, keys, label, form in vocab.entries:
         for m in pattern.finditer(text):
+            if kind == "label" and _IDIOM.search(text, max(0, m.start() - 16), m.start()):
+                continue  # 'on its own' is no housing label
             if not any(taken[m.start():m.end()]):
                 found.append(Mention(m.start(), m.end(), kind, keys, label, form))
                 taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
@@ -198,6 +214,7 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
     return found, masked
 
 
+_IDIOM = re.compile(r"\b(?:on|of)\s+(?:its|their|his|her|my|our|your)\s+$", re.IGNORECASE)
 _QUALIFIER_STOP = re.compile(r"[,.;:!?()\[\]]|\b(?:the|a|an|and|or|of|with|by|to|was|is|were|are|than|from|while|"
                              r"for|at|as|on|in|its|their|his|her|that|which)\b", re.IGNORECASE)
 
@@ -220,11 +237,15 @@ def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -
             lo = text.find(" ", start) + 1
         known = set().union(*(words.get(k, frozenset()) for k in m.keys))
         qual = [w for w in split_words(text[lo:m.start]) if w in known]
+        if not qual and out and out[-1].kind == "feature" and re.fullmatch(r"\s*(?:and|or|&|,)\s*", text[out[-1].end:m.start]):
+            qual = [w for w in split_words(text[out[-1].start:out[-1].end]) if w in known]  # "candidate 1's RSRP and RSRQ"
+            lo = m.start
         keys = tuple(k for k in m.keys if qual and set(qual) <= words.get(k, frozenset()))
         if not keys or len(keys) == len(m.keys):
             out.append(m)
             continue
-        first = next((i for i in range(len(text[lo:m.start])) if not text[lo + i].isspace()), 0) + lo
+        first = next((i for i in range(len(text[lo:m.start])) if not text[lo + i].isspace()), 0) + lo if lo < m.start \
+            else m.start
         while out and out[-1].kind == "feature" and out[-1].start >= first:
             out.pop()  # 'serving BS's' in 'the serving BS's weak RSRP'
         out.append(Mention(min(first, m.start), m.end, "feature", keys))

@@ -1,4 +1,5 @@
-"""Numbers as people write them: thousands separators, currency, a leading dot, k/M suffixes, percentages and
+"""Numbers as people write them: thousands separators, currency, a leading dot, k/M suffixes and scale words
+("40 thousand"), percentages and
 points, fractions, scientific notation, Unicode minus, number words, and the hedge words before them.
 
 A :class:`Number` knows what it may stand for (``value`` and ``alternatives``) and how precisely it was written
@@ -35,7 +36,7 @@ _NUM_RE = re.compile(
     r"(?<![\w.,])(?P<sign>[+\-])?\s?(?P<cur>[$€£])?\s?"
     r"(?P<num>\d{1,3}(?:,\d{3})+(?:\.\d+)?|\d+(?:\.\d+)?|\.\d+)(?!\.\d)(?![\d,]\d)"
     r"(?P<exp>[eE][+\-]?\d+)?(?!st\b|nd\b|rd\b|th\b)"
-    r"(?:\s?(?P<suffix>k|K|M|bn)\b)?"
+    r"(?:\s?(?P<suffix>k|K|M|bn)\b|\s(?P<scale>thousand|million|billion)\b)?"
     r"(?P<den>/\d+(?:\.\d+)?)?"
     r"(?P<pct>\s?(?:%|percent\b|per cent\b|percentage points?\b|pp\b|points?\b))?")
 
@@ -103,7 +104,8 @@ def find_numbers(text: str) -> list[Number]:
         unit = _step(digits.split(".")[0] if not decimals else digits, decimals)
         if m.group("exp"):
             unit *= 10.0 ** int(m.group("exp")[1:])
-        scale = {"k": 1e3, "K": 1e3, "M": 1e6, "bn": 1e9}.get(m.group("suffix") or "", 1.0)
+        scale = {"k": 1e3, "K": 1e3, "M": 1e6, "bn": 1e9, "thousand": 1e3, "million": 1e6, "billion": 1e9}.get(
+            m.group("suffix") or (m.group("scale") or "").lower(), 1.0)
         value, unit = value * scale, unit * scale
         alts = ()
         if m.group("den"):
