@@ -41,7 +41,8 @@ SPLITS = ("dev", "dev2", "test")
 def load_corpus() -> list[dict]:
     """Every narrative with its case's Explanation, domain, split, label and error kind. ``dev2`` holds narratives
     written later, on the dev cases only, in other voices (tuning material like ``dev``)."""
-    cases = {c["id"]: c for c in json.loads((DATA / "cases.json").read_text())}
+    cases = {c["id"]: c for path in (DATA / "cases.json", DATA / "dev2" / "cases.json")
+             for c in json.loads(path.read_text())}
     out = []
     for domain in domains.DOMAINS:
         for path, later in ((DATA / f"{domain}.yaml", False), (DATA / "dev2" / f"{domain}.yaml", True)):

@@ -7,6 +7,7 @@ Cases 0-3 of each domain are the dev split, 4-7 the test split; the split was fi
 written or any verifier change was made. Run once; the corpus refers to the stored numbers, not to a re-run.
 
     .venv/bin/python benchmarks/make_narrative_cases.py
+    .venv/bin/python benchmarks/make_narrative_cases.py --dev2   # dev2/cases.json: two UAV 'stay' dev cases
 """
 from __future__ import annotations
 
@@ -41,18 +42,38 @@ def _explanations(domain: str) -> xairl.Explanation:
     return xairl.explain(policy, states, background=policy.background(100, seed=0))
 
 
+def _one(exp: xairl.Explanation, i: int) -> dict:
+    one = xairl.Explanation(**{**exp.__dict__, "values": exp.values[i:i + 1], "base_values": exp.base_values[i:i + 1],
+                               "outputs": exp.outputs[i:i + 1], "states": exp.states[i:i + 1],
+                               "available": None if exp.available is None else exp.available[i:i + 1]})
+    return json.loads(one.to_json())
+
+
+def _dev2_cases() -> list[dict]:
+    """Two more UAV cases for the dev2 narratives, both 'stay' (the dev split's UAV cases are all handovers), from
+    another pool of flights than the frozen cases."""
+    from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint
+
+    policy = domains.policy("uav")
+    pool = dqn_decision_states(load_checkpoint(), 400, seed=17)
+    states = pool[policy.act(pool) == 0][:2]
+    exp = xairl.explain(policy, states, background=policy.background(100, seed=0))
+    return [{"id": f"uav-stay-{i}", "domain": "uav", "split": "dev", "explanation": _one(exp, i)} for i in range(2)]
+
+
 def main() -> None:
     torch.set_num_threads(1)
+    if "--dev2" in sys.argv:  # added after the freeze: new dev cases only, cases.json is left as it is
+        out = OUT.parent / "dev2" / "cases.json"
+        out.write_text(json.dumps(_dev2_cases(), indent=1) + "\n")
+        print(f"wrote {out}")
+        return
     cases = []
     for domain in domains.DOMAINS:
         exp = _explanations(domain)
         for i in range(len(exp.values)):
-            one = xairl.Explanation(**{**exp.__dict__, "values": exp.values[i:i + 1],
-                                       "base_values": exp.base_values[i:i + 1], "outputs": exp.outputs[i:i + 1],
-                                       "states": exp.states[i:i + 1],
-                                       "available": None if exp.available is None else exp.available[i:i + 1]})
             cases.append({"id": f"{domain}-{i}", "domain": domain, "split": "dev" if i < 4 else "test",
-                          "explanation": json.loads(one.to_json())})
+                          "explanation": _one(exp, i)})
     OUT.write_text(json.dumps(cases, indent=1) + "\n")
     print(f"wrote {len(cases)} cases to {OUT}")
 
