@@ -98,7 +98,8 @@ _ABBREVIATION = re.compile(r"(?:^|[\s(])(?:e\.g|i\.e|vs|approx|ca|etc|no|fig|cf)
 _CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|however)\b|,\s(?:and\s)?(?=but\b)",
                         re.IGNORECASE)
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
-_GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:it|this|that|they|these|those|which|everything"
+_GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|practically|"
+                              r"just about)\s+)?(?:it|this|that|they|these|those|which|everything"
                               r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
                               r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total)\b(?!'s)",
                               re.IGNORECASE)
@@ -231,7 +232,8 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         return checks.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
     after = masked[n.end:n.end + 24]
     nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
-    if nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|by)\s+$", masked[n.end:nxt.start]):
+    if nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|by)\s+(?:a\s+|an\s+|the\s+)?$",
+                                                           masked[n.end:nxt.start]):
         return checks.action_number(n, checks.resolve_action(nxt, book), masked, book)
     gap = masked[n.end:nxt.start] if nxt is not None else ""
     if nxt is not None and nxt.kind != "action" and re.match(r"^[\s-]*(?:[a-z]+[\s-]+){0,2}(?:of\s+)?$", gap,
@@ -293,7 +295,7 @@ def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_word
     name (then it may be a vague mention: 'a quality rating of 10/10 adds ...')."""
     words = [w for w in re.findall(r"[A-Za-z]{3,}", subject.replace("\0", " ")) if w.lower() not in _LINKS]
     if not words or mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")) or \
-            any(w.lower() in name_words for w in words):
+            any(w.lower() in name_words or re.fullmatch(checks._NOUN, w, re.IGNORECASE) for w in words):
         return []
     return [Claim("feature", subject.strip(" ,:-\0"), "contradicted",
                   f"'{word}' is said of something that is not a feature of this model")]
@@ -304,6 +306,13 @@ def _ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook,
     names = _names(mentions)
     for m in checks.RANK_RE.finditer(masked, a, b):
         rank, plural, sign = checks.rank_claim(m, masked)
+        side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])
+        if not sign and side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
+            # 'the main argument for staying': the largest that favours it
+            sign = 1 if side.group(1) else -1
+            obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - side.end() <= 6), None)
+            if obj is not None and checks.resolve_action(obj, book) == book.runner_up:
+                sign = -sign  # '... for the handover' when staying was chosen
         if plural:
             targets = [x for x in names if x.start >= m.end()] or [x for x in names if x.end <= m.start()]
             k = rank or len(targets)

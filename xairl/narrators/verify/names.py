@@ -214,6 +214,7 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
     return found, masked
 
 
+_ORDINALS = frozenset({"second", "third", "fourth", "fifth", "2nd", "3rd", "4th", "5th"})
 _IDIOM = re.compile(r"\b(?:on|of)\s+(?:its|their|his|her|my|our|your)\s+$", re.IGNORECASE)
 _QUALIFIER_STOP = re.compile(r"[,.;:!?()\[\]]|\b(?:the|a|an|and|or|of|with|by|to|was|is|were|are|than|from|while|"
                              r"for|at|as|on|in|its|their|his|her|that|which)\b", re.IGNORECASE)
@@ -241,6 +242,8 @@ def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -
             qual = [w for w in split_words(text[out[-1].start:out[-1].end]) if w in known]  # "candidate 1's RSRP and RSRQ"
             lo = m.start
         keys = tuple(k for k in m.keys if qual and set(qual) <= words.get(k, frozenset()))
+        plain = tuple(k for k in keys if not (words.get(k, frozenset()) & _ORDINALS) - set(qual))
+        keys = plain or keys  # 'the strongest neighbour' is not 'the second strongest neighbour'
         if not keys or len(keys) == len(m.keys):
             out.append(m)
             continue
