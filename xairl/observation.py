@@ -228,7 +228,8 @@ def _numeric(data, what: str) -> np.ndarray:
 
 
 def _finite(arr: np.ndarray, what: str) -> np.ndarray:
-    arr = arr.astype(np.float32)  # check after the cast: values beyond float32's range become inf here
+    with np.errstate(over="ignore"):  # reported below as inf, in one line, not as a numpy warning
+        arr = arr.astype(np.float32)  # check after the cast: values beyond float32's range become inf here
     bad = ~np.isfinite(arr)
     if bad.any():
         r, c = np.argwhere(bad)[0]

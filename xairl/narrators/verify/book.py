@@ -47,6 +47,7 @@ class FactBook:
     global_view: bool = False
     n_states: int = 1
     closed: bool = False             # every number must be one of the facts (a summary made from given facts)
+    base_margin: float | None = None  # the margin with no reason either way (the background's average)
 
     @property
     def contexts(self) -> tuple[str, ...]:
@@ -100,7 +101,8 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     if deciding:
         numbers += [d.runner_up_score, d.q_margin, d.base_margin]
     book = FactBook(feats, exp.output, d.action, d.runner_up if deciding else None, scores,
-                    d.q_margin if deciding else None, base, numbers)
+                    d.q_margin if deciding else None, base, numbers,
+                    base_margin=float(d.base_margin) if deciding else None)
     add_facts(book, DomainFacts(d.extras, d.comparisons))
     return book
 

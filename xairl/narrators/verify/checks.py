@@ -146,9 +146,13 @@ _CONTRIB_BEFORE = re.compile(
     r"another|\banother|drops?|takes|took|loses|gains?|\bby a margin of|\|shap\|:?|"
     r"edge of|favou?red \w+ by|for \w+ by|\bdown|\bup)\s*(?:\(|about|around|roughly|nearly|almost|"
     r"approximately|some|only|just|a further|another|over|under)?\s*[+\-]?[$€£]?\s*$", re.IGNORECASE)
+_LISTS_CONTRIBUTIONS = re.compile(r"shap|attribution|contribut|impact|effect|φ|phi|importance|weight|push|margin",
+                                  re.IGNORECASE)
 _MARGIN_BEFORE = re.compile(r"\b(margin|lead|edge|gap|advantage|difference)(?: of)?\W*(?:about|around|roughly|only|"
                             r"just)?\s*$|\b(won|wins|beat\w*|ahead|stayed ahead|led)\s+(?:\w+\s+){0,3}by\s+(?:about|"
                             r"around|roughly|only|just)?\s*$", re.IGNORECASE)
+_ON_AVERAGE = re.compile(r"^\s*(?:on average|over the background|across the background|at baseline|by default)\b",
+                         re.IGNORECASE)
 _MARGIN_AFTER = re.compile(r"^\s*(?:points?\s+)?(?:above|ahead|higher|more than)\b", re.IGNORECASE)
 _RUNNER_BEFORE = re.compile(r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?[$€£]?\s*$", re.IGNORECASE)
 _SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
@@ -197,6 +201,10 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     # options ('argued against it') without saying which view
     contexts = book.contexts if ctx == EITHER else (ctx or "chosen",)
 
+    # an unsigned number in brackets right after the name is its value ('distance (0.84)'); a signed one may be either
+    # ... unless the sentence has already said it lists contributions ('Top features by absolute SHAP value: A (0.11)')
+    slot = not n.sign and not n.currency and not n.percent and bool(re.search(r"\0\s?\($", before)) and \
+        masked[n.end:n.end + 1] in (")", ",") and not _LISTS_CONTRIBUTIONS.search(masked[:n.start])
     fill_cue = n.percent and re.match(r"\s*(full|of (?:its |the )?capacity)\b", after, re.IGNORECASE)
 
     def test(key):
@@ -204,7 +212,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         if fill_cue and e.fill is not None:  # '8 % full': the fill, nothing else
             return matches(n, e.fill), f"{key}'s fill is {e.fill:.3g} % of its capacity"
         unit = unit_of(key).lower()
-        value_cue = bool(unit) and after.strip().lower().startswith(unit.split()[0]) and not contrib_cue
+        value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or slot) and not contrib_cue
         cands = []
         if not contrib_cue and e.value is not None:
             cands.append(("value", e.value))
@@ -238,6 +246,10 @@ def action_number(n: Number, action: str | None, masked: str, book: FactBook) ->
         return free_number(n, masked, book)
     before = masked[max(0, n.start - 40):n.start]
     if _MARGIN_BEFORE.search(before) and book.margin is not None:
+        if _ON_AVERAGE.match(masked[n.end:n.end + 40]) and book.base_margin is not None:
+            ok = matches(n, book.base_margin)  # 'it led by 3.4 on average over the background'
+            return Claim("number", n.text, "verified" if ok else "contradicted",
+                         f"the margin over the background is {book.base_margin:.4g}")
         ok = matches(n, book.margin)
         return Claim("number", n.text, "verified" if ok else "contradicted", f"the margin is {book.margin:.4g}")
     if action is None or action not in book.scores:

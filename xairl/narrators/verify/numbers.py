@@ -5,7 +5,8 @@ points, fractions, scientific notation, Unicode minus, number words, and the hed
 A :class:`Number` knows what it may stand for (``value`` and ``alternatives``) and how precisely it was written
 (``unit``, one step of its last written digit). :func:`matches` compares it with a fact:
 
-- written plainly: equal after rounding to the written digits, or truncated to them ("6,157" for 6157.86);
+- written plainly: equal after rounding to the written digits, or truncated to them with at least three significant
+  digits ("6,157" for 6157.86, not "0.42" for 0.4252);
 - with a symmetric hedge ("about", "around", "roughly", "approximately", "~", "some", "close to"): within 20 % of the
   fact, or equal after rounding;
 - "nearly", "almost", "just under", "a bit under": the fact is at most the number and within 20 % of it;
@@ -14,6 +15,7 @@ A :class:`Number` knows what it may stand for (``value`` and ``alternatives``) a
 """
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
@@ -138,9 +140,20 @@ def matches(n: Number, fact: float, magnitude_ok: bool = True) -> bool:
     return any(_close(x, target, n.unit if x == n.value else ratio * abs(x), n.hedge) for x in n.readings)
 
 
+def _half_up(v: float, step: float) -> float:
+    """``v`` rounded to a multiple of ``step``, halves away from zero (as people and templates round)."""
+    k = abs(v) / step
+    return math.copysign(math.floor(k + 0.5 + 1e-9) * step, v)
+
+
 def _close(x: float, fact: float, step: float, hedge: str) -> bool:
-    rounding = 0.55 * step + 1e-9 + 1e-6 * abs(fact)  # 0.55: rounded from an already rounded display
-    exact = abs(x - fact) <= rounding or (abs(x) <= abs(fact) < abs(x) + step and x * fact >= 0)
+    rounding = 0.5 * step + 1e-9 + 1e-6 * abs(fact)
+    if abs(x - _half_up(_half_up(fact, step / 10), step)) <= 1e-9 + 1e-6 * abs(fact):
+        return True  # rounded from an already rounded display: 2.345 -> 2.35 -> 2.4
+    # truncated to the written digits ('6,157' for 6157.86) only with three significant digits or more: a short number
+    # is rounded, and '0.42' for 0.4252 is more likely a wrong number than a truncation
+    truncated = abs(x) >= 100 * step and abs(x) <= abs(fact) < abs(x) + step and x * fact >= 0
+    exact = abs(x - fact) <= rounding or truncated
     if not hedge:
         return exact
     near = exact or abs(x - fact) <= HEDGE_TOLERANCE * abs(fact)
