@@ -228,6 +228,11 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         shown = ", ".join(f"{w} {v:.4g}" for w, v in cands)
         return False, f"{n.text} is not {key}'s {shown or 'value'}"
 
+    if re.match(r"\s*[A-Za-z]+\s+(above|below|stronger|weaker|better|worse|higher|lower)\b", after):
+        # '1.9 dB above the serving BS's RSRP': a difference in a unit, neither a value nor a contribution
+        ok = comparison(n, after, book)
+        return Claim("number", n.text, "verified" if ok else ("contradicted" if book.by_unit else "unchecked"),
+                     "a domain comparison in its unit" if ok else "a difference no fact states")
     claim = _over_keys(keys, test, "feature", n.text, "number")
     if claim.status == "contradicted" and comparison(n, after, book):
         return Claim("number", n.text, "verified", "a domain comparison in its unit")
