@@ -4,7 +4,8 @@ The corpus (``benchmarks/data/narratives``): 320 narratives about 32 explanation
 credit default, one output each, not RL; the UAV handover DQN; the toy discrete policy), half accurate and half
 with one labelled error, in many voices. Cases 0-3 of each domain are the dev split (the verifier was tuned on it),
 cases 4-7 the test split (frozen before any tuning; report it apart); ``dev2/`` 60 more narratives on the dev
-cases in other voices (Q&A, LLM-style prose, shorthand, lists), written after the freeze for tuning. A narrative counts as agreeing when
+cases in other voices (Q&A, LLM-style prose, shorthand, lists) and ``dev3/`` 50 more (shares, 'accounts for', pipes,
+counterfactuals), each written after the freeze and measured once before tuning on it. A narrative counts as agreeing when
 ``Verification.ok`` equals its label.
 
     .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain and error kind, speed
@@ -35,24 +36,25 @@ from tests import narrative_domains as domains  # noqa: E402
 DATA = pathlib.Path(__file__).parent / "data" / "narratives"
 
 
-SPLITS = ("dev", "dev2", "test")
+SPLITS = ("dev", "dev2", "dev3", "test")
 
 
 def load_corpus() -> list[dict]:
-    """Every narrative with its case's Explanation, domain, split, label and error kind. ``dev2`` holds narratives
-    written later, on the dev cases only, in other voices (tuning material like ``dev``)."""
+    """Every narrative with its case's Explanation, domain, split, label and error kind. ``dev2`` and ``dev3`` hold
+    narratives written later, on the dev cases only, in other voices (tuning material like ``dev``)."""
     cases = {c["id"]: c for path in (DATA / "cases.json", DATA / "dev2" / "cases.json")
              for c in json.loads(path.read_text())}
     out = []
     for domain in domains.DOMAINS:
-        for path, later in ((DATA / f"{domain}.yaml", False), (DATA / "dev2" / f"{domain}.yaml", True)):
+        for path, later in ((DATA / f"{domain}.yaml", None), (DATA / "dev2" / f"{domain}.yaml", "dev2"),
+                            (DATA / "dev3" / f"{domain}.yaml", "dev3")):
             for case_id, items in yaml.safe_load(path.read_text()).items():
                 case = cases[case_id]
                 assert not later or case["split"] == "dev", f"{path}: {case_id} is not a dev case"
                 exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
                 for item in items:
                     (label, text), = item.items()
-                    out.append({"case": case_id, "domain": domain, "split": "dev2" if later else case["split"],
+                    out.append({"case": case_id, "domain": domain, "split": later or case["split"],
                                 "error": label, "accurate": label == "ok", "text": text, "explanation": exp})
     return out
 
