@@ -171,8 +171,9 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     ctx = _context(sentence, mentions, book)
     claims: list[Claim] = [Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys))
                            for m in mentions if m.kind == "feature"]
+    hypothetical = bool(_HYPOTHETICAL.search(masked))  # 'had X been better, it would have stayed': not what happened
     for m in mentions:
-        c = checks.check_action(sentence, m, book) if m.kind == "action" else \
+        c = checks.check_action(sentence, m, book) if m.kind == "action" and not hypothetical else \
             checks.check_label(sentence, m, book) if m.kind == "label" else None
         if c is not None:
             claims.append(c)
@@ -180,7 +181,8 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book) if len(bounds) > 2 else None  # '..., yet against staying'
-        claims += _check_clause(masked, a, b, inside, book, own or ctx, unit_of, vocab.name_words)
+        found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, vocab.name_words)
+        claims += [c for c in found if not hypothetical or c.kind in ("number", "category")]
     for ident in _IDENT_RE.findall(masked):
         claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
     return claims
@@ -228,6 +230,8 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     credit history'); the name before it in its clause unless a new noun phrase starts between them; else none."""
     if id(n) in paired:
         return checks.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of)
+    if checks._CHANGE_AFTER.match(masked[n.end:n.end + 30]):  # 'most of the $91,462 above the baseline'
+        return checks.free_number(n, masked, book)
     if id(n) in scored:
         return checks.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
     after = masked[n.end:n.end + 24]
@@ -257,7 +261,14 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     return checks.free_number(n, masked, book)
 
 
+_HYPOTHETICAL = re.compile(r"\b(?:would|could|might)\b|\bif it (?:were|was)(?:n't| not) for\b|\bhad\b[^.;]{0,60}\bbeen\b",
+                           re.IGNORECASE)
 _PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
+_SIDE_WORD = re.compile(r"^(?:against|in favou?r of|favou?r\w*|toward\w*|supports?|support\w*|works? against|worked against)$",
+                        re.IGNORECASE)
+#: an object that is not the model's output: the applicant, the house, them
+_PERSON_OBJECT = re.compile(r"^\s+(?:the\s+|this\s+|that\s+)?(?:applicant|borrower|customer|client|person|buyer|seller|"
+                            r"owner|house|home|property|him|her|them|it|us|you)\b", re.IGNORECASE)
 _LINKS = {"but", "and", "also", "yet", "then", "still", "even", "only", "while", "though", "thus", "hence"}
 _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:but|except(?: for)?|apart from|other than)"
                      r"\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
@@ -271,6 +282,8 @@ def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: Fact
     for i, m in enumerate(found):
         if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(masked, m, mentions):
             continue  # 'a salaried job helps': helps the applicant, so lowers the risk? not a checkable direction
+        if book.output != "actions" and _SIDE_WORD.match(m.group(0)) and _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
+            continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
         subjects = [x for x in names if prev <= x.start < m.start()]
         if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')

@@ -270,13 +270,13 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     fact or, when it is a contribution, the one feature whose contribution it is."""
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 30]
     named = None
-    if _MARGIN_BEFORE.search(before) or _MARGIN_AFTER.match(after):
-        named = ("the margin", [book.margin if book.margin is not None else 0.0])  # one available action: 0
-    elif _CHANGE_AFTER.match(after) and book.base is not None:
+    if _CHANGE_AFTER.match(after) and book.base is not None:  # '$91,462 above the baseline'
         change = book.scores[book.chosen] - book.base
         ok = matches(n, change) or (n.percent and _percent_readings(n, abs(change)))
         return Claim("number", n.text, "verified" if ok else "contradicted", f"the change from the baseline is "
                      f"{change:.4g}")
+    if _MARGIN_BEFORE.search(before) or _MARGIN_AFTER.match(after):
+        named = ("the margin", [book.margin if book.margin is not None else 0.0])  # one available action: 0
     elif (_SCORE_BEFORE.search(before) or re.match(r"^\s*(vs\.?|versus)\s", after)) and book.chosen in book.scores:
         named = ("the chosen action's score", [book.scores[book.chosen]])
     elif _RUNNER_BEFORE.search(before) and book.runner_up:
