@@ -4,6 +4,7 @@ import pathlib
 import time
 
 import numpy as np
+import torch
 import pytest
 
 import xairl
@@ -117,7 +118,7 @@ def corpus():
 
 def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
-    for split, floor in (("dev", 0.9), ("test", 0.8)):
+    for split, floor in (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("test", 0.86)):
         part = [it for it in corpus if it["split"] == split]
         agree = sum(it["ok"] == it["accurate"] for it in part) / len(part)
         assert agree >= floor, (split, agree)
@@ -134,3 +135,59 @@ def test_exact_restatements_verify_in_every_domain():
             text = f"The SHAP value of feature {f} is {exp.values[0, j, a]:.2f}."
             res = xairl.verify(text, exp, 0, policy)
             assert res.ok, (case["id"], text, res.problems())
+
+
+def _signal_policy():
+    """Three RSRQ features described the way a radio plugin describes them (serving cell, ranked neighbours)."""
+    who = ("the serving BS", "the strongest neighbour", "the second strongest neighbour")
+    features = {f"rsrq_{k}": xairl.FeatureInfo("dB", f"{w}'s RSRQ", aliases=(f"candidate {k}'s RSRQ",) if k else ())
+                for k, w in enumerate(who)}
+    net = torch.nn.Linear(3, 2)
+    return xairl.TorchPolicy(net, list(features), ["stay", "handover"], features=features)
+
+
+def test_qualifiers_narrow_an_ambiguous_name():
+    policy = _signal_policy()
+    exp = xairl.explain(policy, np.array([[-20.0, -10.0, -14.0]], np.float32),
+                        background=np.zeros((4, 3), np.float32), method="exact")
+    vocab = vocabulary(exp, policy, clean_surface)
+
+    def keys(text):
+        return [m.keys for m in find_mentions(text, vocab)[0] if m.kind == "feature"]
+    assert keys("the serving cell's poor RSRQ") == [("rsrq_0",)]          # 'serving' belongs to rsrq_0 only
+    assert keys("candidate 1's excellent RSRQ") == [("rsrq_1",)]
+    assert keys("the strongest neighbour's weak RSRQ") == [("rsrq_1",)]   # not the *second* strongest
+    assert keys("candidate 1's RSRQ and RSRQ") == [("rsrq_1",), ("rsrq_1",)]  # the qualifier carries over 'and'
+    assert len(keys("its RSRQ")[0]) == 3                                  # no qualifying word: still ambiguous
+
+
+def test_rounding_scale_words_and_truncation():
+    def num(t):
+        return find_numbers(normalise(t))[0]
+    assert num("roughly 40 thousand dollars").value == 40_000
+    assert matches(num("2.4"), 2.345)            # rounded twice: 2.345 -> 2.35 -> 2.4
+    assert matches(num("0.43"), 0.4252) and not matches(num("0.42"), 0.4252)  # half-up, no slack beyond it
+    assert matches(num("6,157"), 6157.86) and not matches(num("0.42"), 0.4299)  # truncation needs 3 digits
+
+
+def test_directions_people_write():
+    exp = _exp(contrib=(0.11, -0.15, 0.05))
+
+    def statuses(text):
+        return [c.status for c in xairl.verify(text, exp, 0).claims if c.kind == "direction"]
+    assert statuses("Everything but the odor raised the prediction.") == ["verified"]  # odor: the opposite
+    assert statuses("Everything but the gill size raised the prediction.") == ["contradicted"]
+    assert statuses("The odor helps (-0.15).") == []            # helps whom? no direction for a one-output model
+    assert statuses("The odor works against the applicant.") == []
+    res = xairl.verify("Had the odor been none, the prediction would have been much higher.", exp, 0)
+    assert res.sentences[0].status == "unchecked" and not res.ok   # hypothetical: not a statement of what happened
+    res = xairl.verify("The prediction is 0.31 above the baseline.", exp, 0)
+    assert [c.status for c in res.claims if c.kind == "number"] == ["contradicted"]  # the change is 0.01
+
+
+def test_vague_names_are_not_invented_features():
+    exp = _exp(names=("overall_quality", "kitchen_quality", "lot_area"), categories=None)
+    res = xairl.verify("A quality rating of 10/10 adds 0.11.", exp, 0)
+    assert not [c for c in res.claims if c.status == "contradicted"]   # 'quality': ambiguous, not unknown
+    res = xairl.verify("The swimming pool adds 0.11.", exp, 0)
+    assert [c.status for c in res.claims if c.kind == "feature"] == ["contradicted"]

@@ -171,9 +171,10 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     ctx = _context(sentence, mentions, book)
     claims: list[Claim] = [Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys))
                            for m in mentions if m.kind == "feature"]
-    hypothetical = bool(_HYPOTHETICAL.search(masked))  # 'had X been better, it would have stayed': not what happened
+    # 'had X been better, it would have stayed': not what happened; only its numbers are checked
+    hypothetical = bool(_HYPOTHETICAL.search(masked))
     for m in mentions:
-        c = checks.check_action(sentence, m, book) if m.kind == "action" and not hypothetical else \
+        c = None if hypothetical else checks.check_action(sentence, m, book) if m.kind == "action" else \
             checks.check_label(sentence, m, book) if m.kind == "label" else None
         if c is not None:
             claims.append(c)
@@ -182,7 +183,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book) if len(bounds) > 2 else None  # '..., yet against staying'
         found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, vocab.name_words)
-        claims += [c for c in found if not hypothetical or c.kind in ("number", "category")]
+        claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     for ident in _IDENT_RE.findall(masked):
         claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
     return claims
