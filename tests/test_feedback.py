@@ -105,6 +105,9 @@ def test_cli_narrate_then_review(tmp_path, capsys, monkeypatch):
     assert len(lines) == 2 and all(x["verified"] and 0 < x["confidence"] <= 1 for x in lines)
     monkeypatch.setattr("sys.stdin", io.StringIO("r\nc\nOperator wording.\n"))
     assert main(["review", "--db", str(db)]) == 0
+    shown = capsys.readouterr().out
+    first = lines[0]["sentences"][0]["text"]
+    assert f"    verified      {first}" in shown.splitlines()  # each sentence with its status
     assert [r.status for r in FeedbackStore(db).records()] == ["rejected", "corrected"]
     out = tmp_path / "corr.jsonl"
     assert main(["review", "--db", str(db), "--export", str(out)]) == 0

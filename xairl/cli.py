@@ -222,7 +222,9 @@ def cmd_review(args) -> int:
     for r in pending:
         bad = [c for c in r.claims if c["status"] != "verified"]
         print(f"\n#{r.id} [{r.template}, {r.source}, confidence {r.confidence:.2f}, "
-              f"{'verified' if r.verified else f'{len(bad)} unverified claim(s)'}]\n    {r.text}")
+              f"{'verified' if r.verified else f'{len(bad)} unverified claim(s)'}]")
+        marked = (r.evidence or {}).get("sentences") or []
+        print("\n".join(f"    {_MARKS.get(st, st):<13} {t}" for t, st in marked) or f"    {r.text}")
         while True:
             try:
                 answer = input("[a]ccept  [r]eject  [c]orrect  [s]kip  [q]uit > ").strip().lower()[:1]
