@@ -10,7 +10,7 @@ A small pipeline, one module per step:
    'barely matters' phrase to the names around it (a number to the name before it in its clause, or pairwise for
    'A and B ... by x and y, respectively'; a direction word to the names since the previous one, or to a list that
    follows it, 'Raising risk: A, B');
-4. :mod:`.checks` checks each claim against :mod:`.book` (values, contributions to the chosen action's score and to
+4. :mod:`.checks` (and :mod:`.ranks` for ranks and magnitude) checks each claim against :mod:`.book` (values, contributions to the chosen action's score and to
    the margin over the runner-up, ranks, shares, labels, scores, domain comparisons) and says verified,
    contradicted or unchecked;
 5. every sentence gets a status (contradicted if any claim is; verified if a claim was checked and none is
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 from ...explanation import Explanation
 from ...policy import Policy
-from . import checks
+from . import checks, ranks
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, vocabulary
@@ -213,11 +213,11 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
         out.append(_bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of))
     out += _directions(masked, a, b, mentions, book, ctx, name_words)
     out += _ranks(masked, a, b, mentions, book, ctx)
-    for m in checks.MINOR_RE.finditer(masked, a, b):
+    for m in ranks.MINOR_RE.finditer(masked, a, b):
         owner = next((x for x in reversed(names) if x.end <= m.start()), None) or next(
             (x for x in names if x.start >= m.end()), None)
         if owner is not None:
-            out.append(checks.check_minor(owner.keys, ctx, book, m.group(0)))
+            out.append(ranks.check_minor(owner.keys, ctx, book, m.group(0)))
     return out
 
 
@@ -309,7 +309,7 @@ def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_word
     name (then it may be a vague mention: 'a quality rating of 10/10 adds ...')."""
     words = [w for w in re.findall(r"[A-Za-z]{3,}", subject.replace("\0", " ")) if w.lower() not in _LINKS]
     if not words or mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")) or \
-            any(w.lower() in name_words or re.fullmatch(checks._NOUN, w, re.IGNORECASE) for w in words):
+            any(w.lower() in name_words or re.fullmatch(ranks.NOUN, w, re.IGNORECASE) for w in words):
         return []
     return [Claim("feature", subject.strip(" ,:-\0"), "contradicted",
                   f"'{word}' is said of something that is not a feature of this model")]
@@ -318,8 +318,8 @@ def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_word
 def _ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
     out = []
     names = _names(mentions)
-    for m in checks.RANK_RE.finditer(masked, a, b):
-        rank, plural, sign = checks.rank_claim(m, masked)
+    for m in ranks.RANK_RE.finditer(masked, a, b):
+        rank, plural, sign = ranks.rank_claim(m, masked)
         side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])
         if not sign and side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
             # 'the main argument for staying': the largest that favours it
@@ -331,20 +331,20 @@ def _ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook,
             targets = [x for x in names if x.start >= m.end()] or [x for x in names if x.end <= m.start()]
             k = rank or len(targets)
             for t in targets:
-                out.append(checks.check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {masked[t.start:t.end]}"))
+                out.append(ranks.check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {masked[t.start:t.end]}"))
             continue
         before = [x for x in names if x.end <= m.start()]
         target = before[-1] if before else next((x for x in names if x.start >= m.end()), None)
         if target is None:
             continue
-        out.append(checks.check_rank(target.keys, rank, None, sign, ctx, book, m.group(0)))
+        out.append(ranks.check_rank(target.keys, rank, None, sign, ctx, book, m.group(0)))
         for x in names:  # 'followed by B', 'B second'
-            if x.start >= m.end() and checks._FOLLOWED.search(masked[max(a, x.start - 24):x.start]):
+            if x.start >= m.end() and ranks.FOLLOWED.search(masked[max(a, x.start - 24):x.start]):
                 rank += 1
-                out.append(checks.check_rank(x.keys, rank, None, sign, ctx, book, f"then {masked[x.start:x.end]}"))
+                out.append(ranks.check_rank(x.keys, rank, None, sign, ctx, book, f"then {masked[x.start:x.end]}"))
     for x in names:
-        o = checks._AFTER_ORD.match(masked[x.end:b])
-        if o and not checks.RANK_RE.match(masked[x.end:b].lstrip(" ,(")):
-            out.append(checks.check_rank(x.keys, checks._ORD[o.group("o").lower()], None, 0, ctx, book,
+        o = ranks.AFTER_ORD.match(masked[x.end:b])
+        if o and not ranks.RANK_RE.match(masked[x.end:b].lstrip(" ,(")):
+            out.append(ranks.check_rank(x.keys, ranks.ORD[o.group("o").lower()], None, 0, ctx, book,
                                          f"{masked[x.start:x.end]} {o.group('o')}"))
     return out

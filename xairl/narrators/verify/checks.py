@@ -1,5 +1,5 @@
-"""One function per kind of claim. Each takes a clause (or sentence) already read into mentions and numbers and
-returns :class:`Claim`\\ s: verified, contradicted, or unchecked (with the reason)."""
+"""One function per kind of claim (ranks and magnitude in :mod:`.ranks`). Each takes a clause (or sentence) already
+read into mentions and numbers and returns :class:`Claim`\\ s: verified, contradicted, or unchecked (with the reason)."""
 from __future__ import annotations
 
 import re
@@ -39,33 +39,9 @@ VALENCE_RE = re.compile(r"^(?:help|hurt)", re.IGNORECASE)  # whose side? a direc
 DIRECTION_RE = re.compile(rf"\b(?:(?P<pos>{_POS})|(?P<neg>{_NEG}))\b", re.IGNORECASE)
 _NEGATION = re.compile(r"\b(not|n't|never|no longer|neither|nor)\b[^.]{0,12}$", re.IGNORECASE)
 
-_ORD = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4, "fifth": 5}
-_COUNT = {"two": 2, "three": 3, "four": 4, "five": 5, "2": 2, "3": 3, "4": 4, "5": 5}
-_NOUN = r"(?:features?|factors?|drivers?|reasons?|contributors?|contributions?|influences?|inputs?|effects?|" \
-        r"positives?|negatives?|boosts?|push(?:es)?|arguments?|concerns?|variables?|predictors?|attributions?|story)"
-_TOPWORD = r"(?:most important|most influential|most significant|most decisive|biggest|largest|strongest|main|top|" \
-           r"primary|key|dominant|leading|greatest|decisive|single biggest|single largest|one big|big)"
-RANK_RE = re.compile(
-    rf"\b(?:(?P<ord>second|third|fourth|fifth|2nd|3rd|4th)(?: most important| most influential| biggest| largest|"
-    rf" strongest)?\s+(?:single\s+)?{_NOUN}"
-    rf"|(?P<because>(?:mostly|mainly|chiefly|largely|primarily) (?:because of|due to|thanks to|on))"
-    rf"|(?:the\s+)?(?P<plural>(?:two|three|four|2|3|4)\s+(?:most important|largest|biggest|strongest|main)|"
-    rf"(?:top|the)[\s-]+(?P<k>two|three|four|2|3|4)(?:\s+most important|\s+largest|\s+biggest)?)\s+{_NOUN}"
-    rf"|(?P<top>{_TOPWORD})(?:\s+single)?\s+(?:risk\s+)?(?P<noun>{_NOUN})"
-    rf"|(?:mattered|matters|counted|counts|weighed) most|dominat\w+|ranks? (?P<rk>first|second|third)"
-    rf"|top[\s-](?P<topk>\d)\b)", re.IGNORECASE)
-_AFTER_ORD = re.compile(r"^\W{0,3}(?:[a-z]+\s+)?(?:was\s+|is\s+|came\s+|a\s+(?:distant|close)\s+)?(?P<o>second|third|fourth)\b",
-                        re.IGNORECASE)
-_FOLLOWED = re.compile(r"\b(?:followed(?: closely)? by|then|next(?: came| was)?|after that|ahead of|second only to)\s*$",
-                       re.IGNORECASE)
-MINOR_RE = re.compile(r"\b(?:barely|hardly|scarcely)\s+(?:\w+\s+)?(?:matter\w*|mov\w*|regist\w*|chang\w*|affect\w*|"
-                      r"counts?|counted)|\b(?:no real|almost no|essentially no|next to no|practically no|virtually no|"
-                      r"little|negligible|minimal|no)\s+(?:\w+\s+)?(?:effect|influence|impact|role|difference)\b|"
-                      r"\bnegligible\b", re.IGNORECASE)
-MINOR_SHARE = 10.0  # % of the sum of |contributions| below which 'barely matters' holds
 
 
-def _over_keys(keys: tuple[str, ...], test, what: str, text: str, kind: str) -> Claim:
+def over_keys(keys: tuple[str, ...], test, what: str, text: str, kind: str) -> Claim:
     """A claim about a mention that may mean several features: verified when it holds for all of them,
     contradicted when for none, else unchecked (ambiguous)."""
     results = [test(k) for k in keys]
@@ -233,7 +209,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         ok = comparison(n, after, book)
         return Claim("number", n.text, "verified" if ok else ("contradicted" if book.by_unit else "unchecked"),
                      "a domain comparison in its unit" if ok else "a difference no fact states")
-    claim = _over_keys(keys, test, "feature", n.text, "number")
+    claim = over_keys(keys, test, "feature", n.text, "number")
     if claim.status == "contradicted" and comparison(n, after, book):
         return Claim("number", n.text, "verified", "a domain comparison in its unit")
     return claim
@@ -341,7 +317,6 @@ def is_frame(masked: str, m: re.Match) -> bool:
 
 
 def check_direction(subjects: list[Mention], polarity: int, ctx: str, word: str, book: FactBook) -> list[Claim]:
-    out = []
     def test(key):
         contribs = book.features[key].contribs
         views = [v for v in book.contexts if v in contribs] if ctx == EITHER else [
@@ -353,58 +328,4 @@ def check_direction(subjects: list[Mention], polarity: int, ctx: str, word: str,
         v, c = (ok or cs)[0]
         return bool(ok), f"{key}'s contribution ({v}) is {c:+.3g}"
 
-    return [_over_keys(s.keys, test, ctx, word, "direction") for s in subjects]
-
-
-# -- ranks and magnitude ------------------------------------------------------------------------------------------
-def rank_claim(m: re.Match, masked: str) -> tuple[int, bool, int]:
-    """(rank or top-k, plural, sign restriction) a rank phrase states."""
-    text = m.group(0).lower()
-    sign = 1 if re.search(r"positive|boost|plus|argument for|push", text) else \
-        -1 if re.search(r"negative|drag|minus", text) else 0
-    if m.group("ord"):
-        return _ORD[m.group("ord").lower()], False, sign
-    if m.group("because"):
-        return 1, False, 0
-    if m.group("rk"):
-        return _ORD[m.group("rk").lower()], False, sign
-    if m.group("topk"):
-        return int(m.group("topk")), True, sign
-    if m.group("plural") or m.group("k"):
-        k = next((v for w, v in _COUNT.items() if re.search(rf"\b{w}\b", text)), 0)
-        return k, True, sign
-    if m.group("noun") and m.group("noun").lower().endswith("s") and m.group("noun").lower() != "story":
-        return 0, True, sign
-    return 1, False, sign
-
-
-def check_rank(keys: tuple[str, ...], rank: int, plural_k: int | None, sign: int, ctx: str | None, book: FactBook,
-               text: str) -> Claim:
-    contexts = (ctx,) if ctx and ctx != EITHER else book.contexts
-
-    def test(key):
-        e = book.features[key]
-        for c in contexts:
-            if c not in e.ranks or (sign and np.sign(e.contribs[c]) != sign):
-                continue
-            actual = e.signed_ranks[c] if sign else e.ranks[c]
-            if actual is None:  # an identifier: context, not a reason
-                continue
-            if (plural_k is not None and actual <= plural_k) or (plural_k is None and actual == rank):
-                return True, f"{key} ranks {actual} ({c})"
-        shown = ", ".join(f"{e.ranks[c]} ({c})" for c in contexts if c in e.ranks)
-        return False, f"{key} ranks {shown}"
-
-    return _over_keys(keys, test, "rank", text, "rank")
-
-
-def check_minor(keys: tuple[str, ...], ctx: str | None, book: FactBook, text: str) -> Claim:
-    contexts = (ctx,) if ctx and ctx != EITHER else book.contexts
-
-    def test(key):
-        shares = [book.features[key].shares[c] for c in contexts if c in book.features[key].shares]
-        if not shares:
-            return None
-        return min(shares) < MINOR_SHARE, f"{key} has {min(shares):.1f} % of the total |contribution|"
-
-    return _over_keys(keys, test, "magnitude", text, "magnitude")
+    return [over_keys(s.keys, test, ctx, word, "direction") for s in subjects]

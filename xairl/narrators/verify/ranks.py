@@ -1,0 +1,92 @@
+"""Rank and magnitude claims: 'the most important feature', 'second', 'the top three', 'mostly because of',
+'followed by', 'barely matters'; the phrases that state them and their checks."""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from .book import FactBook
+from .checks import EITHER, Claim, over_keys
+
+ORD = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4, "fifth": 5}
+COUNT = {"two": 2, "three": 3, "four": 4, "five": 5, "2": 2, "3": 3, "4": 4, "5": 5}
+NOUN = r"(?:features?|factors?|drivers?|reasons?|contributors?|contributions?|influences?|inputs?|effects?|" \
+        r"positives?|negatives?|boosts?|push(?:es)?|arguments?|concerns?|variables?|predictors?|attributions?|story)"
+TOPWORD = r"(?:most important|most influential|most significant|most decisive|biggest|largest|strongest|main|top|" \
+           r"primary|key|dominant|leading|greatest|decisive|single biggest|single largest|one big|big)"
+RANK_RE = re.compile(
+    rf"\b(?:(?P<ord>second|third|fourth|fifth|2nd|3rd|4th)(?: most important| most influential| biggest| largest|"
+    rf" strongest)?\s+(?:single\s+)?{NOUN}"
+    rf"|(?P<because>(?:mostly|mainly|chiefly|largely|primarily) (?:because of|due to|thanks to|on))"
+    rf"|(?:the\s+)?(?P<plural>(?:two|three|four|2|3|4)\s+(?:most important|largest|biggest|strongest|main)|"
+    rf"(?:top|the)[\s-]+(?P<k>two|three|four|2|3|4)(?:\s+most important|\s+largest|\s+biggest)?)\s+{NOUN}"
+    rf"|(?P<top>{TOPWORD})(?:\s+single)?\s+(?:risk\s+)?(?P<noun>{NOUN})"
+    rf"|(?:mattered|matters|counted|counts|weighed) most|dominat\w+|ranks? (?P<rk>first|second|third)"
+    rf"|top[\s-](?P<topk>\d)\b)", re.IGNORECASE)
+AFTER_ORD = re.compile(r"^\W{0,3}(?:[a-z]+\s+)?(?:was\s+|is\s+|came\s+|a\s+(?:distant|close)\s+)?(?P<o>second|third|fourth)\b",
+                        re.IGNORECASE)
+FOLLOWED = re.compile(r"\b(?:followed(?: closely)? by|then|next(?: came| was)?|after that|ahead of|second only to)\s*$",
+                       re.IGNORECASE)
+MINOR_RE = re.compile(r"\b(?:barely|hardly|scarcely)\s+(?:\w+\s+)?(?:matter\w*|mov\w*|regist\w*|chang\w*|affect\w*|"
+                      r"counts?|counted)|\b(?:no real|almost no|essentially no|next to no|practically no|virtually no|"
+                      r"little|negligible|minimal|no)\s+(?:\w+\s+)?(?:effect|influence|impact|role|difference)\b|"
+                      r"\bnegligible\b", re.IGNORECASE)
+MINOR_SHARE = 10.0  # % of the sum of |contributions| below which 'barely matters' holds
+
+def rank_claim(m: re.Match, masked: str) -> tuple[int, bool, int]:
+    """(rank or top-k, plural, sign restriction) a rank phrase states."""
+    text = m.group(0).lower()
+    sign = 1 if re.search(r"positive|boost|plus|argument for|push", text) else \
+        -1 if re.search(r"negative|drag|minus", text) else 0
+    if m.group("ord"):
+        return ORD[m.group("ord").lower()], False, sign
+    if m.group("because"):
+        return 1, False, 0
+    if m.group("rk"):
+        return ORD[m.group("rk").lower()], False, sign
+    if m.group("topk"):
+        return int(m.group("topk")), True, sign
+    if m.group("plural") or m.group("k"):
+        k = next((v for w, v in COUNT.items() if re.search(rf"\b{w}\b", text)), 0)
+        return k, True, sign
+    if m.group("noun") and m.group("noun").lower().endswith("s") and m.group("noun").lower() != "story":
+        return 0, True, sign
+    return 1, False, sign
+
+
+def check_rank(keys: tuple[str, ...], rank: int, plural_k: int | None, sign: int, ctx: str | None, book: FactBook,
+               text: str) -> Claim:
+    contexts = views(ctx, book)
+
+    def test(key):
+        e = book.features[key]
+        for c in contexts:
+            if c not in e.ranks or (sign and np.sign(e.contribs[c]) != sign):
+                continue
+            actual = e.signed_ranks[c] if sign else e.ranks[c]
+            if actual is None:  # an identifier: context, not a reason
+                continue
+            if (plural_k is not None and actual <= plural_k) or (plural_k is None and actual == rank):
+                return True, f"{key} ranks {actual} ({c})"
+        shown = ", ".join(f"{e.ranks[c]} ({c})" for c in contexts if c in e.ranks)
+        return False, f"{key} ranks {shown}"
+
+    return over_keys(keys, test, "rank", text, "rank")
+
+
+def check_minor(keys: tuple[str, ...], ctx: str | None, book: FactBook, text: str) -> Claim:
+    contexts = views(ctx, book)
+
+    def test(key):
+        shares = [book.features[key].shares[c] for c in contexts if c in book.features[key].shares]
+        if not shares:
+            return None
+        return min(shares) < MINOR_SHARE, f"{key} has {min(shares):.1f} % of the total |contribution|"
+
+    return over_keys(keys, test, "magnitude", text, "magnitude")
+
+
+def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
+    """The views a rank or magnitude claim is checked in: the one its sentence names, else any."""
+    return (ctx,) if ctx and ctx != EITHER else book.contexts
