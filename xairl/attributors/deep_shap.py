@@ -1,12 +1,19 @@
 """DeepSHAP: DeepLIFT multipliers averaged over a background, batched over all (state, background) pairs.
 
-Every pair is one row of a doubled batch ``[x_pairs; r_pairs]``. A forward hook on each nonlinear layer ties its
-output to its input through a custom backward (:class:`_Rule`) that gives the DeepLIFT multiplier of its own call
-(so a module used twice is handled per call): the rescale rule Δout/Δin for elementwise layers (and Softmax /
-LogSoftmax as a final layer), the max-pool rule shap uses for MaxPool. Linear layers (Linear, Conv, ConvTranspose,
-average pooling, BatchNorm in eval mode, reshapes) keep their exact gradients. One backward pass per output gives
-the multipliers. This gives the values of shap.DeepExplainer and captum's DeepLiftShap. A pure Sequential MLP on
-flat states takes a faster path (:func:`chain_multipliers`).
+A forward hook on each nonlinear layer ties its output to its input through a custom backward (:class:`_Rule`)
+that gives the DeepLIFT multiplier of its own call (so a module used twice is handled per call): the rescale rule
+Δout/Δin for elementwise layers (and Softmax / LogSoftmax as a final layer), the max-pool rule shap uses for MaxPool.
+Linear layers (Linear, Conv, ConvTranspose, average pooling, BatchNorm in eval mode, reshapes) keep their exact
+gradients. One backward pass per output gives the multipliers: the values of shap.DeepExplainer and captum's
+DeepLiftShap.
+
+Layouts: *split* (the default) runs the background through the network once and records each nonlinear call's
+activations; the batch then holds only the state side of every pair, and only it is back-propagated (half of shap's
+forward and backward work; every rule but Softmax's gives both sides of a pair the same gradient). *Joint* (as shap:
+the batch is ``[state sides; reference sides]``, both back-propagated) serves networks with Softmax / LogSoftmax and
+networks whose calls depend on their input. A pure Sequential MLP on flat states takes a faster path
+(:func:`chain_multipliers`). What is left is the work no exact method skips, a backward pass per output and pair:
+``benchmarks/bench_cnn.py`` times that floor.
 """
 from __future__ import annotations
 
@@ -146,10 +153,10 @@ class _Mismatch(Exception):
     layout."""
 
 
-def _hook(rule, calls=None, pairs=None):
+def _hook(rule, calls=None, m: int = 0):
     """The forward hook of one nonlinear layer. With ``calls`` (the reference side's (input, output) of each call,
-    recorded on the background in call order) and ``pairs`` (a one-element list: how many states the batch pairs
-    with the background), the split layout; else the joint one."""
+    recorded on the background in call order; consumed) and ``m`` (how many states the batch pairs with the
+    background), the split layout; else the joint one."""
     def hook(module, inputs, output):
         if not isinstance(output, torch.Tensor) or not inputs or not isinstance(inputs[0], torch.Tensor):
             return None
@@ -158,7 +165,6 @@ def _hook(rule, calls=None, pairs=None):
         if not calls or calls[0][0] is not module or calls[0][2].shape[1:] != output.shape[1:]:
             raise _Mismatch()
         _, ri, ro = calls.pop(0)
-        m = pairs[0]
         ri, ro = (t.unsqueeze(0).expand(m, *t.shape).reshape(m * t.shape[0], *t.shape[1:]) for t in (ri, ro))
         return _Rule.apply(inputs[0], output, ri, ro, module, rule)
     return hook
@@ -293,15 +299,14 @@ class DeepShap(Attributor):
         if split:
             with _hooked(rules, lambda rule: _recorder(calls)), torch.no_grad():
                 base = module(bt).double().mean(dim=0).cpu().numpy()
-        pairs = [0]
         for s in range(0, n, per):
             xs = xt[s:s + per]
-            m = pairs[0] = len(xs)
+            m = len(xs)
             xp = xs[:, None, :].expand(m, b, f).reshape(m * b, f)
             rp = bt[None, :, :].expand(m, b, f).reshape(m * b, f)
             rows = (xp if split else torch.cat([xp, rp])).detach().requires_grad_(True)
             queue = list(calls)
-            with _hooked(rules, (lambda rule: _hook(rule, queue, pairs)) if split else _hook):
+            with _hooked(rules, (lambda rule: _hook(rule, queue, m)) if split else _hook):
                 out = module(rows)
             if queue:
                 raise _Mismatch()
