@@ -51,3 +51,21 @@ def test_hooks_removed_after_an_injected_failure(name):
         handle.remove()
     assert hook_count(policy.module) == 0
     assert policy.module.training, "the module's training flag must be put back"
+
+
+@pytest.mark.parametrize("name", ["nature_cnn", "dict", "multi_input:connected:relu", "nested"])
+def test_split_layout_equals_the_joint_one(name):
+    """The split layout (reference sides from one background pass, only state sides back-propagated) gives the
+    joint layout's values (shap's: both sides back-propagated), max-pool networks included."""
+    from xairl.attributors.deep_shap import DeepShap, _rescale, check_supported
+
+    policy, x, bg, _ = build(name)
+    rules = check_supported(policy.network)
+    assert not any(rule is _rescale for _, rule in rules)  # no Softmax: the split layout is the one used
+    xt, bt = torch.as_tensor(policy.check_states(x)), torch.as_tensor(policy.check_states(bg))
+    attributor = DeepShap()
+    split, base_s, _ = attributor._attribute_pairs(policy.network, rules, xt, bt, policy.n_actions, split=True)
+    joint, base_j, _ = attributor._attribute_pairs(policy.network, rules, xt, bt, policy.n_actions, split=False)
+    assert np.abs(split - joint).max() <= 1e-6 * max(1.0, np.abs(joint).max()) and np.abs(joint).max() > 1e-6
+    np.testing.assert_allclose(base_s, base_j, rtol=1e-6, atol=1e-6)
+    assert hook_count(policy.network) == 0
