@@ -61,7 +61,7 @@ def _local_grad(layer, h):
 
 
 def _ratio(xi, xo, ri, ro):
-    """Δout/Δin per element of a pair (state side xi/xo, reference side ri/ro), and where |Δin| is too small for it."""
+    """Δout/Δin per element of a pair (state side xi/xo, reference side ri/ro), and where |Δin| is too small."""
     d_in = xi - ri
     ratio = (xo - ro) / torch.where(d_in == 0, torch.ones_like(d_in), d_in)
     return ratio, d_in.abs() < EPS

@@ -10,8 +10,8 @@ A small pipeline, one module per step:
    'barely matters' phrase to the names around it (a number to the name before it in its clause, or pairwise for
    'A and B ... by x and y, respectively'; a direction word to the names since the previous one, or to a list that
    follows it, 'Raising risk: A, B');
-4. :mod:`.checks` (and :mod:`.ranks` for ranks and magnitude) checks each claim against :mod:`.book` (values, contributions to the chosen action's score and to
-   the margin over the runner-up, ranks, shares, labels, scores, domain comparisons) and says verified,
+4. :mod:`.checks` (and :mod:`.ranks` for ranks and magnitude) checks each claim against :mod:`.book` (values,
+   contributions to the chosen action's score and to the margin over the runner-up, ranks, shares, labels, scores, domain comparisons) and says verified,
    contradicted or unchecked;
 5. every sentence gets a status (contradicted if any claim is; verified if a claim was checked and none is
    contradicted; else unchecked), and the text a coverage (share of sentences with a checked claim).
@@ -95,8 +95,8 @@ class Verification:
 
 _SENTENCE_RE = re.compile(r"(?<=[.!?])\s+(?=\S)|\n+\s*(?:[-•*]\s*)?")
 _ABBREVIATION = re.compile(r"(?:^|[\s(])(?:e\.g|i\.e|vs|approx|ca|etc|no|fig|cf)\.$", re.IGNORECASE)
-_CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|however)\b|,\s(?:and\s)?(?=but\b)",
-                        re.IGNORECASE)
+_CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|however)\b"
+                        r"|,\s(?:and\s)?(?=but\b)", re.IGNORECASE)
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
 _GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|practically|"
                               r"just about)\s+)?(?:it|this|that|they|these|those|which|everything"
@@ -255,24 +255,24 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         if _SCORE_GAP.match(masked[prev.end:n.start]) or checks._MARGIN_BEFORE.search(masked[prev.end:n.start]):
             return checks.action_number(n, checks.resolve_action(prev, book), masked, book)
         prev = next((m for m in reversed(names) if m.end <= n.start), None)
-    if prev is not None and not re.search(r"(?:,\s*|\sand\s+)(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s(?!(?:most|"
-                                          r"second|third|main|largest|biggest|top|strongest)\b)",
+    if prev is not None and not re.search(r"(?:,\s*|\sand\s+)(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s"
+                                          r"(?!(?:most|second|third|main|largest|biggest|top|strongest)\b)",
                                           masked[prev.end:n.start], re.IGNORECASE):
         return checks.feature_number(n, prev.keys, masked, book, ctx, unit_of)
     return checks.free_number(n, masked, book)
 
 
-_HYPOTHETICAL = re.compile(r"\b(?:would|could|might)\b|\bif it (?:were|was)(?:n't| not) for\b|\bhad\b[^.;]{0,60}\bbeen\b",
-                           re.IGNORECASE)
+_HYPOTHETICAL = re.compile(r"\b(?:would|could|might)\b|\bif it (?:were|was)(?:n't| not) for\b"
+                           r"|\bhad\b[^.;]{0,60}\bbeen\b", re.IGNORECASE)
 _PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
-_SIDE_WORD = re.compile(r"^(?:against|in favou?r of|favou?r\w*|toward\w*|supports?|support\w*|works? against|worked against)$",
-                        re.IGNORECASE)
+_SIDE_WORD = re.compile(r"^(?:against|in favou?r of|favou?r\w*|toward\w*|supports?|support\w*|works? against|"
+                        r"worked against)$", re.IGNORECASE)
 #: an object that is not the model's output: the applicant, the house, them
 _PERSON_OBJECT = re.compile(r"^\s+(?:the\s+|this\s+|that\s+)?(?:applicant|borrower|customer|client|person|buyer|seller|"
                             r"owner|house|home|property|him|her|them|it|us|you)\b", re.IGNORECASE)
 _LINKS = {"but", "and", "also", "yet", "then", "still", "even", "only", "while", "though", "thus", "hence"}
-_EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:but|except(?: for)?|apart from|other than)"
-                     r"\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
+_EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:but|except(?: for)?|apart from|"
+                     r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
 
 def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
@@ -283,7 +283,8 @@ def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: Fact
     for i, m in enumerate(found):
         if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(masked, m, mentions):
             continue  # 'a salaried job helps': helps the applicant, so lowers the risk? not a checkable direction
-        if book.output != "actions" and _SIDE_WORD.match(m.group(0)) and _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
+        if book.output != "actions" and _SIDE_WORD.match(m.group(0)) and \
+                _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
             continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
         subjects = [x for x in names if prev <= x.start < m.start()]

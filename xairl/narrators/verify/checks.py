@@ -134,8 +134,9 @@ _RUNNER_BEFORE = re.compile(r"\b(vs\.?|versus|against|compared with|over)\s*(?:a
 _SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
 _BASE_AFTER = re.compile(r"^\s*(?:\w+\s+)?(baseline|base value|average|typical|expected|mean)\b", re.IGNORECASE)
 _BASE_WORDS = re.compile(r"\b(baseline|base value|base|average|typical|expected value|mean|on average)\b", re.IGNORECASE)
+#: 'the average prediction of $230,061'
 _BASE_BEFORE = re.compile(r"\b(?:baseline|average|typical|mean|expected)\s+(?:prediction|estimate|output|predicted \w+)"
-                          r"\s*(?:of|is|was|:|=)?\s*[$€£]?\s*$", re.IGNORECASE)  # 'the average prediction of $230,061'
+                          r"\s*(?:of|is|was|:|=)?\s*[$€£]?\s*$", re.IGNORECASE)
 _OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability|chance|risk|price|output|final)\b",
                         re.IGNORECASE)
 _SKIP_AFTER = re.compile(r"^\s*(background|samples?|rows?|states?|draws|features|narratives|coalitions)\b",

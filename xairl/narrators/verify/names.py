@@ -68,12 +68,9 @@ class Vocabulary:
     entries: list[tuple[re.Pattern, str, tuple[str, ...], str, str]]
     short_labels: dict[str, list[tuple[str, str]]]  # feature -> [(label, label)] of 1-2 characters
     words: dict[str, frozenset[str]]  # feature -> the words of its name, description and aliases (qualifiers)
-
-    @property
-    def name_words(self) -> frozenset[str]:
-        """Words of the features' own names ('quality' of ``kitchen_quality``): a phrase with one of them may be a
-        vague mention of a feature, not a thing the model lacks."""
-        return frozenset(w for f in self.words for w in split_words(f) if len(w) >= 3 and not w.isdigit())
+    #: words of the features' own names ('quality' of ``kitchen_quality``): a phrase with one of them may be a vague
+    #: mention of a feature, not a thing the model lacks
+    name_words: frozenset[str] = frozenset()
 
 
 def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
@@ -124,8 +121,9 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
             elif clean(label):
                 entries.append((" ".join(stem(w) for w in split_words(label)), "label", (f,), label, ""))
     entries.sort(key=lambda e: -len(e[0]))
+    names = frozenset(w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit())
     return Vocabulary([(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries], short,
-                      feature_words)
+                      feature_words, names)
 
 
 def _phrase(text: str) -> str:
@@ -238,8 +236,9 @@ def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -
             lo = text.find(" ", start) + 1
         known = set().union(*(words.get(k, frozenset()) for k in m.keys))
         qual = [w for w in split_words(text[lo:m.start]) if w in known]
-        if not qual and out and out[-1].kind == "feature" and re.fullmatch(r"\s*(?:and|or|&|,)\s*", text[out[-1].end:m.start]):
-            qual = [w for w in split_words(text[out[-1].start:out[-1].end]) if w in known]  # "candidate 1's RSRP and RSRQ"
+        if not qual and out and out[-1].kind == "feature" and \
+                re.fullmatch(r"\s*(?:and|or|&|,)\s*", text[out[-1].end:m.start]):  # "candidate 1's RSRP and RSRQ"
+            qual = [w for w in split_words(text[out[-1].start:out[-1].end]) if w in known]
             lo = m.start
         keys = tuple(k for k in m.keys if qual and set(qual) <= words.get(k, frozenset()))
         plain = tuple(k for k in keys if not (words.get(k, frozenset()) & _ORDINALS) - set(qual))

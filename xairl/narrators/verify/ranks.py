@@ -24,8 +24,8 @@ RANK_RE = re.compile(
     rf"|(?P<top>{TOPWORD})(?:\s+single)?\s+(?:risk\s+)?(?P<noun>{NOUN})"
     rf"|(?:mattered|matters|counted|counts|weighed) most|dominat\w+|ranks? (?P<rk>first|second|third)"
     rf"|top[\s-](?P<topk>\d)\b)", re.IGNORECASE)
-AFTER_ORD = re.compile(r"^\W{0,3}(?:[a-z]+\s+)?(?:was\s+|is\s+|came\s+|a\s+(?:distant|close)\s+)?(?P<o>second|third|fourth)\b",
-                        re.IGNORECASE)
+AFTER_ORD = re.compile(r"^\W{0,3}(?:[a-z]+\s+)?(?:was\s+|is\s+|came\s+|a\s+(?:distant|close)\s+)?"
+                       r"(?P<o>second|third|fourth)\b", re.IGNORECASE)
 FOLLOWED = re.compile(r"\b(?:followed(?: closely)? by|then|next(?: came| was)?|after that|ahead of|second only to)\s*$",
                        re.IGNORECASE)
 MINOR_RE = re.compile(r"\b(?:barely|hardly|scarcely)\s+(?:\w+\s+)?(?:matter\w*|mov\w*|regist\w*|chang\w*|affect\w*|"
