@@ -3,10 +3,10 @@
 The corpus (``benchmarks/data/narratives``): 320 narratives about 32 explanations in four domains (house prices and
 credit default, one output each, not RL; the UAV handover DQN; the toy discrete policy), half accurate and half
 with one labelled error, in many voices. Cases 0-3 of each domain are the dev split (the verifier was tuned on it),
-cases 4-7 the test split (frozen before any tuning; report it apart); ``dev2/`` 60 more narratives on the dev
-cases in other voices (Q&A, LLM-style prose, shorthand, lists) and ``dev3/`` 50 more (shares, 'accounts for', pipes,
-counterfactuals), each written after the freeze and measured once before tuning on it. A narrative counts as agreeing when
-``Verification.ok`` equals its label.
+cases 4-7 the test split (frozen before any tuning; report it apart); ``dev2/`` 76 more narratives on the dev
+cases in other voices (Q&A, LLM-style prose, shorthand, lists; 16 of them on two UAV 'stay' cases of its own) and
+``dev3/`` 55 more (shares, 'accounts for', pipes, counterfactuals), each written after the freeze and measured once
+before tuning on it. A narrative counts as agreeing when ``Verification.ok`` equals its label.
 
     .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain and error kind, speed
     .venv/bin/python benchmarks/bench_verifier.py --show test # also every disagreement of the test split
