@@ -191,3 +191,16 @@ def test_vague_names_are_not_invented_features():
     assert not [c for c in res.claims if c.status == "contradicted"]   # 'quality': ambiguous, not unknown
     res = xairl.verify("The swimming pool adds 0.11.", exp, 0)
     assert [c.status for c in res.claims if c.kind == "feature"] == ["contradicted"]
+
+
+def test_a_modal_in_a_relative_clause_keeps_the_claims_checked():
+    from xairl.toy import toy_policy
+
+    policy = toy_policy()
+    exp = xairl.explain(policy, policy.background(1, seed=2), background=policy.background(50))
+    chosen = exp.action_names[exp.chosen[0]]
+    other = next(a for a in exp.action_names if a != chosen)
+    assert xairl.verify(f"The agent chose {chosen}, which could save time.", exp, 0, policy).ok
+    assert xairl.verify(f"The agent chose {other}, which could save time.", exp, 0, policy).status == "contradicted"
+    res = xairl.verify(f"Without the wind, the agent would have chosen {other}.", exp, 0, policy)
+    assert res.status == "unchecked"  # what did not happen is not a claim about the decision

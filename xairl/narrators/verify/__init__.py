@@ -262,8 +262,10 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     return checks.free_number(n, masked, book)
 
 
-_HYPOTHETICAL = re.compile(r"\b(?:would|could|might)\b|\bif it (?:were|was)(?:n't| not) for\b"
-                           r"|\bhad\b[^.;]{0,60}\bbeen\b", re.IGNORECASE)
+#: a sentence about what did not happen: 'Had X been better, ...', 'Without X, it would have ...', 'If it were not
+#: for X'; a modal elsewhere ('chose recharge, which could save battery') leaves the rest of the sentence checked
+_HYPOTHETICAL = re.compile(r"^\W*(?:if|had|without|were|absent|but for)\b|\b(?:would|could|might)(?:\s+\w+ly)?\s+"
+                           r"(?:have|be|not|never)\b|\bif it (?:were|was)(?:n't| not) for\b", re.IGNORECASE)
 _PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
 _SIDE_WORD = re.compile(r"^(?:against|in favou?r of|favou?r\w*|toward\w*|supports?|support\w*|works? against|"
                         r"worked against)$", re.IGNORECASE)
