@@ -204,3 +204,16 @@ def test_a_modal_in_a_relative_clause_keeps_the_claims_checked():
     assert xairl.verify(f"The agent chose {other}, which could save time.", exp, 0, policy).status == "contradicted"
     res = xairl.verify(f"Without the wind, the agent would have chosen {other}.", exp, 0, policy)
     assert res.status == "unchecked"  # what did not happen is not a claim about the decision
+
+
+def test_baseline_and_change_phrasings():
+    exp = _exp(categories=None)  # prediction 0.51, baseline 0.30, change 0.21
+
+    def numbers(text):
+        return [c.status for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    assert numbers("The prediction of 0.51 is well above the base value of 0.30.") == ["verified", "verified"]
+    assert numbers("The prediction (0.51) exceeds the base rate (0.30) by 0.21.") == ["verified"] * 3
+    assert numbers("The prediction (0.51) exceeds the base rate (0.30) by 0.31.")[-1] == "contradicted"
+    # a value and a contribution in brackets after one name are that name's, not a list to pair with the names
+    res = xairl.verify("Key factors raising it include odor (0, SHAP 0.15) and gill_size (1, SHAP 0.11).", exp, 0)
+    assert res.ok and {c.status for c in res.claims} == {"verified"}

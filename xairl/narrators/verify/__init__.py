@@ -101,7 +101,8 @@ _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
 _GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|practically|"
                               r"just about)\s+)?(?:it|this|that|they|these|those|which|everything"
                               r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
-                              r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total)\b(?!'s)",
+                              r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total|the prediction|the predicted \w+"
+                              r"|the estimate|the output|the model's \w+)\b(?!'s)",
                               re.IGNORECASE)
 
 
@@ -203,7 +204,8 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     paired = {}
     if len(names) >= 2 and len(tail) == len(names) and (
             "respectively" in masked[a:b].lower() or checks._CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
-            or _PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])):
+            or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
+                and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
         paired = {id(n): m for n, m in zip(tail, names)}
     actions = [m for m in mentions if m.kind == "action"]
     scored = {}
@@ -323,6 +325,9 @@ def _ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook,
     names = _names(mentions)
     for m in ranks.RANK_RE.finditer(masked, a, b):
         rank, plural, sign = ranks.rank_claim(m, masked)
+        said = checks.DIRECTION_RE.match(masked, m.end() + 1, b) if masked[m.end():m.end() + 1] == " " else None
+        if not sign and said and said.group(0).lower() not in ("for", "against", "toward", "towards"):
+            sign = 1 if said.group("pos") else -1  # 'key factors decreasing the risk', 'the main feature supporting'
         side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])
         if not sign and side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
             # 'the main argument for staying': the largest that favours it

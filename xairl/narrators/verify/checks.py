@@ -142,8 +142,12 @@ _OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability
 _SKIP_AFTER = re.compile(r"^\s*(background|samples?|rows?|states?|draws|features|narratives|coalitions)\b",
                          re.IGNORECASE)
 _LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state)[\s-]*$", re.IGNORECASE)
-_CHANGE_AFTER = re.compile(r"^\s*(?:\w+\s+){0,2}(above|below|under|over|more|less)\s+(the\s+)?(average|baseline|base|"
-                           r"typical|expected|mean)", re.IGNORECASE)
+#: '$91,462 above the baseline' (not '0.38 is slightly above the base value': there the number is the prediction)
+_CHANGE_BEFORE = re.compile(r"\b(?:exceed\w*|above|below|under|higher than|lower than|more than|less than)\b[^;]{0,40}"
+                            r"\bby\s+(?:about|around|roughly|nearly|almost|some|only|just)?\s*[$€£]?\s*$", re.IGNORECASE)
+_CHANGE_AFTER = re.compile(r"^\s*(?!(?:\w+\s+)?(?:is|was|are|were|sits|lies|stands|remains)\b)(?:\w+\s+){0,2}"
+                           r"(above|below|under|over|more|less)\s+(the\s+)?(average|baseline|base|typical|expected|mean)",
+                           re.IGNORECASE)
 _COMPARE_AFTER = re.compile(r"^\s*(?:dB|dBm)?\s*(above|below|stronger|weaker|better|worse|higher|lower|more|less)\b",
                             re.IGNORECASE)
 
@@ -247,7 +251,8 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     fact or, when it is a contribution, the one feature whose contribution it is."""
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 30]
     named = None
-    if _CHANGE_AFTER.match(after) and book.base is not None:  # '$91,462 above the baseline'
+    change_cue = _CHANGE_AFTER.match(after) or (_CHANGE_BEFORE.search(before) and _BASE_WORDS.search(before))
+    if change_cue and book.base is not None:  # '$91,462 above the baseline', 'exceeds the base rate (0.34) by 0.09'
         change = book.scores[book.chosen] - book.base
         ok = matches(n, change) or (n.percent and _percent_readings(n, abs(change)))
         return Claim("number", n.text, "verified" if ok else "contradicted", f"the change from the baseline is "
@@ -263,7 +268,11 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     elif _CONTRIB_BEFORE.search(before) and _owner(n, book):
         return Claim("number", n.text, "verified", f"{_owner(n, book)}'s contribution (the only one it matches)")
     elif book.output != "actions" and not book.global_view:
-        if _BASE_WORDS.search(before[-12:]) or _BASE_AFTER.match(after) or _BASE_BEFORE.search(before):
+        near = before[-24:]
+        base_at = max((m.end() for m in _BASE_WORDS.finditer(near)), default=-1)
+        out_at = max((m.end() for m in _OUT_WORDS.finditer(_BASE_WORDS.sub(lambda m: " " * len(m.group(0)), near))),
+                     default=-1)  # 'value' inside 'base value' is the baseline's word
+        if base_at > out_at or _BASE_AFTER.match(after) or _BASE_BEFORE.search(before):  # the nearer cue decides
             named = ("the baseline", [book.base])
         elif _OUT_WORDS.search(before):
             named = ("the prediction", [book.scores[book.chosen]])
