@@ -285,7 +285,7 @@ def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: Fact
     names = _names(mentions)
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
     for i, m in enumerate(found):
-        if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(masked, m, mentions):
+        if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(m, mentions):
             continue  # 'a salaried job helps': helps the applicant, so lowers the risk? not a checkable direction
         if book.output != "actions" and _SIDE_WORD.match(m.group(0)) and \
                 _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):

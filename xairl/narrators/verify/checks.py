@@ -148,7 +148,10 @@ _CHANGE_BEFORE = re.compile(r"\b(?:exceed\w*|above|below|under|higher than|lower
 _CHANGE_AFTER = re.compile(r"^\s*(?!(?:\w+\s+)?(?:is|was|are|were|sits|lies|stands|remains)\b)(?:\w+\s+){0,2}"
                            r"(above|below|under|over|more|less)\s+(the\s+)?(average|baseline|base|typical|expected|mean)",
                            re.IGNORECASE)
-_COMPARE_AFTER = re.compile(r"^\s*(?:dB|dBm)?\s*(above|below|stronger|weaker|better|worse|higher|lower|more|less)\b",
+_COMPARISON_WORDS = r"(above|below|stronger|weaker|better|worse|higher|lower)"
+#: '1.9 dB above the serving BS's RSRP': a difference in a unit, neither a value nor a contribution
+_DIFFERENCE_AFTER = re.compile(rf"\s*[A-Za-z]+\s+{_COMPARISON_WORDS}\b", re.IGNORECASE)
+_COMPARE_AFTER = re.compile(rf"^\s*(?:dB|dBm)?\s*(?:{_COMPARISON_WORDS}|more|less)\b",
                             re.IGNORECASE)
 
 
@@ -209,8 +212,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         shown = ", ".join(f"{w} {v:.4g}" for w, v in cands)
         return False, f"{n.text} is not {key}'s {shown or 'value'}"
 
-    if re.match(r"\s*[A-Za-z]+\s+(above|below|stronger|weaker|better|worse|higher|lower)\b", after):
-        # '1.9 dB above the serving BS's RSRP': a difference in a unit, neither a value nor a contribution
+    if _DIFFERENCE_AFTER.match(after):
         ok = comparison(n, after, book)
         return Claim("number", n.text, "verified" if ok else ("contradicted" if book.by_unit else "unchecked"),
                      "a domain comparison in its unit" if ok else "a difference no fact states")
@@ -294,7 +296,7 @@ def _owner(n: Number, book: FactBook) -> str | None:
 
 
 # -- directions --------------------------------------------------------------------------------------------------
-def action_object(masked: str, m: re.Match, mentions: list[Mention]) -> Mention | None:
+def action_object(m: re.Match, mentions: list[Mention]) -> Mention | None:
     """The action a direction word is said of, when one is named right after it ('favoured forward', 'helped the
     turn decision')."""
     return next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() <= 16), None)
@@ -307,7 +309,7 @@ def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: Fa
     polarity = 1 if m.group("pos") else -1
     if _NEGATION.search(masked[max(0, m.start() - 30):m.start()]):
         polarity = -polarity
-    obj = action_object(masked, m, mentions)
+    obj = action_object(m, mentions)
     if obj is not None and book.runner_up:
         a = resolve_action(obj, book)
         if a == book.runner_up:

@@ -246,9 +246,9 @@ def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -
         if not keys or len(keys) == len(m.keys):
             out.append(m)
             continue
-        first = next((i for i in range(len(text[lo:m.start])) if not text[lo + i].isspace()), 0) + lo if lo < m.start \
-            else m.start
+        qualifier = text[lo:m.start]
+        first = min(lo + len(qualifier) - len(qualifier.lstrip()), m.start)  # where the qualifying words begin
         while out and out[-1].kind == "feature" and out[-1].start >= first:
             out.pop()  # 'serving BS's' in 'the serving BS's weak RSRP'
-        out.append(Mention(min(first, m.start), m.end, "feature", keys))
+        out.append(Mention(first, m.end, "feature", keys))
     return out
