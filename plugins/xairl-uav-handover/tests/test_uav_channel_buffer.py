@@ -62,3 +62,29 @@ def test_buffer_recursion_by_hand():
                           np.array([2000.0, 1500.0, 0.0]), q_max=2e6)
     np.testing.assert_allclose(q, [0.0, 2500.0, 2e6])   # clipped at 0; 1000+3000-1500; capped at q_max
     np.testing.assert_allclose(lost, [0.0, 0.0, 1e5])   # overflow is lost data
+
+
+def test_uma_av_is_terrestrial_uma_up_to_22_5_m():
+    """TR 36.777 takes UMa-AV UEs at or below 22.5 m as terrestrial (TR 38.901 UMa), values worked by hand:
+    P_LOS(20 m, 200 m) = (0.09 + e^(-200/63) 0.91) (1 + 0.7^1.5 * 1.25 * 8 e^(-4/3)) = 0.3257; C'(h) = 0 at 10 m."""
+    assert los_probability("UMa-AV", 20, 200) == pytest.approx(0.3257, abs=1e-4)
+    assert los_probability("UMa-AV", 10, 200) == pytest.approx(0.1280, abs=1e-4)
+    # NLoS: 13.54 + 39.08 lg 500 + 20 lg 2 - 0.6 (20 - 1.5) = 113.94 dB; LoS before the breakpoint: UMa-AV's formula
+    assert path_loss("UMa-AV", 20, 500, 2.0, False) == pytest.approx(113.94, abs=0.01)
+    assert path_loss("UMa-AV", 20, 500, 2.0, True) == path_loss("UMa-AV", 30, 500, 2.0, True)
+    assert shadow_sigma("UMa-AV", 20, True) == 4.0
+    # above 22.5 m the aerial model again
+    assert los_probability("UMa-AV", 23, 500) == pytest.approx(18 / 500 + np.exp(-500 / (4300 * np.log10(23) - 3800))
+                                                              * (1 - 18 / 500))
+
+
+def test_cells_differ_in_uplink_interference():
+    """Each cell's interference level is drawn per flight within +-spread dB; with no spread the cells of a flight
+    share the layout's mean levels."""
+    from xairl_uav_handover.simulator import Simulator
+
+    flat = Simulator(SimConfig.model_validate({"radio": {"ul_interference_spread_db": 0}}), n_uavs=4, seed=3)
+    spread = Simulator(SimConfig(), n_uavs=4, seed=3)
+    ratio_db = 10 * np.log10(spread._ul_interference / flat._ul_interference)
+    s = SimConfig().radio.ul_interference_spread_db
+    assert s > 0 and (np.abs(ratio_db) <= s + 1e-9).all() and ratio_db.std() > s / 4

@@ -46,6 +46,12 @@ def test_open_loop_agreement_on_known_deciders():
     follow = dict(zip(w.t.tolist(), w.next_serving.tolist()))  # an oracle that does what the network did next
     oracle = agreement([w], lambda _w: (lambda s, c, t: c.index(follow[t]) if follow[t] in c else 0))
     assert oracle.stay_agreement == 1.0 and oracle.target_agreement == oracle.handover_agreement > 0.5
+    assert oracle.new_proposals == oracle.proposals  # each of its proposals is carried out, so none stands
+    # a decider that always proposes the strongest neighbour: one standing proposal per (serving, neighbour) pair
+    eager = agreement([w], lambda _w: (lambda s, c, t: 1 if len(c) > 1 else 0))
+    runs = sum(1 for i in range(len(w.t) - 1) if len(w.candidates[i]) > 1 and (
+        i == 0 or len(w.candidates[i - 1]) < 2 or w.candidates[i - 1][:2] != w.candidates[i][:2]))
+    assert eager.new_proposals == runs < eager.proposals
     assert chm_handovers(load_flight(UKM / "100m.csv")) > 0
 
 

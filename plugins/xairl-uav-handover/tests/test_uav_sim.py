@@ -144,13 +144,13 @@ def test_vector_env_steps_flights_together():
 def test_chm_and_samro_behaviour_on_flights():
     """Table I compares medians: SA-MRO raises its margin where service is fine (most flights) and hands over less
     there; where the link cannot carry the video it lowers the margin and may hand over more than CHM."""
-    cfg = SimConfig()
+    cfg, n = SimConfig(), 100  # medians of a few flights swing: with 20, SA-MRO's low-capacity flights can lead
     medians = {}
     for ctl in (CHM(), SAMRO()):
-        env = HandoverVecEnv(cfg, n_flights=20, decision_every=1)
+        env = HandoverVecEnv(cfg, n_flights=n, decision_every=1)
         env.reset(seed=2)
         ctl.reset(env)
-        hos, truncated = np.zeros(20), np.zeros(20, bool)
+        hos, truncated = np.zeros(n), np.zeros(n, bool)
         while not truncated.all():
             *_, truncated, info = env.step(ctl(env))
             hos += info["handover"]
@@ -161,7 +161,7 @@ def test_chm_and_samro_behaviour_on_flights():
 
 @pytest.mark.parametrize("data, field", [
     ({"radio": {"bs_tx_power_dbm": -5}}, "radio.bs_tx_power_dbm"),
-    ({"flight": {"altitude_m": (10, 150)}}, "altitude_m"),
+    ({"flight": {"altitude_m": (1, 150)}}, "altitude_m"),
     ({"channel": {"scenario": "Mars-AV"}}, "channel.scenario"),
     ({"channel": {"scenarios": "UMa-AV"}}, "channel.scenarios"),
     ({"flight": {"dt_s": 0}}, "flight.dt_s"),

@@ -14,6 +14,7 @@ time step between samples.
 from __future__ import annotations
 
 import re
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,7 +27,7 @@ from .config import SimConfig
 from .features import FEATURES, N_CANDIDATES, state_rows
 from .features import RSRP as RSRP_COLUMNS
 from .simulator import hex_layout, n_sites
-from .uplink import capacity_bps, interference_mw, rsrp_offset_db, sinr_db
+from .uplink import capacity_bps, cell_deviation, interference_mw, rsrp_offset_db, sinr_db
 
 REF_LAT, REF_LON = 2.9228, 101.7715  # centre of the UKM campaign area: local metres are measured from here
 PCI, RSRP, RSRQ = "Physical cell identity (LTE pcell)", "RSRP (LTE pcell)", "RSRQ (LTE pcell)"
@@ -177,20 +178,29 @@ def _measured(f: RealFlight, i: int) -> dict[float, tuple[float, float]]:
 
 class UplinkBuffer:
     """The simulator's buffer and uplink model on a real flight: SINR from the measured serving RSRP (path loss =
-    RSRP offset - RSRP) with the aerial interference at the flight's altitude, sub-stepped at the sim's dt."""
+    RSRP offset - RSRP) with the aerial interference at the flight's altitude, sub-stepped at the sim's dt. Each
+    real cell gets the interference level of a cell of the simulated layout drawn at random, times its own deviation
+    (once per cell and flight, as the simulator draws them), so real and simulated links share one distribution.
 
-    def __init__(self, cfg: SimConfig, altitude_m: float, seed: int = 0):
+    :param flight: the flight's name: each flight draws its own cells' levels.
+    """
+
+    def __init__(self, cfg: SimConfig, altitude_m: float, seed: int = 0, flight: str = ""):
         self.cfg, self.rng, self.q, self.lost = cfg, np.random.default_rng(seed), 0.0, 0.0
+        self._cell_rng, self._interference = np.random.default_rng([seed, zlib.crc32(flight.encode())]), {}
         layout = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
-        self.interference = float(interference_mw(cfg, layout, np.array([altitude_m]))[0, 0])  # the centre cell
+        self.site_interference = interference_mw(cfg, layout, np.array([altitude_m]))[0]  # (N,) mW per site
 
-    def sinr_db(self, rsrp_dbm: float) -> float:
-        return float(sinr_db(self.cfg, rsrp_offset_db(self.cfg) - rsrp_dbm, self.interference))
+    def sinr_db(self, rsrp_dbm: float, cell) -> float:
+        if cell not in self._interference:
+            site = self._cell_rng.integers(len(self.site_interference))
+            self._interference[cell] = float(self.site_interference[site] * cell_deviation(self.cfg, self._cell_rng, ()))
+        return float(sinr_db(self.cfg, rsrp_offset_db(self.cfg) - rsrp_dbm, self._interference[cell]))
 
-    def advance(self, rsrp_dbm: float, seconds: float, handed: bool) -> None:
-        """Serve the buffer for ``seconds`` at the link of a serving cell measured at ``rsrp_dbm``."""
+    def advance(self, rsrp_dbm: float, cell, seconds: float, handed: bool) -> None:
+        """Serve the buffer for ``seconds`` at the link of serving ``cell`` measured at ``rsrp_dbm``."""
         b, dt = self.cfg.buffer, self.cfg.flight.dt_s
-        rate = float(capacity_bps(self.cfg, self.sinr_db(rsrp_dbm)))
+        rate = float(capacity_bps(self.cfg, self.sinr_db(rsrp_dbm, cell)))
         interrupt = self.cfg.handover.interruption_s if handed else 0.0
         for k in range(int(round(seconds / dt))):
             arrivals = self.rng.poisson(b.packet_rate_hz * dt) * b.data_packet_bits
@@ -211,7 +221,7 @@ def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
     cfg = config or SimConfig()
     ids = {p: k for k, p in enumerate(sorted(set(f.pci.tolist())))}
     max_id = n_sites(cfg.layout) - 1  # the simulator's ids: a real flight's cells are ranked into that range
-    link = UplinkBuffer(cfg, f.altitude_m, seed)
+    link = UplinkBuffer(cfg, f.altitude_m, seed, f.name)
     states, cands, queues = [], [], []
     for i in range(len(f.t)):
         cells = _measured(f, i)
@@ -224,7 +234,7 @@ def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
         cands.append(cand)
         queues.append(link.q)
         if i + 1 < len(f.t):
-            link.advance(f.rsrp[i], float(np.clip(f.t[i + 1] - f.t[i], 0, 5)), f.pci[i + 1] != serving)
+            link.advance(f.rsrp[i], serving, float(np.clip(f.t[i + 1] - f.t[i], 0, 5)), f.pci[i + 1] != serving)
     return Walk(f.t, np.array(states), cands, np.append(f.pci[1:], f.pci[-1]), np.array(queues), link.lost)
 
 
@@ -257,6 +267,7 @@ class Agreement:
     instants: int
     network_handovers: int
     proposals: int              # instants at which the policy proposed a handover
+    new_proposals: int          # of those, the ones that start a proposal (not the one of the instant before)
     stay_agreement: float       # share of the network's stays where the policy also stayed
     handover_agreement: float   # share of the network's handovers where the policy proposed one
     target_agreement: float     # share of the network's handovers where the policy proposed the same cell
@@ -266,25 +277,35 @@ class Agreement:
     def proposals_per_min(self) -> float:
         return self.proposals / max(self.minutes, 1e-9)
 
+    @property
+    def new_proposals_per_min(self) -> float:
+        """Open loop, a proposal the network does not carry out stands at every later instant until the policy
+        changes its mind; counted once, as A3 counts one trigger, it is comparable with the network's handovers."""
+        return self.new_proposals / max(self.minutes, 1e-9)
+
 
 def agreement(walks: list[Walk], make_decider) -> Agreement:
     """Open-loop agreement over flights: ``make_decider(walk)`` returns ``decide(state, candidates, t) -> action``
     (a fresh one per flight, for rules with timers)."""
-    n = ho = prop = stay_ok = ho_ok = target_ok = 0
+    n = ho = prop = new = stay_ok = ho_ok = target_ok = 0
     minutes = 0.0
     for w in walks:
         decide = make_decider(w)
         minutes += (w.t[-1] - w.t[0]) / 60
+        standing = None  # (serving, proposed target) of the instant before
         for i in range(len(w.t) - 1):
             cand = w.candidates[i]
             a = int(decide(w.states[i], cand, float(w.t[i])))
             target = cand[a] if a < len(cand) else cand[0]
             net_ho = w.next_serving[i] != cand[0]
-            n, ho, prop = n + 1, ho + net_ho, prop + (target != cand[0])
-            stay_ok += (not net_ho) and target == cand[0]
-            ho_ok += net_ho and target != cand[0]
+            proposes = target != cand[0]
+            n, ho, prop = n + 1, ho + net_ho, prop + proposes
+            new += proposes and standing != (cand[0], target)
+            standing = (cand[0], target) if proposes else None
+            stay_ok += (not net_ho) and not proposes
+            ho_ok += net_ho and proposes
             target_ok += net_ho and target == w.next_serving[i]
-    return Agreement(n, ho, prop, stay_ok / max(n - ho, 1), ho_ok / max(ho, 1), target_ok / max(ho, 1), minutes)
+    return Agreement(n, ho, prop, new, stay_ok / max(n - ho, 1), ho_ok / max(ho, 1), target_ok / max(ho, 1), minutes)
 
 
 def baltaci_rate_by_altitude(folder: str | Path) -> tuple[np.ndarray, np.ndarray, int]:

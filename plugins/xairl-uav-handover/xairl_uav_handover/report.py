@@ -73,13 +73,15 @@ class AgreementRow:
 
     policy: str
     proposals_per_min: float
+    new_proposals_per_min: float
     network_per_min: float
     stay_agreement_pct: float
     handover_agreement_pct: float
     target_agreement_pct: float
 
-    HEADER = ["policy", "proposed HO/min", "network HO/min", "stays when the network stays %",
-              "proposes a HO where the network handed over %", "same target cell %"]
+    HEADER = ["policy", "instants proposing a HO, per min", "new HO proposals/min (a standing one counted once)",
+              "network HO/min", "stays when the network stays %", "proposes a HO where the network handed over %",
+              "same target cell %"]
 
 
 @dataclass
@@ -197,16 +199,19 @@ REAL_NOTES = [
 
 
 def band_rows(flights, chm_real: list[int], cfg, seed: int) -> list[BandRow]:
-    """One row per altitude band with flights; ``chm_real``: CHM's closed-loop handovers on each flight."""
+    """One row per altitude band with flights; ``chm_real``: CHM's closed-loop handovers on each flight. Simulated
+    CHM flies at the band's real flights' own heights, weighted by their minutes, so both sides cover one mix."""
     rows = []
     for lo, hi in BANDS:
         inside = [(f, n) for f, n in zip(flights, chm_real) if lo <= f.altitude_m < hi]
         if not inside:
             continue
-        minutes = sum(f.t[-1] / 60 for f, _ in inside)
-        live = sum(f.observed_handovers for f, _ in inside) / minutes
-        real = sum(n for _, n in inside) / minutes
-        sim = float(np.mean(chm_rate_by_altitude(np.linspace(max(lo, 23.0), hi, 3), cfg, seed=seed)))
+        minutes = np.array([f.t[-1] / 60 for f, _ in inside])
+        live = sum(f.observed_handovers for f, _ in inside) / minutes.sum()
+        real = sum(n for _, n in inside) / minutes.sum()
+        heights, where = np.unique([f.altitude_m for f, _ in inside], return_inverse=True)
+        weight = np.bincount(where, weights=minutes)
+        sim = float(np.average(chm_rate_by_altitude(heights, cfg, seed=seed), weights=weight))
         rows.append(BandRow(f"{lo:g}-{hi:g} m", len(inside), live, real, sim, sim / max(real, 1e-9)))
     return rows
 
@@ -233,7 +238,7 @@ def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
     for name, make in (("DQN", dqn), ("CHM (A3 2 dB, 160 ms)", lambda w: CHMOnSamples(w.cells)),
                        ("SA-MRO", lambda w: SAMROOnSamples(w.cells, cfg))):
         a = agreement(walks, make)
-        rows.append(AgreementRow(name, a.proposals_per_min, a.network_handovers / a.minutes,
+        rows.append(AgreementRow(name, a.proposals_per_min, a.new_proposals_per_min, a.network_handovers / a.minutes,
                                  100 * a.stay_agreement, 100 * a.handover_agreement, 100 * a.target_agreement))
     return rows
 
@@ -261,7 +266,7 @@ def _altitude_figure(out: Path, real: str, cfg, flights, chm_real: list[int], se
 
     from .real_data import baltaci_rate_by_altitude
 
-    alts = np.arange(30, 161, 20)
+    alts = np.arange(20, 161, 20)
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
     ax.plot(alts, chm_rate_by_altitude(alts, cfg, seed=seed), "o-", label="simulator, CHM (A3 2 dB / 160 ms)")
     long = [(f, n) for f, n in zip(flights, chm_real) if f.t[-1] > 60]

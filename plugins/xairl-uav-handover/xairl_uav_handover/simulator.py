@@ -24,7 +24,7 @@ from .buffer import buffer_step
 from .channel import los_probability, path_loss, shadow_sigma
 from .config import LayoutConfig, SimConfig
 from .features import N_CANDIDATES, state_rows
-from .uplink import capacity_bps, interference_mw, rsrp_offset_db, sinr_db
+from .uplink import capacity_bps, cell_deviation, interference_mw, rsrp_offset_db, sinr_db
 
 
 def n_sites(layout: LayoutConfig) -> int:
@@ -90,9 +90,10 @@ class Simulator:
         self._rsrp_offset = rsrp_offset_db(cfg)
         self._dl_noise_mw = 10 ** ((-174 + 10 * np.log10(rad.n_rb * 180e3) + rad.ue_noise_figure_db) / 10)
         self._ul_interference = interference_mw(cfg, self.bs_xy, self.pos[:, 2])
-        # domain randomisation per flight (RadioConfig): cell load and antenna gain deviation
+        # domain randomisation per flight (RadioConfig): cell load, antenna gain and uplink interference deviations
         self._load = rng.uniform(*rad.load_range, (n_uavs, 1))
         self._gain = rng.uniform(-rad.gain_spread_db, rad.gain_spread_db, (n_uavs, 1))
+        self._ul_interference = self._ul_interference * cell_deviation(cfg, rng, (n_uavs, self.N))
         self._meas_every = max(1, int(round(obs.measurement_period_s / self.dt)))
         self._l3_a = 1.0 / 2 ** (obs.l3_filter_k / 4)
         self._measure()
@@ -112,8 +113,8 @@ class Simulator:
         h = self.pos[:, 2:3]
         d3d = np.hypot(d2d, h - c.bs_height_m)
         los = ndtr(self.g_los) < los_probability(c.scenario, h, d2d)
-        self.loss_db = (path_loss(c.scenario, h, d3d, c.carrier_ghz, los) + shadow_sigma(c.scenario, h, los)
-                        * self.g_shadow + c.fading_db * self.g_fast)
+        self.loss_db = (path_loss(c.scenario, h, d3d, c.carrier_ghz, los, c.bs_height_m)
+                        + shadow_sigma(c.scenario, h, los) * self.g_shadow + c.fading_db * self.g_fast)
         self.rsrp = self._rsrp_offset + self._gain - self.loss_db
         rsrp_mw = 10 ** (self.rsrp / 10)
         n_re = 12 * self.cfg.radio.n_rb

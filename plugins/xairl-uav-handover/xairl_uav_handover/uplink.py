@@ -5,8 +5,12 @@ with height): every other cell j has a co-channel aerial UE on the UAV's resourc
 the time, flying at the UAV's height over cell j's site and sending at full power (no power control: a stated
 simplification). Its mean received power at BS b mixes the LoS and NLoS path losses of TR 36.777 by P_LOS(h, d),
 so it grows with height as P_LOS does. The sum over j is precomputed per flight (heights are constant in flight).
-A real flight uses the same model at its altitude, for a cell in the middle of the layout, with the path loss read
-from the measured RSRP; sim and real buffers are thus driven by one uplink model.
+Cells differ in uplink load (how many UEs they serve, where): each cell's interference level deviates from the mean
+by a per-flight draw, uniform within +-``ul_interference_spread_db`` (:func:`cell_deviation`). The downlink RSRP
+the UE measures does not show this; only the uplink buffer does, which is why a UE's buffer tells a handover policy
+something its radio measurements do not (TR 36.777 notes the uplink interference aerial UEs meet varies widely).
+A real flight uses the same model at its altitude, for a cell in the middle of the layout with a deviation drawn per
+real cell, with the path loss read from the measured RSRP; sim and real buffers are thus driven by one uplink model.
 
 Capacity is the paper's ``W_s |B| log2(1 + SINR)``; signal and noise are over the UAV's |B| resource blocks.
 """
@@ -37,12 +41,18 @@ def interference_mw(cfg: SimConfig, bs_xy: np.ndarray, heights: np.ndarray) -> n
     d2d = np.hypot(*(bs_xy[:, None, :] - bs_xy[None, :, :]).transpose(2, 0, 1))[None]  # (1, N, N): site j -> BS b
     d3d = np.hypot(d2d, h - c.bs_height_m)
     p_los = los_probability(c.scenario, h, np.maximum(d2d, 1.0))
-    gain = (p_los * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, True) / 10)
-            + (1 - p_los) * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, False) / 10))
+    gain = (p_los * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, True, c.bs_height_m) / 10)
+            + (1 - p_los) * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, False, c.bs_height_m) / 10))
     n = len(bs_xy)
     gain = gain * (1 - np.eye(n))[None]  # a cell's own UE is the UAV, not an interferer
     per_interferer = 10 ** ((rad.ue_tx_power_dbm + rad.bs_antenna_gain_db) / 10)
     return rad.ul_activity * per_interferer * gain.sum(axis=1)
+
+
+def cell_deviation(cfg: SimConfig, rng: np.random.Generator, shape) -> np.ndarray:
+    """Factors (``shape``) on each cell's mean interference: 10^(u/10), u uniform in +-ul_interference_spread_db."""
+    spread = cfg.radio.ul_interference_spread_db
+    return 10 ** (rng.uniform(-spread, spread, shape) / 10)
 
 
 def sinr_db(cfg: SimConfig, loss_db, interference: np.ndarray) -> np.ndarray:
