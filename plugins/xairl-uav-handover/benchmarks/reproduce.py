@@ -13,25 +13,14 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-import xairl
 from xairl_uav_handover.baselines import CHM, SAMRO
-from xairl_uav_handover.evaluate import table_one
-from xairl_uav_handover.features import FEATURES
 from xairl_uav_handover.config import SimConfig
-from xairl_uav_handover.policy import (DQNController, background_states, dqn_decision_states, load_checkpoint,
-                                       uav_policy)
+from xairl_uav_handover.evaluate import margin_ranking, table_one
+from xairl_uav_handover.policy import DQNController, load_checkpoint
 from xairl_uav_handover.train import TrainConfig, train_checkpoint
 
 KEYS = ("handovers_median", "pingpong_pct_median", "pingpong_pct_pooled", "pingpong_pct_mean",
         "service_availability_pct_mean", "lost_data_kbit_mean", "mean_buffer_kbit_mean", "buffer_nonempty_pct_mean")
-
-
-def margin_ranking(ckpt, n_states: int, seed: int) -> list[str]:
-    policy = uav_policy(ckpt)
-    exp = xairl.explain(policy, dqn_decision_states(ckpt, n_states, seed),
-                        background=background_states(100, seed=seed + 7, config=ckpt.sim_config))
-    importance = np.abs(exp.margin()).mean(axis=0)
-    return [FEATURES[j] for j in np.argsort(-importance)]
 
 
 def train_seeds(seeds: list[int], episodes: int, folder: Path) -> list[str]:

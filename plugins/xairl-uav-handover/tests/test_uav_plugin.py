@@ -10,7 +10,7 @@ from xairl import plugins
 from xairl.cli import main
 from xairl import CheckpointError
 from xairl_uav_handover.baselines import CHM, SAMRO
-from xairl_uav_handover.evaluate import table_one
+from xairl_uav_handover.evaluate import margin_ranking, table_one
 from xairl_uav_handover.features import FEATURES
 from xairl_uav_handover.policy import DQNController, build_qnet, load_checkpoint, save_checkpoint, uav_policy
 
@@ -43,8 +43,9 @@ def test_pretrained_dqn_deep_shap_matches_shap():
 
 def test_pretrained_dqn_meets_table_one_targets():
     """The committed checkpoint on 100 held-out flights: the order CHM > SA-MRO > DQN in median handovers, no
-    ping-pong for the DQN, the buffer in use in >= 30 % of decisions, service kept. (Issue 11's DQN <= 0.2 x CHM is
-    not met: 1 against 4, see the plugin README.)"""
+    ping-pong for the DQN, the buffer in use in >= 30 % of decisions, service kept. (Issue 11's DQN <= 0.2 x CHM
+    holds on these flights, 1 against 5.5, but not on the 200 of benchmarks/reproduce.py, 1 against 4, nor by mean
+    handovers per flight: see the plugin README; so the bound here is 0.25.)"""
     ckpt = load_checkpoint()
     rows = table_one([CHM(), SAMRO(), DQNController(ckpt.net)], ckpt.sim_config, 100, seed=0)
     chm, sa, dqn = rows["CHM"], rows["SA-MRO"], rows["DQN"]
@@ -53,6 +54,12 @@ def test_pretrained_dqn_meets_table_one_targets():
     assert dqn["pingpong_pct_pooled"] < chm["pingpong_pct_pooled"] < sa["pingpong_pct_pooled"]
     assert dqn["buffer_nonempty_pct_mean"] >= 30
     assert dqn["service_availability_pct_mean"] >= 0.95 * chm["service_availability_pct_mean"]
+
+
+def test_buffer_leads_the_pretrained_dqns_margin():
+    """The paper's Figure 2 finding, at small scale: buffer_queue_size is among the two features with the largest
+    mean |contribution to the margin| on the committed DQN's own decision states (issue 11)."""
+    assert "buffer_queue_size" in margin_ranking(load_checkpoint(), n_states=150, seed=0)[:2]
 
 
 def test_corrupt_and_mismatched_checkpoints(tmp_path):

@@ -81,6 +81,18 @@ def format_table(rows: dict[str, dict[str, float]], config: SimConfig, n_flights
     return "\n".join(lines)
 
 
+def margin_ranking(ckpt, n_states: int, seed: int) -> list[str]:
+    """Features by mean |contribution to the margin over the runner-up| (deep_shap) on the DQN's own decision states
+    of held-out flights, most important first (the reproduction's check of the paper's Figure 2)."""
+    import xairl
+
+    from .policy import background_states, dqn_decision_states, uav_policy
+
+    exp = xairl.explain(uav_policy(ckpt), dqn_decision_states(ckpt, n_states, seed),
+                        background=background_states(100, seed=seed + 7, config=ckpt.sim_config))
+    return [FEATURES[j] for j in np.argsort(-np.abs(exp.margin()).mean(axis=0))]
+
+
 def chm_rate_by_altitude(altitudes, config: SimConfig, n_flights: int = 40, duration_s: float = 60.0,
                          seed: int = 0) -> np.ndarray:
     """Conventional handovers per minute for flights held at each altitude (simulator)."""

@@ -231,8 +231,9 @@ def quantile_rows(sim: np.ndarray, real: np.ndarray) -> list[QuantileRow]:
 def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
     from .real_data import agreement
 
-    def dqn(_walk):
-        return lambda s, c, t: int(greedy(ckpt.net, s[None], cfg)[0])
+    def dqn(walk):  # the DQN keeps no state: its action at every sample of the walk in one batch
+        actions = dict(zip(walk.t.tolist(), greedy(ckpt.net, walk.states, cfg).tolist()))
+        return lambda s, c, t: actions[t]
 
     rows = []
     for name, make in (("DQN", dqn), ("CHM (A3 2 dB, 160 ms)", lambda w: CHMOnSamples(w.cells)),
