@@ -258,9 +258,11 @@ def findings(exps: dict[str, Explanation]) -> list[str]:
         order = [grouped.feature_names[j] for j in np.argsort(-imp)]
         buf, pos = order.index("buffer_queue_size") + 1, order.index("position") + 1
         holds = "holds" if buf == 1 and pos == 2 else "does not hold"
-        out.append(f"Paper's Figure 2 finding (buffer first, position second) {holds} on the {label} states: by mean "
-                   f"|contribution to the margin over the runner-up| the buffer ranks {buf} and position (x, y, z) "
-                   f"{pos}; the top three are {', '.join(order[:3])}.")
+        parts = (f"buffer first {'holds' if buf == 1 else 'does not'}, position second "
+                 f"{'holds' if pos == 2 else 'does not'}")
+        out.append(f"Paper's Figure 2 finding (buffer first, position second) {holds} on the {label} states "
+                   f"({parts}): by mean |contribution to the margin over the runner-up| the buffer ranks {buf} and "
+                   f"position (x, y, z) {pos}; the top three are {', '.join(order[:3])}.")
     return out
 
 
