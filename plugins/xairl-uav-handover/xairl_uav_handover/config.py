@@ -39,8 +39,8 @@ class RadioConfig(_Strict):
                                                             "the UAV's resource blocks (see uplink.py). Calibrated "
                                                             "with the cells' spread below: median capacity 38 Mbit/s "
                                                             "in simulation and on the real flights (IMC'22 operator "
-                                                            "B: 37.7); real buffer full in 15-19 % of real states "
-                                                            "over 5 seeds (0.065: 16-20 %; 0.08: 26 %)")
+                                                            "B: 37.7); real buffer full in 13-19 % of real states "
+                                                            "over 5 seeds (0.065: 15-20 %)")
     load_range: tuple[float, float] = Field((0.1, 1.0), description="downlink load of the cells (RSSI for RSRQ), "
                                             "drawn per flight: real networks are loaded anywhere in between")
     gain_spread_db: float = Field(8.0, ge=0, le=20, description="per-flight antenna gain deviation, uniform +-: "
