@@ -59,6 +59,23 @@ def test_handover_facts_with_history():
     assert handover_facts(weak, 0, 1).extras["chm"] == "stay"
 
 
+def test_a3_sentence_verifies_when_the_compared_candidate_is_not_the_strongest_neighbour(uav):
+    """The A3 sentence cites the rule's 2 dB offset while the first comparison is about another candidate (a real
+    state where the DQN stayed with candidate 3 as runner-up and candidate 1 had met A3 for two decisions)."""
+    policy, _, bg = uav
+    state = np.array([61.9, -505.2, 20.0, 0.0, 6.0, -82.0, -79.0, -81.0, -81.0, -16.0, -14.0, -16.0, -12.0],
+                     dtype=np.float32)
+    exp = xairl.explain(policy, state[None], background=bg)
+    facts = handover_facts(state, 0, 3, history=state[None])  # with the state itself: two decisions
+    assert facts.extras["chm"] == "hand over to candidate 1"
+    text = ("The third strongest neighbour's RSRP was {} dB above the serving BS's RSRP; the strongest neighbour has "
+            "been more than {} dB above the serving BS for 2 consecutive decisions, so the conventional A3 rule (CHM) "
+            "would hand over to candidate 1.")
+    assert xairl.verify(text.format("1.0", "2"), exp, 0, policy, facts=facts).ok
+    assert not xairl.verify(text.format("1.0", "5"), exp, 0, policy, facts=facts).ok  # a wrong offset is caught
+    assert not xairl.verify(text.format("4.0", "2"), exp, 0, policy, facts=facts).ok  # and a wrong gap
+
+
 def test_mutation_corpus_on_the_reference_policy(uav):
     policy, exp, _ = uav
     cases = corpus(exp, policy, ("explain_action", "explain_score", "why_not", "handover"), range(40),

@@ -136,6 +136,8 @@ class HandoverFacts:
         if history is not None and held:
             comparisons.append(Comparison(f"the strongest neighbour has been more than {self.offset:g} dB above the "
                                           f"serving BS for {held} consecutive decisions", held, "consecutive"))
+            # the rule's offset is a fact the sentence above cites in dB, whichever candidate the first one compares
+            comparisons.append(Comparison(f"the A3 offset is {self.offset:g} dB", self.offset, "dB"))
         if history is not None and len(history):
             before = 100.0 * float(np.asarray(history)[-1][FEATURES.index("buffer_queue_size")]) / self.q_max
             extras["buffer_trend"] = "rising" if fill > before + 1 else "falling" if fill < before - 1 else "steady"
