@@ -66,7 +66,8 @@ def table_one(controllers, config: SimConfig, n_flights: int, seed: int) -> dict
 
 
 def format_table(rows: dict[str, dict[str, float]], config: SimConfig, n_flights: int) -> str:
-    cols = [("handovers_median", "HO/flight", "{:.1f}"), ("handovers_mean", "HO (mean)", "{:.2f}"), ("pingpong_pct_median", "PP % (med)", "{:.1f}"),
+    cols = [("handovers_median", "HO/flight", "{:.1f}"), ("handovers_mean", "HO (mean)", "{:.2f}"),
+            ("pingpong_pct_median", "PP % (med)", "{:.1f}"),
             ("pingpong_pct_pooled", "PP % (pool)", "{:.1f}"), ("pingpong_pct_mean", "PP % (mean)", "{:.1f}"),
             ("service_availability_pct_mean", "SA %", "{:.2f}"), ("mean_buffer_kbit_mean", "buffer kbit", "{:.1f}"),
             ("buffer_nonempty_pct_mean", "buf>0 %", "{:.1f}"), ("lost_data_kbit_mean", "lost kbit", "{:.1f}"),

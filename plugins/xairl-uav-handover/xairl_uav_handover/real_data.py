@@ -194,7 +194,8 @@ class UplinkBuffer:
     def sinr_db(self, rsrp_dbm: float, cell) -> float:
         if cell not in self._interference:
             site = self._cell_rng.integers(len(self.site_interference))
-            self._interference[cell] = float(self.site_interference[site] * cell_deviation(self.cfg, self._cell_rng, ()))
+            deviation = cell_deviation(self.cfg, self._cell_rng, ())
+            self._interference[cell] = float(self.site_interference[site] * deviation)
         return float(sinr_db(self.cfg, rsrp_offset_db(self.cfg) - rsrp_dbm, self._interference[cell]))
 
     def advance(self, rsrp_dbm: float, cell, seconds: float, handed: bool) -> None:

@@ -48,9 +48,9 @@ class TableOneRow:
     lost_kbit: float
     paper: str
 
-    HEADER = ["policy", "HO/flight (median)", "HO/flight (mean)", "ping-pong % (median)", "ping-pong % (pooled)", "ping-pong % (mean)",
-              "service availability %", "mean buffer kbit", "buffer non-empty % of decisions", "lost kbit",
-              "paper HO / PP %"]
+    HEADER = ["policy", "HO/flight (median)", "HO/flight (mean)", "ping-pong % (median)", "ping-pong % (pooled)",
+              "ping-pong % (mean)", "service availability %", "mean buffer kbit", "buffer non-empty % of decisions",
+              "lost kbit", "paper HO / PP %"]
 
 
 @dataclass
@@ -151,8 +151,9 @@ class UAVReport(Report):
     def _table_one(self, ckpt: Checkpoint, seed: int) -> tuple[str, str]:
         n, cfg = self.options.flights, ckpt.sim_config
         rows = [TableOneRow(name, r["handovers_median"], r["handovers_mean"], r["pingpong_pct_median"],
-                            r["pingpong_pct_pooled"], r["pingpong_pct_mean"], r["service_availability_pct_mean"], r["mean_buffer_kbit_mean"],
-                            r["buffer_nonempty_pct_mean"], r["lost_data_kbit_mean"], "%d / %d" % PAPER[name])
+                            r["pingpong_pct_pooled"], r["pingpong_pct_mean"], r["service_availability_pct_mean"],
+                            r["mean_buffer_kbit_mean"], r["buffer_nonempty_pct_mean"], r["lost_data_kbit_mean"],
+                            "%d / %d" % PAPER[name])
                 for name, r in table_one([CHM(), SAMRO(), DQNController(ckpt.net)], cfg, n, seed).items()]
         return (f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s (ping-pong window "
                 f"{cfg.handover.min_time_of_stay_s:g} s)", _table(rows))

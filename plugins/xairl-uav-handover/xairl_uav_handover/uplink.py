@@ -5,12 +5,13 @@ with height): every other cell j has a co-channel aerial UE on the UAV's resourc
 the time, flying at the UAV's height over cell j's site and sending at full power (no power control: a stated
 simplification). Its mean received power at BS b mixes the LoS and NLoS path losses of TR 36.777 by P_LOS(h, d),
 so it grows with height as P_LOS does. The sum over j is precomputed per flight (heights are constant in flight).
-Cells differ in uplink load (how many UEs they serve, where): each cell's interference level deviates from the mean
-by a per-flight draw, uniform within +-``ul_interference_spread_db`` (:func:`cell_deviation`). The downlink RSRP
-the UE measures does not show this; only the uplink buffer does, which is why a UE's buffer tells a handover policy
-something its radio measurements do not (TR 36.777 notes the uplink interference aerial UEs meet varies widely).
-A real flight uses the same model at its altitude, for a cell in the middle of the layout with a deviation drawn per
-real cell, with the path loss read from the measured RSRP; sim and real buffers are thus driven by one uplink model.
+Cells differ in uplink load (how many UEs they serve, and where): each cell's interference level deviates from the
+layout's mean by a per-flight draw, uniform within +-``ul_interference_spread_db`` (:func:`cell_deviation`; a
+modelling choice, its size measured in config.py). The downlink RSRP the UE measures does not show this; only the
+uplink buffer does, so the buffer tells a handover policy something its radio measurements do not.
+A real flight uses the same model at its altitude: each real cell takes the mean level of a random cell of the
+layout times its own deviation, and the path loss is read from the measured RSRP (real_data.UplinkBuffer); sim and
+real buffers are thus driven by one uplink model.
 
 Capacity is the paper's ``W_s |B| log2(1 + SINR)``; signal and noise are over the UAV's |B| resource blocks.
 """
