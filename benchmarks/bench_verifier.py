@@ -36,7 +36,7 @@ from tests import narrative_domains as domains  # noqa: E402
 DATA = pathlib.Path(__file__).parent / "data" / "narratives"
 
 
-SPLITS = ("dev", "dev2", "dev3", "dev4", "test")
+SPLITS = ("dev", "dev2", "dev3", "dev4", "dev5", "test")
 
 
 def load_corpus() -> list[dict]:
@@ -47,7 +47,8 @@ def load_corpus() -> list[dict]:
     out = []
     for domain in domains.DOMAINS:
         for path, later in ((DATA / f"{domain}.yaml", None), (DATA / "dev2" / f"{domain}.yaml", "dev2"),
-                            (DATA / "dev3" / f"{domain}.yaml", "dev3"), (DATA / "dev4" / f"{domain}.yaml", "dev4")):
+                            (DATA / "dev3" / f"{domain}.yaml", "dev3"), (DATA / "dev4" / f"{domain}.yaml", "dev4"),
+                            (DATA / "dev5" / f"{domain}.yaml", "dev5")):
             for case_id, items in yaml.safe_load(path.read_text()).items():
                 case = cases[case_id]
                 assert not later or case["split"] == "dev", f"{path}: {case_id} is not a dev case"
