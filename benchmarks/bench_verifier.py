@@ -5,8 +5,9 @@ credit default, one output each, not RL; the UAV handover DQN; the toy discrete 
 with one labelled error, in many voices. Cases 0-3 of each domain are the dev split (the verifier was tuned on it),
 cases 4-7 the test split (frozen before any tuning; report it apart); ``dev2/`` 76 more narratives on the dev
 cases in other voices (Q&A, LLM-style prose, shorthand, lists; 16 of them on two UAV 'stay' cases of its own) and
-``dev3/`` 55 more (shares, 'accounts for', pipes, counterfactuals) and ``dev4/`` 44 in the voice of an LLM explaining
-SHAP values, each written after the freeze and measured once before tuning on it. A narrative counts as agreeing when ``Verification.ok`` equals its label.
+``dev3/`` 55 more (shares, 'accounts for', pipes, counterfactuals), ``dev4/`` 44 in the voice of an LLM explaining
+SHAP values and ``dev5/`` 45 in memo, log, arrow and passive voices, each written after the freeze and measured once
+before tuning on it. A narrative counts as agreeing when ``Verification.ok`` equals its label.
 
     .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain and error kind, speed
     .venv/bin/python benchmarks/bench_verifier.py --show test # also every disagreement of the test split
@@ -40,7 +41,7 @@ SPLITS = ("dev", "dev2", "dev3", "dev4", "dev5", "test")
 
 
 def load_corpus() -> list[dict]:
-    """Every narrative with its case's Explanation, domain, split, label and error kind. ``dev2`` to ``dev4`` hold
+    """Every narrative with its case's Explanation, domain, split, label and error kind. ``dev2`` to ``dev5`` hold
     narratives written later, on the dev cases only, in other voices (tuning material like ``dev``)."""
     cases = {c["id"]: c for path in (DATA / "cases.json", DATA / "dev2" / "cases.json")
              for c in json.loads(path.read_text())}

@@ -86,7 +86,8 @@ def feature_info(q_max_bits: float = 2e6) -> dict[str, FeatureInfo]:
 FEATURE_INFO = feature_info()
 ACTION_ALIASES = {"stay": ("keep the serving BS", "staying"),
                   **{a: (f"hand over to candidate {k}", f"a handover to candidate {k}", f"switch to candidate {k}",
-                         "switch cells", "change cells")  # shared by every handover: the chosen one among them
+                         "switch cells", "change cells", "switching", "leaving")  # shared by every handover:
+                     # the chosen one among them
                      for k, a in enumerate(ACTIONS) if k}}
 
 

@@ -149,9 +149,15 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
     return Verification(tuple(out), note)
 
 
-def _context(sentence: str, mentions: list[Mention], book: FactBook) -> str | None:
+# a direction verb whose object is an option ('favoured turning', 'helped turning', '+22.0 toward the handover')
+# weighs it against the other one as much as it raises its score: either view, unless the words name the score
+_TOWARD_ACTION = re.compile(r"\b(favou?r(s|ed|ing)?|help(s|ed|ing)?|toward(s)?|held \w+ back)\s+(?:the |a |an )?$")
+
+
+def _context(sentence: str, mentions: list[Mention], book: FactBook, offset: int = 0) -> str | None:
     """'margin' when the sentence compares with the runner-up, 'chosen' when it names the chosen action's score,
-    None when it does not say (claims then hold if they hold in either view)."""
+    None when it does not say (claims then hold if they hold in either view). ``offset``: where ``sentence`` (a
+    clause) starts in the text the mentions' positions count from."""
     if not book.runner_up:
         return "chosen"
     low = sentence.lower()
@@ -159,7 +165,10 @@ def _context(sentence: str, mentions: list[Mention], book: FactBook) -> str | No
     if runner_named or re.search(r"\b(rather than|instead of|runner.up|relative to|compared (with|to)|versus|vs\.?|"
                                  r"margin|lead|edge|advantage|over (going|staying|turning|handing))\b", low):
         return "margin"
-    if re.search(r"\b(argu\w* (for|against)|in favou?r of|tip(ped|s)? the balance)\b", low):
+    toward = any(m.kind == "action" and _TOWARD_ACTION.search(low[max(0, m.start - offset - 24):m.start - offset])
+                 for m in mentions)
+    if re.search(r"\b(argu\w* (for|against)|in favou?r of|tip(ped|s)? the balance)\b", low) or (
+            toward and not re.search(r"\b(score|q.value|q\(|value of)\b", low)):
         return checks.EITHER  # weighing two options: the margin, or the chosen action's own score
     if re.search(r"\b(score|q.value|q\(|value of)\b", low) or any(
             m.kind == "action" and checks.resolve_action(m, book) == book.chosen for m in mentions):
@@ -182,7 +191,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     bounds = [0] + [m.end() for m in _CLAUSE_RE.finditer(masked)] + [len(masked)]
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
-        own = _context(sentence[a:b], inside, book) if len(bounds) > 2 else None  # '..., yet against staying'
+        own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'
         found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, vocab.name_words)
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     for ident in _IDENT_RE.findall(masked):
@@ -223,8 +232,12 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     return out
 
 
-_SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q\s*=|scored|scores|score of|with a score of|came second at|"
+_SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of)?|scored|scores|score of|"
+                        r"with a score of|came second at|"
                         r"second at|score|at|of|was|=)?\s*\(?(?:q\s*=\s*)?$", re.IGNORECASE)
+
+
+_ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*)\b", re.IGNORECASE)  # 'speed argued for X (-5.48)'
 
 
 def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:
@@ -250,7 +263,8 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     prev = next((m for m in reversed(mentions) if m.end <= n.start), None)
     feature_before = next((m for m in reversed(names) if m.end <= n.start), None)
     if prev is not None and prev.kind == "action" and (
-            n.sign == "+" or re.match(r"^\s*(over|than|versus|vs)\b", after, re.IGNORECASE) or (
+            n.sign == "+" or (feature_before is not None and _ARGUED.search(masked, feature_before.end, prev.start))
+            or re.match(r"^\s*(over|than|versus|vs)\b", after, re.IGNORECASE) or (
             feature_before is not None and checks.DIRECTION_RE.search(masked, feature_before.end, prev.start))):
         prev = feature_before  # '(+2.05)' after 'supported recharging': the feature's contribution
     if prev is not None and prev.kind == "action":
@@ -332,7 +346,7 @@ def _ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook,
         if not sign and side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
             # 'the main argument for staying': the largest that favours it
             sign = 1 if side.group(1) else -1
-            obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - side.end() <= 6), None)
+            obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() - side.end() <= 6), None)
             if obj is not None and checks.resolve_action(obj, book) == book.runner_up:
                 sign = -sign  # '... for the handover' when staying was chosen
         if plural:
