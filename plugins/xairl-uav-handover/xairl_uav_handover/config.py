@@ -50,8 +50,9 @@ class RadioConfig(_Strict):
                                       "cells carry different uplink loads, so a UE's uplink quality is not its "
                                       "downlink RSRP alone (uplink.py). Measured (40 episodes, 100 held-out "
                                       "flights, w_buffer 1, ul_activity 0.08): buffer_queue_size by mean |margin "
-                                      "contribution| ranks 4th at 6 dB (seed 0), 1st/2nd/1st at 10 dB (seeds 0-2); 7th-10th "
-                                      "without it (the earlier calibration)")
+                                      "contribution| ranks 4th at 6 dB (seed 0), 1st/2nd/1st at 10 dB (seeds 0-2); "
+                                      "7th-10th without it (the earlier calibration)")
+
 
 class LayoutConfig(_Strict):
     isd_m: float = Field(500.0, gt=50, le=10_000, description="inter-site distance of the hexagonal grid")
@@ -131,9 +132,10 @@ class RewardConfig(_Strict):
                                                        "120 s, L3 k=4): 3 leaves the DQN at a median 3 handovers per "
                                                        "flight, 10 at 2, 20 at 1, CHM at 6")
     w_buffer: float = Field(2.0, ge=0, description="measured (40 episodes, 100 held-out flights, seeds 0 and 1, "
-                                                   "ul_activity 0.055, spread 10 dB): 1 leaves buffer_queue_size 2nd-3rd by mean |margin contribution| "
-                                                   "and the DQN losing 7-10 % more data than CHM; 2 puts it 1st "
-                                                   "with the DQN losing as much as CHM (-1 to 0 %)")
+                                                   "ul_activity 0.055, spread 10 dB): 1 leaves buffer_queue_size "
+                                                   "2nd-3rd by mean |margin contribution| and the DQN losing 7-10 % "
+                                                   "more data than CHM; 2 puts it 1st with the DQN losing as much as "
+                                                   "CHM (-1 to 0 %)")
     w_rsrp: float = Field(0.5, ge=0)
     w_rsrq: float = Field(0.5, ge=0)
 
