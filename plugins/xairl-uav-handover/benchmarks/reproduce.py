@@ -15,29 +15,12 @@ from pathlib import Path
 import numpy as np
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.config import SimConfig
-from xairl_uav_handover.env import HandoverVecEnv
-from xairl_uav_handover.evaluate import BUFFER, HELD_OUT_SEED, margin_ranking, table_one
+from xairl_uav_handover.evaluate import margin_ranking, run_flights, summarise
 from xairl_uav_handover.policy import DQNController, load_checkpoint
 from xairl_uav_handover.train import TrainConfig, train_checkpoint
 
 KEYS = ("handovers_median", "handovers_mean", "pingpong_pct_median", "pingpong_pct_pooled", "pingpong_pct_mean",
         "service_availability_pct_mean", "lost_data_kbit_mean", "mean_buffer_kbit_mean", "buffer_nonempty_pct_mean")
-
-
-def buffer_before_handovers(ckpt, n_flights: int, seed: int) -> tuple[float, float]:
-    """Shares of the DQN's handovers on held-out flights taken with a non-empty and with a full buffer."""
-    dqn = DQNController(ckpt.net)
-    env = HandoverVecEnv(ckpt.sim_config, n_flights, decision_every=dqn.decision_every)
-    env.reset(seed=HELD_OUT_SEED + seed)
-    dqn.reset(env)
-    before, ended = [], False
-    while not ended:
-        q = env.obs[:, BUFFER].copy()
-        *_, truncated, info = env.step(dqn(env))
-        before += q[info["handover"].astype(bool)].tolist()
-        ended = bool(truncated.all())
-    before = np.array(before)
-    return float(np.mean(before > 0)), float(np.mean(before >= ckpt.sim_config.buffer.q_max_bits))
 
 
 def train_seeds(seeds: list[int], episodes: int, folder: Path) -> list[str]:
@@ -65,9 +48,13 @@ def main():
     per_seed = []
     for path in paths:
         ckpt = load_checkpoint(path)
-        rows = table_one([CHM(), SAMRO(), DQNController(ckpt.net)], ckpt.sim_config, args.flights, args.seed)
+        flown = {c.name: run_flights(c, ckpt.sim_config, args.flights, args.seed)
+                 for c in (CHM(), SAMRO(), DQNController(ckpt.net))}
+        rows = {name: summarise(m) for name, m in flown.items()}
         ranking = margin_ranking(ckpt, args.states, args.seed)
-        nonempty, full = buffer_before_handovers(ckpt, args.flights, args.seed)
+        dqn_ho = max(flown["DQN"]["handovers"].sum(), 1)  # shares of the DQN's handovers by the buffer before them
+        nonempty, full = (float(flown["DQN"][k].sum() / dqn_ho) for k in ("handovers_buffer_nonempty",
+                                                                           "handovers_buffer_full"))
         per_seed.append({"checkpoint": path, "train_seed": ckpt.meta.get("seed"), "rows": rows,
                          "handovers_with_buffer_nonempty": nonempty, "handovers_with_buffer_full": full,
                          "margin_ranking": ranking, "buffer_rank": ranking.index("buffer_queue_size") + 1,

@@ -41,13 +41,28 @@ def _terrestrial_uma_loss(h, d3d, fc_ghz, bs_height_m):
     return pl_los, np.maximum(pl_los, 13.54 + 39.08 * np.log10(d3d) + lg_fc - 0.6 * (h - 1.5))
 
 
+def _where_low(h, aerial, terrestrial, d):
+    """UMa-AV's aerial values (one array or a tuple), replaced at or below 22.5 m by ``terrestrial(h, d)`` evaluated
+    on those elements only: the simulator calls this every step, and most heights are aerial."""
+    aerial = aerial if isinstance(aerial, tuple) else (aerial,)
+    low = h <= TERRESTRIAL_M
+    if not np.any(low):
+        return aerial
+    hb, db, low = np.broadcast_arrays(h, d, low)
+    out = tuple(np.array(np.broadcast_to(a, hb.shape), dtype=float) for a in aerial)
+    for o, t in zip(out, terrestrial(hb[low], db[low])):
+        o[low] = t
+    return out
+
+
 def los_probability(scenario: str, h, d2d):
     """P_LOS for a UAV at height ``h`` and horizontal distance ``d2d`` (TR 36.777 Table B-1)."""
     h, d2d = np.asarray(h, dtype=float), np.asarray(d2d, dtype=float)
     lg = np.log10(h)
     if scenario == "UMa-AV":  # LoS certain above 100 m; terrestrial at or below 22.5 m
-        p = _los_from_d1_p1(d2d, np.maximum(460 * lg - 700, 18.0), np.maximum(4300 * lg - 3800, 1.0))
-        return np.where(h > 100, 1.0, np.where(h <= TERRESTRIAL_M, _terrestrial_uma_los(h, d2d), p))
+        p = np.where(h > 100, 1.0, _los_from_d1_p1(d2d, np.maximum(460 * lg - 700, 18.0),
+                                                   np.maximum(4300 * lg - 3800, 1.0)))
+        return _where_low(h, p, lambda hl, dl: (_terrestrial_uma_los(hl, dl),), d2d)[0]
     if scenario == "UMi-AV":
         return _los_from_d1_p1(d2d, np.maximum(294.05 * lg - 432.94, 18.0), 233.98 * lg - 0.95)
     if scenario == "RMa-AV":  # LoS certain above 40 m
@@ -62,11 +77,10 @@ def path_loss(scenario: str, h, d3d, fc_ghz: float, los, bs_height_m: float = 25
     h, d3d = np.asarray(h, dtype=float), np.maximum(np.asarray(d3d, dtype=float), 1.0)
     lg_h, lg_d = np.log10(h), np.log10(d3d)
     if scenario == "UMa-AV":
-        t_los, t_nlos = _terrestrial_uma_loss(h, d3d, fc_ghz, bs_height_m)
-        low = h <= TERRESTRIAL_M
-        pl_los = np.where(low, t_los, 28.0 + 22.0 * lg_d + 20.0 * np.log10(fc_ghz))
-        pl_nlos = np.where(low, t_nlos, -17.5 + (46.0 - 7.0 * lg_h) * lg_d
-                           + 20.0 * np.log10(40.0 * np.pi * fc_ghz / 3.0))
+        pl_los = 28.0 + 22.0 * lg_d + 20.0 * np.log10(fc_ghz)
+        pl_nlos = -17.5 + (46.0 - 7.0 * lg_h) * lg_d + 20.0 * np.log10(40.0 * np.pi * fc_ghz / 3.0)
+        pl_los, pl_nlos = _where_low(h, (pl_los, pl_nlos),
+                                     lambda hl, dl: _terrestrial_uma_loss(hl, dl, fc_ghz, bs_height_m), d3d)
     elif scenario == "UMi-AV":
         fspl = 32.45 + 20.0 * np.log10(fc_ghz) + 20.0 * lg_d
         pl_los = np.maximum(fspl, 30.9 + (22.25 - 0.5 * lg_h) * lg_d + 20.0 * np.log10(fc_ghz))

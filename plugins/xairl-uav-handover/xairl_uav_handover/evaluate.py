@@ -23,16 +23,22 @@ def run_flights(controller, config: SimConfig, n_flights: int, seed: int) -> dic
     controller.reset(env)
     tot = {k: np.zeros(n_flights) for k in METRICS}
     nonempty, decisions, ended = np.zeros(n_flights), 0, False
+    ho_nonempty, ho_full = np.zeros(n_flights), np.zeros(n_flights)
     while not ended:
-        nonempty += env.obs[:, BUFFER] > 0  # the decision state's buffer
+        queue = env.obs[:, BUFFER].copy()  # the decision state's buffer
+        nonempty += queue > 0
         decisions += 1
         *_, truncated, info = env.step(controller(env))
         for key in METRICS:
             tot[key] += info[key]
+        ho_nonempty += info["handover"] * (queue > 0)
+        ho_full += info["handover"] * (queue >= config.buffer.q_max_bits)
         ended = bool(truncated.all())
     n = env.sim.n_steps
     return {
         "handovers": tot["handover"],
+        "handovers_buffer_nonempty": ho_nonempty,   # decided with a non-empty buffer
+        "handovers_buffer_full": ho_full,           # and with a full one
         "buffer_nonempty_pct": 100 * nonempty / decisions,
         "pingpongs": tot["pingpong"],
         "service_availability_pct": 100 * tot["available"] / n,

@@ -11,8 +11,8 @@ A small pipeline, one module per step:
    'A and B ... by x and y, respectively'; a direction word to the names since the previous one, or to a list that
    follows it, 'Raising risk: A, B');
 4. :mod:`.checks` (and :mod:`.ranks` for ranks and magnitude) checks each claim against :mod:`.book` (values,
-   contributions to the chosen action's score and to the margin over the runner-up, ranks, shares, labels, scores, domain comparisons) and says verified,
-   contradicted or unchecked;
+   contributions to the chosen action's score and to the margin over the runner-up, ranks, shares, labels, scores,
+   domain comparisons) and says verified, contradicted or unchecked;
 5. every sentence gets a status (contradicted if any claim is; verified if a claim was checked and none is
    contradicted; else unchecked), and the text a coverage (share of sentences with a checked claim).
 
@@ -101,8 +101,8 @@ _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
 _GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|practically|"
                               r"just about)\s+)?(?:it|this|that|they|these|those|which|everything"
                               r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
-                              r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total|the prediction|the predicted \w+"
-                              r"|the estimate|the output|the model's \w+)\b(?!'s)",
+                              r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total"
+                              r"|the prediction|the predicted \w+|the estimate|the output|the model's \w+)\b(?!'s)",
                               re.IGNORECASE)
 
 
@@ -165,12 +165,13 @@ def _context(sentence: str, mentions: list[Mention], book: FactBook, offset: int
     if runner_named or re.search(r"\b(rather than|instead of|runner.up|relative to|compared (with|to)|versus|vs\.?|"
                                  r"margin|lead|edge|advantage|over (going|staying|turning|handing))\b", low):
         return "margin"
+    names_score = re.search(r"\b(score|q.value|q\(|value of)\b", low)
     toward = any(m.kind == "action" and _TOWARD_ACTION.search(low[max(0, m.start - offset - 24):m.start - offset])
                  for m in mentions)
     if re.search(r"\b(argu\w* (for|against)|in favou?r of|tip(ped|s)? the balance)\b", low) or (
-            toward and not re.search(r"\b(score|q.value|q\(|value of)\b", low)):
+            toward and not names_score):
         return checks.EITHER  # weighing two options: the margin, or the chosen action's own score
-    if re.search(r"\b(score|q.value|q\(|value of)\b", low) or any(
+    if names_score or any(
             m.kind == "action" and checks.resolve_action(m, book) == book.chosen for m in mentions):
         return "chosen"
     return None
@@ -263,9 +264,9 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     prev = next((m for m in reversed(mentions) if m.end <= n.start), None)
     feature_before = next((m for m in reversed(names) if m.end <= n.start), None)
     if prev is not None and prev.kind == "action" and (
-            n.sign == "+" or (feature_before is not None and _ARGUED.search(masked, feature_before.end, prev.start))
-            or re.match(r"^\s*(over|than|versus|vs)\b", after, re.IGNORECASE) or (
-            feature_before is not None and checks.DIRECTION_RE.search(masked, feature_before.end, prev.start))):
+            n.sign == "+" or re.match(r"^\s*(over|than|versus|vs)\b", after, re.IGNORECASE) or (
+            feature_before is not None and any(r.search(masked, feature_before.end, prev.start)
+                                               for r in (checks.DIRECTION_RE, _ARGUED)))):
         prev = feature_before  # '(+2.05)' after 'supported recharging': the feature's contribution
     if prev is not None and prev.kind == "action":
         if _SCORE_GAP.match(masked[prev.end:n.start]) or checks._MARGIN_BEFORE.search(masked[prev.end:n.start]):
