@@ -102,6 +102,20 @@ def test_sentence_status_and_coverage():
     assert invented.status == "contradicted"
 
 
+def test_a_number_bound_to_the_wrong_name_is_unchecked_not_wrong():
+    """'by 0.15' binds to the nearest name (the cap diameter, -0.05), but it is odor's contribution exactly: the
+    binding was a guess, so the number is left unchecked; a number that is no fact of a named feature, or a hedged
+    one, is still contradicted."""
+    exp = _exp()
+
+    def number(text):
+        return [c for c in xairl.verify(text, exp, 0).claims if c.kind == "number"][0]
+    guessed = number("Odor beats the cap diameter by 0.15.")
+    assert guessed.status == "unchecked" and "odor's contribution" in guessed.detail
+    assert number("Odor beats the cap diameter by 0.35.").status == "contradicted"
+    assert number("Odor beats the cap diameter by about 0.15.").status == "contradicted"
+
+
 @pytest.mark.parametrize("text", ["", " ", "x" * 1_000_000, "Die Geruchsnote erhöht die Vorhersage deutlich.",
                                   "odor adds 1.5e-1", "odor adds\u00a00.15 \u2212 wait", "\x00\x01"])
 def test_bad_input_gives_a_status_not_an_exception(text):
@@ -118,7 +132,8 @@ def corpus():
 
 def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
-    floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("test", 0.86))
+    floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("test", 0.88),
+              ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
         agree = sum(it["ok"] == it["accurate"] for it in part) / len(part)

@@ -193,7 +193,8 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'
-        found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, vocab.name_words)
+        found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, vocab.name_words,
+                              {k for m in _names(mentions) for k in m.keys})
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     for ident in _IDENT_RE.findall(masked):
         claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
@@ -205,7 +206,7 @@ def _names(mentions: list[Mention]) -> list[Mention]:
 
 
 def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
-                  unit_of, name_words=frozenset()) -> list[Claim]:
+                  unit_of, name_words=frozenset(), sentence_keys=frozenset()) -> list[Claim]:
     out: list[Claim] = []
     names = _names(mentions)
     numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not checks.skip_number(n, masked)]
@@ -222,7 +223,17 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     if not names and len(actions) >= 2 and len(numbers) == len(actions) and numbers[0].start >= actions[-1].end:
         scored = {id(n): m for n, m in zip(numbers, actions)}  # 'turn beat recharge 6.30 to 2.37'
     for n in numbers:
-        out.append(_bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of))
+        c = _bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
+        other = None
+        if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure; others are guesses
+            if re.search(r"\0\s?\($", masked[:n.start]):  # 'distance (2.33)': the name's own, written with its sign
+                owner = next(m for m in reversed(mentions) if m.end <= n.start)
+                if owner in names:
+                    other = checks.other_reading(n, set(owner.keys), book, ctx, signed=True)
+            else:
+                other = checks.other_reading(n, sentence_keys, book, ctx)
+        out.append(c if other is None else Claim("number", n.text, "unchecked",
+                                                 f"read as {c.detail}, but it is {other}: which is unclear"))
     out += _directions(masked, a, b, mentions, book, ctx, name_words)
     out += _ranks(masked, a, b, mentions, book, ctx)
     for m in ranks.MINOR_RE.finditer(masked, a, b):

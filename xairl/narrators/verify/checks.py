@@ -222,6 +222,27 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     return claim
 
 
+def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, signed: bool = False) -> str | None:
+    """Another fact the number states exactly when the words bound it to the wrong one: the value, share or
+    contribution (in the sentence's view when it names one, else any) of a feature named in the same sentence. The
+    binding was a guess, so the number is not called wrong; only unhedged numbers of two significant digits or more
+    qualify ('0.06' or 'about 0.1' may match by chance). ``signed``: a contribution only with its sign."""
+    if n.hedge or abs(n.value) < 10 * n.unit:
+        return None
+    views = book.contexts if ctx in (None, EITHER) else (ctx,)
+    for key in sorted(keys):
+        e = book.features[key]
+        if n.percent:  # a percentage is a share (or a fill the binding already tried)
+            facts = [(f"share ({c})", e.shares.get(c), True) for c in views]
+        else:  # a value as written, sign included; a contribution may be its size
+            facts = [("value", e.value, False), *((f"contribution ({c})", e.contribs.get(c), not signed)
+                                                  for c in views)]
+        for what, v, size_ok in facts:
+            if v is not None and matches(replace(n, percent=False), v, magnitude_ok=size_ok):
+                return f"{key}'s {what}"
+    return None
+
+
 def comparison(n: Number, after: str, book: FactBook) -> bool:
     unit = re.match(r"\s*([A-Za-z]+)", after)
     values = book.by_unit.get(unit.group(1).lower(), []) if unit else []
