@@ -102,6 +102,16 @@ def test_sentence_status_and_coverage():
     assert invented.status == "contradicted"
 
 
+def test_a_vague_subject_is_not_an_invented_feature():
+    """Explingo's 'The house's small size decreases the house price prediction': no feature is named, but 'size' of
+    the house is vague, not invented (unchecked); a noun of its own ('the swimming pool') is invented."""
+    exp = _exp(names=("living_area_sqft", "overall_quality"), contrib=(-0.2, 0.1), states=(1256, 5), categories=None)
+    for vague in ("The house's small size decreases the prediction.",
+                  "Its size of around 800 sq ft significantly decreased the prediction."):
+        assert xairl.verify(vague, exp, 0).status == "unchecked", vague
+    assert xairl.verify("The swimming pool decreases the prediction.", exp, 0).status == "contradicted"
+
+
 def test_a_number_bound_to_the_wrong_name_is_unchecked_not_wrong():
     """'by 0.15' binds to the nearest name (the cap diameter, -0.05), but it is odor's contribution exactly: the
     binding was a guess, so the number is left unchecked; a number that is no fact of a named feature, or a hedged

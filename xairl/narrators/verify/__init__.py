@@ -29,7 +29,7 @@ from ...policy import Policy
 from . import checks, ranks
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
-from .names import Mention, find_mentions, vocabulary
+from .names import GENERIC, Mention, find_mentions, vocabulary
 from .numbers import NUMBER_RE, find_numbers, normalise
 
 MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
@@ -301,6 +301,15 @@ _SIDE_WORD = re.compile(r"^(?:against|in favou?r of|favou?r\w*|toward\w*|support
 _PERSON_OBJECT = re.compile(r"^\s+(?:the\s+|this\s+|that\s+)?(?:applicant|borrower|customer|client|person|buyer|seller|"
                             r"owner|house|home|property|him|her|them|it|us|you)\b", re.IGNORECASE)
 _LINKS = {"but", "and", "also", "yet", "then", "still", "even", "only", "while", "though", "thus", "hence"}
+#: words that say how much or which one, not what: a subject made only of them and the names' generic words, after
+#: the thing it belongs to ('the house's small size', 'its size of around 800 sq ft'), is a vague mention, not an
+#: invented feature
+_VAGUE = {"small", "smaller", "large", "larger", "big", "bigger", "short", "long", "the", "this", "that", "its",
+          "their", "about", "around", "roughly", "nearly", "almost", "some", "over", "under", "than"}
+#: the thing a model is about, as a possessor ('the house's', 'the applicant's'): not a feature of its own
+_POSSESSOR = re.compile(r"^\W*(?:the\s+|this\s+|its\s+|their\s+)?(?:house|home|property|file|document|applicant|"
+                        r"borrower|customer|client|user|patient|loan|account|uav|drone|robot|agent|vehicle|device|"
+                        r"sample|instance|case|item)'s\s+", re.IGNORECASE)
 _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:but|except(?: for)?|apart from|"
                      r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
@@ -339,7 +348,11 @@ def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_word
     the subject is a noun phrase of its own, not a pronoun or the decision itself, and has no word of a feature's
     name (then it may be a vague mention: 'a quality rating of 10/10 adds ...')."""
     words = [w for w in re.findall(r"[A-Za-z]{3,}", subject.replace("\0", " ")) if w.lower() not in _LINKS]
-    if not words or mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")) or \
+    head = re.findall(r"[A-Za-z]{3,}", _POSSESSOR.sub("", subject.replace("\0", " ")))
+    if all(w.lower() in _VAGUE or w.lower() in GENERIC or w.lower() in _LINKS or w.lower().endswith("ly")
+           for w in head):
+        return []  # vague: perhaps a feature, not an invented one
+    if mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")) or \
             any(w.lower() in name_words or re.fullmatch(ranks.NOUN, w, re.IGNORECASE) for w in words):
         return []
     return [Claim("feature", subject.strip(" ,:-\0"), "contradicted",
