@@ -102,6 +102,19 @@ def test_sentence_status_and_coverage():
     assert invented.status == "contradicted"
 
 
+def test_a_direction_said_by_taking_a_feature_away():
+    exp = _exp()  # odor +0.15, cap diameter -0.05
+
+    def status(text):
+        return xairl.verify(text, exp, 0).status
+    assert status("If it were not for its odor, the prediction would be much lower.") == "verified"
+    assert status("Had the odor not been foul, the prediction would likely be lower.") == "verified"
+    assert status("Without the cap diameter, the prediction would be higher.") == "verified"
+    assert status("If it were not for its odor, the prediction would be much higher.") == "contradicted"
+    assert status("Without the cap diameter, the prediction would be lower.") == "contradicted"
+    assert status("Had the odor been different, the prediction would be lower.") == "unchecked"  # another value
+
+
 def test_a_vague_subject_is_not_an_invented_feature():
     """Explingo's 'The house's small size decreases the house price prediction': no feature is named, but 'size' of
     the house is vague, not invented (unchecked); a noun of its own ('the swimming pool') is invented."""

@@ -196,6 +196,8 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
         found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, vocab.name_words,
                               {k for m in _names(mentions) for k in m.keys})
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
+    if hypothetical:
+        claims += _without(masked, mentions, book, ctx)
     for ident in _IDENT_RE.findall(masked):
         claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
     return claims
@@ -294,6 +296,26 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
 #: for X'; a modal elsewhere ('chose recharge, which could save battery') leaves the rest of the sentence checked
 _HYPOTHETICAL = re.compile(r"^\W*(?:if|had|without|were|absent|but for)\b|\b(?:would|could|might)(?:\s+\w+ly)?\s+"
                            r"(?:have|be|not|never)\b|\bif it (?:were|was)(?:n't| not) for\b", re.IGNORECASE)
+#: 'If it were not for X, the price would be much lower', 'Had X not been Y, the risk would be higher', 'Without X,
+#: it would be lower': what X did, said by taking it away
+_WITHOUT = re.compile(r"^\W*(?:if it (?:were|was)(?:n't| not) for|but for|without|absent|had)\s+(?P<subject>[^,;]+?)"
+                      r"\s*,\s*(?P<rest>[^;]*?\bwould\s+(?:\w+ly\s+)?(?:be|have been)\s+(?:\w+\s+){0,2}?"
+                      r"(?:much\s+|far\s+|a lot\s+|slightly\s+|a bit\s+|even\s+)?(?P<way>higher|lower|more|less|"
+                      r"greater|smaller|bigger))\b", re.IGNORECASE)
+
+
+def _without(masked: str, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
+    """A direction said by taking a feature away: the output 'would be higher' without X means X lowered it. 'Had X
+    not been ...' only with its 'not' (else it is another value, not X's absence)."""
+    m = _WITHOUT.match(masked)
+    if m is None or (masked.lstrip().lower().startswith("had") and not re.search(r"\bnot\b", m.group("subject"))):
+        return []
+    subjects = list({x.keys: x for x in _names(mentions)  # 'the odor' and its label 'foul': one subject
+                     if m.start("subject") <= x.start < m.end("subject")}.values())
+    polarity = -1 if m.group("way").lower() in ("higher", "more", "greater", "bigger") else 1
+    return checks.check_direction(subjects, polarity, ctx or "chosen", f"without it: {m.group('way')}", book)
+
+
 _PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
 _SIDE_WORD = re.compile(r"^(?:against|in favou?r of|favou?r\w*|toward\w*|supports?|support\w*|works? against|"
                         r"worked against)$", re.IGNORECASE)
