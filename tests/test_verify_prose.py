@@ -155,7 +155,7 @@ def corpus():
 
 def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
-    floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("test", 0.88),
+    floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("dev6", 0.97), ("test", 0.9),
               ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
@@ -279,3 +279,23 @@ def test_options_weighed_against_each_other():
     assert not ok("The agent chose recharge (Q 11.42) over turn (Q 4.10).", "toy-0")
     assert ok("The battery was the strongest argument for turning.", "toy-0")
     assert not ok("The speed was the strongest argument for turning.", "toy-0")
+
+
+def test_the_lead_and_what_is_no_direction():
+    """dev6's voices: 'beat staying by x' and 'the handover's lead of x' are the margin whatever is named before;
+    'pulled in opposite directions' is no direction word."""
+    cases = {c["id"]: c for c in json.loads(
+        (pathlib.Path(__file__).parents[1] / "benchmarks/data/narratives/cases.json").read_text())}
+
+    def status(text, case):
+        domain = case.split("-")[0]
+        exp = xairl.Explanation.from_json(json.dumps(cases[case]["explanation"]))
+        return xairl.verify(text, exp, 0, domains.policy(domain)).status
+    # uav-1: the handover led staying by 0.63; uav-3: by 3.88, the serving RSRQ's share of it +24.5
+    assert status("Handing over beat staying by 0.63.", "uav-1") == "verified"
+    assert status("Handing over beat staying by 6.3.", "uav-1") == "contradicted"
+    lead = "At -27.2 dB the serving RSRQ alone contributes +24.5 to the handover's lead of {} over staying."
+    assert status(lead.format(3.9), "uav-3") == "verified"
+    assert status(lead.format(5.9), "uav-3") == "contradicted"
+    # toy-2: wind +5.31 and speed -5.48 in turn's lead over recharging
+    assert status("Wind and speed pulled in opposite directions.", "toy-2") == "unchecked"

@@ -251,6 +251,7 @@ _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of
                         r"second at|score|at|of|was|=)?\s*\(?(?:q\s*=\s*)?$", re.IGNORECASE)
 
 
+_LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)\s+of\s+(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)
 _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*)\b", re.IGNORECASE)  # 'speed argued for X (-5.48)'
 
 
@@ -264,6 +265,8 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         return checks.free_number(n, masked, book)
     if id(n) in scored:
         return checks.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
+    if book.margin is not None and _LEAD_OF.search(masked[max(0, n.start - 30):n.start]):
+        return checks.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named before
     after = masked[n.end:n.end + 24]
     nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
     if nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|by)\s+(?:a\s+|an\s+|the\s+)?$",

@@ -32,7 +32,8 @@ _POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|support
         r"positive(?:ly)?|more likely|up by|help(?:s|ed|ing)?")
 _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ )?down|"
         r"push(?:es|ed|ing)? (?:\w+ )?down|nudg\w* (?:\w+ )?down|subtract\w*|tak(?:es|ing|e) (?:\w+ )?(?:off|away)|"
-        r"took (?:\w+ )?(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos\w*|negative(?:ly)?|less likely|"
+        r"took (?:\w+ )?(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|negative(?:ly)?|"
+        r"less likely|"
         r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
         r"los(?:t|ing)|diminish\w*|penali[sz]\w*|hurt(?:s|ing)?")
 VALENCE_RE = re.compile(r"^(?:help|hurt)", re.IGNORECASE)  # whose side? a direction only toward a named action
@@ -125,7 +126,7 @@ _CONTRIB_BEFORE = re.compile(
 _LISTS_CONTRIBUTIONS = re.compile(r"shap|attribution|contribut|impact|effect|φ|phi|importance|weight|push|margin",
                                   re.IGNORECASE)
 _MARGIN_BEFORE = re.compile(r"\b(margin|lead|edge|gap|advantage|difference)(?: of)?\W*(?:about|around|roughly|only|"
-                            r"just)?\s*$|\b(won|wins|beat\w*|ahead|stayed ahead|led)\s+(?:\w+\s+){0,3}by\s+(?:about|"
+                            r"just)?\s*$|\b(won|wins|beat\w*|ahead|stayed ahead|led)\s+(?:[\w\0']+\s+){0,3}by\s+(?:about|"
                             r"around|roughly|only|just)?\s*$", re.IGNORECASE)
 _ON_AVERAGE = re.compile(r"^\s*(?:on average|over the background|across the background|at baseline|by default)\b",
                          re.IGNORECASE)
