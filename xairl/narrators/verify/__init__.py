@@ -213,7 +213,8 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     names = _names(mentions)
     numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not checks.skip_number(n, masked)]
     # 'A and B ... by x and y, respectively': numbers after the last name pair up with the names in order
-    tail = [n for n in numbers if names and n.start > names[-1].end]
+    tail = [n for n in numbers if names and n.start > names[-1].end  # not the last name's own '(−22.5 dB)'
+            and not re.fullmatch(r"\s?\([^()]*", masked[names[-1].end:n.start])]
     paired = {}
     if len(names) >= 2 and len(tail) == len(names) and (
             "respectively" in masked[a:b].lower() or checks._CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
@@ -228,10 +229,9 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
         c = _bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
         other = None
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure; others are guesses
-            if re.search(r"\0\s?\($", masked[:n.start]):  # 'distance (2.33)': the name's own, written with its sign
-                owner = next(m for m in reversed(mentions) if m.end <= n.start)
-                if owner in names:
-                    other = checks.other_reading(n, set(owner.keys), book, ctx, signed=True)
+            owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
+            if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
+                other = checks.other_reading(n, set(owner.keys), book, ctx, signed=True)  # 'distance (2.33)': its own
             else:
                 other = checks.other_reading(n, sentence_keys, book, ctx)
         out.append(c if other is None else Claim("number", n.text, "unchecked",
@@ -251,6 +251,8 @@ _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of
                         r"second at|score|at|of|was|=)?\s*\(?(?:q\s*=\s*)?$", re.IGNORECASE)
 
 
+_ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
+                      r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$", re.IGNORECASE)
 _LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)\s+of\s+(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)
 _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*)\b", re.IGNORECASE)  # 'speed argued for X (-5.48)'
 
@@ -265,6 +267,8 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         return checks.free_number(n, masked, book)
     if id(n) in scored:
         return checks.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
+    if book.output != "actions" and _ENDS_AT.search(masked[max(0, n.start - 30):n.start]):
+        return checks.output_number(n, book)  # 'pull it down to 0.142': where the output ends up
     if book.margin is not None and _LEAD_OF.search(masked[max(0, n.start - 30):n.start]):
         return checks.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named before
     after = masked[n.end:n.end + 24]
@@ -335,13 +339,14 @@ _VAGUE = {"small", "smaller", "large", "larger", "big", "bigger", "short", "long
 _POSSESSOR = re.compile(r"^\W*(?:the\s+|this\s+|its\s+|their\s+)?(?:house|home|property|file|document|applicant|"
                         r"borrower|customer|client|user|patient|loan|account|uav|drone|robot|agent|vehicle|device|"
                         r"sample|instance|case|item)'s\s+", re.IGNORECASE)
+_DESPITE = re.compile(r"\b(?:despite|in spite of|notwithstanding|even with)\b[^,;]*$", re.IGNORECASE)
 _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:but|except(?: for)?|apart from|"
                      r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
 
 def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
                 name_words=frozenset()) -> list[Claim]:
-    out, prev = [], a
+    out, prev, bare = [], a, False  # bare: the previous direction word found no subject at all
     names = _names(mentions)
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
     for i, m in enumerate(found):
@@ -355,16 +360,21 @@ def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: Fact
         if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
             nxt = found[i + 1].start() if i + 1 < len(found) else b
             subjects = [x for x in names if m.end() <= x.start < nxt]
-            if not subjects:
+            if bare and subjects and ":" in masked[m.end():subjects[0].start]:
+                subjects = []  # 'Negative drivers outweighed positive ones: A, B': whose list is it? unsaid
+            elif not subjects:
                 subject = masked[prev:m.start()]
                 inside = [x for x in mentions if prev <= x.start < m.start()]
                 pronoun = re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE)
                 if i == 0 and (book.output != "actions" or not pronoun):  # ('tipped the balance toward': one claim)
                     out += _unknown_subject(subject, m.group(0), inside, name_words)
+        conceded = [x for x in subjects if _DESPITE.search(masked[max(prev, x.start - 40):x.start])
+                    and "," in masked[x.end:m.start()]]
+        subjects = [x for x in subjects if x not in conceded]  # 'Despite being unemployed (+0.128), ... pull it down'
         flipped = [x for x in subjects if _EXCEPT.search(masked, prev, x.start)]  # 'everything but the kitchen'
         out += checks.check_direction([x for x in subjects if x not in flipped], polarity, where, m.group(0), book)
         out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
-        prev = m.end()
+        bare, prev = not subjects and not flipped, m.end()
     return out
 
 

@@ -35,7 +35,8 @@ _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? 
         r"took (?:\w+ )?(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|negative(?:ly)?|"
         r"less likely|"
         r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
-        r"los(?:t|ing)|diminish\w*|penali[sz]\w*|hurt(?:s|ing)?")
+        r"los(?:t|ing)|diminish\w*|penali[sz]\w*|hurt(?:s|ing)?|h[eo]ld(?:s|ing)? (?:\w+ ){0,2}back(?: from)?|"
+        r"discourag\w*")
 VALENCE_RE = re.compile(r"^(?:help|hurt)", re.IGNORECASE)  # whose side? a direction only toward a named action
 DIRECTION_RE = re.compile(rf"\b(?:(?P<pos>{_POS})|(?P<neg>{_NEG}))\b", re.IGNORECASE)
 _NEGATION = re.compile(r"\b(not|n't|never|no longer|neither|nor)\b[^.]{0,12}$", re.IGNORECASE)
@@ -126,14 +127,16 @@ _CONTRIB_BEFORE = re.compile(
 _LISTS_CONTRIBUTIONS = re.compile(r"shap|attribution|contribut|impact|effect|φ|phi|importance|weight|push|margin",
                                   re.IGNORECASE)
 _MARGIN_BEFORE = re.compile(r"\b(margin|lead|edge|gap|advantage|difference)(?: of)?\W*(?:about|around|roughly|only|"
-                            r"just)?\s*$|\b(won|wins|beat\w*|ahead|stayed ahead|led)\s+(?:[\w\0']+\s+){0,3}by\s+(?:about|"
-                            r"around|roughly|only|just)?\s*$", re.IGNORECASE)
+                            r"just)?\s*$|\b(won|wins|beat\w*|ahead|stayed ahead|led|edged out|outscored)\s+"
+                            r"(?:[\w\0']+\s+|\([^()]*\)\s+){0,4}by\s+(?:about|around|roughly|only|just)?\s*$",
+                            re.IGNORECASE)
 _ON_AVERAGE = re.compile(r"^\s*(?:on average|over the background|across the background|at baseline|by default)\b",
                          re.IGNORECASE)
 _MARGIN_AFTER = re.compile(r"^\s*(?:points?\s+)?(?:above|ahead|higher|more than)\b", re.IGNORECASE)
 _RUNNER_BEFORE = re.compile(r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?[$€£]?\s*$", re.IGNORECASE)
 _SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
-_BASE_AFTER = re.compile(r"^\s*(?:\w+\s+)?(baseline|base value|average|typical|expected|mean)\b", re.IGNORECASE)
+_BASE_AFTER = re.compile(r"^\s*(?:\w+\s+)?(baseline|base value|base rate|base|average|typical|expected|mean)\b",
+                         re.IGNORECASE)
 _BASE_WORDS = re.compile(r"\b(baseline|base value|base|average|typical|expected value|mean|on average)\b", re.IGNORECASE)
 #: 'the average prediction of $230,061'
 _BASE_BEFORE = re.compile(r"\b(?:baseline|average|typical|mean|expected)\s+(?:prediction|estimate|output|predicted \w+)"
@@ -166,8 +169,9 @@ def skip_number(n: Number, masked: str) -> bool:
         return True
     if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):
         return True  # all three
-    if n.text.lower() == "one" and re.search(r"\b(this|that|the|which|each|every|any|no|a)\s+$", before, re.IGNORECASE):
-        return True  # 'this one': a pronoun
+    if n.text.lower() == "one" and re.search(r"\b(this|that|the|which|each|every|any|no|a)\s+(?:[a-z]+\s+)?$", before,
+                                             re.IGNORECASE):
+        return True  # 'this one', 'the big one': a pronoun
     return bool(_LABEL_BEFORE.search(before)) or bool(_SKIP_AFTER.match(masked[n.end:]))
 
 
@@ -197,10 +201,14 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         if fill_cue and e.fill is not None:  # '8 % full': the fill, nothing else
             return matches(n, e.fill), f"{key}'s fill is {e.fill:.3g} % of its capacity"
         unit = unit_of(key).lower()
-        value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or slot) and not contrib_cue
+        # the unit with a decimal prefix ('2 Mbit' for 2e6 bit, '12 kB' for 12,000 B): the value in that unit
+        prefix = re.match(rf"\s*([kMG])\s?{re.escape(unit_of(key))}\b", after) if unit else None
+        scale = {"k": 1e3, "M": 1e6, "G": 1e9}[prefix.group(1)] if prefix else 1.0
+        value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or slot or bool(prefix)) \
+            and not contrib_cue
         cands = []
         if not contrib_cue and e.value is not None:
-            cands.append(("value", e.value))
+            cands.append(("value" if scale == 1 else f"value in {prefix.group(1)}{unit_of(key)}", e.value / scale))
         if n.percent and not contrib_cue and e.fill is not None:
             cands.append(("fill (% of capacity)", e.fill))
         if not value_cue:
@@ -308,6 +316,13 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     if book.closed:
         return Claim("number", n.text, "contradicted", "none of the facts the summary was made from")
     return Claim("number", n.text, "unchecked", "tied to no feature or quantity of this explanation")
+
+
+def output_number(n: Number, book: FactBook) -> Claim:
+    """A number said to be where the output ends up ('pulls it down to 0.142'): the prediction."""
+    v = book.scores[book.chosen]
+    ok = matches(n, v, magnitude_ok=False) or (n.percent and _percent_readings(n, v))
+    return Claim("number", n.text, "verified" if ok else "contradicted", f"the prediction is {v:.4g}")
 
 
 def _owner(n: Number, book: FactBook) -> str | None:
