@@ -102,7 +102,8 @@ _GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly
                               r"just about)\s+)?(?:it|this|that|they|these|those|which|everything"
                               r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
                               r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total"
-                              r"|the prediction|the predicted \w+|the estimate|the output|the model's \w+)\b(?!'s)",
+                              r"|the prediction|the predicted \w+|the estimate|the output|the model's \w+|(?:the )?(?:q[- ]?value |score )?"
+                              r"(?:gap|margin|lead|difference))\b(?!'s)",
                               re.IGNORECASE)
 
 
@@ -168,7 +169,8 @@ def _context(sentence: str, mentions: list[Mention], book: FactBook, offset: int
     names_score = re.search(r"\b(score|q.value|q\(|value of)\b", low)
     toward = any(m.kind == "action" and _TOWARD_ACTION.search(low[max(0, m.start - offset - 24):m.start - offset])
                  for m in mentions)
-    if re.search(r"\b(argu\w* (for|against)|in favou?r of|tip(ped|s)? the balance)\b", low) or (
+    if re.search(r"\b(argu\w* (for|against)|in favou?r of|in (?:the |its )?[\w' -]{0,40}?favou?r|tip(ped|s)? the "
+                 r"balance|case (for|against)|(?:counted|weighed) (?:\w+ )?against)\b", low) or (
             toward and not names_score):
         return checks.EITHER  # weighing two options: the margin, or the chosen action's own score
     if names_score or any(
@@ -254,7 +256,9 @@ _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of
 _ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
                       r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$", re.IGNORECASE)
 _LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)\s+of\s+(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)
-_ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*)\b", re.IGNORECASE)  # 'speed argued for X (-5.48)'
+#: 'speed argued for X (-5.48)', 'obstacle barely affected the turn score (-0.09)': the feature's contribution
+_ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact\w*|influenc\w*|matter\w*|"
+                     r"shift\w*|worth)\b", re.IGNORECASE)
 
 
 def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:
@@ -273,7 +277,13 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         return checks.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named before
     after = masked[n.end:n.end + 24]
     nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
-    if nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|by)\s+(?:a\s+|an\s+|the\s+)?$",
+    # '+22.0 for the handover' after a feature, 'worth 11.5 for ...': the feature's push, not the action's score
+    pushes = (n.sign == "+" or re.search(r"\bworth\s*$", masked[:n.start])) and any(x.end <= n.start for x in names)
+    if pushes and nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|to|toward|towards)\s+(?:the\s+)?$",
+                                                                   masked[n.end:nxt.start]):
+        owner = next(x for x in reversed(names) if x.end <= n.start)  # for one option over the other: either view
+        return checks.feature_number(n, owner.keys, masked, book, checks.EITHER, unit_of)
+    if nxt is not None and nxt.kind == "action" and not pushes and re.match(r"^\s*(?:for|by)\s+(?:a\s+|an\s+|the\s+)?$",
                                                            masked[n.end:nxt.start]):
         return checks.action_number(n, checks.resolve_action(nxt, book), masked, book)
     gap = masked[n.end:nxt.start] if nxt is not None else ""
@@ -339,6 +349,10 @@ _VAGUE = {"small", "smaller", "large", "larger", "big", "bigger", "short", "long
 _POSSESSOR = re.compile(r"^\W*(?:the\s+|this\s+|its\s+|their\s+)?(?:house|home|property|file|document|applicant|"
                         r"borrower|customer|client|user|patient|loan|account|uav|drone|robot|agent|vehicle|device|"
                         r"sample|instance|case|item)'s\s+", re.IGNORECASE)
+#: '... everything else was positive except the lot': the exception after the direction word
+_EXCEPT_AFTER = re.compile(r"\b(?:except|but not|apart from|other than)(?: for)?\s+(?:the\s+|its\s+|their\s+)?\W*$",
+                           re.IGNORECASE)
+_ALL_RE = re.compile(r"\b(?:everything|all|every\w*|anything)\b", re.IGNORECASE)
 _DESPITE = re.compile(r"\b(?:despite|in spite of|notwithstanding|even with)\b[^,;]*$", re.IGNORECASE)
 _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:but|except(?: for)?|apart from|"
                      r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
@@ -371,7 +385,8 @@ def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: Fact
         conceded = [x for x in subjects if _DESPITE.search(masked[max(prev, x.start - 40):x.start])
                     and "," in masked[x.end:m.start()]]
         subjects = [x for x in subjects if x not in conceded]  # 'Despite being unemployed (+0.128), ... pull it down'
-        flipped = [x for x in subjects if _EXCEPT.search(masked, prev, x.start)]  # 'everything but the kitchen'
+        flipped = [x for x in subjects if _EXCEPT.search(masked, prev, x.start) or (  # 'everything but the kitchen'
+            _EXCEPT_AFTER.search(masked, m.end(), x.start) and _ALL_RE.search(masked, a, m.start()))]
         out += checks.check_direction([x for x in subjects if x not in flipped], polarity, where, m.group(0), book)
         out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
         bare, prev = not subjects and not flipped, m.end()
@@ -403,6 +418,9 @@ def _ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook,
         if not sign and said and said.group(0).lower() not in ("for", "against", "toward", "towards"):
             sign = 1 if said.group("pos") else -1  # 'key factors decreasing the risk', 'the main feature supporting'
         side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])
+        if not sign and not side and book.output == "actions" and re.search(r"(argument|reason)s?$", m.group(0),
+                                                                             re.IGNORECASE):
+            sign = 1  # 'the strongest reason': a reason for what was decided
         if not sign and side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
             # 'the main argument for staying': the largest that favours it
             sign = 1 if side.group(1) else -1

@@ -143,7 +143,7 @@ _BASE_BEFORE = re.compile(r"\b(?:baseline|average|typical|mean|expected)\s+(?:pr
                           r"\s*(?:of|is|was|:|=)?\s*[$€£]?\s*$", re.IGNORECASE)
 _OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability|chance|risk|price|output|final)\b",
                         re.IGNORECASE)
-_SKIP_AFTER = re.compile(r"^\s*(background|samples?|rows?|states?|draws|features|narratives|coalitions)\b",
+_SKIP_AFTER = re.compile(r"^\s*(background|samples?|rows?|states?|draws|features|narratives|coalitions|times|-fold)\b",
                          re.IGNORECASE)
 _LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state)[\s-]*$", re.IGNORECASE)
 #: '$91,462 above the baseline' (not '0.38 is slightly above the base value': there the number is the prediction)

@@ -1,5 +1,5 @@
 """Numbers as people write them: thousands separators, currency, a leading dot, k/M suffixes and scale words
-("40 thousand"), percentages and
+("40 thousand"), signs in words ("minus 1.37"), percentages and
 points, fractions, scientific notation, Unicode minus, number words, and the hedge words before them.
 
 A :class:`Number` knows what it may stand for (``value`` and ``alternatives``) and how precisely it was written
@@ -35,7 +35,7 @@ _HEDGE_RE = re.compile(r"(?:^|[\s(])(" + "|".join(sorted(map(re.escape, HEDGES),
                        + r")\s*[+\-]?[$€£]?\s*$", re.IGNORECASE)
 
 _NUM_RE = re.compile(
-    r"(?<![\w.,])(?P<sign>[+\-])?\s?(?P<cur>[$€£])?\s?"
+    r"(?<![\w.,])(?:(?P<sign>[+\-])|(?P<wsign>(?i:minus|negative|plus))\s)?\s?(?P<cur>[$€£])?\s?"
     r"(?P<num>\d{1,3}(?:,\d{3})+(?:\.\d+)?|\d+(?:\.\d+)?|\.\d+)(?!\.\d)(?![\d,]\d)"
     r"(?P<exp>[eE][+\-]?\d+)?(?!st\b|nd\b|rd\b|th\b)"
     r"(?:\s?(?P<suffix>k|K|M|bn)\b|\s(?P<scale>thousand|million|billion)\b)?"
@@ -114,7 +114,7 @@ def find_numbers(text: str) -> list[Number]:
             den = float(m.group("den")[1:])
             if den:
                 alts = (value / den,)
-        sign = (m.group("sign") or "")
+        sign = m.group("sign") or {"minus": "-", "negative": "-", "plus": "+"}.get((m.group("wsign") or "").lower(), "")
         out.append(Number(m.start(), m.end(), m.group(0).strip(), -value if sign == "-" else value, unit, sign,
                           _hedge(text[:m.start()]), bool(m.group("pct")), m.group("cur") or "", alts))
     for m in _WORD_RE.finditer(text):
