@@ -156,7 +156,7 @@ def corpus():
 def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
     floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("dev6", 0.97),
-              ("dev7", 0.97), ("dev8", 0.9), ("test", 0.9), ("test2", 0.85))
+              ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("test", 0.9), ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
         agree = sum(it["ok"] == it["accurate"] for it in part) / len(part)
@@ -358,3 +358,28 @@ def test_dev8_voices():
                   "housing-2") == "contradicted"
     assert status("Low speed was worth +7.61 to recharging, almost four times what obstacle added (+2.05).",
                   "toy-0") == "verified"
+
+
+def test_comparisons_between_features():
+    """dev9's voices: 'A mattered more than B', chained through 'which', 'A and B both ... more than C', 'less than',
+    'about as much as', 'outweighs'; a comparison with no feature after 'than' is no claim."""
+    exp = _exp()  # odor +0.15, gill size +0.11, cap diameter -0.05
+
+    def status(text):
+        return xairl.verify(text, exp, 0).status
+    assert status("Odor mattered more than gill size, which in turn mattered more than the cap diameter.") == "verified"
+    assert status("Gill size mattered more than odor.") == "contradicted"
+    assert status("Odor and gill size both mattered more than the cap diameter.") == "verified"
+    assert status("The cap diameter lowers it less than odor raises it.") == "verified"
+    near = _exp(contrib=(0.13, 0.15, -0.05))  # within 25 % of each other
+    assert xairl.verify("Gill size pushes it up by about as much as odor.", near, 0).status == "verified"
+    assert status("The cap diameter pushes it down by about as much as odor pushes it up.") == "contradicted"
+    assert status("Odor outweighs gill size.") == "verified" and status("Gill size outweighs odor.") == "contradicted"
+    assert [c for c in xairl.verify("Odor adds more than 0.1.", exp, 0).claims if c.kind == "rank"] == []
+
+
+def test_a_name_first_is_not_a_hypothetical_had():
+    """'Odor had the largest effect' starts with a name, then 'had': what happened, not 'Had it been ...'."""
+    exp = _exp()
+    assert xairl.verify("Odor had the largest effect.", exp, 0).status == "verified"
+    assert xairl.verify("Gill size had the largest effect.", exp, 0).status == "contradicted"

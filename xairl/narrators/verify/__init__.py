@@ -152,7 +152,8 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
 
 # a direction verb whose object is an option ('favoured turning', 'helped turning', '+22.0 toward the handover')
 # weighs it against the other one as much as it raises its score: either view, unless the words name the score
-_TOWARD_ACTION = re.compile(r"\b(favou?r(s|ed|ing)?|help(s|ed|ing)?|toward(s)?|held \w+ back)\s+(?:the |a |an )?$")
+_TOWARD_ACTION = re.compile(r"\b(favou?r(s|ed|ing)?|help(s|ed|ing)?|toward(s)?|held \w+ back|"
+                            r"matter\w* (?:more |less |most )?for)\s+(?:the |a |an )?$")
 
 
 def _context(sentence: str, mentions: list[Mention], book: FactBook, offset: int = 0) -> str | None:
@@ -185,7 +186,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     claims: list[Claim] = [Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys))
                            for m in mentions if m.kind == "feature"]
     # 'had X been better, it would have stayed': not what happened; only its numbers are checked
-    hypothetical = bool(_HYPOTHETICAL.search(masked))
+    hypothetical = bool(_HYPOTHETICAL.search(masked.replace("\0", "X")))  # a name first is a word, not space
     for m in mentions:
         c = None if hypothetical else checks.check_action(sentence, m, book) if m.kind == "action" else \
             checks.check_label(sentence, m, book) if m.kind == "label" else None
@@ -240,6 +241,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
                                                  f"read as {c.detail}, but it is {other}: which is unclear"))
     out += _directions(masked, a, b, mentions, book, ctx, name_words)
     out += _ranks(masked, a, b, mentions, book, ctx)
+    out += _comparisons(masked, a, b, mentions, book, ctx)
     for m in ranks.MINOR_RE.finditer(masked, a, b):
         owner = next((x for x in reversed(names) if x.end <= m.start()), None) or next(
             (x for x in names if x.start >= m.end()), None)
@@ -255,7 +257,9 @@ _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of
 
 _ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
                       r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$", re.IGNORECASE)
-_LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)\s+of\s+(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)
+#: 'the handover's lead of 3.9', 'turning's lead over going forward was 1.55'
+_LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)(?:\s+over\s+[^\d;]{0,30}?)?\s+(?:of|was|is|=|:)\s+"
+                      r"(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)
 #: 'speed argued for X (-5.48)', 'obstacle barely affected the turn score (-0.09)': the feature's contribution
 _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact\w*|influenc\w*|matter\w*|"
                      r"shift\w*|worth)\b", re.IGNORECASE)
@@ -393,6 +397,27 @@ def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: Fact
     return out
 
 
+def _comparisons(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
+    """'A mattered more than B' (and 'which in turn mattered more than C'), 'A and B both mattered more than C', 'A
+    outweighs B': A's |contribution| against B's. B must be one feature named right after 'than'; A the names since
+    the previous comparison, else the last name before the comparative (a relative 'which')."""
+    out, start = [], a
+    names = _names(mentions)
+    for m in ranks.COMPARE_RE.finditer(masked, a, b):
+        b_name = next((x for x in names if x.start >= m.end()), None)
+        if b_name is None or len(b_name.keys) != 1 or not re.fullmatch(
+                r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?", masked[m.end():b_name.start], re.IGNORECASE):
+            continue  # 'more than $500', 'bigger than any other feature': no feature to compare with
+        subjects = [x for x in names if start <= x.start and x.end <= m.start()]
+        if not subjects:
+            subjects = [x for x in names if x.end <= m.start()][-1:]
+        way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
+        for x in subjects:
+            out.append(ranks.check_comparison(x.keys, b_name.keys[0], way, ctx, book, m.group(0).strip()))
+        start = b_name.end
+    return out
+
+
 def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_words=frozenset()) -> list[Claim]:
     """A direction claimed for something that names no feature ('the swimming pool adds ...'): contradicted when
     the subject is a noun phrase of its own, not a pronoun or the decision itself, and has no word of a feature's
@@ -427,8 +452,11 @@ def _ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook,
             obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() - side.end() <= 6), None)
             if obj is not None and checks.resolve_action(obj, book) == book.runner_up:
                 sign = -sign  # '... for the handover' when staying was chosen
-        if plural:
-            targets = [x for x in names if x.start >= m.end()] or [x for x in names if x.end <= m.start()]
+        if plural:  # 'A and B had the largest effects' (before) or 'The top three were A, B and C' (after)
+            before = [x for x in names if x.end <= m.start()]
+            after = [x for x in names if x.start >= m.end()]
+            header = re.match(r"^\W*(?:were|are|was|is|include\w*)?\W*$", masked[m.end():after[0].start]) if after else None
+            targets = after if header or not before else before
             k = rank or len(targets)
             for t in targets:
                 out.append(ranks.check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {masked[t.start:t.end]}"))

@@ -186,9 +186,9 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     ('by', 'adds', 'SHAP value of') say it is a contribution; the feature's unit after it that it is a value."""
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 16]
     contrib_cue = bool(_CONTRIB_BEFORE.search(before))
-    # a number not said to be about the margin is about the chosen action's score; 'either': the words weigh the two
-    # options ('argued against it') without saying which view
-    contexts = book.contexts if ctx == EITHER else (ctx or "chosen",)
+    # a sentence that names no view, or weighs the two options without saying which ('argued against it'): either
+    # view (the chosen action's score or the margin over the runner-up)
+    contexts = book.contexts if ctx in (EITHER, None) else (ctx,)
 
     # an unsigned number in brackets right after the name is its value ('distance (0.84)'); a signed one may be either
     # ... unless the sentence has already said it lists contributions ('Top features by absolute SHAP value: A (0.11)')
@@ -361,7 +361,7 @@ def is_frame(masked: str, m: re.Match) -> bool:
     if m.group(0).lower() != "against":
         return False
     after = masked[m.end():m.end() + 30]
-    return bool(re.match(r"^\s*(?:a\s+|an\s+|the\s+)?[$€£]?[+\-]?\s*[\d.]|^\s*(that|this)\b", after)
+    return bool(re.match(r"^\s*(?:a\s+|an\s+|the\s+)?[+\-]?[$€£]?[+\-]?\s*[\d.]|^\s*(that|this)\b", after)
                 or re.search(r"(^|[.;:\n]\s*)$", masked[:m.start()]))
 
 

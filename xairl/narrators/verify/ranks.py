@@ -1,5 +1,5 @@
 """Rank and magnitude claims: 'the most important feature', 'second', 'the top three', 'mostly because of',
-'followed by', 'barely matters'; the phrases that state them and their checks."""
+'followed by', 'barely matters', 'A mattered more than B'; the phrases that state them and their checks."""
 from __future__ import annotations
 
 import re
@@ -85,6 +85,33 @@ def check_minor(keys: tuple[str, ...], ctx: str | None, book: FactBook, text: st
         return min(shares) < MINOR_SHARE, f"{key} has {min(shares):.1f} % of the total |contribution|"
 
     return over_keys(keys, test, "magnitude", text, "magnitude")
+
+
+#: 'A mattered more than B', 'a bigger effect on the margin than B', 'lowers the risk less than B does', 'A outweighs
+#: B', 'cuts it by about as much as B adds': how large |contribution| is beside another feature's
+COMPARE_RE = re.compile(r"\b(?:(?P<more>more|bigger|larger|greater|stronger|heavier)|(?P<less>less|smaller|weaker)|"
+                        r"(?P<same>as much|as large|as big))\b(?P<gap>(?:\s+[\w'\-\0]+){0,6}?)\s+(?:than|as)\s+"
+                        r"|\b(?P<out>outweigh\w*|dwarf\w*|overshadow\w*)\s+", re.IGNORECASE)
+SAME_WITHIN = 0.25  # 'about as much as': the two sizes within 25 % of the larger
+
+
+def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | None, book: FactBook,
+                     text: str) -> Claim:
+    """|contribution| of A against B's in the sentence's view (any view when it names none): way +1 larger, -1
+    smaller, 0 about the same."""
+    contexts = views(ctx, book)
+
+    def test(key):
+        pairs = [(abs(book.features[key].contribs[c]), abs(book.features[b_key].contribs[c]), c) for c in contexts
+                 if c in book.features[key].contribs and c in book.features[b_key].contribs]
+        if not pairs:
+            return None
+        ok = [c for x, y, c in pairs if (x > y if way > 0 else x < y if way < 0 else
+                                          abs(x - y) <= SAME_WITHIN * max(x, y))]
+        x, y, c = pairs[0]
+        return bool(ok), f"|{key}| {x:.3g} vs |{b_key}| {y:.3g} ({ok[0] if ok else c})"
+
+    return over_keys(a_keys, test, "comparison", text, "rank")
 
 
 def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
