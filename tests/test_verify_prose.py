@@ -383,3 +383,13 @@ def test_a_name_first_is_not_a_hypothetical_had():
     exp = _exp()
     assert xairl.verify("Odor had the largest effect.", exp, 0).status == "verified"
     assert xairl.verify("Gill size had the largest effect.", exp, 0).status == "contradicted"
+
+
+def test_a_direction_belongs_to_the_list_of_names_nearest_it():
+    exp = _exp()  # odor +0.15, gill size +0.11, cap diameter -0.05
+
+    def status(text):
+        return xairl.verify(text, exp, 0).status
+    assert status("With a gill size of 1, the cap diameter lowers the prediction.") == "verified"
+    assert status("Odor (0) and gill size (1) both raise the prediction.") == "verified"
+    assert status("Odor, gill size and the cap diameter raise the prediction.") == "contradicted"

@@ -374,7 +374,7 @@ def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: Fact
                 _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
             continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
-        subjects = [x for x in names if prev <= x.start < m.start()]
+        subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
         if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
             nxt = found[i + 1].start() if i + 1 < len(found) else b
             subjects = [x for x in names if m.end() <= x.start < nxt]
@@ -415,6 +415,28 @@ def _comparisons(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
         for x in subjects:
             out.append(ranks.check_comparison(x.keys, b_name.keys[0], way, ctx, book, m.group(0).strip()))
         start = b_name.end
+    return out
+
+
+_JOIN = re.compile(r"^(?:\s|,|;|&|/|\band\b|\bor\b|\bplus\b|\bas well as\b|\b(?:together|along) with\b|\bboth\b|"
+                   r"\beither\b|\bits\b|\btheir\b|\bthe\b|\([^()]*\)|[+\-]?[$€£]?[\d.,]+\s*[a-zA-Z%]{0,4}|\b(?:of|at|=|:)\b|:|=)*$",
+                   re.IGNORECASE)
+
+
+_PREPOSITION = re.compile(r"\b(?:with|given|despite|after|because of|due to|thanks to|at|for|from|on|in|by)\s+"
+                          r"(?:a\s+|an\s+|the\s+|its\s+|their\s+)?$", re.IGNORECASE)
+
+
+def _subject_list(before: list[Mention], masked: str, start: int) -> list[Mention]:
+    """The subject of a direction word: the list of names that ends nearest to it ('A, B and C raise'), not names
+    from an earlier phrase ('With A at 5, B lowered it': B)."""
+    out = before[-1:]
+    for i in range(len(before) - 2, -1, -1):
+        x = before[i]
+        lead = masked[before[i - 1].end if i else start:x.start]
+        if not _JOIN.match(masked[x.end:out[0].start]) or _PREPOSITION.search(lead):
+            break
+        out.insert(0, x)
     return out
 
 
