@@ -6,10 +6,11 @@ with one labelled error, in many voices. Cases 0-3 of each domain are the dev sp
 cases 4-7 the test split (frozen before any tuning; report it apart); ``dev2/`` 76 more narratives on the dev
 cases in other voices (Q&A, LLM-style prose, shorthand, lists; 16 of them on two UAV 'stay' cases of its own) and
 ``dev3/`` 55 more (shares, 'accounts for', pipes, counterfactuals), ``dev4/`` 44 in the voice of an LLM explaining
-SHAP values and ``dev5/`` 45 in memo, log, arrow and passive voices, each written after the freeze and measured once
-before tuning on it. ``test2/``: 48 more on the test cases (chat, letters, risk notes, decision logs), written
-after the test split's disagreements had been counted by cause (not read) and never tuned on: the second held-out
-figure. A narrative counts as agreeing when ``Verification.ok`` equals its label.
+SHAP values, ``dev5/`` 45 in memo, log, arrow and passive voices, ``dev6/`` to ``dev9/`` 48 each (markdown, tickets,
+voice memos, amount verbs, signs in words, comparisons between features, JSON-ish output), each written after the
+freeze and measured once before tuning on it. ``test2/``: 48 more on the test cases (chat, letters, risk notes,
+decision logs), written after the test split's disagreements had been counted by cause (not read) and never tuned
+on: the second held-out figure. A narrative counts as agreeing when ``Verification.ok`` equals its label.
 
     .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain, error kind, cause; speed
     .venv/bin/python benchmarks/bench_verifier.py --show test # also every disagreement of the test split
@@ -57,7 +58,8 @@ def load_corpus() -> list[dict]:
                             (DATA / "test2" / f"{domain}.yaml", "test2")):
             for case_id, items in yaml.safe_load(path.read_text()).items():
                 case = cases[case_id]
-                assert not later or case["split"] == later.rstrip("0123456789"), f"{path}: {case_id} is not a {later} case"
+                split = later.rstrip("0123456789") if later else None  # dev2..dev9 on dev cases, test2 on test
+                assert not later or case["split"] == split, f"{path}: {case_id} is not a {split} case"
                 exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
                 for item in items:
                     (label, text), = item.items()

@@ -46,6 +46,16 @@ def _exp(names=("gill_size", "odor", "cap_diameter"), contrib=(0.11, 0.15, -0.05
                              output="value", categories=categories)
 
 
+_CASES = {c["id"]: c for c in json.loads(
+    (pathlib.Path(__file__).parents[1] / "benchmarks/data/narratives/cases.json").read_text())}
+
+
+def _on_case(text, case):
+    """``text`` verified against a corpus case, with its domain's policy."""
+    exp = xairl.Explanation.from_json(json.dumps(_CASES[case]["explanation"]))
+    return xairl.verify(text, exp, 0, domains.policy(case.split("-")[0]))
+
+
 def test_name_variants_and_ambiguity():
     exp = _exp(names=("gill_size", "gill_color", "capDiameter"), categories=None)
     vocab = vocabulary(exp, None, clean_surface)
@@ -165,8 +175,7 @@ def test_held_out_corpus_agreement(corpus):
 
 
 def test_exact_restatements_verify_in_every_domain():
-    cases = json.loads((pathlib.Path(__file__).parents[1] / "benchmarks/data/narratives/cases.json").read_text())
-    for case in cases:
+    for case in _CASES.values():
         exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
         policy = domains.policy(case["domain"])
         a = int(exp.focus[0])
@@ -263,12 +272,8 @@ def test_options_weighed_against_each_other():
     score's); '(Q 3.10)' after an action is that action's score; a signed number after '<feature> argued for
     <action>' is the feature's contribution; 'the strongest argument for <runner-up>' ranks among the reasons
     against the decision. Cases of the dev split (dev5's voices)."""
-    cases = {c["id"]: c for c in json.loads(
-        (pathlib.Path(__file__).parents[1] / "benchmarks/data/narratives/cases.json").read_text())}
-    toy = domains.policy("toy")
-
     def ok(text, case):
-        return xairl.verify(text, xairl.Explanation.from_json(json.dumps(cases[case]["explanation"])), 0, toy).ok
+        return _on_case(text, case).ok
     # toy-2: turn chosen over recharge; wind's contribution to the margin 5.31, speed's -5.48
     assert ok("Wind at 1.55 favoured turning by 5.31.", "toy-2")
     assert not ok("Wind at 1.55 favoured turning by 6.31.", "toy-2")
@@ -284,13 +289,8 @@ def test_options_weighed_against_each_other():
 def test_the_lead_and_what_is_no_direction():
     """dev6's voices: 'beat staying by x' and 'the handover's lead of x' are the margin whatever is named before;
     'pulled in opposite directions' is no direction word."""
-    cases = {c["id"]: c for c in json.loads(
-        (pathlib.Path(__file__).parents[1] / "benchmarks/data/narratives/cases.json").read_text())}
-
     def status(text, case):
-        domain = case.split("-")[0]
-        exp = xairl.Explanation.from_json(json.dumps(cases[case]["explanation"]))
-        return xairl.verify(text, exp, 0, domains.policy(domain)).status
+        return _on_case(text, case).status
     # uav-1: the handover led staying by 0.63; uav-3: by 3.88, the serving RSRQ's share of it +24.5
     assert status("Handing over beat staying by 0.63.", "uav-1") == "verified"
     assert status("Handing over beat staying by 6.3.", "uav-1") == "contradicted"
@@ -306,12 +306,8 @@ def test_dev7_voices():
     '0.341 base' the baseline; 'pull it down to x' the prediction; 'despite X, ...' is no subject of what follows;
     '2 Mbit' a value in bit; 'held it back from handing over' a direction; 'A outweighed B: list' gives the list to
     neither."""
-    cases = {c["id"]: c for c in json.loads(
-        (pathlib.Path(__file__).parents[1] / "benchmarks/data/narratives/cases.json").read_text())}
-
     def claims(text, case):
-        exp = xairl.Explanation.from_json(json.dumps(cases[case]["explanation"]))
-        res = xairl.verify(text, exp, 0, domains.policy(case.split("-")[0]))
+        res = _on_case(text, case)
         return res.status, [c.status for c in res.claims if c.kind in ("number", "direction")]
     assert claims("The living area is the big one: forty thousand.", "housing-1")[1] == ["verified"]
     assert claims("Turning (4.07) edged out going forward (2.52) by 1.55.", "toy-3")[0] == "verified"
@@ -334,12 +330,8 @@ def test_dev8_voices():
     '+22.0 for <action>' weigh two options; 'barely affected the turn score (-0.09)' is the feature's contribution;
     'the strongest reason' is a reason for the decision; 'Q-value gap: x in favour of' is no unknown feature;
     'everything else was positive except X' flips X; 'four times' is a ratio, not a claim."""
-    cases = {c["id"]: c for c in json.loads(
-        (pathlib.Path(__file__).parents[1] / "benchmarks/data/narratives/cases.json").read_text())}
-
     def status(text, case):
-        exp = xairl.Explanation.from_json(json.dumps(cases[case]["explanation"]))
-        return xairl.verify(text, exp, 0, domains.policy(case.split("-")[0])).status
+        return _on_case(text, case).status
     assert find_numbers("minus 1.37")[0].value == -1.37 and find_numbers("Negative 0.1")[0].sign == "-"
     # uav-1: the serving BS id counts -1.37 in the margin, +0.22 for the handover's own score
     assert status("Serving BS id 14 counted slightly against the handover (minus 1.37).", "uav-1") == "verified"
@@ -363,10 +355,8 @@ def test_dev8_voices():
 def test_comparisons_between_features():
     """dev9's voices: 'A mattered more than B', chained through 'which', 'A and B both ... more than C', 'less than',
     'about as much as', 'outweighs'; a comparison with no feature after 'than' is no claim."""
-    exp = _exp()  # odor +0.15, gill size +0.11, cap diameter -0.05
-
     def status(text):
-        return xairl.verify(text, exp, 0).status
+        return xairl.verify(text, _exp(), 0).status  # odor +0.15, gill size +0.11, cap diameter -0.05
     assert status("Odor mattered more than gill size, which in turn mattered more than the cap diameter.") == "verified"
     assert status("Gill size mattered more than odor.") == "contradicted"
     assert status("Odor and gill size both mattered more than the cap diameter.") == "verified"
@@ -375,7 +365,7 @@ def test_comparisons_between_features():
     assert xairl.verify("Gill size pushes it up by about as much as odor.", near, 0).status == "verified"
     assert status("The cap diameter pushes it down by about as much as odor pushes it up.") == "contradicted"
     assert status("Odor outweighs gill size.") == "verified" and status("Gill size outweighs odor.") == "contradicted"
-    assert [c for c in xairl.verify("Odor adds more than 0.1.", exp, 0).claims if c.kind == "rank"] == []
+    assert [c for c in xairl.verify("Odor adds more than 0.1.", _exp(), 0).claims if c.kind == "rank"] == []
 
 
 def test_a_name_first_is_not_a_hypothetical_had():
@@ -386,10 +376,8 @@ def test_a_name_first_is_not_a_hypothetical_had():
 
 
 def test_a_direction_belongs_to_the_list_of_names_nearest_it():
-    exp = _exp()  # odor +0.15, gill size +0.11, cap diameter -0.05
-
     def status(text):
-        return xairl.verify(text, exp, 0).status
+        return xairl.verify(text, _exp(), 0).status  # odor +0.15, gill size +0.11, cap diameter -0.05
     assert status("With a gill size of 1, the cap diameter lowers the prediction.") == "verified"
     assert status("Odor (0) and gill size (1) both raise the prediction.") == "verified"
     assert status("Odor, gill size and the cap diameter raise the prediction.") == "contradicted"

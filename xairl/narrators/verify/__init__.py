@@ -102,8 +102,8 @@ _GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly
                               r"just about)\s+)?(?:it|this|that|they|these|those|which|everything"
                               r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
                               r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total"
-                              r"|the prediction|the predicted \w+|the estimate|the output|the model's \w+|(?:the )?(?:q[- ]?value |score )?"
-                              r"(?:gap|margin|lead|difference))\b(?!'s)",
+                              r"|the prediction|the predicted \w+|the estimate|the output|the model's \w+"
+                              r"|(?:the )?(?:q[- ]?value |score )?(?:gap|margin|lead|difference))\b(?!'s)",
                               re.IGNORECASE)
 
 
@@ -418,9 +418,10 @@ def _comparisons(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
     return out
 
 
+#: what may stand between two names of one subject list: commas, and/or, their values ('A (22) and B of 3')
 _JOIN = re.compile(r"^(?:\s|,|;|&|/|\band\b|\bor\b|\bplus\b|\bas well as\b|\b(?:together|along) with\b|\bboth\b|"
-                   r"\beither\b|\bits\b|\btheir\b|\bthe\b|\([^()]*\)|[+\-]?[$€£]?[\d.,]+\s*[a-zA-Z%]{0,4}|\b(?:of|at|=|:)\b|:|=)*$",
-                   re.IGNORECASE)
+                   r"\beither\b|\bits\b|\btheir\b|\bthe\b|\([^()]*\)|[+\-]?[$€£]?[\d.,]+\s*[a-zA-Z%]{0,4}|"
+                   r"\b(?:of|at)\b|:|=)*$", re.IGNORECASE)
 
 
 _PREPOSITION = re.compile(r"\b(?:with|given|despite|after|because of|due to|thanks to|at|for|from|on|in|by)\s+"
@@ -477,7 +478,7 @@ def _ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook,
         if plural:  # 'A and B had the largest effects' (before) or 'The top three were A, B and C' (after)
             before = [x for x in names if x.end <= m.start()]
             after = [x for x in names if x.start >= m.end()]
-            header = re.match(r"^\W*(?:were|are|was|is|include\w*)?\W*$", masked[m.end():after[0].start]) if after else None
+            header = after and re.match(r"^\W*(?:were|are|was|is|include\w*)?\W*$", masked[m.end():after[0].start])
             targets = after if header or not before else before
             k = rank or len(targets)
             for t in targets:
