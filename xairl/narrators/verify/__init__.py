@@ -6,13 +6,14 @@ A small pipeline, one module per step:
    it, with the hedge before it;
 2. :mod:`.names` finds where features (any spelling, words of their name or description), actions (verb forms
    too) and categorical values are named, and masks them;
-3. this module splits sentences into clauses and binds each number, direction word, rank phrase and
-   'barely matters' phrase to the names around it (a number to the name before it in its clause, or pairwise for
-   'A and B ... by x and y, respectively'; a direction word to the names since the previous one, or to a list that
-   follows it, 'Raising risk: A, B');
-4. :mod:`.checks` (and :mod:`.ranks` for ranks and magnitude) checks each claim against :mod:`.book` (values,
-   contributions to the chosen action's score and to the margin over the runner-up, ranks, shares, labels, scores,
-   domain comparisons) and says verified, contradicted or unchecked;
+3. this module splits sentences into clauses, decides each clause's view (the chosen action's score, the margin
+   over the runner-up, or either) and binds each number to the name it is about (the name before it in its clause,
+   pairwise for 'A and B ... by x and y, respectively', an action's score, the margin, the prediction);
+   :mod:`.directions` binds each direction word to the list of names nearest before it (or a list after it,
+   'Raising risk: A, B'), and :mod:`.ranks` each rank, 'barely matters' and 'A mattered more than B' phrase;
+4. :mod:`.checks` (and :mod:`.ranks`) checks each claim against :mod:`.book` (values, contributions to the chosen
+   action's score and to the margin over the runner-up, ranks, shares, labels, scores, domain comparisons) and
+   says verified, contradicted or unchecked;
 5. every sentence gets a status (contradicted if any claim is; verified if a claim was checked and none is
    contradicted; else unchecked), and the text a coverage (share of sentences with a checked claim).
 
@@ -26,10 +27,10 @@ from dataclasses import dataclass
 
 from ...explanation import Explanation
 from ...policy import Policy
-from . import checks, ranks
+from . import checks, directions, ranks
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
-from .names import GENERIC, Mention, find_mentions, vocabulary
+from .names import Mention, find_mentions, named_features, vocabulary
 from .numbers import NUMBER_RE, find_numbers, normalise
 
 MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
@@ -98,15 +99,6 @@ _ABBREVIATION = re.compile(r"(?:^|[\s(])(?:e\.g|i\.e|vs|approx|ca|etc|no|fig|cf)
 _CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|however)\b"
                         r"|,\s(?:and\s)?(?=but\b)", re.IGNORECASE)
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
-_GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|practically|"
-                              r"just about)\s+)?(?:it|this|that|they|these|those|which|everything"
-                              r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
-                              r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total"
-                              r"|the prediction|the predicted \w+|the estimate|the output|the model's \w+"
-                              r"|(?:the )?(?:q[- ]?value |score )?(?:gap|margin|lead|difference))\b(?!'s)",
-                              re.IGNORECASE)
-
-
 def sentences(text: str) -> list[tuple[int, int]]:
     """Sentence spans: split after . ! ? before a capital or a sign, and at line breaks and bullets."""
     spans, start = [], 0
@@ -197,23 +189,19 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'
         found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, vocab.name_words,
-                              {k for m in _names(mentions) for k in m.keys})
+                              {k for m in named_features(mentions) for k in m.keys})
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     if hypothetical:
-        claims += _without(masked, mentions, book, ctx)
+        claims += directions.without(masked, mentions, book, ctx)
     for ident in _IDENT_RE.findall(masked):
         claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
     return claims
 
 
-def _names(mentions: list[Mention]) -> list[Mention]:
-    return [m for m in mentions if m.kind in ("feature", "label")]
-
-
 def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
                   unit_of, name_words=frozenset(), sentence_keys=frozenset()) -> list[Claim]:
     out: list[Claim] = []
-    names = _names(mentions)
+    names = named_features(mentions)
     numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not checks.skip_number(n, masked)]
     # 'A and B ... by x and y, respectively': numbers after the last name pair up with the names in order
     tail = [n for n in numbers if names and n.start > names[-1].end  # not the last name's own '(−22.5 dB)'
@@ -239,9 +227,9 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
                 other = checks.other_reading(n, sentence_keys, book, ctx)
         out.append(c if other is None else Claim("number", n.text, "unchecked",
                                                  f"read as {c.detail}, but it is {other}: which is unclear"))
-    out += _directions(masked, a, b, mentions, book, ctx, name_words)
-    out += _ranks(masked, a, b, mentions, book, ctx)
-    out += _comparisons(masked, a, b, mentions, book, ctx)
+    out += directions.directions(masked, a, b, mentions, book, ctx, name_words)
+    out += ranks.find_ranks(masked, a, b, mentions, book, ctx)
+    out += ranks.find_comparisons(masked, a, b, mentions, book, ctx)
     for m in ranks.MINOR_RE.finditer(masked, a, b):
         owner = next((x for x in reversed(names) if x.end <= m.start()), None) or next(
             (x for x in names if x.start >= m.end()), None)
@@ -317,185 +305,5 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
 #: for X'; a modal elsewhere ('chose recharge, which could save battery') leaves the rest of the sentence checked
 _HYPOTHETICAL = re.compile(r"^\W*(?:if|had|without|were|absent|but for)\b|\b(?:would|could|might)(?:\s+\w+ly)?\s+"
                            r"(?:have|be|not|never)\b|\bif it (?:were|was)(?:n't| not) for\b", re.IGNORECASE)
-#: 'If it were not for X, the price would be much lower', 'Had X not been Y, the risk would be higher', 'Without X,
-#: it would be lower': what X did, said by taking it away
-_WITHOUT = re.compile(r"^\W*(?:if it (?:were|was)(?:n't| not) for|but for|without|absent|had)\s+(?P<subject>[^,;]+?)"
-                      r"\s*,\s*(?P<rest>[^;]*?\bwould\s+(?:\w+ly\s+)?(?:be|have been)\s+(?:\w+\s+){0,2}?"
-                      r"(?:much\s+|far\s+|a lot\s+|slightly\s+|a bit\s+|even\s+)?(?P<way>higher|lower|more|less|"
-                      r"greater|smaller|bigger))\b", re.IGNORECASE)
-
-
-def _without(masked: str, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
-    """A direction said by taking a feature away: the output 'would be higher' without X means X lowered it. 'Had X
-    not been ...' only with its 'not' (else it is another value, not X's absence)."""
-    m = _WITHOUT.match(masked)
-    if m is None or (masked.lstrip().lower().startswith("had") and not re.search(r"\bnot\b", m.group("subject"))):
-        return []
-    subjects = list({x.keys: x for x in _names(mentions)  # 'the odor' and its label 'foul': one subject
-                     if m.start("subject") <= x.start < m.end("subject")}.values())
-    polarity = -1 if m.group("way").lower() in ("higher", "more", "greater", "bigger") else 1
-    return checks.check_direction(subjects, polarity, ctx or "chosen", f"without it: {m.group('way')}", book)
-
-
 _PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
-_SIDE_WORD = re.compile(r"^(?:against|in favou?r of|favou?r\w*|toward\w*|supports?|support\w*|works? against|"
-                        r"worked against)$", re.IGNORECASE)
-#: an object that is not the model's output: the applicant, the house, them
-_PERSON_OBJECT = re.compile(r"^\s+(?:the\s+|this\s+|that\s+)?(?:applicant|borrower|customer|client|person|buyer|seller|"
-                            r"owner|house|home|property|him|her|them|it|us|you)\b", re.IGNORECASE)
-_LINKS = {"but", "and", "also", "yet", "then", "still", "even", "only", "while", "though", "thus", "hence"}
-#: words that say how much or which one, not what: a subject made only of them and the names' generic words, after
-#: the thing it belongs to ('the house's small size', 'its size of around 800 sq ft'), is a vague mention, not an
-#: invented feature
-_VAGUE = {"small", "smaller", "large", "larger", "big", "bigger", "short", "long", "the", "this", "that", "its",
-          "their", "about", "around", "roughly", "nearly", "almost", "some", "over", "under", "than"}
-#: the thing a model is about, as a possessor ('the house's', 'the applicant's'): not a feature of its own
-_POSSESSOR = re.compile(r"^\W*(?:the\s+|this\s+|its\s+|their\s+)?(?:house|home|property|file|document|applicant|"
-                        r"borrower|customer|client|user|patient|loan|account|uav|drone|robot|agent|vehicle|device|"
-                        r"sample|instance|case|item)'s\s+", re.IGNORECASE)
-#: '... everything else was positive except the lot': the exception after the direction word
-_EXCEPT_AFTER = re.compile(r"\b(?:except|but not|apart from|other than)(?: for)?\s+(?:the\s+|its\s+|their\s+)?\W*$",
-                           re.IGNORECASE)
-_ALL_RE = re.compile(r"\b(?:everything|all|every\w*|anything)\b", re.IGNORECASE)
-_DESPITE = re.compile(r"\b(?:despite|in spite of|notwithstanding|even with)\b[^,;]*$", re.IGNORECASE)
-_EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:but|except(?: for)?|apart from|"
-                     r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
-
-def _directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
-                name_words=frozenset()) -> list[Claim]:
-    out, prev, bare = [], a, False  # bare: the previous direction word found no subject at all
-    names = _names(mentions)
-    found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
-    for i, m in enumerate(found):
-        if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(m, mentions):
-            continue  # 'a salaried job helps': helps the applicant, so lowers the risk? not a checkable direction
-        if book.output != "actions" and _SIDE_WORD.match(m.group(0)) and \
-                _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
-            continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
-        polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
-        subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
-        if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
-            nxt = found[i + 1].start() if i + 1 < len(found) else b
-            subjects = [x for x in names if m.end() <= x.start < nxt]
-            if bare and subjects and ":" in masked[m.end():subjects[0].start]:
-                subjects = []  # 'Negative drivers outweighed positive ones: A, B': whose list is it? unsaid
-            elif not subjects:
-                subject = masked[prev:m.start()]
-                inside = [x for x in mentions if prev <= x.start < m.start()]
-                pronoun = re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE)
-                if i == 0 and (book.output != "actions" or not pronoun):  # ('tipped the balance toward': one claim)
-                    out += _unknown_subject(subject, m.group(0), inside, name_words)
-        conceded = [x for x in subjects if _DESPITE.search(masked[max(prev, x.start - 40):x.start])
-                    and "," in masked[x.end:m.start()]]
-        subjects = [x for x in subjects if x not in conceded]  # 'Despite being unemployed (+0.128), ... pull it down'
-        flipped = [x for x in subjects if _EXCEPT.search(masked, prev, x.start) or (  # 'everything but the kitchen'
-            _EXCEPT_AFTER.search(masked, m.end(), x.start) and _ALL_RE.search(masked, a, m.start()))]
-        out += checks.check_direction([x for x in subjects if x not in flipped], polarity, where, m.group(0), book)
-        out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
-        bare, prev = not subjects and not flipped, m.end()
-    return out
-
-
-def _comparisons(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
-    """'A mattered more than B' (and 'which in turn mattered more than C'), 'A and B both mattered more than C', 'A
-    outweighs B': A's |contribution| against B's. B must be one feature named right after 'than'; A the names since
-    the previous comparison, else the last name before the comparative (a relative 'which')."""
-    out, start = [], a
-    names = _names(mentions)
-    for m in ranks.COMPARE_RE.finditer(masked, a, b):
-        b_name = next((x for x in names if x.start >= m.end()), None)
-        if b_name is None or len(b_name.keys) != 1 or not re.fullmatch(
-                r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?", masked[m.end():b_name.start], re.IGNORECASE):
-            continue  # 'more than $500', 'bigger than any other feature': no feature to compare with
-        subjects = [x for x in names if start <= x.start and x.end <= m.start()]
-        if not subjects:
-            subjects = [x for x in names if x.end <= m.start()][-1:]
-        way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
-        for x in subjects:
-            out.append(ranks.check_comparison(x.keys, b_name.keys[0], way, ctx, book, m.group(0).strip()))
-        start = b_name.end
-    return out
-
-
-#: what may stand between two names of one subject list: commas, and/or, their values ('A (22) and B of 3')
-_JOIN = re.compile(r"^(?:\s|,|;|&|/|\band\b|\bor\b|\bplus\b|\bas well as\b|\b(?:together|along) with\b|\bboth\b|"
-                   r"\beither\b|\bits\b|\btheir\b|\bthe\b|\([^()]*\)|[+\-]?[$€£]?[\d.,]+\s*[a-zA-Z%]{0,4}|"
-                   r"\b(?:of|at)\b|:|=)*$", re.IGNORECASE)
-
-
-_PREPOSITION = re.compile(r"\b(?:with|given|despite|after|because of|due to|thanks to|at|for|from|on|in|by)\s+"
-                          r"(?:a\s+|an\s+|the\s+|its\s+|their\s+)?$", re.IGNORECASE)
-
-
-def _subject_list(before: list[Mention], masked: str, start: int) -> list[Mention]:
-    """The subject of a direction word: the list of names that ends nearest to it ('A, B and C raise'), not names
-    from an earlier phrase ('With A at 5, B lowered it': B)."""
-    out = before[-1:]
-    for i in range(len(before) - 2, -1, -1):
-        x = before[i]
-        lead = masked[before[i - 1].end if i else start:x.start]
-        if not _JOIN.match(masked[x.end:out[0].start]) or _PREPOSITION.search(lead):
-            break
-        out.insert(0, x)
-    return out
-
-
-def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_words=frozenset()) -> list[Claim]:
-    """A direction claimed for something that names no feature ('the swimming pool adds ...'): contradicted when
-    the subject is a noun phrase of its own, not a pronoun or the decision itself, and has no word of a feature's
-    name (then it may be a vague mention: 'a quality rating of 10/10 adds ...')."""
-    words = [w for w in re.findall(r"[A-Za-z]{3,}", subject.replace("\0", " ")) if w.lower() not in _LINKS]
-    head = re.findall(r"[A-Za-z]{3,}", _POSSESSOR.sub("", subject.replace("\0", " ")))
-    if all(w.lower() in _VAGUE or w.lower() in GENERIC or w.lower() in _LINKS or w.lower().endswith("ly")
-           for w in head):
-        return []  # vague: perhaps a feature, not an invented one
-    if mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")) or \
-            any(w.lower() in name_words or re.fullmatch(ranks.NOUN, w, re.IGNORECASE) for w in words):
-        return []
-    return [Claim("feature", subject.strip(" ,:-\0"), "contradicted",
-                  f"'{word}' is said of something that is not a feature of this model")]
-
-
-def _ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
-    out = []
-    names = _names(mentions)
-    for m in ranks.RANK_RE.finditer(masked, a, b):
-        rank, plural, sign = ranks.rank_claim(m, masked)
-        said = checks.DIRECTION_RE.match(masked, m.end() + 1, b) if masked[m.end():m.end() + 1] == " " else None
-        if not sign and said and said.group(0).lower() not in ("for", "against", "toward", "towards"):
-            sign = 1 if said.group("pos") else -1  # 'key factors decreasing the risk', 'the main feature supporting'
-        side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])
-        if not sign and not side and book.output == "actions" and re.search(r"(argument|reason)s?$", m.group(0),
-                                                                             re.IGNORECASE):
-            sign = 1  # 'the strongest reason': a reason for what was decided
-        if not sign and side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
-            # 'the main argument for staying': the largest that favours it
-            sign = 1 if side.group(1) else -1
-            obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() - side.end() <= 6), None)
-            if obj is not None and checks.resolve_action(obj, book) == book.runner_up:
-                sign = -sign  # '... for the handover' when staying was chosen
-        if plural:  # 'A and B had the largest effects' (before) or 'The top three were A, B and C' (after)
-            before = [x for x in names if x.end <= m.start()]
-            after = [x for x in names if x.start >= m.end()]
-            header = after and re.match(r"^\W*(?:were|are|was|is|include\w*)?\W*$", masked[m.end():after[0].start])
-            targets = after if header or not before else before
-            k = rank or len(targets)
-            for t in targets:
-                out.append(ranks.check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {masked[t.start:t.end]}"))
-            continue
-        before = [x for x in names if x.end <= m.start()]
-        target = before[-1] if before else next((x for x in names if x.start >= m.end()), None)
-        if target is None:
-            continue
-        out.append(ranks.check_rank(target.keys, rank, None, sign, ctx, book, m.group(0)))
-        for x in names:  # 'followed by B', 'B second'
-            if x.start >= m.end() and ranks.FOLLOWED.search(masked[max(a, x.start - 24):x.start]):
-                rank += 1
-                out.append(ranks.check_rank(x.keys, rank, None, sign, ctx, book, f"then {masked[x.start:x.end]}"))
-    for x in names:
-        o = ranks.AFTER_ORD.match(masked[x.end:b])
-        if o and not ranks.RANK_RE.match(masked[x.end:b].lstrip(" ,(")):
-            out.append(ranks.check_rank(x.keys, ranks.ORD[o.group("o").lower()], None, 0, ctx, book,
-                                         f"{masked[x.start:x.end]} {o.group('o')}"))
-    return out

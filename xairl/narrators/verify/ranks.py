@@ -7,7 +7,8 @@ import re
 import numpy as np
 
 from .book import FactBook
-from .checks import EITHER, Claim, over_keys
+from .checks import DIRECTION_RE, EITHER, Claim, over_keys, resolve_action
+from .names import Mention, named_features
 
 ORD = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4, "fifth": 5}
 COUNT = {"two": 2, "three": 3, "four": 4, "five": 5, "2": 2, "3": 3, "4": 4, "5": 5}
@@ -117,3 +118,71 @@ def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | N
 def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
     """The views a rank or magnitude claim is checked in: the one its sentence names, else any."""
     return (ctx,) if ctx and ctx != EITHER else book.contexts
+
+
+def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
+    """The rank phrases of clause ``masked[a:b]``, each bound to its names ('A was the main reason', 'the top three
+    were A, B and C', 'followed by B', 'A second') and checked."""
+    out = []
+    names = named_features(mentions)
+    for m in RANK_RE.finditer(masked, a, b):
+        rank, plural, sign = rank_claim(m, masked)
+        said = DIRECTION_RE.match(masked, m.end() + 1, b) if masked[m.end():m.end() + 1] == " " else None
+        if not sign and said and said.group(0).lower() not in ("for", "against", "toward", "towards"):
+            sign = 1 if said.group("pos") else -1  # 'key factors decreasing the risk', 'the main feature supporting'
+        side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])
+        if not sign and not side and book.output == "actions" and re.search(r"(argument|reason)s?$", m.group(0),
+                                                                             re.IGNORECASE):
+            sign = 1  # 'the strongest reason': a reason for what was decided
+        if not sign and side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
+            # 'the main argument for staying': the largest that favours it
+            sign = 1 if side.group(1) else -1
+            obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() - side.end() <= 6), None)
+            if obj is not None and resolve_action(obj, book) == book.runner_up:
+                sign = -sign  # '... for the handover' when staying was chosen
+        if plural:  # 'A and B had the largest effects' (before) or 'The top three were A, B and C' (after)
+            before = [x for x in names if x.end <= m.start()]
+            after = [x for x in names if x.start >= m.end()]
+            header = after and re.match(r"^\W*(?:were|are|was|is|include\w*)?\W*$", masked[m.end():after[0].start])
+            targets = after if header or not before else before
+            k = rank or len(targets)
+            for t in targets:
+                out.append(check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {masked[t.start:t.end]}"))
+            continue
+        before = [x for x in names if x.end <= m.start()]
+        target = before[-1] if before else next((x for x in names if x.start >= m.end()), None)
+        if target is None:
+            continue
+        out.append(check_rank(target.keys, rank, None, sign, ctx, book, m.group(0)))
+        for x in names:  # 'followed by B', 'B second'
+            if x.start >= m.end() and FOLLOWED.search(masked[max(a, x.start - 24):x.start]):
+                rank += 1
+                out.append(check_rank(x.keys, rank, None, sign, ctx, book, f"then {masked[x.start:x.end]}"))
+    for x in names:
+        o = AFTER_ORD.match(masked[x.end:b])
+        if o and not RANK_RE.match(masked[x.end:b].lstrip(" ,(")):
+            out.append(check_rank(x.keys, ORD[o.group("o").lower()], None, 0, ctx, book,
+                                         f"{masked[x.start:x.end]} {o.group('o')}"))
+    return out
+
+
+def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None
+                     ) -> list[Claim]:
+    """'A mattered more than B' (and 'which in turn mattered more than C'), 'A and B both mattered more than C', 'A
+    outweighs B': A's |contribution| against B's. B must be one feature named right after 'than'; A the names since
+    the previous comparison, else the last name before the comparative (a relative 'which')."""
+    out, start = [], a
+    names = named_features(mentions)
+    for m in COMPARE_RE.finditer(masked, a, b):
+        b_name = next((x for x in names if x.start >= m.end()), None)
+        if b_name is None or len(b_name.keys) != 1 or not re.fullmatch(
+                r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?", masked[m.end():b_name.start], re.IGNORECASE):
+            continue  # 'more than $500', 'bigger than any other feature': no feature to compare with
+        subjects = [x for x in names if start <= x.start and x.end <= m.start()]
+        if not subjects:
+            subjects = [x for x in names if x.end <= m.start()][-1:]
+        way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
+        for x in subjects:
+            out.append(check_comparison(x.keys, b_name.keys[0], way, ctx, book, m.group(0).strip()))
+        start = b_name.end
+    return out

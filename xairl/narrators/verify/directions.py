@@ -1,0 +1,138 @@
+"""Which names a direction word is said of, and the direction claims that follow: the list of names nearest before
+it ('A, B and C raise'), a list after it ('Raising risk: A, B'), 'everything but X', 'despite X', a feature taken
+away ('without X, it would be higher'), and subjects that name no feature (invented, or only vague)."""
+from __future__ import annotations
+
+import re
+
+from . import checks
+from .book import FactBook
+from .checks import Claim
+from .names import GENERIC, Mention, named_features
+from .ranks import NOUN
+
+_GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|practically|"
+                              r"just about)\s+)?(?:it|this|that|they|these|those|which|everything"
+                              r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
+                              r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total"
+                              r"|the prediction|the predicted \w+|the estimate|the output|the model's \w+"
+                              r"|(?:the )?(?:q[- ]?value |score )?(?:gap|margin|lead|difference))\b(?!'s)",
+                              re.IGNORECASE)
+
+#: 'If it were not for X, the price would be much lower', 'Had X not been Y, the risk would be higher', 'Without X,
+#: it would be lower': what X did, said by taking it away
+_WITHOUT = re.compile(r"^\W*(?:if it (?:were|was)(?:n't| not) for|but for|without|absent|had)\s+(?P<subject>[^,;]+?)"
+                      r"\s*,\s*(?P<rest>[^;]*?\bwould\s+(?:\w+ly\s+)?(?:be|have been)\s+(?:\w+\s+){0,2}?"
+                      r"(?:much\s+|far\s+|a lot\s+|slightly\s+|a bit\s+|even\s+)?(?P<way>higher|lower|more|less|"
+                      r"greater|smaller|bigger))\b", re.IGNORECASE)
+
+
+def without(masked: str, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
+    """A direction said by taking a feature away: the output 'would be higher' without X means X lowered it. 'Had X
+    not been ...' only with its 'not' (else it is another value, not X's absence)."""
+    m = _WITHOUT.match(masked)
+    if m is None or (masked.lstrip().lower().startswith("had") and not re.search(r"\bnot\b", m.group("subject"))):
+        return []
+    subjects = list({x.keys: x for x in named_features(mentions)  # 'the odor' and its label 'foul': one subject
+                     if m.start("subject") <= x.start < m.end("subject")}.values())
+    polarity = -1 if m.group("way").lower() in ("higher", "more", "greater", "bigger") else 1
+    return checks.check_direction(subjects, polarity, ctx or "chosen", f"without it: {m.group('way')}", book)
+
+
+_SIDE_WORD = re.compile(r"^(?:against|in favou?r of|favou?r\w*|toward\w*|supports?|support\w*|works? against|"
+                        r"worked against)$", re.IGNORECASE)
+#: an object that is not the model's output: the applicant, the house, them
+_PERSON_OBJECT = re.compile(r"^\s+(?:the\s+|this\s+|that\s+)?(?:applicant|borrower|customer|client|person|buyer|seller|"
+                            r"owner|house|home|property|him|her|them|it|us|you)\b", re.IGNORECASE)
+_LINKS = {"but", "and", "also", "yet", "then", "still", "even", "only", "while", "though", "thus", "hence"}
+#: words that say how much or which one, not what: a subject made only of them and the names' generic words, after
+#: the thing it belongs to ('the house's small size', 'its size of around 800 sq ft'), is a vague mention, not an
+#: invented feature
+_VAGUE = {"small", "smaller", "large", "larger", "big", "bigger", "short", "long", "the", "this", "that", "its",
+          "their", "about", "around", "roughly", "nearly", "almost", "some", "over", "under", "than"}
+#: the thing a model is about, as a possessor ('the house's', 'the applicant's'): not a feature of its own
+_POSSESSOR = re.compile(r"^\W*(?:the\s+|this\s+|its\s+|their\s+)?(?:house|home|property|file|document|applicant|"
+                        r"borrower|customer|client|user|patient|loan|account|uav|drone|robot|agent|vehicle|device|"
+                        r"sample|instance|case|item)'s\s+", re.IGNORECASE)
+#: '... everything else was positive except the lot': the exception after the direction word
+_EXCEPT_AFTER = re.compile(r"\b(?:except|but not|apart from|other than)(?: for)?\s+(?:the\s+|its\s+|their\s+)?\W*$",
+                           re.IGNORECASE)
+_ALL_RE = re.compile(r"\b(?:everything|all|every\w*|anything)\b", re.IGNORECASE)
+_DESPITE = re.compile(r"\b(?:despite|in spite of|notwithstanding|even with)\b[^,;]*$", re.IGNORECASE)
+_EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:but|except(?: for)?|apart from|"
+                     r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
+
+
+def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
+                name_words=frozenset()) -> list[Claim]:
+    out, prev, bare = [], a, False  # bare: the previous direction word found no subject at all
+    names = named_features(mentions)
+    found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
+    for i, m in enumerate(found):
+        if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(m, mentions):
+            continue  # 'a salaried job helps': helps the applicant, so lowers the risk? not a checkable direction
+        if book.output != "actions" and _SIDE_WORD.match(m.group(0)) and \
+                _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
+            continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
+        polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
+        subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
+        if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
+            nxt = found[i + 1].start() if i + 1 < len(found) else b
+            subjects = [x for x in names if m.end() <= x.start < nxt]
+            if bare and subjects and ":" in masked[m.end():subjects[0].start]:
+                subjects = []  # 'Negative drivers outweighed positive ones: A, B': whose list is it? unsaid
+            elif not subjects:
+                subject = masked[prev:m.start()]
+                inside = [x for x in mentions if prev <= x.start < m.start()]
+                pronoun = re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE)
+                if i == 0 and (book.output != "actions" or not pronoun):  # ('tipped the balance toward': one claim)
+                    out += _unknown_subject(subject, m.group(0), inside, name_words)
+        conceded = [x for x in subjects if _DESPITE.search(masked[max(prev, x.start - 40):x.start])
+                    and "," in masked[x.end:m.start()]]
+        subjects = [x for x in subjects if x not in conceded]  # 'Despite being unemployed (+0.128), ... pull it down'
+        flipped = [x for x in subjects if _EXCEPT.search(masked, prev, x.start) or (  # 'everything but the kitchen'
+            _EXCEPT_AFTER.search(masked, m.end(), x.start) and _ALL_RE.search(masked, a, m.start()))]
+        out += checks.check_direction([x for x in subjects if x not in flipped], polarity, where, m.group(0), book)
+        out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
+        bare, prev = not subjects and not flipped, m.end()
+    return out
+
+
+#: what may stand between two names of one subject list: commas, and/or, their values ('A (22) and B of 3')
+_JOIN = re.compile(r"^(?:\s|,|;|&|/|\band\b|\bor\b|\bplus\b|\bas well as\b|\b(?:together|along) with\b|\bboth\b|"
+                   r"\beither\b|\bits\b|\btheir\b|\bthe\b|\([^()]*\)|[+\-]?[$€£]?[\d.,]+\s*[a-zA-Z%]{0,4}|"
+                   r"\b(?:of|at)\b|:|=)*$", re.IGNORECASE)
+
+
+_PREPOSITION = re.compile(r"\b(?:with|given|despite|after|because of|due to|thanks to|at|for|from|on|in|by)\s+"
+                          r"(?:a\s+|an\s+|the\s+|its\s+|their\s+)?$", re.IGNORECASE)
+
+
+def _subject_list(before: list[Mention], masked: str, start: int) -> list[Mention]:
+    """The subject of a direction word: the list of names that ends nearest to it ('A, B and C raise'), not names
+    from an earlier phrase ('With A at 5, B lowered it': B)."""
+    out = before[-1:]
+    for i in range(len(before) - 2, -1, -1):
+        x = before[i]
+        lead = masked[before[i - 1].end if i else start:x.start]
+        if not _JOIN.match(masked[x.end:out[0].start]) or _PREPOSITION.search(lead):
+            break
+        out.insert(0, x)
+    return out
+
+
+def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_words=frozenset()) -> list[Claim]:
+    """A direction claimed for something that names no feature ('the swimming pool adds ...'): contradicted when
+    the subject is a noun phrase of its own, not a pronoun or the decision itself, and has no word of a feature's
+    name (then it may be a vague mention: 'a quality rating of 10/10 adds ...')."""
+    words = [w for w in re.findall(r"[A-Za-z]{3,}", subject.replace("\0", " ")) if w.lower() not in _LINKS]
+    head = re.findall(r"[A-Za-z]{3,}", _POSSESSOR.sub("", subject.replace("\0", " ")))
+    if all(w.lower() in _VAGUE or w.lower() in GENERIC or w.lower() in _LINKS or w.lower().endswith("ly")
+           for w in head):
+        return []  # vague: perhaps a feature, not an invented one
+    if mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")) or \
+            any(w.lower() in name_words or re.fullmatch(NOUN, w, re.IGNORECASE) for w in words):
+        return []
+    return [Claim("feature", subject.strip(" ,:-\0"), "contradicted",
+                  f"'{word}' is said of something that is not a feature of this model")]
+
