@@ -16,6 +16,8 @@ from tests import narrative_domains as domains
 
 
 @pytest.mark.parametrize("text,value,unit,hedge", [
+    ("22,5 dB", 22.5, 0.1, ""), ("0,098", 0.098, 0.001, ""), ("USD 39 960", 39960, 10, ""),
+    ("between $500 and", 500, 100, "at_least"), ("minus 1.37", -1.37, 0.01, ""),
     ("$12,757.84", 12757.84, 0.01, ""), (".9", 0.9, 0.1, ""), ("about $12,000", 12000, 1000, "approx"),
     ("262KB", 262, 1, ""), ("-4330.84", -4330.84, 0.01, ""), ("~$21k", 21000, 1000, "approx"),
     ("nearly 2 dB", 2, 1, "below"), ("1.2e-3", 0.0012, 1e-4, ""), ("five thousand dollars", 5000, 1000, ""),
@@ -166,7 +168,8 @@ def corpus():
 def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
     floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("dev6", 0.97),
-              ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("test", 0.9), ("test2", 0.85))
+              ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("dev10", 0.97), ("test", 0.9),
+              ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
         agree = sum(it["ok"] == it["accurate"] for it in part) / len(part)
@@ -381,3 +384,24 @@ def test_a_direction_belongs_to_the_list_of_names_nearest_it():
     assert status("With a gill size of 1, the cap diameter lowers the prediction.") == "verified"
     assert status("Odor (0) and gill size (1) both raise the prediction.") == "verified"
     assert status("Odor, gill size and the cap diameter raise the prediction.") == "contradicted"
+
+
+def test_dev10_number_formats():
+    """dev10's formats on their cases: spaced thousands at a sentence's end, a range, percentage points that are not
+    a share, an acronym of a three-word name, '1.3x' (a ratio), 'takes 17.8K off', '+5.48' given to the runner-up."""
+    assert [n.value for n in find_numbers("USD 31 370. Then 12 140, 3")] == [31370, 12140, 3]
+    assert find_numbers("between $500 and $1,000")[1].hedge == "at_most"
+    assert find_numbers("~14 pts")[0].points and not find_numbers("14 %")[0].points
+    assert _on_case("The lot takes off somewhere between $500 and $1,000.", "housing-1").status == "verified"
+    assert _on_case("The lot takes off somewhere between $800 and $1,000.", "housing-1").status == "contradicted"
+    # credit-3: the 20-year history lowers the risk by 4.4 points (13 % of the total |contribution|)
+    assert _on_case("A 20-year credit history lowers the risk by ~4 pts.", "credit-3").status == "verified"
+    assert _on_case("A 20-year credit history lowers the risk by ~14 pts.", "credit-3").status == "contradicted"
+    assert _on_case("DTI of 60 % adds 0.11 to the predicted probability.", "credit-3").status == "verified"
+    assert _on_case("DTI of 60 % lowers the predicted probability.", "credit-3").status == "contradicted"
+    assert _on_case("The serving RSRQ adds about 12 to the margin, roughly 1.3x candidate 1's RSRP.",
+                    "uav-1").status == "verified"
+    assert _on_case("The 2010 construction year takes 17.8K off the estimate.", "housing-2").status == "contradicted"
+    # toy-2: turning chosen over recharging; speed's contribution to that margin -5.48
+    assert _on_case("Speed (-1.70) gives recharging +5.48.", "toy-2").status == "verified"
+    assert _on_case("Speed (-1.70) gives recharging +4.48.", "toy-2").status == "contradicted"

@@ -23,7 +23,7 @@ is listed in the README ("What the verifier checks").
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ...explanation import Explanation
 from ...policy import Policy
@@ -285,6 +285,11 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         return checks.feature_number(n, nxt.keys, masked, book, ctx, unit_of)
     prev = next((m for m in reversed(mentions) if m.end <= n.start), None)
     feature_before = next((m for m in reversed(names) if m.end <= n.start), None)
+    if prev is not None and prev.kind == "action" and n.sign and feature_before is not None and book.runner_up \
+            and checks.resolve_action(prev, book) == book.runner_up and not masked[prev.end:n.start].strip():
+        # 'speed gives recharging +5.48' when turning was chosen: -5.48 in the chosen action's margin
+        flipped = replace(n, value=-n.value, sign="-" if n.sign == "+" else "+")
+        return checks.feature_number(flipped, feature_before.keys, masked, book, "margin", unit_of)
     if prev is not None and prev.kind == "action" and (
             n.sign == "+" or re.match(r"^\s*(over|than|versus|vs)\b", after, re.IGNORECASE) or (
             feature_before is not None and any(r.search(masked, feature_before.end, prev.start)

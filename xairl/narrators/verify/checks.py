@@ -31,7 +31,7 @@ _POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|support
         r"nudg\w* (?:\w+ )?up|drives?|driven by|driving|tipped|tips|argu\w* for|counted for|counts for|"
         r"positive(?:ly)?|more likely|up by|help(?:s|ed|ing)?")
 _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ )?down|"
-        r"push(?:es|ed|ing)? (?:\w+ )?down|nudg\w* (?:\w+ )?down|subtract\w*|tak(?:es|ing|e) (?:\w+ )?(?:off|away)|"
+        r"push(?:es|ed|ing)? (?:\w+ )?down|nudg\w* (?:\w+ )?down|subtract\w*|tak(?:es|ing|e) (?:[\w.,$€£]+ )?(?:off|away)|"
         r"took (?:\w+ )?(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|negative(?:ly)?|"
         r"less likely|"
         r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
@@ -123,7 +123,8 @@ _CONTRIB_BEFORE = re.compile(
     r"contribution(?: of| was| is|:)?|attributions?:?|phi\([^)]*\)\s*=|\|φ\|:?|impact of|effect of|push\w*|"
     r"another|\banother|drops?|takes|took|loses|gains?|\bby a margin of|\|shap\|:?|"
     r"edge of|favou?red \w+ by|for \w+ by|\bdown|\bup)\s*(?:\(|about|around|roughly|nearly|almost|"
-    r"approximately|some|only|just|a further|another|over|under)?\s*[+\-]?[$€£]?\s*$", re.IGNORECASE)
+    r"approximately|some|only|just|a further|another|over|under|(?:somewhere |anywhere )?between)?\s*[+\-]?[$€£]?\s*$",
+    re.IGNORECASE)
 _LISTS_CONTRIBUTIONS = re.compile(r"shap|attribution|contribut|impact|effect|φ|phi|importance|weight|push|margin",
                                   re.IGNORECASE)
 _MARGIN_BEFORE = re.compile(r"\b(margin|lead|edge|gap|advantage|difference)(?: of)?\W*(?:about|around|roughly|only|"
@@ -143,7 +144,8 @@ _BASE_BEFORE = re.compile(r"\b(?:baseline|average|typical|mean|expected)\s+(?:pr
                           r"\s*(?:of|is|was|:|=)?\s*[$€£]?\s*$", re.IGNORECASE)
 _OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability|chance|risk|price|output|final)\b",
                         re.IGNORECASE)
-_SKIP_AFTER = re.compile(r"^\s*(background|samples?|rows?|states?|draws|features|narratives|coalitions|times|-fold)\b",
+_SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|features|narratives|coalitions|times|"
+                         r"-fold)\b|[x×](?![\w]))",
                          re.IGNORECASE)
 _LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state)[\s-]*$", re.IGNORECASE)
 #: '$91,462 above the baseline' (not '0.38 is slightly above the base value': there the number is the prediction)
@@ -216,7 +218,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         for what, v in cands:
             if matches(n, v) or (n.percent and _percent_readings(n, v)):
                 return True, f"{key}: {what}"
-        if n.percent and any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
+        if n.percent and not n.points and any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
             return True, f"{key}: share"
         shown = ", ".join(f"{w} {v:.4g}" for w, v in cands)
         return False, f"{n.text} is not {key}'s {shown or 'value'}"
@@ -241,7 +243,7 @@ def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, si
     views = book.contexts if ctx in (None, EITHER) else (ctx,)
     for key in sorted(keys):
         e = book.features[key]
-        if n.percent:  # a percentage is a share (or a fill the binding already tried)
+        if n.percent and not n.points:  # a percentage is a share (or a fill the binding already tried)
             facts = [(f"share ({c})", e.shares.get(c), True) for c in views]
         else:  # a value as written, sign included; a contribution may be its size
             facts = [("value", e.value, False), *((f"contribution ({c})", e.contribs.get(c), not signed)

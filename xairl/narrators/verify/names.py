@@ -122,8 +122,20 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
                 entries.append((" ".join(stem(w) for w in split_words(label)), "label", (f,), label, ""))
     entries.sort(key=lambda e: -len(e[0]))
     names = frozenset(w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit())
-    return Vocabulary([(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries], short,
-                      feature_words, names)
+    compiled = [(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries]
+    return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, names)
+
+
+def _acronyms(features) -> list:
+    """'DTI' for ``debt_to_income``: the capital initials of a name of three words or more, matched as written (so
+    that 'NOR' of ``number_of_rooms`` is not the word 'nor'); only an acronym one feature has."""
+    owners: dict[str, list[str]] = {}
+    for f in features:
+        words = split_words(f)
+        if len(words) >= 3 and not any(w.isdigit() for w in words):
+            owners.setdefault("".join(w[0] for w in words).upper(), []).append(f)
+    return [(re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "") for acr, fs in owners.items()
+            if len(fs) == 1]
 
 
 def _phrase(text: str) -> str:

@@ -1,5 +1,5 @@
-"""Numbers as people write them: thousands separators, currency, a leading dot, k/M suffixes and scale words
-("40 thousand"), signs in words ("minus 1.37"), percentages and
+"""Numbers as people write them: thousands separators (comma or space), decimal commas ("22,5", "0,098"), currency,
+a leading dot, k/M suffixes and scale words ("40 thousand"), signs in words ("minus 1.37"), percentages ("pts") and
 points, fractions, scientific notation, Unicode minus, number words, and the hedge words before them.
 
 A :class:`Number` knows what it may stand for (``value`` and ``alternatives``) and how precisely it was written
@@ -11,7 +11,8 @@ A :class:`Number` knows what it may stand for (``value`` and ``alternatives``) a
   fact, or equal after rounding;
 - "nearly", "almost", "just under", "a bit under": the fact is at most the number and within 20 % of it;
   "just over", "a little over": at least the number and within 20 %;
-- bounds ("less than", "under", "at most", "more than", "over", "at least"): the fact's magnitude is on that side.
+- bounds ("less than", "under", "at most", "more than", "over", "at least", "between x and y"): the fact's magnitude
+  is on that side.
 """
 from __future__ import annotations
 
@@ -36,11 +37,12 @@ _HEDGE_RE = re.compile(r"(?:^|[\s(])(" + "|".join(sorted(map(re.escape, HEDGES),
 
 _NUM_RE = re.compile(
     r"(?<![\w.,])(?:(?P<sign>[+\-])|(?P<wsign>(?i:minus|negative|plus))\s)?\s?(?P<cur>[$€£])?\s?"
-    r"(?P<num>\d{1,3}(?:,\d{3})+(?:\.\d+)?|\d+(?:\.\d+)?|\.\d+)(?!\.\d)(?![\d,]\d)"
+    r"(?P<num>(?P<dc>0,\d+|\d+,\d{1,2}(?!\d))|\d{1,3}(?:,\d{3})+(?:\.\d+)?|\d{1,3}(?: \d{3})+(?!\d|[.,]\d)|"
+    r"\d+(?:\.\d+)?|\.\d+)(?!\.\d)(?![\d,]\d)"
     r"(?P<exp>[eE][+\-]?\d+)?(?!st\b|nd\b|rd\b|th\b)"
     r"(?:\s?(?P<suffix>k|K|M|bn)\b|\s(?P<scale>thousand|million|billion)\b)?"
     r"(?P<den>/\d+(?:\.\d+)?)?"
-    r"(?P<pct>\s?(?:%|percent\b|per cent\b|percentage points?\b|pp\b|points?\b))?")
+    r"(?P<pct>\s?(?:%|percent\b|per cent\b|percentage points?\b|pp\b|points?\b|pts?\b))?")
 
 _WORDS = {"zero": 0, "one": 1, "two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8,
           "nine": 9, "ten": 10, "eleven": 11, "twelve": 12, "thirteen": 13, "fourteen": 14, "fifteen": 15,
@@ -73,6 +75,7 @@ class Number:
     sign: str = ""
     hedge: str = ""
     percent: bool = False
+    points: bool = False  # percentage points ('12 pts', 'pp'): of a probability, never a share
     currency: str = ""
     alternatives: tuple[float, ...] = ()
 
@@ -99,8 +102,8 @@ def find_numbers(text: str) -> list[Number]:
     """Every number in ``text`` (already :func:`normalise`\\ d), digits and number words, left to right."""
     out = []
     for m in _NUM_RE.finditer(text):
-        raw = m.group("num")
-        digits = raw.replace(",", "")
+        raw = m.group("num")  # a decimal comma ('22,5', '0,098'); thousands by comma or space ('12,757', '39 960')
+        digits = raw.replace(",", ".") if m.group("dc") else raw.replace(",", "").replace(" ", "")
         decimals = len(digits.split(".")[1]) if "." in digits else 0
         value = float(digits + (m.group("exp") or ""))
         unit = _step(digits.split(".")[0] if not decimals else digits, decimals)
@@ -116,16 +119,31 @@ def find_numbers(text: str) -> list[Number]:
                 alts = (value / den,)
         sign = m.group("sign") or {"minus": "-", "negative": "-", "plus": "+"}.get((m.group("wsign") or "").lower(), "")
         out.append(Number(m.start(), m.end(), m.group(0).strip(), -value if sign == "-" else value, unit, sign,
-                          _hedge(text[:m.start()]), bool(m.group("pct")), m.group("cur") or "", alts))
+                          _hedge(text[:m.start()]), bool(m.group("pct")), _points(m.group("pct")),
+                          m.group("cur") or "", alts))
     for m in _WORD_RE.finditer(text):
         value = _WORDS[m.group(1).lower()] + (_WORDS[m.group(2).lower()] if m.group(2) else 0)
         scale = _SCALES[m.group(3).lower()] if m.group(3) else 1
         out.append(Number(m.start(), m.end(), m.group(0), float(value * scale), float(scale),
-                          hedge=_hedge(text[:m.start()]), percent=bool(m.group("pct"))))
+                          hedge=_hedge(text[:m.start()]), percent=bool(m.group("pct")), points=_points(m.group("pct"))))
     return sorted(out, key=lambda n: n.start)
 
 
+def _points(pct: str | None) -> bool:
+    """'percentage points', 'points', 'pp', 'pts': points of a probability, not a share of a whole."""
+    return bool(pct and re.search(r"point|pp|pt", pct, re.IGNORECASE))
+
+
+_RANGE_LOW = re.compile(r"\bbetween\s+[+\-]?[$€£]?\s*$", re.IGNORECASE)
+_RANGE_HIGH = re.compile(r"\bbetween\s+[+\-]?[$€£]?\s*[\d.,]+\s*[A-Za-z%]{0,3}\s+(?:and|to)\s+[+\-]?[$€£]?\s*$",
+                         re.IGNORECASE)
+
+
 def _hedge(before: str) -> str:
+    if _RANGE_LOW.search(before[-30:]):  # 'between $500 and $1,000': a lower and an upper bound
+        return "at_least"
+    if _RANGE_HIGH.search(before[-40:]):
+        return "at_most"
     m = _HEDGE_RE.search(before[-30:])
     return HEDGES[m.group(1).lower()] if m else ""
 
