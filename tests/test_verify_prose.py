@@ -168,7 +168,7 @@ def corpus():
 def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
     floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("dev6", 0.97),
-              ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("dev10", 0.97), ("test", 0.9),
+              ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("dev10", 0.97), ("dev11", 0.94), ("test", 0.9),
               ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
@@ -405,3 +405,22 @@ def test_dev10_number_formats():
     # toy-2: turning chosen over recharging; speed's contribution to that margin -5.48
     assert _on_case("Speed (-1.70) gives recharging +5.48.", "toy-2").status == "verified"
     assert _on_case("Speed (-1.70) gives recharging +4.48.", "toy-2").status == "contradicted"
+
+
+def test_dev11_corrections():
+    """Operators' corrections: a name after 'not', 'rather than', 'instead of' is not what the sentence says things
+    of; 'would not worry' is an opinion, not a hypothetical; 'Q: Anything positive? A: ...' and 'A: a little, +1.77
+    toward ...' name no unknown feature."""
+    exp = _exp()  # odor +0.15, gill size +0.11, cap diameter -0.05
+
+    def status(text):
+        return xairl.verify(text, exp, 0).status
+    assert status("It is not the cap diameter but the odor that raises the prediction most.") == "verified"
+    assert status("It is not the odor but the cap diameter that raises the prediction most.") == "contradicted"
+    assert status("Rather than the cap diameter, odor is what raises the prediction.") == "verified"
+    tiny = _exp(contrib=(0.11, 0.15, -0.01))  # the cap diameter: 4 % of the total |contribution|
+    assert xairl.verify("I would not worry about the cap diameter: its effect is negligible.", tiny, 0).ok
+    assert status("Had the odor not been foul, the prediction would be lower.") == "verified"  # still hypothetical
+    assert status("Q: Anything positive? A: odor, +0.15.") == "verified"
+    assert _on_case("Q: Did the buffer matter? A: a little, +1.77 toward the handover.", "uav-1").status != \
+        "contradicted"

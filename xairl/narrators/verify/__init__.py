@@ -227,17 +227,21 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
                 other = checks.other_reading(n, sentence_keys, book, ctx)
         out.append(c if other is None else Claim("number", n.text, "unchecked",
                                                  f"read as {c.detail}, but it is {other}: which is unclear"))
-    out += directions.directions(masked, a, b, mentions, book, ctx, name_words)
-    out += ranks.find_ranks(masked, a, b, mentions, book, ctx)
-    out += ranks.find_comparisons(masked, a, b, mentions, book, ctx)
+    # 'not the garage but the quality', 'X, rather than Y, is ...': what is said of the sentence is not said of Y
+    said = [m for m in mentions if m.kind == "action" or not _NEGATED.search(masked[max(a, m.start - 40):m.start])]
+    out += directions.directions(masked, a, b, said, book, ctx, name_words)
+    out += ranks.find_ranks(masked, a, b, said, book, ctx)
+    out += ranks.find_comparisons(masked, a, b, said, book, ctx)
     for m in ranks.MINOR_RE.finditer(masked, a, b):
-        owner = next((x for x in reversed(names) if x.end <= m.start()), None) or next(
-            (x for x in names if x.start >= m.end()), None)
+        owner = next((x for x in reversed(named_features(said)) if x.end <= m.start()), None) or next(
+            (x for x in named_features(said) if x.start >= m.end()), None)
         if owner is not None:
             out.append(ranks.check_minor(owner.keys, ctx, book, m.group(0)))
     return out
 
 
+_NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
+                      r"(?:(?:because of|due to|about|the|its|their|a|an)\s+){0,3}$", re.IGNORECASE)
 _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of)?|scored|scores|score of|"
                         r"with a score of|came second at|"
                         r"second at|score|at|of|was|=)?\s*\(?(?:q\s*=\s*)?$", re.IGNORECASE)
@@ -309,6 +313,6 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
 #: a sentence about what did not happen: 'Had X been better, ...', 'Without X, it would have ...', 'If it were not
 #: for X'; a modal elsewhere ('chose recharge, which could save battery') leaves the rest of the sentence checked
 _HYPOTHETICAL = re.compile(r"^\W*(?:if|had|without|were|absent|but for)\b|\b(?:would|could|might)(?:\s+\w+ly)?\s+"
-                           r"(?:have|be|not|never)\b|\bif it (?:were|was)(?:n't| not) for\b", re.IGNORECASE)
+                           r"(?:(?:not|never)\s+)?(?:have|be)\b|\bif it (?:were|was)(?:n't| not) for\b", re.IGNORECASE)
 _PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
 

@@ -31,7 +31,8 @@ _POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|support
         r"nudg\w* (?:\w+ )?up|drives?|driven by|driving|tipped|tips|argu\w* for|counted for|counts for|"
         r"positive(?:ly)?|more likely|up by|help(?:s|ed|ing)?")
 _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ )?down|"
-        r"push(?:es|ed|ing)? (?:\w+ )?down|nudg\w* (?:\w+ )?down|subtract\w*|tak(?:es|ing|e) (?:[\w.,$€£]+ )?(?:off|away)|"
+        r"push(?:es|ed|ing)? (?:\w+ )?down|nudg\w* (?:\w+ )?down|subtract\w*|"
+        r"tak(?:es|ing|e) (?:[\w.,$€£]+ )?(?:off|away)|"
         r"took (?:\w+ )?(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|negative(?:ly)?|"
         r"less likely|"
         r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
@@ -123,7 +124,8 @@ _CONTRIB_BEFORE = re.compile(
     r"contribution(?: of| was| is|:)?|attributions?:?|phi\([^)]*\)\s*=|\|φ\|:?|impact of|effect of|push\w*|"
     r"another|\banother|drops?|takes|took|loses|gains?|\bby a margin of|\|shap\|:?|"
     r"edge of|favou?red \w+ by|for \w+ by|\bdown|\bup)\s*(?:\(|about|around|roughly|nearly|almost|"
-    r"approximately|some|only|just|a further|another|over|under|(?:somewhere |anywhere )?between)?\s*[+\-]?[$€£]?\s*$",
+    r"approximately|some|only|just|a further|another|over|under|(?:somewhere |anywhere )?between)?"
+    r"\s*[+\-]?[$€£]?\s*$",
     re.IGNORECASE)
 _LISTS_CONTRIBUTIONS = re.compile(r"shap|attribution|contribut|impact|effect|φ|phi|importance|weight|push|margin",
                                   re.IGNORECASE)

@@ -11,8 +11,9 @@ from .checks import Claim
 from .names import GENERIC, Mention, named_features
 from .ranks import NOUN
 
-_GENERIC_SUBJECT = re.compile(r"^\W*(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|practically|"
-                              r"just about)\s+)?(?:it|this|that|they|these|those|which|everything"
+_GENERIC_SUBJECT = re.compile(r"^\W*(?:[qa]\s*:\s*)?(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|"
+                              r"practically|just about)\s+)?(?:it|this|that|they|these|those|which|everything"
+                              r"|anything|something"
                               r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
                               r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total"
                               r"|the prediction|the predicted \w+|the estimate|the output|the model's \w+"
@@ -48,7 +49,8 @@ _LINKS = {"but", "and", "also", "yet", "then", "still", "even", "only", "while",
 #: words that say how much or which one, not what: a subject made only of them and the names' generic words, after
 #: the thing it belongs to ('the house's small size', 'its size of around 800 sq ft'), is a vague mention, not an
 #: invented feature
-_VAGUE = {"small", "smaller", "large", "larger", "big", "bigger", "short", "long", "the", "this", "that", "its",
+_VAGUE = {"small", "smaller", "large", "larger", "big", "bigger", "short", "long", "little", "bit", "lot", "the",
+          "this", "that", "its",
           "their", "about", "around", "roughly", "nearly", "almost", "some", "over", "under", "than"}
 #: the thing a model is about, as a possessor ('the house's', 'the applicant's'): not a feature of its own
 _POSSESSOR = re.compile(r"^\W*(?:the\s+|this\s+|its\s+|their\s+)?(?:house|home|property|file|document|applicant|"
