@@ -216,7 +216,15 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     scored = {}
     if not names and len(actions) >= 2 and len(numbers) == len(actions) and numbers[0].start >= actions[-1].end:
         scored = {id(n): m for n, m in zip(numbers, actions)}  # 'turn beat recharge 6.30 to 2.37'
+    # 'A and B together add x': one number after the names (not B's own '(+5.31)', not a list 'x and y'), without a
+    # quantity of its own ('most of the $91,462 above the baseline')
+    summed = len(tail) == 1 and len(names) >= 2 and _SUM_CUE.search(masked, a, b) and not _OWN_QUANTITY.search(
+        masked[max(a, tail[0].start - 12):tail[0].start]) and not checks._CHANGE_AFTER.match(masked[tail[0].end:b])
     for n in numbers:
+        if summed and n is tail[0]:
+            members = [m.keys for m in names if not _NEGATED.search(masked[max(a, m.start - 40):m.start])]
+            out.append(checks.sum_number(n, list(dict.fromkeys(members)), ctx, book))
+            continue
         c = _bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
         other = None
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure; others are guesses
@@ -240,6 +248,10 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     return out
 
 
+#: 'A and B together add x', 'combined', 'sum to', 'between them': the number is their sum
+_SUM_CUE = re.compile(r"\b(?:together|combined|jointly|in total|taken together|between them|sum(?:s|med)? to|add up to|"
+                      r"in sum)\b", re.IGNORECASE)
+_OWN_QUANTITY = re.compile(r"\bof\s+(?:the\s+)?[$€£]?$", re.IGNORECASE)
 _NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
                       r"(?:(?:because of|due to|about|the|its|their|a|an)\s+){0,3}$", re.IGNORECASE)
 _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of)?|scored|scores|score of|"

@@ -154,8 +154,8 @@ _LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state
 _CHANGE_BEFORE = re.compile(r"\b(?:exceed\w*|above|below|under|higher than|lower than|more than|less than)\b[^;]{0,40}"
                             r"\bby\s+(?:about|around|roughly|nearly|almost|some|only|just)?\s*[$€£]?\s*$", re.IGNORECASE)
 _CHANGE_AFTER = re.compile(r"^\s*(?!(?:\w+\s+)?(?:is|was|are|were|sits|lies|stands|remains)\b)(?:\w+\s+){0,2}"
-                           r"(above|below|under|over|more|less)\s+(the\s+)?(average|baseline|base|typical|expected|mean)",
-                           re.IGNORECASE)
+                           r"(above|below|under|over|more|less)\s+(the\s+)?(average|baseline|base|typical|expected|mean)"
+                           r"|^\W*(?:premium|uplift|markup|discount)\b", re.IGNORECASE)
 _COMPARISON_WORDS = r"(above|below|stronger|weaker|better|worse|higher|lower)"
 #: '1.9 dB above the serving BS's RSRP': a difference in a unit, neither a value nor a contribution
 _DIFFERENCE_AFTER = re.compile(rf"\s*[A-Za-z]+\s+{_COMPARISON_WORDS}\b", re.IGNORECASE)
@@ -254,6 +254,28 @@ def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, si
             if v is not None and matches(replace(n, percent=False), v, magnitude_ok=size_ok):
                 return f"{key}'s {what}"
     return None
+
+
+def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book: FactBook) -> Claim:
+    """'A and B together add x': x is the sum of their contributions (in the sentence's view, any when it names none);
+    a member that may mean several features counts only when every meaning agrees."""
+    contexts = book.contexts if ctx in (EITHER, None) else (ctx,)
+    combos = [()]
+    for keys in members:
+        combos = [c + (k,) for c in combos for k in keys]
+    def close(total: float, k: int) -> bool:  # a sum of k rounded figures may be off by k half-steps
+        return matches(n, total) or (not n.hedge and abs(abs(n.value) - abs(total)) <= k * n.unit / 2 + 1e-9
+                                     and (not n.sign or (n.value < 0) == (total < 0)))
+
+    results = [any(all(view in book.features[k].contribs for k in combo)
+                   and close(sum(book.features[k].contribs[view] for k in combo), len(combo)) for view in contexts)
+               for combo in combos]
+    total = sum(book.features[k].contribs.get(contexts[0], 0.0) for k in combos[0])
+    text = f"the sum of {', '.join(combos[0])}'s contributions is {total:.4g}"
+    if all(results):
+        return Claim("number", n.text, "verified", text)
+    return Claim("number", n.text, "unchecked" if any(results) else "contradicted",
+                 "ambiguous: a member may mean several features" if any(results) else text)
 
 
 def comparison(n: Number, after: str, book: FactBook) -> bool:

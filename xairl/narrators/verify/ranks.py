@@ -23,7 +23,8 @@ RANK_RE = re.compile(
     rf"|(?:the\s+)?(?P<plural>(?:two|three|four|2|3|4)\s+(?:most important|largest|biggest|strongest|main)|"
     rf"(?:top|the)[\s-]+(?P<k>two|three|four|2|3|4)(?:\s+most important|\s+largest|\s+biggest)?)\s+{NOUN}"
     rf"|(?P<top>{TOPWORD})(?:\s+single)?\s+(?:risk\s+)?(?P<noun>{NOUN})"
-    rf"|(?:mattered|matters|counted|counts|weighed) most|dominat\w+|ranks? (?P<rk>first|second|third)"
+    rf"|(?:mattered|matters|matter|counted|counts|weighed) most|dominat\w+|ranks? (?P<rk>first|second|third)"
+    rf"|(?:is|was) the (?:single )?(?:largest|biggest|strongest|greatest|most important|most influential)(?![ \w]*\w)"
     rf"|top[\s-](?P<topk>\d)\b)", re.IGNORECASE)
 AFTER_ORD = re.compile(r"^\W{0,3}(?:[a-z]+\s+)?(?:was\s+|is\s+|came\s+|a\s+(?:distant|close)\s+)?"
                        r"(?P<o>second|third|fourth)\b", re.IGNORECASE)
@@ -120,6 +121,10 @@ def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
     return (ctx,) if ctx and ctx != EITHER else book.contexts
 
 
+#: 'Among the positives, X is the largest', 'Of the factors lowering the risk, X matters most': the rank's scope
+_SCOPE = re.compile(r"^\W*(?:among|of)\s+(?:all\s+)?the\s+([^,]{3,60}),", re.IGNORECASE)
+
+
 def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
     """The rank phrases of clause ``masked[a:b]``, each bound to its names ('A was the main reason', 'the top three
     were A, B and C', 'followed by B', 'A second') and checked."""
@@ -131,6 +136,12 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if not sign and said and said.group(0).lower() not in ("for", "against", "toward", "towards"):
             sign = 1 if said.group("pos") else -1  # 'key factors decreasing the risk', 'the main feature supporting'
         side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])
+        scope = _SCOPE.match(masked[a:m.start()])
+        if not sign and scope:  # 'Among the positives, ...', 'Of the factors lowering the risk, ...'
+            said = DIRECTION_RE.search(scope.group(1))
+            sign = 1 if re.search(r"positive|reasons? (?:to|for)", scope.group(1), re.IGNORECASE) else -1 if \
+                re.search(r"negative", scope.group(1), re.IGNORECASE) else \
+                (1 if said.group("pos") else -1) if said else 0
         if not sign and not side and book.output == "actions" and re.search(r"(argument|reason)s?$", m.group(0),
                                                                              re.IGNORECASE):
             sign = 1  # 'the strongest reason': a reason for what was decided
