@@ -263,6 +263,7 @@ def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book:
     combos = [()]
     for keys in members:
         combos = [c + (k,) for c in combos for k in keys]
+
     def close(total: float, k: int) -> bool:  # a sum of k rounded figures may be off by k half-steps
         return matches(n, total) or (not n.hedge and abs(abs(n.value) - abs(total)) <= k * n.unit / 2 + 1e-9
                                      and (not n.sign or (n.value < 0) == (total < 0)))
