@@ -227,7 +227,9 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
             continue
         c = _bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
         other = None
-        if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure; others are guesses
+        # 'respectively' binds for sure, and so does a difference in a unit ('4.0 dB above'); others are guesses
+        if c.status == "contradicted" and id(n) not in paired and not checks.DIFFERENCE_AFTER.match(
+                masked[n.end:n.end + 16]):
             owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
             if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
                 other = checks.other_reading(n, set(owner.keys), book, ctx, signed=True)  # 'distance (2.33)': its own

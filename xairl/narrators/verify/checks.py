@@ -158,7 +158,7 @@ _CHANGE_AFTER = re.compile(r"^\s*(?!(?:\w+\s+)?(?:is|was|are|were|sits|lies|stan
                            r"|^\W*(?:premium|uplift|markup|discount)\b", re.IGNORECASE)
 _COMPARISON_WORDS = r"(above|below|stronger|weaker|better|worse|higher|lower)"
 #: '1.9 dB above the serving BS's RSRP': a difference in a unit, neither a value nor a contribution
-_DIFFERENCE_AFTER = re.compile(rf"\s*[A-Za-z]+\s+{_COMPARISON_WORDS}\b", re.IGNORECASE)
+DIFFERENCE_AFTER = re.compile(rf"\s*[A-Za-z]+\s+{_COMPARISON_WORDS}\b", re.IGNORECASE)
 _COMPARE_AFTER = re.compile(rf"^\s*(?:dB|dBm)?\s*(?:{_COMPARISON_WORDS}|more|less)\b",
                             re.IGNORECASE)
 
@@ -225,7 +225,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         shown = ", ".join(f"{w} {v:.4g}" for w, v in cands)
         return False, f"{n.text} is not {key}'s {shown or 'value'}"
 
-    if _DIFFERENCE_AFTER.match(after):
+    if DIFFERENCE_AFTER.match(after):
         ok = comparison(n, after, book)
         return Claim("number", n.text, "verified" if ok else ("contradicted" if book.by_unit else "unchecked"),
                      "a domain comparison in its unit" if ok else "a difference no fact states")
