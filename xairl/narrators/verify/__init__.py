@@ -220,25 +220,17 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     # quantity of its own ('most of the $91,462 above the baseline')
     summed = len(tail) == 1 and len(names) >= 2 and _SUM_CUE.search(masked, a, b) and not _OWN_QUANTITY.search(
         masked[max(a, tail[0].start - 12):tail[0].start]) and not checks._CHANGE_AFTER.match(masked[tail[0].end:b])
-    for n in numbers:
-        if summed and n is tail[0]:
-            members = [m.keys for m in names if not _NEGATED.search(masked[max(a, m.start - 40):m.start])]
-            out.append(checks.sum_number(n, list(dict.fromkeys(members)), ctx, book))
-            continue
-        c = _bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
-        other = None
-        # 'respectively' binds for sure, and so does a difference in a unit ('4.0 dB above'); others are guesses
-        if c.status == "contradicted" and id(n) not in paired and not checks.DIFFERENCE_AFTER.match(
-                masked[n.end:n.end + 16]):
-            owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
-            if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
-                other = checks.other_reading(n, set(owner.keys), book, ctx, signed=True)  # 'distance (2.33)': its own
-            else:
-                other = checks.other_reading(n, sentence_keys, book, ctx)
-        out.append(c if other is None else Claim("number", n.text, "unchecked",
-                                                 f"read as {c.detail}, but it is {other}: which is unclear"))
     # 'not the garage but the quality', 'X, rather than Y, is ...': what is said of the sentence is not said of Y
     said = [m for m in mentions if m.kind == "action" or not _NEGATED.search(masked[max(a, m.start - 40):m.start])]
+    for n in numbers:
+        if summed and n is tail[0]:
+            members = list(dict.fromkeys(m.keys for m in named_features(said)))
+            out.append(checks.sum_number(n, members, ctx, book))
+            continue
+        c = _bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
+        if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure
+            c = _unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
+        out.append(c)
     out += directions.directions(masked, a, b, said, book, ctx, name_words)
     out += ranks.find_ranks(masked, a, b, said, book, ctx)
     out += ranks.find_comparisons(masked, a, b, said, book, ctx)
@@ -269,6 +261,21 @@ _LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)(?:\s+over\s+[^\d;]{0,30
 #: 'speed argued for X (-5.48)', 'obstacle barely affected the turn score (-0.09)': the feature's contribution
 _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact\w*|influenc\w*|matter\w*|"
                      r"shift\w*|worth)\b", re.IGNORECASE)
+
+
+def _unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, sentence_keys) -> Claim:
+    """A contradicted number that states another fact of a feature named in the sentence exactly: the binding was a
+    guess, so it is unchecked ('which is unclear'). A difference in a unit ('4.0 dB above') binds for sure; a bracket
+    right after a name ('distance (2.33)') may only be that name's own fact, with its sign."""
+    if checks.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
+        return c
+    owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
+    if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
+        other = checks.other_reading(n, set(owner.keys), book, ctx, signed=True)
+    else:
+        other = checks.other_reading(n, sentence_keys, book, ctx)
+    return c if other is None else Claim("number", n.text, "unchecked",
+                                         f"read as {c.detail}, but it is {other}: which is unclear")
 
 
 def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:
