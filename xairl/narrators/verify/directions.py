@@ -50,8 +50,8 @@ _LINKS = {"but", "and", "also", "yet", "then", "still", "even", "only", "while",
 #: the thing it belongs to ('the house's small size', 'its size of around 800 sq ft'), is a vague mention, not an
 #: invented feature
 _VAGUE = {"small", "smaller", "large", "larger", "big", "bigger", "short", "long", "little", "bit", "lot", "the",
-          "this", "that", "its",
-          "their", "about", "around", "roughly", "nearly", "almost", "some", "over", "under", "than"}
+          "this", "that", "its", "their", "about", "around", "roughly", "nearly", "almost", "some", "over", "under",
+          "than"}
 #: the thing a model is about, as a possessor ('the house's', 'the applicant's'): not a feature of its own
 _POSSESSOR = re.compile(r"^\W*(?:the\s+|this\s+|its\s+|their\s+)?(?:house|home|property|file|document|applicant|"
                         r"borrower|customer|client|user|patient|loan|account|uav|drone|robot|agent|vehicle|device|"
@@ -67,6 +67,7 @@ _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:bu
 
 def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
                 name_words=frozenset()) -> list[Claim]:
+    """The direction claims of clause ``masked[a:b]``: each direction word with the names it is said of, checked."""
     out, prev, bare = [], a, False  # bare: the previous direction word found no subject at all
     names = named_features(mentions)
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
