@@ -40,7 +40,7 @@ from tests import narrative_domains as domains  # noqa: E402
 DATA = pathlib.Path(__file__).parent / "data" / "narratives"
 
 
-SPLITS = ("dev", "dev2", "dev3", "dev4", "dev5", "dev6", "dev7", "dev8", "dev9", "dev10", "dev11", "dev12", "test", "test2")
+SPLITS = ("dev", "dev2", "dev3", "dev4", "dev5", "dev6", "dev7", "dev8", "dev9", "dev10", "dev11", "dev12", "dev13", "test", "test2")
 
 
 def load_corpus() -> list[dict]:
@@ -58,6 +58,7 @@ def load_corpus() -> list[dict]:
                             (DATA / "dev10" / f"{domain}.yaml", "dev10"),
                             (DATA / "dev11" / f"{domain}.yaml", "dev11"),
                             (DATA / "dev12" / f"{domain}.yaml", "dev12"),
+                            (DATA / "dev13" / f"{domain}.yaml", "dev13"),
                             (DATA / "test2" / f"{domain}.yaml", "test2")):
             for case_id, items in yaml.safe_load(path.read_text()).items():
                 case = cases[case_id]
