@@ -6,9 +6,9 @@ with one labelled error, in many voices. Cases 0-3 of each domain are the dev sp
 cases 4-7 the test split (frozen before any tuning; report it apart); ``dev2/`` 76 more narratives on the dev
 cases in other voices (Q&A, LLM-style prose, shorthand, lists; 16 of them on two UAV 'stay' cases of its own) and
 ``dev3/`` 55 more (shares, 'accounts for', pipes, counterfactuals), ``dev4/`` 44 in the voice of an LLM explaining
-SHAP values, ``dev5/`` 45 in memo, log, arrow and passive voices, ``dev6/`` to ``dev12/`` 34-48 each (markdown,
+SHAP values, ``dev5/`` 45 in memo, log, arrow and passive voices, ``dev6/`` to ``dev13/`` 23-48 each (markdown,
 tickets, voice memos, amount verbs, signs in words, comparisons between features, JSON-ish output, number formats,
-operators' corrections, sums), each written after the freeze and measured once before tuning on it. ``test2/``: 48 more on the test cases (chat, letters, risk notes,
+operators' corrections, sums, 'from x to y'), each written after the freeze and measured once before tuning on it. ``test2/``: 48 more on the test cases (chat, letters, risk notes,
 decision logs), written after the test split's disagreements had been counted by cause (not read) and never tuned
 on: the second held-out figure. A narrative counts as agreeing when ``Verification.ok`` equals its label.
 

@@ -255,6 +255,10 @@ _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of
 
 _ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
                       r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$", re.IGNORECASE)
+_FROM = re.compile(r"\bfrom\s+(?:(?:an?|the|its)\s+)?(?:(?:average|base(?:line)?|base rate|starting point|typical)"
+                   r"(?:\s+(?:rate|value|estimate|prediction))?\s+(?:of\s+)?)?[$€£]?\s*$", re.IGNORECASE)
+_FROM_TO = re.compile(r"\bfrom\s+[^;]{1,40}?\s+(?:down\s+|up\s+)?to\s+(?:about|around|roughly)?\s*[$€£]?$",
+                      re.IGNORECASE)
 #: 'the handover's lead of 3.9', 'turning's lead over going forward was 1.55'
 _LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)(?:\s+over\s+[^\d;]{0,30}?)?\s+(?:of|was|is|=|:)\s+"
                       r"(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)
@@ -288,8 +292,11 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         return checks.free_number(n, masked, book)
     if id(n) in scored:
         return checks.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
-    if book.output != "actions" and _ENDS_AT.search(masked[max(0, n.start - 30):n.start]):
-        return checks.output_number(n, book)  # 'pull it down to 0.142': where the output ends up
+    if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
+        return checks.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
+    if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 30):n.start]) or _FROM_TO.search(
+            masked[max(0, n.start - 60):n.start])):
+        return checks.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
     if book.margin is not None and _LEAD_OF.search(masked[max(0, n.start - 30):n.start]):
         return checks.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named before
     after = masked[n.end:n.end + 24]

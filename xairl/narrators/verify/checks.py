@@ -345,11 +345,12 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     return Claim("number", n.text, "unchecked", "tied to no feature or quantity of this explanation")
 
 
-def output_number(n: Number, book: FactBook) -> Claim:
-    """A number said to be where the output ends up ('pulls it down to 0.142'): the prediction."""
-    v = book.scores[book.chosen]
+def output_number(n: Number, book: FactBook, start: bool = False) -> Claim:
+    """A number said to be where the output ends up ('pulls it down to 0.142'): the prediction; ``start``: where it
+    starts ('from 34.1 % to ...'), the baseline."""
+    v, what = (book.base, "baseline") if start else (book.scores[book.chosen], "prediction")
     ok = matches(n, v, magnitude_ok=False) or (n.percent and _percent_readings(n, v))
-    return Claim("number", n.text, "verified" if ok else "contradicted", f"the prediction is {v:.4g}")
+    return Claim("number", n.text, "verified" if ok else "contradicted", f"the {what} is {v:.4g}")
 
 
 def _owner(n: Number, book: FactBook) -> str | None:
