@@ -11,9 +11,9 @@ A small pipeline, one module per step:
    pairwise for 'A and B ... by x and y, respectively', an action's score, the margin, the prediction);
    :mod:`.directions` binds each direction word to the list of names nearest before it (or a list after it,
    'Raising risk: A, B'), and :mod:`.ranks` each rank, 'barely matters' and 'A mattered more than B' phrase;
-4. :mod:`.checks` (and :mod:`.ranks`) checks each claim against :mod:`.book` (values, contributions to the chosen
-   action's score and to the margin over the runner-up, ranks, shares, labels, scores, domain comparisons) and
-   says verified, contradicted or unchecked;
+4. :mod:`.quantities` (numbers), :mod:`.checks` (actions, categories, directions) and :mod:`.ranks` check each
+   claim against :mod:`.book` (values, contributions to the chosen action's score and to the margin over the
+   runner-up, ranks, shares, labels, scores, domain comparisons) and say verified, contradicted or unchecked;
 5. every sentence gets a status (contradicted if any claim is; verified if a claim was checked and none is
    contradicted; else unchecked), and the text a coverage (share of sentences with a checked claim).
 
@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 
 from ...explanation import Explanation
 from ...policy import Policy
-from . import checks, directions, ranks
+from . import checks, directions, quantities, ranks
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, named_features, vocabulary
@@ -202,13 +202,13 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
                   unit_of, name_words=frozenset(), sentence_keys=frozenset()) -> list[Claim]:
     out: list[Claim] = []
     names = named_features(mentions)
-    numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not checks.skip_number(n, masked)]
+    numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not quantities.skip_number(n, masked)]
     # 'A and B ... by x and y, respectively': numbers after the last name pair up with the names in order
     tail = [n for n in numbers if names and n.start > names[-1].end  # not the last name's own '(−22.5 dB)'
             and not re.fullmatch(r"\s?\([^()]*", masked[names[-1].end:n.start])]
     paired = {}
     if len(names) >= 2 and len(tail) == len(names) and (
-            "respectively" in masked[a:b].lower() or checks._CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
+            "respectively" in masked[a:b].lower() or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
             or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
                 and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
         paired = {id(n): m for n, m in zip(tail, names)}
@@ -219,13 +219,14 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     # 'A and B together add x': one number after the names (not B's own '(+5.31)', not a list 'x and y'), without a
     # quantity of its own ('most of the $91,462 above the baseline')
     summed = len(tail) == 1 and len(names) >= 2 and _SUM_CUE.search(masked, a, b) and not _OWN_QUANTITY.search(
-        masked[max(a, tail[0].start - 12):tail[0].start]) and not checks._CHANGE_AFTER.match(masked[tail[0].end:b])
+        masked[max(a, tail[0].start - 12):tail[0].start]) and not quantities.CHANGE_AFTER.match(masked[tail[0].end:b])
     # 'not the garage but the quality', 'X, rather than Y, is ...': what is said of the sentence is not said of Y
     said = [m for m in mentions if m.kind == "action" or not _NEGATED.search(masked[max(a, m.start - 40):m.start])]
+    said_names = named_features(said)
     for n in numbers:
         if summed and n is tail[0]:
-            members = list(dict.fromkeys(m.keys for m in named_features(said)))
-            out.append(checks.sum_number(n, members, ctx, book))
+            members = list(dict.fromkeys(m.keys for m in said_names))
+            out.append(quantities.sum_number(n, members, ctx, book))
             continue
         c = _bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure
@@ -235,8 +236,8 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     out += ranks.find_ranks(masked, a, b, said, book, ctx)
     out += ranks.find_comparisons(masked, a, b, said, book, ctx)
     for m in ranks.MINOR_RE.finditer(masked, a, b):
-        owner = next((x for x in reversed(named_features(said)) if x.end <= m.start()), None) or next(
-            (x for x in named_features(said) if x.start >= m.end()), None)
+        owner = next((x for x in reversed(said_names) if x.end <= m.start()), None) or next(
+            (x for x in said_names if x.start >= m.end()), None)
         if owner is not None:
             out.append(ranks.check_minor(owner.keys, ctx, book, m.group(0)))
     return out
@@ -271,13 +272,13 @@ def _unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, c
     """A contradicted number that states another fact of a feature named in the sentence exactly: the binding was a
     guess, so it is unchecked ('which is unclear'). A difference in a unit ('4.0 dB above') binds for sure; a bracket
     right after a name ('distance (2.33)') may only be that name's own fact, with its sign."""
-    if checks.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
+    if quantities.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
         return c
     owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
     if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
-        other = checks.other_reading(n, set(owner.keys), book, ctx, signed=True)
+        other = quantities.other_reading(n, set(owner.keys), book, ctx, signed=True)
     else:
-        other = checks.other_reading(n, sentence_keys, book, ctx)
+        other = quantities.other_reading(n, sentence_keys, book, ctx)
     return c if other is None else Claim("number", n.text, "unchecked",
                                          f"read as {c.detail}, but it is {other}: which is unclear")
 
@@ -287,18 +288,18 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     ('Turn (4.07)', 'staying scored 26.26') or right after it ('7.38 for staying'); a name right after it ('a 7-year
     credit history'); the name before it in its clause unless a new noun phrase starts between them; else none."""
     if id(n) in paired:
-        return checks.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of)
-    if checks._CHANGE_AFTER.match(masked[n.end:n.end + 30]):  # 'most of the $91,462 above the baseline'
-        return checks.free_number(n, masked, book)
+        return quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of)
+    if quantities.CHANGE_AFTER.match(masked[n.end:n.end + 30]):  # 'most of the $91,462 above the baseline'
+        return quantities.free_number(n, masked, book)
     if id(n) in scored:
-        return checks.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
+        return quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
     if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
-        return checks.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
+        return quantities.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
     if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 30):n.start]) or _FROM_TO.search(
             masked[max(0, n.start - 60):n.start])):
-        return checks.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
+        return quantities.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
     if book.margin is not None and _LEAD_OF.search(masked[max(0, n.start - 30):n.start]):
-        return checks.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named before
+        return quantities.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named
     after = masked[n.end:n.end + 24]
     nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
     # '+22.0 for the handover' after a feature, 'worth 11.5 for ...': the feature's push, not the action's score
@@ -306,36 +307,36 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     if pushes and nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|to|toward|towards)\s+(?:the\s+)?$",
                                                                    masked[n.end:nxt.start]):
         owner = next(x for x in reversed(names) if x.end <= n.start)  # for one option over the other: either view
-        return checks.feature_number(n, owner.keys, masked, book, checks.EITHER, unit_of)
+        return quantities.feature_number(n, owner.keys, masked, book, checks.EITHER, unit_of)
     if nxt is not None and nxt.kind == "action" and not pushes and re.match(r"^\s*(?:for|by)\s+(?:a\s+|an\s+|the\s+)?$",
                                                            masked[n.end:nxt.start]):
-        return checks.action_number(n, checks.resolve_action(nxt, book), masked, book)
+        return quantities.action_number(n, checks.resolve_action(nxt, book), masked, book)
     gap = masked[n.end:nxt.start] if nxt is not None else ""
     if nxt is not None and nxt.kind != "action" and re.match(r"^[\s-]*(?:[a-z]+[\s-]+){0,2}(?:of\s+)?$", gap,
                                                                re.IGNORECASE) \
             and not re.search(r"\b(and|or|but|while|with)\b", gap, re.IGNORECASE):
-        return checks.feature_number(n, nxt.keys, masked, book, ctx, unit_of)
+        return quantities.feature_number(n, nxt.keys, masked, book, ctx, unit_of)
     prev = next((m for m in reversed(mentions) if m.end <= n.start), None)
     feature_before = next((m for m in reversed(names) if m.end <= n.start), None)
     if prev is not None and prev.kind == "action" and n.sign and feature_before is not None and book.runner_up \
             and checks.resolve_action(prev, book) == book.runner_up and not masked[prev.end:n.start].strip():
         # 'speed gives recharging +5.48' when turning was chosen: -5.48 in the chosen action's margin
         flipped = replace(n, value=-n.value, sign="-" if n.sign == "+" else "+")
-        return checks.feature_number(flipped, feature_before.keys, masked, book, "margin", unit_of)
+        return quantities.feature_number(flipped, feature_before.keys, masked, book, "margin", unit_of)
     if prev is not None and prev.kind == "action" and (
             n.sign == "+" or re.match(r"^\s*(over|than|versus|vs)\b", after, re.IGNORECASE) or (
             feature_before is not None and any(r.search(masked, feature_before.end, prev.start)
                                                for r in (checks.DIRECTION_RE, _ARGUED)))):
         prev = feature_before  # '(+2.05)' after 'supported recharging': the feature's contribution
     if prev is not None and prev.kind == "action":
-        if _SCORE_GAP.match(masked[prev.end:n.start]) or checks._MARGIN_BEFORE.search(masked[prev.end:n.start]):
-            return checks.action_number(n, checks.resolve_action(prev, book), masked, book)
+        if _SCORE_GAP.match(masked[prev.end:n.start]) or quantities.MARGIN_BEFORE.search(masked[prev.end:n.start]):
+            return quantities.action_number(n, checks.resolve_action(prev, book), masked, book)
         prev = next((m for m in reversed(names) if m.end <= n.start), None)
     if prev is not None and not re.search(r"(?:,\s*|\sand\s+)(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s"
                                           r"(?!(?:most|second|third|main|largest|biggest|top|strongest)\b)",
                                           masked[prev.end:n.start], re.IGNORECASE):
-        return checks.feature_number(n, prev.keys, masked, book, ctx, unit_of)
-    return checks.free_number(n, masked, book)
+        return quantities.feature_number(n, prev.keys, masked, book, ctx, unit_of)
+    return quantities.free_number(n, masked, book)
 
 
 #: a sentence about what did not happen: 'Had X been better, ...', 'Without X, it would have ...', 'If it were not

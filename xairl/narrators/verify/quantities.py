@@ -1,0 +1,257 @@
+"""What a number in a text states and its check: a feature's value, contribution or share, an action's score, the
+margin, the prediction, the baseline, the change from it, a sum of contributions, or a domain comparison in its
+unit. The cue words around the number decide which (:func:`feature_number`, :func:`free_number`); :func:`skip_number`
+says which numbers are no claim (list markers, identifiers, counts of the method's inputs, ratios)."""
+from __future__ import annotations
+
+import re
+from dataclasses import replace
+
+from .book import FactBook
+from .checks import EITHER, Claim, over_keys
+from .numbers import Number, matches
+
+CONTRIB_BEFORE = re.compile(
+    r"(?:\bby|\badds?|\badded|\badding|contribut\w*|\bworth|\bcosts?|\bcosting|subtract\w*|\boff|\baway|\bcut\w*|"
+    r"knock\w*|lifts?|lower\w*|rais\w*|reduc\w*|increas\w*|decreas\w*|shap(?: value)?(?: of| is| was|:|=)?|"
+    r"contribution(?: of| was| is|:)?|attributions?:?|phi\([^)]*\)\s*=|\|φ\|:?|impact of|effect of|push\w*|"
+    r"another|\banother|drops?|takes|took|loses|gains?|\bby a margin of|\|shap\|:?|"
+    r"edge of|favou?red \w+ by|for \w+ by|\bdown|\bup)\s*(?:\(|about|around|roughly|nearly|almost|"
+    r"approximately|some|only|just|a further|another|over|under|(?:somewhere |anywhere )?between)?"
+    r"\s*[+\-]?[$€£]?\s*$",
+    re.IGNORECASE)
+_LISTS_CONTRIBUTIONS = re.compile(r"shap|attribution|contribut|impact|effect|φ|phi|importance|weight|push|margin",
+                                  re.IGNORECASE)
+MARGIN_BEFORE = re.compile(r"\b(margin|lead|edge|gap|advantage|difference)(?: of)?\W*(?:about|around|roughly|only|"
+                            r"just)?\s*$|\b(won|wins|beat\w*|ahead|stayed ahead|led|edged out|outscored)\s+"
+                            r"(?:[\w\0']+\s+|\([^()]*\)\s+){0,4}by\s+(?:about|around|roughly|only|just)?\s*$",
+                            re.IGNORECASE)
+_ON_AVERAGE = re.compile(r"^\s*(?:on average|over the background|across the background|at baseline|by default)\b",
+                         re.IGNORECASE)
+_MARGIN_AFTER = re.compile(r"^\s*(?:points?\s+)?(?:above|ahead|higher|more than)\b", re.IGNORECASE)
+_RUNNER_BEFORE = re.compile(r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?[$€£]?\s*$",
+                            re.IGNORECASE)
+_SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
+_BASE_AFTER = re.compile(r"^\s*(?:\w+\s+)?(baseline|base value|base rate|base|average|typical|expected|mean)\b",
+                         re.IGNORECASE)
+_BASE_WORDS = re.compile(r"\b(baseline|base value|base|average|typical|expected value|mean|on average)\b",
+                         re.IGNORECASE)
+#: 'the average prediction of $230,061'
+_BASE_BEFORE = re.compile(r"\b(?:baseline|average|typical|mean|expected)\s+(?:prediction|estimate|output|predicted \w+)"
+                          r"\s*(?:of|is|was|:|=)?\s*[$€£]?\s*$", re.IGNORECASE)
+_OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability|chance|risk|price|output|final)\b",
+                        re.IGNORECASE)
+_SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|features|narratives|coalitions|times|"
+                         r"-fold)\b|[x×](?![\w]))",
+                         re.IGNORECASE)
+_LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state)[\s-]*$", re.IGNORECASE)
+#: '$91,462 above the baseline' (not '0.38 is slightly above the base value': there the number is the prediction)
+_CHANGE_BEFORE = re.compile(r"\b(?:exceed\w*|above|below|under|higher than|lower than|more than|less than)\b[^;]{0,40}"
+                            r"\bby\s+(?:about|around|roughly|nearly|almost|some|only|just)?\s*[$€£]?\s*$",
+                            re.IGNORECASE)
+CHANGE_AFTER = re.compile(r"^\s*(?!(?:\w+\s+)?(?:is|was|are|were|sits|lies|stands|remains)\b)(?:\w+\s+){0,2}"
+                           r"(above|below|under|over|more|less)\s+(the\s+)?"
+                           r"(average|baseline|base|typical|expected|mean)"
+                           r"|^\W*(?:premium|uplift|markup|discount)\b", re.IGNORECASE)
+_COMPARISON_WORDS = r"(above|below|stronger|weaker|better|worse|higher|lower)"
+#: '1.9 dB above the serving BS's RSRP': a difference in a unit, neither a value nor a contribution
+DIFFERENCE_AFTER = re.compile(rf"\s*[A-Za-z]+\s+{_COMPARISON_WORDS}\b", re.IGNORECASE)
+_COMPARE_AFTER = re.compile(rf"^\s*(?:dB|dBm)?\s*(?:{_COMPARISON_WORDS}|more|less)\b",
+                            re.IGNORECASE)
+
+
+def skip_number(n: Number, masked: str) -> bool:
+    """Numbers that are not claims: list markers ('1.' at a line start), identifiers ('candidate 2', 'top-3'),
+    counts of the method's inputs ('100 background rows')."""
+    before = masked[:n.start]
+    if re.search(r"(^|\n)\s*$", before) and re.match(r"^[.)]\s", masked[n.end:n.end + 2]):
+        return True
+    if re.match(r"^\s+(?:most|largest|biggest|main|top|strongest|key)\b", masked[n.end:]):  # 'the two largest'
+        return True
+    if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):
+        return True  # all three
+    if n.text.lower() == "one" and re.search(r"\b(this|that|the|which|each|every|any|no|a)\s+(?:[a-z]+\s+)?$", before,
+                                             re.IGNORECASE):
+        return True  # 'this one', 'the big one': a pronoun
+    return bool(_LABEL_BEFORE.search(before)) or bool(_SKIP_AFTER.match(masked[n.end:]))
+
+
+def _percent_readings(n: Number, v: float) -> bool:
+    return abs(v) <= 1.0 and matches(replace(n, percent=False, alternatives=()), 100 * v)
+
+
+def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook, ctx: str | None,
+                   unit_of) -> Claim:
+    """A number tied to a feature: its value, its contribution (in the sentence's context, or any context when the
+    sentence does not say), its share, or a percentage of a probability-like contribution. Cue words before it
+    ('by', 'adds', 'SHAP value of') say it is a contribution; the feature's unit after it that it is a value."""
+    before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 16]
+    contrib_cue = bool(CONTRIB_BEFORE.search(before))
+    # a sentence that names no view, or weighs the two options without saying which ('argued against it'): either
+    # view (the chosen action's score or the margin over the runner-up)
+    contexts = book.contexts if ctx in (EITHER, None) else (ctx,)
+
+    # an unsigned number in brackets right after the name is its value ('distance (0.84)'); a signed one may be either
+    # ... unless the sentence has already said it lists contributions ('Top features by absolute SHAP value: A (0.11)')
+    slot = not n.sign and not n.currency and not n.percent and bool(re.search(r"\0\s?\($", before)) and \
+        masked[n.end:n.end + 1] in (")", ",") and not _LISTS_CONTRIBUTIONS.search(masked[:n.start])
+    fill_cue = n.percent and re.match(r"\s*(full|of (?:its |the )?capacity)\b", after, re.IGNORECASE)
+
+    def test(key):
+        e = book.features[key]
+        if fill_cue and e.fill is not None:  # '8 % full': the fill, nothing else
+            return matches(n, e.fill), f"{key}'s fill is {e.fill:.3g} % of its capacity"
+        unit = unit_of(key).lower()
+        # the unit with a decimal prefix ('2 Mbit' for 2e6 bit, '12 kB' for 12,000 B): the value in that unit
+        prefix = re.match(rf"\s*([kMG])\s?{re.escape(unit_of(key))}\b", after) if unit else None
+        scale = {"k": 1e3, "M": 1e6, "G": 1e9}[prefix.group(1)] if prefix else 1.0
+        value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or slot or bool(prefix)) \
+            and not contrib_cue
+        cands = []
+        if not contrib_cue and e.value is not None:
+            cands.append(("value" if scale == 1 else f"value in {prefix.group(1)}{unit_of(key)}", e.value / scale))
+        if n.percent and not contrib_cue and e.fill is not None:
+            cands.append(("fill (% of capacity)", e.fill))
+        if not value_cue:
+            cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
+        for what, v in cands:
+            if matches(n, v) or (n.percent and _percent_readings(n, v)):
+                return True, f"{key}: {what}"
+        if n.percent and not n.points and any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
+            return True, f"{key}: share"
+        shown = ", ".join(f"{w} {v:.4g}" for w, v in cands)
+        return False, f"{n.text} is not {key}'s {shown or 'value'}"
+
+    if DIFFERENCE_AFTER.match(after):
+        ok = comparison(n, after, book)
+        return Claim("number", n.text, "verified" if ok else ("contradicted" if book.by_unit else "unchecked"),
+                     "a domain comparison in its unit" if ok else "a difference no fact states")
+    claim = over_keys(keys, test, "feature", n.text, "number")
+    if claim.status == "contradicted" and comparison(n, after, book):
+        return Claim("number", n.text, "verified", "a domain comparison in its unit")
+    return claim
+
+
+def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, signed: bool = False) -> str | None:
+    """Another fact the number states exactly when the words bound it to the wrong one: the value, share or
+    contribution (in the sentence's view when it names one, else any) of a feature named in the same sentence. The
+    binding was a guess, so the number is not called wrong; only unhedged numbers of two significant digits or more
+    qualify ('0.06' or 'about 0.1' may match by chance). ``signed``: a contribution only with its sign."""
+    if n.hedge or abs(n.value) < 10 * n.unit:
+        return None
+    views = book.contexts if ctx in (None, EITHER) else (ctx,)
+    for key in sorted(keys):
+        e = book.features[key]
+        if n.percent and not n.points:  # a percentage is a share (or a fill the binding already tried)
+            facts = [(f"share ({c})", e.shares.get(c), True) for c in views]
+        else:  # a value as written, sign included; a contribution may be its size
+            facts = [("value", e.value, False), *((f"contribution ({c})", e.contribs.get(c), not signed)
+                                                  for c in views)]
+        for what, v, size_ok in facts:
+            if v is not None and matches(replace(n, percent=False), v, magnitude_ok=size_ok):
+                return f"{key}'s {what}"
+    return None
+
+
+def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book: FactBook) -> Claim:
+    """'A and B together add x': x is the sum of their contributions (in the sentence's view, any when it names none);
+    a member that may mean several features counts only when every meaning agrees."""
+    contexts = book.contexts if ctx in (EITHER, None) else (ctx,)
+    combos = [()]
+    for keys in members:
+        combos = [c + (k,) for c in combos for k in keys]
+
+    def close(total: float, k: int) -> bool:  # a sum of k rounded figures may be off by k half-steps
+        return matches(n, total) or (not n.hedge and abs(abs(n.value) - abs(total)) <= k * n.unit / 2 + 1e-9
+                                     and (not n.sign or (n.value < 0) == (total < 0)))
+
+    results = [any(all(view in book.features[k].contribs for k in combo)
+                   and close(sum(book.features[k].contribs[view] for k in combo), len(combo)) for view in contexts)
+               for combo in combos]
+    total = sum(book.features[k].contribs.get(contexts[0], 0.0) for k in combos[0])
+    text = f"the sum of {', '.join(combos[0])}'s contributions is {total:.4g}"
+    if all(results):
+        return Claim("number", n.text, "verified", text)
+    return Claim("number", n.text, "unchecked" if any(results) else "contradicted",
+                 "ambiguous: a member may mean several features" if any(results) else text)
+
+
+def comparison(n: Number, after: str, book: FactBook) -> bool:
+    unit = re.match(r"\s*([A-Za-z]+)", after)
+    values = book.by_unit.get(unit.group(1).lower(), []) if unit else []
+    return any(matches(n, v) for v in values)
+
+
+def action_number(n: Number, action: str | None, masked: str, book: FactBook) -> Claim:
+    """A number next to an action: its score, or the margin when the words say so ('won by', 'a lead of')."""
+    if book.global_view:  # over many states no single action has a score: a count or another flight-level fact
+        return free_number(n, masked, book)
+    before = masked[max(0, n.start - 40):n.start]
+    if MARGIN_BEFORE.search(before) and book.margin is not None:
+        if _ON_AVERAGE.match(masked[n.end:n.end + 40]) and book.base_margin is not None:
+            ok = matches(n, book.base_margin)  # 'it led by 3.4 on average over the background'
+            return Claim("number", n.text, "verified" if ok else "contradicted",
+                         f"the margin over the background is {book.base_margin:.4g}")
+        ok = matches(n, book.margin)
+        return Claim("number", n.text, "verified" if ok else "contradicted", f"the margin is {book.margin:.4g}")
+    if action is None or action not in book.scores:
+        return Claim("number", n.text, "unchecked", "an action that could not be told apart")
+    ok = matches(n, book.scores[action], magnitude_ok=False)
+    return Claim("number", n.text, "verified" if ok else "contradicted", f"{action}'s score is "
+                 f"{book.scores[action]:.4g}")
+
+
+def free_number(n: Number, masked: str, book: FactBook) -> Claim:
+    """A number tied to no name: a decision-level quantity when the words around it name one (margin, runner-up
+    score, prediction, baseline, change from the baseline, a domain comparison in its unit), else any decision-level
+    fact or, when it is a contribution, the one feature whose contribution it is."""
+    before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 30]
+    named = None
+    change_cue = CHANGE_AFTER.match(after) or (_CHANGE_BEFORE.search(before) and _BASE_WORDS.search(before))
+    if change_cue and book.base is not None:  # '$91,462 above the baseline', 'exceeds the base rate (0.34) by 0.09'
+        change = book.scores[book.chosen] - book.base
+        ok = matches(n, change) or (n.percent and _percent_readings(n, abs(change)))
+        return Claim("number", n.text, "verified" if ok else "contradicted", f"the change from the baseline is "
+                     f"{change:.4g}")
+    if MARGIN_BEFORE.search(before) or _MARGIN_AFTER.match(after):
+        named = ("the margin", [book.margin if book.margin is not None else 0.0])  # one available action: 0
+    elif (_SCORE_BEFORE.search(before) or re.match(r"^\s*(vs\.?|versus)\s", after)) and book.chosen in book.scores:
+        named = ("the chosen action's score", [book.scores[book.chosen]])
+    elif _RUNNER_BEFORE.search(before) and book.runner_up:
+        named = ("the runner-up's score", [book.scores[book.runner_up]])
+    elif _COMPARE_AFTER.match(after) and book.by_unit:
+        named = ("a comparison", [v for vs in book.by_unit.values() for v in vs])
+    elif CONTRIB_BEFORE.search(before) and _owner(n, book):
+        return Claim("number", n.text, "verified", f"{_owner(n, book)}'s contribution (the only one it matches)")
+    elif book.output != "actions" and not book.global_view:
+        near = before[-24:]
+        base_at = max((m.end() for m in _BASE_WORDS.finditer(near)), default=-1)
+        out_at = max((m.end() for m in _OUT_WORDS.finditer(_BASE_WORDS.sub(lambda m: " " * len(m.group(0)), near))),
+                     default=-1)  # 'value' inside 'base value' is the baseline's word
+        if base_at > out_at or _BASE_AFTER.match(after) or _BASE_BEFORE.search(before):  # the nearer cue decides
+            named = ("the baseline", [book.base])
+        elif _OUT_WORDS.search(before):
+            named = ("the prediction", [book.scores[book.chosen]])
+    if named is not None and named[1]:
+        ok = any(matches(n, v, magnitude_ok=False) or (n.percent and _percent_readings(n, v)) for v in named[1])
+        return Claim("number", n.text, "verified" if ok else "contradicted", f"{named[0]} is {named[1][0]:.4g}")
+    if any(matches(n, v) or (n.percent and _percent_readings(n, v)) for v in book.decision_numbers):
+        return Claim("number", n.text, "verified", "a decision-level fact")
+    if book.closed:
+        return Claim("number", n.text, "contradicted", "none of the facts the summary was made from")
+    return Claim("number", n.text, "unchecked", "tied to no feature or quantity of this explanation")
+
+
+def output_number(n: Number, book: FactBook, start: bool = False) -> Claim:
+    """A number said to be where the output ends up ('pulls it down to 0.142'): the prediction; ``start``: where it
+    starts ('from 34.1 % to ...'), the baseline."""
+    v, what = (book.base, "baseline") if start else (book.scores[book.chosen], "prediction")
+    ok = matches(n, v, magnitude_ok=False) or (n.percent and _percent_readings(n, v))
+    return Claim("number", n.text, "verified" if ok else "contradicted", f"the {what} is {v:.4g}")
+
+
+def _owner(n: Number, book: FactBook) -> str | None:
+    """The one feature whose contribution (in any view) the number states, if exactly one."""
+    owners = [f for f, e in book.features.items()
+              if any(matches(n, c) or (n.percent and _percent_readings(n, c)) for c in e.contribs.values())]
+    return owners[0] if len(owners) == 1 else None
