@@ -40,7 +40,7 @@ from tests import narrative_domains as domains  # noqa: E402
 DATA = pathlib.Path(__file__).parent / "data" / "narratives"
 
 
-SPLITS = ("dev", "dev2", "dev3", "dev4", "dev5", "dev6", "dev7", "dev8", "dev9", "dev10", "dev11", "dev12", "dev13", "test", "test2")
+SPLITS = ("dev", "dev2", "dev3", "dev4", "dev5", "dev6", "dev7", "dev8", "dev9", "dev10", "dev11", "dev12", "dev13", "dev14", "test", "test2")
 
 
 def load_corpus() -> list[dict]:
@@ -50,16 +50,8 @@ def load_corpus() -> list[dict]:
              for c in json.loads(path.read_text())}
     out = []
     for domain in domains.DOMAINS:
-        for path, later in ((DATA / f"{domain}.yaml", None), (DATA / "dev2" / f"{domain}.yaml", "dev2"),
-                            (DATA / "dev3" / f"{domain}.yaml", "dev3"), (DATA / "dev4" / f"{domain}.yaml", "dev4"),
-                            (DATA / "dev5" / f"{domain}.yaml", "dev5"), (DATA / "dev6" / f"{domain}.yaml", "dev6"),
-                            (DATA / "dev7" / f"{domain}.yaml", "dev7"), (DATA / "dev8" / f"{domain}.yaml", "dev8"),
-                            (DATA / "dev9" / f"{domain}.yaml", "dev9"),
-                            (DATA / "dev10" / f"{domain}.yaml", "dev10"),
-                            (DATA / "dev11" / f"{domain}.yaml", "dev11"),
-                            (DATA / "dev12" / f"{domain}.yaml", "dev12"),
-                            (DATA / "dev13" / f"{domain}.yaml", "dev13"),
-                            (DATA / "test2" / f"{domain}.yaml", "test2")):
+        for later in (None, *(s for s in SPLITS if s not in ("dev", "test"))):
+            path = DATA / (later or ".") / f"{domain}.yaml"
             for case_id, items in yaml.safe_load(path.read_text()).items():
                 case = cases[case_id]
                 split = later.rstrip("0123456789") if later else None  # dev2..dev9 on dev cases, test2 on test
