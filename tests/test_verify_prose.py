@@ -170,7 +170,7 @@ def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
     floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("dev6", 0.97),
               ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("dev10", 0.97), ("dev11", 0.94), ("dev12", 0.94),
-              ("dev13", 0.95),
+              ("dev13", 0.95), ("dev14", 0.93),
               ("test", 0.92), ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
@@ -405,12 +405,48 @@ ON_CASES = [
     ("housing-3", "The price falls from an average of $230,061 to $195,878.", "verified"),
     ("credit-0", "Retirement brings a 12-point drop in the default probability.", "verified"),
     ("credit-0", "Retirement brings a 19-point drop in the default probability.", "contradicted"),
+    # dev14: a feature's typical value is checked against the background's quartiles (credit age 36 / 48 / 62.25:
+    # Tukey's fences at -3.4 and 101.6); the output's average is the baseline
+    ("credit-0", "The applicant's age of 28, younger than the typical borrower of about 48, raised the risk.",
+     "verified"),
+    ("credit-0", "The applicant's age of 28, younger than the typical borrower of about 110, raised the risk.",
+     "contradicted"),
+    ("housing-1", "The model estimated this house at $316,107, above the average sale price of $230,061.", "verified"),
+    ("housing-1", "The model estimated this house at $316,107, above the average sale price of $250,061.",
+     "contradicted"),
+    ("housing-1", "Overall, size and quality drove the price far above the baseline of $230,061.", "verified"),
+    # 'on the positive side' and 'the lower quartile' are places, not pushes
+    ("credit-0", "On the positive side, the loan purpose (home improvement) slightly lowered the risk.", "verified"),
+    ("toy-1", "The distance of -0.80, close to the lower quartile, added about 1.03 to the turn score.", "verified"),
+    ("credit-0", "Overall, this leads to a 43% predicted probability of default.", "verified"),
+    ("credit-0", "Overall, this leads to a 53% predicted probability of default.", "contradicted"),
+    # 'A and B outweighed C': together (credit-0: age 0.081 + ratio 0.067 against retirement's 0.123)
+    ("credit-0", "The applicant's age and debt-to-income ratio outweighed retirement.", "verified"),
+    ("credit-0", "The applicant's age and debt-to-income ratio both outweighed retirement.", "contradicted"),
+    # ranks among one sign (credit-2: employment +0.128 first overall, the ratio -0.127 first of those lowering it)
+    ("credit-2", "The biggest factor working against default was the low debt-to-income ratio.", "verified"),
+    ("credit-2", "The biggest factor working against default was the 26-year credit history.", "contradicted"),
+    ("credit-3", "The ratio raised the risk most; salaried employment was the strongest factor pulling the other way.",
+     "verified"),
+    ("credit-3", "The ratio raised the risk most; the credit history was the strongest factor pulling the other way.",
+     "contradicted"),
+    ("housing-1", "The house sits in Somerst, one of the pricier neighbourhoods, adding about $14,200.", "verified"),
+    # a coordinated clause's own subject that is no feature
+    ("housing-3", "The fair kitchen lowered the price by about $23,600, and the lack of a finished basement cost "
+                  "another $12,000.", "contradicted"),
 ]
 
 
 @pytest.mark.parametrize("case,text,status", ON_CASES)
 def test_phrasings_on_corpus_cases(case, text, status):
     assert _on_case(text, case).status == status
+
+
+def test_typical_value_between_band_and_fences_is_unchecked():
+    """credit-0's age quartiles 36 / 48 / 62.25: 80 is neither typical nor past Tukey's fence (101.6)."""
+    res = _on_case("The applicant's age of 28 is below the typical borrower's age of about 80.", "credit-0")
+    typical = [c for c in res.claims if c.kind == "number" and c.text == "80"]
+    assert [c.status for c in typical] == ["unchecked"], res.claims
 
 
 def test_dev11_corrections():

@@ -31,7 +31,7 @@ from . import checks, directions, quantities, ranks
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, named_features, vocabulary
-from .numbers import NUMBER_RE, find_numbers, normalise
+from .numbers import NUMBER_RE, find_numbers, matches, normalise
 
 MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
 MAX_CHARS = 200_000  # longer texts are cut here (and the cut reported)
@@ -263,6 +263,10 @@ _FROM_TO = re.compile(r"\bfrom\s+[^;]{1,40}?\s+(?:down\s+|up\s+)?to\s+(?:about|a
 #: 'the handover's lead of 3.9', 'turning's lead over going forward was 1.55'
 _LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)(?:\s+over\s+[^\d;]{0,30}?)?\s+(?:of|was|is|=|:)\s+"
                       r"(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)
+#: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
+_OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
+                           r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)",
+                           re.IGNORECASE)
 #: 'speed argued for X (-5.48)', 'obstacle barely affected the turn score (-0.09)': the feature's contribution
 _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact\w*|influenc\w*|matter\w*|"
                      r"shift\w*|worth)\b", re.IGNORECASE)
@@ -293,6 +297,20 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         return quantities.free_number(n, masked, book)
     if id(n) in scored:
         return quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
+    span = max(0, n.start - 60)
+    stat = quantities.statistic(masked[span:n.start], any(m.kind == "action" and span <= m.start < n.start
+                                                          for m in mentions))
+    if stat == "output" and book.output != "actions":  # 'the average sale price of $230,061', 'the baseline of 0.34'
+        c = quantities.base_number(n, book)  # ... unless it is the prediction ('at the average risk: 33 %')
+        if c.status == "verified" or not quantities.output_number(n, book).status == "verified":
+            return c
+    owner = next((m for m in reversed(names) if m.end <= n.start), None)
+    if stat == "feature" and owner is not None:  # 'a ratio of 0.51, above the average of roughly 0.4'
+        c = quantities.typical_number(n, owner.keys, book)
+        return c if c.status == "verified" or book.base is None or not matches(n, book.base) else \
+            quantities.base_number(n, book)  # 'with a 7-year history, the risk is above the average of 0.34'
+    if book.output != "actions" and _OUTPUT_AFTER.match(masked, n.end):
+        return quantities.output_number(n, book)  # 'leading to a 43% predicted probability of default'
     if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
         return quantities.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
     if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 30):n.start]) or _FROM_TO.search(

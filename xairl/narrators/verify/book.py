@@ -31,6 +31,7 @@ class FeatureFacts:
     signed_ranks: dict[str, int] = field(default_factory=dict)  # context -> rank among contributions of its sign
     shares: dict[str, float] = field(default_factory=dict)    # context -> % of the sum of |contributions|
     fill: float | None = None                                 # % of the feature's capacity
+    quartiles: tuple[float, float, float] | None = None       # the background's 25th, 50th and 75th percentiles
 
 
 @dataclass
@@ -95,6 +96,8 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
                 feats[f].fill = 100.0 * feats[f].value / info.capacity
         if labels is not None and labels[index, j] is not None:
             feats[f].label = str(labels[index, j])
+        if exp.background_quantiles is not None:
+            feats[f].quartiles = tuple(float(q) for q in exp.background_quantiles[:, j])
     scores = {a: float(exp.outputs[index, k]) for k, a in enumerate(exp.action_names)}
     base = float(exp.base_values[index, chosen_i])
     numbers = [d.score, base, d.score - base, d.additivity_gap, *scores.values()]

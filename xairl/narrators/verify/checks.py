@@ -141,8 +141,17 @@ def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: Fa
     return polarity, ctx or "chosen"
 
 
+#: a direction word that names a place, not a push: 'on the positive side', 'the lower quartile', 'lower than average'
+_NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blower(?:\s+|-)(?:than|quartile|end|bound|"
+                         r"half|tail|third|range|percentile|band|limit)\b", re.IGNORECASE)
+
+
 def is_frame(masked: str, m: re.Match) -> bool:
-    """'against' that compares ('7.53 against 7.38', 'Against recharge, ...', 'against that') is not a direction."""
+    """Not a direction: 'against' that compares ('7.53 against 7.38', 'Against recharge, ...', 'against that'), and
+    a word that names a side or a place ('on the positive side', 'the lower quartile', 'lower than the median')."""
+    near = _NOT_A_PUSH.search(masked, max(0, m.start() - 7), min(len(masked), m.end() + 16))
+    if near is not None and near.start() <= m.start() < near.end():
+        return True
     if m.group(0).lower() != "against":
         return False
     after = masked[m.end():m.end() + 30]

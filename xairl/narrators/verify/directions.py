@@ -65,6 +65,10 @@ _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:bu
                      r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
 
+#: a coordinated clause with a subject of its own after an earlier direction word: 'A lowered it by x, and B cost y'
+_NEW_CLAUSE = re.compile(r",\s+(?:and|while|whereas|plus)\s+(?=(?:the|a|an|its|their)\s)(?!.*,)", re.IGNORECASE)
+
+
 def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
                 name_words=frozenset()) -> list[Claim]:
     """The direction claims of clause ``masked[a:b]``: each direction word with the names it is said of, checked."""
@@ -90,6 +94,10 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
                 pronoun = re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE)
                 if i == 0 and (book.output != "actions" or not pronoun):  # ('tipped the balance toward': one claim)
                     out += _unknown_subject(subject, m.group(0), inside, name_words)
+                elif i > 0 and (joined := _NEW_CLAUSE.search(subject)):  # '..., and the basement cost another $12,000'
+                    rest = prev + joined.end()
+                    out += _unknown_subject(masked[rest:m.start()], m.group(0),
+                                            [x for x in inside if x.start >= rest], name_words)
         conceded = [x for x in subjects if _DESPITE.search(masked[max(prev, x.start - 40):x.start])
                     and "," in masked[x.end:m.start()]]
         subjects = [x for x in subjects if x not in conceded]  # 'Despite being unemployed (+0.128), ... pull it down'

@@ -60,6 +60,54 @@ _COMPARE_AFTER = re.compile(rf"^\s*(?:dB|dBm)?\s*(?:{_COMPARISON_WORDS}|more|les
                             re.IGNORECASE)
 
 
+#: 'the typical borrower of about 48', 'the median home from 1966', 'the dataset average of 0.8', 'the average sale
+#: price of $230,061', 'the baseline of 0.34': a statistic of the background, of a feature or of the output
+_STAT_BEFORE = re.compile(r"\b(?P<word>average|typical|median|mean|usual|normal|(?:lower|upper) quartile|baseline|"
+                          r"base rate|base value|base|expected value)\b(?P<between>(?:\s+(?!(?:of|at|from|is|was)\b)"
+                          r"[A-Za-z'\0-]+){0,3}?)\s*(?:of|at|from|is|was|:|=|\()?\s*(?:about|around|roughly|nearly|"
+                          r"approximately|only|just|close to)?\s*[$€£]?\s*$", re.IGNORECASE)
+_OUTPUT_NOUN = re.compile(r"\b(?:predict\w*|estimat\w*|output|probabilit\w*|chances?|risk|rate|price|scores?|q[- ]?values?)"
+                          r"\b", re.IGNORECASE)
+
+
+def statistic(before: str, actions: bool = False) -> str | None:
+    """Is the number right after ``before`` a statistic of the background? 'output' (the baseline: 'the average
+    prediction of', 'the base rate of'), 'feature' ('the typical borrower of about', 'the median of') or None.
+    ``actions``: an action (the output's name) is masked between the statistic's word and the number ('the average
+    sale price of')."""
+    m = _STAT_BEFORE.search(before)
+    if m is None:
+        return None
+    output = m.group("word").lower().startswith(("base", "expected")) or _OUTPUT_NOUN.search(m.group("between"))
+    return "output" if output or (actions and "\0" in m.group("between")) else "feature"
+
+
+def typical_number(n: Number, keys: tuple[str, ...], book: FactBook) -> Claim:
+    """A feature's typical, average or median value ('younger than the typical borrower of about 48'), checked
+    against the background's quartiles (the explanation keeps no mean): verified inside the 25-75 % band,
+    contradicted past Tukey's fences (1.5 interquartile ranges beyond a quartile: an outlier, not a typical value),
+    unchecked between. Categorical features are not checked."""
+    def test(key):
+        e = book.features[key]
+        if e.quartiles is None or e.label is not None or n.percent:
+            return None
+        lo, _, hi = e.quartiles
+        band = f"{key}'s background quartiles are {lo:.4g} to {hi:.4g}"
+        if lo <= n.value <= hi or matches(n, lo, magnitude_ok=False) or matches(n, hi, magnitude_ok=False):
+            return True, f"a typical value of {key} ({band})"
+        if not lo - 1.5 * (hi - lo) <= n.value <= hi + 1.5 * (hi - lo):
+            return False, f"{n.text} is no typical value of {key}: {band}"
+        return None
+    return over_keys(keys, test, "typical value", n.text, "number")
+
+
+def base_number(n: Number, book: FactBook) -> Claim:
+    """'the average prediction of $230,061', 'a base rate of 0.34': the baseline (the background's average output)."""
+    ok = book.base is not None and (matches(n, book.base, magnitude_ok=False) or
+                                    (n.percent and _percent_readings(n, book.base)))
+    return Claim("number", n.text, "verified" if ok else "contradicted", f"the baseline is {book.base:.4g}")
+
+
 def skip_number(n: Number, masked: str) -> bool:
     """Numbers that are not claims: list markers ('1.' at a line start), identifiers ('candidate 2', 'top-3'),
     counts of the method's inputs ('100 background rows')."""
@@ -70,6 +118,8 @@ def skip_number(n: Number, masked: str) -> bool:
         return True
     if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):
         return True  # all three
+    if n.text.lower() == "one" and re.match(r"\s+of\s+(?:the|its|their|our|these|those)\b", masked[n.end:]):
+        return True  # 'one of the pricier neighbourhoods'
     if n.text.lower() == "one" and re.search(r"\b(this|that|the|which|each|every|any|no|a)\s+(?:[a-z]+\s+)?$", before,
                                              re.IGNORECASE):
         return True  # 'this one', 'the big one': a pronoun

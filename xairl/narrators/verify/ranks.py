@@ -57,14 +57,24 @@ def rank_claim(m: re.Match, masked: str) -> tuple[int, bool, int]:
     return 1, False, sign
 
 
+#: a rank among the contributions of the feature's own sign, whichever it is ('the strongest factor pulling the other
+#: way')
+OWN_SIDE = 2
+#: 'the biggest factor working against default': a participle between the rank and its direction word
+_PARTICIPLE = re.compile(r"\s(?:working|pulling|pushing|acting|weighing|counting|going|tilting|leaning)\s+", re.IGNORECASE)
+_OTHER_WAY = re.compile(r"\s(?:\w+ing\s+)?(?:in\s+)?the\s+(?:other|opposite)\s+(?:way|direction)\b", re.IGNORECASE)
+
+
 def check_rank(keys: tuple[str, ...], rank: int, plural_k: int | None, sign: int, ctx: str | None, book: FactBook,
                text: str) -> Claim:
+    """Does a feature hold rank ``rank`` (or, ``plural_k``, one of the top k) by |contribution|? ``sign`` +1 / -1:
+    among the contributions of that sign; :data:`OWN_SIDE`: among those of its own sign."""
     contexts = views(ctx, book)
 
     def test(key):
         e = book.features[key]
         for c in contexts:
-            if c not in e.ranks or (sign and np.sign(e.contribs[c]) != sign):
+            if c not in e.ranks or (sign and sign != OWN_SIDE and np.sign(e.contribs[c]) != sign):
                 continue
             actual = e.signed_ranks[c] if sign else e.ranks[c]
             if actual is None:  # an identifier: context, not a reason
@@ -116,6 +126,19 @@ def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | N
     return over_keys(a_keys, test, "comparison", text, "rank")
 
 
+def check_outweighs(a_keys: list[str], b_key: str, ctx: str | None, book: FactBook, text: str) -> Claim:
+    """'A and B outweighed C': A's and B's |contributions| together against C's (in any view the sentence allows)."""
+    contexts = [c for c in views(ctx, book) if all(c in book.features[k].contribs for k in (*a_keys, b_key))]
+    if not contexts:
+        return Claim("rank", text, "unchecked", "nothing known to check it against (comparison)")
+    sizes = [(sum(abs(book.features[k].contribs[c]) for k in a_keys), abs(book.features[b_key].contribs[c]), c)
+             for c in contexts]
+    ok = [c for x, y, c in sizes if x > y]
+    x, y, c = sizes[0]
+    return Claim("rank", text, "verified" if ok else "contradicted",
+                 f"|{' + '.join(a_keys)}| {x:.3g} vs |{b_key}| {y:.3g} ({ok[0] if ok else c})")
+
+
 def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
     """The views a rank or magnitude claim is checked in: the one its sentence names, else any."""
     return (ctx,) if ctx and ctx != EITHER else book.contexts
@@ -132,8 +155,11 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
     names = named_features(mentions)
     for m in RANK_RE.finditer(masked, a, b):
         rank, plural, sign = rank_claim(m, masked)
-        said = DIRECTION_RE.match(masked, m.end() + 1, b) if masked[m.end():m.end() + 1] == " " else None
-        if not sign and said and said.group(0).lower() not in ("for", "against", "toward", "towards"):
+        gap = _PARTICIPLE.match(masked, m.end(), b)
+        said = DIRECTION_RE.match(masked, gap.end() if gap else m.end() + 1, b) \
+            if masked[m.end():m.end() + 1] == " " else None
+        if not sign and said and (said.group(0).lower() not in ("for", "against", "toward", "towards")
+                                  or book.output != "actions"):  # one output: 'the biggest factor working against it'
             sign = 1 if said.group("pos") else -1  # 'key factors decreasing the risk', 'the main feature supporting'
         side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])
         scope = _SCOPE.match(masked[a:m.start()])
@@ -145,6 +171,8 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if not sign and not side and book.output == "actions" and re.search(r"(argument|reason)s?$", m.group(0),
                                                                              re.IGNORECASE):
             sign = 1  # 'the strongest reason': a reason for what was decided
+        if not sign and _OTHER_WAY.match(masked, m.end(), b):
+            sign = OWN_SIDE  # 'the strongest factor pulling the other way'
         if not sign and side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
             # 'the main argument for staying': the largest that favours it
             sign = 1 if side.group(1) else -1
@@ -193,7 +221,11 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
         if not subjects:
             subjects = [x for x in names if x.end <= m.start()][-1:]
         way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
-        for x in subjects:
-            out.append(check_comparison(x.keys, b_name.keys[0], way, ctx, book, m.group(0).strip()))
+        if m.group("out") and len(subjects) > 1 and all(len(x.keys) == 1 for x in subjects) and \
+                not re.search(r"\b(?:both|each|all|individually)\b", masked[subjects[0].start:m.start()], re.IGNORECASE):
+            out.append(check_outweighs([x.keys[0] for x in subjects], b_name.keys[0], ctx, book, m.group(0).strip()))
+        else:
+            for x in subjects:
+                out.append(check_comparison(x.keys, b_name.keys[0], way, ctx, book, m.group(0).strip()))
         start = b_name.end
     return out
