@@ -263,6 +263,9 @@ _FROM_TO = re.compile(r"\bfrom\s+[^;]{1,40}?\s+(?:down\s+|up\s+)?to\s+(?:about|a
 #: 'the handover's lead of 3.9', 'turning's lead over going forward was 1.55'
 _LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)(?:\s+over\s+[^\d;]{0,30}?)?\s+(?:of|was|is|=|:)\s+"
                       r"(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)
+#: 'which typically scores around 1.3 goals': a habit of the background, when the number reads as a typical value
+_TYPICALLY = re.compile(r"\b(?:typically|usually|normally|on average)\s+(?:[\w\0']+\s+){0,2}?(?:about|around|roughly|"
+                        r"nearly|over|under|just|at least|at most|more than|less than)?\s*$", re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
 _OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
                            r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)",
@@ -305,10 +308,18 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         if c.status == "verified" or not quantities.output_number(n, book).status == "verified":
             return c
     owner = next((m for m in reversed(names) if m.end <= n.start), None)
+    habit = _TYPICALLY.search(masked[span:n.start])
+    if habit and owner is not None and stat is None:  # 'the average team, which typically scores around 1.3 goals'
+        c = quantities.typical_number(n, owner.keys, book)  # one reading; the number's plain binding is the other
+        if c.status == "verified":
+            return c
     if stat == "feature" and owner is not None:  # 'a ratio of 0.51, above the average of roughly 0.4'
         c = quantities.typical_number(n, owner.keys, book)
         return c if c.status == "verified" or book.base is None or not matches(n, book.base) else \
             quantities.base_number(n, book)  # 'with a 7-year history, the risk is above the average of 0.34'
+    if stat == "feature" and book.output != "actions" and book.base and not 0.1 < abs(n.value / book.base) < 10:
+        return Claim("number", n.text, "unchecked", "the typical value of something not named (not the output's "
+                                                    "average: another order of magnitude)")
     if book.output != "actions" and _OUTPUT_AFTER.match(masked, n.end):
         return quantities.output_number(n, book)  # 'leading to a 43% predicted probability of default'
     if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
@@ -333,7 +344,7 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     if nxt is not None and nxt.kind != "action" and re.match(r"^[\s-]*(?:[a-z]+[\s-]+){0,2}(?:of\s+)?$", gap,
                                                                re.IGNORECASE) \
             and not re.search(r"\b(and|or|but|while|with)\b", gap, re.IGNORECASE):
-        return quantities.feature_number(n, nxt.keys, masked, book, ctx, unit_of)
+        return quantities.feature_number(n, nxt.keys, masked, book, ctx, unit_of, name_after=True)
     prev = next((m for m in reversed(mentions) if m.end <= n.start), None)
     feature_before = next((m for m in reversed(names) if m.end <= n.start), None)
     if prev is not None and prev.kind == "action" and n.sign and feature_before is not None and book.runner_up \

@@ -124,6 +124,10 @@ def action_object(m: re.Match, mentions: list[Mention]) -> Mention | None:
     return next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() <= 16), None)
 
 
+_TOWARD_NO = re.compile(r"(?:[\w\0']+\s+){0,4}?towards?\s+(?:a\s+|the\s+)?[\"'“‘]?(?:no|negative|0|not|false)\b",
+                        re.IGNORECASE)
+
+
 def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: FactBook, ctx: str | None
                      ) -> tuple[int, str]:
     """(polarity, context) of a direction word: toward the runner-up ('favoured forward', 'argued for staying')
@@ -131,6 +135,8 @@ def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: Fa
     polarity = 1 if m.group("pos") else -1
     if _NEGATION.search(masked[max(0, m.start() - 30):m.start()]):
         polarity = -polarity
+    if book.output != "actions" and _TOWARD_NO.match(masked, m.start()):
+        polarity = -polarity  # 'tipped the prediction toward "no"': a one-output classifier's lower side
     obj = action_object(m, mentions)
     if obj is not None and book.runner_up:
         a = resolve_action(obj, book)
@@ -143,13 +149,16 @@ def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: Fa
 
 #: a direction word that names a place, not a push: 'on the positive side', 'the lower quartile', 'lower than average'
 _NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blower(?:\s+|-)(?:than|quartile|end|bound|"
-                         r"half|tail|third|range|percentile|band|limit)\b", re.IGNORECASE)
+                         r"half|tail|third|range|percentile|band|limit)\b|\b(?:their|its|his|her|whose)\s+lower\b|"
+                         r"\b(?:might|may|could|would)\s+(?:seem|appear|look|sound)\s+(?:\w+ly\s+)?(?:positive|negative)"
+                         r"\b", re.IGNORECASE)
 
 
 def is_frame(masked: str, m: re.Match) -> bool:
-    """Not a direction: 'against' that compares ('7.53 against 7.38', 'Against recharge, ...', 'against that'), and
-    a word that names a side or a place ('on the positive side', 'the lower quartile', 'lower than the median')."""
-    near = _NOT_A_PUSH.search(masked, max(0, m.start() - 7), min(len(masked), m.end() + 16))
+    """Not a direction: 'against' that compares ('7.53 against 7.38', 'Against recharge, ...', 'against that'), a
+    word that names a side or a place ('on the positive side', 'the lower quartile', 'lower than the median'), an
+    adjective of the subject ('their lower efficiency') and an appearance ('might seem positive')."""
+    near = _NOT_A_PUSH.search(masked, max(0, m.start() - 24), min(len(masked), m.end() + 16))
     if near is not None and near.start() <= m.start() < near.end():
         return True
     if m.group(0).lower() != "against":

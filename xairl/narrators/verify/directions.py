@@ -65,6 +65,8 @@ _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:bu
                      r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
 
+#: 'positive contributions from A and B': the names after the direction word are its subject
+_OF_WHAT = re.compile(r"\s+(?:contributions?|effects?|impacts?|influences?|pushe?s?)\s+(?:from|of|by)\s", re.IGNORECASE)
 #: a coordinated clause with a subject of its own after an earlier direction word: 'A lowered it by x, and B cost y'
 _NEW_CLAUSE = re.compile(r",\s+(?:and|while|whereas|plus)\s+(?=(?:the|a|an|its|their)\s)(?!.*,)", re.IGNORECASE)
 
@@ -83,6 +85,9 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
         subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
+        if _OF_WHAT.match(masked, m.end()):  # 'the slightly positive contributions from corners and attempts'
+            nxt = found[i + 1].start() if i + 1 < len(found) else b
+            subjects = [x for x in names if m.end() <= x.start < nxt]
         if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
             nxt = found[i + 1].start() if i + 1 < len(found) else b
             subjects = [x for x in names if m.end() <= x.start < nxt]

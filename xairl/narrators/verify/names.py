@@ -110,8 +110,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
             phrases[w] = keys
     entries = []
     for phrase, keys in {**phrases, **exact}.items():
-        keys = exact.get(phrase, keys)
-        entries.append((phrase, "feature", tuple(sorted(keys)), "", ""))
+        keys = exact.get(phrase, keys)  # a word or run of a longer name is a 'part' ('kicks' of Free Kicks)
+        entries.append((phrase, "feature", tuple(sorted(keys)), "", "" if phrase in exact else "part"))
     entries += _action_entries(exp, policy, clean)
     short: dict[str, list[tuple[str, str]]] = {}
     for f, labels in (exp.categories or {}).items():
@@ -149,7 +149,10 @@ def _pattern(phrase: str, kind: str) -> re.Pattern:
     if kind == "label":  # a stem ('~') takes any ending, a whole word a plural
         body = r"[\s_\-]*".join(p.replace("\\~", "").replace("~", "") + "[a-z]*" if "~" in p else p + "(?:s|es|ing|ed|er|ers)?"
                                   for p in parts)
-    else:
+    else:  # a plural name also in the singular ('Corners': 'a corner')
+        last = phrase.split()[-1]
+        if len(last) > 4 and last.endswith("s") and not last.endswith(("ss", "us", "is")):
+            parts[-1] = re.escape(last[:-1])
         body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+)?|)".join(parts) + r"(?:s|es)?(?:'s|')?\)?"
     return re.compile(rf"(?<![\w]){body}(?![\w])", re.IGNORECASE)
 
@@ -224,9 +227,25 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
                         and not any(taken[m.start():m.end()]):
                     found.append(Mention(m.start(), m.end(), "label", (f,), label))
                     taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
-    found = _narrow(text, sorted(found, key=lambda m: m.start), vocab.words)
+    found = sorted(found, key=lambda m: m.start)
+    for m in _modifiers(text, found):  # 'corner kicks', 'attempts on goal': one name, not two
+        found.remove(m)
+        taken[m.start:m.end] = bytes(m.end - m.start)
+    found = _narrow(text, found, vocab.words)
     masked = "".join("\0" if t else ch for ch, t in zip(text, taken))
     return found, masked
+
+
+def _modifiers(text: str, found: list[Mention]) -> list[Mention]:
+    """A word of a longer feature name that only completes another feature's whole name: the head of a compound right
+    after it ('corner kicks': Corners, not Free Kicks) or the object of 'on'/'of'/'per' after it ('attempts on goal':
+    Attempts, not Goal Scored)."""
+    out = []
+    for prev, m in zip(found, found[1:]):
+        if prev.kind == m.kind == "feature" and prev.form == "" and m.form == "part" and prev.keys != m.keys and \
+                re.fullmatch(r" |\s+(?:on|of|per)\s+", text[prev.end:m.start]):
+            out.append(m)
+    return out
 
 
 _ORDINALS = frozenset({"second", "third", "fourth", "fifth", "2nd", "3rd", "4th", "5th"})

@@ -64,8 +64,9 @@ _COMPARE_AFTER = re.compile(rf"^\s*(?:dB|dBm)?\s*(?:{_COMPARISON_WORDS}|more|les
 #: price of $230,061', 'the baseline of 0.34': a statistic of the background, of a feature or of the output
 _STAT_BEFORE = re.compile(r"\b(?P<word>average|typical|median|mean|usual|normal|(?:lower|upper) quartile|baseline|"
                           r"base rate|base value|base|expected value)\b(?P<between>(?:\s+(?!(?:of|at|from|is|was)\b)"
-                          r"[A-Za-z'\0-]+){0,3}?)\s*(?:of|at|from|is|was|:|=|\()?\s*(?:about|around|roughly|nearly|"
-                          r"approximately|only|just|close to)?\s*[$€£]?\s*$", re.IGNORECASE)
+                          r"[A-Za-z'\0-]+){0,5}?)\s*(?:of|at|from|is|was|:|=|\()?\s*(?:about|around|roughly|nearly|"
+                          r"approximately|only|just|close to|over|under|above|below)?\s*[$€£]?\s*"
+                          r"(?:[\d.,]+\s*(?:-|–|to)\s*)?$", re.IGNORECASE)
 _OUTPUT_NOUN = re.compile(r"\b(?:predict\w*|estimat\w*|output|probabilit\w*|chances?|risk|rate|price|scores?|q[- ]?values?)"
                           r"\b", re.IGNORECASE)
 
@@ -131,10 +132,11 @@ def _percent_readings(n: Number, v: float) -> bool:
 
 
 def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook, ctx: str | None,
-                   unit_of) -> Claim:
+                   unit_of, name_after: bool = False) -> Claim:
     """A number tied to a feature: its value, its contribution (in the sentence's context, or any context when the
     sentence does not say), its share, or a percentage of a probability-like contribution. Cue words before it
-    ('by', 'adds', 'SHAP value of') say it is a contribution; the feature's unit after it that it is a value."""
+    ('by', 'adds', 'SHAP value of') say it is a contribution; the feature's unit after it that it is a value.
+    ``name_after``: the name follows the number ('took 7 corners'): its value, whatever the verb before."""
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 16]
     contrib_cue = bool(CONTRIB_BEFORE.search(before))
     # a sentence that names no view, or weighs the two options without saying which ('argued against it'): either
@@ -158,7 +160,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or slot or bool(prefix)) \
             and not contrib_cue
         cands = []
-        if not contrib_cue and e.value is not None:
+        if (not contrib_cue or name_after) and e.value is not None:
             cands.append(("value" if scale == 1 else f"value in {prefix.group(1)}{unit_of(key)}", e.value / scale))
         if n.percent and not contrib_cue and e.fill is not None:
             cands.append(("fill (% of capacity)", e.fill))
