@@ -67,7 +67,7 @@ def load_corpus() -> list[dict]:
 def run(items: list[dict], policies: dict) -> list[dict]:
     for it in items:
         t = time.perf_counter()
-        res = xairl.verify(it["text"], it["explanation"], 0, policies.get(it["domain"]))
+        res = xairl.verify(it["text"], it["explanation"], 0, it.get("policy") or policies.get(it["domain"]))
         it["seconds"] = time.perf_counter() - t
         it["sentences"] = max(1, len(re.findall(r"[.!?\n](\s|$)", it["text"].strip() + " ")))
         it["ok"] = res.ok
@@ -136,22 +136,61 @@ def explingo_items(path: str) -> list[dict]:
     return out
 
 
+def shapstories_items(path: str) -> list[dict]:
+    """The LLM-written narratives of SHAPnarrative-agents (``baseline_narratives.json``), each with the one-output
+    Explanation and Policy (the data dictionary's descriptions and categories) built for it in
+    ``data/narratives/outside/shapstories.yaml``; every one is accurate for its case."""
+    import torch
+
+    spec = yaml.safe_load((DATA / "outside" / "shapstories.yaml").read_text())
+    out = []
+    for row in json.loads(pathlib.Path(path).read_text()):
+        domain = spec.get(row.get("dataset", "fifa"))
+        if domain is None or row["index"] not in domain["cases"]:
+            continue
+        batch, prediction, given = domain["cases"][row["index"]]
+        feats = domain["features"]
+        names = tuple(feats)
+        cats = {f: tuple(d[1]) for f, d in feats.items() if isinstance(d[1], list)}
+        median = {f: 2 if f in cats else d[2] for f, d in feats.items()}  # a category's code 2 when unsaid
+        value = {f: (cats[f].index(v) if f in cats else v) for f, (v, _) in given.items()}
+        contrib = np.array([given[f][1] if f in given else 0.001 for f in names])
+        quartiles = np.array([[np.nan if f in cats else feats[f][k] for f in names] for k in (1, 2, 3)], float)
+        exp = xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.array([[prediction - contrib.sum()]]),
+                                outputs=np.array([[prediction]]), states=np.array([[value.get(f, median[f]) for f in names]],
+                                                                                  float),
+                                feature_names=names, action_names=(domain["output"],), method="given", output="value",
+                                background_quantiles=quartiles, categories=cats or None)
+        info = {f: xairl.FeatureInfo(description=d[0], categories=cats.get(f, ())) for f, d in feats.items()}
+        policy = xairl.Policy(torch.nn.Linear(len(names), 1), list(names), [domain["output"]], features=info,
+                              output="value", name=row.get("dataset", "fifa"))
+        out.append({"case": f"{row.get('dataset', 'fifa')}-{row['index']}", "domain": row.get("dataset", "fifa"),
+                    "split": f"shapstories batch {batch}", "error": "ok", "accurate": True,
+                    "text": row["round0_narrative"], "explanation": exp, "policy": policy})
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--show", choices=(*SPLITS, "explingo"), help="list the disagreements of a split")
+    ap.add_argument("--show", choices=(*SPLITS, "outside"), help="list the disagreements of a split")
     ap.add_argument("--explingo", help="path of Explingo's full-experiment/accuracy_tests.json")
+    ap.add_argument("--shapstories", help="path of SHAPnarrative-agents' data/baseline_narratives.json")
     args = ap.parse_args()
-    if args.explingo:
-        items = run(explingo_items(args.explingo), {})
+    if args.explingo or args.shapstories:
+        items = run(explingo_items(args.explingo) if args.explingo else shapstories_items(args.shapstories), {})
+        name = "Explingo accuracy_tests" if args.explingo else "SHAPnarrative-agents baseline narratives"
         agree = sum(it["ok"] == it["accurate"] for it in items)
-        print(f"## Explingo accuracy_tests (outside): agreement {agree}/{len(items)} = {100 * agree / len(items):.1f} %")
-        print("| label | agree | n |\n|---|---|---|")
-        for k, a, n in table(items, lambda it: ("accurate: " if it["accurate"] else "inaccurate: ") + it["error"]):
+        print(f"## {name} (outside): agreement {agree}/{len(items)} = {100 * agree / len(items):.1f} %")
+        print("| group | agree | n |\n|---|---|---|")
+        for k, a, n in table(items, lambda it: (it["split"] + ", " + it["domain"] if args.shapstories else
+                                                ("accurate: " if it["accurate"] else "inaccurate: ") + it["error"])):
             print(f"| {k} | {a} | {n} |")
+        coverage = np.mean([it["result"].coverage for it in items])
+        print(f"\nmean coverage {coverage:.2f}")
         for it in items:
-            if args.show == "explingo" and it["ok"] != it["accurate"]:
+            if args.show == "outside" and it["ok"] != it["accurate"]:
                 probs = "; ".join(f"{c.kind} '{c.text}': {c.status} ({c.detail})" for c in it["result"].problems())
-                print(f"- [{it['error']}] {it['text']!r}\n    -> {probs or 'no problem found'}")
+                print(f"- [{it['case']}: {it['error']}] {it['text']!r}\n    -> {probs or 'no problem found'}")
         return
     policies = {d: domains.policy(d) for d in domains.DOMAINS}
     report(run(load_corpus(), policies), args.show)

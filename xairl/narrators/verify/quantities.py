@@ -87,7 +87,7 @@ def typical_number(n: Number, keys: tuple[str, ...], book: FactBook) -> Claim:
     """A feature's typical, average or median value ('younger than the typical borrower of about 48'), checked
     against the background's quartiles (the explanation keeps no mean): verified inside the 25-75 % band,
     contradicted past Tukey's fences (1.5 interquartile ranges beyond a quartile: an outlier, not a typical value),
-    unchecked between. Categorical features are not checked."""
+    unchecked between or when the quartiles coincide. Categorical features are not checked."""
     def test(key):
         e = book.features[key]
         if e.quartiles is None or e.label is not None or n.percent:
@@ -96,7 +96,8 @@ def typical_number(n: Number, keys: tuple[str, ...], book: FactBook) -> Claim:
         band = f"{key}'s background quartiles are {lo:.4g} to {hi:.4g}"
         if lo <= n.value <= hi or matches(n, lo, magnitude_ok=False) or matches(n, hi, magnitude_ok=False):
             return True, f"a typical value of {key} ({band})"
-        if not lo - 1.5 * (hi - lo) <= n.value <= hi + 1.5 * (hi - lo):
+        if hi > lo and not lo - 1.5 * (hi - lo) <= n.value <= hi + 1.5 * (hi - lo):  # (one value in half the
+            # background, 'failures' 0 / 0 / 0: its mean may lie anywhere)
             return False, f"{n.text} is no typical value of {key}: {band}"
         return None
     return over_keys(keys, test, "typical value", n.text, "number")
