@@ -136,37 +136,43 @@ def explingo_items(path: str) -> list[dict]:
     return out
 
 
-def shapstories_items(path: str) -> list[dict]:
-    """The LLM-written narratives of SHAPnarrative-agents (``baseline_narratives.json``), each with the one-output
-    Explanation and Policy (the data dictionary's descriptions and categories) built for it in
-    ``data/narratives/outside/shapstories.yaml``; every one is accurate for its case."""
+def shapstories_case(dataset: str, index: int) -> tuple[int, xairl.Explanation, xairl.Policy]:
+    """(batch, Explanation, Policy) built for narrative ``index`` of ``dataset`` in
+    ``data/narratives/outside/shapstories.yaml``: one output, the data dictionary's descriptions and categories."""
     import torch
 
-    spec = yaml.safe_load((DATA / "outside" / "shapstories.yaml").read_text())
+    domain = yaml.safe_load((DATA / "outside" / "shapstories.yaml").read_text())[dataset]
+    batch, prediction, given = domain["cases"][index]
+    feats = domain["features"]
+    names = tuple(feats)
+    cats = {f: tuple(d[1]) for f, d in feats.items() if isinstance(d[1], list)}
+    value = {f: (cats[f].index(v) if f in cats else v) for f, (v, _) in given.items()}
+    states = np.array([[value.get(f, 2 if f in cats else feats[f][2]) for f in names]], float)  # else the median
+    contrib = np.array([given[f][1] if f in given else 0.001 for f in names])
+    quartiles = np.array([[np.nan if f in cats else feats[f][k] for f in names] for k in (1, 2, 3)], float)
+    exp = xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.array([[prediction - contrib.sum()]]),
+                            outputs=np.array([[prediction]]), states=states, feature_names=names,
+                            action_names=(domain["output"],), method="given", output="value",
+                            background_quantiles=quartiles, categories=cats or None)
+    info = {f: xairl.FeatureInfo(description=d[0], categories=cats.get(f, ())) for f, d in feats.items()}
+    policy = xairl.Policy(torch.nn.Linear(len(names), 1), list(names), [domain["output"]], features=info,
+                          output="value", name=dataset)
+    return batch, exp, policy
+
+
+def shapstories_items(path: str) -> list[dict]:
+    """The LLM-written narratives of SHAPnarrative-agents (``baseline_narratives.json``) that have a case in
+    ``data/narratives/outside/shapstories.yaml``; every one is accurate for its case."""
+    cases = yaml.safe_load((DATA / "outside" / "shapstories.yaml").read_text())
     out = []
     for row in json.loads(pathlib.Path(path).read_text()):
-        domain = spec.get(row.get("dataset", "fifa"))
-        if domain is None or row["index"] not in domain["cases"]:
+        dataset = row.get("dataset", "fifa")
+        if row["index"] not in cases.get(dataset, {}).get("cases", {}):
             continue
-        batch, prediction, given = domain["cases"][row["index"]]
-        feats = domain["features"]
-        names = tuple(feats)
-        cats = {f: tuple(d[1]) for f, d in feats.items() if isinstance(d[1], list)}
-        median = {f: 2 if f in cats else d[2] for f, d in feats.items()}  # a category's code 2 when unsaid
-        value = {f: (cats[f].index(v) if f in cats else v) for f, (v, _) in given.items()}
-        contrib = np.array([given[f][1] if f in given else 0.001 for f in names])
-        quartiles = np.array([[np.nan if f in cats else feats[f][k] for f in names] for k in (1, 2, 3)], float)
-        exp = xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.array([[prediction - contrib.sum()]]),
-                                outputs=np.array([[prediction]]), states=np.array([[value.get(f, median[f]) for f in names]],
-                                                                                  float),
-                                feature_names=names, action_names=(domain["output"],), method="given", output="value",
-                                background_quantiles=quartiles, categories=cats or None)
-        info = {f: xairl.FeatureInfo(description=d[0], categories=cats.get(f, ())) for f, d in feats.items()}
-        policy = xairl.Policy(torch.nn.Linear(len(names), 1), list(names), [domain["output"]], features=info,
-                              output="value", name=row.get("dataset", "fifa"))
-        out.append({"case": f"{row.get('dataset', 'fifa')}-{row['index']}", "domain": row.get("dataset", "fifa"),
-                    "split": f"shapstories batch {batch}", "error": "ok", "accurate": True,
-                    "text": row["round0_narrative"], "explanation": exp, "policy": policy})
+        batch, exp, policy = shapstories_case(dataset, row["index"])
+        out.append({"case": f"{dataset}-{row['index']}", "domain": dataset, "split": f"shapstories batch {batch}",
+                    "error": "ok", "accurate": True, "text": row["round0_narrative"], "explanation": exp,
+                    "policy": policy})
     return out
 
 

@@ -11,7 +11,7 @@ import xairl
 from xairl.narrators.verify.names import find_mentions, vocabulary
 from xairl.narrators.verify.numbers import find_numbers, matches, normalise
 from xairl.narrators.verify.book import clean_surface
-from benchmarks.bench_verifier import load_corpus, run
+from benchmarks.bench_verifier import load_corpus, run, shapstories_case
 from tests import narrative_domains as domains
 
 
@@ -447,6 +447,70 @@ def test_typical_value_between_band_and_fences_is_unchecked():
     res = _on_case("The applicant's age of 28 is below the typical borrower's age of about 80.", "credit-0")
     typical = [c for c in res.claims if c.kind == "number" and c.text == "80"]
     assert [c.status for c in typical] == ["unchecked"], res.claims
+
+
+def _outside(text, dataset, index):
+    """``text`` against an outside case (FIFA match statistics and UCI student performance, named as in those data
+    sets, with their data dictionaries' descriptions: benchmarks/data/narratives/outside/shapstories.yaml)."""
+    _, exp, policy = shapstories_case(dataset, index)
+    return xairl.verify(text, exp, 0, policy)
+
+
+OUTSIDE = [
+    # fifa-105: goals 0 (-0.20), corners 7 (+0.04), attempts 13 (+0.02), on target 1 (-0.015); a plural name in the
+    # singular, the head of a compound and the object of 'on' belong to the name before them
+    ("fifa", 105, "The team took 7 corner kicks, which slightly boosted their probability.", "verified"),
+    ("fifa", 105, "The team took 7 corner kicks, which slightly lowered their probability.", "contradicted"),
+    ("fifa", 105, "Their 13 attempts on goal, close to the average of 12.33, added a little.", "verified"),
+    ("fifa", 105, "Their 13 attempts on goal, close to the average of 12.33, lowered it slightly.", "contradicted"),
+    ("fifa", 105, "The team took 7 corners.", "verified"),
+    ("fifa", 105, "The team took 9 corners.", "contradicted"),
+    # a typical value by habit; a side word whose object is the classifier's lower class
+    ("fifa", 105, "Failing to score (the average team typically scores around 1.3 goals) hurt the team most.",
+     "verified"),
+    ("fifa", 96, "The lack of corners and fewer attempts tipped the prediction toward \"no.\"", "verified"),
+    ("fifa", 96, "The four goals tipped the prediction toward \"no.\"", "contradicted"),
+    # student-375: failures 0 (+0.12; quartiles 0 / 0 / 0), goout 2 (+0.05), absences 2 (+0.03), Mjob other (-0.01)
+    ("student", 375, "Going out with friends moderately often (2 out of 5, below the average of ~3) also helped.",
+     "verified"),
+    ("student", 375, "Fewer absences than average (2 vs. ~5.75) further supported the prediction.", "verified"),
+    ("student", 375, "Fewer absences than average (3 vs. ~5.75) further supported the prediction.", "contradicted"),
+    ("student", 375, "Fewer absences than average (2 vs. ~25) further supported the prediction.", "contradicted"),
+    ("student", 375, "No past class failures (0 compared to the average of ~0.36) strongly boosted it.", "verified"),
+    ("student", 375, "Unlike 95% of their peers, the student had no past class failures, which boosted the odds.",
+     "verified"),
+    # a description's legend is not needed to name the feature ('weekly study time (1: <2 hours, ...)')
+    ("student", 221, "Their weekly study time (3, compared to the average of ~2) helped.", "verified"),
+    ("student", 221, "Their weekly study time (3, compared to the average of ~2) lowered the odds.", "contradicted"),
+    # a plain label ('other') only next to its feature, and not after a negation
+    ("student", 300, "The student's mother's job wasn't in the 'other' category, which added a little.", "verified"),
+    ("student", 375, "The mother's job (other) was the only minor detractor.", "verified"),
+    ("student", 300, "The mother's job (other) added a little.", "contradicted"),
+    ("student", 82, "Like the other students, this one had no past class failures, which boosted the prediction.",
+     "verified"),
+    # a rank over a list counts the items the verifier does not know too
+    ("student", 261, "The student's low absences, no failures, and balanced social life were the key drivers.",
+     "verified"),
+    ("student", 261, "The student's low absences and no failures were the key drivers.", "contradicted"),
+]
+
+
+@pytest.mark.parametrize("dataset,index,text,status", OUTSIDE)
+def test_phrasings_on_outside_cases(dataset, index, text, status):
+    assert _outside(text, dataset, index).status == status
+
+
+def test_no_direction_in_an_adjective_an_appearance_or_an_aside():
+    """'their lower efficiency' describes the subject; 'might seem positive' is an appearance; after '—likely' comes
+    the writer's reasoning, whose names are not the subject of the claim before it."""
+    text = ("Despite attempting 9 shots (below the average of 12), their lower efficiency here also hurt their "
+            "chances.")
+    assert _outside(text, "fifa", 11).status != "contradicted"
+    text = "The team blocked 9 shots, which might seem positive defensively but hurt the team's chances."
+    assert _outside(text, "fifa", 81).status == "verified"
+    text = ("The most influential factor was the student's frequent outings, which slightly reduced the chance of "
+            "passing—likely because socializing may detract from study time.")
+    assert _outside(text, "student", 82).status != "contradicted"
 
 
 def test_dev11_corrections():

@@ -97,7 +97,8 @@ class Verification:
 _SENTENCE_RE = re.compile(r"(?<=[.!?])\s+(?=\S)|\n+\s*(?:[-•*]\s*)?")
 _ABBREVIATION = re.compile(r"(?:^|[\s(])(?:e\.g|i\.e|vs|approx|ca|etc|no|fig|cf)\.$", re.IGNORECASE)
 _CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|however)\b"
-                        r"|,\s(?:and\s)?(?=but\b)", re.IGNORECASE)
+                        r"|,\s(?:and\s)?(?=but\b)|\s?[—–]\s?(?=(?:likely|possibly|perhaps|probably|since|as|because|this|"
+                        r"which|suggesting|unsurprising)\b)|\s(?=because\b(?!\s+of\b))", re.IGNORECASE)
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
 def sentences(text: str) -> list[tuple[int, int]]:
     """Sentence spans: split after . ! ? before a capital or a sign, and at line breaks and bullets."""
@@ -207,7 +208,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     tail = [n for n in numbers if names and n.start > names[-1].end  # not the last name's own '(−22.5 dB)'
             and not re.fullmatch(r"\s?\([^()]*", masked[names[-1].end:n.start])]
     paired = {}
-    if len(names) >= 2 and len(tail) == len(names) and (
+    if len({m.keys for m in names}) >= 2 and len(tail) == len(names) and (
             "respectively" in masked[a:b].lower() or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
             or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
                 and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
@@ -302,12 +303,13 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         return quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
     span = max(0, n.start - 60)
     stat = quantities.statistic(masked[span:n.start], any(m.kind == "action" and span <= m.start < n.start
-                                                          for m in mentions))
+                                                          for m in mentions), book.output == "actions")
     if stat == "output" and book.output != "actions":  # 'the average sale price of $230,061', 'the baseline of 0.34'
         c = quantities.base_number(n, book)  # ... unless it is the prediction ('at the average risk: 33 %')
         if c.status == "verified" or not quantities.output_number(n, book).status == "verified":
             return c
-    owner = next((m for m in reversed(names) if m.end <= n.start), None)
+    owner = next((m for m in reversed(names) if m.end <= n.start), None) or next(
+        (m for m in names if 0 <= m.start - n.end <= 2), None)  # '... typically scores around 1.3 goals'
     habit = _TYPICALLY.search(masked[span:n.start])
     if habit and owner is not None and stat is None:  # 'the average team, which typically scores around 1.3 goals'
         c = quantities.typical_number(n, owner.keys, book)  # one reading; the number's plain binding is the other

@@ -105,7 +105,8 @@ def check_action(sentence: str, m: Mention, book: FactBook) -> Claim | None:
 # -- categorical values ------------------------------------------------------------------------------------------
 def check_label(sentence: str, m: Mention, book: FactBook) -> Claim | None:
     """A categorical value named ('in CollgCr', 'odor: foul', 'self-employed') must be the state's value."""
-    if re.search(r"\b(not|no|non|rather than|instead of|unlike|than)\W*$", sentence[:m.start], re.IGNORECASE):
+    if re.search(r"(?:\b(?:not|no|non|never|rather than|instead of|unlike|than)|n't)(?:\s+\w+){0,3}?\W*$",
+                 sentence[:m.start], re.IGNORECASE):  # 'not self-employed', "wasn't in the 'other' category"
         return None
     f = m.keys[0]
     actual = book.features[f].label
@@ -128,6 +129,11 @@ _TOWARD_NO = re.compile(r"(?:[\w\0']+\s+){0,4}?towards?\s+(?:a\s+|the\s+)?[\"'â€
                         re.IGNORECASE)
 
 
+def toward_no(masked: str, at: int) -> bool:
+    """'toward "no"', 'towards a negative', 'toward 0' within a few words after ``at``: the lower side of one output."""
+    return bool(_TOWARD_NO.match(masked, at))
+
+
 def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: FactBook, ctx: str | None
                      ) -> tuple[int, str]:
     """(polarity, context) of a direction word: toward the runner-up ('favoured forward', 'argued for staying')
@@ -135,7 +141,7 @@ def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: Fa
     polarity = 1 if m.group("pos") else -1
     if _NEGATION.search(masked[max(0, m.start() - 30):m.start()]):
         polarity = -polarity
-    if book.output != "actions" and _TOWARD_NO.match(masked, m.start()):
+    if book.output != "actions" and toward_no(masked, m.start()):
         polarity = -polarity  # 'tipped the prediction toward "no"': a one-output classifier's lower side
     obj = action_object(m, mentions)
     if obj is not None and book.runner_up:

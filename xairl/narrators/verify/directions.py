@@ -65,6 +65,22 @@ _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:bu
                      r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
 
+#: 'toward X', 'in favour of X' after a direction word: X says which side of a one-output model it is
+_SIDE = re.compile(r"(?:[\w\0']+\s+){0,4}?(?:towards?|in favou?r of)\s+(?:a\s+|an\s+|the\s+)?[\"'“‘]?"
+                   r"(?P<obj>[\w\0]+)", re.IGNORECASE)
+_UP_SIDE = re.compile(r"(?:higher|increase|up|upward|yes|positive|1|true|approval|approve|acceptance)$", re.IGNORECASE)
+
+
+def _unsaid_side(masked: str, m: re.Match, mentions: list[Mention]) -> bool:
+    """A side word whose object is neither the output (named), an up word, nor a down word ('toward "no"'): a class
+    of a one-output classifier the text does not tie to the output ('toward failure', 'in favor of repayment')."""
+    side = _SIDE.match(masked, m.start())
+    if side is None or side.start("obj") - m.start() > 60:
+        return False
+    output = any(x.kind == "action" and x.start == side.start("obj") for x in mentions)
+    return not (output or _UP_SIDE.match(side.group("obj")) or checks.toward_no(masked, m.start()))
+
+
 #: 'positive contributions from A and B': the names after the direction word are its subject
 _OF_WHAT = re.compile(r"\s+(?:contributions?|effects?|impacts?|influences?|pushe?s?)\s+(?:from|of|by)\s", re.IGNORECASE)
 #: a coordinated clause with a subject of its own after an earlier direction word: 'A lowered it by x, and B cost y'
@@ -83,6 +99,8 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if book.output != "actions" and _SIDE_WORD.match(m.group(0)) and \
                 _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
             continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
+        if book.output != "actions" and _unsaid_side(masked, m, mentions):
+            continue  # 'tipped the prediction toward failure': which side of the one output is that? unsaid
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
         subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
         if _OF_WHAT.match(masked, m.end()):  # 'the slightly positive contributions from corners and attempts'

@@ -66,7 +66,9 @@ class Vocabulary:
     """Every surface of an explanation's names, longest first: (regex, kind, keys, label, form)."""
 
     entries: list[tuple[re.Pattern, str, tuple[str, ...], str, str]]
-    short_labels: dict[str, list[tuple[str, str]]]  # feature -> [(label, label)] of 1-2 characters
+    #: feature -> [(label, pattern)] of labels named only right next to their feature: 1-2 characters ('Y', 'Ex') or
+    #: plain words ('other', 'at_home')
+    short_labels: dict[str, list[tuple[str, str]]]
     words: dict[str, frozenset[str]]  # feature -> the words of its name, description and aliases (qualifiers)
     #: words of the features' own names ('quality' of ``kitchen_quality``): a phrase with one of them may be a vague
     #: mention of a feature, not a thing the model lacks
@@ -80,7 +82,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     groups = [g for g in (policy.reason_groups if policy else {}) if g not in exp.feature_names]
     for f in [*exp.feature_names, *groups]:
         info = policy.features.get(f) if policy else None
-        forms = [f, " ".join(split_words(f))] + ([info.description, *info.aliases] if info else [])
+        described = (info.description if clean(info.description) else _head(info.description)) if info else ""
+        forms = [f, " ".join(split_words(f))] + ([described, _head(described), *info.aliases] if info else [])
         feature_words[f] = frozenset(w for form in forms if form for w in split_words(form) if w not in STOP)
         name_words = split_words(f)
         if len(name_words) == 2 and not any(w.isdigit() for w in name_words):  # 'year built' -> 'build year'
@@ -88,7 +91,7 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
         for form in forms:
             if form and clean(form):
                 exact.setdefault(_phrase(form), set()).add(f)
-        for form in [f] + ([info.description] if info and info.description else []):
+        for form in [f] + ([described] if described else []):
             if not clean(form):
                 continue
             owners = set(re.findall(r"(\w+)'s\b", form.lower()))  # 'the applicant's age': not 'applicant'
@@ -117,13 +120,21 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     for f, labels in (exp.categories or {}).items():
         for label in labels:
             if len(label) <= 2:
-                short.setdefault(f, []).append((label, label))
+                short.setdefault(f, []).append((label, re.escape(label)))
+            elif all(w in _PLAIN_LABEL_WORDS for w in split_words(label)):  # 'other', 'at_home': plain words
+                short.setdefault(f, []).append((label, r"[\s_\-]+".join(map(re.escape, split_words(label)))))
             elif clean(label):
                 entries.append((" ".join(stem(w) for w in split_words(label)), "label", (f,), label, ""))
     entries.sort(key=lambda e: -len(e[0]))
     names = frozenset(w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit())
     compiled = [(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries]
     return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, names)
+
+
+def _head(description: str) -> str:
+    """A description without its legend ('weekly study time (1: <2 hours, ...)': 'weekly study time'), for a text
+    that names it without (or a legend that is not clean, see :func:`~.book.clean_surface`)."""
+    return re.split(r"\s*[(:;\[]", description or "", maxsplit=1)[0].strip()
 
 
 def _acronyms(features) -> list:
@@ -152,7 +163,7 @@ def _pattern(phrase: str, kind: str) -> re.Pattern:
     else:  # a plural name also in the singular ('Corners': 'a corner')
         last = phrase.split()[-1]
         if len(last) > 4 and last.endswith("s") and not last.endswith(("ss", "us", "is")):
-            parts[-1] = re.escape(last[:-1])
+            parts[-1] = re.escape(last[:-2] if last.endswith(("sses", "xes", "ches", "shes")) else last[:-1])
         body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+)?|)".join(parts) + r"(?:s|es)?(?:'s|')?\)?"
     return re.compile(rf"(?<![\w]){body}(?![\w])", re.IGNORECASE)
 
@@ -219,10 +230,10 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
                 found.append(Mention(m.start(), m.end(), kind, keys, label, form))
                 taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
     features = [m for m in found if m.kind == "feature"]
-    for f, labels in vocab.short_labels.items():  # 'Y', 'Ex': only right next to their feature
+    for f, labels in vocab.short_labels.items():  # 'Y', 'Ex', 'other': only right next to their feature
         near = [m for m in features if f in m.keys]
-        for label, _ in labels:
-            for m in re.finditer(rf"(?<![\w]){re.escape(label)}(?![\w])", text):
+        for label, surface in labels:
+            for m in re.finditer(rf"(?<![\w]){surface}(?![\w])", text, 0 if len(label) <= 2 else re.IGNORECASE):
                 if any(abs(m.start() - n.end) <= 14 or abs(n.start - m.end()) <= 14 for n in near) \
                         and not any(taken[m.start():m.end()]):
                     found.append(Mention(m.start(), m.end(), "label", (f,), label))
@@ -248,6 +259,9 @@ def _modifiers(text: str, found: list[Mention]) -> list[Mention]:
     return out
 
 
+#: words that make a label too plain to be recognised away from its feature ('the other features', 'at home')
+_PLAIN_LABEL_WORDS = frozenset({"other", "others", "none", "unknown", "yes", "no", "home", "at", "true", "false", "na",
+                                "missing", "not", "applicable", "some"})
 _ORDINALS = frozenset({"second", "third", "fourth", "fifth", "2nd", "3rd", "4th", "5th"})
 _IDIOM = re.compile(r"\b(?:on|of)\s+(?:its|their|his|her|my|our|your)\s+$", re.IGNORECASE)
 _QUALIFIER_STOP = re.compile(r"[,.;:!?()\[\]]|\b(?:the|a|an|and|or|of|with|by|to|was|is|were|are|than|from|while|"

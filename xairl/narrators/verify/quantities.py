@@ -65,22 +65,33 @@ _COMPARE_AFTER = re.compile(rf"^\s*(?:dB|dBm)?\s*(?:{_COMPARISON_WORDS}|more|les
 _STAT_BEFORE = re.compile(r"\b(?P<word>average|typical|median|mean|usual|normal|(?:lower|upper) quartile|baseline|"
                           r"base rate|base value|base|expected value)\b(?P<between>(?:\s+(?!(?:of|at|from|is|was)\b)"
                           r"[A-Za-z'\0-]+){0,5}?)\s*(?:of|at|from|is|was|:|=|\()?\s*(?:about|around|roughly|nearly|"
-                          r"approximately|only|just|close to|over|under|above|below)?\s*[$€£]?\s*"
+                          r"approximately|only|just|close to|over|under|above|below|~|≈)?\s*[$€£]?\s*"
                           r"(?:[\d.,]+\s*(?:-|–|to)\s*)?$", re.IGNORECASE)
 _OUTPUT_NOUN = re.compile(r"\b(?:predict\w*|estimat\w*|output|probabilit\w*|chances?|risk|rate|price|scores?|q[- ]?values?)"
                           r"\b", re.IGNORECASE)
 
 
-def statistic(before: str, actions: bool = False) -> str | None:
+#: '(2 vs. ~5.75)', '(18 vs. 16.8)' after a feature's value: the background's typical value (with one output; with
+#: several, 'vs' sets a score against the runner-up's)
+_VERSUS = re.compile(r"[\d%]\s*(?:\w+\s+)?(?:vs\.?|versus|compared (?:to|with))\s+(?:the\s+)?(?:average\s+(?:of\s+)?)?"
+                     r"[~≈]?\s*$", re.IGNORECASE)
+
+
+def statistic(before: str, action_named: bool = False, several_outputs: bool = False) -> str | None:
     """Is the number right after ``before`` a statistic of the background? 'output' (the baseline: 'the average
     prediction of', 'the base rate of'), 'feature' ('the typical borrower of about', 'the median of') or None.
-    ``actions``: an action (the output's name) is masked between the statistic's word and the number ('the average
-    sale price of')."""
+    ``action_named``: an action is named between the statistic's word and the number ('the average sale price of');
+    ``several_outputs``: 'vs' sets two scores side by side ('7.53 vs 7.38'), not a value and its typical one."""
     m = _STAT_BEFORE.search(before)
+    if m is not None and m.group(0).rstrip().endswith("(") and re.search(r"\bthan\s+(?:the\s+)?$",
+                                                                          before[:m.start()]):
+        m = None  # 'fewer absences than average (2 vs. ~5.75)': the bracket opens with the student's own value
     if m is None:
-        return None
-    output = m.group("word").lower().startswith(("base", "expected")) or _OUTPUT_NOUN.search(m.group("between"))
-    return "output" if output or (actions and "\0" in m.group("between")) else "feature"
+        return "feature" if not several_outputs and _VERSUS.search(before) else None
+    habit = re.search(r"\b(?:typically|usually|normally|often)\b", m.group("between"), re.IGNORECASE)
+    output = m.group("word").lower().startswith(("base", "expected")) or (
+        _OUTPUT_NOUN.search(m.group("between")) and not habit)  # 'the average team typically scores around
+    return "output" if output or (action_named and "\0" in m.group("between")) else "feature"
 
 
 def typical_number(n: Number, keys: tuple[str, ...], book: FactBook) -> Claim:
@@ -110,11 +121,20 @@ def base_number(n: Number, book: FactBook) -> Claim:
     return Claim("number", n.text, "verified" if ok else "contradicted", f"the baseline is {book.base:.4g}")
 
 
+_OF_PEOPLE = re.compile(r"\s+of\s+(?:the\s+|their\s+|its\s+|all\s+)?(?:[\w-]+\s+){0,2}?(?:peers|students|people|"
+                        r"customers|clients|applicants|borrowers|teams|players|cases|samples|population|dataset|"
+                        r"houses|homes|users|patients|rows|records)\b", re.IGNORECASE)
+
+
 def skip_number(n: Number, masked: str) -> bool:
     """Numbers that are not claims: list markers ('1.' at a line start), identifiers ('candidate 2', 'top-3'),
     counts of the method's inputs ('100 background rows')."""
     before = masked[:n.start]
     if re.search(r"(^|\n)\s*$", before) and re.match(r"^[.)]\s", masked[n.end:n.end + 2]):
+        return True
+    if re.search(r"\bout of\s*$", before, re.IGNORECASE):  # 'rated 4 out of 5': the scale's top
+        return True
+    if n.percent and _OF_PEOPLE.match(masked, n.end):  # 'unlike 95% of their peers': a share of the background
         return True
     if re.match(r"^\s+(?:most|largest|biggest|main|top|strongest|key)\b", masked[n.end:]):  # 'the two largest'
         return True

@@ -148,6 +148,17 @@ def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
 _SCOPE = re.compile(r"^\W*(?:among|of)\s+(?:all\s+)?the\s+([^,]{3,60}),", re.IGNORECASE)
 
 
+def _items(masked: str, targets: list[Mention], m: re.Match) -> int:
+    """How many things a plural rank's list names, those the verifier does not know included ('low absences, no
+    failures, and a balanced social life were the key drivers': 3)."""
+    if not targets:
+        return 0
+    first, last = targets[0], targets[-1]
+    span = masked[first.start:m.start()] if first.start < m.start() else masked[m.end():last.end]
+    span = re.split(r"\s(?:were|are|was|is|had|have|made|make)\b", span)[0]
+    return len([x for x in re.split(r",\s*(?:and\s+|or\s+)?|\s+(?:and|or)\s+", span) if x.strip()])
+
+
 def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
     """The rank phrases of clause ``masked[a:b]``, each bound to its names ('A was the main reason', 'the top three
     were A, B and C', 'followed by B', 'A second') and checked."""
@@ -184,7 +195,8 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             after = [x for x in names if x.start >= m.end()]
             header = after and re.match(r"^\W*(?:were|are|was|is|include\w*)?\W*$", masked[m.end():after[0].start])
             targets = after if header or not before else before
-            k = rank or len(targets)
+            k = rank or max(len(targets), _items(masked, targets, m))  # 'A, B and a balanced life were the key ...'
+
             for t in targets:
                 out.append(check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {masked[t.start:t.end]}"))
             continue
