@@ -154,7 +154,7 @@ def shapstories_case(dataset: str, index: int) -> tuple[int, xairl.Explanation, 
                             outputs=np.array([[prediction]]), states=states, feature_names=names,
                             action_names=(domain["output"],), method="given", output="value",
                             background_quantiles=quartiles, categories=cats or None)
-    info = {f: xairl.FeatureInfo(description=d[0], categories=cats.get(f, ())) for f, d in feats.items()}
+    info = {f: xairl.FeatureInfo(d[4] if len(d) > 4 else "", d[0], categories=cats.get(f, ())) for f, d in feats.items()}
     policy = xairl.Policy(torch.nn.Linear(len(names), 1), list(names), [domain["output"]], features=info,
                           output="value", name=dataset)
     return batch, exp, policy

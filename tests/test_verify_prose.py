@@ -492,6 +492,24 @@ OUTSIDE = [
     ("student", 261, "The student's low absences, no failures, and balanced social life were the key drivers.",
      "verified"),
     ("student", 261, "The student's low absences and no failures were the key drivers.", "contradicted"),
+    # diabetes-725 (Pima): age 38 (+0.08), pedigree 0.236 (-0.07), BMI 39.4 (+0.05), glucose 112 (-0.02); the
+    # output's word 'diabetes' is not a part of 'DiabetesPedigreeFunction', 'outcome 1' is a class
+    ("diabetes", 725, "The model predicted a 32% probability of diabetes (outcome 1).", "verified"),
+    ("diabetes", 725, "The model predicted a 42% probability of diabetes (outcome 1).", "contradicted"),
+    ("diabetes", 725, "While age and BMI pushed the prediction toward diabetes, low genetic predisposition and "
+                      "relatively lower glucose levels outweighed these risks.", "verified"),
+    ("diabetes", 725, "Age and BMI pushed the prediction away from diabetes.", "contradicted"),
+    ("diabetes", 725, "Their below-average Diabetes Pedigree Function score (0.236 vs. 0.469) reduced the "
+                      "probability.", "verified"),
+    # diabetes-210: glucose 81 (-0.20), age 25 (-0.08), BMI 27.7 (-0.04), pregnancies 2 (-0.02)
+    ("diabetes", 210, "A BMI of 27.7, while slightly elevated, was still lower than average and contributed modestly "
+                      "to lowering the risk.", "verified"),
+    ("diabetes", 210, "A BMI of 27.7, while slightly elevated, was still lower than average and contributed modestly "
+                      "to raising the risk.", "contradicted"),
+    # a rank said of several features at once: together against all the others
+    ("diabetes", 490, "Overall, the combination of favorable glucose, age, and insulin levels dominated the "
+                      "prediction.", "verified"),
+    ("diabetes", 490, "Overall, the combination of insulin and BMI dominated the prediction.", "contradicted"),
 ]
 
 

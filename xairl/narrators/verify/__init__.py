@@ -99,6 +99,9 @@ _ABBREVIATION = re.compile(r"(?:^|[\s(])(?:e\.g|i\.e|vs|approx|ca|etc|no|fig|cf)
 _CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|however)\b"
                         r"|,\s(?:and\s)?(?=but\b)|\s?[—–]\s?(?=(?:likely|possibly|perhaps|probably|since|as|because|this|"
                         r"which|suggesting|unsurprising)\b)|\s(?=because\b(?!\s+of\b))", re.IGNORECASE)
+#: ', while slightly elevated, was ...': an aside inside the clause (no subject of its own), not a clause
+_APPOSITIVE = re.compile(r"\s(?:while|although|though)\s+(?:\w+ly\s+)?(?:[a-z]+ed|[a-z]+ing|high|low|above|below|"
+                         r"modest|small|large|elevated)\b[^,;.]{0,30},", re.IGNORECASE)
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
 def sentences(text: str) -> list[tuple[int, int]]:
     """Sentence spans: split after . ! ? before a capital or a sign, and at line breaks and bullets."""
@@ -185,7 +188,8 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
             checks.check_label(sentence, m, book) if m.kind == "label" else None
         if c is not None:
             claims.append(c)
-    bounds = [0] + [m.end() for m in _CLAUSE_RE.finditer(masked)] + [len(masked)]
+    bounds = [0] + [m.end() for m in _CLAUSE_RE.finditer(masked) if not _APPOSITIVE.match(masked, m.start())] + [
+        len(masked)]
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'

@@ -8,7 +8,7 @@ import re
 from . import checks
 from .book import FactBook
 from .checks import Claim
-from .names import GENERIC, Mention, named_features
+from .names import GENERIC, Mention, named_features, split_words
 from .ranks import NOUN
 
 _GENERIC_SUBJECT = re.compile(r"^\W*(?:[qa]\s*:\s*)?(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|"
@@ -71,13 +71,14 @@ _SIDE = re.compile(r"(?:[\w\0']+\s+){0,4}?(?:towards?|in favou?r of)\s+(?:a\s+|a
 _UP_SIDE = re.compile(r"(?:higher|increase|up|upward|yes|positive|1|true|approval|approve|acceptance)$", re.IGNORECASE)
 
 
-def _unsaid_side(masked: str, m: re.Match, mentions: list[Mention]) -> bool:
+def _unsaid_side(masked: str, m: re.Match, mentions: list[Mention], book: FactBook) -> bool:
     """A side word whose object is neither the output (named), an up word, nor a down word ('toward "no"'): a class
     of a one-output classifier the text does not tie to the output ('toward failure', 'in favor of repayment')."""
     side = _SIDE.match(masked, m.start())
     if side is None or side.start("obj") - m.start() > 60:
         return False
-    output = any(x.kind == "action" and x.start == side.start("obj") for x in mentions)
+    output = any(x.kind == "action" and x.start == side.start("obj") for x in mentions) or \
+        side.group("obj").lower() in split_words(book.chosen or "")  # 'toward diabetes' of diabetes_probability
     return not (output or _UP_SIDE.match(side.group("obj")) or checks.toward_no(masked, m.start()))
 
 
@@ -99,7 +100,9 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if book.output != "actions" and _SIDE_WORD.match(m.group(0)) and \
                 _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
             continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
-        if book.output != "actions" and _unsaid_side(masked, m, mentions):
+        if any(x.kind == "feature" and 0 < x.start - m.end() <= 1 for x in mentions):
+            continue  # 'relatively lower glucose levels': a value said of the feature, not a push
+        if book.output != "actions" and _unsaid_side(masked, m, mentions, book):
             continue  # 'tipped the prediction toward failure': which side of the one output is that? unsaid
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
         subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
@@ -115,8 +118,9 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
                 subject = masked[prev:m.start()]
                 inside = [x for x in mentions if prev <= x.start < m.start()]
                 pronoun = re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE)
+                opener = masked[max(0, prev - 12):prev] if i == 0 else ""
                 if i == 0 and (book.output != "actions" or not pronoun):  # ('tipped the balance toward': one claim)
-                    out += _unknown_subject(subject, m.group(0), inside, name_words)
+                    out += _unknown_subject(subject, m.group(0), inside, name_words, opener)
                 elif i > 0 and (joined := _NEW_CLAUSE.search(subject)):  # '..., and the basement cost another $12,000'
                     rest = prev + joined.end()
                     out += _unknown_subject(masked[rest:m.start()], m.group(0),
@@ -155,7 +159,13 @@ def _subject_list(before: list[Mention], masked: str, start: int) -> list[Mentio
     return out
 
 
-def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_words=frozenset()) -> list[Claim]:
+#: a clause that opens with a subordinator and names no noun phrase of its own
+_ELLIPTIC = re.compile(r"^\W*(?:while|although|though|whereas|if|when)\b(?![^,;]*\b(?:the|a|an|its|their|his|her|this|"
+                       r"that|these|those)\b)", re.IGNORECASE)
+
+
+def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_words=frozenset(),
+                     opener: str = "") -> list[Claim]:
     """A direction claimed for something that names no feature ('the swimming pool adds ...'): contradicted when
     the subject is a noun phrase of its own, not a pronoun or the decision itself, and has no word of a feature's
     name (then it may be a vague mention: 'a quality rating of 10/10 adds ...')."""
@@ -164,6 +174,8 @@ def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_word
     if all(w.lower() in _VAGUE or w.lower() in GENERIC or w.lower() in _LINKS or w.lower().endswith("ly")
            for w in head):
         return []  # vague: perhaps a feature, not an invented one
+    if _ELLIPTIC.match(re.sub(r".*\b(while|although|though|whereas|if|when)\s*$", r"\1 ", opener) + subject):
+        return []  # '..., while slightly elevated, was still lower ...': the subject is the main clause's
     if mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")) or \
             any(w.lower() in name_words or re.fullmatch(NOUN, w, re.IGNORECASE) for w in words):
         return []

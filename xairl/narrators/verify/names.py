@@ -111,6 +111,9 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     for w, keys in shared.items():  # 'quality' of overall_quality and kitchen_quality: named, but not which
         if len(keys) > 1 and w not in phrases and w not in exact:
             phrases[w] = keys
+    if exp.output != "actions":  # 'the probability of diabetes': the output's words are not a part of a feature's
+        for w in {w for a in exp.action_names for w in split_words(a)}:
+            phrases.pop(w, None)
     entries = []
     for phrase, keys in {**phrases, **exact}.items():
         keys = exact.get(phrase, keys)  # a word or run of a longer name is a 'part' ('kicks' of Free Kicks)

@@ -44,7 +44,7 @@ _OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability
 _SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|features|narratives|coalitions|times|"
                          r"-fold)\b|[x×](?![\w]))",
                          re.IGNORECASE)
-_LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state)[\s-]*$", re.IGNORECASE)
+_LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state|outcome|class)[\s-]*$", re.IGNORECASE)
 #: '$91,462 above the baseline' (not '0.38 is slightly above the base value': there the number is the prediction)
 _CHANGE_BEFORE = re.compile(r"\b(?:exceed\w*|above|below|under|higher than|lower than|more than|less than)\b[^;]{0,40}"
                             r"\bby\s+(?:about|around|roughly|nearly|almost|some|only|just)?\s*[$€£]?\s*$",
@@ -288,7 +288,8 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
                      f"{change:.4g}")
     if MARGIN_BEFORE.search(before) or _MARGIN_AFTER.match(after):
         named = ("the margin", [book.margin if book.margin is not None else 0.0])  # one available action: 0
-    elif (_SCORE_BEFORE.search(before) or re.match(r"^\s*(vs\.?|versus)\s", after)) and book.chosen in book.scores:
+    elif (_SCORE_BEFORE.search(before) or (book.output == "actions" and re.match(r"^\s*(vs\.?|versus)\s", after))) \
+            and book.chosen in book.scores:
         named = ("the chosen action's score", [book.scores[book.chosen]])
     elif _RUNNER_BEFORE.search(before) and book.runner_up:
         named = ("the runner-up's score", [book.scores[book.runner_up]])
@@ -302,6 +303,10 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         out_at = max((m.end() for m in _OUT_WORDS.finditer(_BASE_WORDS.sub(lambda m: " " * len(m.group(0)), near))),
                      default=-1)  # 'value' inside 'base value' is the baseline's word
         if base_at > out_at or _BASE_AFTER.match(after) or _BASE_BEFORE.search(before):  # the nearer cue decides
+            if book.base and not 0.1 < abs(n.value / book.base) < 10 and not re.search(
+                    r"\bbase", near, re.IGNORECASE):  # 'older than average (18 vs. 16.8)': not the output's average
+                return Claim("number", n.text, "unchecked", "an average of another order of magnitude than the "
+                                                            "output's: of something not named")
             named = ("the baseline", [book.base])
         elif _OUT_WORDS.search(before):
             named = ("the prediction", [book.scores[book.chosen]])

@@ -126,6 +126,24 @@ def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | N
     return over_keys(a_keys, test, "comparison", text, "rank")
 
 
+#: a rank said of several features at once
+_COLLECTIVE = re.compile(r"\b(?:combination of|together|combined|collectively|jointly|taken together)\b", re.IGNORECASE)
+
+
+def check_collective(members: list[tuple[str, ...]], ctx: str | None, book: FactBook, text: str) -> Claim:
+    """'The combination of A, B and C dominated': their |contributions| together against all the others'."""
+    if any(len(k) != 1 for k in members):
+        return Claim("rank", text, "unchecked", "ambiguous: a member may mean several features")
+    named = {k[0] for k in members}
+    sizes = [(sum(abs(e.contribs[c]) for f, e in book.features.items() if f in named and c in e.contribs),
+              sum(abs(e.contribs[c]) for f, e in book.features.items() if f not in named and c in e.contribs), c)
+             for c in views(ctx, book)]
+    ok = [c for x, y, c in sizes if x > y]
+    x, y, c = sizes[0]
+    return Claim("rank", text, "verified" if ok else "contradicted",
+                 f"|{' + '.join(sorted(named))}| {x:.3g} vs the others' {y:.3g} ({ok[0] if ok else c})")
+
+
 def check_outweighs(a_keys: list[str], b_key: str, ctx: str | None, book: FactBook, text: str) -> Claim:
     """'A and B outweighed C': A's and B's |contributions| together against C's (in any view the sentence allows)."""
     contexts = [c for c in views(ctx, book) if all(c in book.features[k].contribs for k in (*a_keys, b_key))]
@@ -201,6 +219,9 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
                 out.append(check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {masked[t.start:t.end]}"))
             continue
         before = [x for x in names if x.end <= m.start()]
+        if len(before) >= 2 and _COLLECTIVE.search(masked, a, m.start()):  # 'the combination of A, B and C dominated'
+            out.append(check_collective([x.keys for x in before], ctx, book, m.group(0)))
+            continue
         target = before[-1] if before else next((x for x in names if x.start >= m.end()), None)
         if target is None:
             continue
