@@ -147,7 +147,8 @@ def shapstories_case(dataset: str, index: int) -> tuple[int, xairl.Explanation, 
     names = tuple(feats)
     cats = {f: tuple(d[1]) for f, d in feats.items() if isinstance(d[1], list)}
     value = {f: (cats[f].index(v) if f in cats else v) for f, (v, _) in given.items()}
-    states = np.array([[value.get(f, 2 if f in cats else feats[f][2]) for f in names]], float)  # else the median
+    states = np.array([[value.get(f, min(2, len(cats[f]) - 1) if f in cats else feats[f][2]) for f in names]],
+                      float)  # else the median (a category: its third code)
     contrib = np.array([given[f][1] if f in given else 0.001 for f in names])
     quartiles = np.array([[np.nan if f in cats else feats[f][k] for f in names] for k in (1, 2, 3)], float)
     exp = xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.array([[prediction - contrib.sum()]]),

@@ -510,6 +510,20 @@ OUTSIDE = [
     ("diabetes", 490, "Overall, the combination of favorable glucose, age, and insulin levels dominated the "
                       "prediction.", "verified"),
     ("diabetes", 490, "Overall, the combination of insulin and BMI dominated the prediction.", "contradicted"),
+    # stroke (Kaggle columns): 'the patient' in 'age of the patient' names no feature; a one-hot column is a label
+    ("stroke", 243, "The most influential factor was the patient's high average glucose level (247.51).", "verified"),
+    ("stroke", 243, "The most influential factor was the patient's age (68 years).", "contradicted"),
+    ("stroke", 2819, "Being a child (work_type_children) slightly lowered the risk.", "verified"),
+    ("stroke", 2819, "Being in private work (work_type_Private) slightly lowered the risk.", "contradicted"),
+    # a label after 'compared to' is no claim about this patient; 'a positive prediction' is a class
+    ("stroke", 5029, "Having never smoked slightly reduced the risk compared to smokers.", "verified"),
+    ("stroke", 5029, "Being a smoker slightly reduced the risk.", "contradicted"),
+    ("stroke", 237, "Age and glucose raised the risk, though not enough for a positive prediction.", "verified"),
+    # what might seem or would be: no claim
+    ("stroke", 242, "The high BMI (42.4) might intuitively suggest increased risk, but it slightly lowered it.",
+     "verified"),
+    ("stroke", 15, "Other factors were not severe enough to make age a dominant predictor; age lowered the risk.",
+     "verified"),
 ]
 
 

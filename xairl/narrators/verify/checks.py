@@ -105,7 +105,8 @@ def check_action(sentence: str, m: Mention, book: FactBook) -> Claim | None:
 # -- categorical values ------------------------------------------------------------------------------------------
 def check_label(sentence: str, m: Mention, book: FactBook) -> Claim | None:
     """A categorical value named ('in CollgCr', 'odor: foul', 'self-employed') must be the state's value."""
-    if re.search(r"(?:\b(?:not|no|non|never|rather than|instead of|unlike|than)|n't)(?:\s+\w+){0,3}?\W*$",
+    if re.search(r"(?:\b(?:not|no|non|never|rather than|instead of|unlike|than|compared (?:to|with)|versus|vs|"
+                 r"relative to)|n't)(?:\s+\w+){0,3}?\W*$",
                  sentence[:m.start], re.IGNORECASE):  # 'not self-employed', "wasn't in the 'other' category"
         return None
     f = m.keys[0]
@@ -156,15 +157,16 @@ def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: Fa
 #: a direction word that names a place, not a push: 'on the positive side', 'the lower quartile', 'lower than average'
 _NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blower(?:\s+|-)(?:than|quartile|end|bound|"
                          r"half|tail|third|range|percentile|band|limit)\b|\b(?:their|its|his|her|whose)\s+lower\b|"
-                         r"\b(?:might|may|could|would)\s+(?:seem|appear|look|sound)\s+(?:\w+ly\s+)?(?:positive|negative)"
-                         r"\b", re.IGNORECASE)
+                         r"\b(?:might|may|could|would)\s+(?:\w+ly\s+)?(?:seem|appear|look|sound|suggest|imply|indicate)\s+"
+                         r"(?:\w+ly\s+)?(?:an?\s+)?\w+|\b(?:positive|negative)\s+(?:prediction|outcome|diagnosis|class|"
+                         r"result|label|case|classification)\b", re.IGNORECASE)
 
 
 def is_frame(masked: str, m: re.Match) -> bool:
     """Not a direction: 'against' that compares ('7.53 against 7.38', 'Against recharge, ...', 'against that'), a
     word that names a side or a place ('on the positive side', 'the lower quartile', 'lower than the median'), an
     adjective of the subject ('their lower efficiency') and an appearance ('might seem positive')."""
-    near = _NOT_A_PUSH.search(masked, max(0, m.start() - 24), min(len(masked), m.end() + 16))
+    near = _NOT_A_PUSH.search(masked, max(0, m.start() - 40), min(len(masked), m.end() + 16))
     if near is not None and near.start() <= m.start() < near.end():
         return True
     if m.group(0).lower() != "against":

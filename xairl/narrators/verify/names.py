@@ -91,10 +91,13 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
         for form in forms:
             if form and clean(form):
                 exact.setdefault(_phrase(form), set()).add(f)
-        for form in [f] + ([described] if described else []):
+        for form in [f] + ([_head(described)] if described else []):
             if not clean(form):
                 continue
-            owners = set(re.findall(r"(\w+)'s\b", form.lower()))  # 'the applicant's age': not 'applicant'
+            # 'the applicant's age', 'age of the patient': not 'applicant', 'patient'
+            lowered = form.lower()
+            owners = set(re.findall(r"(\w+)'s\b", lowered)) | set(re.findall(r"\bof (?:the |a |an )?(\w+)$", lowered)) \
+                | _INSTANCES
             words = [w for w in split_words(form) if w not in STOP]
             for i in range(len(words)):
                 for j in range(i + 1, len(words) + 1):
@@ -128,6 +131,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
                 short.setdefault(f, []).append((label, r"[\s_\-]+".join(map(re.escape, split_words(label)))))
             elif clean(label):
                 entries.append((" ".join(stem(w) for w in split_words(label)), "label", (f,), label, ""))
+            if clean(label):  # a one-hot column's name: 'work_type_children', 'smoking_status=never smoked'
+                entries.append((f"{_phrase(f)} {_phrase(label)}", "label", (f,), label, "one-hot"))
     entries.sort(key=lambda e: -len(e[0]))
     names = frozenset(w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit())
     compiled = [(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries]
@@ -262,6 +267,9 @@ def _modifiers(text: str, found: list[Mention]) -> list[Mention]:
     return out
 
 
+#: what a model's input describes: a word of a feature's description, never a feature on its own
+_INSTANCES = frozenset({"patient", "applicant", "borrower", "customer", "client", "person", "student", "team", "player",
+                        "user", "house", "home", "property", "uav", "drone", "vehicle", "agent"})
 #: words that make a label too plain to be recognised away from its feature ('the other features', 'at home')
 _PLAIN_LABEL_WORDS = frozenset({"other", "others", "none", "unknown", "yes", "no", "home", "at", "true", "false", "na",
                                 "missing", "not", "applicable", "some"})

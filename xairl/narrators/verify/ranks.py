@@ -126,6 +126,8 @@ def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | N
     return over_keys(a_keys, test, "comparison", text, "rank")
 
 
+#: a rank in what would (not) be: 'enough to make X a dominant predictor', 'would make X the main reason'
+_WOULD_MAKE = re.compile(r"\b(?:enough to|would|could|might|to)\s+(?:make|render|become)\b[^.;]{0,30}$", re.IGNORECASE)
 #: a rank said of several features at once
 _COLLECTIVE = re.compile(r"\b(?:combination of|together|combined|collectively|jointly|taken together)\b", re.IGNORECASE)
 
@@ -183,6 +185,8 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
     out = []
     names = named_features(mentions)
     for m in RANK_RE.finditer(masked, a, b):
+        if _WOULD_MAKE.search(masked, max(a, m.start() - 50), m.start()):
+            continue  # 'not severe enough to make age a dominant predictor': what did not happen
         rank, plural, sign = rank_claim(m, masked)
         gap = _PARTICIPLE.match(masked, m.end(), b)
         said = DIRECTION_RE.match(masked, gap.end() if gap else m.end() + 1, b) \
