@@ -29,6 +29,7 @@ import pathlib
 import re
 import sys
 import time
+from dataclasses import replace
 
 import numpy as np
 import yaml
@@ -171,10 +172,24 @@ def shapstories_items(path: str) -> list[dict]:
         if row["index"] not in cases.get(dataset, {}).get("cases", {}):
             continue
         batch, exp, policy = shapstories_case(dataset, row["index"])
-        out.append({"case": f"{dataset}-{row['index']}", "domain": dataset, "split": f"shapstories batch {batch}",
-                    "error": "ok", "accurate": True, "text": row["round0_narrative"], "explanation": exp,
-                    "policy": policy})
+        for error, e in (("ok", exp), *manipulated(exp)):
+            out.append({"case": f"{dataset}-{row['index']}", "domain": dataset, "split": f"shapstories batch {batch}",
+                        "error": error, "accurate": error == "ok", "text": row["round0_narrative"], "explanation": e,
+                        "policy": policy})
     return out
+
+
+def manipulated(exp: xairl.Explanation) -> list[tuple[str, xairl.Explanation]]:
+    """The narrative's explanation changed the way SHAPnarrative-metrics manipulates SHAP tables, so that the same
+    (accurate) text becomes wrong: every contribution's sign inverted (the prediction mirrored about the baseline),
+    and the two largest contributions swapped."""
+    values = exp.values.copy()
+    order = np.argsort(-np.abs(values[0, :, 0]))
+    swapped = values.copy()
+    swapped[0, order[:2], 0] = values[0, order[1::-1], 0]
+    base = exp.base_values
+    return [("inverted signs", replace(exp, values=-values, outputs=base - values.sum(axis=1))),
+            ("top two swapped", replace(exp, values=swapped, outputs=base + swapped.sum(axis=1)))]
 
 
 def main() -> None:
@@ -189,11 +204,14 @@ def main() -> None:
         agree = sum(it["ok"] == it["accurate"] for it in items)
         print(f"## {name} (outside): agreement {agree}/{len(items)} = {100 * agree / len(items):.1f} %")
         print("| group | agree | n |\n|---|---|---|")
-        for k, a, n in table(items, lambda it: (it["split"] + ", " + it["domain"] if args.shapstories else
-                                                ("accurate: " if it["accurate"] else "inaccurate: ") + it["error"])):
+        for k, a, n in table(items, lambda it: (f"{it['split']}, {it['domain']}, {it['error']}" if args.shapstories
+                                                else ("accurate: " if it["accurate"] else "inaccurate: ") + it["error"])):
             print(f"| {k} | {a} | {n} |")
-        coverage = np.mean([it["result"].coverage for it in items])
-        print(f"\nmean coverage {coverage:.2f}")
+        if args.shapstories:
+            for k, a, n in table(items, lambda it: it["error"]):
+                print(f"| all, {k} | {a} | {n} |")
+        coverage = np.mean([it["result"].coverage for it in items if it["accurate"]])
+        print(f"\nmean coverage of the accurate narratives {coverage:.2f}")
         for it in items:
             if args.show == "outside" and it["ok"] != it["accurate"]:
                 probs = "; ".join(f"{c.kind} '{c.text}': {c.status} ({c.detail})" for c in it["result"].problems())

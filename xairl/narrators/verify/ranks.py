@@ -19,7 +19,7 @@ TOPWORD = r"(?:most important|most influential|most significant|most decisive|bi
 RANK_RE = re.compile(
     rf"\b(?:(?P<ord>second|third|fourth|fifth|2nd|3rd|4th)(?: most important| most influential| biggest| largest|"
     rf" strongest)?\s+(?:single\s+)?{NOUN}"
-    rf"|(?P<because>(?:mostly|mainly|chiefly|largely|primarily) (?:because of|due to|thanks to|on))"
+    rf"|(?P<because>(?:mostly|mainly|chiefly|largely|primarily) (?:because of|due to|thanks to|on|driven by))"
     rf"|(?:the\s+)?(?P<plural>(?:two|three|four|2|3|4)\s+(?:most important|largest|biggest|strongest|main)|"
     rf"(?:top|the)[\s-]+(?P<k>two|three|four|2|3|4)(?:\s+most important|\s+largest|\s+biggest)?)\s+{NOUN}"
     rf"|(?P<top>{TOPWORD})(?:\s+single)?\s+(?:risk\s+)?(?P<noun>{NOUN})"
