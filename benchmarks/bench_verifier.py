@@ -8,13 +8,20 @@ cases in other voices (Q&A, LLM-style prose, shorthand, lists; 16 of them on two
 ``dev3/`` 55 more (shares, 'accounts for', pipes, counterfactuals), ``dev4/`` 44 in the voice of an LLM explaining
 SHAP values, ``dev5/`` 45 in memo, log, arrow and passive voices, ``dev6/`` to ``dev13/`` 23-48 each (markdown,
 tickets, voice memos, amount verbs, signs in words, comparisons between features, JSON-ish output, number formats,
-operators' corrections, sums, 'from x to y'), each written after the freeze and measured once before tuning on it. ``test2/``: 48 more on the test cases (chat, letters, risk notes,
-decision logs), written after the test split's disagreements had been counted by cause (not read) and never tuned
-on: the second held-out figure. A narrative counts as agreeing when ``Verification.ok`` equals its label.
+operators' corrections, sums, 'from x to y'), ``dev14/`` 31 in the storyteller voice of LLM-written SHAP narratives
+(values against the typical case), each written after the freeze and measured once before tuning on it. ``test2/``:
+48 more on the test cases (chat, letters, risk notes, decision logs), written after the test split's disagreements
+had been counted by cause (not read) and never tuned on: the second held-out figure. A narrative counts as agreeing when ``Verification.ok`` equals its label.
 
     .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain, error kind, cause; speed
     .venv/bin/python benchmarks/bench_verifier.py --show test # also every disagreement of the test split
     .venv/bin/python benchmarks/bench_verifier.py --explingo accuracy_tests.json   # outside corpus, see below
+    .venv/bin/python benchmarks/bench_verifier.py --shapstories baseline_narratives.json  # outside, see below
+
+``--shapstories``: LLM-written narratives of SHAPnarrative-agents (github.com/ADMAntwerp/SHAPnarrative-agents,
+``data/baseline_narratives.json``; not shipped), against explanations built by hand from what each says
+(``data/narratives/outside/shapstories.yaml``), and against the same explanations with every sign inverted and with
+the two largest contributions swapped (then each text is wrong).
 
 ``--explingo``: the hand-labelled narratives of Zytek et al.'s Explingo (github.com/sibyl-dev/Explingo,
 ``full-experiment/accuracy_tests.json``; not shipped here): each explanation is rebuilt from its
