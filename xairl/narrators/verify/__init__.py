@@ -149,7 +149,7 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
 # a direction verb whose object is an option ('favoured turning', 'helped turning', '+22.0 toward the handover')
 # weighs it against the other one as much as it raises its score: either view, unless the words name the score
 _TOWARD_ACTION = re.compile(r"\b(favou?r(s|ed|ing)?|help(s|ed|ing)?|toward(s)?|held \w+ back|"
-                            r"matter\w* (?:more |less |most )?for)\s+(?:the |a |an )?$")
+                            r"matter\w* (?:more |less |most )?for|for)\s+(?:the |a |an )?$")
 
 
 def _context(sentence: str, mentions: list[Mention], book: FactBook, offset: int = 0) -> str | None:
@@ -271,6 +271,11 @@ _LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)(?:\s+over\s+[^\d;]{0,30
 #: 'which typically scores around 1.3 goals': a habit of the background, when the number reads as a typical value
 _TYPICALLY = re.compile(r"\b(?:typically|usually|normally|on average)\s+(?:[\w\0']+\s+){0,2}?(?:about|around|roughly|"
                         r"nearly|over|under|just|at least|at most|more than|less than)?\s*$", re.IGNORECASE)
+#: ', year ' right before a number, after an item that had its number: a list's next item, named by a word the
+#: vocabulary lacks (not ', by', ', at', ', worth' that go on with the same name)
+_NEW_ITEM = re.compile(r",\s*(?!(?:by|at|of|with|and|to|from|for|in|on|adding|worth|costing|contributing|taking|"
+                       r"about|around|roughly|some|nearly|almost|just|only|over|under|which|that|i\.e|e\.g)\b)"
+                       r"(?P<words>[A-Za-z][A-Za-z ]{0,20})(?:[\d.,]+\s*[A-Za-z%]{0,5}\s*)?$", re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
 _OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
                            r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)",
@@ -301,7 +306,8 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     credit history'); the name before it in its clause unless a new noun phrase starts between them; else none."""
     if id(n) in paired:
         return quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of)
-    if quantities.CHANGE_AFTER.match(masked[n.end:n.end + 30]):  # 'most of the $91,462 above the baseline'
+    if quantities.CHANGE_AFTER.match(masked[n.end:n.end + 30]) or quantities.NET_BEFORE.search(
+            masked[max(0, n.start - 60):n.start]):  # 'most of the $91,462 above the baseline', 'net uplift: +$86,046'
         return quantities.free_number(n, masked, book)
     if id(n) in scored:
         return quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
@@ -367,6 +373,12 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
         if _SCORE_GAP.match(masked[prev.end:n.start]) or quantities.MARGIN_BEFORE.search(masked[prev.end:n.start]):
             return quantities.action_number(n, checks.resolve_action(prev, book), masked, book)
         prev = next((m for m in reversed(names) if m.end <= n.start), None)
+    gap_text = re.sub(r"\([^()]*\)", "()", masked[prev.end:n.start]) if prev is not None else ""
+    item = _NEW_ITEM.search(gap_text)
+    if item is not None and re.search(r"\d", gap_text[:item.start()]) and not re.search(
+            r"ed\b|\b(?:adds|raises|lowers|costs|pushes|cuts)\b", item.group("words")) and not checks.DIRECTION_RE.search(
+            item.group("words")):  # '1,270 sq ft -12.1k, year 1945': a new item (not '..., added 6.8')
+        prev = None
     if prev is not None and not re.search(r"(?:,\s*|\sand\s+)(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s"
                                           r"(?!(?:most|second|third|main|largest|biggest|top|strongest)\b)",
                                           masked[prev.end:n.start], re.IGNORECASE):

@@ -32,8 +32,8 @@ _MARGIN_AFTER = re.compile(r"^\s*(?:points?\s+)?(?:above|ahead|higher|more than)
 _RUNNER_BEFORE = re.compile(r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?[$€£]?\s*$",
                             re.IGNORECASE)
 _SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
-_BASE_AFTER = re.compile(r"^\s*(?:\w+\s+)?(baseline|base value|base rate|base|average|typical|expected|mean)\b",
-                         re.IGNORECASE)
+_BASE_AFTER = re.compile(r"^\s*(?!vs\b|versus\b|against\b|compared\b)(?:\w+\s+)?(baseline|base value|base rate|base|"
+                         r"average|typical|expected|mean)\b", re.IGNORECASE)  # not '0.14 vs base 0.34'
 _BASE_WORDS = re.compile(r"\b(baseline|base value|base|average|typical|expected value|mean|on average)\b",
                          re.IGNORECASE)
 #: 'the average prediction of $230,061'
@@ -53,6 +53,11 @@ CHANGE_AFTER = re.compile(r"^\s*(?!(?:\w+\s+)?(?:is|was|are|were|sits|lies|stand
                            r"(above|below|under|over|more|less)\s+(the\s+)?"
                            r"(average|baseline|base|typical|expected|mean)"
                            r"|^\W*(?:premium|uplift|markup|discount)\b", re.IGNORECASE)
+#: 'Net effect of the eight features: +0.089', 'Net uplift over the base value: +$86,046': the change from the baseline
+NET_BEFORE = re.compile(r"\b(?:net (?:effect|uplift|change|shift|push|contribution)|total (?:effect|shift|change)|"
+                        r"(?:uplift|premium|change|shift) (?:over|above|from|relative to) (?:the )?(?:base(?:line)?|"
+                        r"base value|base rate|average))\b(?:\s+(?:of|over|from|across)\s+[^.;:()\d]{1,30}?)?\s*"
+                        r"(?:[:=]|\bis\b|\bwas\b|\bof\b)?\s*(?:about|around|roughly)?\s*[$€£]?$", re.IGNORECASE)
 _COMPARISON_WORDS = r"(above|below|stronger|weaker|better|worse|higher|lower)"
 #: '1.9 dB above the serving BS's RSRP': a difference in a unit, neither a value nor a contribution
 DIFFERENCE_AFTER = re.compile(rf"\s*[A-Za-z]+\s+{_COMPARISON_WORDS}\b", re.IGNORECASE)
@@ -221,7 +226,8 @@ def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, si
             facts = [("value", e.value, False), *((f"contribution ({c})", e.contribs.get(c), not signed)
                                                   for c in views)]
         for what, v, size_ok in facts:
-            if v is not None and matches(replace(n, percent=False), v, magnitude_ok=size_ok):
+            if v is not None and (matches(replace(n, percent=False), v, magnitude_ok=size_ok) or (
+                    n.points and _percent_readings(n, abs(v) if size_ok and not n.sign else v))):  # '12.3 pp'
                 return f"{key}'s {what}"
     return None
 
@@ -238,11 +244,22 @@ def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book:
         return matches(n, total) or (not n.hedge and abs(abs(n.value) - abs(total)) <= k * n.unit / 2 + 1e-9
                                      and (not n.sign or (n.value < 0) == (total < 0)))
 
+    if n.percent and not n.points:  # 'A and B together explain about 70 % of the attribution': their shares
+        results = [any(all(view in book.features[k].shares for k in combo)
+                       and matches(n, sum(book.features[k].shares[view] for k in combo)) for view in contexts)
+                   for combo in combos]
+        total = sum(book.features[k].shares.get(contexts[0], 0.0) for k in combos[0])
+        text = f"the sum of {', '.join(combos[0])}'s shares is {total:.3g} %"
+        return _sum_claim(n, results, text)
     results = [any(all(view in book.features[k].contribs for k in combo)
                    and close(sum(book.features[k].contribs[view] for k in combo), len(combo)) for view in contexts)
                for combo in combos]
     total = sum(book.features[k].contribs.get(contexts[0], 0.0) for k in combos[0])
-    text = f"the sum of {', '.join(combos[0])}'s contributions is {total:.4g}"
+    return _sum_claim(n, results, f"the sum of {', '.join(combos[0])}'s contributions is {total:.4g}")
+
+
+def _sum_claim(n: Number, results: list[bool], text: str) -> Claim:
+    """Verified when every reading of the members holds, contradicted when none does, else ambiguous."""
     if all(results):
         return Claim("number", n.text, "verified", text)
     return Claim("number", n.text, "unchecked" if any(results) else "contradicted",
@@ -280,7 +297,8 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     fact or, when it is a contribution, the one feature whose contribution it is."""
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 30]
     named = None
-    change_cue = CHANGE_AFTER.match(after) or (_CHANGE_BEFORE.search(before) and _BASE_WORDS.search(before))
+    change_cue = CHANGE_AFTER.match(after) or (_CHANGE_BEFORE.search(before) and _BASE_WORDS.search(before)) or \
+        NET_BEFORE.search(masked[max(0, n.start - 60):n.start])
     if change_cue and book.base is not None:  # '$91,462 above the baseline', 'exceeds the base rate (0.34) by 0.09'
         change = book.scores[book.chosen] - book.base
         ok = matches(n, change) or (n.percent and _percent_readings(n, abs(change)))

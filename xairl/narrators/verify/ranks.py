@@ -27,7 +27,7 @@ RANK_RE = re.compile(
     rf"|(?:is|was) the (?:single )?(?:largest|biggest|strongest|greatest|most important|most influential)(?![ \w]*\w)"
     rf"|top[\s-](?P<topk>\d)\b)", re.IGNORECASE)
 AFTER_ORD = re.compile(r"^\W{0,3}(?:[a-z]+\s+)?(?:was\s+|is\s+|came\s+|a\s+(?:distant|close)\s+)?"
-                       r"(?P<o>second|third|fourth)\b", re.IGNORECASE)
+                       r"(?P<o>second|third|fourth|first(?=\s*[(,;:]|\s+(?:then|and|followed)\b|\s*$))\b", re.IGNORECASE)
 FOLLOWED = re.compile(r"\b(?:followed(?: closely)? by|then|next(?: came| was)?|after that|ahead of|second only to)\s*$",
                        re.IGNORECASE)
 MINOR_RE = re.compile(r"\b(?:barely|hardly|scarcely)\s+(?:\w+\s+)?(?:matter\w*|mov\w*|regist\w*|chang\w*|affect\w*|"
@@ -237,8 +237,22 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
     for x in names:
         o = AFTER_ORD.match(masked[x.end:b])
         if o and not RANK_RE.match(masked[x.end:b].lstrip(" ,(")):
-            out.append(check_rank(x.keys, ORD[o.group("o").lower()], None, 0, ctx, book,
-                                         f"{masked[x.start:x.end]} {o.group('o')}"))
+            rank = ORD[o.group("o").lower()]
+            out.append(check_rank(x.keys, rank, None, 0, ctx, book, f"{masked[x.start:x.end]} {o.group('o')}"))
+            for y in names:  # 'A first (+11.0), then B'
+                if rank == 1 and y.start > x.end and FOLLOWED.search(masked[max(a, y.start - 24):y.start]):
+                    rank += 1
+                    out.append(check_rank(y.keys, rank, None, 0, ctx, book, f"then {masked[y.start:y.end]}"))
+    out += _chain(masked, a, b, names, book, ctx)
+    return out
+
+
+def _chain(masked: str, a: int, b: int, names: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
+    """'|phi| ranking: employment > age > DTI': each name's |contribution| above the next one's."""
+    out = []
+    for x, y in zip(names, names[1:]):
+        if re.fullmatch(r"\s*>\s*(?:the\s+)?", masked[x.end:y.start]) and len(y.keys) == 1:
+            out.append(check_comparison(x.keys, y.keys[0], 1, ctx, book, ">"))
     return out
 
 
