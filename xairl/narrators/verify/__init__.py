@@ -107,8 +107,9 @@ def sentences(text: str) -> list[tuple[int, int]]:
     """Sentence spans: split after . ! ? before a capital or a sign, and at line breaks and bullets."""
     spans, start = [], 0
     for m in _SENTENCE_RE.finditer(text):
-        if _ABBREVIATION.search(text[max(0, m.start() - 8):m.start()]):
-            continue
+        if _ABBREVIATION.search(text[max(0, m.start() - 8):m.start()]) or re.fullmatch(r"\s*\d{1,2}\.",
+                                                                                          text[start:m.start()]):
+            continue  # 'e.g. X', '1. Living area ...': no sentence end
         if text[start:m.start()].strip():
             spans.append((start, m.start()))
         start = m.end()
@@ -237,6 +238,9 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure
             c = _unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
         out.append(c)
+    first = numbers[0] if numbers else None
+    if first is not None and first.sign and not any(m.start < first.start for m in mentions):
+        out += directions.unknown_label(masked[a:first.start], name_words)  # '; roof condition -12.1k;'
     out += directions.directions(masked, a, b, said, book, ctx, name_words)
     out += ranks.find_ranks(masked, a, b, said, book, ctx)
     out += ranks.find_comparisons(masked, a, b, said, book, ctx)
@@ -286,12 +290,15 @@ _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact
 
 
 def _unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, sentence_keys) -> Claim:
-    """A contradicted number that states another fact of a feature named in the sentence exactly: the binding was a
-    guess, so it is unchecked ('which is unclear'). A difference in a unit ('4.0 dB above') binds for sure; a bracket
-    right after a name ('distance (2.33)') may only be that name's own fact, with its sign."""
+    """A contradicted number that states another fact of a feature named in the sentence exactly (not truncated): the
+    binding was a guess, so it is unchecked ('which is unclear'). A difference in a unit ('4.0 dB above') and a number
+    right after its name ('battery +1.70') bind for sure; a bracket right after a name ('distance (2.33)') may only be
+    that name's own fact, with its sign."""
     if quantities.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
         return c
     owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
+    if owner in names and re.fullmatch(r" ?", masked[owner.end:n.start]) and n.sign:
+        return c  # 'battery +1.70': a signed number right after its name, a sure binding
     if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
         other = quantities.other_reading(n, set(owner.keys), book, ctx, signed=True)
     else:
@@ -306,8 +313,7 @@ def _bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook
     credit history'); the name before it in its clause unless a new noun phrase starts between them; else none."""
     if id(n) in paired:
         return quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of)
-    if quantities.CHANGE_AFTER.match(masked[n.end:n.end + 30]) or quantities.NET_BEFORE.search(
-            masked[max(0, n.start - 60):n.start]):  # 'most of the $91,462 above the baseline', 'net uplift: +$86,046'
+    if quantities.is_change(n, masked):  # '$91,462 above the baseline', 'net uplift: +$86,046', 'below base by $34,184'
         return quantities.free_number(n, masked, book)
     if id(n) in scored:
         return quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)

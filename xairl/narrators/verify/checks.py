@@ -69,6 +69,10 @@ _RUNNER_AFTER = re.compile(r"^\W{0,3}(?:\([^)]*\)\s*)?(?:came|was|is|as)?\s*(?:t
                            r"(?:second|runner.up)\b", re.IGNORECASE)
 
 
+_RUNNER_BEFORE = re.compile(r"\b(?:runner[\s-]?up|second(?: choice| best| place)?|next best|alternative)\s*[:=→]\s*$",
+                            re.IGNORECASE)
+
+
 def resolve_action(m: Mention, book: FactBook) -> str | None:
     """The action a mention means: itself, or for a head word shared by several actions the chosen (else the
     runner-up) one among them."""
@@ -87,9 +91,10 @@ def check_action(sentence: str, m: Mention, book: FactBook) -> Claim | None:
     if book.global_view or book.output != "actions":
         return None
     a = resolve_action(m, book)
-    choice = m.form == "past" or bool(_CHOICE_BEFORE.search(sentence[:m.start])) or bool(
-        _CHOICE_AFTER.match(sentence[m.end:]))
-    if _RUNNER_AFTER.match(sentence[m.end:]) and not choice:
+    runner_header = _RUNNER_BEFORE.search(sentence[:m.start])  # 'Runner-up: recharge (3.88)'
+    choice = not runner_header and (m.form == "past" or bool(_CHOICE_BEFORE.search(sentence[:m.start])) or bool(
+        _CHOICE_AFTER.match(sentence[m.end:])))
+    if (_RUNNER_AFTER.match(sentence[m.end:]) or runner_header) and not choice:
         ok = a is not None and a == book.runner_up
         return Claim("action", text, "verified" if ok else "contradicted",
                      f"the runner-up was {book.runner_up}")

@@ -164,6 +164,22 @@ _ELLIPTIC = re.compile(r"^\W*(?:while|although|though|whereas|if|when)\b(?![^,;]
                        r"that|these|those)\b)", re.IGNORECASE)
 
 
+#: a list item's label before its signed number: 'roof condition -12.1k', 'Pool: +6,500'
+_LIST_LABEL = re.compile(r"\W*(?P<label>(?:[A-Za-z][A-Za-z'-]*\s+){0,3}[A-Za-z][A-Za-z'-]*)\s*[:=(]?\s*")
+#: labels of decision-level quantities, not features
+_QUANTITY_LABELS = {"net", "sum", "total", "delta", "change", "diff", "difference", "base", "baseline", "risk", "price",
+                    "estimate", "probability", "prediction", "output", "score", "gap", "margin", "lead", "effect",
+                    "shap", "phi", "value", "contribution", "attribution", "result", "overall", "uplift", "premium"}
+
+
+def unknown_label(text: str, name_words=frozenset()) -> list[Claim]:
+    """A list item named by a label that is no feature and carries a signed number ('; roof condition -12.1k')."""
+    m = _LIST_LABEL.fullmatch(text)
+    if m is None or any(w.lower() in _QUANTITY_LABELS for w in m.group("label").split()):
+        return []
+    return _unknown_subject(m.group("label"), "a signed number", [], name_words)
+
+
 def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_words=frozenset(),
                      opener: str = "") -> list[Claim]:
     """A direction claimed for something that names no feature ('the swimming pool adds ...'): contradicted when

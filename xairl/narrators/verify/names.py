@@ -173,7 +173,7 @@ def _pattern(phrase: str, kind: str) -> re.Pattern:
         if len(last) > 4 and last.endswith("s") and not last.endswith(("ss", "us", "is")):
             parts[-1] = re.escape(last[:-2] if last.endswith(("sses", "xes", "ches", "shes")) else last[:-1])
         body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+)?|)".join(parts) + r"(?:s|es)?(?:'s|')?\)?"
-    return re.compile(rf"(?<![\w]){body}(?![\w])", re.IGNORECASE)
+    return re.compile(rf"(?<![\w]){body}(?![\w])(?![.,]\d)", re.IGNORECASE)  # not 'RSRQ (-3' of 'RSRQ (-3.2 dB)'
 
 
 def _inflect(head: str) -> list[tuple[str, str]]:

@@ -148,14 +148,14 @@ def _hedge(before: str) -> str:
     return HEDGES[m.group(1).lower()] if m else ""
 
 
-def matches(n: Number, fact: float, magnitude_ok: bool = True) -> bool:
+def matches(n: Number, fact: float, magnitude_ok: bool = True, truncated_ok: bool = True) -> bool:
     """Does ``n`` state ``fact``? ``magnitude_ok``: an unsigned number may state a negative fact's size ("lowered
-    it by 0.4"). A written sign must agree with the fact's."""
+    it by 0.4"). A written sign must agree with the fact's. ``truncated_ok``: digits cut off count as rounding."""
     if n.sign and (fact < 0) != (n.sign == "-") and fact != 0:
         return False
     target = fact if n.sign or not magnitude_ok else abs(fact)
     ratio = n.unit / max(abs(n.value), 1e-12)  # an alternative reading ('3/10' as 0.3) keeps the relative precision
-    return any(_close(x, target, n.unit if x == n.value else ratio * abs(x), n.hedge) for x in n.readings)
+    return any(_close(x, target, n.unit if x == n.value else ratio * abs(x), n.hedge, truncated_ok) for x in n.readings)
 
 
 def _half_up(v: float, step: float) -> float:
@@ -164,13 +164,13 @@ def _half_up(v: float, step: float) -> float:
     return math.copysign(math.floor(k + 0.5 + 1e-9) * step, v)
 
 
-def _close(x: float, fact: float, step: float, hedge: str) -> bool:
+def _close(x: float, fact: float, step: float, hedge: str, truncated_ok: bool = True) -> bool:
     rounding = 0.5 * step + 1e-9 + 1e-6 * abs(fact)
     if abs(x - _half_up(_half_up(fact, step / 10), step)) <= 1e-9 + 1e-6 * abs(fact):
         return True  # rounded from an already rounded display: 2.345 -> 2.35 -> 2.4
     # truncated to the written digits ('6,157' for 6157.86) only with three significant digits or more: a short number
     # is rounded, and '0.42' for 0.4252 is more likely a wrong number than a truncation
-    truncated = abs(x) >= 100 * step and abs(x) <= abs(fact) < abs(x) + step and x * fact >= 0
+    truncated = truncated_ok and abs(x) >= 100 * step and abs(x) <= abs(fact) < abs(x) + step and x * fact >= 0
     exact = abs(x - fact) <= rounding or truncated
     if not hedge:
         return exact

@@ -226,7 +226,7 @@ def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, si
             facts = [("value", e.value, False), *((f"contribution ({c})", e.contribs.get(c), not signed)
                                                   for c in views)]
         for what, v, size_ok in facts:
-            if v is not None and (matches(replace(n, percent=False), v, magnitude_ok=size_ok) or (
+            if v is not None and (matches(replace(n, percent=False), v, magnitude_ok=size_ok, truncated_ok=False) or (
                     n.points and _percent_readings(n, abs(v) if size_ok and not n.sign else v))):  # '12.3 pp'
                 return f"{key}'s {what}"
     return None
@@ -291,15 +291,21 @@ def action_number(n: Number, action: str | None, masked: str, book: FactBook) ->
                  f"{book.scores[action]:.4g}")
 
 
+def is_change(n: Number, masked: str) -> bool:
+    """Is ``n`` the change from the baseline? '$91,462 above the baseline', 'exceeds the base rate (0.34) by 0.09',
+    'below base by $34,184', 'Net uplift over the base value: +$86,046'."""
+    before = masked[max(0, n.start - 60):n.start]
+    return bool(CHANGE_AFTER.match(masked[n.end:n.end + 30]) or NET_BEFORE.search(before) or (
+        _CHANGE_BEFORE.search(before[-40:]) and _BASE_WORDS.search(before[-40:])))
+
+
 def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     """A number tied to no name: a decision-level quantity when the words around it name one (margin, runner-up
     score, prediction, baseline, change from the baseline, a domain comparison in its unit), else any decision-level
     fact or, when it is a contribution, the one feature whose contribution it is."""
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 30]
     named = None
-    change_cue = CHANGE_AFTER.match(after) or (_CHANGE_BEFORE.search(before) and _BASE_WORDS.search(before)) or \
-        NET_BEFORE.search(masked[max(0, n.start - 60):n.start])
-    if change_cue and book.base is not None:  # '$91,462 above the baseline', 'exceeds the base rate (0.34) by 0.09'
+    if is_change(n, masked) and book.base is not None:  # '$91,462 above the baseline', 'exceeds the base rate (0.34) by 0.09'
         change = book.scores[book.chosen] - book.base
         ok = matches(n, change) or (n.percent and _percent_readings(n, abs(change)))
         return Claim("number", n.text, "verified" if ok else "contradicted", f"the change from the baseline is "

@@ -244,7 +244,31 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
                     rank += 1
                     out.append(check_rank(y.keys, rank, None, 0, ctx, book, f"then {masked[y.start:y.end]}"))
     out += _chain(masked, a, b, names, book, ctx)
+    out += _in_order(masked, a, b, names, book, ctx)
     return out
+
+
+#: 'In order of size: A, B, C', 'Largest first: A, B', '1. A ...' / '2) B ...' (a numbered item, by the importance
+#: its number gives)
+_ORDER_CUE = re.compile(r"\b(?:in (?:descending )?order of (?:size|importance|magnitude|influence|impact|effect)|"
+                        r"(?:largest|biggest|strongest|most important) first|ranked(?: by [\w|]+)?|"
+                        r"by (?:importance|size|magnitude|\|shap\|))\s*[:\-—]\s*", re.IGNORECASE)
+_ITEM_NUMBER = re.compile(r"^\W{0,2}(?P<k>[1-5])[.)]\s+(?=\0)")
+
+
+def _in_order(masked: str, a: int, b: int, names: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
+    """A list said to be in order of size ranks its names 1, 2, 3 ...; a numbered item starting with a name ranks it
+    by its number."""
+    item = _ITEM_NUMBER.match(masked[a:b])
+    if item and names and names[0].start == a + item.end():
+        k = int(item.group("k"))
+        return [check_rank(names[0].keys, k, None, 0, ctx, book, f"item {k}")]
+    cue = _ORDER_CUE.search(masked, a, b)
+    if cue is None:
+        return []
+    listed = [x for x in names if x.start >= cue.end()]
+    return [check_rank(x.keys, k, None, 0, ctx, book, f"{cue.group(0).strip()} #{k}")
+            for k, x in enumerate(listed[:5], 1)]
 
 
 def _chain(masked: str, a: int, b: int, names: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
