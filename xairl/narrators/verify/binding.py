@@ -1,0 +1,146 @@
+"""Which fact a number states: the name it is bound to (a pair of a 'respectively' list, an action right before or
+after it, a name right after it, the name before it in its clause) or a decision-level quantity its cue words name
+(the change from the baseline, a typical value, the baseline, where the output starts or ends, the margin), then its
+check in :mod:`.quantities`; and when a contradicted binding was only a guess."""
+from __future__ import annotations
+
+import re
+from dataclasses import replace
+
+from . import checks, quantities
+from .book import FactBook
+from .checks import Claim
+from .numbers import matches
+
+_SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of)?|scored|scores|score of|"
+                        r"with a score of|came second at|"
+                        r"second at|score|at|of|was|=)?\s*\(?(?:q\s*=\s*)?$", re.IGNORECASE)
+
+
+_ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
+                      r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$", re.IGNORECASE)
+_FROM = re.compile(r"\bfrom\s+(?:(?:an?|the|its)\s+)?(?:(?:average|base(?:line)?|base rate|starting point|typical)"
+                   r"(?:\s+(?:rate|value|estimate|prediction))?\s+(?:of\s+)?)?[$€£]?\s*$", re.IGNORECASE)
+_FROM_TO = re.compile(r"\bfrom\s+[^;]{1,40}?\s+(?:down\s+|up\s+)?to\s+(?:about|around|roughly)?\s*[$€£]?$",
+                      re.IGNORECASE)
+#: 'the handover's lead of 3.9', 'turning's lead over going forward was 1.55'
+_LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)(?:\s+over\s+[^\d;]{0,30}?)?\s+(?:of|was|is|=|:)\s+"
+                      r"(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)
+#: 'which typically scores around 1.3 goals': a habit of the background, when the number reads as a typical value
+_TYPICALLY = re.compile(r"\b(?:typically|usually|normally|on average)\s+(?:[\w\0']+\s+){0,2}?(?:about|around|roughly|"
+                        r"nearly|over|under|just|at least|at most|more than|less than)?\s*$", re.IGNORECASE)
+#: ', year ' right before a number, after an item that had its number: a list's next item, named by a word the
+#: vocabulary lacks (not ', by', ', at', ', worth' that go on with the same name)
+_NEW_ITEM = re.compile(r",\s*(?!(?:by|at|of|with|and|to|from|for|in|on|adding|worth|costing|contributing|taking|"
+                       r"about|around|roughly|some|nearly|almost|just|only|over|under|which|that|i\.e|e\.g)\b)"
+                       r"(?P<words>[A-Za-z][A-Za-z ]{0,20})(?:[\d.,]+\s*[A-Za-z%]{0,5}\s*)?$", re.IGNORECASE)
+#: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
+_OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
+                           r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)",
+                           re.IGNORECASE)
+#: 'speed argued for X (-5.48)', 'obstacle barely affected the turn score (-0.09)': the feature's contribution
+_ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact\w*|influenc\w*|matter\w*|"
+                     r"shift\w*|worth)\b", re.IGNORECASE)
+
+
+def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, sentence_keys) -> Claim:
+    """A contradicted number that states another fact of a feature named in the sentence exactly (not truncated): the
+    binding was a guess, so it is unchecked ('which is unclear'). A difference in a unit ('4.0 dB above') and a number
+    right after its name ('battery +1.70') bind for sure; a bracket right after a name ('distance (2.33)') may only be
+    that name's own fact, with its sign."""
+    if quantities.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
+        return c
+    owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
+    if owner in names and re.fullmatch(r" ?", masked[owner.end:n.start]) and n.sign:
+        return c  # 'battery +1.70': a signed number right after its name, a sure binding
+    if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
+        other = quantities.other_reading(n, set(owner.keys), book, ctx, signed=True)
+    else:
+        other = quantities.other_reading(n, sentence_keys, book, ctx)
+    return c if other is None else Claim("number", n.text, "unchecked",
+                                         f"read as {c.detail}, but it is {other}: which is unclear")
+
+
+def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:
+    """Which name a number belongs to, then its check: a pair of a 'respectively' list; an action right before it
+    ('Turn (4.07)', 'staying scored 26.26') or right after it ('7.38 for staying'); a name right after it ('a 7-year
+    credit history'); the name before it in its clause unless a new noun phrase starts between them; else none."""
+    if id(n) in paired:
+        return quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of)
+    if quantities.is_change(n, masked):  # '$91,462 above the baseline', 'net uplift: +$86,046', 'below base by $34,184'
+        return quantities.free_number(n, masked, book)
+    if id(n) in scored:
+        return quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
+    span = max(0, n.start - 60)
+    stat = quantities.statistic(masked[span:n.start], any(m.kind == "action" and span <= m.start < n.start
+                                                          for m in mentions), book.output == "actions")
+    if stat == "output" and book.output != "actions":  # 'the average sale price of $230,061', 'the baseline of 0.34'
+        c = quantities.base_number(n, book)  # ... unless it is the prediction ('at the average risk: 33 %')
+        if c.status == "verified" or not quantities.output_number(n, book).status == "verified":
+            return c
+    owner = next((m for m in reversed(names) if m.end <= n.start), None) or next(
+        (m for m in names if 0 <= m.start - n.end <= 2), None)  # '... typically scores around 1.3 goals'
+    habit = _TYPICALLY.search(masked[span:n.start])
+    if habit and owner is not None and stat is None:  # 'the average team, which typically scores around 1.3 goals'
+        c = quantities.typical_number(n, owner.keys, book)  # one reading; the number's plain binding is the other
+        if c.status == "verified":
+            return c
+    if stat == "feature" and owner is not None:  # 'a ratio of 0.51, above the average of roughly 0.4'
+        c = quantities.typical_number(n, owner.keys, book)
+        return c if c.status == "verified" or book.base is None or not matches(n, book.base) else \
+            quantities.base_number(n, book)  # 'with a 7-year history, the risk is above the average of 0.34'
+    if stat == "feature" and book.output != "actions" and book.base and not 0.1 < abs(n.value / book.base) < 10:
+        return Claim("number", n.text, "unchecked", "the typical value of something not named (not the output's "
+                                                    "average: another order of magnitude)")
+    if book.output != "actions" and _OUTPUT_AFTER.match(masked, n.end):
+        return quantities.output_number(n, book)  # 'leading to a 43% predicted probability of default'
+    if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
+        return quantities.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
+    if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 30):n.start]) or _FROM_TO.search(
+            masked[max(0, n.start - 60):n.start])):
+        return quantities.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
+    if book.margin is not None and _LEAD_OF.search(masked[max(0, n.start - 30):n.start]):
+        return quantities.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named
+    after = masked[n.end:n.end + 24]
+    nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
+    # '+22.0 for the handover' after a feature, 'worth 11.5 for ...': the feature's push, not the action's score
+    pushes = (n.sign == "+" or re.search(r"\bworth\s*$", masked[:n.start])) and any(x.end <= n.start for x in names)
+    if pushes and nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|to|toward|towards)\s+(?:the\s+)?$",
+                                                                   masked[n.end:nxt.start]):
+        owner = next(x for x in reversed(names) if x.end <= n.start)  # for one option over the other: either view
+        return quantities.feature_number(n, owner.keys, masked, book, checks.EITHER, unit_of)
+    if nxt is not None and nxt.kind == "action" and not pushes and re.match(r"^\s*(?:for|by)\s+(?:a\s+|an\s+|the\s+)?$",
+                                                           masked[n.end:nxt.start]):
+        return quantities.action_number(n, checks.resolve_action(nxt, book), masked, book)
+    gap = masked[n.end:nxt.start] if nxt is not None else ""
+    if nxt is not None and nxt.kind != "action" and re.match(r"^[\s-]*(?:[a-z]+[\s-]+){0,2}(?:of\s+)?$", gap,
+                                                               re.IGNORECASE) \
+            and not re.search(r"\b(and|or|but|while|with)\b", gap, re.IGNORECASE):
+        return quantities.feature_number(n, nxt.keys, masked, book, ctx, unit_of, name_after=True)
+    prev = next((m for m in reversed(mentions) if m.end <= n.start), None)
+    feature_before = next((m for m in reversed(names) if m.end <= n.start), None)
+    if prev is not None and prev.kind == "action" and n.sign and feature_before is not None and book.runner_up \
+            and checks.resolve_action(prev, book) == book.runner_up and not masked[prev.end:n.start].strip():
+        # 'speed gives recharging +5.48' when turning was chosen: -5.48 in the chosen action's margin
+        flipped = replace(n, value=-n.value, sign="-" if n.sign == "+" else "+")
+        return quantities.feature_number(flipped, feature_before.keys, masked, book, "margin", unit_of)
+    if prev is not None and prev.kind == "action" and (
+            n.sign == "+" or re.match(r"^\s*(over|than|versus|vs)\b", after, re.IGNORECASE) or (
+            feature_before is not None and any(r.search(masked, feature_before.end, prev.start)
+                                               for r in (checks.DIRECTION_RE, _ARGUED)))):
+        prev = feature_before  # '(+2.05)' after 'supported recharging': the feature's contribution
+    if prev is not None and prev.kind == "action":
+        if _SCORE_GAP.match(masked[prev.end:n.start]) or quantities.MARGIN_BEFORE.search(masked[prev.end:n.start]):
+            return quantities.action_number(n, checks.resolve_action(prev, book), masked, book)
+        prev = next((m for m in reversed(names) if m.end <= n.start), None)
+    gap_text = re.sub(r"\([^()]*\)", "()", masked[prev.end:n.start]) if prev is not None else ""
+    item = _NEW_ITEM.search(gap_text)
+    if item is not None and re.search(r"\d", gap_text[:item.start()]) and not re.search(
+            r"ed\b|\b(?:adds|raises|lowers|costs|pushes|cuts)\b", item.group("words")) and not checks.DIRECTION_RE.search(
+            item.group("words")):  # '1,270 sq ft -12.1k, year 1945': a new item (not '..., added 6.8')
+        prev = None
+    if prev is not None and not re.search(r"(?:,\s*|\sand\s+)(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s"
+                                          r"(?!(?:most|second|third|main|largest|biggest|top|strongest)\b)",
+                                          masked[prev.end:n.start], re.IGNORECASE):
+        return quantities.feature_number(n, prev.keys, masked, book, ctx, unit_of)
+    return quantities.free_number(n, masked, book)
