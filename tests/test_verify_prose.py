@@ -170,8 +170,8 @@ def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
     floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("dev6", 0.97),
               ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("dev10", 0.97), ("dev11", 0.94), ("dev12", 0.94),
-              ("dev13", 0.95), ("dev14", 0.93), ("dev15", 0.92), ("dev16", 0.95),
-              ("test", 0.92), ("test2", 0.85))
+              ("dev13", 0.95), ("dev14", 0.93), ("dev15", 0.92), ("dev16", 0.95), ("dev17", 0.9),
+              ("test", 0.93), ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
         agree = sum(it["ok"] == it["accurate"] for it in part) / len(part)
@@ -460,6 +460,25 @@ ON_CASES = [
     # a list item named by something that is no feature
     ("housing-3", "Negatives: kitchen (Fa) -23.6k; roof condition -12.1k; CollgCr -5.8k.", "contradicted"),
     ("housing-3", "Net: -34.2k. Kitchen (Fa) -23.6k; CollgCr -5.8k.", "verified"),
+    # dev17: everyday hedges; a participle after a comma says what the clause's subject does; 'to about x' after a
+    # motion verb is where the output ends; a number in points is never a value, and a sentence in points counts its
+    # bare numbers in points too
+    ("housing-0", "The estimate lands north of $298k, a bit over $68k above the average house.", "verified"),
+    ("housing-0", "The estimate lands north of $318k, a bit over $88k above the average house.", "contradicted"),
+    ("housing-1", "The lot barely registers: it takes off just shy of $1,000.", "verified"),
+    ("housing-1", "Living area alone is worth upwards of $59k here.", "contradicted"),
+    ("credit-0", "Being retired shaves off something like 12 points.", "verified"),
+    ("credit-0", "Retirement alone offsets most of the push from age and debt, taking 12.3 pp off.", "verified"),
+    ("credit-2", "Everything else drags it well below the 34 % base, to about 14 %.", "verified"),
+    ("credit-2", "Everything else drags it well below the 34 % base, to about 24 %.", "contradicted"),
+    ("credit-1", "The low debt ratio takes the risk down by close to 10 points, the salaried job by a bit under 9.",
+     "verified"),
+    ("credit-1", "The low debt ratio takes the risk down by close to 10 points, the salaried job by a bit under 5.",
+     "contradicted"),
+    ("uav-1", "Candidate 1's RSRQ takes a good 9 points off the handover's margin.", "contradicted"),
+    ("uav-0", "The handover wins by a whisker, about 0.14.", "verified"),
+    ("uav-0", "The handover wins by a whisker, about 1.4.", "contradicted"),
+    ("toy-3", "Forward comes out ahead of turn by roughly 1.5.", "contradicted"),
     # ranks among one sign (credit-2: employment +0.128 first overall, the ratio -0.127 first of those lowering it)
     ("credit-2", "The biggest factor working against default was the low debt-to-income ratio.", "verified"),
     ("credit-2", "The biggest factor working against default was the 26-year credit history.", "contradicted"),

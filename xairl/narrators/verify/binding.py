@@ -18,7 +18,11 @@ _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of
 
 
 _ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
-                      r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$", re.IGNORECASE)
+                      r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$|"
+                      r"\b(?:drags?|dragged|pushe?s?|pushed|pulls?|pulled|brings?|brought|takes?|took|moves?|moved|"
+                      r"lowers?|lowered|raises?|raised|lifts?|lifted)\b[^.;]{0,40},?(?<!close)(?<!due)(?<!thanks)(?<!up)"
+                      r"(?<!next)(?<!compared)(?<!relative)(?<!similar)\s+to\s+(?:about|around|roughly|"
+                      r"only|just)?\s*[$€£]?$", re.IGNORECASE)
 _FROM = re.compile(r"\bfrom\s+(?:(?:an?|the|its)\s+)?(?:(?:average|base(?:line)?|base rate|starting point|typical)"
                    r"(?:\s+(?:rate|value|estimate|prediction))?\s+(?:of\s+)?)?[$€£]?\s*$", re.IGNORECASE)
 _FROM_TO = re.compile(r"\bfrom\s+[^;]{1,40}?\s+(?:down\s+|up\s+)?to\s+(?:about|around|roughly)?\s*[$€£]?$",
@@ -33,7 +37,11 @@ _TYPICALLY = re.compile(r"\b(?:typically|usually|normally|on average)\s+(?:[\w\0
 #: vocabulary lacks (not ', by', ', at', ', worth' that go on with the same name)
 _NEW_ITEM = re.compile(r",\s*(?!(?:by|at|of|with|and|to|from|for|in|on|adding|worth|costing|contributing|taking|"
                        r"about|around|roughly|some|nearly|almost|just|only|over|under|which|that|i\.e|e\.g)\b)"
-                       r"(?P<words>[A-Za-z][A-Za-z ]{0,20})(?:[\d.,]+\s*[A-Za-z%]{0,5}\s*)?$", re.IGNORECASE)
+                       r"(?P<words>[A-Za-z]+(?: [A-Za-z]+){0,2} ?)(?:[\d.,]+\s*[A-Za-z%]{0,5}\s*)?$", re.IGNORECASE)
+#: verbs that go on with the same name ('..., accounts for some 14 points'), not a new item's label
+_ITEM_VERB = re.compile(r"ed\b|\b(?:is|was|are|were|has|had|have|accounts?|adds?|gives?|takes?|brings?|makes?|puts?|"
+                        r"contributes?|explains?|costs?|counts?|weighs?|pulls?|pushes?|lowers?|raises?|cuts?|"
+                        r"drives?|moves?|shifts?|sits?|comes?)\b", re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
 _OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
                            r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)",
@@ -89,14 +97,15 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
         c = quantities.typical_number(n, owner.keys, book)
         return c if c.status == "verified" or book.base is None or not matches(n, book.base) else \
             quantities.base_number(n, book)  # 'with a 7-year history, the risk is above the average of 0.34'
-    if stat == "feature" and book.output != "actions" and book.base and not 0.1 < abs(n.value / book.base) < 10:
+    if stat == "feature" and book.output != "actions" and book.base and not 0.1 < abs(
+            n.value / (100 if n.percent else 1) / book.base) < 10:
         return Claim("number", n.text, "unchecked", "the typical value of something not named (not the output's "
                                                     "average: another order of magnitude)")
     if book.output != "actions" and _OUTPUT_AFTER.match(masked, n.end):
         return quantities.output_number(n, book)  # 'leading to a 43% predicted probability of default'
     if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
         return quantities.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
-    if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 30):n.start]) or _FROM_TO.search(
+    if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 70):n.start]) or _FROM_TO.search(
             masked[max(0, n.start - 60):n.start])):
         return quantities.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
     if book.margin is not None and _LEAD_OF.search(masked[max(0, n.start - 30):n.start]):
@@ -135,9 +144,8 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
         prev = next((m for m in reversed(names) if m.end <= n.start), None)
     gap_text = re.sub(r"\([^()]*\)", "()", masked[prev.end:n.start]) if prev is not None else ""
     item = _NEW_ITEM.search(gap_text)
-    if item is not None and re.search(r"\d", gap_text[:item.start()]) and not re.search(
-            r"ed\b|\b(?:adds|raises|lowers|costs|pushes|cuts)\b", item.group("words")) and not checks.DIRECTION_RE.search(
-            item.group("words")):  # '1,270 sq ft -12.1k, year 1945': a new item (not '..., added 6.8')
+    if item is not None and re.search(r"\d", gap_text[:item.start()]) and not _ITEM_VERB.search(item.group("words")) \
+            and not checks.DIRECTION_RE.search(item.group("words")):  # '..., year 1945': a new item ('..., added 6.8': not)
         prev = None
     if prev is not None and not re.search(r"(?:,\s*|\sand\s+)(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s"
                                           r"(?!(?:most|second|third|main|largest|biggest|top|strongest)\b)",

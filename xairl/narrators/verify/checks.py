@@ -32,8 +32,8 @@ _POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|support
         r"positive(?:ly)?|more likely|up by|help(?:s|ed|ing)?")
 _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ )?down|"
         r"push(?:es|ed|ing)? (?:\w+ )?down|nudg\w* (?:\w+ )?down|subtract\w*|"
-        r"tak(?:es|ing|e) (?:[\w.,$€£]+ )?(?:off|away)|"
-        r"took (?:\w+ )?(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|negative(?:ly)?|"
+        r"tak(?:es|ing|e) (?:[\w.,$€£]+ ){0,4}(?:off|away)|"
+        r"took (?:[\w.,$€£]+ ){0,4}(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|negative(?:ly)?|"
         r"less likely|"
         r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
         r"los(?:t|ing)|diminish\w*|penali[sz]\w*|hurt(?:s|ing)?|h[eo]ld(?:s|ing)? (?:\w+ ){0,2}back(?: from)?|"
@@ -64,7 +64,8 @@ _CHOICE_BEFORE = re.compile(r"(?:[:→]|->|=>|\b(?:made|makes|led|leads) (?:it|t
                             r"preferred|prefers|opted for|opted to|went for|goes for)\s+(?:to\s+)?$", re.IGNORECASE)
 _CHOICE_AFTER = re.compile(r"^\W{0,3}(?:\([^)]*\)\s*)?(?:was|is|got)?\s*(?:chosen|picked|selected|preferred|the choice)\b|"
                            r"^\W{0,3}(?:\([^)]*\)\s*)?(?:narrowly\s+|clearly\s+)?(?:won|wins|beat|beats|edged out|"
-                           r"prevailed|came out ahead)\b", re.IGNORECASE)
+                           r"prevailed|came out ahead|comes out ahead|come out ahead|came out on top|comes out on top)\b",
+                           re.IGNORECASE)
 _RUNNER_AFTER = re.compile(r"^\W{0,3}(?:\([^)]*\)\s*)?(?:came|was|is|as)?\s*(?:the\s+|a\s+)?(?:close\s+|distant\s+)?"
                            r"(?:second|runner.up)\b", re.IGNORECASE)
 

@@ -65,6 +65,9 @@ _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:bu
                      r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
 
+#: a participle after a comma says what the clause's subject does, not its last object
+_PARTICIPLE_AFTER_COMMA = re.compile(r"(?:tak|add|rais|lower|push|pull|cutt|reduc|increas|boost|cost|shav|knock|drag|"
+                                     r"lift|decreas|subtract)\w*ing\b", re.IGNORECASE)
 #: 'toward X', 'in favour of X' after a direction word: X says which side of a one-output model it is
 _SIDE = re.compile(r"(?:[\w\0']+\s+){0,4}?(?:towards?|in favou?r of)\s+(?:a\s+|an\s+|the\s+)?[\"'“‘]?"
                    r"(?P<obj>[\w\0]+)", re.IGNORECASE)
@@ -106,6 +109,9 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             continue  # 'tipped the prediction toward failure': which side of the one output is that? unsaid
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
         subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
+        if _PARTICIPLE_AFTER_COMMA.match(m.group(0)) and re.search(r",\s*$", masked[a:m.start()]) and names and \
+                names[0].start < m.start():
+            subjects = [names[0]]  # 'Retirement offsets the push from age and debt, taking 12.3 pp off': retirement
         if _OF_WHAT.match(masked, m.end()):  # 'the slightly positive contributions from corners and attempts'
             nxt = found[i + 1].start() if i + 1 < len(found) else b
             subjects = [x for x in names if m.end() <= x.start < nxt]

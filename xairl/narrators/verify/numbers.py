@@ -7,12 +7,12 @@ A :class:`Number` knows what it may stand for (``value`` and ``alternatives``) a
 
 - written plainly: equal after rounding to the written digits, or truncated to them with at least three significant
   digits ("6,157" for 6157.86, not "0.42" for 0.4252);
-- with a symmetric hedge ("about", "around", "roughly", "approximately", "~", "some", "close to"): within 20 % of the
-  fact, or equal after rounding;
-- "nearly", "almost", "just under", "a bit under": the fact is at most the number and within 20 % of it;
-  "just over", "a little over": at least the number and within 20 %;
-- bounds ("less than", "under", "at most", "more than", "over", "at least", "between x and y"): the fact's magnitude
-  is on that side.
+- with a symmetric hedge ("about", "around", "roughly", "approximately", "~", "some", "close to", "something like",
+  "in the ballpark of", "give or take", "a good"): within 20 % of the fact, or equal after rounding;
+- "nearly", "almost", "just under", "a bit under", "a hair under", "the better part of": the fact is at most the
+  number and within 20 % of it; "just over", "a little over", "a touch above": at least the number and within 20 %;
+- bounds ("less than", "under", "at most", "more than", "over", "at least", "north of", "well under", "between x
+  and y"): the fact's magnitude is on that side.
 """
 from __future__ import annotations
 
@@ -22,14 +22,16 @@ from dataclasses import dataclass
 
 HEDGE_TOLERANCE = 0.2  # how far a hedged number may be from the fact, relative to the fact
 
-_APPROX = ("about", "around", "roughly", "approximately", "approx.", "approx", "~", "some", "close to", "circa",
-           "ca.", "an estimated", "on the order of")
+_APPROX = ("about", "around", "roughly", "approximately", "approx.", "approx", "~", "≈", "some", "close to", "circa",
+           "ca.", "an estimated", "on the order of", "something like", "in the ballpark of", "somewhere near",
+           "somewhere around", "give or take", "maybe", "a good", "in the region of", "the order of")
 _BELOW = ("nearly", "almost", "just under", "a bit under", "a little under", "slightly under", "just shy of",
-          "a bit less than", "slightly less than", "a little less than")
+          "a bit less than", "slightly less than", "a little less than", "a hair under", "a touch under",
+          "the better part of", "not quite")
 _ABOVE = ("just over", "a little over", "a bit over", "slightly over", "slightly more than", "a bit more than",
-          "a little more than", "just above")
-_AT_MOST = ("less than", "under", "at most", "up to", "no more than", "below")
-_AT_LEAST = ("more than", "over", "at least", "no less than", "upwards of")
+          "a little more than", "just above", "a touch above", "a touch over", "a hair over", "a bit above")
+_AT_MOST = ("less than", "under", "at most", "up to", "no more than", "below", "well under", "well below", "south of")
+_AT_LEAST = ("more than", "over", "at least", "no less than", "upwards of", "well over", "well above", "north of")
 HEDGES = {**{h: "approx" for h in _APPROX}, **{h: "below" for h in _BELOW}, **{h: "above" for h in _ABOVE},
           **{h: "at_most" for h in _AT_MOST}, **{h: "at_least" for h in _AT_LEAST}}
 _HEDGE_RE = re.compile(r"(?:^|[\s(])(" + "|".join(sorted(map(re.escape, HEDGES), key=len, reverse=True))

@@ -24,12 +24,14 @@ _LISTS_CONTRIBUTIONS = re.compile(r"shap|attribution|contribut|impact|effect|φ|
                                   re.IGNORECASE)
 MARGIN_BEFORE = re.compile(r"\b(margin|lead|edge|gap|advantage|difference)(?: of)?\W*(?:about|around|roughly|only|"
                             r"just)?\s*$|\b(won|wins|beat\w*|ahead|stayed ahead|led|edged out|outscored)\s+"
-                            r"(?:[\w\0']+\s+|\([^()]*\)\s+){0,4}by\s+(?:about|around|roughly|only|just)?\s*$",
-                            re.IGNORECASE)
+                            r"(?:[\w\0']+\s+|\([^()]*\)\s+){0,4}by\s+(?:a\s+(?:whisker|hair|nose|wide margin|"
+                            r"narrow margin|small margin|large margin|mile)\s*,?\s*)?(?:about|around|roughly|only|just|"
+                            r"a bit over|a little over|some|nearly|almost)?\s*$", re.IGNORECASE)
 _ON_AVERAGE = re.compile(r"^\s*(?:on average|over the background|across the background|at baseline|by default)\b",
                          re.IGNORECASE)
 _MARGIN_AFTER = re.compile(r"^\s*(?:points?\s+)?(?:above|ahead|higher|more than)\b", re.IGNORECASE)
-_RUNNER_BEFORE = re.compile(r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?[$€£]?\s*$",
+_RUNNER_BEFORE = re.compile(r"(?<!bit )(?<!little )(?<!just )(?<!well )(?<!slightly )(?<!touch )(?<!hair )"
+                            r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?[$€£]?\s*$",
                             re.IGNORECASE)
 _SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
 _BASE_AFTER = re.compile(r"^\s*(?!vs\b|versus\b|against\b|compared\b)(?:\w+\s+)?(baseline|base value|base rate|base|"
@@ -174,6 +176,8 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     slot = not n.sign and not n.currency and not n.percent and bool(re.search(r"\0\s?\($", before)) and \
         masked[n.end:n.end + 1] in (")", ",") and not _LISTS_CONTRIBUTIONS.search(masked[:n.start])
     fill_cue = n.percent and re.match(r"\s*(full|of (?:its |the )?capacity)\b", after, re.IGNORECASE)
+    # '..., the salaried job by a bit under 9' in a sentence that counts in points: points of a probability too
+    in_points = book.output != "actions" and not n.percent and bool(re.search(r"\b(?:points?|pts|pp)\b", masked))
 
     def test(key):
         e = book.features[key]
@@ -186,14 +190,15 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or slot or bool(prefix)) \
             and not contrib_cue
         cands = []
-        if (not contrib_cue or name_after) and e.value is not None:
+        if (not contrib_cue or name_after) and e.value is not None and not (n.points and unit not in ("points", "pts")):
             cands.append(("value" if scale == 1 else f"value in {prefix.group(1)}{unit_of(key)}", e.value / scale))
         if n.percent and not contrib_cue and e.fill is not None:
             cands.append(("fill (% of capacity)", e.fill))
         if not value_cue:
             cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
         for what, v in cands:
-            if matches(n, v) or (n.percent and _percent_readings(n, v)):
+            if matches(n, v) or ((n.percent or (in_points and what.startswith("contribution")))
+                                 and _percent_readings(n, v)):
                 return True, f"{key}: {what}"
         if n.percent and not n.points and any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
             return True, f"{key}: share"
@@ -327,7 +332,7 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         out_at = max((m.end() for m in _OUT_WORDS.finditer(_BASE_WORDS.sub(lambda m: " " * len(m.group(0)), near))),
                      default=-1)  # 'value' inside 'base value' is the baseline's word
         if base_at > out_at or _BASE_AFTER.match(after) or _BASE_BEFORE.search(before):  # the nearer cue decides
-            if book.base and not 0.1 < abs(n.value / book.base) < 10 and not re.search(
+            if book.base and not 0.1 < abs(n.value / (100 if n.percent else 1) / book.base) < 10 and not re.search(
                     r"\bbase", near, re.IGNORECASE):  # 'older than average (18 vs. 16.8)': not the output's average
                 return Claim("number", n.text, "unchecked", "an average of another order of magnitude than the "
                                                             "output's: of something not named")
