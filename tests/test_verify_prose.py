@@ -170,7 +170,7 @@ def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
     floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("dev6", 0.97),
               ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("dev10", 0.97), ("dev11", 0.94), ("dev12", 0.94),
-              ("dev13", 0.95), ("dev14", 0.93), ("dev15", 0.92), ("dev16", 0.95), ("dev17", 0.9),
+              ("dev13", 0.95), ("dev14", 0.93), ("dev15", 0.92), ("dev16", 0.95), ("dev17", 0.9), ("dev18", 0.88),
               ("test", 0.93), ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
@@ -479,6 +479,26 @@ ON_CASES = [
     ("uav-0", "The handover wins by a whisker, about 0.14.", "verified"),
     ("uav-0", "The handover wins by a whisker, about 1.4.", "contradicted"),
     ("toy-3", "Forward comes out ahead of turn by roughly 1.5.", "contradicted"),
+    # dev18: plain language. 'N in 100' is a percentage; "it's worth $x" is the prediction (not a pair list with
+    # 'the usual $y'); 'about average (33%)' may be the prediction; 'lower than it would be' is a claim, 'lower than
+    # average' is not; 'It turned, helped by X' is X's push toward the choice; ', though,' is an aside
+    ("credit-0", "Your chance of default is put at 43 in 100, compared with 34 in 100 for a typical applicant.",
+     "verified"),
+    ("credit-0", "Your chance of default is put at 53 in 100, compared with 34 in 100 for a typical applicant.",
+     "contradicted"),
+    ("housing-1", "Big house, top quality, good area: that's why it's worth about $316k instead of the usual $230k.",
+     "verified"),
+    ("housing-1", "Big house, top quality, good area: that's why it's worth about $416k instead of the usual $230k.",
+     "contradicted"),
+    ("credit-3", "Your risk is about average (33%).", "verified"),
+    ("credit-0", "Mostly because you're retired, the risk is lower than it would be; your age pushes it back up.",
+     "verified"),
+    ("credit-0", "Because of your age, the risk is lower than it would be.", "contradicted"),
+    ("toy-1", "It turned, helped by the wind.", "verified"),
+    ("toy-1", "It turned, helped by the low battery.", "contradicted"),
+    ("credit-1", "Your salaried job brings the risk down. Your low debt, though, pushes it up.", "contradicted"),
+    ("toy-0", "It went to recharge because it was barely moving.", "verified"),
+    ("toy-0", "It went to turn because it was barely moving.", "contradicted"),
     # ranks among one sign (credit-2: employment +0.128 first overall, the ratio -0.127 first of those lowering it)
     ("credit-2", "The biggest factor working against default was the low debt-to-income ratio.", "verified"),
     ("credit-2", "The biggest factor working against default was the 26-year credit history.", "contradicted"),

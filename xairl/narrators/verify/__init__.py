@@ -96,7 +96,8 @@ class Verification:
 
 _SENTENCE_RE = re.compile(r"(?<=[.!?])\s+(?=\S)|\n+\s*(?:[-•*]\s*)?")
 _ABBREVIATION = re.compile(r"(?:^|[\s(])(?:e\.g|i\.e|vs|approx|ca|etc|no|fig|cf)\.$", re.IGNORECASE)
-_CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|however)\b"
+_CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|"
+                        r"however)\b(?!,)"  # ('A, though, pushes it up': an aside)
                         r"|,\s(?:and\s)?(?=but\b)|\s?[—–]\s?(?=(?:likely|possibly|perhaps|probably|since|as|because|this|"
                         r"which|suggesting|unsurprising)\b)|\s(?=because\b(?!\s+of\b))", re.IGNORECASE)
 #: ', while slightly elevated, was ...': an aside inside the clause (no subject of its own), not a clause
@@ -213,7 +214,9 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     tail = [n for n in numbers if names and n.start > names[-1].end  # not the last name's own '(−22.5 dB)'
             and not re.fullmatch(r"\s?\([^()]*", masked[names[-1].end:n.start])]
     paired = {}
-    if len({m.keys for m in names}) >= 2 and len(tail) == len(names) and (
+    own_cue = any(quantities.statistic(masked[max(0, n.start - 60):n.start]) or binding.OUTPUT_BEFORE.search(
+        masked[max(0, n.start - 60):n.start]) for n in tail)  # '... worth about $316k instead of the usual $230k'
+    if len({m.keys for m in names}) >= 2 and len(tail) == len(names) and not own_cue and (
             "respectively" in masked[a:b].lower() or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
             or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
                 and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
@@ -259,8 +262,9 @@ _OWN_QUANTITY = re.compile(r"\bof\s+(?:the\s+)?[$€£]?$", re.IGNORECASE)
 _NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
                       r"(?:(?:because of|due to|about|the|its|their|a|an)\s+){0,3}$", re.IGNORECASE)
 #: a sentence about what did not happen: 'Had X been better, ...', 'Without X, it would have ...', 'If it were not
-#: for X'; a modal elsewhere ('chose recharge, which could save battery') leaves the rest of the sentence checked
-_HYPOTHETICAL = re.compile(r"^\W*(?:if|had|without|were|absent|but for)\b|\b(?:would|could|might)(?:\s+\w+ly)?\s+"
+#: for X'; a modal elsewhere ('chose recharge, which could save battery', 'lower than it would be') leaves the rest checked
+_HYPOTHETICAL = re.compile(r"^\W*(?:if|had|without|were|absent|but for)\b|(?<!than it )(?<!than they )"
+                           r"\b(?:would|could|might)(?:\s+\w+ly)?\s+"
                            r"(?:(?:not|never)\s+)?(?:have|be)\b|\bif it (?:were|was)(?:n't| not) for\b", re.IGNORECASE)
 _PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
 

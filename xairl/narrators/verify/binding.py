@@ -42,6 +42,12 @@ _NEW_ITEM = re.compile(r",\s*(?!(?:by|at|of|with|and|to|from|for|in|on|adding|wo
 _ITEM_VERB = re.compile(r"ed\b|\b(?:is|was|are|were|has|had|have|accounts?|adds?|gives?|takes?|brings?|makes?|puts?|"
                         r"contributes?|explains?|costs?|counts?|weighs?|pulls?|pushes?|lowers?|raises?|cuts?|"
                         r"drives?|moves?|shifts?|sits?|comes?)\b", re.IGNORECASE)
+#: "it's worth about $316k", 'your chance of default is put at 43 in 100': the thing the model is about, valued
+OUTPUT_BEFORE = re.compile(r"\b(?:it|this house|the house|the home|this home|the property|your home|your house)(?:'s| is| was|"
+                           r" would be|'d be)\s+(?:now\s+|still\s+)?(?:worth|valued at|priced at|estimated at|put at)\s+"
+                           r"(?:about|around|roughly|some|just under|just over|nearly|almost)?\s*[$€£]?$|"
+                           r"\b(?:chance|risk|probability|likelihood) of [\w\s]{1,20}? is (?:put |estimated |rated )?at\s+"
+                           r"(?:about|around|roughly)?\s*$", re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
 _OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
                            r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)",
@@ -101,7 +107,8 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
             n.value / (100 if n.percent else 1) / book.base) < 10:
         return Claim("number", n.text, "unchecked", "the typical value of something not named (not the output's "
                                                     "average: another order of magnitude)")
-    if book.output != "actions" and _OUTPUT_AFTER.match(masked, n.end):
+    if book.output != "actions" and (_OUTPUT_AFTER.match(masked, n.end) or OUTPUT_BEFORE.search(
+            masked[max(0, n.start - 60):n.start])):  # '... leading to a 43% predicted probability', "it's worth $316k"
         return quantities.output_number(n, book)  # 'leading to a 43% predicted probability of default'
     if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
         return quantities.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...

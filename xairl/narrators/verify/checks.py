@@ -27,11 +27,11 @@ CHECKED = {"number", "direction", "rank", "action", "category", "magnitude"}
 EITHER = "either"  # a sentence's view when its words weigh two options without naming the view (margin or score)
 
 _POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|supported|supporting|favou?r(?:s|ed|ing)?|"
-        r"in favou?r of|toward|towards|push(?:es|ed|ing)? (?:\w+ )?up|pull(?:s|ed|ing)? (?:\w+ )?up|"
+        r"in favou?r of|toward|towards|push(?:es|ed|ing)? (?:\w+ ){0,2}up|pull(?:s|ed|ing)? (?:\w+ ){0,2}up|"
         r"nudg\w* (?:\w+ )?up|drives?|driven by|driving|tipped|tips|argu\w* for|counted for|counts for|"
         r"positive(?:ly)?|more likely|up by|help(?:s|ed|ing)?")
-_NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ )?down|"
-        r"push(?:es|ed|ing)? (?:\w+ )?down|nudg\w* (?:\w+ )?down|subtract\w*|"
+_NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ ){0,2}down|"
+        r"push(?:es|ed|ing)? (?:\w+ ){0,2}down|nudg\w* (?:\w+ )?down|subtract\w*|"
         r"tak(?:es|ing|e) (?:[\w.,$€£]+ ){0,4}(?:off|away)|"
         r"took (?:[\w.,$€£]+ ){0,4}(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|negative(?:ly)?|"
         r"less likely|"
@@ -61,7 +61,8 @@ def over_keys(keys: tuple[str, ...], test, what: str, text: str, kind: str) -> C
 # -- actions ---------------------------------------------------------------------------------------------------
 _CHOICE_BEFORE = re.compile(r"(?:[:→]|->|=>|\b(?:made|makes|led|leads) (?:it|the \w+) (?:to )?)\s*$|"
                             r"\b(chose|chooses|choose|picked|picks|selected|selects|decided on|decided to|decides to|"
-                            r"preferred|prefers|opted for|opted to|went for|goes for)\s+(?:to\s+)?$", re.IGNORECASE)
+                            r"preferred|prefers|opted for|opted to|went for|goes for|went to|switched to|moved to)\s+"
+                            r"(?:to\s+)?$", re.IGNORECASE)
 _CHOICE_AFTER = re.compile(r"^\W{0,3}(?:\([^)]*\)\s*)?(?:was|is|got)?\s*(?:chosen|picked|selected|preferred|the choice)\b|"
                            r"^\W{0,3}(?:\([^)]*\)\s*)?(?:narrowly\s+|clearly\s+)?(?:won|wins|beat|beats|edged out|"
                            r"prevailed|came out ahead|comes out ahead|come out ahead|came out on top|comes out on top)\b",
@@ -161,8 +162,9 @@ def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: Fa
 
 
 #: a direction word that names a place, not a push: 'on the positive side', 'the lower quartile', 'lower than average'
-_NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blower(?:\s+|-)(?:than|quartile|end|bound|"
-                         r"half|tail|third|range|percentile|band|limit)\b|\b(?:their|its|his|her|whose)\s+lower\b|"
+_NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blower(?:\s+|-)(?:quartile|end|bound|"
+                         r"half|tail|third|range|percentile|band|limit)\b|\blower(?:\s+|-)than(?:\s+|-)(?:the\s+)?"
+                         r"(?:average|median|typical|usual|mean|norm|normal|most)\b|\b(?:their|its|his|her|whose)\s+lower\b|"
                          r"\b(?:might|may|could|would)\s+(?:\w+ly\s+)?(?:seem|appear|look|sound|suggest|imply|indicate)\s+"
                          r"(?:\w+ly\s+)?(?:an?\s+)?\w+|\b(?:positive|negative)\s+(?:prediction|outcome|diagnosis|class|"
                          r"result|label|case|classification)\b", re.IGNORECASE)

@@ -65,6 +65,9 @@ _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:bu
                      r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
 
+#: a subordinate clause between a direction word and a name: the name is that clause's subject
+_SUBORDINATE = re.compile(r"\b(?:after|before|when|while|because|since|although|though|if|once|until|whereas)\b",
+                          re.IGNORECASE)
 #: a participle after a comma says what the clause's subject does, not its last object
 _PARTICIPLE_AFTER_COMMA = re.compile(r"(?:tak|add|rais|lower|push|pull|cutt|reduc|increas|boost|cost|shav|knock|drag|"
                                      r"lift|decreas|subtract)\w*ing\b", re.IGNORECASE)
@@ -98,8 +101,10 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
     names = named_features(mentions)
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
     for i, m in enumerate(found):
-        if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(m, mentions):
-            continue  # 'a salaried job helps': helps the applicant, so lowers the risk? not a checkable direction
+        if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(m, mentions) and not (
+                re.match(r"\s+by\b", masked[m.end():]) and book.output == "actions" and any(
+                    x.kind == "action" and checks.resolve_action(x, book) == book.chosen for x in mentions)):
+            continue  # 'a salaried job helps': helps the applicant, so lowers the risk? ('It turned, helped by X': X)
         if book.output != "actions" and _SIDE_WORD.match(m.group(0)) and \
                 _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
             continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
@@ -118,6 +123,8 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
             nxt = found[i + 1].start() if i + 1 < len(found) else b
             subjects = [x for x in names if m.end() <= x.start < nxt]
+            if subjects and _SUBORDINATE.search(masked, m.end(), subjects[0].start):
+                subjects = []  # 'raised your risk the most after retirement lowered it': not retirement's
             if bare and subjects and ":" in masked[m.end():subjects[0].start]:
                 subjects = []  # 'Negative drivers outweighed positive ones: A, B': whose list is it? unsaid
             elif not subjects:
@@ -178,11 +185,14 @@ _QUANTITY_LABELS = {"net", "sum", "total", "delta", "change", "diff", "differenc
                     "shap", "phi", "value", "contribution", "attribution", "result", "overall", "uplift", "premium"}
 
 
+_OWNERS = {"its", "their", "your", "his", "her", "our", "my"}
+
+
 def unknown_label(text: str, name_words=frozenset()) -> list[Claim]:
     """A list item named by a label that is no feature and carries a signed number ('; roof condition -12.1k')."""
     m = _LIST_LABEL.fullmatch(text)
-    if m is None or any(w.lower() in _QUANTITY_LABELS for w in m.group("label").split()):
-        return []
+    if m is None or any(w.lower() in _QUANTITY_LABELS | _OWNERS for w in m.group("label").split()):
+        return []  # ('Its signal quality of -3.2 dB': something named before, vaguely)
     return _unknown_subject(m.group("label"), "a signed number", [], name_words)
 
 

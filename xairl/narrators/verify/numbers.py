@@ -44,7 +44,7 @@ _NUM_RE = re.compile(
     r"(?P<exp>[eE][+\-]?\d+)?(?!st\b|nd\b|rd\b|th\b)"
     r"(?:\s?(?P<suffix>k|K|M|bn)\b|\s(?P<scale>thousand|million|billion)\b)?"
     r"(?P<den>/\d+(?:\.\d+)?)?"
-    r"(?P<pct>\s?(?:%|percent\b|per cent\b|percentage points?\b|pp\b|-?points?\b|pts?\b))?")
+    r"(?P<pct>\s?(?:%|percent\b|per cent\b|percentage points?\b|pp\b|-?points?\b|pts?\b|(?:in|out of) 100\b))?")
 
 _WORDS = {"zero": 0, "one": 1, "two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8,
           "nine": 9, "ten": 10, "eleven": 11, "twelve": 12, "thirteen": 13, "fourteen": 14, "fifteen": 15,

@@ -336,7 +336,11 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
                     r"\bbase", near, re.IGNORECASE):  # 'older than average (18 vs. 16.8)': not the output's average
                 return Claim("number", n.text, "unchecked", "an average of another order of magnitude than the "
                                                             "output's: of something not named")
-            named = ("the baseline", [book.base])
+            prediction = book.scores[book.chosen]
+            if not re.search(r"\bbase", near, re.IGNORECASE) and (matches(n, prediction, magnitude_ok=False) or (
+                    n.percent and _percent_readings(n, prediction))):
+                return Claim("number", n.text, "verified", "the prediction (next to a word for the average)")
+            named = ("the baseline", [book.base])  # ('your risk is about average (33%)': the prediction)
         elif _OUT_WORDS.search(before):
             named = ("the prediction", [book.scores[book.chosen]])
     if named is not None and named[1]:
