@@ -48,7 +48,7 @@ from tests import narrative_domains as domains  # noqa: E402
 DATA = pathlib.Path(__file__).parent / "data" / "narratives"
 
 
-SPLITS = ("dev", "dev2", "dev3", "dev4", "dev5", "dev6", "dev7", "dev8", "dev9", "dev10", "dev11", "dev12", "dev13", "dev14", "dev15", "dev16", "dev17", "dev18", "test", "test2")
+SPLITS = ("dev", "dev2", "dev3", "dev4", "dev5", "dev6", "dev7", "dev8", "dev9", "dev10", "dev11", "dev12", "dev13", "dev14", "dev15", "dev16", "dev17", "dev18", "dev19", "test", "test2")
 
 
 def load_corpus() -> list[dict]:
