@@ -11,7 +11,8 @@ tickets, voice memos, amount verbs, signs in words, comparisons between features
 operators' corrections, sums, 'from x to y'), ``dev14/`` 31 in the storyteller voice of LLM-written SHAP narratives
 (values against the typical case), each written after the freeze and measured once before tuning on it. ``test2/``:
 48 more on the test cases (chat, letters, risk notes, decision logs), written after the test split's disagreements
-had been counted by cause (not read) and never tuned on: the second held-out figure. A narrative counts as agreeing when ``Verification.ok`` equals its label.
+had been counted by cause (not read) and never tuned on: the second held-out figure. A narrative counts as agreeing
+when ``Verification.ok`` equals its label.
 
     .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain, error kind, cause; speed
     .venv/bin/python benchmarks/bench_verifier.py --show test # also every disagreement of the test split
@@ -48,7 +49,7 @@ from tests import narrative_domains as domains  # noqa: E402
 DATA = pathlib.Path(__file__).parent / "data" / "narratives"
 
 
-SPLITS = ("dev", "dev2", "dev3", "dev4", "dev5", "dev6", "dev7", "dev8", "dev9", "dev10", "dev11", "dev12", "dev13", "dev14", "dev15", "dev16", "dev17", "dev18", "dev19", "test", "test2")
+SPLITS = ("dev", *(f"dev{k}" for k in range(2, 20)), "test", "test2")
 
 
 def load_corpus() -> list[dict]:
@@ -163,7 +164,8 @@ def shapstories_case(dataset: str, index: int) -> tuple[int, xairl.Explanation, 
                             outputs=np.array([[prediction]]), states=states, feature_names=names,
                             action_names=(domain["output"],), method="given", output="value",
                             background_quantiles=quartiles, categories=cats or None)
-    info = {f: xairl.FeatureInfo(d[4] if len(d) > 4 else "", d[0], categories=cats.get(f, ())) for f, d in feats.items()}
+    info = {f: xairl.FeatureInfo(d[4] if len(d) > 4 else "", d[0], categories=cats.get(f, ()))
+            for f, d in feats.items()}
     policy = xairl.Policy(torch.nn.Linear(len(names), 1), list(names), [domain["output"]], features=info,
                           output="value", name=dataset)
     return batch, exp, policy
@@ -211,8 +213,11 @@ def main() -> None:
         agree = sum(it["ok"] == it["accurate"] for it in items)
         print(f"## {name} (outside): agreement {agree}/{len(items)} = {100 * agree / len(items):.1f} %")
         print("| group | agree | n |\n|---|---|---|")
-        for k, a, n in table(items, lambda it: (f"{it['split']}, {it['domain']}, {it['error']}" if args.shapstories
-                                                else ("accurate: " if it["accurate"] else "inaccurate: ") + it["error"])):
+        def group(it):
+            if args.shapstories:
+                return f"{it['split']}, {it['domain']}, {it['error']}"
+            return ("accurate: " if it["accurate"] else "inaccurate: ") + it["error"]
+        for k, a, n in table(items, group):
             print(f"| {k} | {a} | {n} |")
         if args.shapstories:
             for k, a, n in table(items, lambda it: it["error"]):

@@ -171,6 +171,7 @@ def test_held_out_corpus_agreement(corpus):
     floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("dev6", 0.97),
               ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("dev10", 0.97), ("dev11", 0.94), ("dev12", 0.94),
               ("dev13", 0.95), ("dev14", 0.93), ("dev15", 0.92), ("dev16", 0.95), ("dev17", 0.9), ("dev18", 0.88),
+              ("dev19", 0.95),
               ("test", 0.93), ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
@@ -499,6 +500,16 @@ ON_CASES = [
     ("credit-1", "Your salaried job brings the risk down. Your low debt, though, pushes it up.", "contradicted"),
     ("toy-0", "It went to recharge because it was barely moving.", "verified"),
     ("toy-0", "It went to turn because it was barely moving.", "contradicted"),
+    # dev19: long reports. 'overall' is an adverb, not overall_quality; 'it' names what came before; 'the 8.32-point
+    # lead' is the margin; 'two inputs dominate: A ..., B ...' ranks them top two
+    ("housing-2", "The one real weakness is the kitchen. Rated fair, it takes $23,750 off, the third-largest effect "
+                  "overall.", "verified"),
+    ("toy-0", "Speed is worth 5.56 of the 8.32-point lead.", "verified"),
+    ("toy-0", "Speed is worth 5.56 of the 9.32-point lead.", "contradicted"),
+    ("toy-2", "Two inputs dominate the comparison with recharging: wind favours turning by 5.31 and speed favours "
+              "recharging by 5.48.", "verified"),
+    ("toy-2", "Two inputs dominate the comparison with recharging: wind favours turning by 5.31 and the obstacle "
+              "by 1.50.", "contradicted"),
     # ranks among one sign (credit-2: employment +0.128 first overall, the ratio -0.127 first of those lowering it)
     ("credit-2", "The biggest factor working against default was the low debt-to-income ratio.", "verified"),
     ("credit-2", "The biggest factor working against default was the 26-year credit history.", "contradicted"),

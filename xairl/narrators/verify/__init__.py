@@ -9,8 +9,9 @@ A small pipeline, one module per step:
 3. this module splits sentences into clauses and decides each clause's view (the chosen action's score, the margin
    over the runner-up, or either); :mod:`.binding` binds each number to the name it is about (the name before it
    in its clause, pairwise for 'A and B ... by x and y, respectively', an action's score, the margin, the
-   prediction, a typical value, the change from the baseline); :mod:`.directions` binds each direction word to the list of names nearest before it (or a list after it,
-   'Raising risk: A, B'), and :mod:`.ranks` each rank, 'barely matters' and 'A mattered more than B' phrase;
+   prediction, a typical value, the change from the baseline); :mod:`.directions` binds each direction word to
+   the list of names nearest before it (or a list after it, 'Raising risk: A, B'), and :mod:`.ranks` each rank,
+   'barely matters' and 'A mattered more than B' phrase;
 4. :mod:`.quantities` (numbers), :mod:`.checks` (actions, categories, directions) and :mod:`.ranks` check each
    claim against :mod:`.book` (values, contributions to the chosen action's score and to the margin over the
    runner-up, ranks, shares, labels, scores, domain comparisons) and say verified, contradicted or unchecked;
@@ -98,7 +99,8 @@ _SENTENCE_RE = re.compile(r"(?<=[.!?])\s+(?=\S)|\n+\s*(?:[-•*]\s*)?")
 _ABBREVIATION = re.compile(r"(?:^|[\s(])(?:e\.g|i\.e|vs|approx|ca|etc|no|fig|cf)\.$", re.IGNORECASE)
 _CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|"
                         r"however)\b(?!,)"  # ('A, though, pushes it up': an aside)
-                        r"|,\s(?:and\s)?(?=but\b)|\s?[—–]\s?(?=(?:likely|possibly|perhaps|probably|since|as|because|this|"
+                        r"|,\s(?:and\s)?(?=but\b)|\s?[—–]\s?(?=(?:likely|possibly|perhaps|probably|since|as|because|"
+                        r"this|"
                         r"which|suggesting|unsurprising)\b)|\s(?=because\b(?!\s+of\b))", re.IGNORECASE)
 #: ', while slightly elevated, was ...': an aside inside the clause (no subject of its own), not a clause
 _APPOSITIVE = re.compile(r"\s(?:while|although|though)\s+(?:\w+ly\s+)?(?:[a-z]+ed|[a-z]+ing|high|low|above|below|"
@@ -262,7 +264,8 @@ _OWN_QUANTITY = re.compile(r"\bof\s+(?:the\s+)?[$€£]?$", re.IGNORECASE)
 _NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
                       r"(?:(?:because of|due to|about|the|its|their|a|an)\s+){0,3}$", re.IGNORECASE)
 #: a sentence about what did not happen: 'Had X been better, ...', 'Without X, it would have ...', 'If it were not
-#: for X'; a modal elsewhere ('chose recharge, which could save battery', 'lower than it would be') leaves the rest checked
+#: for X'; a modal elsewhere ('chose recharge, which could save battery', 'lower than it would be') leaves the rest
+#: checked
 _HYPOTHETICAL = re.compile(r"^\W*(?:if|had|without|were|absent|but for)\b|(?<!than it )(?<!than they )"
                            r"\b(?:would|could|might)(?:\s+\w+ly)?\s+"
                            r"(?:(?:not|never)\s+)?(?:have|be)\b|\bif it (?:were|was)(?:n't| not) for\b", re.IGNORECASE)

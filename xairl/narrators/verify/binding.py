@@ -20,7 +20,8 @@ _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of
 _ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
                       r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$|"
                       r"\b(?:drags?|dragged|pushe?s?|pushed|pulls?|pulled|brings?|brought|takes?|took|moves?|moved|"
-                      r"lowers?|lowered|raises?|raised|lifts?|lifted)\b[^.;]{0,40},?(?<!close)(?<!due)(?<!thanks)(?<!up)"
+                      r"lowers?|lowered|raises?|raised|lifts?|lifted)\b[^.;]{0,40},?(?<!close)(?<!due)(?<!thanks)"
+                      r"(?<!up)"
                       r"(?<!next)(?<!compared)(?<!relative)(?<!similar)\s+to\s+(?:about|around|roughly|"
                       r"only|just)?\s*[$€£]?$", re.IGNORECASE)
 _FROM = re.compile(r"\bfrom\s+(?:(?:an?|the|its)\s+)?(?:(?:average|base(?:line)?|base rate|starting point|typical)"
@@ -43,10 +44,12 @@ _ITEM_VERB = re.compile(r"ed\b|\b(?:is|was|are|were|has|had|have|accounts?|adds?
                         r"contributes?|explains?|costs?|counts?|weighs?|pulls?|pushes?|lowers?|raises?|cuts?|"
                         r"drives?|moves?|shifts?|sits?|comes?)\b", re.IGNORECASE)
 #: "it's worth about $316k", 'your chance of default is put at 43 in 100': the thing the model is about, valued
-OUTPUT_BEFORE = re.compile(r"\b(?:it|this house|the house|the home|this home|the property|your home|your house)(?:'s| is| was|"
-                           r" would be|'d be)\s+(?:now\s+|still\s+)?(?:worth|valued at|priced at|estimated at|put at)\s+"
+OUTPUT_BEFORE = re.compile(r"\b(?:it|this house|the house|the home|this home|the property|your home|your house)"
+                           r"(?:'s| is| was| would be|'d be)\s+(?:now\s+|still\s+)?(?:worth|valued at|priced at|"
+                           r"estimated at|put at)\s+"
                            r"(?:about|around|roughly|some|just under|just over|nearly|almost)?\s*[$€£]?$|"
-                           r"\b(?:chance|risk|probability|likelihood) of [\w\s]{1,20}? is (?:put |estimated |rated )?at\s+"
+                           r"\b(?:chance|risk|probability|likelihood) of [\w\s]{1,20}? is (?:put |estimated |rated )?"
+                           r"at\s+"
                            r"(?:about|around|roughly)?\s*$", re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
 _OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
@@ -115,7 +118,8 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 70):n.start]) or _FROM_TO.search(
             masked[max(0, n.start - 60):n.start])):
         return quantities.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
-    if book.margin is not None and _LEAD_OF.search(masked[max(0, n.start - 30):n.start]):
+    if book.margin is not None and (_LEAD_OF.search(masked[max(0, n.start - 30):n.start]) or
+                                    quantities.MARGIN_AFTER.match(masked[n.end:n.end + 30])):  # 'the 8.32-point lead'
         return quantities.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named
     after = masked[n.end:n.end + 24]
     nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
@@ -152,7 +156,7 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     gap_text = re.sub(r"\([^()]*\)", "()", masked[prev.end:n.start]) if prev is not None else ""
     item = _NEW_ITEM.search(gap_text)
     if item is not None and re.search(r"\d", gap_text[:item.start()]) and not _ITEM_VERB.search(item.group("words")) \
-            and not checks.DIRECTION_RE.search(item.group("words")):  # '..., year 1945': a new item ('..., added 6.8': not)
+            and not checks.DIRECTION_RE.search(item.group("words")):  # '..., year 1945' (not '..., added 6.8')
         prev = None
     if prev is not None and not re.search(r"(?:,\s*|\sand\s+)(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s"
                                           r"(?!(?:most|second|third|main|largest|biggest|top|strongest)\b)",

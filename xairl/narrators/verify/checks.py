@@ -33,7 +33,8 @@ _POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|support
 _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ ){0,2}down|"
         r"push(?:es|ed|ing)? (?:\w+ ){0,2}down|nudg\w* (?:\w+ )?down|subtract\w*|"
         r"tak(?:es|ing|e) (?:[\w.,$€£]+ ){0,4}(?:off|away)|"
-        r"took (?:[\w.,$€£]+ ){0,4}(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|negative(?:ly)?|"
+        r"took (?:[\w.,$€£]+ ){0,4}(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|"
+        r"negative(?:ly)?|"
         r"less likely|"
         r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
         r"los(?:t|ing)|diminish\w*|penali[sz]\w*|hurt(?:s|ing)?|h[eo]ld(?:s|ing)? (?:\w+ ){0,2}back(?: from)?|"
@@ -63,9 +64,10 @@ _CHOICE_BEFORE = re.compile(r"(?:[:→]|->|=>|\b(?:made|makes|led|leads) (?:it|t
                             r"\b(chose|chooses|choose|picked|picks|selected|selects|decided on|decided to|decides to|"
                             r"preferred|prefers|opted for|opted to|went for|goes for|went to|switched to|moved to)\s+"
                             r"(?:to\s+)?$", re.IGNORECASE)
-_CHOICE_AFTER = re.compile(r"^\W{0,3}(?:\([^)]*\)\s*)?(?:was|is|got)?\s*(?:chosen|picked|selected|preferred|the choice)\b|"
+_CHOICE_AFTER = re.compile(r"^\W{0,3}(?:\([^)]*\)\s*)?(?:was|is|got)?\s*(?:chosen|picked|selected|preferred|"
+                           r"the choice)\b|"
                            r"^\W{0,3}(?:\([^)]*\)\s*)?(?:narrowly\s+|clearly\s+)?(?:won|wins|beat|beats|edged out|"
-                           r"prevailed|came out ahead|comes out ahead|come out ahead|came out on top|comes out on top)\b",
+                           r"prevailed|comes? out ahead|came out ahead|comes? out on top|came out on top)\b",
                            re.IGNORECASE)
 _RUNNER_AFTER = re.compile(r"^\W{0,3}(?:\([^)]*\)\s*)?(?:came|was|is|as)?\s*(?:the\s+|a\s+)?(?:close\s+|distant\s+)?"
                            r"(?:second|runner.up)\b", re.IGNORECASE)
@@ -164,8 +166,10 @@ def direction_target(masked: str, m: re.Match, mentions: list[Mention], book: Fa
 #: a direction word that names a place, not a push: 'on the positive side', 'the lower quartile', 'lower than average'
 _NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blower(?:\s+|-)(?:quartile|end|bound|"
                          r"half|tail|third|range|percentile|band|limit)\b|\blower(?:\s+|-)than(?:\s+|-)(?:the\s+)?"
-                         r"(?:average|median|typical|usual|mean|norm|normal|most)\b|\b(?:their|its|his|her|whose)\s+lower\b|"
-                         r"\b(?:might|may|could|would)\s+(?:\w+ly\s+)?(?:seem|appear|look|sound|suggest|imply|indicate)\s+"
+                         r"(?:average|median|typical|usual|mean|norm|normal|most)\b|"
+                         r"\b(?:their|its|his|her|whose)\s+lower\b|"
+                         r"\b(?:might|may|could|would)\s+(?:\w+ly\s+)?(?:seem|appear|look|sound|suggest|imply|"
+                         r"indicate)\s+"
                          r"(?:\w+ly\s+)?(?:an?\s+)?\w+|\b(?:positive|negative)\s+(?:prediction|outcome|diagnosis|class|"
                          r"result|label|case|classification)\b", re.IGNORECASE)
 

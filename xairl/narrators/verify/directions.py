@@ -206,6 +206,8 @@ def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_word
     if all(w.lower() in _VAGUE or w.lower() in GENERIC or w.lower() in _LINKS or w.lower().endswith("ly")
            for w in head):
         return []  # vague: perhaps a feature, not an invented one
+    if re.search(r"\b(?:it|this|that|they|these|those|which|who)\W*$", subject.replace("\0", " "), re.IGNORECASE):
+        return []  # 'Rated fair, it takes $23,750 off': a pronoun for something named before
     if _ELLIPTIC.match(re.sub(r".*\b(while|although|though|whereas|if|when)\s*$", r"\1 ", opener) + subject):
         return []  # '..., while slightly elevated, was still lower ...': the subject is the main clause's
     if mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")) or \

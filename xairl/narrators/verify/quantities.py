@@ -29,7 +29,10 @@ MARGIN_BEFORE = re.compile(r"\b(margin|lead|edge|gap|advantage|difference)(?: of
                             r"a bit over|a little over|some|nearly|almost)?\s*$", re.IGNORECASE)
 _ON_AVERAGE = re.compile(r"^\s*(?:on average|over the background|across the background|at baseline|by default)\b",
                          re.IGNORECASE)
-_MARGIN_AFTER = re.compile(r"^\s*(?:points?\s+)?(?:above|ahead|higher|more than)\b", re.IGNORECASE)
+#: '3.9 points ahead', 'the 8.32-point lead', '3.9 points of margin': the margin
+MARGIN_AFTER = re.compile(r"^\s*(?:points?\s+)?(?:above|ahead|higher|more than)\b|"
+                          r"^(?:-?\s*points?)?\s+(?:lead|margin|gap|edge|advantage)\b|"
+                          r"^\s+points?\s+of\s+(?:lead|margin|gap)\b", re.IGNORECASE)
 _RUNNER_BEFORE = re.compile(r"(?<!bit )(?<!little )(?<!just )(?<!well )(?<!slightly )(?<!touch )(?<!hair )"
                             r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?[$€£]?\s*$",
                             re.IGNORECASE)
@@ -74,7 +77,8 @@ _STAT_BEFORE = re.compile(r"\b(?P<word>average|typical|median|mean|usual|normal|
                           r"[A-Za-z'\0-]+){0,5}?)\s*(?:of|at|from|is|was|:|=|\()?\s*(?:about|around|roughly|nearly|"
                           r"approximately|only|just|close to|over|under|above|below|~|≈)?\s*[$€£]?\s*"
                           r"(?:[\d.,]+\s*(?:-|–|to)\s*)?$", re.IGNORECASE)
-_OUTPUT_NOUN = re.compile(r"\b(?:predict\w*|estimat\w*|output|probabilit\w*|chances?|risk|rate|price|scores?|q[- ]?values?)"
+_OUTPUT_NOUN = re.compile(r"\b(?:predict\w*|estimat\w*|output|probabilit\w*|chances?|risk|rate|price|scores?|"
+                          r"q[- ]?values?)"
                           r"\b", re.IGNORECASE)
 
 
@@ -310,12 +314,12 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     fact or, when it is a contribution, the one feature whose contribution it is."""
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 30]
     named = None
-    if is_change(n, masked) and book.base is not None:  # '$91,462 above the baseline', 'exceeds the base rate (0.34) by 0.09'
+    if is_change(n, masked) and book.base is not None:  # '$91,462 above the baseline', 'exceeds ... (0.34) by 0.09'
         change = book.scores[book.chosen] - book.base
         ok = matches(n, change) or (n.percent and _percent_readings(n, abs(change)))
         return Claim("number", n.text, "verified" if ok else "contradicted", f"the change from the baseline is "
                      f"{change:.4g}")
-    if MARGIN_BEFORE.search(before) or _MARGIN_AFTER.match(after):
+    if MARGIN_BEFORE.search(before) or MARGIN_AFTER.match(after):
         named = ("the margin", [book.margin if book.margin is not None else 0.0])  # one available action: 0
     elif (_SCORE_BEFORE.search(before) or (book.output == "actions" and re.match(r"^\s*(vs\.?|versus)\s", after))) \
             and book.chosen in book.scores:

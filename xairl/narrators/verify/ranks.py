@@ -17,8 +17,8 @@ NOUN = r"(?:features?|factors?|drivers?|reasons?|contributors?|contributions?|in
 TOPWORD = r"(?:most important|most influential|most significant|most decisive|biggest|largest|strongest|main|top|" \
            r"primary|key|dominant|leading|greatest|decisive|single biggest|single largest|one big|big)"
 RANK_RE = re.compile(
-    rf"\b(?:(?P<ord>second|third|fourth|fifth|2nd|3rd|4th)(?: most important| most influential| biggest| largest|"
-    rf" strongest)?\s+(?:single\s+)?{NOUN}"
+    rf"\b(?:(?P<ord>second|third|fourth|fifth|2nd|3rd|4th)(?:[\s-]most[\s-]important|[\s-]most[\s-]influential|"
+    rf"[\s-]biggest|[\s-]largest|[\s-]strongest)?\s+(?:single\s+)?{NOUN}"
     rf"|(?P<because>(?:mostly|mainly|chiefly|largely|primarily) (?:because of|due to|thanks to|on|driven by))"
     rf"|(?:the\s+)?(?P<plural>(?:two|three|four|2|3|4)\s+(?:most important|largest|biggest|strongest|main)|"
     rf"(?:top|the)[\s-]+(?P<k>two|three|four|2|3|4)(?:\s+most important|\s+largest|\s+biggest)?)\s+{NOUN}"
@@ -27,7 +27,8 @@ RANK_RE = re.compile(
     rf"|(?:is|was) the (?:single )?(?:largest|biggest|strongest|greatest|most important|most influential)(?![ \w]*\w)"
     rf"|top[\s-](?P<topk>\d)\b)", re.IGNORECASE)
 AFTER_ORD = re.compile(r"^\W{0,3}(?:[a-z]+\s+)?(?:was\s+|is\s+|came\s+|a\s+(?:distant|close)\s+)?"
-                       r"(?P<o>second|third|fourth|first(?=\s*[(,;:]|\s+(?:then|and|followed)\b|\s*$))\b", re.IGNORECASE)
+                       r"(?P<o>second|third|fourth|first(?=\s*[(,;:]|\s+(?:then|and|followed)\b|\s*$))\b",
+                       re.IGNORECASE)
 FOLLOWED = re.compile(r"\b(?:followed(?: closely)? by|then|next(?: came| was)?|after that|ahead of|second only to)\s*$",
                        re.IGNORECASE)
 MINOR_RE = re.compile(r"\b(?:barely|hardly|scarcely)\s+(?:\w+\s+)?(?:matter\w*|mov\w*|regist\w*|chang\w*|affect\w*|"
@@ -61,7 +62,8 @@ def rank_claim(m: re.Match, masked: str) -> tuple[int, bool, int]:
 #: way')
 OWN_SIDE = 2
 #: 'the biggest factor working against default': a participle between the rank and its direction word
-_PARTICIPLE = re.compile(r"\s(?:working|pulling|pushing|acting|weighing|counting|going|tilting|leaning)\s+", re.IGNORECASE)
+_PARTICIPLE = re.compile(r"\s(?:working|pulling|pushing|acting|weighing|counting|going|tilting|leaning)\s+",
+                         re.IGNORECASE)
 _OTHER_WAY = re.compile(r"\s(?:\w+ing\s+)?(?:in\s+)?the\s+(?:other|opposite)\s+(?:way|direction)\b", re.IGNORECASE)
 
 
@@ -126,6 +128,8 @@ def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | N
     return over_keys(a_keys, test, "comparison", text, "rank")
 
 
+#: 'Two inputs dominate', 'both features dominate': a plural rank of that many
+_COUNTED = re.compile(r"\b(two|three|four|both)\s+(?:[\w-]+\s+)?$", re.IGNORECASE)
 #: a rank in what would (not) be: 'enough to make X a dominant predictor', 'would make X the main reason'
 _WOULD_MAKE = re.compile(r"\b(?:enough to|would|could|might|to)\s+(?:make|render|become)\b[^.;]{0,30}$", re.IGNORECASE)
 #: a rank said of several features at once
@@ -188,6 +192,9 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if _WOULD_MAKE.search(masked, max(a, m.start() - 50), m.start()):
             continue  # 'not severe enough to make age a dominant predictor': what did not happen
         rank, plural, sign = rank_claim(m, masked)
+        count = _COUNTED.search(masked, max(a, m.start() - 30), m.start())
+        if count and m.group(0).lower().startswith("dominat"):  # 'Two inputs dominate ...: A ..., B ...'
+            rank, plural = COUNT.get(count.group(1).lower(), 2), True
         gap = _PARTICIPLE.match(masked, m.end(), b)
         said = DIRECTION_RE.match(masked, gap.end() if gap else m.end() + 1, b) \
             if masked[m.end():m.end() + 1] == " " else None
@@ -297,7 +304,8 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
             subjects = [x for x in names if x.end <= m.start()][-1:]
         way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
         if m.group("out") and len(subjects) > 1 and all(len(x.keys) == 1 for x in subjects) and \
-                not re.search(r"\b(?:both|each|all|individually)\b", masked[subjects[0].start:m.start()], re.IGNORECASE):
+                not re.search(r"\b(?:both|each|all|individually)\b", masked[subjects[0].start:m.start()],
+                              re.IGNORECASE):
             out.append(check_outweighs([x.keys[0] for x in subjects], b_name.keys[0], ctx, book, m.group(0).strip()))
         else:
             for x in subjects:
