@@ -611,6 +611,28 @@ OUTSIDE = [
      "verified"),
     ("stroke", 15, "Other factors were not severe enough to make age a dominant predictor; age lowered the risk.",
      "verified"),
+    # South German Credit (good-credit probability): a number of the meaning of a code in the description's legend
+    # (status 4 = '200 DM or more', savings 3 = '100 to 500 DM')
+    ("credit", 175, "Having a checking account balance above 200 DM strongly increased the likelihood.", "verified"),
+    ("credit", 175, "Having a checking account balance below 0 DM strongly increased the likelihood.", "contradicted"),
+    ("credit", 175, "Their savings account balance (between 100 and 500 DM) further reinforced the prediction.",
+     "verified"),
+    ("credit", 175, "Their savings account balance (over 1000 DM) further reinforced the prediction.", "contradicted"),
+    ("credit", 124, "Another key factor was their long employment duration (over 7 years).", "verified"),
+    ("credit", 124, "The key factor was their long employment duration (over 7 years).", "contradicted"),
+    ("credit", 675, "The loan duration of 6 months was much shorter than average (21 months).", "verified"),
+    ("credit", 675, "The loan duration of 6 months was much shorter than average (91 months).", "contradicted"),
+    # a good outcome's 'risk' is its inverse framing; 'raised concerns', 'this negative impact', 'balanced X against
+    # Y' and a 'because' clause's subject claim no direction of a feature; 'added to the negative outlook' lowers
+    ("credit", 571, "The loan amount of 9,055 DM raised concerns; the purpose slightly reduced risk.", "verified"),
+    ("credit", 319, "However, this negative impact was partially offset by the customer's status (value: 4), which "
+                    "boosted the prediction.", "verified"),
+    ("credit", 700, "The prediction balanced the customer's financial gaps against their strong savings, which boosted "
+                    "it.", "verified"),
+    ("credit", 990, "Having no savings account (value 1) added to the negative outlook.", "verified"),
+    ("credit", 990, "Being unemployed (value 1) added to the positive outlook.", "contradicted"),
+    ("credit", 319, "Other installment plans (value: 1) slightly lowered the probability, because existing debt "
+                    "obligations increase repayment risk.", "verified"),
 ]
 
 

@@ -90,7 +90,8 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
         return quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
     span = max(0, n.start - 60)
     stat = quantities.statistic(masked[span:n.start], any(m.kind == "action" and span <= m.start < n.start
-                                                          for m in mentions), book.output == "actions")
+                                                          for m in mentions), book.output == "actions",
+                                bool(re.match(r"[^()]*?\b(?:vs\.?|versus|compared)\b", masked[n.end:n.end + 40])))
     if stat == "output" and book.output != "actions":  # 'the average sale price of $230,061', 'the baseline of 0.34'
         c = quantities.base_number(n, book)  # ... unless it is the prediction ('at the average risk: 33 %')
         if c.status == "verified" or not quantities.output_number(n, book).status == "verified":

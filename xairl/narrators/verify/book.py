@@ -32,6 +32,7 @@ class FeatureFacts:
     shares: dict[str, float] = field(default_factory=dict)    # context -> % of the sum of |contributions|
     fill: float | None = None                                 # % of the feature's capacity
     quartiles: tuple[float, float, float] | None = None       # the background's 25th, 50th and 75th percentiles
+    legend: dict[int, str] = field(default_factory=dict)      # code -> its meaning, from the description's legend
 
 
 @dataclass
@@ -53,6 +54,19 @@ class FactBook:
     @property
     def contexts(self) -> tuple[str, ...]:
         return ("chosen", "margin") if self.runner_up else ("chosen",)
+
+
+_LEGEND_ENTRY = re.compile(r"^\s*(\d+)\s*[:=]?\s+(\S.*?)\s*$")
+
+
+def legend(description: str) -> dict[int, str]:
+    """A data dictionary's legend of codes in a description: 'savings (1 none, 2 below 100 DM, 3 100 to 500 DM)' ->
+    {1: 'none', 2: 'below 100 DM', 3: '100 to 500 DM'}; at least two entries, else none."""
+    for inside in re.findall(r"\(([^()]*)\)", description or ""):
+        entries = [_LEGEND_ENTRY.match(part) for part in re.split(r"[,;]", inside)]
+        if len(entries) >= 2 and all(entries):
+            return {int(m.group(1)): m.group(2) for m in entries}
+    return {}
 
 
 def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None) -> FactBook:
@@ -98,6 +112,8 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
             feats[f].label = str(labels[index, j])
         if exp.background_quantiles is not None:
             feats[f].quartiles = tuple(float(q) for q in exp.background_quantiles[:, j])
+        if info is not None:
+            feats[f].legend = legend(info.description)
     scores = {a: float(exp.outputs[index, k]) for k, a in enumerate(exp.action_names)}
     base = float(exp.base_values[index, chosen_i])
     numbers = [d.score, base, d.score - base, d.additivity_gap, *scores.values()]

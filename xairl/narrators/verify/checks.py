@@ -171,7 +171,9 @@ _NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blowe
                          r"\b(?:might|may|could|would)\s+(?:\w+ly\s+)?(?:seem|appear|look|sound|suggest|imply|"
                          r"indicate)\s+"
                          r"(?:\w+ly\s+)?(?:an?\s+)?\w+|\b(?:positive|negative)\s+(?:prediction|outcome|diagnosis|class|"
-                         r"result|label|case|classification)\b", re.IGNORECASE)
+                         r"result|label|case|classification)\b|\b(?:raised?|raising|rais\w+)\s+(?:some\s+|serious\s+)?"
+                         r"(?:concerns?|questions?|doubts?|eyebrows|(?:red\s+)?flags?|alarms?)\b|"
+                         r"\b(?:this|that|these|those|the same)\s+(?:positive|negative)\b", re.IGNORECASE)
 
 
 def is_frame(masked: str, m: re.Match) -> bool:
@@ -183,6 +185,9 @@ def is_frame(masked: str, m: re.Match) -> bool:
         return True
     if m.group(0).lower() != "against":
         return False
+    if re.search(r"\b(?:balanc\w*|weigh\w*|set|sets|pitt\w*)\s+(?:[\w\0'’-]+\s+){1,8}$",
+                 masked[max(0, m.start() - 70):m.start()], re.IGNORECASE):
+        return True  # 'balanced the customer's gaps against their savings': two things set side by side
     after = masked[m.end():m.end() + 30]
     return bool(re.match(r"^\s*(?:a\s+|an\s+|the\s+)?[+\-]?[$€£]?[+\-]?\s*[\d.]|^\s*(that|this)\b", after)
                 or re.search(r"(^|[.;:\n]\s*)$", masked[:m.start()]))

@@ -84,10 +84,12 @@ def _unsaid_side(masked: str, m: re.Match, mentions: list[Mention], book: FactBo
     if side is None or side.start("obj") - m.start() > 60:
         return False
     output = any(x.kind == "action" and x.start == side.start("obj") for x in mentions) or \
-        side.group("obj").lower() in split_words(book.chosen or "")  # 'toward diabetes' of diabetes_probability
+        side.group("obj").lower() == (split_words(book.chosen or "") or [""])[0]  # 'toward diabetes' (diabetes_...)
     return not (output or _UP_SIDE.match(side.group("obj")) or checks.toward_no(masked, m.start()))
 
 
+#: words of an output that is a good outcome (its risk is the inverse framing)
+_GOOD_OUTCOME = {"good", "pass", "approval", "approved", "repay", "repayment", "success", "survival", "win"}
 #: 'positive contributions from A and B': the names after the direction word are its subject
 _OF_WHAT = re.compile(r"\s+(?:contributions?|effects?|impacts?|influences?|pushe?s?)\s+(?:from|of|by)\s", re.IGNORECASE)
 #: a coordinated clause with a subject of its own after an earlier direction word: 'A lowered it by x, and B cost y'
@@ -110,9 +112,14 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
         if any(x.kind == "feature" and 0 < x.start - m.end() <= 1 for x in mentions):
             continue  # 'relatively lower glucose levels': a value said of the feature, not a push
+        if book.output != "actions" and re.match(r"\s+(?:the\s+|their\s+|its\s+|default\s+|credit\s+)?risk\b",
+                                                 masked[m.end():]) and _GOOD_OUTCOME & set(split_words(book.chosen or "")):
+            continue  # 'reduced risk' of a good-credit probability: the framing is the output's inverse
         if book.output != "actions" and _unsaid_side(masked, m, mentions, book):
             continue  # 'tipped the prediction toward failure': which side of the one output is that? unsaid
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
+        if re.match(r"\s+to\s+(?:the\s+)?(?:negative|downside|risks?|concerns?|worries)\b", masked[m.end():]):
+            polarity = -polarity  # 'added to the negative outlook'
         subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
         if _PARTICIPLE_AFTER_COMMA.match(m.group(0)) and re.search(r",\s*$", masked[a:m.start()]) and names and \
                 names[0].start < m.start():
@@ -132,7 +139,9 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
                 inside = [x for x in mentions if prev <= x.start < m.start()]
                 pronoun = re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE)
                 opener = masked[max(0, prev - 12):prev] if i == 0 else ""
-                if i == 0 and (book.output != "actions" or not pronoun):  # ('tipped the balance toward': one claim)
+                reasoning = re.match(r"\W*(?:because|since|as)\b", masked[a:b], re.IGNORECASE)
+                if i == 0 and (book.output != "actions" or not pronoun) and not reasoning:  # (a 'because' clause:
+                    # the writer's reasoning about the world, not about this model's features)
                     out += _unknown_subject(subject, m.group(0), inside, name_words, opener)
                 elif i > 0 and (joined := _NEW_CLAUSE.search(subject)):  # '..., and the basement cost another $12,000'
                     rest = prev + joined.end()

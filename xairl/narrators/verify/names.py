@@ -25,7 +25,8 @@ GENERIC = {"size", "area", "number", "total", "rate", "ratio", "level", "value",
            "year", "feature", "count", "amount", "length", "time", "state", "status", "quality", "id", "feet",
            "square", "sq", "ft", "kb", "m", "db", "dbm", "bit", "bits", "percent", "one", "two", "model", "data",
            "information", "prediction", "new", "old", "high", "low", "first", "second", "third", "average",
-           "strongest", "weakest", "biggest", "largest", "main", "top", "overall"}  # rank words say which, not what
+           "strongest", "weakest", "biggest", "largest", "main", "top", "overall",
+           "other", "others"}  # rank words say which, not what
 #: participles that name a feature whose words are said the other way round ('year built' -> 'the build year')
 _BASE_FORM = {"built": "build", "sold": "sale", "made": "make", "paid": "pay", "owned": "own", "used": "use"}
 _IRREGULAR = {"keep": "kept", "go": "went", "choose": "chose", "hold": "held", "run": "ran", "stay": "stayed"}

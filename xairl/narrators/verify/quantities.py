@@ -9,7 +9,7 @@ from dataclasses import replace
 
 from .book import FactBook
 from .checks import EITHER, Claim, over_keys
-from .numbers import Number, matches
+from .numbers import Number, find_numbers, matches
 
 CONTRIB_BEFORE = re.compile(
     r"(?:\bby|\badds?|\badded|\badding|contribut\w*|\bworth|\bcosts?|\bcosting|subtract\w*|\boff|\baway|\bcut\w*|"
@@ -88,14 +88,16 @@ _VERSUS = re.compile(r"[\d%]\s*(?:\w+\s+)?(?:vs\.?|versus|compared (?:to|with))\
                      r"[~≈]?\s*$", re.IGNORECASE)
 
 
-def statistic(before: str, action_named: bool = False, several_outputs: bool = False) -> str | None:
+def statistic(before: str, action_named: bool = False, several_outputs: bool = False, versus: bool = True
+              ) -> str | None:
     """Is the number right after ``before`` a statistic of the background? 'output' (the baseline: 'the average
     prediction of', 'the base rate of'), 'feature' ('the typical borrower of about', 'the median of') or None.
     ``action_named``: an action is named between the statistic's word and the number ('the average sale price of');
-    ``several_outputs``: 'vs' sets two scores side by side ('7.53 vs 7.38'), not a value and its typical one."""
+    ``several_outputs``: 'vs' sets two scores side by side ('7.53 vs 7.38'), not a value and its typical one;
+    ``versus``: the bracket the number opens goes on with 'vs' ('than average (2 vs. 3)': the first is the value)."""
     m = _STAT_BEFORE.search(before)
     if m is not None and m.group(0).rstrip().endswith("(") and re.search(r"\bthan\s+(?:the\s+)?$",
-                                                                          before[:m.start()]):
+                                                                          before[:m.start()]) and versus:
         m = None  # 'fewer absences than average (2 vs. ~5.75)': the bracket opens with the student's own value
     if m is None:
         return "feature" if not several_outputs and _VERSUS.search(before) else None
@@ -193,6 +195,9 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         scale = {"k": 1e3, "M": 1e6, "G": 1e9}[prefix.group(1)] if prefix else 1.0
         value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or slot or bool(prefix)) \
             and not contrib_cue
+        meaning = None if contrib_cue or n.percent else _code_meaning(n, e)
+        if meaning is not None:  # 'a balance above 200 DM' for status 4 ('200 DM or more'), before any rounding
+            return meaning
         cands = []
         if (not contrib_cue or name_after) and e.value is not None and not (n.points and unit not in ("points", "pts")):
             cands.append(("value" if scale == 1 else f"value in {prefix.group(1)}{unit_of(key)}", e.value / scale))
@@ -217,6 +222,20 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     if claim.status == "contradicted" and comparison(n, after, book):
         return Claim("number", n.text, "verified", "a domain comparison in its unit")
     return claim
+
+
+def _code_meaning(n: Number, e) -> tuple[bool, str] | None:
+    """A number of the meaning of the feature's code in its legend ('over 200 DM' for status 4 = '200 DM or more'):
+    verified; a number only other codes' meanings have: contradicted; else nothing to say."""
+    if not e.legend or e.value is None or e.value != int(e.value) or n.value == e.value:
+        return None  # (the code itself, 'value 1', is its value)
+    here = e.legend.get(int(e.value), "")
+    if any(n.value == x.value for x in find_numbers(here)):  # a legend's numbers are exact
+        return True, f"the meaning of its code {int(e.value)}: {here}"
+    others = [t for k, t in e.legend.items() if k != int(e.value)
+              and any(n.value == x.value for x in find_numbers(t))]
+    return (False, f"{n.text} is the meaning of another code ({others[0]}); its code {int(e.value)} means "
+                   f"{here or 'nothing in the legend'}") if others else None
 
 
 def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, signed: bool = False) -> str | None:

@@ -189,8 +189,9 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
     out = []
     names = named_features(mentions)
     for m in RANK_RE.finditer(masked, a, b):
-        if _WOULD_MAKE.search(masked, max(a, m.start() - 50), m.start()):
-            continue  # 'not severe enough to make age a dominant predictor': what did not happen
+        if _WOULD_MAKE.search(masked, max(a, m.start() - 50), m.start()) or re.search(
+                r"\b(?:another|one|a|an|other)\s+$", masked[max(a, m.start() - 10):m.start()], re.IGNORECASE):
+            continue  # 'not severe enough to make age a dominant predictor', 'another key factor': no rank said
         rank, plural, sign = rank_claim(m, masked)
         count = _COUNTED.search(masked, max(a, m.start() - 30), m.start())
         if count and m.group(0).lower().startswith("dominat"):  # 'Two inputs dominate ...: A ..., B ...'
