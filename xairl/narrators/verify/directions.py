@@ -112,8 +112,9 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
         if any(x.kind == "feature" and 0 < x.start - m.end() <= 1 for x in mentions):
             continue  # 'relatively lower glucose levels': a value said of the feature, not a push
-        if book.output != "actions" and re.match(r"\s+(?:the\s+|their\s+|its\s+|default\s+|credit\s+)?risk\b",
-                                                 masked[m.end():]) and _GOOD_OUTCOME & set(split_words(book.chosen or "")):
+        good_outcome = _GOOD_OUTCOME & set(split_words(book.chosen or ""))
+        if book.output != "actions" and good_outcome and re.match(
+                r"\s+(?:the\s+|their\s+|its\s+|default\s+|credit\s+)?risk\b", masked[m.end():]):
             continue  # 'reduced risk' of a good-credit probability: the framing is the output's inverse
         if book.output != "actions" and _unsaid_side(masked, m, mentions, book):
             continue  # 'tipped the prediction toward failure': which side of the one output is that? unsaid
