@@ -21,9 +21,8 @@ _ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|land
                       r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$|"
                       r"\b(?:drags?|dragged|pushe?s?|pushed|pulls?|pulled|brings?|brought|takes?|took|moves?|moved|"
                       r"lowers?|lowered|raises?|raised|lifts?|lifted)\b[^.;]{0,40},?(?<!close)(?<!due)(?<!thanks)"
-                      r"(?<!up)"
-                      r"(?<!next)(?<!compared)(?<!relative)(?<!similar)\s+to\s+(?:about|around|roughly|"
-                      r"only|just)?\s*[$€£]?$", re.IGNORECASE)
+                      r"(?<!up)(?<!next)(?<!compared)(?<!relative)(?<!similar)\s+to\s+(?:about|around|roughly|only|"
+                      r"just)?\s*[$€£]?$", re.IGNORECASE)  # ('drags it well below the 34 % base, to about 14 %')
 _FROM = re.compile(r"\bfrom\s+(?:(?:an?|the|its)\s+)?(?:(?:average|base(?:line)?|base rate|starting point|typical)"
                    r"(?:\s+(?:rate|value|estimate|prediction))?\s+(?:of\s+)?)?[$€£]?\s*$", re.IGNORECASE)
 _FROM_TO = re.compile(r"\bfrom\s+[^;]{1,40}?\s+(?:down\s+|up\s+)?to\s+(?:about|around|roughly)?\s*[$€£]?$",
@@ -49,8 +48,7 @@ OUTPUT_BEFORE = re.compile(r"\b(?:it|this house|the house|the home|this home|the
                            r"estimated at|put at)\s+"
                            r"(?:about|around|roughly|some|just under|just over|nearly|almost)?\s*[$€£]?$|"
                            r"\b(?:chance|risk|probability|likelihood) of [\w\s]{1,20}? is (?:put |estimated |rated )?"
-                           r"at\s+"
-                           r"(?:about|around|roughly)?\s*$", re.IGNORECASE)
+                           r"at\s+(?:about|around|roughly)?\s*$", re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
 _OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
                            r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)",
@@ -79,9 +77,11 @@ def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ct
 
 
 def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:
-    """Which name a number belongs to, then its check: a pair of a 'respectively' list; an action right before it
-    ('Turn (4.07)', 'staying scored 26.26') or right after it ('7.38 for staying'); a name right after it ('a 7-year
-    credit history'); the name before it in its clause unless a new noun phrase starts between them; else none."""
+    """Which fact a number states, then its check: a pair of a 'respectively' list; the change from the baseline, a
+    statistic of the background (the baseline, a feature's typical value), the prediction or the margin when its cue
+    words say so; an action right before it ('Turn (4.07)', 'staying scored 26.26') or right after it ('7.38 for
+    staying'); a name right after it ('a 7-year credit history'); the name before it in its clause unless a new noun
+    phrase or list item starts between them; else none."""
     if id(n) in paired:
         return quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of)
     if quantities.is_change(n, masked):  # '$91,462 above the baseline', 'net uplift: +$86,046', 'below base by $34,184'
@@ -94,7 +94,7 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
                                 bool(re.match(r"[^()]*?\b(?:vs\.?|versus|compared)\b", masked[n.end:n.end + 40])))
     if stat == "output" and book.output != "actions":  # 'the average sale price of $230,061', 'the baseline of 0.34'
         c = quantities.base_number(n, book)  # ... unless it is the prediction ('at the average risk: 33 %')
-        if c.status == "verified" or not quantities.output_number(n, book).status == "verified":
+        if c.status == "verified" or quantities.output_number(n, book).status != "verified":
             return c
     owner = next((m for m in reversed(names) if m.end <= n.start), None) or next(
         (m for m in names if 0 <= m.start - n.end <= 2), None)  # '... typically scores around 1.3 goals'
@@ -113,7 +113,7 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
                                                     "average: another order of magnitude)")
     if book.output != "actions" and (_OUTPUT_AFTER.match(masked, n.end) or OUTPUT_BEFORE.search(
             masked[max(0, n.start - 60):n.start])):  # '... leading to a 43% predicted probability', "it's worth $316k"
-        return quantities.output_number(n, book)  # 'leading to a 43% predicted probability of default'
+        return quantities.output_number(n, book)
     if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
         return quantities.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
     if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 70):n.start]) or _FROM_TO.search(

@@ -102,6 +102,7 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
     out, prev, bare = [], a, False  # bare: the previous direction word found no subject at all
     names = named_features(mentions)
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
+    good_outcome = _GOOD_OUTCOME & set(split_words(book.chosen or ""))
     for i, m in enumerate(found):
         if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(m, mentions) and not (
                 re.match(r"\s+by\b", masked[m.end():]) and book.output == "actions" and any(
@@ -112,7 +113,6 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
         if any(x.kind == "feature" and 0 < x.start - m.end() <= 1 for x in mentions):
             continue  # 'relatively lower glucose levels': a value said of the feature, not a push
-        good_outcome = _GOOD_OUTCOME & set(split_words(book.chosen or ""))
         if book.output != "actions" and good_outcome and re.match(
                 r"\s+(?:the\s+|their\s+|its\s+|default\s+|credit\s+)?risk\b", masked[m.end():]):
             continue  # 'reduced risk' of a good-credit probability: the framing is the output's inverse
@@ -193,8 +193,6 @@ _LIST_LABEL = re.compile(r"\W*(?P<label>(?:[A-Za-z][A-Za-z'-]*\s+){0,3}[A-Za-z][
 _QUANTITY_LABELS = {"net", "sum", "total", "delta", "change", "diff", "difference", "base", "baseline", "risk", "price",
                     "estimate", "probability", "prediction", "output", "score", "gap", "margin", "lead", "effect",
                     "shap", "phi", "value", "contribution", "attribution", "result", "overall", "uplift", "premium"}
-
-
 _OWNERS = {"its", "their", "your", "his", "her", "our", "my"}
 
 

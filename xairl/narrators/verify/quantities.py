@@ -78,8 +78,7 @@ _STAT_BEFORE = re.compile(r"\b(?P<word>average|typical|median|mean|usual|normal|
                           r"approximately|only|just|close to|over|under|above|below|~|≈)?\s*[$€£]?\s*"
                           r"(?:[\d.,]+\s*(?:-|–|to)\s*)?$", re.IGNORECASE)
 _OUTPUT_NOUN = re.compile(r"\b(?:predict\w*|estimat\w*|output|probabilit\w*|chances?|risk|rate|price|scores?|"
-                          r"q[- ]?values?)"
-                          r"\b", re.IGNORECASE)
+                          r"q[- ]?values?)\b", re.IGNORECASE)
 
 
 #: '(2 vs. ~5.75)', '(18 vs. 16.8)' after a feature's value: the background's typical value (with one output; with
@@ -120,8 +119,8 @@ def typical_number(n: Number, keys: tuple[str, ...], book: FactBook) -> Claim:
         band = f"{key}'s background quartiles are {lo:.4g} to {hi:.4g}"
         if lo <= n.value <= hi or matches(n, lo, magnitude_ok=False) or matches(n, hi, magnitude_ok=False):
             return True, f"a typical value of {key} ({band})"
-        if hi > lo and not lo - 1.5 * (hi - lo) <= n.value <= hi + 1.5 * (hi - lo):  # (one value in half the
-            # background, 'failures' 0 / 0 / 0: its mean may lie anywhere)
+        # quartiles that coincide ('failures' 0 / 0 / 0, one value in most rows): the mean may lie anywhere
+        if hi > lo and not lo - 1.5 * (hi - lo) <= n.value <= hi + 1.5 * (hi - lo):
             return False, f"{n.text} is no typical value of {key}: {band}"
         return None
     return over_keys(keys, test, "typical value", n.text, "number")
