@@ -171,7 +171,7 @@ def test_held_out_corpus_agreement(corpus):
     floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("dev6", 0.97),
               ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("dev10", 0.97), ("dev11", 0.94), ("dev12", 0.94),
               ("dev13", 0.95), ("dev14", 0.93), ("dev15", 0.92), ("dev16", 0.95), ("dev17", 0.9), ("dev18", 0.88),
-              ("dev19", 0.95),
+              ("dev19", 0.95), ("dev20", 0.93),
               ("test", 0.93), ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
@@ -510,6 +510,11 @@ ON_CASES = [
               "recharging by 5.48.", "verified"),
     ("toy-2", "Two inputs dominate the comparison with recharging: wind favours turning by 5.31 and the obstacle "
               "by 1.50.", "contradicted"),
+    # dev20: a colleague writing in a second language
+    ("credit-0", "Employment (retired) is making the risk more low, of 0.12 approximately.", "verified"),
+    ("credit-0", "Employment (retired) is making the risk more high, of 0.12 approximately.", "contradicted"),
+    ("credit-1", "Debt-to-income of 0,24 decrease risk for 0,098; salaried employment decrease for 0,086.", "verified"),
+    ("credit-1", "Debt-to-income of 0,24 decrease risk for 0,198.", "contradicted"),
     # ranks among one sign (credit-2: employment +0.128 first overall, the ratio -0.127 first of those lowering it)
     ("credit-2", "The biggest factor working against default was the low debt-to-income ratio.", "verified"),
     ("credit-2", "The biggest factor working against default was the 26-year credit history.", "contradicted"),

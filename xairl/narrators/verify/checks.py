@@ -29,13 +29,13 @@ EITHER = "either"  # a sentence's view when its words weigh two options without 
 _POS = (r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|supported|supporting|favou?r(?:s|ed|ing)?|"
         r"in favou?r of|toward|towards|push(?:es|ed|ing)? (?:\w+ ){0,2}up|pull(?:s|ed|ing)? (?:\w+ ){0,2}up|"
         r"nudg\w* (?:\w+ )?up|drives?|driven by|driving|tipped|tips|argu\w* for|counted for|counts for|"
-        r"positive(?:ly)?|more likely|up by|help(?:s|ed|ing)?")
+        r"positive(?:ly)?|more likely|up by|help(?:s|ed|ing)?|more high|less low")
 _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ ){0,2}down|"
         r"push(?:es|ed|ing)? (?:\w+ ){0,2}down|nudg\w* (?:\w+ )?down|subtract\w*|"
         r"tak(?:es|ing|e) (?:[\w.,$€£]+ ){0,4}(?:off|away)|"
         r"took (?:[\w.,$€£]+ ){0,4}(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|"
         r"negative(?:ly)?|"
-        r"less likely|"
+        r"less likely|more low|less high|"
         r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
         r"los(?:t|ing)|diminish\w*|penali[sz]\w*|hurt(?:s|ing)?|h[eo]ld(?:s|ing)? (?:\w+ ){0,2}back(?: from)?|"
         r"discourag\w*")
