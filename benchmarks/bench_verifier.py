@@ -26,7 +26,9 @@ the two largest contributions swapped (then each text is wrong).
 
 ``--explingo``: the hand-labelled narratives of Zytek et al.'s Explingo (github.com/sibyl-dev/Explingo,
 ``full-experiment/accuracy_tests.json``; not shipped here): each explanation is rebuilt from its
-(feature, value, contribution) tuples as a one-output Explanation; score 0 is inaccurate, 2 and 4 accurate.
+(feature, value, contribution) tuples as a one-output Explanation; score 0 is inaccurate, 2 and 4 accurate. Its
+``full-experiment/dataset/gold_standards.json`` (the hand-written reference narratives, ``description``, and plain
+restatements, ``bad_description``) are all accurate.
 """
 from __future__ import annotations
 
@@ -139,9 +141,16 @@ def explingo_items(path: str) -> list[dict]:
                                 outputs=np.array([[contrib.sum()]]), states=states, feature_names=tuple(names),
                                 action_names=("prediction",), method="given", output="value",
                                 categories=cats or None)
-        out.append({"case": row["explanation"][:40], "domain": row["context"].split(" predicts ")[-1][:28],
-                    "split": "explingo", "error": row["accuracy_rationalization"],
-                    "accurate": row["accuracy_score"] > 0, "text": row["narrative"], "explanation": exp})
+        domain = row["context"].split(" predicts ")[-1][:28]
+        if "narrative" in row:  # accuracy_tests.json: a labelled narrative
+            out.append({"case": row["explanation"][:40], "domain": domain, "split": "explingo",
+                        "error": row["accuracy_rationalization"], "accurate": row["accuracy_score"] > 0,
+                        "text": row["narrative"], "explanation": exp})
+        for key in ("description", "bad_description"):  # dataset/gold_standards.json: accurate texts
+            if row.get(key):
+                out.append({"case": row["explanation"][:40], "domain": domain, "split": "explingo",
+                            "error": f"gold {key.replace('_', ' ')}", "accurate": True, "text": row[key],
+                            "explanation": exp})
     return out
 
 

@@ -646,6 +646,39 @@ def test_phrasings_on_outside_cases(dataset, index, text, status):
     assert _outside(text, dataset, index).status == status
 
 
+def _tuples(text):
+    """A one-output Explanation from '(name, value, contribution), ...' tuples, as Explingo writes them."""
+    rows = [t.split(", ") for t in text.strip("()").split("), (")]
+    names = tuple(r[0] for r in rows)
+    cats = {r[0]: (r[1],) for r in rows if not r[1].replace(".", "").isdigit()}
+    c = np.array([float(r[2]) for r in rows])
+    return xairl.Explanation(values=c.reshape(1, -1, 1), base_values=np.zeros((1, 1)), outputs=np.array([[c.sum()]]),
+                             states=np.array([[0.0 if r[0] in cats else float(r[1]) for r in rows]]),
+                             feature_names=names, action_names=("price",), method="given", output="value",
+                             categories=cats or None)
+
+
+def test_names_that_are_phrases_and_coarse_amounts():
+    """Feature names written as phrases ('Rates the overall condition of the house'): 'the house' names none of
+    them; 'condition' means both names with the word ('conditions' too); two words of one name are one mention
+    ('sale condition'); 'about $10,000' after 'increased the price by' is a contribution, unchecked when several
+    round to it, never the prediction."""
+    exp = _tuples("(Refers to walkout or garden level walls, Gd, 17607.43), (Rates the overall condition of the house, "
+                  "8.00, 13038.14), (Second floor square feet, 0.00, -10142.29), (Proximity to various conditions, "
+                  "Feedr, -8251.83)")
+    assert xairl.verify("The house's location on a feeder street reduced the price by about $8,000.", exp).ok
+    assert not xairl.verify("The house's location on a feeder street reduced the price by about $28,000.", exp).ok
+    exp = _tuples("(Original construction date, 1915.00, -17966.77), (Second floor square feet, 756.00, 10129.96), "
+                  "(Total square feet of basement area, 756.00, -8362.22), (Condition of sale, Abnorml, -6786.66)")
+    text = "The smaller basement area and abnormal sale condition reduce it by about $8,400 and $6,800, respectively."
+    assert xairl.verify(text, exp).status == "verified"
+    assert xairl.verify(text.replace("$6,800", "$9,800"), exp).status == "contradicted"
+    exp = _tuples("(Rates the overall material and finish of the house, 8.00, 9655.79), (Original construction date, "
+                  "2000.00, 8192.46), (Second floor square feet, 1053.00, 18094.05)")
+    res = xairl.verify("The house's good condition (rated 8/10) increased the price by about $10,000.", exp)
+    assert res.status == "unchecked", res.claims
+
+
 def test_no_direction_in_an_adjective_an_appearance_or_an_aside():
     """'their lower efficiency' describes the subject; 'might seem positive' is an appearance; after '—likely' comes
     the writer's reasoning, whose names are not the subject of the claim before it."""

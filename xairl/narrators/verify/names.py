@@ -104,7 +104,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
                 for j in range(i + 1, len(words) + 1):
                     run = words[i:j]
                     if len(run) == 1 and (run[0] in GENERIC or len(run[0]) < 3 or run[0].isdigit() or (
-                            form != f and (run[0] in owners or len(run[0]) < 5) and run[0] not in split_words(f))):
+                            run[0] in owners and (form != f or len(words) >= 3)) or (  # 'of the house' in a name
+                            form != f and len(run[0]) < 5 and run[0] not in split_words(f))):
                         continue
                     phrases.setdefault(" ".join(run), set()).add(f)
     shared: dict[str, set[str]] = {}
@@ -115,6 +116,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     for w, keys in shared.items():  # 'quality' of overall_quality and kitchen_quality: named, but not which
         if len(keys) > 1 and w not in phrases and w not in exact:
             phrases[w] = keys
+    for phrase in [p for p in phrases if p.endswith("s") and p[:-1] in phrases]:  # 'condition' and 'conditions'
+        phrases[phrase] = phrases[phrase[:-1]] = phrases[phrase] | phrases[phrase[:-1]]
     if exp.output != "actions":  # 'the probability of diabetes': the output's words are not a part of a feature's
         for w in {w for a in exp.action_names for w in split_words(a)}:
             phrases.pop(w, None)
@@ -251,7 +254,16 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
     for m in _modifiers(text, found):  # 'corner kicks', 'attempts on goal': one name, not two
         found.remove(m)
         taken[m.start:m.end] = bytes(m.end - m.start)
-    found = _narrow(text, found, vocab.words)
+    merged: list[Mention] = []
+    for m in found:  # 'the abnormal sale condition' (Condition of sale): two words of one name, one mention
+        last = merged[-1] if merged else None
+        if last is not None and m.kind == last.kind == "feature" and m.keys == last.keys and \
+                text[last.end:m.start] == " ":
+            merged[-1] = Mention(last.start, m.end, "feature", m.keys, "", last.form)
+            taken[last.end:m.start] = b"\1"
+        else:
+            merged.append(m)
+    found = _narrow(text, merged, vocab.words)
     masked = "".join("\0" if t else ch for ch, t in zip(text, taken))
     return found, masked
 

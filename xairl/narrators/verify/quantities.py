@@ -98,6 +98,9 @@ def statistic(before: str, action_named: bool = False, several_outputs: bool = F
     if m is not None and m.group(0).rstrip().endswith("(") and re.search(r"\bthan\s+(?:the\s+)?$",
                                                                           before[:m.start()]) and versus:
         m = None  # 'fewer absences than average (2 vs. ~5.75)': the bracket opens with the student's own value
+    if m is not None and re.search(r"\bby\b|\b\w+(?:ed|es)\b", m.group("between"), re.IGNORECASE) and not re.search(
+            r"\b(?:typically|usually|normally|often)\b", m.group("between"), re.IGNORECASE):
+        m = None  # 'the larger than average second floor increased the price by about': a verb, not a noun phrase
     if m is None:
         return "feature" if not several_outputs and _VERSUS.search(before) else None
     habit = re.search(r"\b(?:typically|usually|normally|often)\b", m.group("between"), re.IGNORECASE)
@@ -346,8 +349,11 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         named = ("the runner-up's score", [book.scores[book.runner_up]])
     elif _COMPARE_AFTER.match(after) and book.by_unit:
         named = ("a comparison", [v for vs in book.by_unit.values() for v in vs])
-    elif CONTRIB_BEFORE.search(before) and _owner(n, book):
-        return Claim("number", n.text, "verified", f"{_owner(n, book)}'s contribution (the only one it matches)")
+    elif CONTRIB_BEFORE.search(before) and _owners(n, book):
+        owners = _owners(n, book)
+        if len(owners) == 1:
+            return Claim("number", n.text, "verified", f"{owners[0]}'s contribution (the only one it matches)")
+        return Claim("number", n.text, "unchecked", f"a contribution of one of {', '.join(owners)}: which is unsaid")
     elif book.output != "actions" and not book.global_view:
         near = before[-24:]
         base_at = max((m.end() for m in _BASE_WORDS.finditer(near)), default=-1)
@@ -383,8 +389,14 @@ def output_number(n: Number, book: FactBook, start: bool = False) -> Claim:
     return Claim("number", n.text, "verified" if ok else "contradicted", f"the {what} is {v:.4g}")
 
 
-def _owner(n: Number, book: FactBook) -> str | None:
-    """The one feature whose contribution (in any view) the number states, if exactly one."""
-    owners = [f for f, e in book.features.items()
-              if any(matches(n, c) or (n.percent and _percent_readings(n, c)) for c in e.contribs.values())]
-    return owners[0] if len(owners) == 1 else None
+def _owners(n: Number, book: FactBook) -> list[str]:
+    """The features whose contribution (in any view) the number states: the one it states as written rounds ('about
+    $8,300' for -8,251.83) when only one does, else all it states within its hedge."""
+    found = []
+    for strict in (True, False):
+        m = replace(n, hedge="") if strict else n
+        found = [f for f, e in book.features.items()
+                 if any(matches(m, c) or (m.percent and _percent_readings(m, c)) for c in e.contribs.values())]
+        if len(found) == 1:
+            return found
+    return found
