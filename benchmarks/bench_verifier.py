@@ -9,7 +9,9 @@ cases in other voices (Q&A, LLM-style prose, shorthand, lists; 16 of them on two
 SHAP values, ``dev5/`` 45 in memo, log, arrow and passive voices, ``dev6/`` to ``dev13/`` 23-48 each (markdown,
 tickets, voice memos, amount verbs, signs in words, comparisons between features, JSON-ish output, number formats,
 operators' corrections, sums, 'from x to y'), ``dev14/`` 31 in the storyteller voice of LLM-written SHAP narratives
-(values against the typical case), each written after the freeze and measured once before tuning on it. ``test2/``:
+(values against the typical case), ``dev15/`` to ``dev20/`` 16-41 each (an analyst's terse notes, lists, everyday
+hedges, plain language, long reports, a second language), each written after the freeze and measured once before
+tuning on it. ``test2/``:
 48 more on the test cases (chat, letters, risk notes, decision logs), written after the test split's disagreements
 had been counted by cause (not read) and never tuned on: the second held-out figure. A narrative counts as agreeing
 when ``Verification.ok`` equals its label.
