@@ -53,7 +53,7 @@ from tests import narrative_domains as domains  # noqa: E402
 DATA = pathlib.Path(__file__).parent / "data" / "narratives"
 
 
-SPLITS = ("dev", *(f"dev{k}" for k in range(2, 21)), "test", "test2")
+SPLITS = ("dev", *(f"dev{k}" for k in range(2, 22)), "test", "test2")
 
 
 def load_corpus() -> list[dict]:
