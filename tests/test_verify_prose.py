@@ -171,7 +171,7 @@ def test_held_out_corpus_agreement(corpus):
     floors = (("dev", 0.98), ("dev2", 0.95), ("dev3", 0.93), ("dev4", 0.95), ("dev5", 0.93), ("dev6", 0.97),
               ("dev7", 0.97), ("dev8", 0.9), ("dev9", 0.97), ("dev10", 0.97), ("dev11", 0.94), ("dev12", 0.94),
               ("dev13", 0.95), ("dev14", 0.93), ("dev15", 0.92), ("dev16", 0.95), ("dev17", 0.9), ("dev18", 0.88),
-              ("dev19", 0.95), ("dev20", 0.93),
+              ("dev19", 0.95), ("dev20", 0.93), ("dev21", 0.9),
               ("test", 0.93), ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
@@ -510,6 +510,13 @@ ON_CASES = [
               "recharging by 5.48.", "verified"),
     ("toy-2", "Two inputs dominate the comparison with recharging: wind favours turning by 5.31 and the obstacle "
               "by 1.50.", "contradicted"),
+    # dev21: engineers' notes. 'the deciding input', 'largest margin term' rank; 'Q_recharge' is an action's score
+    ("uav-1", "Handover to neighbour 1. The deciding input was candidate 1's RSRP.", "verified"),
+    ("uav-1", "Handover to neighbour 1. The deciding input was the serving RSRP.", "contradicted"),
+    ("toy-3", "t=3: TURN (4.07) vs FWD (2.52). Largest margin term: distance (-2.15).", "verified"),
+    ("toy-3", "t=3: TURN (4.07) vs FWD (2.52). Largest margin term: battery (+1.46).", "contradicted"),
+    ("toy-0", "Driver: speed -1.79 sigma (+7.61 on Q_recharge).", "verified"),
+    ("toy-0", "Driver: speed -1.79 sigma (+7.61 on Q_charging).", "contradicted"),
     # dev20: a colleague writing in a second language
     ("credit-0", "Employment (retired) is making the risk more low, of 0.12 approximately.", "verified"),
     ("credit-0", "Employment (retired) is making the risk more high, of 0.12 approximately.", "contradicted"),

@@ -202,7 +202,10 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     if hypothetical:
         claims += directions.without(masked, mentions, book, ctx)
+    actions = {a.lower() for a in book.scores}
     for ident in _IDENT_RE.findall(masked):
+        if re.fullmatch(r"q_(\w+)", ident.lower()) and ident.lower()[2:] in actions:
+            continue  # 'Q_recharge': an action's score
         claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
     return claims
 

@@ -13,16 +13,16 @@ from .names import Mention, named_features
 ORD = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4, "fifth": 5}
 COUNT = {"two": 2, "three": 3, "four": 4, "five": 5, "2": 2, "3": 3, "4": 4, "5": 5}
 NOUN = r"(?:features?|factors?|drivers?|reasons?|contributors?|contributions?|influences?|inputs?|effects?|things?|" \
-        r"positives?|negatives?|boosts?|push(?:es)?|arguments?|concerns?|variables?|predictors?|attributions?|story)"
+        r"terms?|positives?|negatives?|boosts?|push(?:es)?|arguments?|concerns?|variables?|predictors?|attributions?|story)"
 TOPWORD = r"(?:most important|most influential|most significant|most decisive|biggest|largest|strongest|main|top|" \
-           r"primary|key|dominant|leading|greatest|decisive|single biggest|single largest|one big|big)"
+           r"primary|key|dominant|leading|greatest|decisive|deciding|single biggest|single largest|one big|big)"
 RANK_RE = re.compile(
     rf"\b(?:(?P<ord>second|third|fourth|fifth|2nd|3rd|4th)(?:[\s-]most[\s-]important|[\s-]most[\s-]influential|"
     rf"[\s-]biggest|[\s-]largest|[\s-]strongest)?\s+(?:single\s+)?{NOUN}"
     rf"|(?P<because>(?:mostly|mainly|chiefly|largely|primarily) (?:because of|due to|thanks to|on|driven by))"
     rf"|(?:the\s+)?(?P<plural>(?:two|three|four|2|3|4)\s+(?:most important|largest|biggest|strongest|main)|"
     rf"(?:top|the)[\s-]+(?P<k>two|three|four|2|3|4)(?:\s+most important|\s+largest|\s+biggest)?)\s+{NOUN}"
-    rf"|(?P<top>{TOPWORD})(?:\s+single)?\s+(?:risk\s+)?(?P<noun>{NOUN})"
+    rf"|(?P<top>{TOPWORD})(?:\s+single)?\s+(?:(?:risk|margin|score|shap)\s+)?(?P<noun>{NOUN})"
     rf"|(?:mattered|matters|matter|counted|counts|weighed) most|dominat\w+|ranks? (?P<rk>first|second|third)"
     rf"|(?:is|was) the (?:single )?(?:largest|biggest|strongest|greatest|most important|most influential)(?![ \w]*\w)"
     rf"|top[\s-](?P<topk>\d)\b)", re.IGNORECASE)
