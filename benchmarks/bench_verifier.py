@@ -12,9 +12,8 @@ operators' corrections, sums, 'from x to y'), ``dev14/`` 31 in the storyteller v
 (values against the typical case), ``dev15/`` to ``dev20/`` 16-41 each (an analyst's terse notes, lists, everyday
 hedges, plain language, long reports, a second language) and ``dev21/`` 17 engineers' notes, each written after the
 freeze and measured once before tuning on it. ``test2/``: 48 more on the test cases (chat, letters, risk notes,
-decision logs), written after the test split's disagreements
-had been counted by cause (not read) and never tuned on: the second held-out figure. A narrative counts as agreeing
-when ``Verification.ok`` equals its label.
+decision logs), written after the test split's disagreements had been counted by cause (not read) and never tuned
+on: the second held-out figure. A narrative counts as agreeing when ``Verification.ok`` equals its label.
 
     .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain, error kind, cause; speed
     .venv/bin/python benchmarks/bench_verifier.py --show test # also every disagreement of the test split
