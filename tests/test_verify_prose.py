@@ -510,6 +510,8 @@ ON_CASES = [
               "recharging by 5.48.", "verified"),
     ("toy-2", "Two inputs dominate the comparison with recharging: wind favours turning by 5.31 and the obstacle "
               "by 1.50.", "contradicted"),
+    # 'of the three' counts the things compared, it is no claim (a rewrite of the local LM)
+    ("uav-1", "Candidate 1's RSRP (-83.6 dBm) was the strongest of the three neighbours.", "verified"),
     # dev21: engineers' notes. 'the deciding input', 'largest margin term' rank; 'Q_recharge' is an action's score
     ("uav-1", "Handover to neighbour 1. The deciding input was candidate 1's RSRP.", "verified"),
     ("uav-1", "Handover to neighbour 1. The deciding input was the serving RSRP.", "contradicted"),

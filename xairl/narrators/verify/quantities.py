@@ -155,6 +155,8 @@ def skip_number(n: Number, masked: str) -> bool:
         return True
     if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):
         return True  # all three
+    if n.text[0].isalpha() and re.search(r"\b(?:of|among) the\s+$", before, re.IGNORECASE):
+        return True  # 'the strongest of the three'
     if n.text.lower() == "one" and re.match(r"\s+of\s+(?:the|its|their|our|these|those)\b", masked[n.end:]):
         return True  # 'one of the pricier neighbourhoods'
     if n.text.lower() == "one" and re.search(r"\b(this|that|the|which|each|every|any|no|a)\s+(?:[a-z]+\s+)?$", before,
