@@ -140,27 +140,21 @@ def check_collective(members: list[tuple[str, ...]], ctx: str | None, book: Fact
     """'The combination of A, B and C dominated': their |contributions| together against all the others'."""
     if any(len(k) != 1 for k in members):
         return Claim("rank", text, "unchecked", "ambiguous: a member may mean several features")
-    named = {k[0] for k in members}
-    sizes = [(sum(abs(e.contribs[c]) for f, e in book.features.items() if f in named and c in e.contribs),
-              sum(abs(e.contribs[c]) for f, e in book.features.items() if f not in named and c in e.contribs), c)
-             for c in views(ctx, book)]
-    ok = [c for x, y, c in sizes if x > y]
-    x, y, c = sizes[0]
-    return Claim("rank", text, "verified" if ok else "contradicted",
-                 f"|{' + '.join(sorted(named))}| {x:.3g} vs the others' {y:.3g} ({ok[0] if ok else c})")
+    named = sorted({k[0] for k in members})
+    return check_outweighs(named, [f for f in book.features if f not in named], ctx, book, text)
 
 
-def check_outweighs(a_keys: list[str], b_key: str, ctx: str | None, book: FactBook, text: str) -> Claim:
+def check_outweighs(a_keys: list[str], b_keys: list[str], ctx: str | None, book: FactBook, text: str) -> Claim:
     """'A and B outweighed C': A's and B's |contributions| together against C's (in any view the sentence allows)."""
-    contexts = [c for c in views(ctx, book) if all(c in book.features[k].contribs for k in (*a_keys, b_key))]
+    contexts = [c for c in views(ctx, book) if all(c in book.features[k].contribs for k in a_keys)]
     if not contexts:
         return Claim("rank", text, "unchecked", "nothing known to check it against (comparison)")
-    sizes = [(sum(abs(book.features[k].contribs[c]) for k in a_keys), abs(book.features[b_key].contribs[c]), c)
-             for c in contexts]
+    sizes = [(sum(abs(book.features[k].contribs[c]) for k in a_keys),
+              sum(abs(book.features[k].contribs.get(c, 0.0)) for k in b_keys), c) for c in contexts]
     ok = [c for x, y, c in sizes if x > y]
     x, y, c = sizes[0]
     return Claim("rank", text, "verified" if ok else "contradicted",
-                 f"|{' + '.join(a_keys)}| {x:.3g} vs |{b_key}| {y:.3g} ({ok[0] if ok else c})")
+                 f"|{' + '.join(a_keys)}| {x:.3g} vs |{' + '.join(b_keys)}| {y:.3g} ({ok[0] if ok else c})")
 
 
 def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
@@ -307,7 +301,7 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
         if m.group("out") and len(subjects) > 1 and all(len(x.keys) == 1 for x in subjects) and \
                 not re.search(r"\b(?:both|each|all|individually)\b", masked[subjects[0].start:m.start()],
                               re.IGNORECASE):
-            out.append(check_outweighs([x.keys[0] for x in subjects], b_name.keys[0], ctx, book, m.group(0).strip()))
+            out.append(check_outweighs([x.keys[0] for x in subjects], [b_name.keys[0]], ctx, book, m.group(0).strip()))
         else:
             for x in subjects:
                 out.append(check_comparison(x.keys, b_name.keys[0], way, ctx, book, m.group(0).strip()))
