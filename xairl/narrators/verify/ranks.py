@@ -13,7 +13,8 @@ from .names import Mention, named_features
 ORD = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4, "fifth": 5}
 COUNT = {"two": 2, "three": 3, "four": 4, "five": 5, "2": 2, "3": 3, "4": 4, "5": 5}
 NOUN = r"(?:features?|factors?|drivers?|reasons?|contributors?|contributions?|influences?|inputs?|effects?|things?|" \
-        r"terms?|positives?|negatives?|boosts?|push(?:es)?|arguments?|concerns?|variables?|predictors?|attributions?|story)"
+        r"terms?|positives?|negatives?|boosts?|push(?:es)?|arguments?|concerns?|variables?|predictors?|" \
+        r"attributions?|story)"
 TOPWORD = r"(?:most important|most influential|most significant|most decisive|biggest|largest|strongest|main|top|" \
            r"primary|key|dominant|leading|greatest|decisive|deciding|single biggest|single largest|one big|big)"
 RANK_RE = re.compile(
