@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import argparse
 import collections
+import functools
 import json
 import pathlib
 import re
@@ -155,12 +156,18 @@ def explingo_items(path: str) -> list[dict]:
     return out
 
 
+@functools.cache
+def _shapstories_cases() -> dict:
+    """``data/narratives/outside/shapstories.yaml``, read once."""
+    return yaml.safe_load((DATA / "outside" / "shapstories.yaml").read_text())
+
+
 def shapstories_case(dataset: str, index: int) -> tuple[int, xairl.Explanation, xairl.Policy]:
     """(batch, Explanation, Policy) built for narrative ``index`` of ``dataset`` in
     ``data/narratives/outside/shapstories.yaml``: one output, the data dictionary's descriptions and categories."""
     import torch
 
-    domain = yaml.safe_load((DATA / "outside" / "shapstories.yaml").read_text())[dataset]
+    domain = _shapstories_cases()[dataset]
     batch, prediction, given = domain["cases"][index]
     feats = domain["features"]
     names = tuple(feats)
@@ -184,7 +191,7 @@ def shapstories_case(dataset: str, index: int) -> tuple[int, xairl.Explanation, 
 def shapstories_items(path: str) -> list[dict]:
     """The LLM-written narratives of SHAPnarrative-agents (``baseline_narratives.json``) that have a case in
     ``data/narratives/outside/shapstories.yaml``; every one is accurate for its case."""
-    cases = yaml.safe_load((DATA / "outside" / "shapstories.yaml").read_text())
+    cases = _shapstories_cases()
     out = []
     for row in json.loads(pathlib.Path(path).read_text()):
         dataset = row.get("dataset", "fifa")

@@ -9,7 +9,7 @@ A small pipeline, one module per step:
 3. this module splits sentences into clauses and decides each clause's view (the chosen action's score, the margin
    over the runner-up, or either); :mod:`.binding` binds each number to the name it is about (the name before it
    in its clause, pairwise for 'A and B ... by x and y, respectively', an action's score, the margin, the
-   prediction, a typical value, the change from the baseline); :mod:`.directions` binds each direction word to
+   prediction, a typical value (:mod:`.background`), the change from the baseline); :mod:`.directions` binds each direction word to
    the list of names nearest before it (or a list after it, 'Raising risk: A, B'), and :mod:`.ranks` each rank,
    'barely matters' and 'A mattered more than B' phrase;
 4. :mod:`.quantities` (numbers), :mod:`.checks` (actions, categories, directions) and :mod:`.ranks` check each
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 from ...explanation import Explanation
 from ...policy import Policy
-from . import binding, checks, directions, quantities, ranks
+from . import background, binding, checks, directions, quantities, ranks
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, named_features, vocabulary
@@ -219,7 +219,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     tail = [n for n in numbers if names and n.start > names[-1].end  # not the last name's own '(−22.5 dB)'
             and not re.fullmatch(r"\s?\([^()]*", masked[names[-1].end:n.start])]
     paired = {}
-    own_cue = any(quantities.statistic(masked[max(0, n.start - 60):n.start]) or binding.OUTPUT_BEFORE.search(
+    own_cue = any(background.statistic(masked[max(0, n.start - 60):n.start]) or binding.OUTPUT_BEFORE.search(
         masked[max(0, n.start - 60):n.start]) for n in tail)  # '... worth about $316k instead of the usual $230k'
     if len({m.keys for m in names}) >= 2 and len(tail) == len(names) and not own_cue and (
             "respectively" in masked[a:b].lower() or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])

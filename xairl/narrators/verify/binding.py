@@ -7,7 +7,7 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
-from . import checks, quantities
+from . import background, checks, quantities
 from .book import FactBook
 from .checks import Claim
 from .numbers import matches
@@ -88,41 +88,9 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
         return quantities.free_number(n, masked, book)
     if id(n) in scored:
         return quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
-    span = max(0, n.start - 60)
-    stat = quantities.statistic(masked[span:n.start], any(m.kind == "action" and span <= m.start < n.start
-                                                          for m in mentions), book.output == "actions",
-                                bool(re.match(r"[^()]*?\b(?:vs\.?|versus|compared)\b", masked[n.end:n.end + 40])))
-    if stat == "output" and book.output != "actions":  # 'the average sale price of $230,061', 'the baseline of 0.34'
-        c = quantities.base_number(n, book)  # ... unless it is the prediction ('at the average risk: 33 %')
-        if c.status == "verified" or quantities.output_number(n, book).status != "verified":
-            return c
-    owner = next((m for m in reversed(names) if m.end <= n.start), None) or next(
-        (m for m in names if 0 <= m.start - n.end <= 2), None)  # '... typically scores around 1.3 goals'
-    habit = _TYPICALLY.search(masked[span:n.start])
-    if habit and owner is not None and stat is None:  # 'the average team, which typically scores around 1.3 goals'
-        c = quantities.typical_number(n, owner.keys, book)  # one reading; the number's plain binding is the other
-        if c.status == "verified":
-            return c
-    if stat == "feature" and owner is not None:  # 'a ratio of 0.51, above the average of roughly 0.4'
-        c = quantities.typical_number(n, owner.keys, book)
-        return c if c.status == "verified" or book.base is None or not matches(n, book.base) else \
-            quantities.base_number(n, book)  # 'with a 7-year history, the risk is above the average of 0.34'
-    if stat == "feature" and book.output != "actions" and book.base and not 0.1 < abs(
-            n.value / (100 if n.percent else 1) / book.base) < 10:
-        return Claim("number", n.text, "unchecked", "the typical value of something not named (not the output's "
-                                                    "average: another order of magnitude)")
-    if book.output != "actions" and (_OUTPUT_AFTER.match(masked, n.end) or OUTPUT_BEFORE.search(
-            masked[max(0, n.start - 60):n.start])):  # '... leading to a 43% predicted probability', "it's worth $316k"
-        return quantities.output_number(n, book)
-    if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
-        return quantities.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
-    if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 70):n.start]) or _FROM_TO.search(
-            masked[max(0, n.start - 60):n.start])):
-        return quantities.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
-    if book.margin is not None and (_LEAD_OF.search(masked[max(0, n.start - 30):n.start]) or
-                                    quantities.MARGIN_AFTER.match(masked[n.end:n.end + 30])):  # 'the 8.32-point lead'
-        return quantities.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named
-    after = masked[n.end:n.end + 24]
+    by_cue = _by_cue(n, masked, mentions, names, book)
+    if by_cue is not None:
+        return by_cue
     nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
     # '+22.0 for the handover' after a feature, 'worth 11.5 for ...': the feature's push, not the action's score
     pushes = (n.sign == "+" or re.search(r"\bworth\s*$", masked[:n.start])) and any(x.end <= n.start for x in names)
@@ -138,6 +106,54 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
                                                                re.IGNORECASE) \
             and not re.search(r"\b(and|or|but|while|with)\b", gap, re.IGNORECASE):
         return quantities.feature_number(n, nxt.keys, masked, book, ctx, unit_of, name_after=True)
+    return _by_name_before(n, masked, mentions, names, book, ctx, unit_of)
+
+
+def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
+    """A number whose cue words say what it is, whatever name is near: a statistic of the background (the baseline,
+    a feature's typical value), the prediction ('a 43% predicted probability', 'from x to y'), the margin ('the
+    8.32-point lead'); None when they say nothing."""
+    span = max(0, n.start - 60)
+    stat = background.statistic(masked[span:n.start], any(m.kind == "action" and span <= m.start < n.start
+                                                          for m in mentions), book.output == "actions",
+                                bool(re.match(r"[^()]*?\b(?:vs\.?|versus|compared)\b", masked[n.end:n.end + 40])))
+    if stat == "output" and book.output != "actions":  # 'the average sale price of $230,061', 'the baseline of 0.34'
+        c = background.base_number(n, book)  # ... unless it is the prediction ('at the average risk: 33 %')
+        if c.status == "verified" or quantities.output_number(n, book).status != "verified":
+            return c
+    owner = next((m for m in reversed(names) if m.end <= n.start), None) or next(
+        (m for m in names if 0 <= m.start - n.end <= 2), None)  # '... typically scores around 1.3 goals'
+    if _TYPICALLY.search(masked[span:n.start]) and owner is not None and stat is None:
+        c = background.typical_number(n, owner.keys, book)  # 'which typically scores around 1.3 goals': one reading,
+        if c.status == "verified":  # the number's plain binding is the other
+            return c
+    if stat == "feature" and owner is not None:  # 'a ratio of 0.51, above the average of roughly 0.4'
+        c = background.typical_number(n, owner.keys, book)
+        return c if c.status == "verified" or book.base is None or not matches(n, book.base) else \
+            background.base_number(n, book)  # 'with a 7-year history, the risk is above the average of 0.34'
+    if stat == "feature" and book.output != "actions" and book.base and not 0.1 < abs(
+            n.value / (100 if n.percent else 1) / book.base) < 10:
+        return Claim("number", n.text, "unchecked", "the typical value of something not named (not the output's "
+                                                    "average: another order of magnitude)")
+    if book.output != "actions" and (_OUTPUT_AFTER.match(masked, n.end) or OUTPUT_BEFORE.search(
+            masked[span:n.start])):  # '... leading to a 43% predicted probability', "it's worth $316k"
+        return quantities.output_number(n, book)
+    if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
+        return quantities.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
+    if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 70):n.start]) or _FROM_TO.search(
+            masked[span:n.start])):
+        return quantities.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
+    if book.margin is not None and (_LEAD_OF.search(masked[max(0, n.start - 30):n.start]) or
+                                    quantities.MARGIN_AFTER.match(masked[n.end:n.end + 30])):  # 'the 8.32-point lead'
+        return quantities.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named
+    return None
+
+
+def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_of) -> Claim:
+    """The name before a number: an action's score ('staying scored 26.26') or, after it, a feature's push
+    ('supported recharging (+2.05)'); else the feature nearest before it in its clause unless a new noun phrase or
+    list item starts between them; else a number tied to no name."""
+    after = masked[n.end:n.end + 24]
     prev = next((m for m in reversed(mentions) if m.end <= n.start), None)
     feature_before = next((m for m in reversed(names) if m.end <= n.start), None)
     if prev is not None and prev.kind == "action" and n.sign and feature_before is not None and book.runner_up \

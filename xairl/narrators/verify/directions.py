@@ -102,22 +102,9 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
     out, prev, bare = [], a, False  # bare: the previous direction word found no subject at all
     names = named_features(mentions)
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
-    good_outcome = _GOOD_OUTCOME & set(split_words(book.chosen or ""))
     for i, m in enumerate(found):
-        if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(m, mentions) and not (
-                re.match(r"\s+by\b", masked[m.end():]) and book.output == "actions" and any(
-                    x.kind == "action" and checks.resolve_action(x, book) == book.chosen for x in mentions)):
-            continue  # 'a salaried job helps': helps the applicant, so lowers the risk? ('It turned, helped by X': X)
-        if book.output != "actions" and _SIDE_WORD.match(m.group(0)) and \
-                _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
-            continue  # 'working against the applicant': against them raises their risk; whose side is unsaid
-        if any(x.kind == "feature" and 0 < x.start - m.end() <= 1 for x in mentions):
-            continue  # 'relatively lower glucose levels': a value said of the feature, not a push
-        if book.output != "actions" and good_outcome and re.match(
-                r"\s+(?:the\s+|their\s+|its\s+|default\s+|credit\s+)?risk\b", masked[m.end():]):
-            continue  # 'reduced risk' of a good-credit probability: the framing is the output's inverse
-        if book.output != "actions" and _unsaid_side(masked, m, mentions, book):
-            continue  # 'tipped the prediction toward failure': which side of the one output is that? unsaid
+        if _no_push(m, masked, mentions, book):
+            continue
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
         if re.match(r"\s+to\s+(?:the\s+)?(?:negative|downside|risks?|concerns?|worries)\b", masked[m.end():]):
             polarity = -polarity  # 'added to the negative outlook'
@@ -157,6 +144,26 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
         bare, prev = not subjects and not flipped, m.end()
     return out
+
+
+def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) -> bool:
+    """A direction word that claims no checkable push here: 'helps'/'hurts' without a named action ('a salaried job
+    helps': the applicant?; but 'It turned, helped by X'), a side of a person ('working against the applicant'), a
+    value said of a feature ('relatively lower glucose levels'), the inverse framing of a good outcome ('reduced risk'
+    of a good-credit probability), a class the text does not tie to the one output ('toward failure')."""
+    one_output = book.output != "actions"
+    if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(m, mentions) and not (
+            re.match(r"\s+by\b", masked[m.end():]) and not one_output and any(
+                x.kind == "action" and checks.resolve_action(x, book) == book.chosen for x in mentions)):
+        return True
+    if one_output and _SIDE_WORD.match(m.group(0)) and _PERSON_OBJECT.match(masked[m.end():m.end() + 30]):
+        return True
+    if any(x.kind == "feature" and 0 < x.start - m.end() <= 1 for x in mentions):
+        return True
+    if one_output and _GOOD_OUTCOME & set(split_words(book.chosen or "")) and re.match(
+            r"\s+(?:the\s+|their\s+|its\s+|default\s+|credit\s+)?risk\b", masked[m.end():]):
+        return True
+    return one_output and _unsaid_side(masked, m, mentions, book)
 
 
 #: what may stand between two names of one subject list: commas, and/or, their values ('A (22) and B of 3')

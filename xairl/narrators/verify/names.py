@@ -93,21 +93,9 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
             if form and clean(form):
                 exact.setdefault(_phrase(form), set()).add(f)
         for form in [f] + ([_head(described)] if described else []):
-            if not clean(form):
-                continue
-            # 'the applicant's age', 'age of the patient': not 'applicant', 'patient'
-            lowered = form.lower()
-            owners = set(re.findall(r"(\w+)'s\b", lowered)) | set(re.findall(r"\bof (?:the |a |an )?(\w+)$", lowered)) \
-                | _INSTANCES
-            words = [w for w in split_words(form) if w not in STOP]
-            for i in range(len(words)):
-                for j in range(i + 1, len(words) + 1):
-                    run = words[i:j]
-                    if len(run) == 1 and (run[0] in GENERIC or len(run[0]) < 3 or run[0].isdigit() or (
-                            run[0] in owners and (form != f or len(words) >= 3)) or (  # 'of the house' in a name
-                            form != f and len(run[0]) < 5 and run[0] not in split_words(f))):
-                        continue
-                    phrases.setdefault(" ".join(run), set()).add(f)
+            if clean(form):
+                for run in _runs(form, f):
+                    phrases.setdefault(run, set()).add(f)
     shared: dict[str, set[str]] = {}
     for f in [*exp.feature_names, *groups]:
         for w in split_words(f):
@@ -126,7 +114,38 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
         keys = exact.get(phrase, keys)  # a word or run of a longer name is a 'part' ('kicks' of Free Kicks)
         entries.append((phrase, "feature", tuple(sorted(keys)), "", "" if phrase in exact else "part"))
     entries += _action_entries(exp, policy, clean)
-    short: dict[str, list[tuple[str, str]]] = {}
+    label_entries, short = _label_entries(exp, clean)
+    entries += label_entries
+    entries.sort(key=lambda e: -len(e[0]))
+    names = frozenset(w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit())
+    compiled = [(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries]
+    return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, names)
+
+
+def _runs(form: str, f: str) -> list[str]:
+    """The runs of words of feature ``f``'s name or description ``form`` that may name it: every run of two words or
+    more, single words unless generic, short, a number, or the instance the form is about ('the applicant's age', 'age
+    of the patient': not 'applicant', 'patient'; in a description, or a name that is a phrase)."""
+    lowered = form.lower()
+    owners = set(re.findall(r"(\w+)'s\b", lowered)) | set(re.findall(r"\bof (?:the |a |an )?(\w+)$", lowered)) | \
+        _INSTANCES
+    words = [w for w in split_words(form) if w not in STOP]
+    out = []
+    for i in range(len(words)):
+        for j in range(i + 1, len(words) + 1):
+            run = words[i:j]
+            if len(run) == 1 and (run[0] in GENERIC or len(run[0]) < 3 or run[0].isdigit() or (
+                    run[0] in owners and (form != f or len(words) >= 3)) or (
+                    form != f and len(run[0]) < 5 and run[0] not in split_words(f))):
+                continue
+            out.append(" ".join(run))
+    return out
+
+
+def _label_entries(exp: Explanation, clean) -> tuple[list, dict[str, list[tuple[str, str]]]]:
+    """Vocabulary entries of categorical labels (a stem of each word; a one-hot column's name 'work_type_children'),
+    and the labels named only right next to their feature: 1-2 characters ('Y', 'Ex') or plain words ('other')."""
+    entries, short = [], {}
     for f, labels in (exp.categories or {}).items():
         for label in labels:
             if len(label) <= 2:
@@ -137,10 +156,7 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
                 entries.append((" ".join(stem(w) for w in split_words(label)), "label", (f,), label, ""))
             if clean(label):  # a one-hot column's name: 'work_type_children', 'smoking_status=never smoked'
                 entries.append((f"{_phrase(f)} {_phrase(label)}", "label", (f,), label, "one-hot"))
-    entries.sort(key=lambda e: -len(e[0]))
-    names = frozenset(w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit())
-    compiled = [(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries]
-    return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, names)
+    return entries, short
 
 
 def _head(description: str) -> str:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 HEDGE_TOLERANCE = 0.2  # how far a hedged number may be from the fact, relative to the fact
 
@@ -158,6 +158,11 @@ def matches(n: Number, fact: float, magnitude_ok: bool = True, truncated_ok: boo
     target = fact if n.sign or not magnitude_ok else abs(fact)
     ratio = n.unit / max(abs(n.value), 1e-12)  # an alternative reading ('3/10' as 0.3) keeps the relative precision
     return any(_close(x, target, n.unit if x == n.value else ratio * abs(x), n.hedge, truncated_ok) for x in n.readings)
+
+
+def percent_reading(n: Number, v: float) -> bool:
+    """Does a percentage state a probability-like fact ('43 %' for 0.43, '12 points' for 0.12)?"""
+    return abs(v) <= 1.0 and matches(replace(n, percent=False, alternatives=()), 100 * v)
 
 
 def _half_up(v: float, step: float) -> float:

@@ -9,7 +9,7 @@ from dataclasses import replace
 
 from .book import FactBook
 from .checks import EITHER, Claim, over_keys
-from .numbers import Number, find_numbers, matches
+from .numbers import Number, find_numbers, matches, percent_reading
 
 CONTRIB_BEFORE = re.compile(
     r"(?:\bby|\badds?|\badded|\badding|contribut\w*|\bworth|\bcosts?|\bcosting|subtract\w*|\boff|\baway|\bcut\w*|"
@@ -70,72 +70,6 @@ _COMPARE_AFTER = re.compile(rf"^\s*(?:dB|dBm)?\s*(?:{_COMPARISON_WORDS}|more|les
                             re.IGNORECASE)
 
 
-#: 'the typical borrower of about 48', 'the median home from 1966', 'the dataset average of 0.8', 'the average sale
-#: price of $230,061', 'the baseline of 0.34': a statistic of the background, of a feature or of the output
-_STAT_BEFORE = re.compile(r"\b(?P<word>average|typical|median|mean|usual|normal|(?:lower|upper) quartile|baseline|"
-                          r"base rate|base value|base|expected value)\b(?P<between>(?:\s+(?!(?:of|at|from|is|was)\b)"
-                          r"[A-Za-z'\0-]+){0,5}?)\s*(?:of|at|from|is|was|:|=|\()?\s*(?:about|around|roughly|nearly|"
-                          r"approximately|only|just|close to|over|under|above|below|~|≈)?\s*[$€£]?\s*"
-                          r"(?:[\d.,]+\s*(?:-|–|to)\s*)?$", re.IGNORECASE)
-_OUTPUT_NOUN = re.compile(r"\b(?:predict\w*|estimat\w*|output|probabilit\w*|chances?|risk|rate|price|scores?|"
-                          r"q[- ]?values?)\b", re.IGNORECASE)
-
-
-#: '(2 vs. ~5.75)', '(18 vs. 16.8)' after a feature's value: the background's typical value (with one output; with
-#: several, 'vs' sets a score against the runner-up's)
-_VERSUS = re.compile(r"[\d%]\s*(?:\w+\s+)?(?:vs\.?|versus|compared (?:to|with))\s+(?:the\s+)?(?:average\s+(?:of\s+)?)?"
-                     r"[~≈]?\s*$", re.IGNORECASE)
-
-
-def statistic(before: str, action_named: bool = False, several_outputs: bool = False, versus: bool = True
-              ) -> str | None:
-    """Is the number right after ``before`` a statistic of the background? 'output' (the baseline: 'the average
-    prediction of', 'the base rate of'), 'feature' ('the typical borrower of about', 'the median of') or None.
-    ``action_named``: an action is named between the statistic's word and the number ('the average sale price of');
-    ``several_outputs``: 'vs' sets two scores side by side ('7.53 vs 7.38'), not a value and its typical one;
-    ``versus``: the bracket the number opens goes on with 'vs' ('than average (2 vs. 3)': the first is the value)."""
-    m = _STAT_BEFORE.search(before)
-    if m is not None and m.group(0).rstrip().endswith("(") and re.search(r"\bthan\s+(?:the\s+)?$",
-                                                                          before[:m.start()]) and versus:
-        m = None  # 'fewer absences than average (2 vs. ~5.75)': the bracket opens with the student's own value
-    if m is not None and re.search(r"\bby\b|\b\w+(?:ed|es)\b", m.group("between"), re.IGNORECASE) and not re.search(
-            r"\b(?:typically|usually|normally|often)\b", m.group("between"), re.IGNORECASE):
-        m = None  # 'the larger than average second floor increased the price by about': a verb, not a noun phrase
-    if m is None:
-        return "feature" if not several_outputs and _VERSUS.search(before) else None
-    habit = re.search(r"\b(?:typically|usually|normally|often)\b", m.group("between"), re.IGNORECASE)
-    output = m.group("word").lower().startswith(("base", "expected")) or (
-        _OUTPUT_NOUN.search(m.group("between")) and not habit)  # 'the average team typically scores around
-    return "output" if output or (action_named and "\0" in m.group("between")) else "feature"
-
-
-def typical_number(n: Number, keys: tuple[str, ...], book: FactBook) -> Claim:
-    """A feature's typical, average or median value ('younger than the typical borrower of about 48'), checked
-    against the background's quartiles (the explanation keeps no mean): verified inside the 25-75 % band,
-    contradicted past Tukey's fences (1.5 interquartile ranges beyond a quartile: an outlier, not a typical value),
-    unchecked between or when the quartiles coincide. Categorical features are not checked."""
-    def test(key):
-        e = book.features[key]
-        if e.quartiles is None or e.label is not None or n.percent:
-            return None
-        lo, _, hi = e.quartiles
-        band = f"{key}'s background quartiles are {lo:.4g} to {hi:.4g}"
-        if lo <= n.value <= hi or matches(n, lo, magnitude_ok=False) or matches(n, hi, magnitude_ok=False):
-            return True, f"a typical value of {key} ({band})"
-        # quartiles that coincide ('failures' 0 / 0 / 0, one value in most rows): the mean may lie anywhere
-        if hi > lo and not lo - 1.5 * (hi - lo) <= n.value <= hi + 1.5 * (hi - lo):
-            return False, f"{n.text} is no typical value of {key}: {band}"
-        return None
-    return over_keys(keys, test, "typical value", n.text, "number")
-
-
-def base_number(n: Number, book: FactBook) -> Claim:
-    """'the average prediction of $230,061', 'a base rate of 0.34': the baseline (the background's average output)."""
-    ok = book.base is not None and (matches(n, book.base, magnitude_ok=False) or
-                                    (n.percent and _percent_readings(n, book.base)))
-    return Claim("number", n.text, "verified" if ok else "contradicted", f"the baseline is {book.base:.4g}")
-
-
 _OF_PEOPLE = re.compile(r"\s+of\s+(?:the\s+|their\s+|its\s+|all\s+)?(?:[\w-]+\s+){0,2}?(?:peers|students|people|"
                         r"customers|clients|applicants|borrowers|teams|players|cases|samples|population|dataset|"
                         r"houses|homes|users|patients|rows|records)\b", re.IGNORECASE)
@@ -163,10 +97,6 @@ def skip_number(n: Number, masked: str) -> bool:
                                              re.IGNORECASE):
         return True  # 'this one', 'the big one': a pronoun
     return bool(_LABEL_BEFORE.search(before)) or bool(_SKIP_AFTER.match(masked[n.end:]))
-
-
-def _percent_readings(n: Number, v: float) -> bool:
-    return abs(v) <= 1.0 and matches(replace(n, percent=False, alternatives=()), 100 * v)
 
 
 def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook, ctx: str | None,
@@ -211,7 +141,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
             cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
         for what, v in cands:
             if matches(n, v) or ((n.percent or (in_points and what.startswith("contribution")))
-                                 and _percent_readings(n, v)):
+                                 and percent_reading(n, v)):
                 return True, f"{key}: {what}"
         if n.percent and not n.points and any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
             return True, f"{key}: share"
@@ -259,7 +189,7 @@ def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, si
                                                   for c in views)]
         for what, v, size_ok in facts:
             if v is not None and (matches(replace(n, percent=False), v, magnitude_ok=size_ok, truncated_ok=False) or (
-                    n.points and _percent_readings(n, abs(v) if size_ok and not n.sign else v))):  # '12.3 pp'
+                    n.points and percent_reading(n, abs(v) if size_ok and not n.sign else v))):  # '12.3 pp'
                 return f"{key}'s {what}"
     return None
 
@@ -339,7 +269,7 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     named = None
     if is_change(n, masked) and book.base is not None:  # '$91,462 above the baseline', 'exceeds ... (0.34) by 0.09'
         change = book.scores[book.chosen] - book.base
-        ok = matches(n, change) or (n.percent and _percent_readings(n, abs(change)))
+        ok = matches(n, change) or (n.percent and percent_reading(n, abs(change)))
         return Claim("number", n.text, "verified" if ok else "contradicted", f"the change from the baseline is "
                      f"{change:.4g}")
     if MARGIN_BEFORE.search(before) or MARGIN_AFTER.match(after):
@@ -351,8 +281,7 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         named = ("the runner-up's score", [book.scores[book.runner_up]])
     elif _COMPARE_AFTER.match(after) and book.by_unit:
         named = ("a comparison", [v for vs in book.by_unit.values() for v in vs])
-    elif CONTRIB_BEFORE.search(before) and _owners(n, book):
-        owners = _owners(n, book)
+    elif CONTRIB_BEFORE.search(before) and (owners := _owners(n, book)):
         if len(owners) == 1:
             return Claim("number", n.text, "verified", f"{owners[0]}'s contribution (the only one it matches)")
         return Claim("number", n.text, "unchecked", f"a contribution of one of {', '.join(owners)}: which is unsaid")
@@ -368,15 +297,15 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
                                                             "output's: of something not named")
             prediction = book.scores[book.chosen]
             if not re.search(r"\bbase", near, re.IGNORECASE) and (matches(n, prediction, magnitude_ok=False) or (
-                    n.percent and _percent_readings(n, prediction))):
+                    n.percent and percent_reading(n, prediction))):
                 return Claim("number", n.text, "verified", "the prediction (next to a word for the average)")
             named = ("the baseline", [book.base])  # ('your risk is about average (33%)': the prediction)
         elif _OUT_WORDS.search(before):
             named = ("the prediction", [book.scores[book.chosen]])
     if named is not None and named[1]:
-        ok = any(matches(n, v, magnitude_ok=False) or (n.percent and _percent_readings(n, v)) for v in named[1])
+        ok = any(matches(n, v, magnitude_ok=False) or (n.percent and percent_reading(n, v)) for v in named[1])
         return Claim("number", n.text, "verified" if ok else "contradicted", f"{named[0]} is {named[1][0]:.4g}")
-    if any(matches(n, v) or (n.percent and _percent_readings(n, v)) for v in book.decision_numbers):
+    if any(matches(n, v) or (n.percent and percent_reading(n, v)) for v in book.decision_numbers):
         return Claim("number", n.text, "verified", "a decision-level fact")
     if book.closed:
         return Claim("number", n.text, "contradicted", "none of the facts the summary was made from")
@@ -387,7 +316,7 @@ def output_number(n: Number, book: FactBook, start: bool = False) -> Claim:
     """A number said to be where the output ends up ('pulls it down to 0.142'): the prediction; ``start``: where it
     starts ('from 34.1 % to ...'), the baseline."""
     v, what = (book.base, "baseline") if start else (book.scores[book.chosen], "prediction")
-    ok = matches(n, v, magnitude_ok=False) or (n.percent and _percent_readings(n, v))
+    ok = matches(n, v, magnitude_ok=False) or (n.percent and percent_reading(n, v))
     return Claim("number", n.text, "verified" if ok else "contradicted", f"the {what} is {v:.4g}")
 
 
@@ -398,7 +327,7 @@ def _owners(n: Number, book: FactBook) -> list[str]:
     for strict in (True, False):
         m = replace(n, hedge="") if strict else n
         found = [f for f, e in book.features.items()
-                 if any(matches(m, c) or (m.percent and _percent_readings(m, c)) for c in e.contribs.values())]
+                 if any(matches(m, c) or (m.percent and percent_reading(m, c)) for c in e.contribs.values())]
         if len(found) == 1:
             return found
     return found

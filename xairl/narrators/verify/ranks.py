@@ -191,30 +191,7 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         count = _COUNTED.search(masked, max(a, m.start() - 30), m.start())
         if count and m.group(0).lower().startswith("dominat"):  # 'Two inputs dominate ...: A ..., B ...'
             rank, plural = COUNT.get(count.group(1).lower(), 2), True
-        gap = _PARTICIPLE.match(masked, m.end(), b)
-        said = DIRECTION_RE.match(masked, gap.end() if gap else m.end() + 1, b) \
-            if masked[m.end():m.end() + 1] == " " else None
-        if not sign and said and (said.group(0).lower() not in ("for", "against", "toward", "towards")
-                                  or book.output != "actions"):  # one output: 'the biggest factor working against it'
-            sign = 1 if said.group("pos") else -1  # 'key factors decreasing the risk', 'the main feature supporting'
-        side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])
-        scope = _SCOPE.match(masked[a:m.start()])
-        if not sign and scope:  # 'Among the positives, ...', 'Of the factors lowering the risk, ...'
-            said = DIRECTION_RE.search(scope.group(1))
-            sign = 1 if re.search(r"positive|reasons? (?:to|for)", scope.group(1), re.IGNORECASE) else -1 if \
-                re.search(r"negative", scope.group(1), re.IGNORECASE) else \
-                (1 if said.group("pos") else -1) if said else 0
-        if not sign and not side and book.output == "actions" and re.search(r"(argument|reason)s?$", m.group(0),
-                                                                             re.IGNORECASE):
-            sign = 1  # 'the strongest reason': a reason for what was decided
-        if not sign and _OTHER_WAY.match(masked, m.end(), b):
-            sign = OWN_SIDE  # 'the strongest factor pulling the other way'
-        if not sign and side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
-            # 'the main argument for staying': the largest that favours it
-            sign = 1 if side.group(1) else -1
-            obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() - side.end() <= 6), None)
-            if obj is not None and resolve_action(obj, book) == book.runner_up:
-                sign = -sign  # '... for the handover' when staying was chosen
+        sign = sign or _rank_sign(m, masked, a, b, mentions, book)
         if plural:  # 'A and B had the largest effects' (before) or 'The top three were A, B and C' (after)
             before = [x for x in names if x.end <= m.start()]
             after = [x for x in names if x.start >= m.end()]
@@ -233,22 +210,59 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if target is None:
             continue
         out.append(check_rank(target.keys, rank, None, sign, ctx, book, m.group(0)))
-        for x in names:  # 'followed by B', 'B second'
-            if x.start >= m.end() and FOLLOWED.search(masked[max(a, x.start - 24):x.start]):
-                rank += 1
-                out.append(check_rank(x.keys, rank, None, sign, ctx, book, f"then {masked[x.start:x.end]}"))
+        out += _followed(masked, a, m.end(), names, rank, sign, ctx, book)  # 'followed by B', 'B second'
     for x in names:
         o = AFTER_ORD.match(masked[x.end:b])
         if o and not RANK_RE.match(masked[x.end:b].lstrip(" ,(")):
             rank = ORD[o.group("o").lower()]
             out.append(check_rank(x.keys, rank, None, 0, ctx, book, f"{masked[x.start:x.end]} {o.group('o')}"))
-            for y in names:  # 'A first (+11.0), then B'
-                if rank == 1 and y.start > x.end and FOLLOWED.search(masked[max(a, y.start - 24):y.start]):
-                    rank += 1
-                    out.append(check_rank(y.keys, rank, None, 0, ctx, book, f"then {masked[y.start:y.end]}"))
+            if rank == 1:  # 'A first (+11.0), then B'
+                out += _followed(masked, a, x.end + 1, names, rank, 0, ctx, book)
     out += _chain(masked, a, b, names, book, ctx)
     out += _in_order(masked, a, b, names, book, ctx)
     return out
+
+
+def _followed(masked: str, a: int, start: int, names: list[Mention], rank: int, sign: int, ctx: str | None,
+              book: FactBook) -> list[Claim]:
+    """'..., followed by B, then C' after a rank: the names after ``start`` with such a word before them, next in
+    rank."""
+    out = []
+    for x in names:
+        if x.start >= start and FOLLOWED.search(masked[max(a, x.start - 24):x.start]):
+            rank += 1
+            out.append(check_rank(x.keys, rank, None, sign, ctx, book, f"then {masked[x.start:x.end]}"))
+    return out
+
+
+def _rank_sign(m: re.Match, masked: str, a: int, b: int, mentions: list[Mention], book: FactBook) -> int:
+    """The sign a rank phrase ranks among, from the words around it: a direction right after it ('key factors
+    decreasing the risk', 'the biggest factor working against default'), a scope ('Among the positives, ...'), 'the
+    strongest reason' (for what was decided), 'pulling the other way' (its own sign), 'the main argument for staying';
+    0 when they say none."""
+    gap = _PARTICIPLE.match(masked, m.end(), b)
+    said = DIRECTION_RE.match(masked, gap.end() if gap else m.end() + 1, b) \
+        if masked[m.end():m.end() + 1] == " " else None
+    if said and (said.group(0).lower() not in ("for", "against", "toward", "towards") or book.output != "actions"):
+        return 1 if said.group("pos") else -1  # (one output: 'the biggest factor working against it')
+    side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])
+    scope = _SCOPE.match(masked[a:m.start()])
+    if scope:  # 'Among the positives, ...', 'Of the factors lowering the risk, ...'
+        said = DIRECTION_RE.search(scope.group(1))
+        sign = 1 if re.search(r"positive|reasons? (?:to|for)", scope.group(1), re.IGNORECASE) else -1 if \
+            re.search(r"negative", scope.group(1), re.IGNORECASE) else (1 if said.group("pos") else -1) if said else 0
+        if sign:
+            return sign
+    if not side and book.output == "actions" and re.search(r"(argument|reason)s?$", m.group(0), re.IGNORECASE):
+        return 1  # 'the strongest reason': a reason for what was decided
+    if _OTHER_WAY.match(masked, m.end(), b):
+        return OWN_SIDE  # 'the strongest factor pulling the other way'
+    if side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
+        sign = 1 if side.group(1) else -1  # 'the main argument for staying': the largest that favours it
+        obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() - side.end() <= 6), None)
+        return -sign if obj is not None and resolve_action(obj, book) == book.runner_up else sign  # ('for the
+        # handover' when staying was chosen)
+    return 0
 
 
 #: 'In order of size: A, B, C', 'Largest first: A, B', '1. A ...' / '2) B ...' (a numbered item, by the importance
