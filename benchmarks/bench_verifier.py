@@ -129,20 +129,25 @@ def report(items: list[dict], show: str | None) -> None:
     print(f"\nspeed: {1000 * per_sentence:.2f} ms per sentence (mean over {len(items)} narratives)")
 
 
+def explanation_from_tuples(text: str, output: str = "prediction") -> xairl.Explanation:
+    """A one-output Explanation from '(name, value, contribution), ...' tuples, as Explingo writes them (a value that
+    is not a number is a category); no baseline is given, so it is 0."""
+    tuples = re.findall(r"\(([^()]*?),\s*([^,()]+?),\s*(-?[\d.]+)\)", text)
+    names = [t[0].strip() for t in tuples]
+    raw = [t[1].strip() for t in tuples]
+    contrib = np.array([float(t[2]) for t in tuples])
+    cats = {n: (v,) for n, v in zip(names, raw) if not re.fullmatch(r"-?[\d.]+", v)}
+    states = np.array([[0.0 if n in cats else float(v) for n, v in zip(names, raw)]])
+    return xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.zeros((1, 1)),
+                             outputs=np.array([[contrib.sum()]]), states=states, feature_names=tuple(names),
+                             action_names=(output,), method="given", output="value", categories=cats or None)
+
+
 def explingo_items(path: str) -> list[dict]:
     """Explingo's labelled narratives, each with a one-output Explanation rebuilt from its tuples."""
     out = []
     for row in json.loads(pathlib.Path(path).read_text()):
-        tuples = re.findall(r"\(([^()]*?),\s*([^,()]+?),\s*(-?[\d.]+)\)", row["explanation"])
-        names = [t[0].strip() for t in tuples]
-        raw = [t[1].strip() for t in tuples]
-        contrib = np.array([float(t[2]) for t in tuples])
-        cats = {n: (v,) for n, v in zip(names, raw) if not re.fullmatch(r"-?[\d.]+", v)}
-        states = np.array([[0.0 if n in cats else float(v) for n, v in zip(names, raw)]])
-        exp = xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.zeros((1, 1)),
-                                outputs=np.array([[contrib.sum()]]), states=states, feature_names=tuple(names),
-                                action_names=("prediction",), method="given", output="value",
-                                categories=cats or None)
+        exp = explanation_from_tuples(row["explanation"])
         domain = row["context"].split(" predicts ")[-1][:28]
         if "narrative" in row:  # accuracy_tests.json: a labelled narrative
             out.append({"case": row["explanation"][:40], "domain": domain, "split": "explingo",

@@ -11,7 +11,7 @@ import xairl
 from xairl.narrators.verify.names import find_mentions, vocabulary
 from xairl.narrators.verify.numbers import find_numbers, matches, normalise
 from xairl.narrators.verify.book import clean_surface
-from benchmarks.bench_verifier import load_corpus, run, shapstories_case
+from benchmarks.bench_verifier import explanation_from_tuples, load_corpus, run, shapstories_case
 from tests import narrative_domains as domains
 
 
@@ -656,15 +656,7 @@ def test_phrasings_on_outside_cases(dataset, index, text, status):
 
 
 def _tuples(text):
-    """A one-output Explanation from '(name, value, contribution), ...' tuples, as Explingo writes them."""
-    rows = [t.split(", ") for t in text.strip("()").split("), (")]
-    names = tuple(r[0] for r in rows)
-    cats = {r[0]: (r[1],) for r in rows if not r[1].replace(".", "").isdigit()}
-    c = np.array([float(r[2]) for r in rows])
-    return xairl.Explanation(values=c.reshape(1, -1, 1), base_values=np.zeros((1, 1)), outputs=np.array([[c.sum()]]),
-                             states=np.array([[0.0 if r[0] in cats else float(r[1]) for r in rows]]),
-                             feature_names=names, action_names=("price",), method="given", output="value",
-                             categories=cats or None)
+    return explanation_from_tuples(text, output="price")
 
 
 def test_names_that_are_phrases_and_coarse_amounts():
