@@ -194,19 +194,22 @@ def shapstories_case(dataset: str, index: int) -> tuple[int, xairl.Explanation, 
 
 
 def shapstories_items(path: str) -> list[dict]:
-    """The LLM-written narratives of SHAPnarrative-agents (``baseline_narratives.json``) that have a case in
-    ``data/narratives/outside/shapstories.yaml``; every one is accurate for its case."""
+    """The LLM-written narratives of SHAPnarrative-agents (``baseline_narratives.json``, ``..._best.json``) that have a
+    case in ``data/narratives/outside/shapstories.yaml``; each is accurate for its case unless the file's entry there
+    lists it as contradicting it."""
     cases = _shapstories_cases()
+    about = cases["files"].get(pathlib.Path(path).name, {})
     out = []
     for row in json.loads(pathlib.Path(path).read_text()):
-        dataset = row.get("dataset", "fifa")
+        dataset, case = row.get("dataset", "fifa"), f"{row.get('dataset', 'fifa')}-{row['index']}"
         if row["index"] not in cases.get(dataset, {}).get("cases", {}):
             continue
         batch, exp, policy = shapstories_case(dataset, row["index"])
-        for error, e in (("ok", exp), *manipulated(exp)):
-            out.append({"case": f"{dataset}-{row['index']}", "domain": dataset, "split": f"shapstories batch {batch}",
-                        "error": error, "accurate": error == "ok", "text": row["round0_narrative"], "explanation": e,
-                        "policy": policy})
+        split = "held out" if dataset in about.get("held_out", ()) else f"batch {batch}"
+        label = about.get("contradicting", {}).get(case, "ok")
+        for error, e in ((label, exp), *manipulated(exp)):
+            out.append({"case": case, "domain": dataset, "split": f"shapstories {split}", "error": error,
+                        "accurate": error == "ok", "text": row["round0_narrative"], "explanation": e, "policy": policy})
     return out
 
 
