@@ -101,7 +101,8 @@ _CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whe
                         r"however)\b(?!,)"  # ('A, though, pushes it up': an aside)
                         r"|,\s(?:and\s)?(?=but\b)|\s?[—–]\s?(?=(?:likely|possibly|perhaps|probably|since|as|because|"
                         r"this|"
-                        r"which|suggesting|unsurprising)\b)|\s(?=because\b(?!\s+of\b))", re.IGNORECASE)
+                        r"which|suggesting|unsurprising)\b)|\s(?=because\b(?!\s+of\b))"
+                        r"|,\s(?=(?:as|since)\s(?!(?:well|a result|such|much|many|far|long|of)\b))", re.IGNORECASE)
 #: ', while slightly elevated, was ...': an aside inside the clause (no subject of its own), not a clause
 _APPOSITIVE = re.compile(r"\s(?:while|although|though)\s+(?:\w+ly\s+)?(?:[a-z]+ed|[a-z]+ing|high|low|above|below|"
                          r"modest|small|large|elevated)\b[^,;.]{0,30},", re.IGNORECASE)

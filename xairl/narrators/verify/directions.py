@@ -8,7 +8,7 @@ import re
 from . import checks
 from .book import FactBook
 from .checks import Claim
-from .names import GENERIC, Mention, named_features, split_words
+from .names import GENERIC, Mention, named_features, split_words, stem
 from .ranks import NOUN
 
 _GENERIC_SUBJECT = re.compile(r"^\W*(?:[qa]\s*:\s*)?(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|"
@@ -65,6 +65,9 @@ _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:bu
                      r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
 
+#: a clause with a subject of its own after a comma: ', this effect was', ', it was'
+_NEW_SUBJECT = re.compile(r",\s*(?:this|that|these|those|it|they)\s+(?:\w+\s+)?(?:is|was|are|were|has|had)\b",
+                          re.IGNORECASE)
 #: a subordinate clause between a direction word and a name: the name is that clause's subject
 _SUBORDINATE = re.compile(r"\b(?:after|before|when|while|because|since|although|though|if|once|until|whereas)\b",
                           re.IGNORECASE)
@@ -90,6 +93,13 @@ def _unsaid_side(masked: str, m: re.Match, mentions: list[Mention], book: FactBo
 
 #: words of an output that is a good outcome (its risk is the inverse framing)
 _GOOD_OUTCOME = {"good", "pass", "approval", "approved", "repay", "repayment", "success", "survival", "win"}
+
+
+def _good_outcome(book: FactBook) -> bool:
+    """The one output is the probability of a good outcome (credit repaid, a pass): a risk is its other side."""
+    return book.output != "actions" and bool(_GOOD_OUTCOME & set(split_words(book.chosen or "")))
+
+
 #: 'positive contributions from A and B': the names after the direction word are its subject
 _OF_WHAT = re.compile(r"\s+(?:contributions?|effects?|impacts?|influences?|pushe?s?)\s+(?:from|of|by)\s", re.IGNORECASE)
 #: a coordinated clause with a subject of its own after an earlier direction word: 'A lowered it by x, and B cost y'
@@ -106,8 +116,10 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if _no_push(m, masked, mentions, book):
             continue
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
-        if re.match(r"\s+to\s+(?:the\s+)?(?:negative|downside|risks?|concerns?|worries)\b", masked[m.end():]):
-            polarity = -polarity  # 'added to the negative outlook'
+        if re.match(r"\s+to\s+(?:the\s+)?(?:negative|downside|risks?|concerns?|worries)\b", masked[m.end():]) \
+                and _good_outcome(book):
+            polarity = -polarity  # 'added to the negative outlook' of a good-credit probability (of a diabetes
+            # probability, 'contributed positively to the risk' raises it)
         subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
         if _PARTICIPLE_AFTER_COMMA.match(m.group(0)) and re.search(r",\s*$", masked[a:m.start()]) and names and \
                 names[0].start < m.start():
@@ -118,8 +130,10 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
             nxt = found[i + 1].start() if i + 1 < len(found) else b
             subjects = [x for x in names if m.end() <= x.start < nxt]
-            if subjects and _SUBORDINATE.search(masked, m.end(), subjects[0].start):
-                subjects = []  # 'raised your risk the most after retirement lowered it': not retirement's
+            if subjects and (_SUBORDINATE.search(masked, m.end(), subjects[0].start) or
+                             _NEW_SUBJECT.search(masked, m.end(), subjects[0].start)):
+                subjects = []  # 'raised your risk the most after retirement lowered it', '..., which increased the
+                # risk, this effect was outweighed by the glucose': not the later clause's name
             if bare and subjects and ":" in masked[m.end():subjects[0].start]:
                 subjects = []  # 'Negative drivers outweighed positive ones: A, B': whose list is it? unsaid
             elif not subjects:
@@ -160,7 +174,7 @@ def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) 
         return True
     if any(x.kind == "feature" and 0 < x.start - m.end() <= 1 for x in mentions):
         return True
-    if one_output and _GOOD_OUTCOME & set(split_words(book.chosen or "")) and re.match(
+    if _good_outcome(book) and re.match(
             r"\s+(?:the\s+|their\s+|its\s+|default\s+|credit\s+)?risk\b", masked[m.end():]):
         return True
     return one_output and _unsaid_side(masked, m, mentions, book)
@@ -225,8 +239,10 @@ def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_word
         return []  # 'Rated fair, it takes $23,750 off': a pronoun for something named before
     if _ELLIPTIC.match(re.sub(r".*\b(while|although|though|whereas|if|when)\s*$", r"\1 ", opener) + subject):
         return []  # '..., while slightly elevated, was still lower ...': the subject is the main clause's
+    said = {w.lower() for w in words} | {stem(w) for w in words if w.lower().endswith("ing")}  # 'scoring': scored
     if mentions or _GENERIC_SUBJECT.match(subject.replace("\0", " ")) or \
-            any(w.lower() in name_words or re.fullmatch(NOUN, w, re.IGNORECASE) for w in words):
+            any(re.fullmatch(NOUN, w, re.IGNORECASE) for w in words) or \
+            any(x in said if isinstance(x, str) else x <= said for x in name_words):
         return []
     return [Claim("feature", subject.strip(" ,:-\0"), "contradicted",
                   f"'{word}' is said of something that is not a feature of this model")]

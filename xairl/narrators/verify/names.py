@@ -71,19 +71,23 @@ class Vocabulary:
     #: plain words ('other', 'at_home')
     short_labels: dict[str, list[tuple[str, str]]]
     words: dict[str, frozenset[str]]  # feature -> the words of its name, description and aliases (qualifiers)
-    #: words of the features' own names ('quality' of ``kitchen_quality``): a phrase with one of them may be a vague
-    #: mention of a feature, not a thing the model lacks
-    name_words: frozenset[str] = frozenset()
+    #: words of the features' own names ('quality' of ``kitchen_quality``) and their stems ('scor~' of 'scoring'), and
+    #: the set of content words of each description of two or more ('mother', 'job'): a phrase with one such word, or
+    #: with all the words of one such set ('the mother having a job'), may be a vague mention of a feature, not a
+    #: thing the model lacks
+    name_words: frozenset = frozenset()
 
 
 def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     phrases: dict[str, set[str]] = {}
     exact: dict[str, set[str]] = {}
     feature_words: dict[str, frozenset[str]] = {}
+    described_words: list[frozenset[str]] = []  # the content words of each description ('mother's job': mother, job)
     groups = [g for g in (policy.reason_groups if policy else {}) if g not in exp.feature_names]
     for f in [*exp.feature_names, *groups]:
         info = policy.features.get(f) if policy else None
         described = (info.description if clean(info.description) else _head(info.description)) if info else ""
+        described_words.append(frozenset(w for w in split_words(_head(described)) if w not in STOP and len(w) >= 3))
         forms = [f, " ".join(split_words(f))] + ([described, _head(described), *info.aliases] if info else [])
         feature_words[f] = frozenset(w for form in forms if form for w in split_words(form) if w not in STOP)
         name_words = split_words(f)
@@ -117,9 +121,10 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     label_entries, short = _label_entries(exp, clean)
     entries += label_entries
     entries.sort(key=lambda e: -len(e[0]))
-    names = frozenset(w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit())
+    names = {w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit()}
+    names |= {stem(w) for w in names} | {ws for ws in described_words if len(ws) >= 2}
     compiled = [(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries]
-    return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, names)
+    return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, frozenset(names))
 
 
 def _runs(form: str, f: str) -> list[str]:

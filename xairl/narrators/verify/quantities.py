@@ -47,9 +47,11 @@ _BASE_BEFORE = re.compile(r"\b(?:baseline|average|typical|mean|expected)\s+(?:pr
 _OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability|chance|risk|price|output|final)\b",
                         re.IGNORECASE)
 _SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|features|narratives|coalitions|times|"
-                         r"-fold)\b|[x×](?![\w]))",
+                         r"-fold|outcomes|options|classes|sides|factors|reasons|drivers|categories|possibilities|"
+                         r"scenarios|-?points?\s+scale|scale)\b|[x×](?![\w]))",
                          re.IGNORECASE)
-_LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state|outcome|class)[\s-]*$", re.IGNORECASE)
+_LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state|outcome|class|type)[\s-]*$",
+                           re.IGNORECASE)
 #: '$91,462 above the baseline' (not '0.38 is slightly above the base value': there the number is the prediction)
 _CHANGE_BEFORE = re.compile(r"\b(?:exceed\w*|above|below|under|higher than|lower than|more than|less than)\b[^;]{0,40}"
                             r"\bby\s+(?:about|around|roughly|nearly|almost|some|only|just)?\s*[$€£]?\s*$",

@@ -134,7 +134,8 @@ _COUNTED = re.compile(r"\b(two|three|four|both)\s+(?:[\w-]+\s+)?$", re.IGNORECAS
 #: a rank in what would (not) be: 'enough to make X a dominant predictor', 'would make X the main reason'
 _WOULD_MAKE = re.compile(r"\b(?:enough to|would|could|might|to)\s+(?:make|render|become)\b[^.;]{0,30}$", re.IGNORECASE)
 #: a rank said of several features at once
-_COLLECTIVE = re.compile(r"\b(?:combination of|together|combined|collectively|jointly|taken together)\b", re.IGNORECASE)
+_COLLECTIVE = re.compile(r"\b(?:combination of|together|combined|collectively|jointly|taken together|"
+                         r"(?:contributions|effects|influences|impacts) (?:from|of))\b", re.IGNORECASE)
 
 
 def check_collective(members: list[tuple[str, ...]], ctx: str | None, book: FactBook, text: str) -> Claim:
