@@ -647,6 +647,38 @@ OUTSIDE = [
     ("credit", 990, "Being unemployed (value 1) added to the positive outlook.", "contradicted"),
     ("credit", 319, "Other installment plans (value: 1) slightly lowered the probability, because existing debt "
                     "obligations increase repayment risk.", "verified"),
+    # other LLMs' narratives of the same cases (baseline_narratives_best.json): 'this boost' refers back; a risk
+    # output's 'risk' is the output itself; counting nouns and 'type 2' are no values; ', as ...' gives a reason
+    ("fifa", 69, "However, this boost was offset by the team having only 1 corner kick, which significantly reduced "
+                 "the probability.", "verified"),
+    ("fifa", 69, "However, this boost was offset by the team having only 1 corner kick, which significantly raised "
+                 "the probability.", "contradicted"),
+    ("diabetes", 66, "The patient's age of 38 also contributed positively to the risk.", "verified"),
+    ("diabetes", 66, "The patient's age of 38 also contributed negatively to the risk.", "contradicted"),
+    ("diabetes", 66, "The glucose level of 109 lowered the probability, leaving a nearly equal split between the two "
+                     "outcomes.", "verified"),
+    ("diabetes", 66, "The glucose level of 119 lowered the probability, leaving a nearly equal split between the two "
+                     "outcomes.", "contradicted"),
+    ("diabetes", 66, "Next, the age of 38 raised the risk, as older age is generally associated with higher diabetes "
+                     "likelihood.", "verified"),
+    ("student", 300, "Going out with friends, rated 4 on a 5-point scale, reduced the probability.", "verified"),
+    ("student", 300, "Going out with friends, rated 3 on a 5-point scale, reduced the probability.", "contradicted"),
+    ("diabetes", 375, "The patient's age of 58 raised the risk of type 2 diabetes.", "verified"),
+    ("diabetes", 375, "The patient's age of 48 raised the risk of type 2 diabetes.", "contradicted"),
+    # 'the contributions from A and B dominated' is said of the two together
+    ("diabetes", 490, "The strong protective contributions from low glucose and young age dominated.", "verified"),
+    ("diabetes", 66, "The strong contributions from glucose and BMI dominated.", "contradicted"),
+    # a gerund of a name's word and all the words of a description are vague mentions, not invented features; a
+    # flag's one-word legend ('sex (1 = male)') names its value
+    ("fifa", 19, "Next, one goal gave a slight positive contribution, though scoring only once did not strongly boost "
+                 "the probability.", "verified"),
+    ("fifa", 19, "Next, one goal gave a slight positive contribution, though the team's singing did not strongly "
+                 "boost the probability.", "contradicted"),
+    ("student", 375, "However, the student's mother having a job categorized as \"other\" slightly reduced the "
+                     "probability.", "unchecked"),
+    ("student", 375, "However, the student's love of chess slightly reduced the probability.", "contradicted"),
+    ("student", 246, "Finally, being male provided a slight positive contribution.", "verified"),
+    ("student", 252, "Finally, being male provided a slight positive contribution.", "contradicted"),
 ]
 
 

@@ -61,10 +61,11 @@ _LEGEND_ENTRY = re.compile(r"^\s*(\d+)\s*[:=]?\s+(\S.*?)\s*$")
 
 def legend(description: str) -> dict[int, str]:
     """A data dictionary's legend of codes in a description: 'savings (1 none, 2 below 100 DM, 3 100 to 500 DM)' ->
-    {1: 'none', 2: 'below 100 DM', 3: '100 to 500 DM'}; at least two entries, else none."""
+    {1: 'none', 2: 'below 100 DM', 3: '100 to 500 DM'}; at least two entries, or one written with '=' ('sex (1 =
+    male)'), else none."""
     for inside in re.findall(r"\(([^()]*)\)", description or ""):
         entries = [_LEGEND_ENTRY.match(part) for part in re.split(r"[,;]", inside)]
-        if len(entries) >= 2 and all(entries):
+        if all(entries) and (len(entries) >= 2 or "=" in inside):
             return {int(m.group(1)): m.group(2) for m in entries}
     return {}
 

@@ -120,9 +120,15 @@ def check_label(sentence: str, m: Mention, book: FactBook) -> Claim | None:
         return None
     f = m.keys[0]
     actual = book.features[f].label
+    text = sentence[m.start:m.end]
+    if m.form == "legend":  # 'being male' of 'sex (1 = male)': the meaning of the state's code
+        e = book.features[f]
+        code = int(e.value) if e.value is not None and e.value == int(e.value) else None
+        ok = code is not None and e.legend.get(code, "").lower() == m.label.lower()
+        return Claim("category", text, "verified" if ok else "contradicted",
+                     f"{f} is {code if code is not None else e.value} ({e.legend.get(code, 'not ' + m.label)})")
     if actual is None:
         return None
-    text = sentence[m.start:m.end]
     ok = actual.lower() == m.label.lower()
     return Claim("category", text, "verified" if ok else "contradicted",
                  f"{f} is {actual}" if ok else f"{f} is {actual}, not {m.label}")

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 from ...explanation import Explanation
 from ...policy import Policy
+from .book import legend
 
 STOP = {"the", "a", "an", "of", "in", "on", "to", "for", "and", "or", "s", "its", "it", "by", "with", "at", "from",
         "per", "than", "is", "as", "out", "above", "below", "over", "under", "after", "before", "between", "within",
@@ -119,7 +120,7 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
         entries.append((phrase, "feature", tuple(sorted(keys)), "", "" if phrase in exact else "part"))
     entries += _action_entries(exp, policy, clean)
     label_entries, short = _label_entries(exp, clean)
-    entries += label_entries
+    entries += label_entries + _legend_entries(exp, policy)
     entries.sort(key=lambda e: -len(e[0]))
     names = {w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit()}
     names |= {stem(w) for w in names} | {ws for ws in described_words if len(ws) >= 2}
@@ -144,6 +145,23 @@ def _runs(form: str, f: str) -> list[str]:
                     form != f and len(run[0]) < 5 and run[0] not in split_words(f))):
                 continue
             out.append(" ".join(run))
+    return out
+
+
+#: legend meanings too common to name a feature's code
+_COMMON_MEANINGS = {"yes", "no", "none", "true", "false", "low", "high", "other", "unknown", "never", "always"}
+
+
+def _legend_entries(exp: Explanation, policy: Policy | None) -> list:
+    """The meaning of a flag's one-entry legend, when it is one word ('sex (1 = male)': 'male'), named as its value
+    (the words of a longer legend, 'bank' of '1 bank, 2 stores, 3 none', are too often said of other things)."""
+    out = []
+    for f in exp.feature_names:
+        info = policy.features.get(f) if policy else None
+        meanings = legend(info.description if info else "").values()
+        for meaning in meanings if len(meanings) == 1 else ():
+            if re.fullmatch(r"[A-Za-z]{4,}", meaning) and meaning.lower() not in _COMMON_MEANINGS | STOP:
+                out.append((meaning.lower(), "label", (f,), meaning, "legend"))
     return out
 
 
