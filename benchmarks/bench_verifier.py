@@ -21,15 +21,19 @@ on: the second held-out figure. A narrative counts as agreeing when ``Verificati
     .venv/bin/python benchmarks/bench_verifier.py --shapstories baseline_narratives.json  # outside, see below
 
 ``--shapstories``: LLM-written narratives of SHAPnarrative-agents (github.com/ADMAntwerp/SHAPnarrative-agents,
-``data/baseline_narratives.json``; not shipped), against explanations built by hand from what each says
-(``data/narratives/outside/shapstories.yaml``), and against the same explanations with every sign inverted and with
-the two largest contributions swapped (then each text is wrong).
+``data/baseline_narratives.json``, and other LLMs' narratives of the same cases in ``data/baseline_narratives_best.json``;
+not shipped), against explanations built by hand from what each baseline narrative says
+(``data/narratives/outside/shapstories.yaml``, which also lists the best-file narratives that contradict their case
+and the domains held out from tuning), and against the same explanations with every sign inverted and with the two
+largest contributions swapped (then each text is wrong: these narratives always rank).
 
 ``--explingo``: the hand-labelled narratives of Zytek et al.'s Explingo (github.com/sibyl-dev/Explingo,
 ``full-experiment/accuracy_tests.json``; not shipped here): each explanation is rebuilt from its
 (feature, value, contribution) tuples as a one-output Explanation; score 0 is inaccurate, 2 and 4 accurate. Its
-``full-experiment/dataset/gold_standards.json`` (the hand-written reference narratives, ``description``, and plain
-restatements, ``bad_description``) are all accurate.
+``full-experiment/dataset/gold_standards.json`` and ``dataset/unaligned_examples_1.json`` (hand-written reference
+narratives, ``description``, and plain restatements, ``bad_description``) are accurate; each is also run against
+its explanation with every sign inverted and with the two largest contributions swapped (a description that names
+no rank and whose top two share a sign stays true under the swap: that group's misses are not all errors).
 """
 from __future__ import annotations
 
@@ -153,11 +157,13 @@ def explingo_items(path: str) -> list[dict]:
             out.append({"case": row["explanation"][:40], "domain": domain, "split": "explingo",
                         "error": row["accuracy_rationalization"], "accurate": row["accuracy_score"] > 0,
                         "text": row["narrative"], "explanation": exp})
-        for key in ("description", "bad_description"):  # dataset/gold_standards.json: accurate texts
-            if row.get(key):
-                out.append({"case": row["explanation"][:40], "domain": domain, "split": "explingo",
-                            "error": f"gold {key.replace('_', ' ')}", "accurate": True, "text": row[key],
-                            "explanation": exp})
+        for key in ("description", "bad_description"):  # dataset/*.json: accurate texts, and wrong for the same
+            if row.get(key):  # explanation manipulated
+                kind = key.replace('_', ' ')
+                for error, e in ((f"gold {kind}", exp), *manipulated(exp)):
+                    out.append({"case": row["explanation"][:40], "domain": domain, "split": "explingo",
+                                "error": error if e is exp else f"{error}, {kind}", "accurate": e is exp,
+                                "text": row[key], "explanation": e})
     return out
 
 
@@ -234,7 +240,8 @@ def main() -> None:
     args = ap.parse_args()
     if args.explingo or args.shapstories:
         items = run(explingo_items(args.explingo) if args.explingo else shapstories_items(args.shapstories), {})
-        name = "Explingo accuracy_tests" if args.explingo else "SHAPnarrative-agents baseline narratives"
+        name = f"Explingo {pathlib.Path(args.explingo).stem}" if args.explingo else \
+            f"SHAPnarrative-agents {pathlib.Path(args.shapstories).stem}"
         agree = sum(it["ok"] == it["accurate"] for it in items)
         print(f"## {name} (outside): agreement {agree}/{len(items)} = {100 * agree / len(items):.1f} %")
         print("| group | agree | n |\n|---|---|---|")

@@ -2,6 +2,7 @@
 import json
 import pathlib
 import time
+from dataclasses import replace
 
 import numpy as np
 import torch
@@ -710,6 +711,26 @@ def test_names_that_are_phrases_and_coarse_amounts():
                   "2000.00, 8192.46), (Second floor square feet, 1053.00, 18094.05)")
     res = xairl.verify("The house's good condition (rated 8/10) increased the price by about $10,000.", exp)
     assert res.status == "unchecked", res.claims
+
+
+def test_explingo_unaligned_voice_and_signed_restatements():
+    """Explingo's dataset/unaligned_examples_1.json voice: 'The SHAP value says that the house price decreases
+    because A is x, ...' says A lowered the price (a reporting clause and the output as subject name no invented
+    feature); a restatement 'X has a value of v and a SHAP value of c' binds c to X, and an unsigned SHAP value is a
+    positive one."""
+    exp = _tuples("(Above ground living area square feet, 1256.00, -12527.46), (Rates the overall material and finish "
+                  "of the house, 5.00, -10743.76), (Wood deck area in square feet, 736.00, 9846.38)")
+    text = ("The SHAP value says that the house price decreases because the above ground living area is 1256 sq ft "
+            "and the material quality is rated 5.")
+    assert xairl.verify(text, exp).status == "verified"
+    assert xairl.verify(text.replace("decreases", "increases"), exp).status == "contradicted"
+    text = "The Above ground living area square feet feature has a values of 1256.00 and a SHAP value of -12527.46."
+    assert xairl.verify(text, exp).status == "verified"
+    assert xairl.verify(text.replace("-12527.46", "-10743.76"), exp).status == "contradicted"  # another's
+    text = "The Wood deck area in square feet feature has a values of 736.00 and a SHAP value of 9846.38."
+    assert xairl.verify(text, exp).status == "verified"
+    assert xairl.verify(text, replace(exp, values=-exp.values)).status == "contradicted"  # it is -9846.38
+    assert xairl.verify(text.replace("a SHAP", "a negative SHAP"), replace(exp, values=-exp.values)).ok
 
 
 def test_no_direction_in_an_adjective_an_appearance_or_an_aside():

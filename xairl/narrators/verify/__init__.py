@@ -106,6 +106,9 @@ _CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whe
 #: ', while slightly elevated, was ...': an aside inside the clause (no subject of its own), not a clause
 _APPOSITIVE = re.compile(r"\s(?:while|although|though)\s+(?:\w+ly\s+)?(?:[a-z]+ed|[a-z]+ing|high|low|above|below|"
                          r"modest|small|large|elevated)\b[^,;.]{0,30},", re.IGNORECASE)
+#: 'the house price decreases because A is x and B is y': the reason names what moved the output, in one clause
+_OUTPUT_MOVED = re.compile(rf"\b(?:price|prediction|probability|risk|estimate|output|score)\s+(?:\w+ly\s+)?"
+                           rf"{checks.DIRECTION_RE.pattern}$", re.IGNORECASE)
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
 def sentences(text: str) -> list[tuple[int, int]]:
     """Sentence spans: split after . ! ? before a capital or a sign, and at line breaks and bullets."""
@@ -193,8 +196,8 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
             checks.check_label(sentence, m, book) if m.kind == "label" else None
         if c is not None:
             claims.append(c)
-    bounds = [0] + [m.end() for m in _CLAUSE_RE.finditer(masked) if not _APPOSITIVE.match(masked, m.start())] + [
-        len(masked)]
+    bounds = [0] + [m.end() for m in _CLAUSE_RE.finditer(masked) if not _APPOSITIVE.match(masked, m.start())
+                    and not _OUTPUT_MOVED.search(sentence, 0, m.start())] + [len(masked)]
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'

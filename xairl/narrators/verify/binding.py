@@ -71,7 +71,8 @@ def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ct
     if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
         other = quantities.other_reading(n, set(owner.keys), book, ctx, signed=True)
     else:
-        other = quantities.other_reading(n, sentence_keys, book, ctx)
+        other = quantities.other_reading(n, sentence_keys, book, ctx,
+                                         signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
     return c if other is None else Claim("number", n.text, "unchecked",
                                          f"read as {c.detail}, but it is {other}: which is unclear")
 
@@ -176,7 +177,9 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
             and not checks.DIRECTION_RE.search(item.group("words")):  # '..., year 1945' (not '..., added 6.8')
         prev = None
     if prev is not None and not re.search(r"(?:,\s*|\sand\s+)(?:and\s+)?(?:a|an|the|its|their|his|her|zero|no)\s"
-                                          r"(?!(?:most|second|third|main|largest|biggest|top|strongest)\b)",
+                                          r"(?!(?:most|second|third|main|largest|biggest|top|strongest|shap|"
+                                          r"contribution|attribution|impact|effect)\b)",  # (not 'and a SHAP value of':
+                                          # the same name's)
                                           masked[prev.end:n.start], re.IGNORECASE):
         return quantities.feature_number(n, prev.keys, masked, book, ctx, unit_of)
     return quantities.free_number(n, masked, book)

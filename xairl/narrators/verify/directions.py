@@ -17,6 +17,9 @@ _GENERIC_SUBJECT = re.compile(r"^\W*(?:[qa]\s*:\s*)?(?:and\s+|but\s+|also\s+|so\
                               r"(?: else)?|every \w+|all(?: \w+)?|both|each|none|nothing|the rest|others?|the model"
                               r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total"
                               r"|the prediction|the predicted \w+|the estimate|the output|the model's \w+"
+                              r"|(?:the|its|their)\s+(?:(?:house|home|property|patient|applicant|customer|student|"
+                              r"team)(?:'s)?\s+)?(?:sale\s+)?(?:price|value|cost|risk|probability|chance|odds|"
+                              r"likelihood)"
                               r"|(?:the )?(?:q[- ]?value |score )?(?:gap|margin|lead|difference))\b(?!'s)",
                               re.IGNORECASE)
 
@@ -65,6 +68,9 @@ _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:bu
                      r"other than)\s+(?:the\s+|its\s+)?\W*$", re.IGNORECASE)
 
 
+#: the output as the subject of a direction word: 'the house price decreases (because ...)', 'it rises'
+_OUTPUT_BEFORE = re.compile(r"\b(?:price|prediction|probability|risk|estimate|output|score|value|it)\s+(?:\w+ly\s+)?$",
+                            re.IGNORECASE)
 #: a clause with a subject of its own after a comma: ', this effect was', ', it was'
 _NEW_SUBJECT = re.compile(r",\s*(?:this|that|these|those|it|they)\s+(?:\w+\s+)?(?:is|was|are|were|has|had)\b",
                           re.IGNORECASE)
@@ -130,8 +136,13 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
             nxt = found[i + 1].start() if i + 1 < len(found) else b
             subjects = [x for x in names if m.end() <= x.start < nxt]
-            if subjects and (_SUBORDINATE.search(masked, m.end(), subjects[0].start) or
-                             _NEW_SUBJECT.search(masked, m.end(), subjects[0].start)):
+            sub = _SUBORDINATE.search(masked, m.end(), subjects[0].start) if subjects else None
+            said_of_output = _OUTPUT_BEFORE.search(masked, prev, m.start()) or any(
+                x.kind == "action" and re.fullmatch(r"\s+(?:\w+ly\s+)?", masked[x.end:m.start()]) for x in mentions)
+            if sub is not None and sub.group(0).lower() in ("because", "since") and said_of_output and \
+                    not checks.DIRECTION_RE.search(masked, sub.end(), subjects[-1].end):
+                sub = None  # 'the price decreases because the living area is 1256 sq ft and ...': the area's push
+            if subjects and (sub is not None or _NEW_SUBJECT.search(masked, m.end(), subjects[0].start)):
                 subjects = []  # 'raised your risk the most after retirement lowered it', '..., which increased the
                 # risk, this effect was outweighed by the glucose': not the later clause's name
             if bare and subjects and ":" in masked[m.end():subjects[0].start]:
@@ -225,11 +236,17 @@ def unknown_label(text: str, name_words=frozenset()) -> list[Claim]:
     return _unknown_subject(m.group("label"), "a signed number", [], name_words)
 
 
+#: a reporting clause before the subject: 'The SHAP value says that ...', 'This shows that ...'
+_REPORTED = re.compile(r"^.*\b(?:says?|shows?|indicates?|suggests?|means?|tells? us|reveals?|implies|explains?)\s+"
+                       r"that\s+", re.IGNORECASE)
+
+
 def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_words=frozenset(),
                      opener: str = "") -> list[Claim]:
     """A direction claimed for something that names no feature ('the swimming pool adds ...'): contradicted when
     the subject is a noun phrase of its own, not a pronoun or the decision itself, and has no word of a feature's
     name (then it may be a vague mention: 'a quality rating of 10/10 adds ...')."""
+    subject = _REPORTED.sub("", subject)  # 'The SHAP value says that the house price increases': the house price
     words = [w for w in re.findall(r"[A-Za-z]{3,}", subject.replace("\0", " ")) if w.lower() not in _LINKS]
     head = re.findall(r"[A-Za-z]{3,}", _POSSESSOR.sub("", subject.replace("\0", " ")))
     if all(w.lower() in _VAGUE or w.lower() in GENERIC or w.lower() in _LINKS or w.lower().endswith("ly")

@@ -77,6 +77,16 @@ _OF_PEOPLE = re.compile(r"\s+of\s+(?:the\s+|their\s+|its\s+|all\s+)?(?:[\w-]+\s+
                         r"houses|homes|users|patients|rows|records)\b", re.IGNORECASE)
 
 
+_SIGNED_NAMED = re.compile(r"(?<![|\w])(?:shap(?: value)?|contribution|attribution)\s*(?:of|is|was|:|=)\s*$",
+                           re.IGNORECASE)
+
+
+def signed_named(before: str) -> bool:
+    """'a SHAP value of 0.3' names the signed quantity: unsigned, it states a positive one (not 'a negative SHAP
+    value of 0.3', not '|SHAP| 0.3')."""
+    return bool(_SIGNED_NAMED.search(before)) and "negative" not in before.lower()
+
+
 def skip_number(n: Number, masked: str) -> bool:
     """Numbers that are not claims: list markers ('1.' at a line start), identifiers ('candidate 2', 'top-3'),
     counts of the method's inputs ('100 background rows')."""
@@ -109,6 +119,8 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     ``name_after``: the name follows the number ('took 7 corners'): its value, whatever the verb before."""
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 16]
     contrib_cue = bool(CONTRIB_BEFORE.search(before))
+    # 'a SHAP value of 0.3' names the signed quantity: unsigned, it is positive (not 'a negative SHAP value of 0.3')
+    signed_cue = signed_named(before)
     # a sentence that names no view, or weighs the two options without saying which ('argued against it'): either
     # view (the chosen action's score or the margin over the runner-up)
     contexts = book.contexts if ctx in (EITHER, None) else (ctx,)
@@ -142,7 +154,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         if not value_cue:
             cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
         for what, v in cands:
-            if matches(n, v) or ((n.percent or (in_points and what.startswith("contribution")))
+            if matches(n, v, magnitude_ok=not (signed_cue and what.startswith("contribution"))) or ((n.percent or (in_points and what.startswith("contribution")))
                                  and percent_reading(n, v)):
                 return True, f"{key}: {what}"
         if n.percent and not n.points and any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
