@@ -179,9 +179,9 @@ _NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blowe
                          r"(?:\w+ly\s+)?(?:an?\s+)?\w+|\b(?:positive|negative)\s+(?:prediction|outcome|diagnosis|class|"
                          r"result|label|case|classification)\b|\b(?:raised?|raising|rais\w+)\s+(?:some\s+|serious\s+)?"
                          r"(?:concerns?|questions?|doubts?|eyebrows|(?:red\s+)?flags?|alarms?)\b|"
-                         r"\b(?:this|that|these|those|such|the same)\s+(?:(?:small|slight|modest|mild|minor|large|big|strong|major|"
-                         r"initial|early|upward|downward|positive|negative)\s+)?(?:positive|negative|boost|increase|lift|"
-                         r"gain|reduction|decrease|drag|push|rise|drop)\b", re.IGNORECASE)
+                         r"\b(?:this|that|these|those|such|the same)\s+(?:(?:small|slight|modest|mild|minor|large|"
+                         r"big|strong|major|initial|early|upward|downward|positive|negative)\s+)?(?:positive|negative|"
+                         r"boost|increase|lift|gain|reduction|decrease|drag|push|rise|drop)\b", re.IGNORECASE)
 
 
 def is_frame(masked: str, m: re.Match) -> bool:

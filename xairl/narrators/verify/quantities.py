@@ -154,8 +154,9 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         if not value_cue:
             cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
         for what, v in cands:
-            if matches(n, v, magnitude_ok=not (signed_cue and what.startswith("contribution"))) or ((n.percent or (in_points and what.startswith("contribution")))
-                                 and percent_reading(n, v)):
+            contribution = what.startswith("contribution")
+            if matches(n, v, magnitude_ok=not (signed_cue and contribution)) or (
+                    (n.percent or (in_points and contribution)) and percent_reading(n, v)):
                 return True, f"{key}: {what}"
         if n.percent and not n.points and any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
             return True, f"{key}: share"
