@@ -680,6 +680,54 @@ OUTSIDE = [
     ("student", 375, "However, the student's love of chess slightly reduced the probability.", "contradicted"),
     ("student", 246, "Finally, being male provided a slight positive contribution.", "verified"),
     ("student", 252, "Finally, being male provided a slight positive contribution.", "contradicted"),
+    # the worst LLM's narratives (baseline_narratives_worst.json, FIFA, student, diabetes): 'driven by' of one output
+    # says what mattered, not which way ('drives it up' does); ranks scoped to where the prediction went ('the
+    # primary reasons for the model's prediction', 'the factors that led to ... a low probability')
+    ("diabetes", 668, "The prediction was largely driven by the patient's glucose level, which was lower than "
+                      "expected.", "verified"),
+    ("diabetes", 668, "The glucose level drives the probability up.", "contradicted"),
+    ("fifa", 84, "Their lack of goal scoring and limited attacking threat were the primary reasons for the model's "
+                 "prediction.", "verified"),
+    ("fifa", 84, "Their corner kicks and limited attacking threat were the primary reasons for the model's "
+                 "prediction.", "contradicted"),
+    ("fifa", 105, "The team's lack of goal scoring and relatively low number of shots on target were the primary "
+                  "factors that led to the model's prediction of a low probability.", "verified"),
+    ("fifa", 105, "The team's lack of goal scoring and its seven corner kicks were the primary factors that led to "
+                  "the model's prediction of a low probability.", "contradicted"),
+    ("fifa", 118, "The goals led to a predicted probability of 66.00% for receiving the award.", "verified"),
+    ("fifa", 118, "The goals led to a predicted probability of 76.00% for receiving the award.", "contradicted"),
+    # 'which could be due to' gives a reason (no hypothetical); 'not effective in increasing' negates; 'the opposing
+    # team', 'dominate the game', 'the negative contributions from other areas' claim nothing of a feature
+    ("fifa", 40, "The number of attempts also had a negative impact, which could be due to the team's inability to "
+                 "convert them.", "verified"),
+    ("fifa", 40, "The number of attempts also had a positive impact, which could be due to the team's inability to "
+                 "convert them.", "contradicted"),
+    ("fifa", 40, "The team's corner kicks were not effective in increasing their chances.", "verified"),
+    ("fifa", 105, "The team's corner kicks were not effective in increasing their chances.", "contradicted"),
+    ("fifa", 96, "Scoring four goals raised the probability, but not enough to outweigh the negative contributions "
+                 "from other areas.", "verified"),
+    ("fifa", 56, "The 8 corner kicks put pressure on the opposing team's defense and raised the probability.",
+     "verified"),
+    ("fifa", 40, "The 3 corner kicks put pressure on the opposing team's defense and raised the probability.",
+     "contradicted"),
+    ("fifa", 81, "The 719 passes suggest that the team was able to dominate the game.", "verified"),
+    # 'A and B being the most significant', 'X and Y were the most important factors' with X unknown: top 2
+    ("fifa", 84, "The prediction was shaped by many factors, with the team's inability to score goals and convert "
+                 "attempts being the most significant.", "verified"),
+    ("fifa", 40, "The prediction was shaped by many factors, with the team's inability to score goals and convert "
+                 "attempts being the most significant.", "contradicted"),
+    ("student", 82, "The student's relatively low level of socializing and lack of past failures were likely the most "
+                    "important factors.", "verified"),
+    ("student", 300, "The student's relatively high level of socializing and high number of absences were likely the "
+                     "most important factors.", "contradicted"),
+    # a label's stem takes inflections, not compounds ('coursework' is no 'course'); a label given after its
+    # feature ("the mother's job, which is categorized as 'other'")
+    ("student", 252, "Having one past failure suggests that the student has struggled with their coursework, which "
+                     "lowered the probability.", "verified"),
+    ("student", 82, "Additionally, the mother's job, which is categorized as \"other\", had a small positive "
+                    "contribution.", "contradicted"),
+    ("student", 375, "Additionally, the mother's job, which is categorized as \"other\", had a small negative "
+                     "contribution.", "verified"),
 ]
 
 

@@ -275,6 +275,9 @@ _NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
 #: checked
 _HYPOTHETICAL = re.compile(r"^\W*(?:if|had|without|were|absent|but for)\b|(?<!than it )(?<!than they )"
                            r"\b(?:would|could|might)(?:\s+\w+ly)?\s+"
-                           r"(?:(?:not|never)\s+)?(?:have|be)\b|\bif it (?:were|was)(?:n't| not) for\b", re.IGNORECASE)
+                           r"(?:(?:not|never)\s+)?(?:have|be)\b(?!\s+(?:due|because|related|linked|attributed|"
+                           r"explained|caused|associated|indicative|a sign|the result|seen|viewed|considered|"
+                           r"interpreted|reflecting|influenced)\b)"  # ('which could be due to ...': a reason, not
+                           r"|\bif it (?:were|was)(?:n't| not) for\b", re.IGNORECASE)  # what would have been)
 _PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
 

@@ -55,6 +55,14 @@ class FactBook:
     def contexts(self) -> tuple[str, ...]:
         return ("chosen", "margin") if self.runner_up else ("chosen",)
 
+    @property
+    def outcome_sign(self) -> int:
+        """Where one output went from the baseline: +1 up, -1 down, 0 unknown or several actions. 'The prediction
+        was driven by X' and 'the reasons for the prediction' are said of the features that moved it that way."""
+        if self.output == "actions" or self.base is None or self.chosen not in self.scores:
+            return 0
+        return int(np.sign(self.scores[self.chosen] - self.base))
+
 
 _LEGEND_ENTRY = re.compile(r"^\s*(\d+)\s*[:=]?\s+(\S.*?)\s*$")
 

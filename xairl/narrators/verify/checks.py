@@ -41,7 +41,9 @@ _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? 
         r"discourag\w*")
 VALENCE_RE = re.compile(r"^(?:help|hurt)", re.IGNORECASE)  # whose side? a direction only toward a named action
 DIRECTION_RE = re.compile(rf"\b(?:(?P<pos>{_POS})|(?P<neg>{_NEG}))\b", re.IGNORECASE)
-_NEGATION = re.compile(r"\b(not|n't|never|no longer|neither|nor)\b[^.]{0,12}$", re.IGNORECASE)
+_NEGATION = re.compile(r"\b(not|n't|never|no longer|neither|nor)\b[^.]{0,12}$|\b(?:not|n't)\s+(?:\w+\s+){1,2}(?:in|at)\s+$|"
+                       r"\b(?:fail\w*|unable|insufficient)\s+(?:\w+\s+)?(?:to|in)\s+$", re.IGNORECASE)  # ('not effective
+# in increasing', 'failed to raise')
 
 
 
@@ -181,7 +183,13 @@ _NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blowe
                          r"(?:concerns?|questions?|doubts?|eyebrows|(?:red\s+)?flags?|alarms?)\b|"
                          r"\b(?:this|that|these|those|such|the same)\s+(?:(?:small|slight|modest|mild|minor|large|"
                          r"big|strong|major|initial|early|upward|downward|positive|negative)\s+)?(?:positive|negative|"
-                         r"boost|increase|lift|gain|reduction|decrease|drag|push|rise|drop)\b", re.IGNORECASE)
+                         r"boost|increase|lift|gain|reduction|decrease|drag|push|rise|drop)\b|"
+                         r"\b(?:potential|possible)\s+(?:positive|negative)\b|"  # 'the potential negative effects of'
+                         r"\bopposing\s+(?:team|side|player|defen[cs]e|goal|club|squad)|"  # the other team
+                         r"\b(?:positive|negative)\s+(?:and\s+(?:positive|negative)\s+)?(?:risk\s+)?(?:factors|"
+                         r"aspects|indicators|signals|features|influences|contributions|effects|impacts)\b(?!\s+(?:of|from)\b)",
+                         re.IGNORECASE)  # 'a mix of positive and negative risk factors', 'outweigh the negative
+# contributions' (said of nothing named: 'negative contributions from A' is A's)
 
 
 def is_frame(masked: str, m: re.Match) -> bool:

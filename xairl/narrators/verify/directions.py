@@ -174,8 +174,9 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
 def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) -> bool:
     """A direction word that claims no checkable push here: 'helps'/'hurts' without a named action ('a salaried job
     helps': the applicant?; but 'It turned, helped by X'), a side of a person ('working against the applicant'), a
-    value said of a feature ('relatively lower glucose levels'), the inverse framing of a good outcome ('reduced risk'
-    of a good-credit probability), a class the text does not tie to the one output ('toward failure')."""
+    value said of a feature ('relatively lower glucose levels'), 'driven by' of one output (what mattered, either way),
+    the inverse framing of a good outcome ('reduced risk' of a good-credit probability), a class the text does not
+    tie to the one output ('toward failure')."""
     one_output = book.output != "actions"
     if checks.VALENCE_RE.match(m.group(0)) and not checks.action_object(m, mentions) and not (
             re.match(r"\s+by\b", masked[m.end():]) and not one_output and any(
@@ -185,6 +186,9 @@ def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) 
         return True
     if any(x.kind == "feature" and 0 < x.start - m.end() <= 1 for x in mentions):
         return True
+    if one_output and re.fullmatch(r"driv\w+(?: by)?", m.group(0), re.IGNORECASE) and not re.match(
+            r"\s+(?:\w+\s+){0,3}?(?:up|down|higher|lower)\b", masked[m.end():m.end() + 30], re.IGNORECASE):
+        return True  # 'the prediction was driven by the glucose', 'X drives this estimate': what mattered, no way
     if _good_outcome(book) and re.match(
             r"\s+(?:the\s+|their\s+|its\s+|default\s+|credit\s+)?risk\b", masked[m.end():]):
         return True

@@ -148,6 +148,9 @@ def _runs(form: str, f: str) -> list[str]:
     return out
 
 
+#: a label given to its feature after it: "the mother's job, which is categorized as 'other'"
+_ASSIGNED = re.compile(r"[\s,]*(?:which|that)?\s*(?:is|was|being)?\s*(?:categori[sz]ed|classified|listed|coded|"
+                       r"recorded|labell?ed|given)\s+as\s+(?:an?\s+)?[\"'“‘]?", re.IGNORECASE)
 #: legend meanings too common to name a feature's code
 _COMMON_MEANINGS = {"yes", "no", "none", "true", "false", "low", "high", "other", "unknown", "never", "always"}
 
@@ -205,11 +208,15 @@ def _phrase(text: str) -> str:
                     if w != "the") if text else ""
 
 
+#: the endings a label's stem takes ('retir~': retired, retirement, retiree; not 'cours~' in 'coursework')
+_STEM_ENDING = r"(?:e|es|ed|ing|ment|ments|ement|ements|ee|ees|er|ers|s|y|ies|ied|ion|ions|ive|al)?"
+
+
 def _pattern(phrase: str, kind: str) -> re.Pattern:
     """Words in order, separated by spaces, hyphens, underscores or nothing; plural 's' and possessive allowed."""
     parts = [re.escape(w) for w in phrase.split()]
     if kind == "label":  # a stem ('~') takes any ending, a whole word a plural
-        body = r"[\s_\-]*".join(p.replace("\\~", "").replace("~", "") + "[a-z]*" if "~" in p else p + "(?:s|es|ing|ed|er|ers)?"
+        body = r"[\s_\-]*".join(p.replace("\\~", "").replace("~", "") + _STEM_ENDING if "~" in p else p + "(?:s|es|ing|ed|er|ers)?"
                                   for p in parts)
     else:  # a plural name also in the singular ('Corners': 'a corner')
         last = phrase.split()[-1]
@@ -285,8 +292,8 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
         near = [m for m in features if f in m.keys]
         for label, surface in labels:
             for m in re.finditer(rf"(?<![\w]){surface}(?![\w])", text, 0 if len(label) <= 2 else re.IGNORECASE):
-                if any(abs(m.start() - n.end) <= 14 or abs(n.start - m.end()) <= 14 for n in near) \
-                        and not any(taken[m.start():m.end()]):
+                if any(abs(m.start() - n.end) <= 14 or abs(n.start - m.end()) <= 14 or _ASSIGNED.fullmatch(
+                        text, n.end, m.start()) for n in near) and not any(taken[m.start():m.end()]):
                     found.append(Mention(m.start(), m.end(), "label", (f,), label))
                     taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
     found = sorted(found, key=lambda m: m.start)

@@ -24,8 +24,10 @@ RANK_RE = re.compile(
     rf"|(?:the\s+)?(?P<plural>(?:two|three|four|2|3|4)\s+(?:most important|largest|biggest|strongest|main)|"
     rf"(?:top|the)[\s-]+(?P<k>two|three|four|2|3|4)(?:\s+most important|\s+largest|\s+biggest)?)\s+{NOUN}"
     rf"|(?P<top>{TOPWORD})(?:\s+single)?\s+(?:(?:risk|margin|score|shap)\s+)?(?P<noun>{NOUN})"
-    rf"|(?:mattered|matters|matter|counted|counts|weighed) most|dominat\w+|ranks? (?P<rk>first|second|third)"
-    rf"|(?:is|was) the (?:single )?(?:largest|biggest|strongest|greatest|most important|most influential)(?![ \w]*\w)"
+    rf"|(?:mattered|matters|matter|counted|counts|weighed) most|dominat\w+(?!\s+(?:the\s+)?(?:game|match|play|"
+    rf"possession|opponents?|proceedings|the\s+ball))|ranks? (?P<rk>first|second|third)"
+    rf"|(?:is|was|(?P<plverb>being|were|are)) the (?:single )?(?:largest|biggest|strongest|greatest|most important|"
+    rf"most influential|most significant)(?![ \w]*\w)"
     rf"|top[\s-](?P<topk>\d)\b)", re.IGNORECASE)
 AFTER_ORD = re.compile(r"^\W{0,3}(?:[a-z]+\s+)?(?:was\s+|is\s+|came\s+|a\s+(?:distant|close)\s+)?"
                        r"(?P<o>second|third|fourth|first(?=\s*[(,;:]|\s+(?:then|and|followed)\b|\s*$))\b",
@@ -51,6 +53,8 @@ def rank_claim(m: re.Match, masked: str) -> tuple[int, bool, int]:
         return ORD[m.group("rk").lower()], False, sign
     if m.group("topk"):
         return int(m.group("topk")), True, sign
+    if m.group("plverb"):  # 'A and B were the most important', '... with A and B being the most significant': as
+        return 0, True, sign  # many as the list names (one: the first)
     if m.group("plural") or m.group("k"):
         k = next((v for w, v in COUNT.items() if re.search(rf"\b{w}\b", text)), 0)
         return k, True, sign
@@ -168,13 +172,31 @@ def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
 _SCOPE = re.compile(r"^\W*(?:among|of)\s+(?:all\s+)?the\s+([^,]{3,60}),", re.IGNORECASE)
 
 
-def _items(masked: str, targets: list[Mention], m: re.Match) -> int:
+#: a one-output side a rank is scoped to: what its factors led to ('... that led to the model's prediction of a low
+#: probability': the lowering ones)
+_TOWARD_SIDE = re.compile(r"\s+(?:that\s+|which\s+)?(?:led|leading|lead|contribut\w+|point\w*)\s+to\s+(?:the\s+|a\s+|an\s+|"
+                          r"its\s+|their\s+)?(?:model's\s+)?(?:(?:prediction|predicted\s+outcome|outcome)\s+of\s+"
+                          r"(?:a\s+|an\s+)?)?(?:(?P<low>low|lower|not|no)|high|higher)\b", re.IGNORECASE)
+#: what may open a clause before its subject list: discourse words, a subordinator
+_LEAD_IN = re.compile(r"^.*\b(?:that|which|while|whereas|when|because|since|if)\s+|^\W*(?:overall|in summary|in short|"
+                      r"in the end|ultimately|together|finally|also|then|thus|so|however|but|and)\b\W*",
+                      re.IGNORECASE)
+
+
+def _items(masked: str, a: int, targets: list[Mention], m: re.Match) -> int:
     """How many things a plural rank's list names, those the verifier does not know included ('low absences, no
-    failures, and a balanced social life were the key drivers': 3)."""
+    failures, and a balanced social life were the key drivers': 3; 'a low level of socializing and no failures were
+    the most important factors': 2, from the clause's start)."""
     if not targets:
         return 0
     first, last = targets[0], targets[-1]
-    span = masked[first.start:m.start()] if first.start < m.start() else masked[m.end():last.end]
+    if first.start < m.start():
+        head = masked[a:first.start]
+        start = first.start if re.search(r"[,;:]", head) else a + len(_LEAD_IN.match(head).group(0)) \
+            if _LEAD_IN.match(head) else a
+        span = masked[start:m.start()]
+    else:
+        span = masked[m.end():last.end]
     span = re.split(r"\s(?:were|are|was|is|had|have|made|make)\b", span)[0]
     return len([x for x in re.split(r",\s*(?:and\s+|or\s+)?|\s+(?:and|or)\s+", span) if x.strip()])
 
@@ -198,7 +220,7 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             after = [x for x in names if x.start >= m.end()]
             header = after and re.match(r"^\W*(?:were|are|was|is|include\w*)?\W*$", masked[m.end():after[0].start])
             targets = after if header or not before else before
-            k = rank or max(len(targets), _items(masked, targets, m))  # 'A, B and a balanced life were the key ...'
+            k = rank or max(len(targets), _items(masked, a, targets, m))  # 'A, B and a balanced life were the key ...'
 
             for t in targets:
                 out.append(check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {masked[t.start:t.end]}"))
@@ -258,6 +280,13 @@ def _rank_sign(m: re.Match, masked: str, a: int, b: int, mentions: list[Mention]
         return 1  # 'the strongest reason': a reason for what was decided
     if _OTHER_WAY.match(masked, m.end(), b):
         return OWN_SIDE  # 'the strongest factor pulling the other way'
+    toward = _TOWARD_SIDE.match(masked, m.end(), b)
+    if toward and book.output != "actions":  # 'the primary factors that led to ... a low probability', 'the main
+        return -1 if toward.group("low") else 1  # contributors to the predicted outcome of not having diabetes'
+    if side and side.group(1) and book.outcome_sign and re.match(
+            r"\s+for\s+(?:the\s+|this\s+|its\s+)?(?:model's\s+)?(?:prediction|outcome|decision|result|predicted|low|"
+            r"high)\b", masked[m.end():b], re.IGNORECASE):
+        return book.outcome_sign  # 'the primary reasons for the model's prediction': for where it went
     if side and re.search(r"(argument|reason|push)s?$", m.group(0), re.IGNORECASE):
         sign = 1 if side.group(1) else -1  # 'the main argument for staying': the largest that favours it
         obj = next((x for x in mentions if x.kind == "action" and 0 <= x.start - m.end() - side.end() <= 6), None)
