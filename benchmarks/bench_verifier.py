@@ -22,10 +22,10 @@ on: the second held-out figure. A narrative counts as agreeing when ``Verificati
 
 ``--shapstories``: LLM-written narratives of SHAPnarrative-agents (github.com/ADMAntwerp/SHAPnarrative-agents,
 ``data/baseline_narratives.json``, and other LLMs' narratives of the same cases in
-``data/baseline_narratives_best.json``; not shipped), against explanations built by hand from what each baseline narrative says
-(``data/narratives/outside/shapstories.yaml``, which also lists the best-file narratives that contradict their case
-and the domains held out from tuning), and against the same explanations with every sign inverted and with the two
-largest contributions swapped (then each text is wrong: these narratives always rank).
+``data/baseline_narratives_best.json`` and ``..._worst.json``; not shipped), against explanations built by hand from
+what each baseline narrative says (``data/narratives/outside/shapstories.yaml``, which also lists, per file, the
+narratives that contradict their case, labelled by hand, and the domains held out from tuning), and against the same
+explanations with every sign inverted and with the two largest contributions swapped (then each text is wrong).
 
 ``--explingo``: the hand-labelled narratives of Zytek et al.'s Explingo (github.com/sibyl-dev/Explingo,
 ``full-experiment/accuracy_tests.json``; not shipped here): each explanation is rebuilt from its

@@ -50,7 +50,8 @@ OUTPUT_BEFORE = re.compile(r"\b(?:it|this house|the house|the home|this home|the
                            r"\b(?:chance|risk|probability|likelihood) of [\w\s]{1,20}? is (?:put |estimated |rated )?"
                            r"at\s+(?:about|around|roughly)?\s*$|"
                            r"\b(?:predicted\s+|estimated\s+)?(?:probability|chance|likelihood)\s+(?:of|is|was|=|:)\s*"
-                           r"(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)  # 'a predicted probability of 66%'
+                           r"(?:about|around|roughly|only|just)?\s*$",  # 'a predicted probability of 66%'
+                           re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
 _OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
                            r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)",

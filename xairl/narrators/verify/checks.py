@@ -41,9 +41,10 @@ _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? 
         r"discourag\w*")
 VALENCE_RE = re.compile(r"^(?:help|hurt)", re.IGNORECASE)  # whose side? a direction only toward a named action
 DIRECTION_RE = re.compile(rf"\b(?:(?P<pos>{_POS})|(?P<neg>{_NEG}))\b", re.IGNORECASE)
-_NEGATION = re.compile(r"\b(not|n't|never|no longer|neither|nor)\b[^.]{0,12}$|\b(?:not|n't)\s+(?:\w+\s+){1,2}(?:in|at)\s+$|"
-                       r"\b(?:fail\w*|unable|insufficient)\s+(?:\w+\s+)?(?:to|in)\s+$", re.IGNORECASE)  # ('not effective
-# in increasing', 'failed to raise')
+#: a negation before a direction word ('does not increase', 'not effective in increasing', 'failed to raise')
+_NEGATION = re.compile(r"\b(not|n't|never|no longer|neither|nor)\b[^.]{0,12}$|"
+                       r"\b(?:not|n't)\s+(?:\w+\s+){1,2}(?:in|at)\s+$|"
+                       r"\b(?:fail\w*|unable|insufficient)\s+(?:\w+\s+)?(?:to|in)\s+$", re.IGNORECASE)
 
 
 
@@ -187,7 +188,8 @@ _NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blowe
                          r"\b(?:potential|possible)\s+(?:positive|negative)\b|"  # 'the potential negative effects of'
                          r"\bopposing\s+(?:team|side|player|defen[cs]e|goal|club|squad)|"  # the other team
                          r"\b(?:positive|negative)\s+(?:and\s+(?:positive|negative)\s+)?(?:risk\s+)?(?:factors|"
-                         r"aspects|indicators|signals|features|influences|contributions|effects|impacts)\b(?!\s+(?:of|from)\b)",
+                         r"aspects|indicators|signals|features|influences|contributions|effects|impacts)\b"
+                         r"(?!\s+(?:of|from)\b)",
                          re.IGNORECASE)  # 'a mix of positive and negative risk factors', 'outweigh the negative
 # contributions' (said of nothing named: 'negative contributions from A' is A's)
 

@@ -216,8 +216,8 @@ def _pattern(phrase: str, kind: str) -> re.Pattern:
     """Words in order, separated by spaces, hyphens, underscores or nothing; plural 's' and possessive allowed."""
     parts = [re.escape(w) for w in phrase.split()]
     if kind == "label":  # a stem ('~') takes any ending, a whole word a plural
-        body = r"[\s_\-]*".join(p.replace("\\~", "").replace("~", "") + _STEM_ENDING if "~" in p else p + "(?:s|es|ing|ed|er|ers)?"
-                                  for p in parts)
+        body = r"[\s_\-]*".join(p.replace("\\~", "").replace("~", "") + _STEM_ENDING if "~" in p else
+                                  p + "(?:s|es|ing|ed|er|ers)?" for p in parts)
     else:  # a plural name also in the singular ('Corners': 'a corner')
         last = phrase.split()[-1]
         if len(last) > 4 and last.endswith("s") and not last.endswith(("ss", "us", "is")):

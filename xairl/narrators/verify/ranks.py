@@ -174,9 +174,10 @@ _SCOPE = re.compile(r"^\W*(?:among|of)\s+(?:all\s+)?the\s+([^,]{3,60}),", re.IGN
 
 #: a one-output side a rank is scoped to: what its factors led to ('... that led to the model's prediction of a low
 #: probability': the lowering ones)
-_TOWARD_SIDE = re.compile(r"\s+(?:that\s+|which\s+)?(?:led|leading|lead|contribut\w+|point\w*)\s+to\s+(?:the\s+|a\s+|an\s+|"
-                          r"its\s+|their\s+)?(?:model's\s+)?(?:(?:prediction|predicted\s+outcome|outcome)\s+of\s+"
-                          r"(?:a\s+|an\s+)?)?(?:(?P<low>low|lower|not|no)|high|higher)\b", re.IGNORECASE)
+_TOWARD_SIDE = re.compile(r"\s+(?:that\s+|which\s+)?(?:(?:led|leading|lead|contribut\w+|point\w*)\s+)?to\s+"
+                          r"(?:the\s+|a\s+|an\s+|its\s+|their\s+)?(?:model's\s+)?(?:(?:prediction|predicted\s+outcome|"
+                          r"outcome)\s+of\s+(?:a\s+|an\s+)?)?(?:(?P<low>low|lower|not|no)|high|higher)\b",
+                          re.IGNORECASE)
 #: what may open a clause before its subject list: discourse words, a subordinator
 _LEAD_IN = re.compile(r"^.*\b(?:that|which|while|whereas|when|because|since|if)\s+|^\W*(?:overall|in summary|in short|"
                       r"in the end|ultimately|together|finally|also|then|thus|so|however|but|and)\b\W*",
