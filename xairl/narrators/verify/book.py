@@ -57,8 +57,8 @@ class FactBook:
 
     @property
     def outcome_sign(self) -> int:
-        """Where one output went from the baseline: +1 up, -1 down, 0 unknown or several actions. 'The prediction
-        was driven by X' and 'the reasons for the prediction' are said of the features that moved it that way."""
+        """Where one output went from the baseline: +1 up, -1 down, 0 unknown or several actions ('the primary
+        reasons for the model's prediction' are the features that moved it that way)."""
         if self.output == "actions" or self.base is None or self.chosen not in self.scores:
             return 0
         return int(np.sign(self.scores[self.chosen] - self.base))

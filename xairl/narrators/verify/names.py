@@ -215,7 +215,7 @@ _STEM_ENDING = r"(?:e|es|ed|ing|ment|ments|ement|ements|ee|ees|er|ers|s|y|ies|ie
 def _pattern(phrase: str, kind: str) -> re.Pattern:
     """Words in order, separated by spaces, hyphens, underscores or nothing; plural 's' and possessive allowed."""
     parts = [re.escape(w) for w in phrase.split()]
-    if kind == "label":  # a stem ('~') takes any ending, a whole word a plural
+    if kind == "label":  # a stem ('~') takes an inflection (_STEM_ENDING), a whole word a plural
         body = r"[\s_\-]*".join(p.replace("\\~", "").replace("~", "") + _STEM_ENDING if "~" in p else
                                   p + "(?:s|es|ing|ed|er|ers)?" for p in parts)
     else:  # a plural name also in the singular ('Corners': 'a corner')

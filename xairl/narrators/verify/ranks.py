@@ -193,8 +193,8 @@ def _items(masked: str, a: int, targets: list[Mention], m: re.Match) -> int:
     first, last = targets[0], targets[-1]
     if first.start < m.start():
         head = masked[a:first.start]
-        start = first.start if re.search(r"[,;:]", head) else a + len(_LEAD_IN.match(head).group(0)) \
-            if _LEAD_IN.match(head) else a
+        lead = _LEAD_IN.match(head)
+        start = first.start if re.search(r"[,;:]", head) else a + (len(lead.group(0)) if lead else 0)
         span = masked[start:m.start()]
     else:
         span = masked[m.end():last.end]
