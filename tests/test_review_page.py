@@ -46,6 +46,7 @@ def test_a_post_without_the_page_token_is_refused(store):
 @pytest.mark.skipif(not BROWSER, reason="Debian's chromium and chromium-driver are not installed (make test installs them)")
 def test_review_in_headless_chromium(store, tmp_path):
     from selenium import webdriver
+    from selenium.common.exceptions import StaleElementReferenceException
     from selenium.webdriver.chrome.service import Service
     from selenium.webdriver.common.by import By
     from selenium.webdriver.support.ui import WebDriverWait
@@ -53,6 +54,9 @@ def test_review_in_headless_chromium(store, tmp_path):
     def message(driver):
         shown = driver.find_elements(By.CSS_SELECTOR, ".message")
         return shown[0].text if shown else False
+
+    def wait(driver):  # a click posts and the page reloads: an element read during the reload is stale, read again
+        return WebDriverWait(driver, 20, ignored_exceptions=(StaleElementReferenceException,))
 
     opts = webdriver.ChromeOptions()
     opts.binary_location = shutil.which("chromium")
@@ -72,11 +76,11 @@ def test_review_in_headless_chromium(store, tmp_path):
         assert card.find_elements(By.CSS_SELECTOR, "span.s.verified")
         driver.save_screenshot(str(tmp_path / "review.png"))
         card.find_element(By.CSS_SELECTOR, "button.accept").click()
-        assert f"#{first} accepted" in WebDriverWait(driver, 20).until(message)
+        assert f"#{first} accepted" in wait(driver).until(message)
         card = driver.find_element(By.ID, f"item-{second}")
         card.find_element(By.NAME, "correction").send_keys("The policy turned: the goal was close.")
         card.find_element(By.CSS_SELECTOR, "button.correct").click()
-        WebDriverWait(driver, 20).until(lambda d: f"#{second} corrected" in (message(d) or ""))
+        wait(driver).until(lambda d: f"#{second} corrected" in (message(d) or ""))
         assert "Nothing to review" in driver.page_source
     finally:
         driver.quit()
