@@ -19,6 +19,7 @@ on: the second held-out figure. A narrative counts as agreeing when ``Verificati
     .venv/bin/python benchmarks/bench_verifier.py --show test # also every disagreement of the test split
     .venv/bin/python benchmarks/bench_verifier.py --explingo accuracy_tests.json   # outside corpus, see below
     .venv/bin/python benchmarks/bench_verifier.py --shapstories baseline_narratives.json  # outside, see below
+    .venv/bin/python benchmarks/bench_verifier.py --shapstories baseline_narratives_worst.json  # held-out parts too
 
 ``--shapstories``: LLM-written narratives of SHAPnarrative-agents (github.com/ADMAntwerp/SHAPnarrative-agents,
 ``data/baseline_narratives.json``, and other LLMs' narratives of the same cases in
@@ -200,14 +201,15 @@ def shapstories_case(dataset: str, index: int) -> tuple[int, xairl.Explanation, 
 
 
 def shapstories_items(path: str) -> list[dict]:
-    """The LLM-written narratives of SHAPnarrative-agents (``baseline_narratives.json``, ``..._best.json``) that have a
-    case in ``data/narratives/outside/shapstories.yaml``; each is accurate for its case unless the file's entry there
-    lists it as contradicting it."""
+    """The LLM-written narratives of SHAPnarrative-agents (``baseline_narratives.json``, ``..._best.json``,
+    ``..._worst.json``) that have a case in ``data/narratives/outside/shapstories.yaml``; each is accurate for its case
+    unless the file's entry there lists it as contradicting it."""
     cases = _shapstories_cases()
     about = cases["files"].get(pathlib.Path(path).name, {})
     out = []
     for row in json.loads(pathlib.Path(path).read_text()):
-        dataset, case = row.get("dataset", "fifa"), f"{row.get('dataset', 'fifa')}-{row['index']}"
+        dataset = row.get("dataset", "fifa")
+        case = f"{dataset}-{row['index']}"
         if row["index"] not in cases.get(dataset, {}).get("cases", {}):
             continue
         batch, exp, policy = shapstories_case(dataset, row["index"])
