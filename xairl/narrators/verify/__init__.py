@@ -107,8 +107,8 @@ _CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whe
 _APPOSITIVE = re.compile(r"\s(?:while|although|though)\s+(?:\w+ly\s+)?(?:[a-z]+ed|[a-z]+ing|high|low|above|below|"
                          r"modest|small|large|elevated)\b[^,;.]{0,30},", re.IGNORECASE)
 #: 'the house price decreases because A is x and B is y': the reason names what moved the output, in one clause
-_OUTPUT_MOVED = re.compile(rf"\b(?:price|prediction|probability|risk|estimate|output|score)\s+(?:\w+ly\s+)?"
-                           rf"{checks.DIRECTION_RE.pattern}$", re.IGNORECASE)
+_OUTPUT_MOVED = re.compile(rf"\b(?:{checks.OUTPUT_WORDS})\s+(?:\w+ly\s+)?{checks.DIRECTION_RE.pattern}$",
+                           re.IGNORECASE)
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
 def sentences(text: str) -> list[tuple[int, int]]:
     """Sentence spans: split after . ! ? before a capital or a sign, and at line breaks and bullets."""

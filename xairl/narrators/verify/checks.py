@@ -39,6 +39,8 @@ _NEG = (r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? 
         r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
         r"los(?:t|ing)|diminish\w*|penali[sz]\w*|hurt(?:s|ing)?|h[eo]ld(?:s|ing)? (?:\w+ ){0,2}back(?: from)?|"
         r"discourag\w*")
+#: words that name a one-output model's output ('the house price', 'the predicted probability')
+OUTPUT_WORDS = r"price|prediction|probability|risk|estimate|output|score"
 VALENCE_RE = re.compile(r"^(?:help|hurt)", re.IGNORECASE)  # whose side? a direction only toward a named action
 DIRECTION_RE = re.compile(rf"\b(?:(?P<pos>{_POS})|(?P<neg>{_NEG}))\b", re.IGNORECASE)
 #: a negation before a direction word ('does not increase', 'not effective in increasing', 'failed to raise')

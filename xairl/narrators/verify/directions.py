@@ -69,8 +69,19 @@ _EXCEPT = re.compile(r"\b(?:everything|all|anything|every\w*)\s+(?:\w+\s+)?(?:bu
 
 
 #: the output as the subject of a direction word: 'the house price decreases (because ...)', 'it rises'
-_OUTPUT_BEFORE = re.compile(r"\b(?:price|prediction|probability|risk|estimate|output|score|value|it)\s+(?:\w+ly\s+)?$",
-                            re.IGNORECASE)
+_OUTPUT_BEFORE = re.compile(rf"\b(?:{checks.OUTPUT_WORDS}|value|it)\s+(?:\w+ly\s+)?$", re.IGNORECASE)
+
+
+def _reason_moved_output(masked: str, prev: int, m: re.Match, sub: re.Match, subjects: list[Mention],
+                         mentions: list[Mention]) -> bool:
+    """'The house price decreases because A is x and B is y': the output is the direction word's subject (named, or
+    the output's own name right before it) and a 'because'/'since' reason names what moved it, with no direction word
+    of its own."""
+    if sub.group(0).lower() not in ("because", "since") or checks.DIRECTION_RE.search(masked, sub.end(),
+                                                                                   subjects[-1].end):
+        return False
+    return bool(_OUTPUT_BEFORE.search(masked, prev, m.start())) or any(
+        x.kind == "action" and re.fullmatch(r"\s+(?:\w+ly\s+)?", masked[x.end:m.start()]) for x in mentions)
 #: a clause with a subject of its own after a comma: ', this effect was', ', it was'
 _NEW_SUBJECT = re.compile(r",\s*(?:this|that|these|those|it|they)\s+(?:\w+\s+)?(?:is|was|are|were|has|had)\b",
                           re.IGNORECASE)
@@ -137,10 +148,7 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             nxt = found[i + 1].start() if i + 1 < len(found) else b
             subjects = [x for x in names if m.end() <= x.start < nxt]
             sub = _SUBORDINATE.search(masked, m.end(), subjects[0].start) if subjects else None
-            said_of_output = _OUTPUT_BEFORE.search(masked, prev, m.start()) or any(
-                x.kind == "action" and re.fullmatch(r"\s+(?:\w+ly\s+)?", masked[x.end:m.start()]) for x in mentions)
-            if sub is not None and sub.group(0).lower() in ("because", "since") and said_of_output and \
-                    not checks.DIRECTION_RE.search(masked, sub.end(), subjects[-1].end):
+            if sub is not None and _reason_moved_output(masked, prev, m, sub, subjects, mentions):
                 sub = None  # 'the price decreases because the living area is 1256 sq ft and ...': the area's push
             if subjects and (sub is not None or _NEW_SUBJECT.search(masked, m.end(), subjects[0].start)):
                 subjects = []  # 'raised your risk the most after retirement lowered it', '..., which increased the
