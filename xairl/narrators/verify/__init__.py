@@ -18,14 +18,18 @@ A small pipeline, one module per step:
 5. every sentence gets a status (contradicted if any claim is; verified if a claim was checked and none is
    contradicted; else unchecked), and the text a coverage (share of sentences with a checked claim).
 
-``Verification.ok``: nothing contradicted and coverage >= :data:`MIN_COVERAGE` (0.5). What is and is not checked
+Two verdicts: ``Verification.accurate``, nothing contradicted; ``Verification.ok``, accurate and coverage >=
+:data:`MIN_COVERAGE` (0.5). What is and is not checked
 is listed in the README ("What the verifier checks").
 """
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+import numpy as np
+
+from ...errors import InputError
 from ...explanation import Explanation
 from ...policy import Policy
 from . import background, binding, checks, directions, quantities, ranks
@@ -36,6 +40,10 @@ from .numbers import NUMBER_RE, find_numbers, normalise
 
 MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
 MAX_CHARS = 200_000  # longer texts are cut here (and the cut reported)
+#: a longer sentence is read in pieces of at most this many characters, cut at a clause boundary (commas, 'and'):
+#: the clause readers look back over their sentence, so a bound on its length keeps the time linear in the text
+MAX_SENTENCE = 600
+NON_FINITE = "the explanation holds a non-finite number (NaN or infinity) for this state: nothing can be checked"
 
 __all__ = ["Claim", "Verification", "SentenceCheck", "verify", "clean_surface", "fact_book", "NUMBER_RE",
            "MIN_COVERAGE"]
@@ -82,7 +90,13 @@ class Verification:
         return "verified" if self.sentences and self.coverage >= MIN_COVERAGE else "unchecked"
 
     @property
+    def accurate(self) -> bool:
+        """Nothing the text says is contradicted (what a person's accuracy label measures; coverage aside)."""
+        return not any(s.status == "contradicted" for s in self.sentences)
+
+    @property
     def ok(self) -> bool:
+        """Accurate, and at least :data:`MIN_COVERAGE` of the sentences checked: what narration gates on."""
         return self.status == "verified"
 
     def problems(self) -> list[Claim]:
@@ -115,14 +129,32 @@ def sentences(text: str) -> list[tuple[int, int]]:
     spans, start = [], 0
     for m in _SENTENCE_RE.finditer(text):
         if _ABBREVIATION.search(text[max(0, m.start() - 8):m.start()]) or re.fullmatch(r"\s*\d{1,2}\.",
-                                                                                          text[start:m.start()]):
-            continue  # 'e.g. X', '1. Living area ...': no sentence end
+                                                                                          text[start:m.start()]) \
+                or text[max(0, m.start() - 2):m.start() - 1].isspace():
+            continue  # 'e.g. X', '1. Living area ...', 'over ? (score 2.1)' (a name, not an end): no sentence end
         if text[start:m.start()].strip():
             spans.append((start, m.start()))
         start = m.end()
     if text[start:].strip():
         spans.append((start, len(text)))
-    return spans
+    return [piece for span in spans for piece in _pieces(text, *span)]
+
+
+def _pieces(text: str, a: int, b: int) -> list[tuple[int, int]]:
+    """A sentence longer than :data:`MAX_SENTENCE` cut at its last clause boundary (';', ',', ' and ', a space) before
+    the limit, again and again."""
+    out = []
+    while b - a > MAX_SENTENCE:
+        window = text[a:a + MAX_SENTENCE]
+        cut = max(window.rfind(";"), window.rfind(","), window.rfind(" and "))
+        cut = cut if cut > MAX_SENTENCE // 3 else window.rfind(" ")
+        cut = a + (cut if cut > 0 else MAX_SENTENCE)
+        if text[a:cut].strip():
+            out.append((a, cut))
+        a = cut + 1 if text[cut:cut + 1] in ";, " else cut
+    if text[a:b].strip():
+        out.append((a, b))
+    return out
 
 
 def verify(text: str, explanation: Explanation, index: int | None = 0, policy: Policy | None = None,
@@ -136,10 +168,15 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
     :returns: a :class:`Verification`; never raises on odd text (empty, very long, another language).
     """
     note = ""
-    text = normalise(text if isinstance(text, str) else str(text))
+    if not isinstance(text, str):
+        raise InputError(f"verify() reads text (a str), not {type(text).__name__}: decode it first, "
+                         f"e.g. data.decode('utf-8').")
+    text = normalise(text)
     if len(text) > MAX_CHARS:
         text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
-    book = fact_book(explanation, index, policy)
+    finite = _finite(explanation, index)
+    with np.errstate(all="ignore"):  # (a non-finite explanation's facts are computed, then nothing is checked)
+        book = fact_book(explanation, index, policy)
     if facts is not None:
         add_facts(book, facts)
         book.closed = index is None  # a summary made from these facts: a number that is none of them is wrong
@@ -149,9 +186,34 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
         info = policy.features.get(f) if policy else None
         return info.unit if info else ""
 
-    out = [SentenceCheck(text[a:b].strip(), tuple(_check_sentence(text[a:b], book, vocab, unit_of)))
-           for a, b in sentences(text)]
+    out = []
+    for a, b in sentences(text):
+        claims = _read_sentence(text[a:b], book, vocab, unit_of)
+        if not finite:
+            claims = [replace(c, status="unchecked", detail=NON_FINITE) if c.kind in CHECKED else c for c in claims]
+        out.append(SentenceCheck(text[a:b].strip(), tuple(claims)))
     return Verification(tuple(out), note)
+
+
+def _finite(exp: Explanation, index: int | None) -> bool:
+    """Are the numbers the facts come from (contributions, scores, baselines, the state) all finite?"""
+    rows = slice(None) if index is None else slice(index, index + 1)
+    arrays = [exp.values[rows], exp.outputs[rows], exp.base_values[rows]]
+    if exp.states is not None:
+        arrays.append(exp.states[rows])
+    return all(np.isfinite(np.asarray(a, dtype=float)).all() for a in arrays)
+
+
+def _read_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]:
+    """The claims of one sentence; a sentence without a word ('1 1 1') claims nothing. An unexpected failure of a
+    reader leaves the sentence unchecked with the reason (never an exception to the caller; the fuzz test in
+    tests/test_verify_robust.py requires that none happens)."""
+    if not re.search(r"[^\W\d_]{2}", sentence):
+        return []
+    try:
+        return _check_sentence(sentence, book, vocab, unit_of)
+    except Exception as e:  # noqa: BLE001 - a verifier bug must not take the narration down with it
+        return [Claim("internal", sentence.strip(), "unchecked", f"the verifier failed here ({type(e).__name__}: {e})")]
 
 
 # a direction verb whose object is an option ('favoured turning', 'helped turning', '+22.0 toward the handover')

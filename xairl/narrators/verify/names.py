@@ -121,10 +121,16 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     entries += _action_entries(exp, policy, clean)
     label_entries, short = _label_entries(exp, clean)
     entries += label_entries + _legend_entries(exp, policy)
+    entries += [(name, kind, (name,), "", "literal") for kind, names in (("feature", exp.feature_names),
+                                                                          ("action", exp.action_names))
+                for name in names if name.strip() and clean(name)]  # 'sensors[0]', '速度', '?' as written
+    entries = [e for e in entries if e[0].split()]
     entries.sort(key=lambda e: -len(e[0]))
     names = {w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit()}
     names |= {stem(w) for w in names} | {ws for ws in described_words if len(ws) >= 2}
-    compiled = [(_pattern(p, kind), kind, keys, label, form) for p, kind, keys, label, form in entries]
+    compiled = [(_literal(p), kind, keys, label, "") if form == "literal" else (_pattern(p, kind), kind, keys, label,
+                                                                                 form)
+                for p, kind, keys, label, form in entries]
     return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, frozenset(names))
 
 
@@ -140,6 +146,8 @@ def _runs(form: str, f: str) -> list[str]:
     for i in range(len(words)):
         for j in range(i + 1, len(words) + 1):
             run = words[i:j]
+            if not any(re.search(r"[a-z]", w) for w in run):
+                continue  # '2 2' of 'obs[0,2,2]' would name a pixel by any number '22'
             if len(run) == 1 and (run[0] in GENERIC or len(run[0]) < 3 or run[0].isdigit() or (
                     run[0] in owners and (form != f or len(words) >= 3)) or (
                     form != f and len(run[0]) < 5 and run[0] not in split_words(f))):
@@ -224,6 +232,15 @@ def _pattern(phrase: str, kind: str) -> re.Pattern:
             parts[-1] = re.escape(last[:-2] if last.endswith(("sses", "xes", "ches", "shes")) else last[:-1])
         body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+)?|)".join(parts) + r"(?:s|es)?(?:'s|')?\)?"
     return re.compile(rf"(?<![\w]){body}(?![\w])(?![.,]\d)", re.IGNORECASE)  # not 'RSRQ (-3' of 'RSRQ (-3.2 dB)'
+
+
+def _literal(name: str) -> re.Pattern:
+    """A name exactly as written, whatever its digits, brackets or script ('obs[1,32,35]', '速度'), not inside a
+    longer word or name; a name of punctuation only ('?', '-') only between spaces (or a bracket or comma after it),
+    so that it is not every minus sign."""
+    if not re.search(r"[^\W_]", name):
+        return re.compile(rf"(?<![^\s(]){re.escape(name)}(?=[\s,;:)]|$)")
+    return re.compile(rf"(?<![\w\[]){re.escape(name)}(?![\w\]])", re.IGNORECASE)
 
 
 def _inflect(head: str) -> list[tuple[str, str]]:

@@ -107,13 +107,18 @@ def find_numbers(text: str) -> list[Number]:
         raw = m.group("num")  # a decimal comma ('22,5', '0,098'); thousands by comma or space ('12,757', '39 960')
         digits = raw.replace(",", ".") if m.group("dc") else raw.replace(",", "").replace(" ", "")
         decimals = len(digits.split(".")[1]) if "." in digits else 0
-        value = float(digits + (m.group("exp") or ""))
-        unit = _step(digits.split(".")[0] if not decimals else digits, decimals)
-        if m.group("exp"):
-            unit *= 10.0 ** int(m.group("exp")[1:])
+        try:
+            value = float(digits + (m.group("exp") or ""))
+            unit = _step(digits.split(".")[0] if not decimals else digits, decimals)
+            if m.group("exp"):
+                unit *= 10.0 ** int(m.group("exp")[1:])
+        except (OverflowError, ValueError):
+            continue  # '1e999', a 320-digit number: no float states it, so it states no fact
         scale = {"k": 1e3, "K": 1e3, "M": 1e6, "bn": 1e9, "thousand": 1e3, "million": 1e6, "billion": 1e9}.get(
             m.group("suffix") or (m.group("scale") or "").lower(), 1.0)
         value, unit = value * scale, unit * scale
+        if not (math.isfinite(value) and math.isfinite(unit) and unit > 0):
+            continue  # too large or too small for a float ('1e-400' has no step): left unread, never a claim
         alts = ()
         if m.group("den"):
             den = float(m.group("den")[1:])
@@ -153,6 +158,8 @@ def _hedge(before: str) -> str:
 def matches(n: Number, fact: float, magnitude_ok: bool = True, truncated_ok: bool = True) -> bool:
     """Does ``n`` state ``fact``? ``magnitude_ok``: an unsigned number may state a negative fact's size ("lowered
     it by 0.4"). A written sign must agree with the fact's. ``truncated_ok``: digits cut off count as rounding."""
+    if not math.isfinite(fact):
+        return False  # (verify() leaves every claim about a non-finite explanation unchecked)
     if n.sign and (fact < 0) != (n.sign == "-") and fact != 0:
         return False
     target = fact if n.sign or not magnitude_ok else abs(fact)
@@ -168,6 +175,8 @@ def percent_reading(n: Number, v: float) -> bool:
 def _half_up(v: float, step: float) -> float:
     """``v`` rounded to a multiple of ``step``, halves away from zero (as people and templates round)."""
     k = abs(v) / step
+    if not math.isfinite(k) or k > 1e15:
+        return v  # beyond a float's integer precision: already as round as it can be
     return math.copysign(math.floor(k + 0.5 + 1e-9) * step, v)
 
 
