@@ -32,11 +32,11 @@ import numpy as np
 from ...errors import InputError
 from ...explanation import Explanation
 from ...policy import Policy
-from . import background, binding, checks, directions, quantities, ranks
+from . import background, binding, checks, directions, parse, quantities, ranks
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
-from .names import Mention, find_mentions, named_features, vocabulary
-from .numbers import NUMBER_RE, find_numbers, normalise
+from .names import Mention, find_mentions, named_features, split_words, vocabulary
+from .numbers import NUMBER_RE, find_numbers, matches, normalise
 
 MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
 MAX_CHARS = 200_000  # longer texts are cut here (and the cut reported)
@@ -248,6 +248,12 @@ def _context(sentence: str, mentions: list[Mention], book: FactBook, offset: int
 
 def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]:
     mentions, masked = find_mentions(sentence, vocab)
+    docs = []
+
+    def parsed():  # the sentence's parse, made once and only when a reader asks for it
+        if not docs:
+            docs.append(parse.read(sentence, [(m.start, m.end, "|".join(m.keys)) for m in mentions]))
+        return docs[0]
     ctx = _context(sentence, mentions, book)
     claims: list[Claim] = [Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys))
                            for m in mentions if m.kind == "feature"]
@@ -263,21 +269,39 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'
-        found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, vocab.name_words,
+        found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, parsed, vocab.name_words,
                               {k for m in named_features(mentions) for k in m.keys})
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     if hypothetical:
         claims += directions.without(masked, mentions, book, ctx)
-    actions = {a.lower() for a in book.scores}
-    for ident in _IDENT_RE.findall(masked):
-        if re.fullmatch(r"q_(\w+)", ident.lower()) and ident.lower()[2:] in actions:
-            continue  # 'Q_recharge': an action's score
-        claims.append(Claim("feature", ident, "contradicted", "not a feature or action of this explanation"))
+    claims += [c for m in _IDENT_RE.finditer(masked) if (c := _identifier(m, masked, book, vocab.words))]
     return claims
 
 
+def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None:
+    """An identifier that is no name of the explanation ('battery_level', 'sum_phi', 'EXTEND_NS'): an invented
+    feature when a number is given to it ('battery_level: +0.3') that is no decision-level fact ('sum_phi=-0.016' is
+    the change from the baseline) and it is not one name's words shortened ('wait_max' may be 'waiting_time_max');
+    else unchecked (a variable, a model's or an action's code: nothing is claimed of a feature)."""
+    ident = m.group(0)
+    if re.fullmatch(r"q_(\w+)", ident.lower()) and book.output == "actions":  # 'Q_recharge': an action's score
+        if ident.lower()[2:] in {a.lower() for a in book.scores}:
+            return None
+        return Claim("action", ident, "contradicted", f"no action of this explanation is named {ident[2:]!r}",
+                     "identifier.q-of-action")
+    given = re.match(r"\s?[:=(]?\s?(?=[+\-]?[$€£]?\.?\d)", masked[m.end():m.end() + 6])
+    number = next(iter(find_numbers(masked[m.end():m.end() + 40])), None) if given else None
+    words = [w for w in split_words(ident) if len(w) >= 3]
+    ours = any(words and all(any(k.startswith(w) for k in own) for w in words) for own in known.values())
+    if number is None or ours or any(matches(number, x, magnitude_ok=False) for x in book.decision_numbers):
+        return Claim("feature", ident, "unchecked", "an identifier that names nothing of this explanation",
+                     "identifier.other")
+    return Claim("feature", ident, "contradicted", f"given {number.text}, but it is not a feature or action of this "
+                                                   f"explanation", "identifier.given-number")
+
+
 def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
-                  unit_of, name_words=frozenset(), sentence_keys=frozenset()) -> list[Claim]:
+                  unit_of, parsed, name_words=frozenset(), sentence_keys=frozenset()) -> list[Claim]:
     out: list[Claim] = []
     names = named_features(mentions)
     numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not quantities.skip_number(n, masked)]
@@ -311,6 +335,8 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
         c = binding.bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure
             c = binding.unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
+        if c.status == "contradicted" and id(n) not in paired:
+            c = binding.by_parse(c, n, masked, book, ctx, unit_of, parsed, name_words)
         out.append(c)
     first = numbers[0] if numbers else None
     if first is not None and first.sign and not any(m.start < first.start for m in mentions):

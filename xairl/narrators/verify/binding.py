@@ -10,7 +10,9 @@ from dataclasses import replace
 from . import background, checks, quantities
 from .book import FactBook
 from .checks import Claim
-from .numbers import matches
+from .numbers import find_numbers, matches
+from .names import split_words, stem
+from .parse import quantified
 
 _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of)?|scored|scores|score of|"
                         r"with a score of|came second at|"
@@ -80,6 +82,53 @@ def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ct
                                          f"read as {c.detail}, but it is {other}: which is unclear")
 
 
+#: nouns a number may measure that are facts of an explanation (a score, the margin, a contribution, the output):
+#: a number measuring one of these keeps its reading; any other noun ('30 days', '41 GB', 'the 47.5-point gap')
+#: is something the explanation does not hold
+FACT_NOUNS = frozenset({"score", "scores", "margin", "lead", "edge", "contribution", "contributions", "effect",
+                        "effects", "impact", "impacts", "attribution", "attributions", "value", "values", "shap",
+                        "prediction", "predictions", "probability", "chance", "risk", "estimate", "output", "baseline",
+                        "base", "average", "mean", "expectation", "price", "push", "boost", "penalty", "bonus", "drop",
+                        "rise", "increase", "decrease", "change", "gap", "difference", "weight", "share", "sum",
+                        "total", "q", "q-value", "importance", "influence", "gain", "loss", "uplift", "bump", "nudge",
+                        "hit", "swing", "cost", "lift", "pull", "drag", "net", "reason", "reasons", "driver",
+                        "drivers", "factor", "factors", "feature", "features", "variable", "variables", "signal",
+                        "mass", "magnitude", "deviation", "delta", "jump", "fall", "spread", "bar", "rank"})
+
+
+#: fact nouns that name a decision-level quantity, not one feature's push
+AGGREGATE_NOUNS = frozenset({"total", "sum", "net", "gap", "difference", "change", "mass", "prediction", "predictions",
+                             "score", "baseline", "base", "average", "mean", "margin", "lead", "edge", "output",
+                             "estimate", "probability", "risk", "price", "delta", "expectation", "spread", "features",
+                             "factors", "variables"})
+
+
+def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, known=frozenset()) -> Claim:
+    """A second reading of a contradicted number from the sentence's parse (:func:`.parse.quantified`): a number that
+    measures another name is checked against that name; one that measures a noun the explanation holds no fact of
+    ('30 days', '41 GB') is unchecked; one that measures a fact noun ('the total effect (1.41)') is checked as a
+    decision-level number; otherwise the first reading stands. ``parsed()`` gives the sentence's parse, made only
+    when asked for."""
+    units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
+    if c.rule not in GUESSED:
+        return c  # bound by its cue words or a list: sure
+    q = quantified(parsed(), n.start, n.end, units)
+    if "|" in q.key:
+        return c  # an ambiguous name: the first reading stands
+    if q.key in book.features:
+        other = quantities.feature_number(n, (q.key,), masked, book, ctx, unit_of)
+        return replace(other, rule="parse.measures-name") if other.status != "contradicted" else c
+    if q.noun and (labelled := _label_number(n, q.noun, book)) is not None:
+        return labelled  # 'a two-year contract' when the contract is 'One year'
+    if q.noun and q.noun not in FACT_NOUNS and q.noun not in known and stem(q.noun) not in known:
+        return Claim("number", n.text, "unchecked", f"it counts '{q.noun}', which the explanation holds no fact of "
+                                                    f"(first read as {c.detail})", "parse.counts-other")
+    if q.noun in AGGREGATE_NOUNS or q.aggregate:  # 'the total effect (1.41)', 'the net drop of 1.21 points'
+        other = quantities.free_number(n, masked, book)
+        return replace(other, rule="parse.measures-whole") if other.status == "verified" else c
+    return c  # 'a bump of 19.1' after a name: that name's push, as first read
+
+
 def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:
     """Which fact a number states, then its check: a pair of a 'respectively' list; the change from the baseline, a
     statistic of the background (the baseline, a feature's typical value), the prediction or the margin when its cue
@@ -87,30 +136,42 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     staying'); a name right after it ('a 7-year credit history'); the name before it in its clause unless a new noun
     phrase or list item starts between them; else none."""
     if id(n) in paired:
-        return quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of)
+        return _rule(quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of), "number.respectively")
     if quantities.is_change(n, masked):  # '$91,462 above the baseline', 'net uplift: +$86,046', 'below base by $34,184'
-        return quantities.free_number(n, masked, book)
+        return _rule(quantities.free_number(n, masked, book), "number.change")
     if id(n) in scored:
-        return quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book)
+        return _rule(quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book),
+                     "number.action-scores")
     by_cue = _by_cue(n, masked, mentions, names, book)
     if by_cue is not None:
-        return by_cue
+        return _rule(by_cue, "number.cue")
     nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
     # '+22.0 for the handover' after a feature, 'worth 11.5 for ...': the feature's push, not the action's score
     pushes = (n.sign == "+" or re.search(r"\bworth\s*$", masked[:n.start])) and any(x.end <= n.start for x in names)
     if pushes and nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|to|toward|towards)\s+(?:the\s+)?$",
                                                                    masked[n.end:nxt.start]):
         owner = next(x for x in reversed(names) if x.end <= n.start)  # for one option over the other: either view
-        return quantities.feature_number(n, owner.keys, masked, book, checks.EITHER, unit_of)
+        return _rule(quantities.feature_number(n, owner.keys, masked, book, checks.EITHER, unit_of), "number.push-for")
     if nxt is not None and nxt.kind == "action" and not pushes and re.match(r"^\s*(?:for|by)\s+(?:a\s+|an\s+|the\s+)?$",
                                                            masked[n.end:nxt.start]):
-        return quantities.action_number(n, checks.resolve_action(nxt, book), masked, book)
+        return _rule(quantities.action_number(n, checks.resolve_action(nxt, book), masked, book), "number.for-action")
     gap = masked[n.end:nxt.start] if nxt is not None else ""
     if nxt is not None and nxt.kind != "action" and re.match(r"^[\s-]*(?:[a-z]+[\s-]+){0,2}(?:of\s+)?$", gap,
                                                                re.IGNORECASE) \
             and not re.search(r"\b(and|or|but|while|with)\b", gap, re.IGNORECASE):
-        return quantities.feature_number(n, nxt.keys, masked, book, ctx, unit_of, name_after=True)
-    return _by_name_before(n, masked, mentions, names, book, ctx, unit_of)
+        return _rule(quantities.feature_number(n, nxt.keys, masked, book, ctx, unit_of, name_after=True),
+                     GUESSED[0])
+    return _rule(_by_name_before(n, masked, mentions, names, book, ctx, unit_of), GUESSED[1])
+
+
+
+#: the bindings made by position alone (the name right after a number, the name before it, no name at all): a
+#: parse may correct them
+GUESSED = ("number.name-after", "number.name-before", "number.free")
+
+
+def _rule(c: Claim, rule: str) -> Claim:
+    return c if c.rule else replace(c, rule=rule)
 
 
 def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
@@ -164,7 +225,8 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
             and checks.resolve_action(prev, book) == book.runner_up and not masked[prev.end:n.start].strip():
         # 'speed gives recharging +5.48' when turning was chosen: -5.48 in the chosen action's margin
         flipped = replace(n, value=-n.value, sign="-" if n.sign == "+" else "+")
-        return quantities.feature_number(flipped, feature_before.keys, masked, book, "margin", unit_of)
+        return _rule(quantities.feature_number(flipped, feature_before.keys, masked, book, "margin", unit_of),
+                     "number.gives-runner-up")
     if prev is not None and prev.kind == "action" and (
             n.sign == "+" or re.match(r"^\s*(over|than|versus|vs)\b", after, re.IGNORECASE) or (
             feature_before is not None and any(r.search(masked, feature_before.end, prev.start)
@@ -172,7 +234,8 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
         prev = feature_before  # '(+2.05)' after 'supported recharging': the feature's contribution
     if prev is not None and prev.kind == "action":
         if _SCORE_GAP.match(masked[prev.end:n.start]) or quantities.MARGIN_BEFORE.search(masked[prev.end:n.start]):
-            return quantities.action_number(n, checks.resolve_action(prev, book), masked, book)
+            return _rule(quantities.action_number(n, checks.resolve_action(prev, book), masked, book),
+                         "number.action-before")
         prev = next((m for m in reversed(names) if m.end <= n.start), None)
     gap_text = re.sub(r"\([^()]*\)", "()", masked[prev.end:n.start]) if prev is not None else ""
     item = _NEW_ITEM.search(gap_text)
@@ -185,4 +248,17 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
                                           # the same name's)
                                           masked[prev.end:n.start], re.IGNORECASE):
         return quantities.feature_number(n, prev.keys, masked, book, ctx, unit_of)
-    return quantities.free_number(n, masked, book)
+    return _rule(quantities.free_number(n, masked, book), "number.free")
+
+
+def _label_number(n, noun: str, book: FactBook) -> Claim | None:
+    """A number counting a word of one categorical value's label ('two-year' of the label 'One year', '24 months')
+    states that label: verified when the label holds the number, else contradicted; None when no single label has
+    the word and a number."""
+    held = [(f, ff.label) for f, ff in book.features.items() if ff.label and stem(noun) in {
+        stem(w) for w in split_words(ff.label)} and find_numbers(ff.label)]
+    if len(held) != 1:
+        return None
+    f, label = held[0]
+    ok = any(x.value == abs(n.value) for x in find_numbers(label))
+    return Claim("category", n.text, "verified" if ok else "contradicted", f"{f} is '{label}'", "parse.label-number")

