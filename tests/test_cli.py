@@ -122,3 +122,21 @@ def test_installed_script_smoke():
                          env={**os.environ, "XAIRL_DEBUG": ""}, timeout=120)
     assert res.returncode == 0, res.stderr
     assert json.loads(res.stdout)["method"] == "deep_shap"
+
+
+def test_verify_trace_names_the_reading_of_each_claim(tmp_path, capsys):
+    exp = xairl.Explanation(values=np.array([[[0.3], [-0.2]]]), base_values=np.zeros((1, 1)),
+                            outputs=np.array([[0.1]]), states=np.array([[1.0, 2.0]]), feature_names=("speed", "load"),
+                            action_names=("risk",), method="given", output="value")
+    path = tmp_path / "exp.json"
+    path.write_text(exp.to_json())
+    rc, out, _ = run(capsys, "verify", "Speed raised the risk by 0.3 over the last 30 days.", "--explanation",
+                     str(path), "--trace")
+    assert rc == 0 and "accurate: yes; ok: yes" in out
+    assert "number.name-before" in out and "parse.counts-other" in out and "it counts 'days'" in out
+    rc, out, _ = run(capsys, "verify", "The load lowered it by 0.5.", "--explanation", str(path))
+    assert rc == 1 and out.startswith("[contradicted]") and "accurate: no" in out
+    rc, _, err = run(capsys, "verify", "x", "--explanation", str(tmp_path / "missing.json"))
+    assert rc == 2 and err.count("\n") == 1 and "--explanation" in err
+    rc, _, err = run(capsys, "verify", "x", "--explanation", str(path), "--index", "3")
+    assert rc == 2 and "--index 3" in err

@@ -203,6 +203,31 @@ def cmd_prompts(args) -> int:
     return 0 if not problems else 1
 
 
+def cmd_verify(args) -> int:
+    """Check a text against an explanation; with --trace, every claim with the words it was read from and the
+    reading (rule) that bound it."""
+    from .explanation import Explanation
+    from .narrators.verify import verify
+
+    text = args.text if args.text != "-" else sys.stdin.read()
+    try:
+        raw = open(args.explanation, encoding="utf-8").read()
+    except OSError as exc:
+        raise InputError(f"cannot read --explanation {args.explanation}: {exc.strerror}; give the JSON that "
+                         f"Explanation.to_json() writes.") from None
+    exp = Explanation.from_json(raw)
+    if not 0 <= args.index < exp.values.shape[0]:
+        raise InputError(f"--index {args.index} is outside the explanation's {exp.values.shape[0]} state(s).")
+    result = verify(text, exp, args.index)
+    for sentence in result.sentences:
+        print(f"[{sentence.status}] {sentence.text}")
+        for c in sentence.claims if args.trace else ():
+            print(f"    {c.status:<12} {c.kind:<9} {c.text!r:<28} {c.rule or '-':<22} {c.detail}")
+    print(f"accurate: {'yes' if result.accurate else 'no'}; ok: {'yes' if result.ok else 'no'} "
+          f"(coverage {result.coverage:.0%}){'; ' + result.note if result.note else ''}")
+    return 0 if result.accurate else 1
+
+
 def cmd_review(args) -> int:
     from .feedback import FeedbackStore
 
@@ -275,6 +300,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("target", nargs="?", help="template name (show) or .yaml path (check)")
     p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder")
     p.set_defaults(run=cmd_prompts)
+    p = sub.add_parser("verify", help="check a text's claims against an explanation (exit 1 when one is "
+                       "contradicted)")
+    p.add_argument("text", help="the text to check, or - to read it from standard input")
+    p.add_argument("--explanation", required=True, metavar="FILE", help="the explanation, as Explanation.to_json() "
+                   "writes it")
+    p.add_argument("--index", type=int, default=0, help="which state of the explanation the text is about")
+    p.add_argument("--trace", action="store_true", help="every claim: status, kind, words, rule, reason")
+    p.set_defaults(run=cmd_verify)
     p = sub.add_parser("review", help="accept, reject or correct recorded narratives in the terminal, or in a local "
                        "web page with the evidence (--serve)")
     p.add_argument("--db", default=None, help="feedback store (default: in the user dir)")

@@ -132,10 +132,10 @@ class Policy:
             raise InputError("a 'value' policy has one output; give one name in action_names (e.g. ['value']).")
         names = set(self.feature_names)
         described = {f for f, i in self.features.items() if i.kind != "group"}
-        unknown = sorted(described - names) + sorted({f for g in self.groups.values() for f in g} - names)
+        unknown = sorted(described - names) + sorted({str(f) for g in self.groups.values() for f in g} - names)
         if unknown:
             raise InputError(f"metadata names unknown feature(s) {', '.join(unknown[:5])}; use names from "
-                             "feature_names.")
+                             "feature_names (column indices, as xairl.patches gives, go to Explanation.grouped).")
         for g, info in self.features.items():
             if info.kind == "group" and g not in self.groups:
                 raise InputError(f"features['{g}'] has kind 'group' but '{g}' is not in groups; add it to groups.")

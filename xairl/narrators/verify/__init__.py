@@ -255,7 +255,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
             docs.append(parse.read(sentence, [(m.start, m.end, "|".join(m.keys)) for m in mentions]))
         return docs[0]
     ctx = _context(sentence, mentions, book)
-    claims: list[Claim] = [Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys))
+    claims: list[Claim] = [Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys), "names.mention")
                            for m in mentions if m.kind == "feature"]
     # 'had X been better, it would have stayed': not what happened; only its numbers are checked
     hypothetical = bool(_HYPOTHETICAL.search(masked.replace("\0", "X")))  # a name first is a word, not space
@@ -263,7 +263,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
         c = None if hypothetical else checks.check_action(sentence, m, book) if m.kind == "action" else \
             checks.check_label(sentence, m, book) if m.kind == "label" else None
         if c is not None:
-            claims.append(c)
+            claims.append(binding.named(c, "action.choice" if m.kind == "action" else "category.label"))
     bounds = [0] + [m.end() for m in _CLAUSE_RE.finditer(masked) if not _APPOSITIVE.match(masked, m.start())
                     and not _OUTPUT_MOVED.search(sentence, 0, m.start())] + [len(masked)]
     for a, b in zip(bounds, bounds[1:]):
@@ -273,7 +273,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
                               {k for m in named_features(mentions) for k in m.keys})
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     if hypothetical:
-        claims += directions.without(masked, mentions, book, ctx)
+        claims += [binding.named(c, "direction.without") for c in directions.without(masked, mentions, book, ctx)]
     claims += [c for m in _IDENT_RE.finditer(masked) if (c := _identifier(m, masked, book, vocab.words))]
     return claims
 
@@ -330,7 +330,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     for n in numbers:
         if summed and n is tail[0]:
             members = list(dict.fromkeys(m.keys for m in said_names))
-            out.append(quantities.sum_number(n, members, ctx, book))
+            out.append(binding.named(quantities.sum_number(n, members, ctx, book), "number.sum"))
             continue
         c = binding.bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure
@@ -340,15 +340,17 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
         out.append(c)
     first = numbers[0] if numbers else None
     if first is not None and first.sign and not any(m.start < first.start for m in mentions):
-        out += directions.unknown_label(masked[a:first.start], name_words)  # '; roof condition -12.1k;'
-    out += directions.directions(masked, a, b, said, book, ctx, name_words)
-    out += ranks.find_ranks(masked, a, b, said, book, ctx)
-    out += ranks.find_comparisons(masked, a, b, said, book, ctx)
+        out += [binding.named(c, "direction.unknown-name") for c in directions.unknown_label(
+            masked[a:first.start], name_words)]  # '; roof condition -12.1k;'
+    out += [binding.named(c, "direction.subject") for c in directions.directions(masked, a, b, said, book, ctx,
+                                                                                name_words)]
+    out += [binding.named(c, "rank.words") for c in ranks.find_ranks(masked, a, b, said, book, ctx)]
+    out += [binding.named(c, "rank.comparison") for c in ranks.find_comparisons(masked, a, b, said, book, ctx)]
     for m in ranks.MINOR_RE.finditer(masked, a, b):
         owner = next((x for x in reversed(said_names) if x.end <= m.start()), None) or next(
             (x for x in said_names if x.start >= m.end()), None)
         if owner is not None:
-            out.append(ranks.check_minor(owner.keys, ctx, book, m.group(0)))
+            out.append(binding.named(ranks.check_minor(owner.keys, ctx, book, m.group(0)), "rank.minor"))
     return out
 
 

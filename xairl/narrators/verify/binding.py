@@ -136,32 +136,32 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     staying'); a name right after it ('a 7-year credit history'); the name before it in its clause unless a new noun
     phrase or list item starts between them; else none."""
     if id(n) in paired:
-        return _rule(quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of), "number.respectively")
+        return named(quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of), "number.respectively")
     if quantities.is_change(n, masked):  # '$91,462 above the baseline', 'net uplift: +$86,046', 'below base by $34,184'
-        return _rule(quantities.free_number(n, masked, book), "number.change")
+        return named(quantities.free_number(n, masked, book), "number.change")
     if id(n) in scored:
-        return _rule(quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book),
+        return named(quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book),
                      "number.action-scores")
     by_cue = _by_cue(n, masked, mentions, names, book)
     if by_cue is not None:
-        return _rule(by_cue, "number.cue")
+        return named(by_cue, "number.cue")
     nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
     # '+22.0 for the handover' after a feature, 'worth 11.5 for ...': the feature's push, not the action's score
     pushes = (n.sign == "+" or re.search(r"\bworth\s*$", masked[:n.start])) and any(x.end <= n.start for x in names)
     if pushes and nxt is not None and nxt.kind == "action" and re.match(r"^\s*(?:for|to|toward|towards)\s+(?:the\s+)?$",
                                                                    masked[n.end:nxt.start]):
         owner = next(x for x in reversed(names) if x.end <= n.start)  # for one option over the other: either view
-        return _rule(quantities.feature_number(n, owner.keys, masked, book, checks.EITHER, unit_of), "number.push-for")
+        return named(quantities.feature_number(n, owner.keys, masked, book, checks.EITHER, unit_of), "number.push-for")
     if nxt is not None and nxt.kind == "action" and not pushes and re.match(r"^\s*(?:for|by)\s+(?:a\s+|an\s+|the\s+)?$",
                                                            masked[n.end:nxt.start]):
-        return _rule(quantities.action_number(n, checks.resolve_action(nxt, book), masked, book), "number.for-action")
+        return named(quantities.action_number(n, checks.resolve_action(nxt, book), masked, book), "number.for-action")
     gap = masked[n.end:nxt.start] if nxt is not None else ""
     if nxt is not None and nxt.kind != "action" and re.match(r"^[\s-]*(?:[a-z]+[\s-]+){0,2}(?:of\s+)?$", gap,
                                                                re.IGNORECASE) \
             and not re.search(r"\b(and|or|but|while|with)\b", gap, re.IGNORECASE):
-        return _rule(quantities.feature_number(n, nxt.keys, masked, book, ctx, unit_of, name_after=True),
+        return named(quantities.feature_number(n, nxt.keys, masked, book, ctx, unit_of, name_after=True),
                      GUESSED[0])
-    return _rule(_by_name_before(n, masked, mentions, names, book, ctx, unit_of), GUESSED[1])
+    return named(_by_name_before(n, masked, mentions, names, book, ctx, unit_of), GUESSED[1])
 
 
 
@@ -170,8 +170,11 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
 GUESSED = ("number.name-after", "number.name-before", "number.free")
 
 
-def _rule(c: Claim, rule: str) -> Claim:
+def named(c: Claim, rule: str) -> Claim:
+    """``c`` with the id of the reading that made it, unless a more specific one already named it."""
     return c if c.rule else replace(c, rule=rule)
+
+
 
 
 def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
@@ -225,7 +228,7 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
             and checks.resolve_action(prev, book) == book.runner_up and not masked[prev.end:n.start].strip():
         # 'speed gives recharging +5.48' when turning was chosen: -5.48 in the chosen action's margin
         flipped = replace(n, value=-n.value, sign="-" if n.sign == "+" else "+")
-        return _rule(quantities.feature_number(flipped, feature_before.keys, masked, book, "margin", unit_of),
+        return named(quantities.feature_number(flipped, feature_before.keys, masked, book, "margin", unit_of),
                      "number.gives-runner-up")
     if prev is not None and prev.kind == "action" and (
             n.sign == "+" or re.match(r"^\s*(over|than|versus|vs)\b", after, re.IGNORECASE) or (
@@ -234,7 +237,7 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
         prev = feature_before  # '(+2.05)' after 'supported recharging': the feature's contribution
     if prev is not None and prev.kind == "action":
         if _SCORE_GAP.match(masked[prev.end:n.start]) or quantities.MARGIN_BEFORE.search(masked[prev.end:n.start]):
-            return _rule(quantities.action_number(n, checks.resolve_action(prev, book), masked, book),
+            return named(quantities.action_number(n, checks.resolve_action(prev, book), masked, book),
                          "number.action-before")
         prev = next((m for m in reversed(names) if m.end <= n.start), None)
     gap_text = re.sub(r"\([^()]*\)", "()", masked[prev.end:n.start]) if prev is not None else ""
@@ -248,7 +251,7 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
                                           # the same name's)
                                           masked[prev.end:n.start], re.IGNORECASE):
         return quantities.feature_number(n, prev.keys, masked, book, ctx, unit_of)
-    return _rule(quantities.free_number(n, masked, book), "number.free")
+    return named(quantities.free_number(n, masked, book), "number.free")
 
 
 def _label_number(n, noun: str, book: FactBook) -> Claim | None:
