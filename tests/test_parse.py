@@ -58,7 +58,7 @@ def test_names_are_one_token_whatever_their_digits_or_script():
     ("It is 43% of the net drop of 1.21 points.", "1.21", parse.Quantified(noun="drop", aggregate=True)),
     ("The total absolute effect (1.41) is split three ways.", "1.41", parse.Quantified(noun="effect", aggregate=True)),
     ("The glucose level of 119 lowered it.", "119", parse.Quantified(key="glucose")),
-    ("Speed raised it by 0.4.", "0.4", parse.Quantified()),  # an amount of a verb: the verifier's binding decides
+    ("Speed raised it by 0.4.", "0.4", parse.Quantified(key="Speed")),  # the subject of the verb it amounts to
 ])
 def test_the_noun_phrase_a_number_measures(sentence, number, expected):
     spans = [(sentence.index(n), sentence.index(n) + len(n), n) for n in ("glucose", "Speed") if n in sentence]

@@ -293,7 +293,8 @@ def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None
     number = next(iter(find_numbers(masked[m.end():m.end() + 40])), None) if given else None
     words = [w for w in split_words(ident) if len(w) >= 3]
     ours = any(words and all(any(k.startswith(w) for k in own) for w in words) for own in known.values())
-    if number is None or ours or any(matches(number, x, magnitude_ok=False) for x in book.decision_numbers):
+    sums = list(book.aggregates.values()) if quantities.AGGREGATE_CUE.search(ident.replace("_", " ")) else []
+    if number is None or ours or any(matches(number, x, magnitude_ok=False) for x in [*book.decision_numbers, *sums]):
         return Claim("feature", ident, "unchecked", "an identifier that names nothing of this explanation",
                      "identifier.other")
     return Claim("feature", ident, "contradicted", f"given {number.text}, but it is not a feature or action of this "

@@ -50,6 +50,9 @@ class FactBook:
     n_states: int = 1
     closed: bool = False             # every number must be one of the facts (a summary made from given facts)
     base_margin: float | None = None  # the margin with no reason either way (the background's average)
+    #: sums over all features a text may cite with its cue words ('the positives add up to +0.39', 'the total
+    #: absolute attribution of 1.62'): what -> number
+    aggregates: dict[str, float] = field(default_factory=dict)
 
     @property
     def contexts(self) -> tuple[str, ...]:
@@ -131,6 +134,13 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     book = FactBook(feats, exp.output, d.action, d.runner_up if deciding else None, scores,
                     d.q_margin if deciding else None, base, numbers,
                     base_margin=float(d.base_margin) if deciding else None)
+    for ctx, contrib in views.items():
+        of = "" if ctx == "chosen" else " (margin)"
+        book.aggregates |= {f"the sum of the positive contributions{of}": float(contrib[contrib > 0].sum()),
+                            f"the sum of the negative contributions{of}": float(contrib[contrib < 0].sum()),
+                            f"the sum of |contributions|{of}": float(np.abs(contrib).sum()),
+                            f"the sum of the contributions{of}": float(contrib.sum())}
+    book.aggregates["the number of features"] = float(len(exp.feature_names))
     add_facts(book, DomainFacts(d.extras, d.comparisons))
     return book
 

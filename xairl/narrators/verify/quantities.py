@@ -197,8 +197,8 @@ def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, si
     views = book.contexts if ctx in (None, EITHER) else (ctx,)
     for key in sorted(keys):
         e = book.features[key]
-        if n.percent and not n.points:  # a percentage is a share (or a fill the binding already tried)
-            facts = [(f"share ({c})", e.shares.get(c), True) for c in views]
+        if n.percent and not n.points:  # a percentage is a share (or a fill the binding already tried), or a value
+            facts = [(f"share ({c})", e.shares.get(c), True) for c in views] + [("value", e.value, False)]  # ('12 %')
         else:  # a value as written, sign included; a contribution may be its size
             facts = [("value", e.value, False), *((f"contribution ({c})", e.contribs.get(c), not signed)
                                                   for c in views)]
@@ -346,3 +346,21 @@ def _owners(n: Number, book: FactBook) -> list[str]:
         if len(found) == 1:
             return found
     return found
+
+
+#: words that say a number sums over the features: 'the positives add up to', 'total absolute attribution',
+#: 'sum_shap=', 'net', 'n_features='
+AGGREGATE_CUE = re.compile(r"\b(?:total|sum\w*|add(?:s|ed)?\s+up|altogether|combined|in all|overall|net|"
+                           r"positives?|negatives?|upward|downward|absolute|pos\w*|neg\w*|n_features|features)\b",
+                           re.IGNORECASE)
+
+
+def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
+    """A number after words that sum over the features, equal to one such sum (:attr:`FactBook.aggregates`):
+    verified; otherwise None (its other readings decide)."""
+    if not book.aggregates or not AGGREGATE_CUE.search(masked[max(0, n.start - 50):n.start]):
+        return None
+    for what, v in book.aggregates.items():
+        if (matches(n, v) and not n.percent) or (n.points and percent_reading(n, v)):  # ('50 %' is a share)
+            return Claim("number", n.text, "verified", what)
+    return None

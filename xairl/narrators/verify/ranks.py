@@ -133,6 +133,46 @@ def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | N
     return over_keys(a_keys, test, "comparison", text, "rank")
 
 
+#: a multiplier before a comparative: 'roughly 1.7 times', 'nearly twice', 'three times', 'half', '35 %'
+_RATIO_BEFORE = re.compile(r"(?:(?P<num>\d+(?:\.\d+)?)\s*(?:times|x|-fold|fold)|(?P<word>twice|double|thrice|"
+                           r"half|one and a half times|two and a half times|(?:three|four|five|ten) times)|"
+                           r"(?P<pct>\d+(?:\.\d+)?)\s*(?:%|percent))\s*(?:\w+\s+){0,3}?$", re.IGNORECASE)
+_RATIO_WORDS = {"twice": 2.0, "double": 2.0, "thrice": 3.0, "half": 0.5, "one and a half times": 1.5,
+                "two and a half times": 2.5, "three times": 3.0, "four times": 4.0, "five times": 5.0,
+                "ten times": 10.0}
+RATIO_WITHIN = 0.25  # a ratio in words ('roughly twice') holds within 25 % of the sizes' ratio
+
+
+def _ratio(before: str, way: int) -> float | None:
+    """The ratio a multiplier before 'as much as' / 'more than' / 'less than' states: '1.7 times as much' 1.7,
+    '35 % more' 1.35, '20 % less' 0.8, 'twice as much' 2; None without one."""
+    m = _RATIO_BEFORE.search(before)
+    if m is None:
+        return None
+    if m.group("pct"):
+        share = float(m.group("pct")) / 100
+        return 1 + share if way > 0 else 1 - share if way < 0 else share
+    return float(m.group("num")) if m.group("num") else _RATIO_WORDS[m.group("word").lower()]
+
+
+def check_ratio(a_keys: tuple[str, ...], b_key: str, ratio: float, ctx: str | None, book: FactBook,
+                text: str) -> Claim:
+    """'A mattered 1.7 times as much as B': |A| / |B| within :data:`RATIO_WITHIN` of the ratio, in the sentence's
+    view (any view when it names none)."""
+    contexts = views(ctx, book)
+
+    def test(key):
+        pairs = [(abs(book.features[key].contribs[c]), abs(book.features[b_key].contribs[c]), c) for c in contexts
+                 if c in book.features[key].contribs and c in book.features[b_key].contribs]
+        if not pairs or not ratio > 0:
+            return None
+        ok = [c for x, y, c in pairs if y > 0 and abs(x / y - ratio) <= RATIO_WITHIN * ratio]
+        x, y, c = pairs[0]
+        return bool(ok), f"|{key}| / |{b_key}| is {x / y if y else float('inf'):.3g}, said {ratio:.3g} ({c})"
+
+    return over_keys(a_keys, test, "ratio", text, "rank")
+
+
 #: 'Two inputs dominate', 'both features dominate': a plural rank of that many
 _COUNTED = re.compile(r"\b(two|three|four|both)\s+(?:[\w-]+\s+)?$", re.IGNORECASE)
 #: a rank in what would (not) be: 'enough to make X a dominant predictor', 'would make X the main reason'
@@ -344,7 +384,11 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
         if not subjects:
             subjects = [x for x in names if x.end <= m.start()][-1:]
         way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
-        if m.group("out") and len(subjects) > 1 and all(len(x.keys) == 1 for x in subjects) and \
+        ratio = _ratio(masked[max(a, m.start() - 40):m.start()], way)
+        if ratio is not None and not m.group("out"):  # 'roughly 1.7 times as much as B', '35 % more than B'
+            out += [check_ratio(x.keys, b_name.keys[0], ratio, ctx, book, masked[m.start():m.end()].strip())
+                    for x in subjects]
+        elif m.group("out") and len(subjects) > 1 and all(len(x.keys) == 1 for x in subjects) and \
                 not re.search(r"\b(?:both|each|all|individually)\b", masked[subjects[0].start:m.start()],
                               re.IGNORECASE):
             out.append(check_outweighs([x.keys[0] for x in subjects], [b_name.keys[0]], ctx, book, m.group(0).strip()))
