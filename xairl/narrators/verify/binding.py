@@ -45,7 +45,9 @@ _ITEM_VERB = re.compile(r"ed\b|\b(?:is|was|are|were|has|had|have|accounts?|adds?
                         r"contributes?|explains?|costs?|counts?|weighs?|pulls?|pushes?|lowers?|raises?|cuts?|"
                         r"drives?|moves?|shifts?|sits?|comes?)\b", re.IGNORECASE)
 #: "it's worth about $316k", 'your chance of default is put at 43 in 100': the thing the model is about, valued
-OUTPUT_BEFORE = re.compile(r"\b(?:it|this house|the house|the home|this home|the property|your home|your house)"
+OUTPUT_BEFORE = re.compile(r"\b(?:estimated\s+|predicted\s+)?q[\s-]?values?\s+(?:of|at|is|was|=|:)\s*(?:about|around|roughly|"
+                           r"approximately|just under|just over|nearly|almost)?\s*$|"
+                           r"\b(?:it|this house|the house|the home|this home|the property|your home|your house)"
                            r"(?:'s| is| was| would be|'d be)\s+(?:now\s+|still\s+)?(?:worth|valued at|priced at|"
                            r"estimated at|put at)\s+"
                            r"(?:about|around|roughly|some|just under|just over|nearly|almost)?\s*[$€£]?$|"

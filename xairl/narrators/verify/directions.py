@@ -194,6 +194,8 @@ def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) 
         return True
     if any(x.kind == "feature" and 0 < x.start - m.end() <= 1 for x in mentions):
         return True
+    if re.fullmatch(r"against", m.group(0), re.IGNORECASE) and _VERSUS.match(masked, m.end()):
+        return True  # 'roughly 7% against a typical 26%': a comparison of two numbers, no push
     if one_output and re.fullmatch(r"driv\w+(?: by)?", m.group(0), re.IGNORECASE) and not re.match(
             r"\s+(?:\w+\s+){0,3}?(?:up|down|higher|lower)\b", masked[m.end():m.end() + 30], re.IGNORECASE):
         return True  # 'the prediction was driven by the glucose', 'X drives this estimate': what mattered, no way
@@ -203,6 +205,9 @@ def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) 
     return one_output and _unsaid_side(masked, m, mentions, book)
 
 
+#: 'against a typical 26 %', 'against the average of 5.6', 'against 26 %': 'against' as 'versus'
+_VERSUS = re.compile(r"\s+(?:(?:a|an|the|its|their)\s+)?(?:(?:typical|average|usual|baseline|base|expected|mean|norm\w*|"
+                     r"overall|portfolio|population)\b|[+\-]?[$€£]?\d)", re.IGNORECASE)
 #: what may stand between two names of one subject list: commas, and/or, their values ('A (22) and B of 3')
 _JOIN = re.compile(r"^(?:\s|,|;|&|/|\band\b|\bor\b|\bplus\b|\bas well as\b|\b(?:together|along) with\b|\bboth\b|"
                    r"\beither\b|\bits\b|\btheir\b|\bthe\b|\([^()]*\)|[+\-]?[$€£]?[\d.,]+\s*[a-zA-Z%]{0,4}|"

@@ -100,10 +100,19 @@ def _step(digits: str, decimals: int) -> float:
     return 10.0 ** (len(digits) - len(stripped)) if stripped else 1.0
 
 
+#: dates and clock times: no fact of an explanation ('2026-12-02T10:02:11Z', '5 p.m.', '14:30')
+_WHEN_RE = re.compile(r"\b\d{4}-\d{2}-\d{2}(?:[T ]\d{1,2}:\d{2}(?::\d{2}(?:\.\d+)?)?Z?)?|\b\d{1,2}:\d{2}(?::\d{2})?\b|"
+                      r"\b\d{1,2}(?:[:.]\d{2})?\s?(?:a\.m\.|p\.m\.|am\b|pm\b)", re.IGNORECASE)
+
+
 def find_numbers(text: str) -> list[Number]:
-    """Every number in ``text`` (already :func:`normalise`\\ d), digits and number words, left to right."""
+    """Every number in ``text`` (already :func:`normalise`\\ d), digits and number words, left to right; none inside
+    a date or a clock time."""
     out = []
+    when = [(m.start(), m.end()) for m in _WHEN_RE.finditer(text)]
     for m in _NUM_RE.finditer(text):
+        if any(a <= m.start("num") < b for a, b in when):
+            continue
         raw = m.group("num")  # a decimal comma ('22,5', '0,098'); thousands by comma or space ('12,757', '39 960')
         digits = raw.replace(",", ".") if m.group("dc") else raw.replace(",", "").replace(" ", "")
         decimals = len(digits.split(".")[1]) if "." in digits else 0
@@ -131,6 +140,11 @@ def find_numbers(text: str) -> list[Number]:
         out.append(Number(m.start(), m.end(), m.group(0).strip(), -value if sign == "-" else value, unit, sign,
                           _hedge(text[:m.start()]), bool(m.group("pct")), _points(m.group("pct")),
                           m.group("cur") or "", alts))
+    for first, second in zip(out, out[1:]):  # '2-3 points', '10–12 minutes': a range, not a minus
+        if second.start == first.end + 1 and text[first.end] in "-–" and not second.sign and first.text[-1].isdigit():
+            out[out.index(first)] = replace(first, hedge=first.hedge or "at_least", percent=second.percent,
+                                            points=second.points)
+            out[out.index(second)] = replace(second, hedge="at_most")
     for m in _WORD_RE.finditer(text):
         value = _WORDS[m.group(1).lower()] + (_WORDS[m.group(2).lower()] if m.group(2) else 0)
         scale = _SCALES[m.group(3).lower()] if m.group(3) else 1

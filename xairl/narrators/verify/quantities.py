@@ -50,7 +50,8 @@ _SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|fea
                          r"-fold|outcomes|options|classes|sides|factors|reasons|drivers|categories|possibilities|"
                          r"scenarios|-?points?\s+scale|scale)\b|[x×](?![\w]))",
                          re.IGNORECASE)
-_LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state|outcome|class|type)[\s-]*$",
+_LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state|outcome|class|type|acct|account|ref|"
+                           r"ticket|order|episode|ep|seed|run|version|customer|patient|flight|no\.)[\s\-=:#]*$",
                            re.IGNORECASE)
 #: '$91,462 above the baseline' (not '0.38 is slightly above the base value': there the number is the prediction)
 _CHANGE_BEFORE = re.compile(r"\b(?:exceed\w*|above|below|under|higher than|lower than|more than|less than)\b[^;]{0,40}"
@@ -287,7 +288,11 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         ok = matches(n, change) or (n.percent and percent_reading(n, abs(change)))
         return Claim("number", n.text, "verified" if ok else "contradicted", f"the change from the baseline is "
                      f"{change:.4g}")
-    if MARGIN_BEFORE.search(before) or MARGIN_AFTER.match(after):
+    if (MARGIN_BEFORE.search(before) or MARGIN_AFTER.match(after)) and book.output != "actions" and \
+            book.base is not None and book.chosen in book.scores:  # one output: 'the 47.5-point gap' to the average
+        change = book.scores[book.chosen] - book.base
+        named = ("the change from the baseline", [change, abs(change)])
+    elif MARGIN_BEFORE.search(before) or MARGIN_AFTER.match(after):
         named = ("the margin", [book.margin if book.margin is not None else 0.0])  # one available action: 0
     elif (_SCORE_BEFORE.search(before) or (book.output == "actions" and re.match(r"^\s*(vs\.?|versus)\s", after))) \
             and book.chosen in book.scores:
