@@ -157,6 +157,9 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
                                                                    masked[n.end:nxt.start]):
         owner = next(x for x in reversed(names) if x.end <= n.start)  # for one option over the other: either view
         return named(quantities.feature_number(n, owner.keys, masked, book, checks.EITHER, unit_of), "number.push-for")
+    if nxt is not None and nxt.kind == "action" and book.output != "actions" and re.match(
+            r"^\s*(?:in|of|as)?\s*(?:the\s+|an?\s+)?(?:predicted\s+|expected\s+|estimated\s+)?$", masked[n.end:nxt.start]):
+        return named(quantities.output_number(n, book), "number.output-after")  # '$2,603 in expected claim cost'
     if nxt is not None and nxt.kind == "action" and not pushes and re.match(r"^\s*(?:for|by)\s+(?:a\s+|an\s+|the\s+)?$",
                                                            masked[n.end:nxt.start]):
         return named(quantities.action_number(n, checks.resolve_action(nxt, book), masked, book), "number.for-action")
@@ -182,11 +185,23 @@ def named(c: Claim, rule: str) -> Claim:
 
 
 
+#: a log line's key before its value ('pred=0.469', 'yhat: 2738.6', 'base=0.26', 'ev=1850'): what the value is
+_KEY_OUTPUT = re.compile(r"(?:^|[\s,;|(\[{])(?:pred\w*|yhat|y_hat|y|out|output|p|prob\w*|p_\w+|score|q)\s*[=:]\s*$",
+                         re.IGNORECASE)
+_KEY_BASE = re.compile(r"(?:^|[\s,;|(\[{])(?:base\w*|ev|e\[f\(x\)\]|expected_value|mean_pred\w*|avg)\s*[=:]\s*$",
+                       re.IGNORECASE)
+
+
 def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
     """A number whose cue words say what it is, whatever name is near: a statistic of the background (the baseline,
     a feature's typical value), the prediction ('a 43% predicted probability', 'from x to y'), the margin ('the
     8.32-point lead'); None when they say nothing."""
     span = max(0, n.start - 60)
+    if book.output != "actions" and book.base is not None:
+        if _KEY_OUTPUT.search(masked[span:n.start]):
+            return quantities.output_number(n, book)
+        if _KEY_BASE.search(masked[span:n.start]):
+            return background.base_number(n, book)
     stat = background.statistic(masked[span:n.start], any(m.kind == "action" and span <= m.start < n.start
                                                           for m in mentions), book.output == "actions",
                                 bool(re.match(r"[^()]*?\b(?:vs\.?|versus|compared)\b", masked[n.end:n.end + 40])))

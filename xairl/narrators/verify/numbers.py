@@ -101,15 +101,20 @@ def _step(digits: str, decimals: int) -> float:
 
 
 #: dates and clock times: no fact of an explanation ('2026-12-02T10:02:11Z', '5 p.m.', '14:30')
+_MONTH = r"(?:jan|feb|mar|apr|may|jun|jul|aug|sep|sept|oct|nov|dec)[a-z]*\.?"
 _WHEN_RE = re.compile(r"\b\d{4}-\d{2}-\d{2}(?:[T ]\d{1,2}:\d{2}(?::\d{2}(?:\.\d+)?)?Z?)?|\b\d{1,2}:\d{2}(?::\d{2})?\b|"
-                      r"\b\d{1,2}(?:[:.]\d{2})?\s?(?:a\.m\.|p\.m\.|am\b|pm\b)", re.IGNORECASE)
+                      r"\b\d{1,2}(?:[:.]\d{2})?\s?(?:a\.m\.|p\.m\.|am\b|pm\b)|\b\d{1,2}/\d{1,2}/\d{2,4}\b|"
+                      rf"\b\d{{1,2}}(?:st|nd|rd|th)?\s+(?:of\s+)?{_MONTH}(?:\s+\d{{4}})?\b|\b{_MONTH}\s+\d{{1,2}}(?:st|nd|rd|th)?"
+                      rf"(?:,?\s+\d{{4}})?\b", re.IGNORECASE)
+#: a code: letters joined to digits by a hyphen ('QX-20931', '4471-B', 'Y-19-553'), a long number-number ('2024-0387')
+_CODE_RE = re.compile(r"\b[A-Za-z]+(?:-\d+)+[A-Za-z]?\b|\b\d+-[A-Z]{1,3}\b|\b\d{3,}-\d{3,}\b")
 
 
 def find_numbers(text: str) -> list[Number]:
     """Every number in ``text`` (already :func:`normalise`\\ d), digits and number words, left to right; none inside
-    a date or a clock time."""
+    a date, a clock time or a code ('QX-20931')."""
     out = []
-    when = [(m.start(), m.end()) for m in _WHEN_RE.finditer(text)]
+    when = [(m.start(), m.end()) for r in (_WHEN_RE, _CODE_RE) for m in r.finditer(text)]
     for m in _NUM_RE.finditer(text):
         if any(a <= m.start("num") < b for a, b in when):
             continue
