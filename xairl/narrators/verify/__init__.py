@@ -305,7 +305,8 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
                   unit_of, parsed, name_words=frozenset(), sentence_keys=frozenset()) -> list[Claim]:
     out: list[Claim] = []
     names = named_features(mentions)
-    numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not quantities.skip_number(n, masked)]
+    numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not quantities.skip_number(n, masked)
+               and not quantities.window_of_name(n, sentence_keys)]
     # 'A and B ... by x and y, respectively': numbers after the last name pair up with the names in order
     tail = [n for n in numbers if names and n.start > names[-1].end  # not the last name's own '(−22.5 dB)'
             and not re.fullmatch(r"\s?\([^()]*", masked[names[-1].end:n.start])]
@@ -317,6 +318,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
             or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
                 and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
         paired = {id(n): m for n, m in zip(tail, names)}
+    paired |= ranks.compared_pairs(masked, a, b, names, numbers)  # 'A mattered twice as much as B (0.88 vs 0.49)'
     actions = [m for m in mentions if m.kind == "action"]
     scored = {}
     if not names and len(actions) >= 2 and len(numbers) == len(actions) and numbers[0].start >= actions[-1].end:

@@ -94,6 +94,8 @@ def skip_number(n: Number, masked: str) -> bool:
     before = masked[:n.start]
     if re.search(r"(^|\n)\s*$", before) and re.match(r"^[.)]\s", masked[n.end:n.end + 2]):
         return True
+    if (masked[n.start - 1:n.start] == "\0" and not masked[n.start].isspace()) or masked[n.end:n.end + 1] == "\0":
+        return True  # glued to a name: 'PM2.5' of a masked 'PM2', '2nd' of a name
     if re.search(r"\bout of\s*$", before, re.IGNORECASE):  # 'rated 4 out of 5': the scale's top
         return True
     if n.percent and _OF_PEOPLE.match(masked, n.end):  # 'unlike 95% of their peers': a share of the background
@@ -110,6 +112,14 @@ def skip_number(n: Number, masked: str) -> bool:
                                              re.IGNORECASE):
         return True  # 'this one', 'the big one': a pronoun
     return bool(_LABEL_BEFORE.search(before)) or bool(_SKIP_AFTER.match(masked[n.end:]))
+
+
+def window_of_name(n: Number, keys) -> bool:
+    """An integer that is the window or range a named feature's name holds ('fires within 200 km' of
+    ``fire_count_200km``, 'in the last 30 days' of ``data_usage_gb_30d``): a part of the name, not a claim."""
+    if n.sign or n.percent or n.currency or n.hedge or n.value != int(n.value):
+        return False
+    return any(str(int(n.value)) in re.findall(r"(\d+)[a-z]", k.lower()) for k in keys)
 
 
 def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook, ctx: str | None,

@@ -397,3 +397,23 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
                 out.append(check_comparison(x.keys, b_name.keys[0], way, ctx, book, m.group(0).strip()))
         start = b_name.end
     return out
+
+
+#: two numbers in brackets set side by side: '(0.88 versus 0.49)', '(8.5 against 4.4 points)', '(0.188 vs 0.097)'
+_SIDE_BY_SIDE = re.compile(r"\s*\(\s*[^()\0]{0,20}?\s+(?:vs\.?|versus|against|compared with|to)\s+[^()\0]{0,20}\)")
+
+
+def compared_pairs(masked: str, a: int, b: int, names: list[Mention], numbers) -> dict:
+    """'A mattered about twice as much as B (0.88 vs 0.49)': the bracket's first number is A's, the second B's
+    (A the comparison's subject as :func:`find_comparisons` reads it); id(number) -> mention."""
+    out = {}
+    for m in COMPARE_RE.finditer(masked, a, b):
+        b_name = next((x for x in names if x.start >= m.end()), None)
+        if b_name is None or not re.fullmatch(r"\s*(?:the\s+|its\s+|their\s+)?", masked[m.end():b_name.start]):
+            continue
+        bracket = _SIDE_BY_SIDE.match(masked, b_name.end)
+        subjects = [x for x in names if x.end <= m.start()][-1:]
+        inside = [n for n in numbers if bracket and b_name.end <= n.start and n.end <= bracket.end()]
+        if bracket and subjects and len(inside) == 2:
+            out[id(inside[0])], out[id(inside[1])] = subjects[0], b_name
+    return out
