@@ -269,7 +269,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'
-        found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, parsed, vocab.name_words,
+        found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, parsed, vocab,
                               {k for m in named_features(mentions) for k in m.keys})
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     if hypothetical:
@@ -281,7 +281,8 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
 def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None:
     """An identifier that is no name of the explanation ('battery_level', 'sum_phi', 'EXTEND_NS'): an invented
     feature when a number is given to it ('battery_level: +0.3') that is no decision-level fact ('sum_phi=-0.016' is
-    the change from the baseline) and it is not one name's words shortened ('wait_max' may be 'waiting_time_max');
+    the change from the baseline), or a direction word right after it ('wind_speed pushed ...'), and it is not one
+    name's words shortened ('wait_max' may be 'waiting_time_max');
     else unchecked (a variable, a model's or an action's code: nothing is claimed of a feature)."""
     ident = m.group(0)
     if re.fullmatch(r"q_(\w+)", ident.lower()) and book.output == "actions":  # 'Q_recharge': an action's score
@@ -291,19 +292,25 @@ def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None
                      "identifier.q-of-action")
     given = re.match(r"\s?[:=(]?\s?(?=[+\-]?[$€£]?\.?\d)", masked[m.end():m.end() + 6])
     number = next(iter(find_numbers(masked[m.end():m.end() + 40])), None) if given else None
+    pushes = checks.DIRECTION_RE.search(masked, m.end(), m.end() + 30)
+    if pushes is not None and not re.fullmatch(r"(?:\s+[a-z]+){0,2}\s+", masked[m.end():pushes.start()]):
+        pushes = None  # only a direction word within the next two words: 'wind_speed pushed toward it
     words = [w for w in split_words(ident) if len(w) >= 3]
     ours = any(words and all(any(k.startswith(w) for k in own) for w in words) for own in known.values())
     sums = list(book.aggregates.values()) if quantities.AGGREGATE_CUE.search(ident.replace("_", " ")) else []
-    if number is None or ours or any(matches(number, x, magnitude_ok=False) for x in [*book.decision_numbers, *sums]):
+    if ours or (number is None and pushes is None) or (number is not None and any(
+            matches(number, x, magnitude_ok=False) for x in [*book.decision_numbers, *sums])):
         return Claim("feature", ident, "unchecked", "an identifier that names nothing of this explanation",
                      "identifier.other")
-    return Claim("feature", ident, "contradicted", f"given {number.text}, but it is not a feature or action of this "
-                                                   f"explanation", "identifier.given-number")
+    said = f"given {number.text}" if number is not None else f"'{pushes.group(0)}' is said of it"
+    return Claim("feature", ident, "contradicted", f"{said}, but it is not a feature or action of this explanation",
+                 "identifier.claimed")
 
 
 def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
-                  unit_of, parsed, name_words=frozenset(), sentence_keys=frozenset()) -> list[Claim]:
+                  unit_of, parsed, vocab, sentence_keys=frozenset()) -> list[Claim]:
     out: list[Claim] = []
+    name_words = vocab.name_words
     names = named_features(mentions)
     numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not quantities.skip_number(n, masked)
                and not quantities.window_of_name(n, sentence_keys)]
@@ -325,7 +332,10 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
         scored = {id(n): m for n, m in zip(numbers, actions)}  # 'turn beat recharge 6.30 to 2.37'
     # 'A and B together add x': one number after the names (not B's own '(+5.31)', not a list 'x and y'), without a
     # quantity of its own ('most of the $91,462 above the baseline')
-    summed = len(tail) == 1 and len(names) >= 2 and _SUM_CUE.search(masked, a, b) and not _OWN_QUANTITY.search(
+    # (with more numbers after: the cue between the names and the first, 'A, B and C together add x, y % of it', and
+    # not one number per name, '(+10.97 and +22.02)')
+    summed = len(tail) >= 1 and len(names) >= 2 and (_SUM_CUE.search(masked, a, b) if len(tail) == 1 else _SUM_CUE.search(
+        masked, names[-1].end, tail[0].start) and len(tail) != len({m.keys for m in names})) and not _OWN_QUANTITY.search(
         masked[max(a, tail[0].start - 12):tail[0].start]) and not quantities.CHANGE_AFTER.match(masked[tail[0].end:b])
     # 'not the garage but the quality', 'X, rather than Y, is ...': what is said of the sentence is not said of Y
     said = [m for m in mentions if m.kind == "action" or not _NEGATED.search(masked[max(a, m.start - 40):m.start])]
@@ -339,7 +349,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure
             c = binding.unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
         if c.status == "contradicted" and id(n) not in paired:
-            c = binding.by_parse(c, n, masked, book, ctx, unit_of, parsed, name_words)
+            c = binding.by_parse(c, n, masked, book, ctx, unit_of, parsed, vocab)
         out.append(c)
     first = numbers[0] if numbers else None
     if first is not None and first.sign and not any(m.start < first.start for m in mentions):

@@ -105,7 +105,7 @@ AGGREGATE_NOUNS = frozenset({"total", "sum", "net", "gap", "difference", "change
                              "factors", "variables"})
 
 
-def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, known=frozenset()) -> Claim:
+def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, vocab) -> Claim:
     """A second reading of a contradicted number from the sentence's parse (:func:`.parse.quantified`): a number that
     measures another name is checked against that name; one that measures a noun the explanation holds no fact of
     ('30 days', '41 GB') is unchecked; one that measures a fact noun ('the total effect (1.41)') is checked as a
@@ -122,6 +122,13 @@ def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, kno
         return replace(other, rule="parse.measures-name") if other.status != "contradicted" else c
     if q.noun and (labelled := _label_number(n, q.noun, book)) is not None:
         return labelled  # 'a two-year contract' when the contract is 'One year'
+    owners = [f for f, words in vocab.words.items() if f in book.features and q.noun and q.noun not in FACT_NOUNS
+              and stem(q.noun) in {stem(w) for w in words}]
+    if len(owners) == 1:  # 'twelve years without a claim': the one feature with years in its name (ncd_years)
+        other = quantities.feature_number(n, (owners[0],), masked, book, ctx, unit_of)
+        if other.status == "verified":
+            return replace(other, rule="parse.measures-name")
+    known = vocab.name_words
     if q.noun and q.noun not in FACT_NOUNS and q.noun not in known and stem(q.noun) not in known:
         return Claim("number", n.text, "unchecked", f"it counts '{q.noun}', which the explanation holds no fact of "
                                                     f"(first read as {c.detail})", "parse.counts-other")
@@ -192,13 +199,21 @@ _KEY_BASE = re.compile(r"(?:^|[\s,;|(\[{])(?:base\w*|ev|e\[f\(x\)\]|expected_val
                        re.IGNORECASE)
 
 
+def _output_is(before: str, book: FactBook) -> bool:
+    """'the forecast is 53', 'the expected claim cost stands at $2,738.60': one output's word, then its number."""
+    words = {w for a in book.scores for w in split_words(a) if len(w) >= 4} | {"forecast", "prediction", "estimate"}
+    return bool(re.search(rf"\b(?:{'|'.join(map(re.escape, sorted(words)))})\s+(?:is|was|stands at|stood at|comes out at|"
+                          rf"came out at|sits at|=|:)\s*(?:about|around|roughly|approximately|just under|just over|"
+                          rf"nearly|almost)?\s*[$€£]?$", before, re.IGNORECASE))
+
+
 def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
     """A number whose cue words say what it is, whatever name is near: a statistic of the background (the baseline,
     a feature's typical value), the prediction ('a 43% predicted probability', 'from x to y'), the margin ('the
     8.32-point lead'); None when they say nothing."""
     span = max(0, n.start - 60)
     if book.output != "actions" and book.base is not None:
-        if _KEY_OUTPUT.search(masked[span:n.start]):
+        if _KEY_OUTPUT.search(masked[span:n.start]) or _output_is(masked[span:n.start], book):
             return quantities.output_number(n, book)
         if _KEY_BASE.search(masked[span:n.start]):
             return background.base_number(n, book)

@@ -30,6 +30,8 @@ class FeatureFacts:
     ranks: dict[str, int] = field(default_factory=dict)       # context -> rank by |contribution|
     signed_ranks: dict[str, int] = field(default_factory=dict)  # context -> rank among contributions of its sign
     shares: dict[str, float] = field(default_factory=dict)    # context -> % of the sum of |contributions|
+    side_shares: dict[str, float] = field(default_factory=dict)  # context -> % of its own side's sum ('57 % of the
+    #                                                               positive push')
     fill: float | None = None                                 # % of the feature's capacity
     quartiles: tuple[float, float, float] | None = None       # the background's 25th, 50th and 75th percentiles
     legend: dict[int, str] = field(default_factory=dict)      # code -> its meaning, from the description's legend
@@ -135,6 +137,10 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
                     d.q_margin if deciding else None, base, numbers,
                     base_margin=float(d.base_margin) if deciding else None)
     for ctx, contrib in views.items():
+        for j, f in enumerate(exp.feature_names):
+            side = float(np.abs(contrib[np.sign(contrib) == np.sign(contrib[j])]).sum())
+            if side and contrib[j]:
+                feats[f].side_shares[ctx] = 100.0 * abs(float(contrib[j])) / side
         of = "" if ctx == "chosen" else " (margin)"
         book.aggregates |= {f"the sum of the positive contributions{of}": float(contrib[contrib > 0].sum()),
                             f"the sum of the negative contributions{of}": float(contrib[contrib < 0].sum()),

@@ -171,6 +171,8 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
                 return True, f"{key}: {what}"
         if n.percent and not n.points and any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
             return True, f"{key}: share"
+        if n.percent and not n.points and any(matches(n, e.side_shares[c]) for c in contexts if c in e.side_shares):
+            return True, f"{key}: share of its side (the contributions of its sign)"
         shown = ", ".join(f"{w} {v:.4g}" for w, v in cands)
         return False, f"{n.text} is not {key}'s {shown or 'value'}"
 
@@ -370,10 +372,16 @@ AGGREGATE_CUE = re.compile(r"\b(?:total|sum\w*|add(?:s|ed)?\s+up|altogether|comb
                            re.IGNORECASE)
 
 
+#: 'x of y': the whole a part is of ('11.3 of 21.9 points', '$665 of roughly $806')
+_PART_OF = re.compile(r"\d[\d.,]*\s*(?:points?|pts|%)?\s+of\s+(?:roughly\s+|about\s+|around\s+|some\s+)?[$€£]?\s*$",
+                      re.IGNORECASE)
+
+
 def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
     """A number after words that sum over the features, equal to one such sum (:attr:`FactBook.aggregates`):
     verified; otherwise None (its other readings decide)."""
-    if not book.aggregates or not AGGREGATE_CUE.search(masked[max(0, n.start - 50):n.start]):
+    before = masked[max(0, n.start - 50):n.start]
+    if not book.aggregates or not (AGGREGATE_CUE.search(before) or _PART_OF.search(before)):
         return None
     for what, v in book.aggregates.items():
         if (matches(n, v) and not n.percent) or (n.points and percent_reading(n, v)):  # ('50 %' is a share)
