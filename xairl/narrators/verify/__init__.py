@@ -278,6 +278,11 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     return claims
 
 
+#: an identifier's word that names a decision-level quantity ('p_churn', 'y_hat', 'sum_shap', 'base_value')
+_DECISION_KEY = re.compile(r"\b(?:pred\w*|yhat|y|hat|out|output|p|prob\w*|score|q|base\w*|ev|delta|margin|gap|"
+                           r"value)\b", re.IGNORECASE)
+
+
 def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None:
     """An identifier that is no name of the explanation ('battery_level', 'sum_phi', 'EXTEND_NS'): an invented
     feature when a number is given to it ('battery_level: +0.3') that is no decision-level fact ('sum_phi=-0.016' is
@@ -297,9 +302,11 @@ def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None
         pushes = None  # only a direction word within the next two words: 'wind_speed pushed toward it
     words = [w for w in split_words(ident) if len(w) >= 3]
     ours = any(words and all(any(k.startswith(w) for k in own) for w in words) for own in known.values())
-    sums = list(book.aggregates.values()) if quantities.AGGREGATE_CUE.search(ident.replace("_", " ")) else []
+    spaced = ident.replace("_", " ")
+    sums = list(book.aggregates.values()) if quantities.AGGREGATE_CUE.search(spaced) else []
+    decision = book.decision_numbers if _DECISION_KEY.search(spaced) else []
     if ours or (number is None and pushes is None) or (number is not None and any(
-            matches(number, x, magnitude_ok=False) for x in [*book.decision_numbers, *sums])):
+            matches(number, x, magnitude_ok=False) for x in [*decision, *sums])):
         return Claim("feature", ident, "unchecked", "an identifier that names nothing of this explanation",
                      "identifier.other")
     said = f"given {number.text}" if number is not None else f"'{pushes.group(0)}' is said of it"
