@@ -18,9 +18,12 @@ A small pipeline, one module per step:
 5. every sentence gets a status (contradicted if any claim is; verified if a claim was checked and none is
    contradicted; else unchecked), and the text a coverage (share of sentences with a checked claim).
 
+A number bound by position alone and contradicted gets a second reading from the sentence's parse (:mod:`.parse`,
+spaCy): the noun phrase it measures. Every claim names the reading that made it (``Claim.rule``).
+
 Two verdicts: ``Verification.accurate``, nothing contradicted; ``Verification.ok``, accurate and coverage >=
-:data:`MIN_COVERAGE` (0.5). What is and is not checked
-is listed in the README ("What the verifier checks").
+:data:`MIN_COVERAGE` (0.5). How to read a trace and add a rule: docs/verifier.md; what is and is not checked: the
+README ("What the verifier checks").
 """
 from __future__ import annotations
 

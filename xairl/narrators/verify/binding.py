@@ -10,8 +10,8 @@ from dataclasses import replace
 from . import background, checks, quantities
 from .book import FactBook
 from .checks import Claim
-from .numbers import find_numbers, matches
 from .names import split_words, stem
+from .numbers import find_numbers, matches
 from .parse import quantified
 
 _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of)?|scored|scores|score of|"
@@ -106,14 +106,15 @@ AGGREGATE_NOUNS = frozenset({"total", "sum", "net", "gap", "difference", "change
 
 
 def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, vocab) -> Claim:
-    """A second reading of a contradicted number from the sentence's parse (:func:`.parse.quantified`): a number that
-    measures another name is checked against that name; one that measures a noun the explanation holds no fact of
-    ('30 days', '41 GB') is unchecked; one that measures a fact noun ('the total effect (1.41)') is checked as a
-    decision-level number; otherwise the first reading stands. ``parsed()`` gives the sentence's parse, made only
-    when asked for."""
-    units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
+    """A second reading of a number bound by position alone (:data:`GUESSED`) and contradicted, from the sentence's
+    parse (:func:`.parse.quantified`): a number that measures another name (or a noun of one feature's name only)
+    is checked against that name; one inside a categorical label ('a two-year contract') against the label; one that
+    measures a noun the explanation holds no fact of ('30 days', '41 GB') is unchecked; one that measures a whole
+    ('the total effect (1.41)') is checked as a decision-level number; otherwise the first reading stands.
+    ``parsed()`` gives the sentence's parse, made only when asked for."""
     if c.rule not in GUESSED:
         return c  # bound by its cue words or a list: sure
+    units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
     q = quantified(parsed(), n.start, n.end, units)
     if "|" in q.key:
         return c  # an ambiguous name: the first reading stands
@@ -179,7 +180,6 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     return named(_by_name_before(n, masked, mentions, names, book, ctx, unit_of), GUESSED[1])
 
 
-
 #: the bindings made by position alone (the name right after a number, the name before it, no name at all): a
 #: parse may correct them
 GUESSED = ("number.name-after", "number.name-before", "number.free")
@@ -188,8 +188,6 @@ GUESSED = ("number.name-after", "number.name-before", "number.free")
 def named(c: Claim, rule: str) -> Claim:
     """``c`` with the id of the reading that made it, unless a more specific one already named it."""
     return c if c.rule else replace(c, rule=rule)
-
-
 
 
 #: a log line's key before its value ('pred=0.469', 'yhat: 2738.6', 'base=0.26', 'ev=1850'): what the value is

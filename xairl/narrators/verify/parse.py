@@ -37,8 +37,8 @@ def pipeline():
 
 
 def read(sentence: str, spans: list[tuple[int, int, str]]):
-    """The parse of ``sentence`` with each (start, end, key) span merged into one token; the token's ``_`` is not
-    used: a merged token's ``ent_id_`` holds its key ('' for any other token)."""
+    """The parse of ``sentence`` with each (start, end, key) span merged into one token before tagging and parsing;
+    a merged token's ``ent_id_`` holds its key ('' for any other token)."""
     nlp = pipeline()
     doc = nlp.make_doc(sentence)
     taken: set[int] = set()
@@ -67,8 +67,8 @@ class Quantified:
 def quantified(doc, start: int, end: int, units: frozenset = frozenset()) -> Quantified:
     """The noun phrase the number at characters [start, end) of the parsed sentence modifies: climb from the number
     through number, unit and apposition links ('30' -> 'days'; '(1.41)' -> 'effect'; '1.21' -> 'points' -> 'of' ->
-    'drop'), stopping at the first name or content noun; a verb or a clause head stops the climb (the number is then
-    an adverbial amount, 'raised it by 0.4': nothing found)."""
+    'drop'), stopping at the first name or content noun; an amount of a verb ('A raised it by 0.4', 'A adds 0.4') is
+    its subject's (:func:`_subject`); any other link stops the climb with nothing found."""
     span = doc.char_span(start, end, alignment_mode="expand")
     if span is None:
         return Quantified()
