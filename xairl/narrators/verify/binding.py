@@ -98,11 +98,9 @@ FACT_NOUNS = frozenset({"score", "scores", "margin", "lead", "edge", "contributi
                         "mass", "magnitude", "deviation", "delta", "jump", "fall", "spread", "bar", "rank"})
 
 
-#: fact nouns that name a decision-level quantity, not one feature's push
+#: fact nouns that only name a decision-level quantity, never one feature's ('distance (score 1.15)' is no whole)
 AGGREGATE_NOUNS = frozenset({"total", "sum", "net", "gap", "difference", "change", "mass", "prediction", "predictions",
-                             "score", "baseline", "base", "average", "mean", "margin", "lead", "edge", "output",
-                             "estimate", "probability", "risk", "price", "delta", "expectation", "spread", "features",
-                             "factors", "variables"})
+                             "baseline", "margin", "lead", "output", "delta"})
 
 
 def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, vocab) -> Claim:
