@@ -367,9 +367,9 @@ def _owners(n: Number, book: FactBook) -> list[str]:
 
 #: words that say a number sums over the features: 'the positives add up to', 'total absolute attribution',
 #: 'sum_shap=', 'net', 'n_features='
-AGGREGATE_CUE = re.compile(r"\b(?:total|sum\w*|add(?:s|ed)?\s+up|altogether|combined|in all|overall|net|"
-                           r"positives?|negatives?|upward|downward|absolute|pos\w*|neg\w*|n_features|features)\b",
-                           re.IGNORECASE)
+AGGREGATE_CUE = re.compile(r"\b(?:total|sum\w*|add(?:s|ed)?\s+up|altogether|combined|in all|overall|net|positives|"
+                           r"negatives|(?:positive|negative|upward|downward)\s+(?:side|factors|contributions|push|"
+                           r"pressure|drivers|ones)|absolute|pos|neg|pos_\w+|neg_\w+|n_features)\b", re.IGNORECASE)
 
 
 #: 'x of y': the whole a part is of ('11.3 of 21.9 points', '$665 of roughly $806')
