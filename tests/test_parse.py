@@ -59,6 +59,8 @@ def test_names_are_one_token_whatever_their_digits_or_script():
     ("The total absolute effect (1.41) is split three ways.", "1.41", parse.Quantified(noun="effect", aggregate=True)),
     ("The glucose level of 119 lowered it.", "119", parse.Quantified(key="glucose")),
     ("Speed raised it by 0.4.", "0.4", parse.Quantified(key="Speed")),  # the subject of the verb it amounts to
+    ("Speed, with an index of 2.4, adds about 3.8.", "3.8", parse.Quantified(key="Speed")),
+    ("The co-signer lowers the risk by 0.02.", "0.02", parse.Quantified()),  # no name: no second reading
 ])
 def test_the_noun_phrase_a_number_measures(sentence, number, expected):
     spans = [(sentence.index(n), sentence.index(n) + len(n), n) for n in ("glucose", "Speed") if n in sentence]

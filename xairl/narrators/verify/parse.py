@@ -21,6 +21,7 @@ UNIT_WORDS = frozenset({"point", "points", "pts", "pt", "pp", "%", "percent", "p
                         "db", "dbm", "dbw", "sigma", "σ", "sd", "std", "m", "km", "s", "ms", "mbit", "kb", "mb", "kwh",
                         "w", "kw", "hz", "mhz", "ghz", "x", "times", "fold", "mg", "g", "kg", "l", "ml", "°c", "°",
                         "c", "f"})
+_HEDGES = frozenset({"about", "around", "roughly", "some", "nearly", "almost", "approximately", "over", "under"})
 _CLIMB = frozenset({"nummod", "quantmod", "compound", "appos", "npadvmod", "amod", "nmod", "punct", "dep"})
 
 
@@ -89,6 +90,8 @@ def quantified(doc, start: int, end: int, units: frozenset = frozenset()) -> Qua
             return _subject(head.head)  # 'A, which ..., raised it by 0.4': what the verb's subject names
         if token.dep_ in ("dobj", "npadvmod") and head.pos_ == "VERB":
             return _subject(head)  # 'A adds 0.4'
+        if token.dep_ == "pobj" and head.lower_ in _HEDGES and head.head.pos_ == "VERB":
+            return _subject(head.head)  # 'A adds about 3.8'
         if token.dep_ not in _CLIMB and not (token.dep_ == "pobj" and head.lower_ == "of"):
             return Quantified()
         if any(ch.isdigit() for ch in head.text):
@@ -132,7 +135,7 @@ def _subject(verb) -> Quantified:
                 return Quantified(key=s.ent_id_)
             if s.lower_ in ("which", "that", "who") and verb.dep_ == "relcl" and verb.head.ent_id_:
                 return Quantified(key=verb.head.ent_id_)
-            return Quantified()
+            return Quantified()  # (a subject that is no name may be an invented feature: no second reading)
         if verb.dep_ == "conj":
             verb = verb.head
         elif verb.dep_ == "relcl" and verb.head.ent_id_:
