@@ -36,6 +36,10 @@ _LAZY = {
     "FeatureFact": "xairl.narrators.facts",
     "Comparison": "xairl.narrators.facts",
     "DomainFacts": "xairl.narrators.facts",
+    "decision_facts": "xairl.narrators.facts",
+    "narration_units": "xairl.narrators.facts:units",  # each group narrated as one reason, then the other features
+    "format_number": "xairl.narrators.facts:fmt",  # how every narrated number is written
+    "value_level": "xairl.narrators.facts:level",  # 'low' / 'moderate' / 'high' of a value, and its words
     # reports
     "Report": "xairl.report",
     "ReportRequest": "xairl.report",
@@ -60,7 +64,8 @@ __version__ = "0.1.0"
 
 def __getattr__(name: str):
     if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
+        module, _, attr = _LAZY[name].partition(":")  # 'module' or 'module:attr' (a public name of its own)
+        value = getattr(importlib.import_module(module), attr or name)
         globals()[name] = value
         return value
     raise AttributeError(f"module 'xairl' has no attribute '{name}'")

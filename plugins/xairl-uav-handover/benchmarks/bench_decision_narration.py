@@ -26,9 +26,6 @@ from pathlib import Path
 import numpy as np
 
 import xairl
-from xairl.narrators.facts import level
-from xairl.narrators.verify.book import clean_surface
-from xairl.narrators.verify.names import find_mentions, vocabulary
 from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.policy import background_states, greedy, load_checkpoint, uav_policy
 
@@ -65,7 +62,6 @@ def real(ckpt, n: int, seed: int = 0):
 
 
 def measure(policy, exp, histories, template: str) -> dict:
-    vocab = vocabulary(exp, policy, clean_surface)
     margin = exp.margin()
     names = exp.feature_names
     idx = {f: j for j, f in enumerate(names)}
@@ -77,17 +73,17 @@ def measure(policy, exp, histories, template: str) -> dict:
         out["not_verified"] += not n.verified  # checked with the facts the hook stated from the history
         out["partial_coverage"] += any(status == "unchecked" for _, status in n.sentences)
         first = True
-        for text, _ in n.sentences:
-            mentions, _ = find_mentions(text, vocab)
-            feats = [m for m in mentions if m.kind == "feature" and len(m.keys) == 1]
+        for sentence in xairl.verify(n.text, exp, i, policy).sentences:
+            text = sentence.text  # the features it names unambiguously, in order: the verifier's name mentions
+            feats = [c.detail for c in sentence.claims if c.rule == "names.mention" and " / " not in c.detail]
             if first and feats and exp.chosen[i] != exp.runner_up[i]:
-                key = feats[0].keys[0]
+                key = feats[0]
                 cols = [idx[f] for f in groups.get(key, (key,))]
                 if margin[i, cols].sum() < 0 and "despite" not in text.lower():
                     out["opposing_lead"] += 1
                 first = False
-            for m in feats:
-                info = policy.features.get(m.keys[0])
+            for f in feats:
+                info = policy.features.get(f)
                 if info is not None and info.kind == "identifier" and DIRECTION.search(text):
                     out["identifier_cause"] += 1
         for f, info in policy.features.items():
@@ -95,7 +91,7 @@ def measure(policy, exp, histories, template: str) -> dict:
                 continue
             label = info.description or f
             value = float(exp.states[i, idx[f]])
-            truth = level(value, info, None)[0]
+            truth = xairl.value_level(value, info, None)[0]
             for word, lvl in ((info.low, "low"), (info.high, "high")):
                 if re.search(re.escape(label) + r"\s*\([^)]*\b" + re.escape(word), n.text) and truth != lvl:
                     out["level_contradicts_range"] += 1

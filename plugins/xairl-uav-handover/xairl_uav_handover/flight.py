@@ -19,8 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from xairl import Comparison, DomainFacts, Explanation, Policy, verify
-from xairl.narrators.facts import decision_facts, fmt, units
+from xairl import Comparison, DomainFacts, Explanation, Policy, decision_facts, verify
+from xairl import format_number as fmt
+from xairl import narration_units as units
 
 from .features import FEATURES, RSRP
 from .policy import Checkpoint, greedy

@@ -10,9 +10,10 @@ A small pipeline, one module per step:
    over the runner-up, or either); :mod:`.binding` binds each number to the name it is about (the name before it
    in its clause, pairwise for 'A and B ... by x and y, respectively', an action's score, the margin, the
    prediction, a typical value (:mod:`.background`), the change from the baseline); :mod:`.directions` binds each direction word to
-   the list of names nearest before it (or a list after it, 'Raising risk: A, B'), and :mod:`.ranks` each rank,
-   'barely matters' and 'A mattered more than B' phrase;
-4. :mod:`.quantities` (numbers), :mod:`.checks` (actions, categories, directions) and :mod:`.ranks` check each
+   the list of names nearest before it (or a list after it, 'Raising risk: A, B'), :mod:`.ranks` each rank and
+   'barely matters' phrase, and :mod:`.comparisons` each 'A mattered more than B' and ratio;
+4. :mod:`.quantities` (numbers), :mod:`.checks` (actions, categories, directions), :mod:`.ranks` and
+   :mod:`.comparisons` check each
    claim against :mod:`.book` (values, contributions to the chosen action's score and to the margin over the
    runner-up, ranks, shares, labels, scores, domain comparisons) and say verified, contradicted or unchecked;
 5. every sentence gets a status (contradicted if any claim is; verified if a claim was checked and none is
@@ -35,7 +36,7 @@ import numpy as np
 from ...errors import InputError
 from ...explanation import Explanation
 from ...policy import Policy
-from . import background, binding, checks, directions, parse, quantities, ranks
+from . import background, binding, checks, comparisons, directions, parse, quantities, ranks
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, named_features, split_words, vocabulary
@@ -335,7 +336,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
             or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
                 and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
         paired = {id(n): m for n, m in zip(tail, names)}
-    paired |= ranks.compared_pairs(masked, a, b, names, numbers)  # 'A mattered twice as much as B (0.88 vs 0.49)'
+    paired |= comparisons.compared_pairs(masked, a, b, names, numbers)  # 'A mattered twice as much as B (0.88 vs 0.49)'
     actions = [m for m in mentions if m.kind == "action"]
     scored = {}
     if not names and len(actions) >= 2 and len(numbers) == len(actions) and numbers[0].start >= actions[-1].end:
@@ -368,7 +369,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     out += [binding.named(c, "direction.subject") for c in directions.directions(masked, a, b, said, book, ctx,
                                                                                 name_words)]
     out += [binding.named(c, "rank.words") for c in ranks.find_ranks(masked, a, b, said, book, ctx)]
-    out += [binding.named(c, "rank.comparison") for c in ranks.find_comparisons(masked, a, b, said, book, ctx)]
+    out += [binding.named(c, "rank.comparison") for c in comparisons.find_comparisons(masked, a, b, said, book, ctx)]
     for m in ranks.MINOR_RE.finditer(masked, a, b):
         owner = next((x for x in reversed(said_names) if x.end <= m.start()), None) or next(
             (x for x in said_names if x.start >= m.end()), None)

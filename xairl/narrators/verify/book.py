@@ -137,18 +137,24 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
                     d.q_margin if deciding else None, base, numbers,
                     base_margin=float(d.base_margin) if deciding else None)
     for ctx, contrib in views.items():
-        for j, f in enumerate(exp.feature_names):
-            side = float(np.abs(contrib[np.sign(contrib) == np.sign(contrib[j])]).sum())
-            if side and contrib[j]:
-                feats[f].side_shares[ctx] = 100.0 * abs(float(contrib[j])) / side
-        of = "" if ctx == "chosen" else " (margin)"
-        book.aggregates |= {f"the sum of the positive contributions{of}": float(contrib[contrib > 0].sum()),
-                            f"the sum of the negative contributions{of}": float(contrib[contrib < 0].sum()),
-                            f"the sum of |contributions|{of}": float(np.abs(contrib).sum()),
-                            f"the sum of the contributions{of}": float(contrib.sum())}
+        _add_sums(book, ctx, contrib, exp.feature_names)
     book.aggregates["the number of features"] = float(len(exp.feature_names))
     add_facts(book, DomainFacts(d.extras, d.comparisons))
     return book
+
+
+def _add_sums(book: FactBook, ctx: str, contrib: np.ndarray, names) -> None:
+    """The sums over the features in view ``ctx`` ('the positives add up to +0.39') and each feature's share of its
+    own side ('57 % of all the positive push')."""
+    for j, f in enumerate(names):
+        side = float(np.abs(contrib[np.sign(contrib) == np.sign(contrib[j])]).sum())
+        if side and contrib[j]:
+            book.features[f].side_shares[ctx] = 100.0 * abs(float(contrib[j])) / side
+    of = "" if ctx == "chosen" else " (margin)"
+    book.aggregates |= {f"the sum of the positive contributions{of}": float(contrib[contrib > 0].sum()),
+                        f"the sum of the negative contributions{of}": float(contrib[contrib < 0].sum()),
+                        f"the sum of |contributions|{of}": float(np.abs(contrib).sum()),
+                        f"the sum of the contributions{of}": float(contrib.sum())}
 
 
 def add_facts(book: FactBook, facts: DomainFacts) -> None:

@@ -149,9 +149,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         if fill_cue and e.fill is not None:  # '8 % full': the fill, nothing else
             return matches(n, e.fill), f"{key}'s fill is {e.fill:.3g} % of its capacity"
         unit = unit_of(key).lower()
-        # the unit with a decimal prefix ('2 Mbit' for 2e6 bit, '12 kB' for 12,000 B): the value in that unit
-        prefix = re.match(rf"\s*([kMG])\s?{re.escape(unit_of(key))}\b", after) if unit else None
-        scale = {"k": 1e3, "M": 1e6, "G": 1e9}[prefix.group(1)] if prefix else 1.0
+        prefix, scale = _prefixed(after, unit_of(key))
         value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or slot or bool(prefix)) \
             and not contrib_cue
         meaning = None if contrib_cue or n.percent else _code_meaning(n, e)
@@ -159,7 +157,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
             return meaning
         cands = []
         if (not contrib_cue or name_after) and e.value is not None and not (n.points and unit not in ("points", "pts")):
-            cands.append(("value" if scale == 1 else f"value in {prefix.group(1)}{unit_of(key)}", e.value / scale))
+            cands.append(("value" if scale == 1 else f"value in {prefix}{unit_of(key)}", e.value / scale))
         if n.percent and not contrib_cue and e.fill is not None:
             cands.append(("fill (% of capacity)", e.fill))
         if not value_cue:
@@ -169,10 +167,9 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
             if matches(n, v, magnitude_ok=not (signed_cue and contribution)) or (
                     (n.percent or (in_points and contribution)) and percent_reading(n, v)):
                 return True, f"{key}: {what}"
-        if n.percent and not n.points and any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
-            return True, f"{key}: share"
-        if n.percent and not n.points and any(matches(n, e.side_shares[c]) for c in contexts if c in e.side_shares):
-            return True, f"{key}: share of its side (the contributions of its sign)"
+        share = _share(n, e, contexts)
+        if share:
+            return True, f"{key}: {share}"
         shown = ", ".join(f"{w} {v:.4g}" for w, v in cands)
         return False, f"{n.text} is not {key}'s {shown or 'value'}"
 
@@ -184,6 +181,25 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     if claim.status == "contradicted" and comparison(n, after, book):
         return Claim("number", n.text, "verified", "a domain comparison in its unit")
     return claim
+
+
+def _prefixed(after: str, unit: str) -> tuple[str, float]:
+    """The unit right after a number with a decimal prefix ('2 Mbit' for 2e6 bit, '12 kB' for 12,000 B): the prefix
+    and its scale; ('', 1.0) without one."""
+    prefix = re.match(rf"\s*([kMG])\s?{re.escape(unit)}\b", after) if unit else None
+    return (prefix.group(1), {"k": 1e3, "M": 1e6, "G": 1e9}[prefix.group(1)]) if prefix else ("", 1.0)
+
+
+def _share(n: Number, e, contexts) -> str:
+    """Which share of the total a percentage states: of all |contributions| ('share'), or of its own side's ('57 %
+    of all the positive push'); '' for none (percentage points are never a share)."""
+    if not n.percent or n.points:
+        return ""
+    if any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
+        return "share"
+    if any(matches(n, e.side_shares[c]) for c in contexts if c in e.side_shares):
+        return "share of its side (the contributions of its sign)"
+    return ""
 
 
 def _code_meaning(n: Number, e) -> tuple[bool, str] | None:

@@ -1,5 +1,6 @@
 """Rank and magnitude claims: 'the most important feature', 'second', 'the top three', 'mostly because of',
-'followed by', 'barely matters', 'A mattered more than B'; the phrases that state them and their checks."""
+'followed by', 'barely matters'; the phrases that state them and their checks (comparisons between features:
+:mod:`.comparisons`)."""
 from __future__ import annotations
 
 import re
@@ -7,7 +8,8 @@ import re
 import numpy as np
 
 from .book import FactBook
-from .checks import DIRECTION_RE, EITHER, Claim, over_keys, resolve_action
+from .checks import DIRECTION_RE, Claim, over_keys, resolve_action
+from .comparisons import check_comparison, check_outweighs, views
 from .names import Mention, named_features
 
 ORD = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4, "fifth": 5}
@@ -106,73 +108,6 @@ def check_minor(keys: tuple[str, ...], ctx: str | None, book: FactBook, text: st
     return over_keys(keys, test, "magnitude", text, "magnitude")
 
 
-#: 'A mattered more than B', 'a bigger effect on the margin than B', 'lowers the risk less than B does', 'A outweighs
-#: B', 'cuts it by about as much as B adds': how large |contribution| is beside another feature's
-COMPARE_RE = re.compile(r"\b(?:(?P<more>more|bigger|larger|greater|stronger|heavier)|(?P<less>less|smaller|weaker)|"
-                        r"(?P<same>as much|as large|as big))\b(?P<gap>(?:\s+[\w'\-\0]+){0,6}?)\s+(?:than|as)\s+"
-                        r"|\b(?P<out>outweigh\w*|dwarf\w*|overshadow\w*)\s+", re.IGNORECASE)
-SAME_WITHIN = 0.25  # 'about as much as': the two sizes within 25 % of the larger
-
-
-def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | None, book: FactBook,
-                     text: str) -> Claim:
-    """|contribution| of A against B's in the sentence's view (any view when it names none): way +1 larger, -1
-    smaller, 0 about the same."""
-    contexts = views(ctx, book)
-
-    def test(key):
-        pairs = [(abs(book.features[key].contribs[c]), abs(book.features[b_key].contribs[c]), c) for c in contexts
-                 if c in book.features[key].contribs and c in book.features[b_key].contribs]
-        if not pairs:
-            return None
-        ok = [c for x, y, c in pairs if (x > y if way > 0 else x < y if way < 0 else
-                                          abs(x - y) <= SAME_WITHIN * max(x, y))]
-        x, y, c = pairs[0]
-        return bool(ok), f"|{key}| {x:.3g} vs |{b_key}| {y:.3g} ({ok[0] if ok else c})"
-
-    return over_keys(a_keys, test, "comparison", text, "rank")
-
-
-#: a multiplier before a comparative: 'roughly 1.7 times', 'nearly twice', 'three times', 'half', '35 %'
-_RATIO_BEFORE = re.compile(r"(?:(?P<num>\d+(?:\.\d+)?)\s*(?:times|x|-fold|fold)|(?P<word>twice|double|thrice|"
-                           r"half|one and a half times|two and a half times|(?:three|four|five|ten) times)|"
-                           r"(?P<pct>\d+(?:\.\d+)?)\s*(?:%|percent))\s*(?:\w+\s+){0,3}?$", re.IGNORECASE)
-_RATIO_WORDS = {"twice": 2.0, "double": 2.0, "thrice": 3.0, "half": 0.5, "one and a half times": 1.5,
-                "two and a half times": 2.5, "three times": 3.0, "four times": 4.0, "five times": 5.0,
-                "ten times": 10.0}
-RATIO_WITHIN = 0.25  # a ratio in words ('roughly twice') holds within 25 % of the sizes' ratio
-
-
-def _ratio(before: str, way: int) -> float | None:
-    """The ratio a multiplier before 'as much as' / 'more than' / 'less than' states: '1.7 times as much' 1.7,
-    '35 % more' 1.35, '20 % less' 0.8, 'twice as much' 2; None without one."""
-    m = _RATIO_BEFORE.search(before)
-    if m is None:
-        return None
-    if m.group("pct"):
-        share = float(m.group("pct")) / 100
-        return 1 + share if way > 0 else 1 - share if way < 0 else share
-    return float(m.group("num")) if m.group("num") else _RATIO_WORDS[m.group("word").lower()]
-
-
-def check_ratio(a_keys: tuple[str, ...], b_key: str, ratio: float, ctx: str | None, book: FactBook,
-                text: str) -> Claim:
-    """'A mattered 1.7 times as much as B': |A| / |B| within :data:`RATIO_WITHIN` of the ratio, in the sentence's
-    view (any view when it names none)."""
-    contexts = views(ctx, book)
-
-    def test(key):
-        pairs = [(abs(book.features[key].contribs[c]), abs(book.features[b_key].contribs[c]), c) for c in contexts
-                 if c in book.features[key].contribs and c in book.features[b_key].contribs]
-        if not pairs or not ratio > 0:
-            return None
-        ok = [c for x, y, c in pairs if y > 0 and abs(x / y - ratio) <= RATIO_WITHIN * ratio]
-        x, y, c = pairs[0]
-        return bool(ok), f"|{key}| / |{b_key}| is {x / y if y else float('inf'):.3g}, said {ratio:.3g} ({c})"
-
-    return over_keys(a_keys, test, "ratio", text, "rank")
-
-
 #: 'Two inputs dominate', 'both features dominate': a plural rank of that many
 _COUNTED = re.compile(r"\b(two|three|four|both)\s+(?:[\w-]+\s+)?$", re.IGNORECASE)
 #: a rank in what would (not) be: 'enough to make X a dominant predictor', 'would make X the main reason'
@@ -188,24 +123,6 @@ def check_collective(members: list[tuple[str, ...]], ctx: str | None, book: Fact
         return Claim("rank", text, "unchecked", "ambiguous: a member may mean several features")
     named = sorted({k[0] for k in members})
     return check_outweighs(named, [f for f in book.features if f not in named], ctx, book, text)
-
-
-def check_outweighs(a_keys: list[str], b_keys: list[str], ctx: str | None, book: FactBook, text: str) -> Claim:
-    """'A and B outweighed C': A's and B's |contributions| together against C's (in any view the sentence allows)."""
-    contexts = [c for c in views(ctx, book) if all(c in book.features[k].contribs for k in a_keys)]
-    if not contexts:
-        return Claim("rank", text, "unchecked", "nothing known to check it against (comparison)")
-    sizes = [(sum(abs(book.features[k].contribs[c]) for k in a_keys),
-              sum(abs(book.features[k].contribs.get(c, 0.0)) for k in b_keys), c) for c in contexts]
-    ok = [c for x, y, c in sizes if x > y]
-    x, y, c = sizes[0]
-    return Claim("rank", text, "verified" if ok else "contradicted",
-                 f"|{' + '.join(a_keys)}| {x:.3g} vs |{' + '.join(b_keys)}| {y:.3g} ({ok[0] if ok else c})")
-
-
-def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
-    """The views a rank or magnitude claim is checked in: the one its sentence names, else any."""
-    return (ctx,) if ctx and ctx != EITHER else book.contexts
 
 
 #: 'Among the positives, X is the largest', 'Of the factors lowering the risk, X matters most': the rank's scope
@@ -365,55 +282,4 @@ def _chain(masked: str, a: int, b: int, names: list[Mention], book: FactBook, ct
     for x, y in zip(names, names[1:]):
         if re.fullmatch(r"\s*>\s*(?:the\s+)?", masked[x.end:y.start]) and len(y.keys) == 1:
             out.append(check_comparison(x.keys, y.keys[0], 1, ctx, book, ">"))
-    return out
-
-
-def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None
-                     ) -> list[Claim]:
-    """'A mattered more than B' (and 'which in turn mattered more than C'), 'A and B both mattered more than C', 'A
-    outweighs B': A's |contribution| against B's. B must be one feature named right after 'than'; A the names since
-    the previous comparison, else the last name before the comparative (a relative 'which')."""
-    out, start = [], a
-    names = named_features(mentions)
-    for m in COMPARE_RE.finditer(masked, a, b):
-        b_name = next((x for x in names if x.start >= m.end()), None)
-        if b_name is None or len(b_name.keys) != 1 or not re.fullmatch(
-                r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?", masked[m.end():b_name.start], re.IGNORECASE):
-            continue  # 'more than $500', 'bigger than any other feature': no feature to compare with
-        subjects = [x for x in names if start <= x.start and x.end <= m.start()]
-        if not subjects:
-            subjects = [x for x in names if x.end <= m.start()][-1:]
-        way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
-        ratio = _ratio(masked[max(a, m.start() - 40):m.start()], way)
-        if ratio is not None and not m.group("out"):  # 'roughly 1.7 times as much as B', '35 % more than B'
-            out += [check_ratio(x.keys, b_name.keys[0], ratio, ctx, book, masked[m.start():m.end()].strip())
-                    for x in subjects]
-        elif m.group("out") and len(subjects) > 1 and all(len(x.keys) == 1 for x in subjects) and \
-                not re.search(r"\b(?:both|each|all|individually)\b", masked[subjects[0].start:m.start()],
-                              re.IGNORECASE):
-            out.append(check_outweighs([x.keys[0] for x in subjects], [b_name.keys[0]], ctx, book, m.group(0).strip()))
-        else:
-            for x in subjects:
-                out.append(check_comparison(x.keys, b_name.keys[0], way, ctx, book, m.group(0).strip()))
-        start = b_name.end
-    return out
-
-
-#: two numbers in brackets set side by side: '(0.88 versus 0.49)', '(8.5 against 4.4 points)', '(0.188 vs 0.097)'
-_SIDE_BY_SIDE = re.compile(r"\s*\(\s*[^()\0]{0,20}?\s+(?:vs\.?|versus|against|compared with|to)\s+[^()\0]{0,20}\)")
-
-
-def compared_pairs(masked: str, a: int, b: int, names: list[Mention], numbers) -> dict:
-    """'A mattered about twice as much as B (0.88 vs 0.49)': the bracket's first number is A's, the second B's
-    (A the comparison's subject as :func:`find_comparisons` reads it); id(number) -> mention."""
-    out = {}
-    for m in COMPARE_RE.finditer(masked, a, b):
-        b_name = next((x for x in names if x.start >= m.end()), None)
-        if b_name is None or not re.fullmatch(r"\s*(?:the\s+|its\s+|their\s+)?", masked[m.end():b_name.start]):
-            continue
-        bracket = _SIDE_BY_SIDE.match(masked, b_name.end)
-        subjects = [x for x in names if x.end <= m.start()][-1:]
-        inside = [n for n in numbers if bracket and b_name.end <= n.start and n.end <= bracket.end()]
-        if bracket and subjects and len(inside) == 2:
-            out[id(inside[0])], out[id(inside[1])] = subjects[0], b_name
     return out

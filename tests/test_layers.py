@@ -1,0 +1,33 @@
+"""The layers as documented: the core (``xairl/``) and its benchmarks import no plugin (they reach plugins through
+the registry, ``xairl.get_policy``), and the reference plugin's code and benchmarks use only what ``import xairl``
+exports, never xairl's private modules."""
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PLUGIN = ROOT / "plugins" / "xairl-uav-handover"
+
+
+def _imports(path: Path) -> set[str]:
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            out.add(node.module)
+    return out
+
+
+@pytest.mark.parametrize("path", sorted([*(ROOT / "xairl").rglob("*.py"), *(ROOT / "benchmarks").glob("*.py")]),
+                         ids=lambda p: str(p.relative_to(ROOT)))
+def test_the_core_imports_no_plugin(path):
+    assert not {m for m in _imports(path) if m.split(".")[0] == "xairl_uav_handover"}
+
+
+@pytest.mark.parametrize("path", sorted([*(PLUGIN / "xairl_uav_handover").rglob("*.py"),
+                                         *(PLUGIN / "benchmarks").glob("*.py")]),
+                         ids=lambda p: str(p.relative_to(ROOT)))
+def test_the_plugin_uses_public_names_only(path):
+    assert not {m for m in _imports(path) if m.startswith("xairl.")}
