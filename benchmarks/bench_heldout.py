@@ -29,7 +29,7 @@ import yaml
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 import xairl  # noqa: E402
-from benchmarks.bench_verifier import manipulated  # noqa: E402
+from benchmarks.bench_verifier import manipulated, one_output  # noqa: E402
 from xairl.narrators.verify import parse  # noqa: E402
 
 HELDOUT = pathlib.Path(__file__).parent / "data" / "narratives" / "heldout"
@@ -37,16 +37,10 @@ HELDOUT = pathlib.Path(__file__).parent / "data" / "narratives" / "heldout"
 
 def case_explanation(case: dict) -> xairl.Explanation:
     """A one-output Explanation from a case: [name, value, contribution] per feature (a string value is a category),
-    the base value and the prediction."""
-    names = tuple(str(f[0]) for f in case["features"])
-    cats = {str(f[0]): (str(f[1]),) for f in case["features"] if isinstance(f[1], str)}
-    states = np.array([[0.0 if isinstance(f[1], str) else float(f[1]) for f in case["features"]]])
-    values = np.array([float(f[2]) for f in case["features"]]).reshape(1, -1, 1)
-    base = float(case["base_value"])
-    return xairl.Explanation(values=values, base_values=np.array([[base]]),
-                             outputs=np.array([[base + values.sum()]]), states=states, feature_names=names,
-                             action_names=(case.get("output") or "prediction",), method="given", output="value",
-                             categories=cats or None)
+    the base value and the output's words."""
+    names, values, contributions = zip(*[(str(f[0]), f[1], float(f[2])) for f in case["features"]])
+    return one_output(list(names), list(values), list(contributions), float(case["base_value"]),
+                      case.get("output") or "prediction")
 
 
 def load(path: pathlib.Path) -> list[dict]:

@@ -141,13 +141,19 @@ def explanation_from_tuples(text: str, output: str = "prediction") -> xairl.Expl
     """A one-output Explanation from '(name, value, contribution), ...' tuples, as Explingo writes them (a value that
     is not a number is a category); no baseline is given, so it is 0."""
     tuples = re.findall(r"\(([^()]*?),\s*([^,()]+?),\s*(-?[\d.]+)\)", text)
-    names = [t[0].strip() for t in tuples]
-    raw = [t[1].strip() for t in tuples]
-    contrib = np.array([float(t[2]) for t in tuples])
-    cats = {n: (v,) for n, v in zip(names, raw) if not re.fullmatch(r"-?[\d.]+", v)}
-    states = np.array([[0.0 if n in cats else float(v) for n, v in zip(names, raw)]])
-    return xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.zeros((1, 1)),
-                             outputs=np.array([[contrib.sum()]]), states=states, feature_names=tuple(names),
+    values = [float(v) if re.fullmatch(r"-?[\d.]+", v.strip()) else v.strip() for _, v, _ in tuples]
+    return one_output([t[0].strip() for t in tuples], values, [float(t[2]) for t in tuples], output=output)
+
+
+def one_output(names: list[str], values: list, contributions: list[float], base: float = 0.0,
+               output: str = "prediction") -> xairl.Explanation:
+    """A one-output Explanation of one state: each feature's value (a str is a category's label) and contribution;
+    the prediction is the baseline plus their sum."""
+    cats = {n: (v,) for n, v in zip(names, values) if isinstance(v, str)}
+    states = np.array([[0.0 if isinstance(v, str) else float(v) for v in values]])
+    contrib = np.array(contributions, dtype=float)
+    return xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.array([[base]]),
+                             outputs=np.array([[base + contrib.sum()]]), states=states, feature_names=tuple(names),
                              action_names=(output,), method="given", output="value", categories=cats or None)
 
 

@@ -4,6 +4,7 @@ after it, a name right after it, the name before it in its clause) or a decision
 check in :mod:`.quantities`; and when a contradicted binding was only a guess."""
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import replace
 
@@ -197,10 +198,15 @@ _KEY_BASE = re.compile(r"(?:^|[\s,;|(\[{])(?:base\w*|ev|e\[f\(x\)\]|expected_val
 
 def _output_is(before: str, book: FactBook) -> bool:
     """'the forecast is 53', 'the expected claim cost stands at $2,738.60': one output's word, then its number."""
-    words = {w for a in book.scores for w in split_words(a) if len(w) >= 4} | {"forecast", "prediction", "estimate"}
-    return bool(re.search(rf"\b(?:{'|'.join(map(re.escape, sorted(words)))})\s+(?:is|was|stands at|stood at|comes out at|"
-                          rf"came out at|sits at|=|:)\s*(?:about|around|roughly|approximately|just under|just over|"
-                          rf"nearly|almost)?\s*[$€£]?$", before, re.IGNORECASE))
+    return bool(_output_words(tuple(book.scores)).search(before))
+
+
+@functools.lru_cache(maxsize=64)
+def _output_words(outputs: tuple[str, ...]) -> re.Pattern:
+    words = {w for a in outputs for w in split_words(a) if len(w) >= 4} | {"forecast", "prediction", "estimate"}
+    return re.compile(rf"\b(?:{'|'.join(map(re.escape, sorted(words)))})\s+(?:is|was|stands at|stood at|comes out at|"
+                      rf"came out at|sits at|=|:)\s*(?:about|around|roughly|approximately|just under|just over|"
+                      rf"nearly|almost)?\s*[$€£]?$", re.IGNORECASE)
 
 
 def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:

@@ -22,11 +22,8 @@ def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | N
                      text: str) -> Claim:
     """|contribution| of A against B's in the sentence's view (any view when it names none): way +1 larger, -1
     smaller, 0 about the same."""
-    contexts = views(ctx, book)
-
     def test(key):
-        pairs = [(abs(book.features[key].contribs[c]), abs(book.features[b_key].contribs[c]), c) for c in contexts
-                 if c in book.features[key].contribs and c in book.features[b_key].contribs]
+        pairs = _sizes(key, b_key, ctx, book)
         if not pairs:
             return None
         ok = [c for x, y, c in pairs if (x > y if way > 0 else x < y if way < 0 else
@@ -35,6 +32,12 @@ def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | N
         return bool(ok), f"|{key}| {x:.3g} vs |{b_key}| {y:.3g} ({ok[0] if ok else c})"
 
     return over_keys(a_keys, test, "comparison", text, "rank")
+
+
+def _sizes(a_key: str, b_key: str, ctx: str | None, book: FactBook) -> list[tuple[float, float, str]]:
+    """(|A|, |B|, view) in each view the sentence allows where both contributions are known."""
+    return [(abs(book.features[a_key].contribs[c]), abs(book.features[b_key].contribs[c]), c) for c in views(ctx, book)
+            if c in book.features[a_key].contribs and c in book.features[b_key].contribs]
 
 
 #: a multiplier before a comparative: 'roughly 1.7 times', 'nearly twice', 'three times', 'half', '35 %'
@@ -63,11 +66,8 @@ def check_ratio(a_keys: tuple[str, ...], b_key: str, ratio: float, ctx: str | No
                 text: str) -> Claim:
     """'A mattered 1.7 times as much as B': |A| / |B| within :data:`RATIO_WITHIN` of the ratio, in the sentence's
     view (any view when it names none)."""
-    contexts = views(ctx, book)
-
     def test(key):
-        pairs = [(abs(book.features[key].contribs[c]), abs(book.features[b_key].contribs[c]), c) for c in contexts
-                 if c in book.features[key].contribs and c in book.features[b_key].contribs]
+        pairs = _sizes(key, b_key, ctx, book)
         if not pairs or not ratio > 0:
             return None
         ok = [c for x, y, c in pairs if y > 0 and abs(x / y - ratio) <= RATIO_WITHIN * ratio]

@@ -145,11 +145,11 @@ def find_numbers(text: str) -> list[Number]:
         out.append(Number(m.start(), m.end(), m.group(0).strip(), -value if sign == "-" else value, unit, sign,
                           _hedge(text[:m.start()]), bool(m.group("pct")), _points(m.group("pct")),
                           m.group("cur") or "", alts))
-    for first, second in zip(out, out[1:]):  # '2-3 points', '10–12 minutes': a range, not a minus
+    for k in range(len(out) - 1):  # '2-3 points', '10–12 minutes': a range, not a minus
+        first, second = out[k], out[k + 1]
         if second.start == first.end + 1 and text[first.end] in "-–" and not second.sign and first.text[-1].isdigit():
-            out[out.index(first)] = replace(first, hedge=first.hedge or "at_least", percent=second.percent,
-                                            points=second.points)
-            out[out.index(second)] = replace(second, hedge="at_most")
+            out[k] = replace(first, hedge=first.hedge or "at_least", percent=second.percent, points=second.points)
+            out[k + 1] = replace(second, hedge="at_most")
     for m in _WORD_RE.finditer(text):
         value = _WORDS[m.group(1).lower()] + (_WORDS[m.group(2).lower()] if m.group(2) else 0)
         scale = _SCALES[m.group(3).lower()] if m.group(3) else 1
