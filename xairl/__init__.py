@@ -45,6 +45,9 @@ _LAZY = {
     "ReportRequest": "xairl.report",
     "ReportContent": "xairl.report",
     "table_html": "xairl.report",
+    # files written whole or not at all (a crash never leaves a partial file under its final name)
+    "atomic_write": "xairl.files",
+    "save_figure": "xairl.files",
     # registries
     "get_policy": "xairl.plugins",
     "get_attributor": "xairl.plugins",

@@ -14,6 +14,53 @@ from . import plugins
 from .errors import InputError, XairlError
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with its errors as one line and exit status 2 through :func:`main` (not usage text)."""
+
+    def error(self, message: str):
+        raise InputError(f"{self.prog}: {message}; see `{self.prog} --help`.")
+
+
+def _count(low: int, high: int | None = None):
+    """An argparse type: an integer in ``low..high``."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
+        if value < low or (high is not None and value > high):
+            bound = f"at least {low}" if high is None else f"between {low} and {high}"
+            raise argparse.ArgumentTypeError(f"{value} must be {bound}")
+        return value
+
+    parse.__name__ = "number"
+    return parse
+
+
+def _new_file(text: str) -> str:
+    """An argparse type: a file to write whose folder exists (an existing file is replaced)."""
+    from pathlib import Path
+
+    path = Path(text)
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is a folder; give a file name")
+    if not path.parent.is_dir():
+        raise argparse.ArgumentTypeError(f"the folder {path.parent} does not exist; create it first")
+    return text
+
+
+def _out_dir(text: str) -> str:
+    """An argparse type: a folder to write into, new or existing, whose parent exists."""
+    from pathlib import Path
+
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is a file, not a folder; give a folder for the report")
+    if not path.exists() and not path.parent.is_dir():
+        raise argparse.ArgumentTypeError(f"the folder {path.parent} does not exist; create it first")
+    return text
+
+
 def _parse_options(pairs: Sequence[str]) -> dict:
     """``["n_steps=32", "method=riemann_left"]`` -> dict; values are read as JSON when they parse, else as text."""
     opts: dict = {}
@@ -22,8 +69,8 @@ def _parse_options(pairs: Sequence[str]) -> dict:
         if not sep or not key.strip():
             raise InputError(f"option '{pair}' is not key=value; write e.g. -o n_steps=32.")
         try:
-            opts[key.strip()] = json.loads(raw)
-        except ValueError:
+            opts[key.strip()] = json.loads(raw, parse_constant=lambda c: c)  # NaN/Infinity stay text: refused later
+        except (ValueError, RecursionError):
             opts[key.strip()] = raw
     return opts
 
@@ -71,8 +118,6 @@ def cmd_report(args) -> int:
     from .report import ReportRequest, write_report
 
     report = plugins.registry("report").load(args.plugin)(_parse_options(args.option))
-    if args.n < 1:
-        raise InputError("--n must be at least 1 state per dataset.")
     method_options = plugins.get_attributor(args.method)(_parse_options(args.method_option)).options.model_dump()
     req = ReportRequest(out=Path(args.out), method=args.method, options=method_options, narrate=args.narrate,
                         narrator=args.narrator, narrator_options=_parse_options(args.narrator_option),
@@ -97,7 +142,7 @@ def cmd_explain(args) -> int:
         states = read_states(args.states, policy.feature_names, policy.observation)
     else:
         states = policy.background(args.n, seed=args.seed + 1)
-    bg = read_states(args.background, policy.feature_names, policy.observation) if args.background else \
+    bg = read_states(args.background, policy.feature_names, policy.observation, "background") if args.background else \
         policy.background(args.background_size, seed=args.seed)
     exp = explain(policy, states, background=bg, method=args.method, options=options.model_dump())
     if args.out:
@@ -211,13 +256,19 @@ def cmd_verify(args) -> int:
 
     text = args.text if args.text != "-" else sys.stdin.read()
     try:
-        raw = open(args.explanation, encoding="utf-8").read()
+        with open(args.explanation, "rb") as fh:
+            raw = fh.read()
     except OSError as exc:
         raise InputError(f"cannot read --explanation {args.explanation}: {exc.strerror}; give the JSON that "
                          f"Explanation.to_json() writes.") from None
-    exp = Explanation.from_json(raw)
-    if not 0 <= args.index < exp.values.shape[0]:
-        raise InputError(f"--index {args.index} is outside the explanation's {exp.values.shape[0]} state(s).")
+    try:
+        exp = Explanation.from_json(raw)
+    except InputError as exc:
+        raise InputError(f"--explanation {args.explanation}: {exc}") from None
+    try:
+        exp.check_index(args.index)
+    except InputError as exc:
+        raise InputError(f"--index {args.index}: {exc}") from None
     result = verify(text, exp, args.index)
     for sentence in result.sentences:
         print(f"[{sentence.status}] {sentence.text}")
@@ -238,7 +289,9 @@ def cmd_review(args) -> int:
         serve(store, args.port)
         return 0
     if args.export:
-        with open(args.export, "w") as fh:
+        from .files import atomic_write
+
+        with atomic_write(args.export) as fh:
             n = store.export_corrections(fh)
         print(f"wrote {n} correction(s) to {args.export}")
         return 0
@@ -285,7 +338,7 @@ def _narration_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="xairl", description="Explain what a reinforcement-learning policy decided "
+    parser = _Parser(prog="xairl", description="Explain what a reinforcement-learning policy decided "
                                      "and why.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     p = sub.add_parser("plugins", help="list installed plugins and what each registers")
@@ -305,15 +358,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("text", help="the text to check, or - to read it from standard input")
     p.add_argument("--explanation", required=True, metavar="FILE", help="the explanation, as Explanation.to_json() "
                    "writes it")
-    p.add_argument("--index", type=int, default=0, help="which state of the explanation the text is about")
+    p.add_argument("--index", type=_count(0), default=0, help="which state of the explanation the text is about")
     p.add_argument("--trace", action="store_true", help="every claim: status, kind, words, rule, reason")
     p.set_defaults(run=cmd_verify)
     p = sub.add_parser("review", help="accept, reject or correct recorded narratives in the terminal, or in a local "
                        "web page with the evidence (--serve)")
-    p.add_argument("--db", default=None, help="feedback store (default: in the user dir)")
+    p.add_argument("--db", type=_new_file, default=None, help="feedback store (default: in the user dir)")
     p.add_argument("--serve", action="store_true", help="serve the review page on http://127.0.0.1:PORT/")
-    p.add_argument("--port", type=int, default=8765, help="port of the review page (default 8765)")
-    p.add_argument("--export", metavar="FILE", help="write the corrections as JSON lines instead of reviewing")
+    p.add_argument("--port", type=_count(0, 65535), default=8765, help="port of the review page (default 8765; 0: "
+                   "any free port)")
+    p.add_argument("--export", type=_new_file, metavar="FILE", help="write the corrections as JSON lines instead of reviewing")
     p.set_defaults(run=cmd_review)
     commands = plugins.registry("command")
     for name in commands.names():
@@ -328,22 +382,22 @@ def _explain_parser(p: argparse.ArgumentParser) -> None:
                    "returning one); default: toy")
     p.add_argument("--policy-arg", action="append", default=[], metavar="KEY=VALUE",
                    help="argument of a module:attr policy function, e.g. --policy-arg checkpoint=my_q.pt")
-    p.add_argument("--out", default=None, metavar="DIR",
+    p.add_argument("--out", type=_out_dir, default=None, metavar="DIR",
                    help="write explanations.jsonl, figures and report.html into DIR instead of printing")
     p.add_argument("--states", help="states to explain: .csv with a header naming the features, .npy "
                    "(n, *obs_shape), .npz (dict observations) or .json; "
                    "default: --n states from the policy's sampler")
     p.add_argument("--background", help="background states file (default: the policy's sampler)")
-    p.add_argument("--background-size", type=int, default=100, help="background states drawn from the sampler")
-    p.add_argument("--n", type=int, default=5, help="states to sample when --states is not given")
-    p.add_argument("--seed", type=int, default=0, help="seed of the sampled states and background")
+    p.add_argument("--background-size", type=_count(1, 1_000_000), default=100, help="background states drawn from the sampler")
+    p.add_argument("--n", type=_count(1, 10_000_000), default=5, help="states to sample when --states is not given")
+    p.add_argument("--seed", type=_count(0, 2 ** 32 - 1), default=0, help="seed of the sampled states and background")
     p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
     p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",
                    help="an option of the method, validated against its schema; repeatable")
     p.add_argument("--format", choices=("table", "jsonl"), default="table", help="output format")
-    p.add_argument("--top", type=int, default=5, help="features shown per state in the table")
+    p.add_argument("--top", type=_count(1), default=5, help="features shown per state in the table")
     _narration_arguments(p)
-    p.add_argument("--feedback-db", default=None, help="SQLite store of shown narratives (default: in the user dir)")
+    p.add_argument("--feedback-db", type=_new_file, default=None, help="SQLite store of shown narratives (default: in the user dir)")
     p.add_argument("--no-record", action="store_true", help="do not record the narratives for review")
     p.add_argument("--examples-from-feedback", action="store_true",
                    help="give the local LM the operators' latest accepted or corrected narratives as examples")
@@ -354,9 +408,9 @@ def _report_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--plugin", required=True, help="the report's name (see `xairl plugins`), e.g. uav-handover")
     p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",
                    help="an option of the plugin's report, validated against its schema (e.g. -o real=PATH)")
-    p.add_argument("--out", default="xairl-report", help="report folder (default xairl-report)")
-    p.add_argument("--n", type=int, default=500, help="states explained per dataset")
-    p.add_argument("--seed", type=int, default=0, help="seed of everything the report samples")
+    p.add_argument("--out", type=_out_dir, default="xairl-report", help="report folder (default xairl-report)")
+    p.add_argument("--n", type=_count(1, 1_000_000), default=500, help="states explained per dataset")
+    p.add_argument("--seed", type=_count(0, 2 ** 32 - 1), default=0, help="seed of everything the report samples")
     p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
     p.add_argument("-m", "--method-option", action="append", default=[], metavar="KEY=VALUE",
                    help="an option of the attribution method; repeatable")

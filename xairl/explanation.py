@@ -1,13 +1,14 @@
 """Explanation: the one result type of every attributor, shaped (states, features, actions)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
-from typing import Any, Mapping, Sequence
+import json
+from dataclasses import MISSING, dataclass, field, fields, replace
+from typing import Any, Mapping, Sequence, get_type_hints
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
-from .errors import InputError
+from .errors import InputError, validation_message
 
 
 @dataclass(frozen=True)
@@ -64,6 +65,12 @@ class Explanation:
             raise InputError(f"Explanation.states has shape {self.states.shape}, expected {(n, f)}.")
         if len(self.feature_names) != f or len(self.action_names) != a:
             raise InputError("Explanation names do not match the values' shape.")
+        for name in ("values", "base_values", "outputs", "states", "background_quantiles"):
+            arr = getattr(self, name)
+            if arr is not None and not np.isfinite(arr).all():
+                raise InputError(f"Explanation.{name} holds NaN or infinity ({int((~np.isfinite(arr)).sum())} "
+                                 "value(s)): the network's outputs or contributions overflowed; nothing here can be "
+                                 "trusted. Check the states' scale (a float32 network overflows beyond ~1e38).")
         for arr in (self.values, self.base_values, self.outputs, self.available):
             if arr is not None:
                 arr.setflags(write=False)
@@ -71,6 +78,15 @@ class Explanation:
     @property
     def shape(self) -> tuple[int, int, int]:
         return self.values.shape
+
+    def check_index(self, index) -> int:
+        """``index`` as the position of one explained state; a one-line :class:`InputError` for anything else (a
+        float, a string, a bool, a position outside the states)."""
+        if isinstance(index, bool) or not isinstance(index, (int, np.integer)):
+            raise InputError(f"a state index is a whole number, not {type(index).__name__} {str(index)[:40]!r}.")
+        if not 0 <= index < len(self.values):
+            raise InputError(f"index {index} is out of range: the explanation has {len(self.values)} state(s).")
+        return int(index)
 
     def _ranked(self) -> np.ndarray:
         """Actions per state, best available first (unavailable ones last)."""
@@ -233,72 +249,95 @@ class Explanation:
         return out
 
     def to_json(self) -> str:
-        """JSON text (see :class:`ExplanationRecord` for the schema)."""
-        return ExplanationRecord.from_explanation(self).model_dump_json()
+        """JSON text: each field of this class under its own name, arrays as nested lists (:func:`from_json` reads
+        it back)."""
+        data = {f.name: _plain(getattr(self, f.name)) for f in fields(self)}
+        try:
+            return json.dumps(data, allow_nan=False)
+        except (TypeError, ValueError) as exc:  # options or extras a plugin filled with something JSON cannot hold
+            raise InputError(f"this explanation cannot be written as JSON ({exc}); keep its options and extras to "
+                             "numbers, text, lists and dicts.") from None
 
     @classmethod
-    def from_json(cls, text: str) -> "Explanation":
-        return ExplanationRecord.model_validate_json(text).to_explanation()
+    def from_json(cls, text: str | bytes) -> "Explanation":
+        """The explanation :meth:`to_json` wrote; raises :class:`InputError` with a one-line reason on anything
+        else (not JSON, NaN or infinity, nesting too deep, wrong fields, shapes that disagree)."""
+        def refuse(constant):
+            raise ValueError(f"{constant} is not a finite number")
+
+        def finite(literal):
+            value = float(literal)
+            return value if np.isfinite(value) else refuse(literal[:20])
+
+        try:
+            data = json.loads(text, parse_constant=refuse, parse_float=finite)
+        except RecursionError:
+            raise InputError("the explanation's JSON is nested too deeply; give the JSON that Explanation.to_json() "
+                             "writes.") from None
+        except (ValueError, TypeError) as exc:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
+            raise InputError(f"the explanation is not valid JSON ({' '.join(str(exc).split())[:120]}); give the "
+                             "JSON that Explanation.to_json() writes.") from None
+        try:
+            record = dict(_JSON_FORM.model_validate(data))
+        except ValidationError as exc:
+            raise InputError(f"the explanation's JSON does not match Explanation.to_json(): "
+                             f"{validation_message(exc, 'explanation')}") from None
+        except RecursionError:
+            raise InputError("the explanation's JSON is nested too deeply.") from None
+        try:
+            return cls(**{k: _ARRAY_FIELDS[k][1](v) if k in _ARRAY_FIELDS and v is not None else v
+                          for k, v in record.items()})
+        except (ValueError, OverflowError) as exc:  # ragged lists, numbers beyond float64
+            raise InputError(f"the explanation's arrays cannot be read ({' '.join(str(exc).split())[:120]}).") from None
 
 
-class ExplanationRecord(BaseModel):
-    """The JSON form of an :class:`Explanation` (nested lists, names, method and options)."""
+def _plain(value):
+    """A field's value as JSON-ready Python: arrays as nested lists, mappings as dicts, tuples as lists."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (tuple, list)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
 
-    model_config = ConfigDict(extra="forbid")
 
-    values: list[list[list[float]]]
-    base_values: list[list[float]]
-    outputs: list[list[float]]
-    states: list[list[float]] | None
-    feature_names: list[str]
-    action_names: list[str]
-    method: str
-    options: dict[str, Any] = {}
-    extras: dict[str, Any] = {}
-    background_quantiles: list[list[float]] | None = None
-    available: list[list[bool]] | None = None
-    output: str = "actions"
-    observation: dict[str, Any] | None = None
-    categories: dict[str, list[str]] | None = None
+def _floats(v) -> np.ndarray:
+    return np.asarray(v, dtype=np.float64)
 
-    @classmethod
-    def from_explanation(cls, e: Explanation) -> "ExplanationRecord":
-        return cls(
-            values=e.values.tolist(),
-            base_values=e.base_values.tolist(),
-            outputs=e.outputs.tolist(),
-            states=None if e.states is None else e.states.tolist(),
-            feature_names=list(e.feature_names),
-            action_names=list(e.action_names),
-            method=e.method,
-            options=dict(e.options),
-            extras={k: np.asarray(v).tolist() for k, v in e.extras.items()},
-            background_quantiles=None if e.background_quantiles is None else e.background_quantiles.tolist(),
-            available=None if e.available is None else e.available.tolist(),
-            output=e.output,
-            observation=None if e.observation is None else dict(e.observation),
-            categories=None if not e.categories else {k: list(v) for k, v in e.categories.items()},
-        )
 
-    def to_explanation(self) -> Explanation:
-        return Explanation(
-            values=np.asarray(self.values, dtype=np.float64).reshape(
-                len(self.outputs), len(self.feature_names), len(self.action_names)
-            ),
-            base_values=np.asarray(self.base_values, dtype=np.float64),
-            outputs=np.asarray(self.outputs, dtype=np.float64),
-            states=None if self.states is None else np.asarray(self.states, dtype=np.float64),
-            feature_names=tuple(self.feature_names),
-            action_names=tuple(self.action_names),
-            method=self.method,
-            options=self.options,
-            extras={k: np.asarray(v) for k, v in self.extras.items()},
-            background_quantiles=None if self.background_quantiles is None else np.asarray(self.background_quantiles),
-            available=None if self.available is None else np.asarray(self.available, dtype=bool),
-            output=self.output,
-            observation=self.observation,
-            categories=self.categories,
-        )
+def _array_field(ndim: int, item=float):
+    """The JSON type of an array field (nested lists ``ndim`` deep) and how it becomes an array again."""
+    kind = item
+    for _ in range(ndim):
+        kind = list[kind]
+    return kind, (_floats if item is float else lambda v: np.asarray(v, dtype=bool))
+
+
+#: the array fields of :class:`Explanation` (all others are JSON as they are); the schema itself is the dataclass
+_ARRAY_FIELDS = {"values": _array_field(3), "base_values": _array_field(2), "outputs": _array_field(2),
+                 "states": _array_field(2), "background_quantiles": _array_field(2),
+                 "available": _array_field(2, bool)}
+
+
+def _json_form() -> type[BaseModel]:
+    """A validator of the JSON form, generated from the dataclass's own fields (names, types and defaults)."""
+    hints = get_type_hints(Explanation)
+    spec = {}
+    for f in fields(Explanation):
+        kind = hints[f.name]
+        if f.name in _ARRAY_FIELDS:
+            kind = _ARRAY_FIELDS[f.name][0] if f.name in ("values", "base_values", "outputs") else \
+                _ARRAY_FIELDS[f.name][0] | None
+        default = ... if f.default is MISSING and f.default_factory is MISSING else \
+            Field(default_factory=f.default_factory) if f.default_factory is not MISSING else f.default
+        spec[f.name] = (kind, default)
+    return create_model("ExplanationJSON", __config__=ConfigDict(extra="forbid"), **spec)
+
+
+_JSON_FORM = _json_form()
 
 
 class StateRecord(BaseModel):

@@ -64,7 +64,13 @@ class FeedbackStore:
 
     def __init__(self, path: str | Path | None = None):
         self.path = Path(path) if path else user_dir() / "feedback.sqlite"
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        if path is None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        elif not self.path.parent.is_dir():
+            raise InputError(f"{self.path}: the folder {self.path.parent} does not exist; create it or pass another "
+                             "path.")
+        if self.path.is_dir():
+            raise InputError(f"{self.path} is a folder; pass a file path for the feedback store.")
         try:
             with self._tx() as db:
                 db.execute(SCHEMA)

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import csv
 import json
+import os
+import zipfile
 from pathlib import Path
 from typing import Sequence
 
@@ -22,8 +24,16 @@ def as_states(data, n_features: int, what: str = "states") -> np.ndarray:
     return Observation.flat(n_features).flatten(data, what)
 
 
-def read_states(path: str | Path, feature_names: Sequence[str], observation: Observation | None = None
-                ) -> np.ndarray:
+#: the most memory a states file may take once read (as float64), unless $XAIRL_MAX_STATES_BYTES says otherwise:
+#: checked from the file's header before anything is loaded, so a small file that expands enormously is refused
+MAX_STATES_BYTES = 2 * 1024 ** 3
+#: CSV and JSON files are parsed into Python objects first (~10x their size): larger ones should be .npy
+MAX_TEXT_BYTES = 256 * 1024 ** 2
+LIMIT_ENV = "XAIRL_MAX_STATES_BYTES"
+
+
+def read_states(path: str | Path, feature_names: Sequence[str], observation: Observation | None = None,
+                what: str = "states") -> np.ndarray:
     """Read states from .npy (any shape the observation takes), .npz (one array per key of a dict observation, or
     ``arr_0, arr_1, ...`` for several inputs), .csv (header row naming the features, any order) or .json (list of
     rows or of objects).
@@ -31,46 +41,97 @@ def read_states(path: str | Path, feature_names: Sequence[str], observation: Obs
     :param path: file to read.
     :param feature_names: the policy's features; CSV/JSON objects are reordered to match them.
     :param observation: the policy's observation (default: flat with these features).
+    :param what: what the file holds, in messages ("states", "background").
     """
     observation = observation or Observation.flat(len(feature_names))
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"{path}: no such file; give a .csv, .npy or .json file of states.")
+        raise InputError(f"{path}: no such file; give a .csv, .npy or .json file of {what}.")
     suffix = path.suffix.lower()
     try:
         if suffix == ".npy":
-            data = np.load(path, allow_pickle=False)
+            data = _load_npy(path)
         elif suffix == ".npz":
-            with np.load(path, allow_pickle=False) as z:
-                data = {k: z[k] for k in z.files}
+            data = _load_npz(path)
             if observation.kind == "tuple":
                 data = [data.get(f"arr_{i}") for i in range(len(observation.parts))]
                 if any(d is None for d in data):
                     raise InputError(f"the policy takes {len(observation.parts)} inputs; save them with "
                                      "np.savez(path, x0, x1, ...).")
-        elif suffix == ".csv":
-            data = _read_csv(path, feature_names)
-        elif suffix == ".json":
-            data = _read_json(path, feature_names)
+        elif suffix in (".csv", ".json"):
+            if path.stat().st_size > MAX_TEXT_BYTES:
+                raise InputError(f"a {suffix} file of {path.stat().st_size / 1024 ** 2:.0f} MB is too large to parse "
+                                 f"(limit {MAX_TEXT_BYTES // 1024 ** 2} MB); save the {what} as .npy instead.")
+            data = _read_csv(path, feature_names) if suffix == ".csv" else _read_json(path, feature_names)
         else:
             raise InputError(f"{path}: unknown file type '{suffix}'; use .csv, .npy, .npz or .json.")
     except InputError as exc:
         msg = str(exc)
         raise InputError(msg if msg.startswith(str(path)) else f"{path}: {msg}") from None
-    except (ValueError, OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot read it ({exc}).") from None
+    except RecursionError:
+        raise InputError(f"{path}: nested too deeply to hold {what}; give rows of numbers.") from None
+    except (ValueError, OSError, UnicodeDecodeError, EOFError, zipfile.BadZipFile) as exc:
+        raise InputError(f"{path}: cannot read it ({' '.join(str(exc).split())[:160]}).") from None
     try:
-        return observation.flatten(data)
+        return observation.flatten(data, what)
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
 
 
+def _limit() -> int:
+    raw = os.environ.get(LIMIT_ENV, "")
+    return int(raw) if raw.isdigit() else MAX_STATES_BYTES
+
+
+def _check_size(shape: tuple[int, ...], name: str = "") -> None:
+    """Refuse an array whose header promises more than the memory limit, before it is loaded."""
+    need = 8 * int(np.prod(shape, dtype=object))  # as float64, which every state becomes
+    if need > _limit():
+        where = f" '{name}'" if name else ""
+        raise InputError(f"the array{where} has shape {shape} and would take {need / 1024 ** 3:.3g} GiB in memory, "
+                         f"more than the {_limit() / 1024 ** 3:.3g} GiB limit; explain it in parts, or raise the limit "
+                         f"with ${LIMIT_ENV}=BYTES.")
+
+
+def _header(fh, name: str = "") -> tuple[tuple[int, ...], np.dtype]:
+    """Shape and dtype from a .npy header, refused when the array would exceed the memory limit."""
+    version = np.lib.format.read_magic(fh)
+    shape, _, dtype = (np.lib.format.read_array_header_1_0(fh) if version == (1, 0) else
+                       np.lib.format.read_array_header_2_0(fh))
+    _check_size(shape, name)
+    return shape, dtype
+
+
+def _load_npy(path: Path) -> np.ndarray:
+    with path.open("rb") as fh:
+        shape, dtype = _header(fh)
+        start = fh.tell()
+    promised = int(np.prod(shape, dtype=object)) * dtype.itemsize
+    if not dtype.hasobject and path.stat().st_size - start < promised:
+        raise InputError(f"its header promises an array of shape {shape} ({promised} bytes) but the file holds "
+                         f"{path.stat().st_size - start}; it is truncated: save it again.")
+    return np.load(path, allow_pickle=False)
+
+
+def _load_npz(path: Path) -> dict[str, np.ndarray]:
+    """Each array's header is read from the zip before any array is expanded (a small file may hold gigabytes)."""
+    with zipfile.ZipFile(path) as z:
+        for info in z.infolist():
+            with z.open(info) as fh:
+                _header(fh, info.filename.removesuffix(".npy"))
+    with np.load(path, allow_pickle=False) as z:
+        return {k: z[k] for k in z.files}
+
+
 def _read_csv(path: Path, feature_names: Sequence[str]) -> np.ndarray:
-    with path.open(newline="") as fh:
+    with path.open(newline="", encoding="utf-8-sig") as fh:  # -sig: a byte-order mark is not part of the header
         rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
     if not rows:
         raise InputError("the CSV file is empty; it needs a header row and at least one row of states.")
     header = [h.strip() for h in rows[0]]
+    twice = sorted({h for h in header if h in feature_names and header.count(h) > 1})
+    if twice:
+        raise InputError(f"column(s) {', '.join(twice)} appear more than once in the header; keep one of each.")
     missing = [f for f in feature_names if f not in header]
     if missing:
         raise InputError(
@@ -91,7 +152,7 @@ def _read_csv(path: Path, feature_names: Sequence[str]) -> np.ndarray:
 
 
 def _read_json(path: Path, feature_names: Sequence[str]):
-    data = json.loads(path.read_text())
+    data = json.loads(path.read_text(encoding="utf-8-sig"))
     if isinstance(data, dict) and "states" in data:
         data = data["states"]
     if isinstance(data, list) and data and all(isinstance(r, dict) for r in data):

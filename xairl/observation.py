@@ -222,9 +222,20 @@ def _numeric(data, what: str) -> np.ndarray:
     if hasattr(data, "detach"):  # a torch tensor, without importing torch here
         data = data.detach().cpu().numpy()
     try:
-        return np.asarray(data, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{what} must be numeric; could not convert ({exc}).") from None
+        arr = np.asarray(data)
+        if arr.dtype.kind in _REFUSED_KINDS:  # numpy would drop the imaginary part or count nanoseconds
+            raise InputError(f"{what} hold {_REFUSED_KINDS[arr.dtype.kind]} ({arr.dtype}); give real numbers "
+                             "(float or int), converting the column yourself if that is meant.")
+        return arr.astype(np.float64)
+    except (TypeError, ValueError, OverflowError) as exc:
+        if isinstance(exc, InputError):
+            raise
+        raise InputError(f"{what} must be numeric; could not convert ({' '.join(str(exc).split())[:120]}).") from None
+    except RecursionError:
+        raise InputError(f"{what} are nested too deeply to be states.") from None
+
+
+_REFUSED_KINDS = {"c": "complex numbers", "M": "dates", "m": "time spans"}
 
 
 def _finite(arr: np.ndarray, what: str) -> np.ndarray:

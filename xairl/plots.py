@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from .explanation import Explanation
+from .files import save_figure
 
 
 def _plt():
@@ -57,7 +58,7 @@ def images(exp: Explanation, index: int, path: Path) -> Path:
     for ax in axes:
         ax.axis("off")
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path, dpi=90)
     plt.close(fig)
     return path
 
@@ -103,7 +104,7 @@ def beeswarms(panels: list[tuple[str, Explanation]], path: Path, order: np.ndarr
         bar.ax.set_yticklabels(["low", "high"])
         bar.set_label("feature value")
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path, dpi=90)
     plt.close(fig)
     return path
 
@@ -134,7 +135,7 @@ def waterfall(exp: Explanation, index: int, path: Path, title: str = "", shown: 
     if title:
         ax.set_title(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path, dpi=90)
     plt.close(fig)
     return path
 
@@ -154,6 +155,6 @@ def importance_bars(panels: list[tuple[str, Explanation]], path: Path) -> Path:
     ax.set_xlabel("mean |contribution to the chosen action's Q-value|")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path, dpi=90)
     plt.close(fig)
     return path

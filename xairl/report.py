@@ -18,6 +18,7 @@ import numpy as np
 
 from .evidence import CARD_STYLE, card_html, evidence
 from .explanation import Explanation, StateRecord
+from .files import atomic_write, write_text
 from .options import Options, parse_options
 from .policy import Policy
 
@@ -144,16 +145,17 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     t0 = time.time()
     out = Path(req.out)
     out.mkdir(parents=True, exist_ok=True)
+    (out / "report.html").unlink(missing_ok=True)  # a failed re-run must not leave the last run's report beside it
     exps: list[tuple[str, Explanation]] = []
     explained = explained or {}
     for label, states in tqdm(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress):
         exps.append((label, explained.get(label) or explain(content.policy, states, background=content.background,
                                                             method=req.method, options=req.options)))
-    with open(out / "explanations.jsonl", "w") as fh:
+    with atomic_write(out / "explanations.jsonl") as fh:
         for label, exp in exps:
             for rec in exp.records(dataset=label):
                 fh.write(rec.model_dump_json() + "\n")
-    (out / "explanations.schema.json").write_text(json.dumps(StateRecord.model_json_schema(), indent=2))
+    write_text(out / "explanations.schema.json", json.dumps(StateRecord.model_json_schema(), indent=2))
     ref_label, ref = exps[0]
     pick = _interesting(ref)
     # images and dicts are plotted by patch / by key (thousands of pixels are no beeswarm); the image plot shows
@@ -181,7 +183,7 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
                 "background states": len(content.background), "seconds to explain, plot and narrate": round(time.time() - t0, 1),
                 **content.settings}
     path = out / "report.html"
-    path.write_text(_html(content.title, tables, notes, exps, figures, narratives, settings))
+    write_text(path, _html(content.title, tables, notes, exps, figures, narratives, settings))
     return path
 
 

@@ -46,6 +46,11 @@ class Attributor:
         x = policy.check_states(states)
         bg = policy.background() if background is None else policy.check_states(background, "background")
         outputs = policy.scores(x)
+        bad = ~np.isfinite(outputs).all(axis=1)
+        if bad.any():
+            raise InputError(f"the policy's outputs are NaN or infinite for {int(bad.sum())} state(s), first state "
+                             f"{int(np.argmax(bad))}: nothing can be explained; check the states' scale (a float32 "
+                             "network overflows on inputs near 1e38).")
         module = policy.network
         was_training = policy.module.training  # the user's flag; the wrapper's own means nothing
         module.eval()
@@ -87,7 +92,7 @@ class Attributor:
             # float32 rounding is absolute below 1: the scale does not fall under it
             scale, what = max(float(np.abs(outputs).max()), float(np.abs(base).max()), 1.0), "the output scale"
         scale = max(scale, 1e-6)
-        if gap > self.tolerance * scale:
+        if not gap <= self.tolerance * scale:  # NaN is refused too
             raise UnsupportedModelError(
                 f"{self.name} contributions do not add up to the output (gap {gap:.3g}, {what} {scale:.3g}, "
                 f"tolerance {self.tolerance:g} of it): {self.gap_reason}; otherwise {alternatives(policy, self.name)}")

@@ -11,7 +11,7 @@ from .base import Attributor, Options
 
 
 class IntegratedGradientsOptions(Options):
-    n_steps: int = Field(64, ge=2, description="points on the path from baseline to state")
+    n_steps: int = Field(64, ge=2, le=100_000, description="points on the path from baseline to state")
     method: Literal["gausslegendre", "riemann_trapezoid", "riemann_middle", "riemann_left", "riemann_right"] = Field(
         "gausslegendre", description="integral approximation")
     baseline: Literal["mean", "zeros"] = Field("mean", description="background mean, or the all-zero state")

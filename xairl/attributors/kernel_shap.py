@@ -1,7 +1,7 @@
 """KernelSHAP through shap.KernelExplainer: model-agnostic, sampled coalitions, seeded."""
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 import torch
@@ -11,9 +11,11 @@ from .base import Attributor, Options
 
 
 class KernelShapOptions(Options):
-    nsamples: int | Literal["auto"] = Field("auto", description="coalitions evaluated per state; 'auto' = 2F + 2048")
-    l1_reg: bool | float | str = Field(False, description="shap's feature selection; False keeps every feature")
-    seed: int = Field(0, description="seed of the coalition sampler")
+    nsamples: Annotated[int, Field(ge=1, le=10_000_000)] | Literal["auto"] = Field(
+        "auto", description="coalitions evaluated per state; 'auto' = 2F + 2048")
+    l1_reg: bool | float | Literal["auto", "aic", "bic"] | Annotated[str, Field(pattern=r"^num_features\(\d+\)$")] = \
+        Field(False, description="shap's feature selection; False keeps every feature")
+    seed: int = Field(0, ge=0, le=2 ** 32 - 1, description="seed of the coalition sampler")
 
 
 class KernelShap(Attributor):

@@ -78,6 +78,7 @@ class Narrator:
         """
         from .. import prompts
 
+        index = None if index is None else explanation.check_index(index)
         default = "global_summary" if index is None else \
             "explain_action" if explanation.output == "actions" else "explain_output"
         tpl = prompts.load(template or default, prompt_dirs)

@@ -197,8 +197,9 @@ def unit_ranks(contrib: np.ndarray, reasons: np.ndarray) -> tuple[np.ndarray, np
     for sgn in (1, -1):
         for r, j in enumerate([j for j in order if np.sign(contrib[j]) == sgn], 1):
             signed[j] = r
-    total = float(np.abs(contrib).sum()) or 1.0
-    return rank, signed, 100 * np.abs(contrib) / total
+    size = np.abs(contrib)
+    size = size / (size.max() or 1.0)  # scaled first: a sum of contributions near 1e308 would overflow
+    return rank, signed, 100 * size / (float(size.sum()) or 1.0)
 
 
 def level(value: float, info: FeatureInfo, quartiles: tuple[float, float] | None) -> tuple[str, str]:
@@ -260,9 +261,7 @@ def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = Non
     """Facts about state ``index``: the action, runner-up, Q-gap, top-``k`` reasons for the chosen action's score,
     for the margin against the runner-up, the reasons that favour the decision and its strongest concession, the
     identifiers as context, and the policy plugin's own facts (given ``history``, the episode's earlier states)."""
-    n = len(exp.values)
-    if not 0 <= index < n:
-        raise InputError(f"index {index} is out of range: the explanation has {n} state(s).")
+    index = exp.check_index(index)
     if exp.states is None:
         raise InputError("this explanation has no states (it was grouped); narrate the ungrouped explanation.")
     if exp.output != "actions" and exp.values.shape[2] != 1:

@@ -94,11 +94,12 @@ def load_model(spec: str | None = None):
         raise InputError(f"{path}: not a transformers model folder (no config.json) nor a .gguf file.")
     from transformers import AutoModelForCausalLM, AutoTokenizer
 
-    try:
+    try:  # safetensors only: pickled weights (pytorch_model.bin) can run code when loaded
         tok = AutoTokenizer.from_pretrained(str(folder), local_files_only=True)
-        model = AutoModelForCausalLM.from_pretrained(str(folder), local_files_only=True).eval()
-    except (OSError, ValueError) as exc:
-        raise InputError(f"{folder}: cannot load the model ({exc}).") from None
+        model = AutoModelForCausalLM.from_pretrained(str(folder), local_files_only=True, use_safetensors=True).eval()
+    except Exception as exc:  # transformers raises many kinds on a broken or foreign folder
+        raise InputError(f"{folder}: cannot load the model ({' '.join(str(exc).split())[:200]}); give a folder with "
+                         "config.json and .safetensors weights, or a .gguf file.") from None
     if tok.pad_token is None:
         tok.pad_token = tok.eos_token
     _LOADED[key] = (model, tok)

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from xairl import Comparison, DomainFacts, Explanation, Policy, decision_facts, verify
+from xairl import Comparison, DomainFacts, Explanation, Policy, decision_facts, save_figure, verify
 from xairl import format_number as fmt
 from xairl import narration_units as units
 
@@ -181,6 +181,6 @@ def timeline_figure(tl: FlightTimeline, exp: Explanation, policy: Policy, path: 
     ax[0].set_title(tl.label, fontsize=10)
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=80)
+    save_figure(fig, path, dpi=80)
     plt.close(fig)
     return path

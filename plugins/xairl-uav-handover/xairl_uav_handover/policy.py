@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from xairl import CheckpointError, Policy
+from xairl import CheckpointError, Policy, atomic_write
 
 from .config import SimConfig
 from .env import HandoverVecEnv
@@ -40,10 +40,12 @@ def build_qnet(mean: np.ndarray, std: np.ndarray, hidden=(64, 64)) -> torch.nn.S
 
 
 def save_checkpoint(net: torch.nn.Module, path: str | Path, meta: dict) -> None:
-    from safetensors.torch import save_file
+    from safetensors.torch import save
 
-    save_file({k: v.detach().cpu().contiguous() for k, v in net.state_dict().items()}, str(path),
-              metadata={"xairl": json.dumps(meta)})
+    data = save({k: v.detach().cpu().contiguous() for k, v in net.state_dict().items()},
+                metadata={"xairl": json.dumps(meta)})
+    with atomic_write(path, "wb") as fh:  # a killed training run never leaves half a checkpoint
+        fh.write(data)
 
 
 @dataclass(frozen=True)
@@ -71,7 +73,9 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
         tensors = load_file(str(path))
     except (SafetensorError, OSError, ValueError) as exc:
         raise CheckpointError(f"{path}: not a readable safetensors checkpoint ({exc}); re-train or re-download it.")
-    hidden = tuple(meta.get("hidden", (64, 64)))
+    if not isinstance(meta, dict):
+        raise CheckpointError(f"{path}: its metadata is not a JSON object; re-train or re-download it.")
+    hidden = _hidden_widths(path, meta, tensors)
     f = len(FEATURES)
     net = build_qnet(np.zeros(f), np.ones(f), hidden)
     try:
@@ -84,6 +88,23 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
     except ValueError as exc:
         raise CheckpointError(f"{path}: its simulator settings are invalid ({str(exc).splitlines()[0]}).") from None
     return Checkpoint(path, net.eval(), meta, config)
+
+
+def _hidden_widths(path: Path, meta: dict, tensors: dict) -> tuple[int, ...]:
+    """The hidden widths the metadata states, checked against the tensors before anything is built (a 200-byte
+    file could otherwise ask for a network of 40 GB)."""
+    stated = meta.get("hidden", [64, 64])
+    # the weights of Linear layers 1, 3, 5, ... (layer 0 is the frozen normalisation), as build_qnet numbers them
+    try:
+        weights = sorted((k for k in tensors if k.endswith(".weight")), key=lambda k: int(k.split(".")[0]))
+        widths = tuple(int(tensors[k].shape[0]) for k in weights[1:-1])
+    except (ValueError, IndexError):
+        raise CheckpointError(f"{path}: its tensors are not those of the UAV DQN ({', '.join(list(tensors)[:4])}); "
+                              "re-train or re-download it.") from None
+    if not (isinstance(stated, list) and all(isinstance(h, int) for h in stated) and tuple(stated) == widths):
+        raise CheckpointError(f"{path}: its metadata says hidden={str(stated)[:60]} but its tensors have hidden "
+                              f"widths {list(widths)}; re-train or re-download it.")
+    return widths
 
 
 def greedy(net: torch.nn.Module, obs: np.ndarray, config: SimConfig) -> np.ndarray:

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import Field
 
-from xairl import Explanation, Options, Report, ReportContent, ReportRequest, table_html
+from xairl import Explanation, Options, Report, ReportContent, ReportRequest, save_figure, table_html
 
 from .baselines import CHM, SAMRO, CHMOnSamples, SAMROOnSamples
 from .evaluate import PAPER, chm_rate_by_altitude, table_one
@@ -295,6 +295,6 @@ def _altitude_figure(out: Path, real: str, cfg, flights, chm_real: list[int], se
     ax.legend(fontsize=8)
     fig.tight_layout()
     path = Path(out) / "handover_rate_vs_altitude.png"
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path, dpi=90)
     plt.close(fig)
     return caption, path

@@ -29,7 +29,7 @@ README ("What the verifier checks").
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -47,7 +47,6 @@ MAX_CHARS = 200_000  # longer texts are cut here (and the cut reported)
 #: a longer sentence is read in pieces of at most this many characters, cut at a clause boundary (commas, 'and'):
 #: the clause readers look back over their sentence, so a bound on its length keeps the time linear in the text
 MAX_SENTENCE = 600
-NON_FINITE = "the explanation holds a non-finite number (NaN or infinity) for this state: nothing can be checked"
 
 __all__ = ["Claim", "Verification", "SentenceCheck", "verify", "clean_surface", "fact_book", "NUMBER_RE",
            "MIN_COVERAGE"]
@@ -175,11 +174,11 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
     if not isinstance(text, str):
         raise InputError(f"verify() reads text (a str), not {type(text).__name__}: decode it first, "
                          f"e.g. data.decode('utf-8').")
+    index = None if index is None else explanation.check_index(index)
     text = normalise(text)
     if len(text) > MAX_CHARS:
         text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
-    finite = _finite(explanation, index)
-    with np.errstate(all="ignore"):  # (a non-finite explanation's facts are computed, then nothing is checked)
+    with np.errstate(all="ignore"):  # sums of contributions near 1e308 overflow: an infinite fact matches no number
         book = fact_book(explanation, index, policy)
     if facts is not None:
         add_facts(book, facts)
@@ -193,19 +192,8 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
     out = []
     for a, b in sentences(text):
         claims = _read_sentence(text[a:b], book, vocab, unit_of)
-        if not finite:
-            claims = [replace(c, status="unchecked", detail=NON_FINITE) if c.kind in CHECKED else c for c in claims]
         out.append(SentenceCheck(text[a:b].strip(), tuple(claims)))
     return Verification(tuple(out), note)
-
-
-def _finite(exp: Explanation, index: int | None) -> bool:
-    """Are the numbers the facts come from (contributions, scores, baselines, the state) all finite?"""
-    rows = slice(None) if index is None else slice(index, index + 1)
-    arrays = [exp.values[rows], exp.outputs[rows], exp.base_values[rows]]
-    if exp.states is not None:
-        arrays.append(exp.states[rows])
-    return all(np.isfinite(np.asarray(a, dtype=float)).all() for a in arrays)
 
 
 def _read_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]:

@@ -181,7 +181,7 @@ def matches(n: Number, fact: float, magnitude_ok: bool = True, truncated_ok: boo
     """Does ``n`` state ``fact``? ``magnitude_ok``: an unsigned number may state a negative fact's size ("lowered
     it by 0.4"). A written sign must agree with the fact's. ``truncated_ok``: digits cut off count as rounding."""
     if not math.isfinite(fact):
-        return False  # (verify() leaves every claim about a non-finite explanation unchecked)
+        return False  # (a ratio of a zero contribution: no number states it)
     if n.sign and (fact < 0) != (n.sign == "-") and fact != 0:
         return False
     target = fact if n.sign or not magnitude_ok else abs(fact)
