@@ -3,13 +3,19 @@ each one (the state, the margin's waterfall, each sentence marked verified / con
 confidence components), and accept, reject or correct it. Verdicts go to the same SQLite store as the terminal
 review.
 
-The server is Python's own (http.server), bound to 127.0.0.1 only; every form carries a token made at start-up, so
-a page from elsewhere open in the same browser cannot post verdicts.
+The server is Python's own (http.server), bound to 127.0.0.1 only. Defended against pages on other sites open in
+the same browser and against hostile clients: a Host allow-list (``127.0.0.1:PORT``, ``localhost:PORT``; else 421)
+against DNS rebinding, the Origin of a POST checked when sent (else 403), a token made at start-up in every form,
+a body limit (413, decided before reading), socket timeouts that drop stalled clients, and 400 for malformed
+forms, all without tracebacks. Not defended: anyone with a shell on this machine (they can read the store
+anyway); there is no TLS and no authentication beyond the token.
 """
 from __future__ import annotations
 
 import html
+import re
 import secrets
+import sys
 import threading
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -20,6 +26,18 @@ from .evidence import CARD_STYLE, card_html
 from .feedback import FeedbackStore, Record
 
 HOST = "127.0.0.1"
+MAX_BODY = 1_000_000  # a correction is a few sentences; more than this is not from the page
+TIMEOUT = 10.0  # seconds a client may stall before its connection is dropped
+_NUMBER = re.compile(r"[0-9]{1,18}")  # fits SQLite's 64-bit integer and stays under int()'s digit limit
+
+
+class _Server(ThreadingHTTPServer):
+    daemon_threads = True  # shutdown does not wait for a stalled client
+
+    def handle_error(self, request, client_address):
+        """A client that vanished or stalled (OSError) is its own affair; a bug of ours still shows."""
+        if not isinstance(sys.exc_info()[1], OSError):
+            super().handle_error(request, client_address)
 
 
 def _item(r: Record, token: str) -> str:
@@ -49,9 +67,11 @@ def page(store: FeedbackStore, token: str, show_all: bool = False, message: str 
             f"</head><body>{head}{note}{body}</body></html>")
 
 
-def make_server(store: FeedbackStore, port: int = 0) -> ThreadingHTTPServer:
-    """A review server for ``store`` on 127.0.0.1 (``port`` 0: any free port; ``server.server_address`` says)."""
+def make_server(store: FeedbackStore, port: int = 0, timeout: float = TIMEOUT) -> ThreadingHTTPServer:
+    """A review server for ``store`` on 127.0.0.1 (``port`` 0: any free port; ``server.server_address`` says);
+    ``timeout``: seconds a client may stall."""
     token = secrets.token_urlsafe(16)
+    hosts: set[str] = set()  # filled once the port is bound
 
     class Handler(BaseHTTPRequestHandler):
         def _send(self, status: int, body: str = "", location: str | None = None) -> None:
@@ -59,12 +79,23 @@ def make_server(store: FeedbackStore, port: int = 0) -> ThreadingHTTPServer:
             self.send_response(status)
             if location:
                 self.send_header("Location", location)
-            self.send_header("Content-Type", "text/html; charset=utf-8")
+            self.send_header("Content-Type", f"text/{'plain' if status >= 400 else 'html'}; charset=utf-8")
             self.send_header("Content-Length", str(len(data)))
             self.end_headers()
             self.wfile.write(data)
 
+        def _misdirected(self) -> bool:
+            """DNS rebinding: a hostile name resolved to 127.0.0.1 arrives with that name as Host; answer 421."""
+            sent = self.headers.get_all("Host") or []
+            if len(sent) == 1 and sent[0].strip().lower() in hosts:
+                return False
+            self._send(HTTPStatus.MISDIRECTED_REQUEST, "misdirected request: this page answers only to "
+                       f"http://{HOST}:{self.server.server_address[1]}/")
+            return True
+
         def do_GET(self):  # noqa: N802 (http.server's naming)
+            if self._misdirected():
+                return
             url = urlparse(self.path)
             if url.path != "/":
                 return self._send(HTTPStatus.NOT_FOUND, "not found")
@@ -72,25 +103,45 @@ def make_server(store: FeedbackStore, port: int = 0) -> ThreadingHTTPServer:
             self._send(HTTPStatus.OK, page(store, token, bool(q.get("all")), q.get("msg", [""])[0]))
 
         def do_POST(self):  # noqa: N802
+            if self._misdirected():
+                return
             if urlparse(self.path).path != "/review":
                 return self._send(HTTPStatus.NOT_FOUND, "not found")
-            size = min(int(self.headers.get("Content-Length") or 0), 1_000_000)
-            form = {k: v[0] for k, v in parse_qs(self.rfile.read(size).decode("utf-8", "replace")).items()}
-            if not secrets.compare_digest(form.get("token", ""), token):
+            origin = self.headers.get("Origin")  # browsers send it; a client without one is judged by the token
+            if origin is not None and origin.strip().lower() not in {f"http://{h}" for h in hosts}:
+                return self._send(HTTPStatus.FORBIDDEN, "this form is not from this review page")
+            length = self.headers.get("Content-Length")
+            if length is None:
+                return self._send(HTTPStatus.LENGTH_REQUIRED, "Content-Length required")
+            if not _NUMBER.fullmatch(length.strip()):
+                return self._send(HTTPStatus.BAD_REQUEST, "bad Content-Length")
+            if int(length) > MAX_BODY:  # refused unread: cutting it would store part of a correction
+                return self._send(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"payload too large (over {MAX_BODY} bytes)")
+            raw = self.rfile.read(int(length))
+            if len(raw) < int(length):
+                return self._send(HTTPStatus.BAD_REQUEST, "body shorter than its Content-Length")
+            form = {k: v[0] for k, v in parse_qs(raw.decode("utf-8", "replace")).items()}
+            sent = form.get("token", "").encode()  # bytes: compare_digest raises on non-ASCII str
+            if not secrets.compare_digest(sent, token.encode()):
                 return self._send(HTTPStatus.FORBIDDEN, "this form is not from this review page; reload it")
+            if not _NUMBER.fullmatch(form.get("id", "")):
+                return self._send(HTTPStatus.BAD_REQUEST, "id must be a narrative's number")
             status = form.get("status", "")
             correction = form.get("correction", "").strip() if status == "corrected" else None
             try:
-                store.review(int(form.get("id", "-1")), status, correction)
+                store.review(int(form["id"]), status, correction)
                 msg = f"#{form['id']} {status}"
             except (InputError, ValueError) as exc:
                 msg = f"not stored: {exc}"
             self._send(HTTPStatus.SEE_OTHER, location="/?" + urlencode({"msg": msg}))
 
-        def log_message(self, *args):  # quiet: the terminal shows only the address
+        def log_message(self, *args):  # quiet (log_error too): the terminal shows only the address
             pass
 
-    return ThreadingHTTPServer((HOST, port), Handler)
+    Handler.timeout = timeout  # a socket timeout: a client that stalls is dropped and its thread freed
+    server = _Server((HOST, port), Handler)
+    hosts.update(f"{name}:{server.server_address[1]}" for name in (HOST, "localhost"))
+    return server
 
 
 def serve(store: FeedbackStore, port: int = 8765) -> None:
@@ -106,8 +157,8 @@ def serve(store: FeedbackStore, port: int = 8765) -> None:
         server.server_close()
 
 
-def serve_in_thread(store: FeedbackStore) -> tuple[ThreadingHTTPServer, str]:
+def serve_in_thread(store: FeedbackStore, timeout: float = TIMEOUT) -> tuple[ThreadingHTTPServer, str]:
     """A server on a free port in a daemon thread, and its address (for tests and notebooks)."""
-    server = make_server(store, 0)
+    server = make_server(store, 0, timeout)
     threading.Thread(target=server.serve_forever, daemon=True).start()
     return server, f"http://{HOST}:{server.server_address[1]}/"
