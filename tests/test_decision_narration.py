@@ -1,5 +1,7 @@
 """Decision narration: reasons for the margin first with the strongest opposing one as a concession, feature kinds
 (identifier, group, capacity, thresholds), level words, coverage in the confidence, evidence."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import torch
@@ -100,14 +102,11 @@ def test_history_reaches_a_hook_that_takes_it(case):
         steps = 0 if history is None else len(history)
         return xairl.DomainFacts(comparisons=(xairl.Comparison(f"it has gone for {steps} steps", steps, "steps"),))
 
-    p.facts_hook = hook
-    try:
-        n = xairl.narrate(exp, 0, policy=p, robustness=False, history=np.zeros((4, 5)))
-        assert seen[0] == (4, 5) and "gone for 4 steps" in n.text and n.verified
-        p.facts_hook = lambda state, chosen, runner_up: xairl.DomainFacts()  # no history parameter: called without
-        assert xairl.narrate(exp, 0, policy=p, robustness=False, history=np.zeros((4, 5))).verified
-    finally:
-        p.facts_hook = None
+    hooked = replace(p, facts_hook=hook)  # a Policy is frozen: a changed one is a new one
+    n = xairl.narrate(exp, 0, policy=hooked, robustness=False, history=np.zeros((4, 5)))
+    assert seen[0] == (4, 5) and "gone for 4 steps" in n.text and n.verified
+    plain = replace(p, facts_hook=lambda state, chosen, runner_up: xairl.DomainFacts())  # called without history
+    assert xairl.narrate(exp, 0, policy=plain, robustness=False, history=np.zeros((4, 5))).verified
 
 
 def test_coverage_lowers_confidence_and_evidence_marks_sentences(case):

@@ -1,6 +1,7 @@
-"""The layers as documented: the core (``xairl/``) and its benchmarks import no plugin (they reach plugins through
-the registry, ``xairl.get_policy``), and the reference plugin's code and benchmarks use only what ``import xairl``
-exports, never xairl's private modules."""
+"""The layers as documented in docs/architecture.md: the core's modules import only from the layers below theirs
+(the import-linter contracts in pyproject.toml), no module of the core is part of an import cycle, the core (``xairl/``)
+and its benchmarks import no plugin (they reach plugins through the registry, ``xairl.get_policy``), and the
+reference plugin's code and benchmarks use only what ``import xairl`` exports, never xairl's private modules."""
 import ast
 from pathlib import Path
 
@@ -31,3 +32,20 @@ def test_the_core_imports_no_plugin(path):
                          ids=lambda p: str(p.relative_to(ROOT)))
 def test_the_plugin_uses_public_names_only(path):
     assert not {m for m in _imports(path) if m.startswith("xairl.")}
+
+
+def test_the_core_keeps_its_layers(capsys):
+    from importlinter.cli import lint_imports
+
+    rc = lint_imports(config_filename=str(ROOT / "pyproject.toml"), no_cache=True)
+    assert rc == 0, capsys.readouterr().out[-3000:]
+
+
+def test_no_module_of_the_core_is_in_an_import_cycle():
+    """Imports inside functions count (grimp reads them all): a lazy import is still a loop in the design."""
+    import grimp
+
+    graph = grimp.build_graph("xairl", cache_dir=None)
+    cycles = [(a, b) for a in sorted(graph.modules) for b in sorted(graph.find_modules_directly_imported_by(a))
+              if graph.chain_exists(importer=b, imported=a)]
+    assert not cycles, [graph.find_shortest_chain(importer=b, imported=a) for a, b in cycles[:3]]

@@ -1,6 +1,7 @@
 import subprocess
 import sys
 import textwrap
+from dataclasses import replace
 
 import pytest
 
@@ -179,10 +180,10 @@ def test_facts_hook_must_return_domain_facts():
 
     policy = toy_policy()
     exp = xairl.explain(policy, policy.background(1, seed=2), background=policy.background(20), method="exact")
-    policy.facts_hook = lambda state, chosen, runner_up: xairl.DomainFacts(
-        {"note": 7}, (xairl.Comparison("the gap was 1.5 m", 1.5, "m"),))
+    policy = replace(policy, facts_hook=lambda state, chosen, runner_up: xairl.DomainFacts(
+        {"note": 7}, (xairl.Comparison("the gap was 1.5 m", 1.5, "m"),)))
     assert xairl.verify("The gap was 1.5 m.", exp, 0, policy).ok
     assert not xairl.verify("The gap was 2.5 m.", exp, 0, policy).ok
-    policy.facts_hook = lambda state, chosen, runner_up: {"extras": {}, "comparisons": []}
+    policy = replace(policy, facts_hook=lambda state, chosen, runner_up: {"extras": {}, "comparisons": []})
     with pytest.raises(PluginError, match="facts_hook returned dict; it must return xairl.DomainFacts"):
         xairl.narrate(exp, 0, policy=policy)

@@ -136,7 +136,7 @@ def test_multidiscrete_is_explained_one_branch_at_a_time():
     x = states(model.observation_space, 8)
     for b, n in ((0, 3), (1, 2)):
         policy = xairl.from_sb3(model, branch=b)
-        assert policy.action_names == [f"action_{b}={i}" for i in range(n)]
+        assert policy.action_names == tuple(f"action_{b}={i}" for i in range(n))
         np.testing.assert_array_equal(policy.act(x), model.predict(x, deterministic=True)[0][:, b])
 
 

@@ -62,9 +62,11 @@ FEATURE_KINDS = ("numeric", "categorical", "identifier", "group")
 OUTPUT_KINDS = ("actions", "continuous", "value")
 
 
-@dataclass
+@dataclass(frozen=True, eq=False)  # eq=False: two policies are the same object or different ones
 class Policy:
-    """A decision maker: a torch module and what its inputs and outputs mean.
+    """A decision maker: a torch module and what its inputs and outputs mean. Built normalised (names as tuples of
+    str, metadata copied, ``observation`` as an :class:`Observation`) and frozen: change a field
+    with ``dataclasses.replace(policy, facts_hook=...)``, which checks the new policy again.
 
     :param module: maps a batch of states to (batch, n_outputs) (a (batch,) output is read as one column). Its
         input is one tensor (batch, *shape), a dict of tensors, or several tensors, as ``observation`` says.
@@ -110,15 +112,21 @@ class Policy:
             raise InputError(f"module must be a torch.nn.Module, got {type(self.module).__name__}.")
         if self.output not in OUTPUT_KINDS:
             raise InputError(f"output '{self.output}' is unknown; use one of {', '.join(OUTPUT_KINDS)}.")
-        self.observation = _observation(self.observation, self.feature_names)
-        if self.feature_names is None:
-            self.feature_names = self.observation.feature_names()
-        self.network = PolicyNetwork(self.module, self.observation, self.name)
+        def normalise(name: str, value) -> None:  # a frozen dataclass sets its own fields only here
+            object.__setattr__(self, name, value)
+
+        normalise("observation", _observation(self.observation, self.feature_names))
+        normalise("name", str(self.name))
+        normalise("network", PolicyNetwork(self.module, self.observation, self.name))
         if self.action_names is None:  # count the outputs on one all-zero state
-            n = 1 if self.output == "value" else self.scores(np.zeros((1, self.observation.n_features))).shape[1]
-            self.action_names = ["value"] if self.output == "value" else [f"action_{i}" for i in range(n)]
-        self.feature_names = [str(f) for f in self.feature_names]
-        self.action_names = [str(a) for a in self.action_names]
+            n = 1 if self.output == "value" else self._raw_scores(np.zeros((1, self.observation.n_features))).shape[1]
+            normalise("action_names", ["value"] if self.output == "value" else [f"action_{i}" for i in range(n)])
+        names = self.observation.feature_names() if self.feature_names is None else self.feature_names
+        normalise("feature_names", tuple(str(f) for f in names))
+        normalise("action_names", tuple(str(a) for a in self.action_names))
+        normalise("features", dict(self.features))  # copies: the caller's dicts stay theirs
+        normalise("groups", {str(g): tuple(m) for g, m in dict(self.groups).items()})
+        normalise("action_aliases", {str(a): tuple(v) for a, v in dict(self.action_aliases).items()})
         for what, names in (("feature_names", self.feature_names), ("action_names", self.action_names)):
             if not names:
                 raise InputError(f"{what} is empty; name every input column and every output.")
@@ -169,21 +177,24 @@ class Policy:
 
     def scores(self, states) -> np.ndarray:
         """Outputs (n, n_actions) of the module in eval mode, without gradients."""
-        x = torch.as_tensor(self.check_states(states), device=self.device)
-        was_training = self.module.training
-        self.module.eval()
-        try:
-            with torch.no_grad():
-                out = self.network(x)
-        finally:
-            self.module.train(was_training)
-        out = out.detach().cpu().numpy().astype(np.float64)
-        if self.action_names is not None and out.shape[1] != self.n_actions:
+        out = self._raw_scores(self.check_states(states))
+        if out.shape[1] != self.n_actions:
             raise InputError(
                 f"the module returned shape {tuple(out.shape)} but {self.n_actions} outputs are named; "
                 f"it must map {self.observation.describe()} to (batch, {self.n_actions})."
             )
         return out
+
+    def _raw_scores(self, x: np.ndarray) -> np.ndarray:
+        """The module's outputs for checked flat states, in eval mode, without gradients (its flag restored)."""
+        was_training = self.module.training
+        self.module.eval()
+        try:
+            with torch.no_grad():
+                out = self.network(torch.as_tensor(x, dtype=torch.float32, device=self.device))
+        finally:
+            self.module.train(was_training)
+        return out.detach().cpu().numpy().astype(np.float64)
 
     def available(self, states) -> np.ndarray:
         """Bool (n, n_actions): the actions available in each state (all of them without an ``action_mask``)."""
@@ -270,9 +281,3 @@ def _observation(obs, feature_names) -> Observation:
         return Observation.flat(shape[0]) if len(shape) == 1 else Observation.array(shape)
     raise InputError(f"observation must be a shape, a dict of shapes or a list of shapes; got {type(obs).__name__}.")
 
-
-def __getattr__(name: str):  # from_sb3 lives in xairl.sb3; this keeps ``from xairl.policy import from_sb3``
-    if name == "from_sb3":
-        from .sb3 import from_sb3
-        return from_sb3
-    raise AttributeError(name)

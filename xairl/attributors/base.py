@@ -15,6 +15,10 @@ from ..options import Options, parse_options
 from ..policy import Policy
 
 
+#: the most features exact Shapley values enumerate (2^16 coalitions); here so that refusals can name it
+EXACT_MAX_FEATURES = 16
+
+
 class Attributor:
     """Turns (policy, states, background) into an :class:`Explanation` for all actions at once.
 
@@ -119,10 +123,8 @@ class Attributor:
 
 def alternatives(policy: Policy, exclude: str) -> str:
     """What to use instead of method ``exclude``: only methods that accept this network."""
-    from ..attributors.exact import MAX_FEATURES
-
     options = [m for m in ("deep_shap", "integrated_gradients", "kernel_shap") if m != exclude]
-    if policy.n_features <= MAX_FEATURES and exclude != "exact":
+    if policy.n_features <= EXACT_MAX_FEATURES and exclude != "exact":
         options.append("exact")
     hint = " (kernel_shap: model-agnostic but sampled; give it a small background)" if policy.n_features > 64 else ""
     return f"use method={' or '.join(repr(o) for o in options)}{hint}."

@@ -12,9 +12,8 @@ import torch
 from pydantic import Field
 
 from ..errors import InputError
+from .base import EXACT_MAX_FEATURES as MAX_FEATURES
 from .base import Attributor, Options
-
-MAX_FEATURES = 16
 
 
 class ExactOptions(Options):

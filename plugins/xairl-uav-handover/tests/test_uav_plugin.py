@@ -71,8 +71,31 @@ def test_corrupt_and_mismatched_checkpoints(tmp_path):
         load_checkpoint(tmp_path / "missing.safetensors")
     other = tmp_path / "other.safetensors"
     save_checkpoint(build_qnet(np.zeros(13), np.ones(13), hidden=(8,)), other, {"hidden": [64, 64]})
-    with pytest.raises(CheckpointError, match="does not match"):
+    with pytest.raises(CheckpointError, match=r"metadata says hidden=\[64, 64\] but its tensors have hidden widths \[8\]"):
         load_checkpoint(other)
+
+
+def test_checkpoint_metadata_is_checked_against_its_tensors_before_anything_is_built(tmp_path, monkeypatch):
+    """(issue 27) a 200-byte file whose metadata says hidden=[100000]*3 used to allocate 40 GB before the shape
+    check: the widths are now read from the tensors and the network is never built."""
+    from safetensors.torch import save_file
+
+    import xairl_uav_handover.policy as module
+
+    built = []
+    monkeypatch.setattr(module, "build_qnet", lambda *a, **k: built.append(a) or pytest.fail("network built"))
+    tiny = tmp_path / "tiny.safetensors"
+    save_file({"0.weight": torch.zeros(2)}, str(tiny), metadata={"xairl": json.dumps({"hidden": [100000] * 3})})
+    assert tiny.stat().st_size < 300
+    with pytest.raises(CheckpointError, match=r"hidden=\[100000, 100000, 100000\] but its tensors have hidden "
+                                              r"widths \[\]"):
+        load_checkpoint(tiny)
+    for meta, tensors, message in [([1], {"0.weight": torch.zeros(2)}, "metadata is not a JSON object"),
+                                   ({"hidden": [64]}, {"a.weight": torch.zeros(())}, "tensors are not those")]:
+        save_file(tensors, str(tiny), metadata={"xairl": json.dumps(meta)})
+        with pytest.raises(CheckpointError, match=message):
+            load_checkpoint(tiny)
+    assert not built
 
 
 def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
