@@ -97,7 +97,7 @@ def test_user_errors_are_one_line_exit_2(capsys, argv, match):
 
 
 @pytest.mark.parametrize("content, match", [
-    ("battery,distance\n1,2\n", "missing column"),
+    ("battery,distance\n1,2\n", "lack column"),
     (",".join(FEATURES) + "\n1,2,nan,4,5\n", "NaN/inf"),
     (",".join(FEATURES) + "\n1,2,three,4,5\n", "'three' is not a number"),
 ])

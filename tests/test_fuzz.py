@@ -1,6 +1,8 @@
 """Property-based fuzzing: whatever the input, the API raises only our errors and the CLI never shows a traceback.
 
-Case counts (max_examples) add up to 1,300 generated cases per run; hypothesis is seeded so runs repeat.
+Case counts (max_examples) add up to 3,700 generated cases per run, 2,400 of them for the CLI's input readers
+(.npy, .npz, CSV, JSON, command-line values) and Explanation.from_json (issue 27); hypothesis is seeded so runs
+repeat.
 """
 import json
 import string
@@ -76,6 +78,99 @@ def test_cli_json_files(tmp_path_factory, doc, raw, garbage):
     path = tmp_path_factory.mktemp("json") / "s.json"
     path.write_text(garbage if raw else json.dumps(doc, allow_nan=True))
     _cli_ok(["explain", "--states", str(path), "--method", "exact"])
+
+
+NPY_DTYPES = ["<f4", "<f8", "<i8", "|b1", "<c8", "<M8[D]", "<m8[s]", "|O", "<U3", "|V4"]
+
+
+@fast(500)
+@given(dtype=st.sampled_from(NPY_DTYPES), shape=st.lists(st.one_of(st.integers(0, 6), st.integers(10 ** 9, 10 ** 12)),
+                                                            max_size=4),
+       body=st.binary(max_size=200), cut=st.integers(0, 120), packed=st.booleans(),
+       key=st.sampled_from(["arr_0", "obs", "x", ""]))
+def test_cli_npy_and_npz_files_of_any_header_and_body(tmp_path_factory, dtype, shape, body, cut, packed, key):
+    """Headers claiming any shape and dtype (objects, dates, complex, billions of rows), bodies short, long or random,
+    headers cut anywhere, as a .npy or inside a .npz."""
+    import io
+    import zipfile
+
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, {"descr": dtype, "fortran_order": False, "shape": tuple(shape)})
+    raw = buf.getvalue()
+    raw = raw[:cut] if cut < 20 else raw + body
+    folder = tmp_path_factory.mktemp("npy")
+    if packed:
+        path = folder / "s.npz"
+        with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+            z.writestr(f"{key}.npy", raw)
+    else:
+        path = folder / "s.npy"
+        path.write_bytes(raw)
+    _cli_ok(["explain", "--states", str(path), "--method", "exact"])
+
+
+@fast(300)
+@given(flag=st.sampled_from(["--n", "--seed", "--background-size", "--top", "--index", "--port", "-o", "--out",
+                             "--feedback-db", "--export"]),
+       value=st.one_of(st.integers(-10 ** 20, 10 ** 20).map(str), st.text(max_size=12), st.sampled_from(
+           ["", "-", "nan", "1e999", "0", "/", "/etc/passwd", "nsamples=-5", "seed=1e400", "n_steps=" + "9" * 30,
+            "max_pairs=[[[]]]", "=", "x=" + "[" * 3000])))
+def test_cli_values_of_any_flag(flag, value):
+    """Command-line values: refused in one line or run; a valid run here is made small (one state, one sample)."""
+    if flag in ("--index",):
+        argv = ["verify", "text", "--explanation", "/nonexistent.json", flag, value]
+    elif flag in ("--port", "--export"):
+        argv = ["review", "--db", "/nonexistent/f.sqlite", flag, value]
+    elif flag == "-o":
+        argv = ["explain", "--n", "1", "--background-size", "5", "--method", "kernel_shap", "-o", "nsamples=8",
+                flag, value]
+    elif flag in ("--n", "--background-size"):
+        argv = ["explain", "--method", "exact", "--background-size", "5", flag, value if not value.isdigit() or
+                int(value) > 10 ** 7 else "2"]
+    else:
+        argv = ["explain", "--n", "1", "--background-size", "5", "--method", "exact", flag, value]
+    if flag == "--out" and value and not value.startswith("/"):
+        return  # a relative folder would be written into the checkout
+    _cli_ok(argv)
+
+
+EXPLANATION = xairl.explain(POLICY, BG[:2], background=BG, method="exact").to_json()
+json_values = st.recursive(st.one_of(st.none(), st.booleans(), st.integers(-10 ** 30, 10 ** 30), floats,
+                                     st.text(max_size=4)),
+                           lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=6), inner,
+                                                                                          max_size=4), max_leaves=20)
+
+
+@fast(800)
+@given(edits=st.lists(st.tuples(st.integers(0, len(EXPLANATION)), st.integers(0, 40), st.sampled_from(
+    ["", "NaN", "Infinity", "1e400", "-", "[", "]", "{", "}", ",", '"', "null", "true", "1" + "0" * 400, "[[[]]]",
+     '"values"', '"x"', "0.5", "\\u0000", "é"])), min_size=1, max_size=4))
+def test_explanation_from_json_with_any_edit(edits):
+    """The JSON Explanation.to_json() writes, cut and spliced anywhere: an Explanation or one InputError line."""
+    text = EXPLANATION
+    for at, width, insert in edits:
+        text = text[:at] + insert + text[at + width:]
+    _from_json_ok(text)
+
+
+@fast(500)
+@given(doc=st.dictionaries(st.sampled_from(["values", "base_values", "outputs", "states", "feature_names",
+                                            "action_names", "method", "options", "extras", "available", "output",
+                                            "observation", "categories", "background_quantiles", "other"]),
+                           json_values, max_size=15), base=st.booleans())
+def test_explanation_from_json_of_any_document(doc, base):
+    """Any JSON document keyed by the schema's fields, alone or over a valid explanation."""
+    whole = {**json.loads(EXPLANATION), **doc} if base else doc
+    _from_json_ok(json.dumps(whole, allow_nan=True))
+
+
+def _from_json_ok(text):
+    try:
+        exp = xairl.Explanation.from_json(text)
+    except XairlError as exc:
+        assert "\n" not in str(exc)
+        return
+    assert np.isfinite(exp.values).all() and np.isfinite(exp.outputs).all()
 
 
 def _cli_ok(argv):

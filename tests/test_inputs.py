@@ -73,7 +73,7 @@ def test_csv_reorders_columns_by_header(tmp_path):
 
 
 @pytest.mark.parametrize("name, text, match", [
-    ("a.csv", "battery,distance,speed,obstacle\n1,2,3,4\n", "missing column.*wind"),
+    ("a.csv", "battery,distance,speed,obstacle\n1,2,3,4\n", "states lack column.*wind"),
     ("b.csv", ",".join(FEATURES) + "\n1,2,x,4,5\n", "line 2, column 'speed': 'x' is not a number"),
     ("c.csv", "", "empty"),
     ("d.csv", ",".join(FEATURES) + "\n", "empty"),

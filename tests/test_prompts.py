@@ -1,12 +1,15 @@
 """Templates: lookup order, sandbox, `xairl prompts` and check with line numbers."""
 from pathlib import Path
 
+import jinja2
 import pytest
 
 import xairl
 from xairl import prompts
 from xairl.cli import main
 from xairl.errors import UnknownNameError
+from xairl.narrators import check_template
+from xairl.narrators.facts import sample_context
 from xairl.prompts import TemplateError
 from xairl.toy import toy_policy
 
@@ -17,7 +20,7 @@ def test_builtins_are_found_and_clean():
     found = prompts.available()
     assert {"explain_action", "why_not", "global_summary"} <= set(found)
     for path in found.values():
-        assert prompts.check(path) == []
+        assert check_template(path) == []
 
 
 def test_user_dir_overrides_builtin_and_explicit_dir_overrides_user(user_path, tmp_path):
@@ -50,7 +53,7 @@ def test_unknown_template():
 def test_check_reports_problems_with_lines(tmp_path, body, expected):
     path = tmp_path / "t.yaml"
     path.write_text(body)
-    problems = prompts.check(path)
+    problems = check_template(path)
     assert problems and any(expected in p for p in problems), problems
     assert all(str(path) in p for p in problems)
 
@@ -76,7 +79,8 @@ def test_prompts_cli(capsys, tmp_path):
     assert main(["prompts", "show"]) == 2
 
 
-HOSTILE = sorted((Path(__file__).parent / "hostile_templates").glob("*.yaml"))
+HOSTILE_DIR = Path(__file__).parent / "hostile_templates"
+HOSTILE = sorted(HOSTILE_DIR.glob("*.yaml"))
 
 
 @pytest.mark.parametrize("path", HOSTILE, ids=lambda p: p.stem)
@@ -94,4 +98,56 @@ def test_hostile_templates_are_refused_quickly(path):
 
 
 def test_hostile_corpus_size():
-    assert len(HOSTILE) >= 20
+    assert len(HOSTILE) >= 41
+
+
+@pytest.mark.parametrize("path", HOSTILE, ids=lambda p: p.stem)
+def test_hostile_templates_stay_small(path):
+    """Bounds hold for the whole rendering: each attack is refused before it allocates or loops much."""
+    import time
+    import tracemalloc
+
+    tracemalloc.start()
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises((TemplateError, UnknownNameError)) as info:
+            prompts.load(path).render_variants(sample_context("decision"))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert time.perf_counter() - t0 < 2.0
+    assert peak < 50 * 2**20, f"peak {peak / 2**20:.0f} MB"
+    assert str(path) in str(info.value) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("stem", ["binary", "deep_parens"])
+def test_prompts_check_unreadable_template_is_one_line_error(capsys, stem):
+    """A file that is not UTF-8 text, or nests deeper than the parser can go: exit 2, one line, no traceback."""
+    path = HOSTILE_DIR / f"{stem}.yaml"
+    assert main(["prompts", "check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"xairl: error: {path}") and err.count("\n") == 1, err
+    assert "Traceback" not in err and "internal error" not in err
+
+
+def test_refusals_name_the_bound(tmp_path):
+    path = tmp_path / "t.yaml"
+    path.write_text('name: t\nsentences:\n  - ["ok"]\n  - ["{{ \'x\'|center(1000000) }}"]\n')
+    with pytest.raises(TemplateError, match=r"t.yaml:4: refused by the sandbox \(.*100000"):
+        prompts.load(path).render_variants(sample_context("decision"))
+
+
+@pytest.mark.parametrize("text", [
+    "{{ ('x' * 1000 * 100)|length }}",  # a string at the size bound
+    "{% for a in 'x' * 100 %}{% for b in 'x' * 99 %}{% endfor %}{% endfor %}done",  # 100 + 9,900 steps
+    "{{ '%5.2f' % 3.14159 }} {{ '{:>6}'.format('a') }} {{ 'a'|center(9) }} {{ 'b'.ljust(4) }}|",
+    "{{ [1, 2] + [3] }} {{ 'a' ~ 1 ~ [2] }} {{ ['a', 'b']|join(', ') }} {{ 'aa'|replace('a', 'bb') }}",
+    "{{ 'a b'|indent(2, first=True) }} {{ 'ab cd'|wordwrap(2, break_on_hyphens=False) }} "
+    "{{ 'abcdef'|truncate(5, leeway=0) }} {{ [1, 2, 3]|batch(2, 0)|list }} {{ [[1], [2]]|sum(start=[]) }}",
+    "{% macro m(x) %}<{{ x }}>{% endmacro %}{% for t in ('a', 'b') %}{{ m(t) }}{% else %}none{% endfor %}",
+])
+def test_legitimate_templates_within_bounds_render(tmp_path, text):
+    path = tmp_path / "t.yaml"
+    path.write_text(f'name: t\nsentences:\n  - ["{text}"]\n')
+    out = prompts.load(path).render_variants(sample_context("decision"))[0][0]
+    assert out == " ".join(jinja2.Environment().from_string(text).render().split())

@@ -90,7 +90,7 @@ def test_a_module_taking_two_inputs_given_one_says_so():
                                          r"argument.*\) on input \(2, 6\)"):
         flat.scores(np.zeros((2, 6)))
     two = xairl.Policy(TwoInputs(), observation=[(4,), (2,)], action_names=["a", "b"])
-    assert two.feature_names[:2] == ["input0[0]", "input0[1]"] and two.feature_names[4:] == ["input1[0]", "input1[1]"]
+    assert two.feature_names[:2] == ("input0[0]", "input0[1]") and two.feature_names[4:] == ("input1[0]", "input1[1]")
     rng = np.random.default_rng(0)
     e = xairl.explain(two, [rng.normal(size=(2, 4)), rng.normal(size=(2, 2))],
                       background=[rng.normal(size=(9, 4)), rng.normal(size=(9, 2))])

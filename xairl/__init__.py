@@ -38,7 +38,8 @@ _LAZY = {
     "DomainFacts": "xairl.narrators.facts",
     "decision_facts": "xairl.narrators.facts",
     "narration_units": "xairl.narrators.facts:units",  # each group narrated as one reason, then the other features
-    "format_number": "xairl.narrators.facts:fmt",  # how every narrated number is written
+    "format_number": "xairl.prompts:fmt",  # how every narrated number is written
+    "check_template": "xairl.narrators",  # a template file's problems, one line each (`xairl prompts check`)
     "value_level": "xairl.narrators.facts:level",  # 'low' / 'moderate' / 'high' of a value, and its words
     # reports
     "Report": "xairl.report",

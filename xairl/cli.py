@@ -27,7 +27,7 @@ def _count(low: int, high: int | None = None):
         try:
             value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
+            raise argparse.ArgumentTypeError(f"{_short(text)!r} is not a whole number") from None
         if value < low or (high is not None and value > high):
             bound = f"at least {low}" if high is None else f"between {low} and {high}"
             raise argparse.ArgumentTypeError(f"{value} must be {bound}")
@@ -37,28 +37,45 @@ def _count(low: int, high: int | None = None):
     return parse
 
 
-def _new_file(text: str) -> str:
-    """An argparse type: a file to write whose folder exists (an existing file is replaced)."""
-    from pathlib import Path
+def _short(text: str, limit: int = 80) -> str:
+    return text if len(text) <= limit else text[:limit] + "..."
 
-    path = Path(text)
+
+def _path(check):
+    """An argparse type from ``check(path) -> problem or None``; a path the system refuses is a problem too."""
+    def parse(text: str) -> str:
+        from pathlib import Path
+
+        try:
+            problem = check(Path(text)) if text else "an empty path"
+        except (OSError, ValueError) as exc:  # a name too long, a NUL byte
+            problem = f"cannot use {_short(text)!r} ({getattr(exc, 'strerror', None) or exc})"
+        if problem:
+            raise argparse.ArgumentTypeError(problem)
+        return text
+
+    parse.__name__ = "path"
+    return parse
+
+
+@_path
+def _new_file(path) -> str | None:
+    """A file to write whose folder exists (an existing file is replaced)."""
     if path.is_dir():
-        raise argparse.ArgumentTypeError(f"{text} is a folder; give a file name")
+        return f"{_short(str(path))} is a folder; give a file name"
     if not path.parent.is_dir():
-        raise argparse.ArgumentTypeError(f"the folder {path.parent} does not exist; create it first")
-    return text
+        return f"the folder {_short(str(path.parent))} does not exist; create it first"
+    return None
 
 
-def _out_dir(text: str) -> str:
-    """An argparse type: a folder to write into, new or existing, whose parent exists."""
-    from pathlib import Path
-
-    path = Path(text)
+@_path
+def _out_dir(path) -> str | None:
+    """A folder to write into, new or existing, whose parent exists."""
     if path.exists() and not path.is_dir():
-        raise argparse.ArgumentTypeError(f"{text} is a file, not a folder; give a folder for the report")
+        return f"{_short(str(path))} is a file, not a folder; give a folder for the report"
     if not path.exists() and not path.parent.is_dir():
-        raise argparse.ArgumentTypeError(f"the folder {path.parent} does not exist; create it first")
-    return text
+        return f"the folder {_short(str(path.parent))} does not exist; create it first"
+    return None
 
 
 def _parse_options(pairs: Sequence[str]) -> dict:
@@ -176,8 +193,8 @@ def _state_shape(path):
         return None
     try:
         shape = np.load(path, mmap_mode="r", allow_pickle=False).shape
-    except (OSError, ValueError):
-        return None  # read_states reports the problem with the file
+    except Exception:  # a peek only: read_states reports whatever is wrong with the file
+        return None
     return shape[1:] if len(shape) > 1 else shape
 
 
@@ -241,7 +258,9 @@ def cmd_prompts(args) -> int:
         print(f"# {tpl.path}")
         print(tpl.path.read_text(), end="")
         return 0
-    problems = prompts.check(args.target)
+    from .narrators import check_template
+
+    problems = check_template(args.target)
     for p in problems:
         print(p)
     print(f"{args.target}: {'ok' if not problems else f'{len(problems)} problem(s)'}")
@@ -379,7 +398,8 @@ def build_parser() -> argparse.ArgumentParser:
 def _explain_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--policy", default="toy", help="registered policy name (see `xairl plugins`), or with nothing "
                    "installed package.module:attr or path/file.py:attr (a Policy, a torch module, or a function "
-                   "returning one); default: toy")
+                   "returning one, called with the --policy-arg values); default: toy. A module:attr or file.py:attr "
+                   "imports and runs that code, as any Python entry point does: give only code you trust")
     p.add_argument("--policy-arg", action="append", default=[], metavar="KEY=VALUE",
                    help="argument of a module:attr policy function, e.g. --policy-arg checkpoint=my_q.pt")
     p.add_argument("--out", type=_out_dir, default=None, metavar="DIR",

@@ -40,7 +40,7 @@ def validation_message(exc, what: str) -> str:
     """
     parts = []
     for err in exc.errors():
-        loc = ".".join(str(p) for p in err["loc"]) or "value"
+        loc = ".".join(str(p)[:40] for p in err["loc"]) or "value"
         msg = "unknown option" if err["type"] == "extra_forbidden" else err["msg"]
         parts.append(f"{loc}: {msg}")
-    return f"invalid {what} ({'; '.join(parts)})."
+    return " ".join(f"invalid {what} ({'; '.join(parts[:6])}{'; ...' if len(parts) > 6 else ''}).".split())

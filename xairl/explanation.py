@@ -52,6 +52,16 @@ class Explanation:
     categories: Mapping[str, Sequence[str]] | None = None
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "feature_names", tuple(self.feature_names))  # normalised, as the JSON reads back
+        object.__setattr__(self, "action_names", tuple(self.action_names))
+        if self.categories:
+            object.__setattr__(self, "categories", {str(k): tuple(v) for k, v in self.categories.items()})
+        for name in ("values", "base_values", "outputs"):
+            if not isinstance(getattr(self, name), np.ndarray):
+                raise InputError(f"Explanation.{name} must be a numpy array, not {type(getattr(self, name)).__name__}.")
+        if self.values.ndim != 3:
+            raise InputError(f"Explanation.values has shape {self.values.shape}; expected (states, features, "
+                             "actions).")
         n, f, a = self.values.shape
         for name, arr, shape in (
             ("base_values", self.base_values, (n, a)),
@@ -65,7 +75,7 @@ class Explanation:
             raise InputError(f"Explanation.states has shape {self.states.shape}, expected {(n, f)}.")
         if len(self.feature_names) != f or len(self.action_names) != a:
             raise InputError("Explanation names do not match the values' shape.")
-        for name in ("values", "base_values", "outputs", "states", "background_quantiles"):
+        for name in ("values", "base_values", "outputs", "states"):  # (a missing quartile: no level words)
             arr = getattr(self, name)
             if arr is not None and not np.isfinite(arr).all():
                 raise InputError(f"Explanation.{name} holds NaN or infinity ({int((~np.isfinite(arr)).sum())} "
@@ -285,10 +295,11 @@ class Explanation:
         except RecursionError:
             raise InputError("the explanation's JSON is nested too deeply.") from None
         try:
-            return cls(**{k: _ARRAY_FIELDS[k][1](v) if k in _ARRAY_FIELDS and v is not None else v
-                          for k, v in record.items()})
-        except (ValueError, OverflowError) as exc:  # ragged lists, numbers beyond float64
-            raise InputError(f"the explanation's arrays cannot be read ({' '.join(str(exc).split())[:120]}).") from None
+            arrays = {k: _ARRAY_FIELDS[k][1](v) for k, v in record.items() if k in _ARRAY_FIELDS and v is not None}
+        except (ValueError, OverflowError):  # ragged lists, numbers beyond float64
+            raise InputError("the explanation's arrays have rows of different lengths or numbers beyond float64; "
+                             "give the JSON that Explanation.to_json() writes.") from None
+        return cls(**{**record, **arrays})
 
 
 def _plain(value):

@@ -62,7 +62,7 @@ def read_states(path: str | Path, feature_names: Sequence[str], observation: Obs
             if path.stat().st_size > MAX_TEXT_BYTES:
                 raise InputError(f"a {suffix} file of {path.stat().st_size / 1024 ** 2:.0f} MB is too large to parse "
                                  f"(limit {MAX_TEXT_BYTES // 1024 ** 2} MB); save the {what} as .npy instead.")
-            data = _read_csv(path, feature_names) if suffix == ".csv" else _read_json(path, feature_names)
+            data = (_read_csv if suffix == ".csv" else _read_json)(path, feature_names, what)
         else:
             raise InputError(f"{path}: unknown file type '{suffix}'; use .csv, .npy, .npz or .json.")
     except InputError as exc:
@@ -123,11 +123,11 @@ def _load_npz(path: Path) -> dict[str, np.ndarray]:
         return {k: z[k] for k in z.files}
 
 
-def _read_csv(path: Path, feature_names: Sequence[str]) -> np.ndarray:
+def _read_csv(path: Path, feature_names: Sequence[str], what: str) -> np.ndarray:
     with path.open(newline="", encoding="utf-8-sig") as fh:  # -sig: a byte-order mark is not part of the header
         rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
     if not rows:
-        raise InputError("the CSV file is empty; it needs a header row and at least one row of states.")
+        raise InputError(f"the CSV file is empty; it needs a header row and at least one row of {what}.")
     header = [h.strip() for h in rows[0]]
     twice = sorted({h for h in header if h in feature_names and header.count(h) > 1})
     if twice:
@@ -135,7 +135,8 @@ def _read_csv(path: Path, feature_names: Sequence[str]) -> np.ndarray:
     missing = [f for f in feature_names if f not in header]
     if missing:
         raise InputError(
-            f"missing column(s) {', '.join(missing)}; the header must name the features: {', '.join(feature_names)}."
+            f"the {what} lack column(s) {', '.join(missing)}; the header must name the features: "
+            f"{', '.join(feature_names)}."
         )
     idx = [header.index(f) for f in feature_names]
     out = np.empty((len(rows) - 1, len(idx)), dtype=np.float64)
@@ -151,7 +152,7 @@ def _read_csv(path: Path, feature_names: Sequence[str]) -> np.ndarray:
     return out
 
 
-def _read_json(path: Path, feature_names: Sequence[str]):
+def _read_json(path: Path, feature_names: Sequence[str], what: str):
     data = json.loads(path.read_text(encoding="utf-8-sig"))
     if isinstance(data, dict) and "states" in data:
         data = data["states"]
@@ -161,5 +162,5 @@ def _read_json(path: Path, feature_names: Sequence[str]):
             raise InputError(f"objects lack key(s) {', '.join(missing)}; each needs: {', '.join(feature_names)}.")
         data = [[r[f] for f in feature_names] for r in data]
     if not isinstance(data, list):
-        raise InputError("expected a JSON list of states (rows of numbers or objects keyed by feature name).")
+        raise InputError(f"expected a JSON list of {what} (rows of numbers or objects keyed by feature name).")
     return data

@@ -5,11 +5,11 @@ Run: python examples/custom_prompt/run.py
 from pathlib import Path
 
 import xairl
-from xairl import prompts
 
 here = Path(__file__).parent / "prompts"
 for path in sorted(here.glob("*.yaml")):
-    print(path.name, "ok" if not prompts.check(path) else prompts.check(path))
+    problems = xairl.check_template(path)
+    print(path.name, "ok" if not problems else problems)
 policy = xairl.get_policy("toy")
 exp = xairl.explain(policy, policy.background(2, seed=4))
 for name in ("explain_action", "one_liner"):

@@ -1,6 +1,7 @@
 """Narration: facts by code, words by a template or a local language model, every claim verified."""
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Iterable
 
 from ..explanation import Explanation
@@ -32,4 +33,13 @@ def narrate(explanation: Explanation, index: int | None = 0, narrator: str = "te
     return narrative
 
 
-__all__ = ["Narrative", "Narrator", "Verification", "confidence", "narrate", "verify"]
+def check_template(path: str | Path) -> list[str]:
+    """Problems of a template file, one line each (:func:`xairl.prompts.check`), including a trial rendering with
+    sample facts; what ``xairl prompts check`` prints."""
+    from .. import prompts
+    from .facts import sample_context
+
+    return prompts.check(path, sample_context)
+
+
+__all__ = ["Narrative", "Narrator", "Verification", "check_template", "confidence", "narrate", "verify"]

@@ -10,24 +10,7 @@ import numpy as np
 from ..errors import InputError, PluginError
 from ..explanation import Explanation
 from ..policy import FeatureInfo, Policy
-
-
-def fmt(x: float, signed: bool = False) -> str:
-    """How every number is written: 0 decimals from 100, 1 from 10, else 2 (3 significant digits below 0.01)."""
-    a = abs(x)
-    if float(x).is_integer() and a < 1e6:  # ids, counts
-        s = f"{x:.0f}"
-    elif a >= 100:
-        s = f"{x:.0f}"
-    elif a >= 10:
-        s = f"{x:.1f}"
-    elif a >= 0.01 or a == 0:
-        s = f"{x:.2f}"
-    else:
-        s = f"{x:.3g}"
-    if s.startswith("-") and float(s) == 0:
-        s = s[1:]
-    return ("+" + s) if signed and not s.startswith("-") else s
+from ..prompts import fmt
 
 
 @dataclass(frozen=True)
@@ -327,3 +310,27 @@ def global_facts(exp: Explanation, policy: Policy | None = None, k: int = 5) -> 
         ranking.append({"name": name, "label": info.description or name, "unit": info.unit, "rank": rank,
                         "mean_abs": float(mean_abs[j]), "high_values": effect})
     return GlobalFacts(len(contrib), exp.method, tuple(ranking))
+
+
+class _SampleExtras(dict):
+    """Plugin-defined extras are unknown to the core: any key reads as 1 in a trial rendering."""
+
+    def __missing__(self, key):
+        return 1
+
+
+def sample_context(kind: str) -> dict:
+    """Plausible facts of a template ``kind`` ('decision' or 'global'), for trial renderings
+    (:func:`xairl.narrators.check_template`)."""
+    if kind == "global":
+        return GlobalFacts(10, "deep_shap", tuple({"name": f"f{i}", "label": f"feature {i}", "unit": "", "rank": i,
+                                                    "mean_abs": 1.0 / i, "high_values": "toward"}
+                                                   for i in range(1, 4))).context()
+    feats = tuple(FeatureFact(f"f{i}", f"feature {i}", 1.0, "m", 0.5 / i, 30.0, "toward", "high", "high", i,
+                              value_text="1.00 m") for i in range(1, 4))
+    against = FeatureFact("f4", "feature 4", 2.0, "m", -0.1, 10.0, "against", "low", "low", 4, value_text="2.00 m")
+    ident = FeatureFact("f5", "feature 5", 15.0, "", 0.0, 0.0, "toward", "unknown", "", 0, "identifier",
+                        value_text="15")
+    return DecisionFacts(0, "a", "b", 1.0, 0.5, 0.5, 0.2, "deep_shap", 0.0, feats, feats,
+                         (Comparison("x is 1 dB above y", 1.0, "dB"),), {}, reasons=feats, concession=against,
+                         base_margin=0.1, identifiers=(ident,)).context() | {"extras": _SampleExtras()}
