@@ -278,3 +278,28 @@ def test_help_says_that_a_module_attr_policy_runs_code(capsys):
         main(["explain", "--help"])
     out = " ".join(capsys.readouterr().out.split())
     assert "imports and runs that code" in out and "trust" in out
+
+
+# 9. code health -----------------------------------------------------------------------------------------------------
+def test_the_confidence_doc_states_the_weights_the_code_uses():
+    import importlib
+    import re
+
+    confidence = importlib.import_module("xairl.narrators.confidence")  # (the package exports a function of that name)
+    stated = {k: float(w) for k, w in re.findall(r"``(\w+)`` \(weight ([\d.]+)\)", confidence.__doc__)}
+    assert stated == confidence.WEIGHTS
+
+
+def test_a_policy_is_built_normalised_and_frozen():
+    import dataclasses
+
+    policy = xairl.Policy(POLICY.module, list(FEATURES), ["forward", "turn", "recharge"],
+                          groups={"motion": ["speed", "wind"]})
+    assert policy.feature_names == FEATURES and isinstance(policy.action_names, tuple)
+    assert policy.groups == {"motion": ("speed", "wind")}
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        policy.feature_names = ("a",)
+    renamed = dataclasses.replace(policy, name="renamed")  # a changed policy is a new one, checked again
+    assert renamed.name == "renamed" and renamed.network is not policy.network
+    with pytest.raises(InputError, match="duplicates"):
+        dataclasses.replace(policy, action_names=["a", "a", "b"])

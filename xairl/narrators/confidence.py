@@ -1,12 +1,13 @@
 """The confidence score of a narrative, in [0, 1]: ``verification x weighted mean of the measured components``.
 
 - ``verification``: 1 when every claim of the shown text was verified, else 0 (an unverified text has no confidence);
-- ``additivity`` (weight 0.2): 1 / (1 + gap / (1e-3 * max(1, |score|))): 1 when contributions add up to the score;
-- ``margin`` (0.3): 1 - exp(-q_margin / tau), tau = the mean |contribution| per feature: a Q-gap smaller than a
-  typical single feature's effect is a near tie (discrete actions only: a value or a continuous action has none);
-- ``agreement`` (0.25): (1 + Spearman rho) / 2 between the |contributions| of this method and a second one
+- ``coverage`` (weight 0.2): the share of the text's sentences that hold a checked claim (the verifier's coverage);
+- ``additivity`` (weight 0.15): 1 / (1 + gap / (1e-3 * max(1, |score|))): 1 when contributions add up to the score;
+- ``margin`` (weight 0.25): 1 - exp(-q_margin / tau), tau = the mean |contribution| per feature: a Q-gap smaller than
+  a typical single feature's effect is a near tie (discrete actions only: a value or a continuous action has none);
+- ``agreement`` (weight 0.2): (1 + Spearman rho) / 2 between the |contributions| of this method and a second one
   (integrated gradients, or deep_shap when the first is integrated gradients) on the same state;
-- ``stability`` (0.25): mean of (1 + rho) / 2 between the contributions with the full background and with two
+- ``stability`` (weight 0.2): mean of (1 + rho) / 2 between the contributions with the full background and with two
   half-size resamples of it.
 
 Cost: ``additivity`` and ``margin`` are read off the Explanation. ``agreement`` and ``stability`` (the robustness
@@ -21,7 +22,7 @@ import numpy as np
 from ..explanation import Explanation
 from ..policy import Policy
 
-WEIGHTS = {"coverage": 0.2, "additivity": 0.15, "margin": 0.25, "agreement": 0.2, "stability": 0.2}
+WEIGHTS = {"coverage": 0.2, "additivity": 0.15, "margin": 0.25, "agreement": 0.2, "stability": 0.2}  # as the doc says
 
 
 def _spearman(a: np.ndarray, b: np.ndarray) -> float:
