@@ -11,7 +11,7 @@ import pytest
 
 import xairl
 from xairl.feedback import FeedbackStore
-from xairl.review import page, serve_in_thread
+from xairl.review import TIMEOUT, page, serve_in_thread
 from xairl.toy import toy_policy
 
 BROWSER = shutil.which("chromium") and shutil.which("chromedriver")
@@ -74,97 +74,93 @@ def _statuses(store):
     return [(r.status, r.correction) for r in store.records()]
 
 
-def test_a_foreign_host_or_origin_is_refused(store):
-    server, _ = serve_in_thread(store)
-    port = server.server_address[1]
-    try:
-        token = _token(port)
-        status, body = _http(port, "GET", "/", {"Host": "evil.example"})
-        assert status == 421 and token not in body
-        assert _http(port, "GET", "/", {})[0] == 421  # no Host at all: an HTTP/1.0 rebinding request
-        assert _http(port, "GET", "/", {"Host": f"localhost:{port + 1}"})[0] == 421
-        form = f"id=1&status=accepted&token={token}"
-        assert _post(port, form, host="evil.example", origin="http://evil.example")[0] == 421
-        assert _post(port, form, origin="http://evil.example")[0] == 403
-        assert _post(port, form, origin="null")[0] == 403
-        assert _statuses(store) == [("pending", None)] * 2
-        status, body = _http(port, "GET", "/", {"Host": f"localhost:{port}"})
-        assert status == 200 and token in body
-        assert _post(port, form, host=f"localhost:{port}", origin=f"http://localhost:{port}")[0] == 303
-        assert _post(port, f"id=2&status=rejected&token={token}")[0] == 303  # no Origin: the token decides
-        assert _statuses(store) == [("accepted", None), ("rejected", None)]
-    finally:
+@pytest.fixture
+def serve(store):
+    """Starts the review server on a free port (``timeout``: seconds a client may stall) and returns the port; every
+    server started is shut down after the test."""
+    servers = []
+
+    def start(timeout: float = TIMEOUT) -> int:
+        server, _ = serve_in_thread(store, timeout)
+        servers.append(server)
+        return server.server_address[1]
+
+    yield start
+    for server in servers:
         server.shutdown()
 
 
-def test_a_body_over_the_limit_is_refused_unread(store):
-    server, _ = serve_in_thread(store)
-    port = server.server_address[1]
-    try:
-        token = _token(port)
-        headers = {"Host": f"127.0.0.1:{port}", "Content-Length": "10000000"}
-        start = f"token={token}&id=1&status=corrected&correction=".encode()  # and never the rest
-        status, body = _http(port, "POST", "/review", headers, start)
-        assert status == 413 and "too large" in body.lower()
-        assert _statuses(store) == [("pending", None)] * 2
-    finally:
-        server.shutdown()
+def test_a_foreign_host_or_origin_is_refused(store, serve):
+    port = serve()
+    token = _token(port)
+    status, body = _http(port, "GET", "/", {"Host": "evil.example"})
+    assert status == 421 and token not in body
+    assert _http(port, "GET", "/", {})[0] == 421  # no Host at all: an HTTP/1.0 rebinding request
+    assert _http(port, "GET", "/", {"Host": f"localhost:{port + 1}"})[0] == 421
+    form = f"id=1&status=accepted&token={token}"
+    assert _post(port, form, host="evil.example", origin="http://evil.example")[0] == 421
+    assert _post(port, form, origin="http://evil.example")[0] == 403
+    assert _post(port, form, origin="null")[0] == 403
+    assert _statuses(store) == [("pending", None)] * 2
+    status, body = _http(port, "GET", "/", {"Host": f"localhost:{port}"})
+    assert status == 200 and token in body
+    assert _post(port, form, host=f"localhost:{port}", origin=f"http://localhost:{port}")[0] == 303
+    assert _post(port, f"id=2&status=rejected&token={token}")[0] == 303  # no Origin: the token decides
+    assert _statuses(store) == [("accepted", None), ("rejected", None)]
 
 
-def test_a_stalled_request_is_dropped_and_others_are_served(store):
-    server, _ = serve_in_thread(store, timeout=1)
-    port = server.server_address[1]
-    try:
-        stalled = [socket.create_connection(("127.0.0.1", port), timeout=10) for _ in range(5)]
-        for s in stalled:  # claims 100 bytes, sends 10
-            s.sendall(f"POST /review HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 100\r\n\r\n".encode()
-                      + b"token=abcd")
-        assert _http(port, "GET", "/", {"Host": f"127.0.0.1:{port}"})[0] == 200
-        start = time.monotonic()
-        for s in stalled:
-            assert s.recv(1024) == b""  # closed by the server, nothing answered
-            s.close()
-        assert time.monotonic() - start < 5
-        assert _statuses(store) == [("pending", None)] * 2
-    finally:
-        server.shutdown()
+def test_a_body_over_the_limit_is_refused_unread(store, serve):
+    port = serve()
+    token = _token(port)
+    headers = {"Host": f"127.0.0.1:{port}", "Content-Length": "10000000"}
+    start = f"token={token}&id=1&status=corrected&correction=".encode()  # and never the rest
+    status, body = _http(port, "POST", "/review", headers, start)
+    assert status == 413 and "too large" in body.lower()
+    assert _statuses(store) == [("pending", None)] * 2
 
 
-def test_bad_ids_and_lengths_get_400(store):
-    server, _ = serve_in_thread(store)
-    port = server.server_address[1]
-    try:
-        token = _token(port)
-        for id_part in (f"id={10**30}", "id=abc", "", "id=-1", "id=1.0"):
-            status, body = _post(port, f"{id_part}&status=accepted&token={token}")
-            assert status == 400 and "id" in body, id_part
-        host = {"Host": f"127.0.0.1:{port}"}
-        assert _http(port, "POST", "/review", host, f"id=1&status=accepted&token={token}".encode())[0] in (400, 411)
-        assert _http(port, "POST", "/review", {**host, "Content-Length": "ten"})[0] == 400
-        assert _http(port, "POST", "/review", {**host, "Content-Length": "-5"})[0] == 400
-        assert _statuses(store) == [("pending", None)] * 2
-        status, _ = _post(port, f"id=1&status=approved&token={token}")  # unknown status: reported, not stored
-        assert status == 303 and _statuses(store) == [("pending", None)] * 2
-    finally:
-        server.shutdown()
-
-
-def test_hostile_requests_print_no_traceback(store, capfd):
-    server, _ = serve_in_thread(store)
-    port = server.server_address[1]
-    try:
-        token = _token(port)
-        _post(port, f"id={10**30}&status=accepted&token={token}")
-        assert _post(port, "id=1&status=accepted&token=%C3%A9")[0] == 403  # a non-ASCII token is just wrong
-        s = socket.create_connection(("127.0.0.1", port))  # a client that resets mid-request
-        s.sendall(f"POST /review HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 100\r\n\r\nid=1".encode())
-        time.sleep(0.2)
-        s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+def test_a_stalled_request_is_dropped_and_others_are_served(store, serve):
+    port = serve(timeout=1)
+    stalled = [socket.create_connection(("127.0.0.1", port), timeout=10) for _ in range(5)]
+    for s in stalled:  # claims 100 bytes, sends 10
+        s.sendall(f"POST /review HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 100\r\n\r\n".encode()
+                  + b"token=abcd")
+    assert _http(port, "GET", "/", {"Host": f"127.0.0.1:{port}"})[0] == 200
+    start = time.monotonic()
+    for s in stalled:
+        assert s.recv(1024) == b""  # closed by the server, nothing answered
         s.close()
-        time.sleep(0.5)
-        assert _http(port, "GET", "/", {"Host": f"127.0.0.1:{port}"})[0] == 200
-    finally:
-        server.shutdown()
+    assert time.monotonic() - start < 5
+    assert _statuses(store) == [("pending", None)] * 2
+
+
+def test_bad_ids_and_lengths_get_400(store, serve):
+    port = serve()
+    token = _token(port)
+    for id_part in (f"id={10**30}", "id=abc", "", "id=-1", "id=1.0"):
+        status, body = _post(port, f"{id_part}&status=accepted&token={token}")
+        assert status == 400 and "id" in body, id_part
+    host = {"Host": f"127.0.0.1:{port}"}
+    assert _http(port, "POST", "/review", host, f"id=1&status=accepted&token={token}".encode())[0] in (400, 411)
+    assert _http(port, "POST", "/review", {**host, "Content-Length": "ten"})[0] == 400
+    assert _http(port, "POST", "/review", {**host, "Content-Length": "-5"})[0] == 400
+    assert _statuses(store) == [("pending", None)] * 2
+    status, _ = _post(port, f"id=1&status=approved&token={token}")  # unknown status: reported, not stored
+    assert status == 303 and _statuses(store) == [("pending", None)] * 2
+
+
+def test_hostile_requests_print_no_traceback(store, capfd, serve):
+    port = serve()
+    token = _token(port)
+    _post(port, f"id={10**30}&status=accepted&token={token}")
+    assert _post(port, "id=1&status=accepted&token=%C3%A9")[0] == 403  # a non-ASCII token is just wrong
+    s = socket.create_connection(("127.0.0.1", port))  # a client that resets mid-request
+    s.sendall(f"POST /review HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 100\r\n\r\nid=1".encode())
+    time.sleep(0.2)
+    s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+    s.close()
+    time.sleep(0.5)
+    assert _http(port, "GET", "/", {"Host": f"127.0.0.1:{port}"})[0] == 200
     err = capfd.readouterr().err
     assert "Traceback" not in err and err == ""
 
