@@ -1,6 +1,6 @@
 """Property-based fuzzing: whatever the input, the API raises only our errors and the CLI never shows a traceback.
 
-Case counts (max_examples) add up to 3,700 generated cases per run, 2,400 of them for the CLI's input readers
+Case counts (max_examples) add up to 3,400 generated cases per run, 2,100 of them for the CLI's input readers
 (.npy, .npz, CSV, JSON, command-line values) and Explanation.from_json (issue 27); hypothesis is seeded so runs
 repeat.
 """
