@@ -22,6 +22,10 @@ _LAZY = {
     # attribution
     "explain": "xairl.attributors",
     "Attributor": "xairl.attributors",
+    # streaming: any number of states, chunk by chunk, to a resumable Parquet dataset
+    "explain_chunks": "xairl.stream",
+    "explain_to_parquet": "xairl.stream",
+    "read_parquet": "xairl.stream",
     # options (attributors, narrators, reports and plugins' own settings)
     "Options": "xairl.options",
     "parse_options": "xairl.options",

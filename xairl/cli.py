@@ -155,12 +155,18 @@ def cmd_explain(args) -> int:
     policy = plugins.load_policy(args.policy, _parse_options(args.policy_arg), _state_shape(args.states))
     method = plugins.get_attributor(args.method)  # unknown names fail before any file is read
     options = method(_parse_options(args.option)).options
-    if args.states:
+    if args.format == "parquet" and not args.out:
+        raise InputError("--format parquet writes a folder: give it with --out DIR.")
+    if args.states and args.format == "parquet":
+        states = None  # streamed from the file, chunk by chunk
+    elif args.states:
         states = read_states(args.states, policy.feature_names, policy.observation)
     else:
         states = policy.background(args.n, seed=args.seed + 1)
     bg = read_states(args.background, policy.feature_names, policy.observation, "background") if args.background else \
         policy.background(args.background_size, seed=args.seed)
+    if args.format == "parquet":
+        return _stream(args, policy, args.states or states, bg, options.model_dump())
     exp = explain(policy, states, background=bg, method=args.method, options=options.model_dump())
     if args.out:
         return _write_report(args, exp, policy, bg)
@@ -212,6 +218,39 @@ def _write_report(args, exp, policy, bg) -> int:
                             datasets=[("states", exp.states)])
     path = write_report(req, content, explained={"states": exp})
     print(f"report: {path.resolve()}")
+    return 0
+
+
+def _stream(args, policy, states, bg, options: dict) -> int:
+    """``--format parquet``: explained chunk by chunk into DIR/explanations.parquet (resumable), with a progress bar
+    on a terminal, and a report whose figures show a uniform sample of the states."""
+    import time
+    from pathlib import Path
+
+    from .report import ReportContent, ReportRequest, table_html, write_report
+    from .stream import explain_to_parquet
+
+    out = Path(args.out)
+    t0 = time.time()
+    summary = explain_to_parquet(policy, states, out, background=bg, method=args.method, options=options,
+                                 chunk_size=args.chunk_size, resume=args.resume)
+    seconds = time.time() - t0
+    means = summary.to_dict(policy.feature_names)["mean_abs_contribution"]
+    order = sorted(policy.feature_names, key=lambda f: -means["margin"][f])
+    table = table_html(["feature", "mean |contribution| to the margin", "to the chosen score"],
+                       [[f, f"{means['margin'][f]:.4g}", f"{means['chosen_score'][f]:.4g}"] for f in order])
+    req = ReportRequest(out=out, method=args.method, options=options, narrate=args.narrate, narrator=args.narrator,
+                        narrator_options=_parse_options(args.narrator_option), template=args.template,
+                        prompt_dirs=args.prompts, seed=args.seed, n_states=summary.n,
+                        robustness=not args.no_robustness, progress=False, records=False)
+    content = ReportContent(title=f"xairl: {policy.name}", policy=policy, background=bg,
+                            datasets=[("states", summary.sample_explanation().states)],
+                            tables=[(f"Mean |contribution| over all {summary.n} states", table)],
+                            notes=[f"{summary.n} states explained in {seconds:.1f} s ({summary.n / max(seconds, 1e-9):.0f}"
+                                   f" states/s) into {out / 'explanations.parquet'}; the figures show a uniform "
+                                   f"sample of {len(summary.sample)} of them."])
+    path = write_report(req, content, explained={"states": summary.sample_explanation()})
+    print(f"explanations: {(out / 'explanations.parquet').resolve()} ({summary.n} states)\nreport: {path.resolve()}")
     return 0
 
 
@@ -414,7 +453,12 @@ def _explain_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
     p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",
                    help="an option of the method, validated against its schema; repeatable")
-    p.add_argument("--format", choices=("table", "jsonl"), default="table", help="output format")
+    p.add_argument("--format", choices=("table", "jsonl", "parquet"), default="table",
+                   help="table or jsonl on the terminal; parquet: streamed chunk by chunk into --out DIR (any number "
+                   "of states, resumable with --resume)")
+    p.add_argument("--chunk-size", type=_count(1, 10_000_000), default=50_000, help="states per chunk with --format "
+                   "parquet (memory grows with it)")
+    p.add_argument("--resume", action="store_true", help="with --format parquet: continue an interrupted run in --out")
     p.add_argument("--top", type=_count(1), default=5, help="features shown per state in the table")
     _narration_arguments(p)
     p.add_argument("--feedback-db", type=_new_file, default=None, help="SQLite store of shown narratives (default: in the user dir)")

@@ -5,7 +5,6 @@ timeout, so many processes can record at once without losing rows, and an interr
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import sqlite3
 import time
@@ -16,6 +15,7 @@ from typing import Iterator, TextIO
 
 from .errors import InputError
 from .paths import user_dir
+from .policy import model_hash
 
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS narratives (
@@ -33,15 +33,6 @@ CREATE TABLE IF NOT EXISTS narratives (
     evidence TEXT
 )"""
 STATUSES = ("accepted", "rejected", "corrected")
-
-
-def model_hash(module) -> str:
-    """Short SHA-256 of a torch module's parameters and buffers (which network said it)."""
-    h = hashlib.sha256()
-    for name, tensor in sorted(module.state_dict().items()):
-        h.update(name.encode())
-        h.update(tensor.detach().cpu().contiguous().numpy().tobytes())
-    return h.hexdigest()[:16]
 
 
 @dataclass(frozen=True)

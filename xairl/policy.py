@@ -2,6 +2,7 @@
 value), with names, metadata and the structure of its input."""
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field
 from typing import Any, Callable, Literal, Mapping, Sequence
 
@@ -224,6 +225,15 @@ class Policy:
 
 
 TorchPolicy = Policy  # the name users of plain torch networks (CleanRL style) look for
+
+
+def model_hash(module) -> str:
+    """Short SHA-256 of a torch module's parameters and buffers (which network said it)."""
+    h = hashlib.sha256()
+    for name, tensor in sorted(module.state_dict().items()):
+        h.update(name.encode())
+        h.update(tensor.detach().cpu().contiguous().numpy().tobytes())
+    return h.hexdigest()[:16]
 
 
 class PolicyNetwork(torch.nn.Module):

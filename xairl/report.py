@@ -46,6 +46,7 @@ class ReportRequest:
     n_narrated: int = 6
     robustness: bool = True
     progress: bool = True
+    records: bool = True  # write explanations.jsonl (False when the explanations are already written as Parquet)
 
 
 @dataclass
@@ -151,11 +152,12 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     for label, states in tqdm(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress):
         exps.append((label, explained.get(label) or explain(content.policy, states, background=content.background,
                                                             method=req.method, options=req.options)))
-    with atomic_write(out / "explanations.jsonl") as fh:
-        for label, exp in exps:
-            for rec in exp.records(dataset=label):
-                fh.write(rec.model_dump_json() + "\n")
-    write_text(out / "explanations.schema.json", json.dumps(StateRecord.model_json_schema(), indent=2))
+    if req.records:
+        with atomic_write(out / "explanations.jsonl") as fh:
+            for label, exp in exps:
+                for rec in exp.records(dataset=label):
+                    fh.write(rec.model_dump_json() + "\n")
+        write_text(out / "explanations.schema.json", json.dumps(StateRecord.model_json_schema(), indent=2))
     ref_label, ref = exps[0]
     pick = _interesting(ref)
     # images and dicts are plotted by patch / by key (thousands of pixels are no beeswarm); the image plot shows

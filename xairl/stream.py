@@ -1,0 +1,332 @@
+"""Explaining more states than fit in memory: states read in chunks, explained chunk by chunk, each chunk written as
+a Parquet file of its own as soon as it is done, and global figures from running sums and a uniform sample.
+
+    for start, exp in xairl.explain_chunks(policy, "states.npy", background=bg, chunk_size=50_000): ...
+    xairl.explain_to_parquet(policy, "states.npy", "out/", background=bg)      # resumable: resume=True
+    exp = xairl.read_parquet("out/explanations.parquet")                      # back as one Explanation
+
+The output folder holds ``explanations.parquet/`` (a Parquet dataset, one ``part-<first row>.parquet`` per chunk:
+``pandas.read_parquet`` and ``pyarrow.dataset`` read the folder as one table), ``run.json`` (what ran: the source,
+the chunk size, the method and its options, hashes of the policy and the background; ``resume`` refuses another
+run) and ``summary.json`` (mean |contribution| per feature over all states). Each part is written to a hidden
+``.part`` file and renamed when complete, so an interrupted run leaves only whole chunks, and ``resume`` explains
+exactly the chunks that are missing.
+
+Columns of a part: ``index`` (the state's row in the source), ``state`` (F float32), ``values`` (F x A float32,
+feature-major: ``values.reshape(F, A)``), ``base_values``, ``outputs`` and ``additivity_gap`` (A float64 each), and
+``chosen`` and ``runner_up`` (action indices, -1 when nothing is chosen). The schema's metadata (key ``xairl``)
+holds the names, the method, its options and the policy's hash.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Iterator
+
+import numpy as np
+
+from .errors import InputError
+from .explanation import Explanation
+from .files import write_text
+from .inputs import read_states
+from .policy import Policy, model_hash
+
+CHUNK = 50_000  # states per chunk: a few MB of results, and bounded memory whatever the attributor
+SAMPLE = 1_000  # states kept (uniformly, by reservoir sampling) for the figures of a streamed run
+DATASET = "explanations.parquet"
+
+
+# ---- reading ---------------------------------------------------------------------------------------------------
+def count_states(source, policy: Policy) -> int | None:
+    """Rows in a states source (an array, .npy, .parquet; None for a CSV, which is counted as it is read)."""
+    if not isinstance(source, (str, Path)):
+        return len(policy.check_states(source)) if not hasattr(source, "shape") else int(source.shape[0])
+    path = Path(source)
+    if path.suffix.lower() == ".npy":
+        return int(_npy(path).shape[0])
+    if path.suffix.lower() == ".parquet":
+        import pyarrow.parquet as pq
+
+        return int(pq.ParquetFile(path).metadata.num_rows)
+    if path.suffix.lower() == ".csv":
+        return None
+    return len(read_states(path, policy.feature_names, policy.observation))
+
+
+def state_chunks(source, policy: Policy, chunk_size: int = CHUNK, start: int = 0) -> Iterator[tuple[int, np.ndarray]]:
+    """(first row, checked float32 states) for each chunk of ``chunk_size`` rows from row ``start`` on.
+
+    :param source: an array (any form the policy's observation takes), or a file: .npy (memory-mapped), .parquet
+        (read by record batch; one column per feature, named as the features), .csv (read by block; a header naming
+        the features), or .npz/.json (read whole, then chunked).
+    """
+    if chunk_size < 1:
+        raise InputError(f"chunk size must be at least 1, got {chunk_size}.")
+    path = Path(source) if isinstance(source, (str, Path)) else None
+    suffix = path.suffix.lower() if path else ""
+    if path is not None and not path.is_file():
+        raise InputError(f"{path}: no such file; give a .npy, .parquet, .csv, .npz or .json file of states.")
+    if suffix in (".parquet", ".csv"):
+        yield from _rechunk(_table_batches(path, policy, chunk_size), policy, chunk_size, start, str(path))
+        return
+    rows = _npy(path) if suffix == ".npy" else read_states(path, policy.feature_names, policy.observation) \
+        if path is not None else policy.check_states(source)
+    n = len(rows)
+    for a in range(start - start % chunk_size, n, chunk_size):
+        what = f"{path}: rows {a}..{min(a + chunk_size, n) - 1}" if path else f"states {a}..{min(a + chunk_size, n) - 1}"
+        yield a, policy.check_states(np.asarray(rows[a:a + chunk_size]), what)
+
+
+def _npy(path: Path) -> np.ndarray:
+    try:
+        return np.load(path, mmap_mode="r", allow_pickle=False)  # pages are read as chunks need them
+    except (ValueError, OSError, EOFError) as exc:
+        raise InputError(f"{path}: cannot read it as .npy ({' '.join(str(exc).split())[:120]}).") from None
+
+
+def _table_batches(path: Path, policy: Policy, chunk_size: int) -> Iterator[np.ndarray]:
+    """Record batches of a Parquet or CSV file, as float64 arrays with the features' columns in the policy's order."""
+    import pyarrow as pa
+
+    names = list(policy.feature_names)
+    try:
+        if path.suffix.lower() == ".parquet":
+            import pyarrow.parquet as pq
+
+            missing = [f for f in names if f not in pq.ParquetFile(path).schema_arrow.names]
+            if missing:
+                raise InputError(f"{path}: lacks column(s) {', '.join(missing[:5])}; one column per feature, named as "
+                                 "the features.")
+            batches = pq.ParquetFile(path).iter_batches(batch_size=chunk_size, columns=names)
+        else:
+            from pyarrow import csv
+
+            reader = csv.open_csv(path, convert_options=csv.ConvertOptions(include_columns=names,
+                                                                             column_types={f: pa.float64() for f in names}))
+            batches = iter(reader)
+        for batch in batches:
+            yield np.column_stack([batch.column(f).to_numpy(zero_copy_only=False) for f in names]) \
+                if batch.num_rows else np.empty((0, len(names)))
+    except (pa.ArrowException, OSError) as exc:
+        raise InputError(f"{path}: cannot read it ({' '.join(str(exc).split())[:160]}).") from None
+
+
+def _rechunk(batches: Iterator[np.ndarray], policy: Policy, chunk_size: int, start: int, what: str):
+    """Batches of any size -> chunks of exactly ``chunk_size`` rows (the last may be shorter), from ``start`` on."""
+    buffered, first, row = [], 0, 0
+    for batch in batches:
+        buffered.append(batch)
+        row += len(batch)
+        while row - first >= chunk_size:
+            rows = np.concatenate(buffered)
+            chunk, rest = rows[:chunk_size], rows[chunk_size:]
+            if first + chunk_size > start - start % chunk_size:
+                yield first, policy.check_states(chunk, f"{what}: rows {first}..{first + chunk_size - 1}")
+            first += chunk_size
+            buffered = [rest]
+    rows = np.concatenate(buffered) if buffered else np.empty((0, policy.n_features))
+    if len(rows) and first >= start - start % chunk_size:
+        yield first, policy.check_states(rows, f"{what}: rows {first}..{first + len(rows) - 1}")
+
+
+# ---- explaining ------------------------------------------------------------------------------------------------
+def explain_chunks(policy: Policy, states, background=None, method: str = "deep_shap", options: dict | None = None,
+                   chunk_size: int = CHUNK, start: int = 0) -> Iterator[tuple[int, Explanation]]:
+    """(first row, Explanation) for each chunk of ``states`` (an array or a file, see :func:`state_chunks`), in
+    order; memory stays that of one chunk whatever the number of states."""
+    from .attributors import explain
+
+    bg = policy.background() if background is None else policy.check_states(background, "background")
+    for first, x in state_chunks(states, policy, chunk_size, start):
+        yield first, explain(policy, x, background=bg, method=method, options=options)
+
+
+# ---- writing ---------------------------------------------------------------------------------------------------
+def _part_name(first: int) -> str:
+    return f"part-{first:012d}.parquet"
+
+
+def write_part(folder: Path, first: int, exp: Explanation, meta: dict) -> Path:
+    """One chunk as ``folder/part-<first>.parquet``, written whole or not at all."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from .files import atomic_write
+
+    n, f, a = exp.values.shape
+
+    def fixed(arr: np.ndarray, width: int, kind) -> pa.Array:
+        return pa.FixedSizeListArray.from_arrays(pa.array(np.ascontiguousarray(arr).reshape(-1), kind), width)
+
+    decides = exp.output == "actions"
+    columns = {
+        "index": pa.array(np.arange(first, first + n, dtype=np.int64)),
+        "state": fixed(exp.states.astype(np.float32), f, pa.float32()),
+        "values": fixed(exp.values.astype(np.float32), f * a, pa.float32()),
+        "base_values": fixed(exp.base_values, a, pa.float64()),
+        "outputs": fixed(exp.outputs, a, pa.float64()),
+        "additivity_gap": fixed(exp.additivity_gap, a, pa.float64()),
+        "chosen": pa.array(exp.chosen if decides else np.full(n, -1), pa.int32()),
+        "runner_up": pa.array(exp.runner_up if decides else np.full(n, -1), pa.int32()),
+    }
+    if exp.available is not None:  # the action mask: chosen and runner-up are taken among available actions
+        columns["available"] = fixed(exp.available, a, pa.bool_())
+    table = pa.table(columns).replace_schema_metadata({"xairl": json.dumps(meta)})
+    path = folder / _part_name(first)
+    with atomic_write(path, "wb") as fh:
+        pq.write_table(table, fh, compression="zstd")
+    return path
+
+
+def read_parquet(path: str | Path) -> Explanation:
+    """A written dataset (the ``explanations.parquet`` folder or one part) as one Explanation, rows in index order
+    (for runs that fit in memory; stream larger ones with pyarrow.dataset)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = Path(path)
+    parts = sorted(path.glob("part-*.parquet")) if path.is_dir() else [path]
+    if not parts:
+        raise InputError(f"{path}: no explanation parts in it; write them with xairl.explain_to_parquet.")
+    try:
+        table = pa.concat_tables([pq.read_table(p) for p in parts])
+        meta = json.loads(table.schema.metadata[b"xairl"])
+    except (pa.ArrowException, OSError, KeyError, ValueError) as exc:
+        raise InputError(f"{path}: not an xairl Parquet dataset ({' '.join(str(exc).split())[:120]}).") from None
+    table = table.sort_by("index")
+    f, a = len(meta["feature_names"]), len(meta["action_names"])
+
+    def rows(name: str, width: int) -> np.ndarray:
+        return table.column(name).combine_chunks().flatten().to_numpy().reshape(-1, width).astype(np.float64)
+
+    available = rows("available", a).astype(bool) if "available" in table.column_names else None
+    return Explanation(values=rows("values", f * a).reshape(-1, f, a), base_values=rows("base_values", a),
+                       outputs=rows("outputs", a), states=rows("state", f), feature_names=tuple(meta["feature_names"]),
+                       action_names=tuple(meta["action_names"]), method=meta["method"], options=meta["options"],
+                       output=meta["output"], observation=meta.get("observation"), available=available,
+                       categories=meta.get("categories"))
+
+
+@dataclass
+class RunningSummary:
+    """Figures of a streamed run without a second pass: sums of |contribution| per feature (to the chosen score and
+    to the margin over the runner-up), and a uniform sample of ``size`` states (reservoir sampling, seeded)."""
+
+    size: int = SAMPLE
+    seed: int = 0
+    n: int = 0
+    abs_chosen: np.ndarray | None = None
+    abs_margin: np.ndarray | None = None
+    sample: list = field(default_factory=list)  # (row, Explanation of one state)
+
+    def add(self, first: int, exp: Explanation) -> None:
+        chosen, margin = np.abs(exp.for_chosen()).sum(axis=0), np.abs(exp.margin()).sum(axis=0)
+        self.abs_chosen = chosen if self.abs_chosen is None else self.abs_chosen + chosen
+        self.abs_margin = margin if self.abs_margin is None else self.abs_margin + margin
+        m = len(exp.values)
+        # Algorithm R: state number t (1-based) replaces a random slot j < t when j < size; the draws are seeded per
+        # chunk, so a resumed run keeps the same sample
+        slots = np.random.default_rng([self.seed, first]).integers(0, np.arange(self.n + 1, self.n + m + 1))
+        slots = np.where(np.arange(self.n, self.n + m) < self.size, np.arange(self.n, self.n + m), slots)
+        for i in np.flatnonzero(slots < self.size):
+            entry = (first + int(i), _rows(exp, int(i)))
+            if slots[i] < len(self.sample):
+                self.sample[slots[i]] = entry
+            else:
+                self.sample.append(entry)
+        self.n += m
+
+    def sample_explanation(self) -> Explanation | None:
+        """The sampled states as one Explanation, in row order."""
+        if not self.sample:
+            return None
+        parts = [e for _, e in sorted(self.sample, key=lambda p: p[0])]
+        first = parts[0]
+        return Explanation(**{**first.__dict__, **{k: np.concatenate([getattr(p, k) for p in parts])
+                                                   for k in ("values", "base_values", "outputs", "states")},
+                              "available": None if first.available is None else
+                              np.concatenate([p.available for p in parts])})
+
+    def to_dict(self, feature_names) -> dict:
+        mean = {"chosen_score": self.abs_chosen / max(self.n, 1), "margin": self.abs_margin / max(self.n, 1)}
+        return {"states": self.n, "sampled_for_figures": len(self.sample),
+                "mean_abs_contribution": {k: dict(zip(feature_names, v.tolist())) for k, v in mean.items()}}
+
+
+def _rows(exp: Explanation, i: int) -> Explanation:
+    s = slice(i, i + 1)
+    return Explanation(**{**exp.__dict__, "values": exp.values[s], "base_values": exp.base_values[s],
+                          "outputs": exp.outputs[s], "states": exp.states[s],
+                          "available": None if exp.available is None else exp.available[s]})
+
+
+def run_identity(policy: Policy, source, background: np.ndarray, method: str, options: dict, chunk_size: int
+                 ) -> dict[str, Any]:
+    """What makes two runs the same run (``resume`` continues only that)."""
+    if isinstance(source, (str, Path)):
+        stat = Path(source).stat()
+        where = {"source": str(Path(source).resolve()), "source_bytes": stat.st_size, "source_mtime": stat.st_mtime}
+    else:
+        where = {"source": "array", "source_sha256": hashlib.sha256(np.ascontiguousarray(source).tobytes()).hexdigest()}
+    return {**where, "chunk_size": chunk_size, "method": method, "options": options, "policy": policy.name,
+            "policy_hash": model_hash(policy.module),
+            "background_sha256": hashlib.sha256(np.ascontiguousarray(background).tobytes()).hexdigest()}
+
+
+def explain_to_parquet(policy: Policy, states, out: str | Path, background=None, method: str = "deep_shap",
+                       options: dict | None = None, chunk_size: int = CHUNK, resume: bool = False,
+                       progress: bool | None = None) -> RunningSummary:
+    """Explain ``states`` chunk by chunk into ``out`` (layout in the module doc), with a progress bar on a terminal
+    (``progress=None``: only when stderr is one). ``resume=True`` continues an interrupted run of the same
+    states, policy, background, method, options and chunk size; without it, a folder that already holds a run is
+    refused (nothing is overwritten)."""
+    from tqdm import tqdm
+
+    from .attributors import explain
+    from .plugins import get_attributor
+
+    out = Path(out)
+    parts = out / DATASET
+    options = get_attributor(method)(options).options.model_dump()
+    bg = policy.background() if background is None else policy.check_states(background, "background")
+    identity = run_identity(policy, states, bg, method, options, chunk_size)
+    done = _existing_run(out, identity, resume)
+    parts.mkdir(parents=True, exist_ok=True)
+    write_text(out / "run.json", json.dumps(identity, indent=2))
+    meta = {"feature_names": list(policy.feature_names), "action_names": list(policy.action_names), "method": method,
+            "options": options, "output": policy.output, "policy": policy.name, "policy_hash": identity["policy_hash"],
+            "observation": policy.observation.to_dict(),
+            "categories": {f: list(i.categories) for f, i in policy.features.items() if i.categories} or None}
+    summary = RunningSummary()
+    total = count_states(states, policy)
+    bar = tqdm(total=total, unit="states", desc=f"explaining ({method})", disable=False if progress else
+               None if progress is None else True, smoothing=0.1)
+    with bar:
+        for first, x in state_chunks(states, policy, chunk_size):
+            if first not in done:  # (a whole chunk from an interrupted run is not explained again)
+                write_part(parts, first, explain(policy, x, background=bg, method=method, options=options), meta)
+            summary.add(first, read_parquet(parts / _part_name(first)))  # as written: a resumed run sums the same
+            bar.update(len(x))
+    write_text(out / "summary.json", json.dumps(summary.to_dict(policy.feature_names), indent=2))
+    return summary
+
+
+def _existing_run(out: Path, identity: dict, resume: bool) -> set[int]:
+    """First rows of the chunks an earlier run completed (empty for a new folder); refuses another run's folder."""
+    parts = sorted((out / DATASET).glob("part-*.parquet")) if (out / DATASET).is_dir() else []
+    if not parts and not (out / "run.json").exists():
+        return set()
+    if not resume:
+        raise InputError(f"{out} already holds a run ({len(parts)} chunk(s) written); pass --resume to continue it, "
+                         "or give another folder.")
+    try:
+        earlier = json.loads((out / "run.json").read_text())
+    except (OSError, ValueError):
+        earlier = None
+    if earlier != json.loads(json.dumps(identity)):
+        changed = sorted(k for k in identity if not earlier or earlier.get(k) != json.loads(json.dumps(identity))[k])
+        raise InputError(f"{out} holds another run (it differs in {', '.join(changed) or 'run.json'}); resume needs "
+                         "the same states, policy, background, method, options and chunk size.")
+    return {int(p.stem.split("-")[1]) for p in parts}
