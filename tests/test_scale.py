@@ -1,0 +1,45 @@
+"""The Ray engine (issue 28) on a local Ray started by the test (2 workers, loopback only): the same Parquet parts,
+bit for bit, as the local engine, resume included; and the local engine never imports Ray."""
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from xairl.cli import main
+from xairl.stream import explain_to_parquet, read_parquet
+from xairl.toy import toy_policy
+
+ray = pytest.importorskip("ray", reason="the Ray engine is the 'scale' extra (make test installs it)")
+POLICY = toy_policy()
+
+
+def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path):
+    from xairl.scale import explain_on_ray
+
+    states = tmp_path / "s.npy"
+    np.save(states, POLICY.background(6_000, seed=4))
+    bg = POLICY.background(30)
+    explain_to_parquet(POLICY, states, tmp_path / "local", background=bg, chunk_size=1000, progress=False)
+    summary = explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=1000, workers=2)
+    local, distributed = (read_parquet(tmp_path / d / "explanations.parquet") for d in ("local", "ray"))
+    assert np.array_equal(local.values, distributed.values) and np.array_equal(local.outputs, distributed.outputs)
+    assert summary.n == 6_000 and not ray.is_initialized()  # the Ray it started is stopped
+    assert (tmp_path / "local" / "summary.json").read_text() == (tmp_path / "ray" / "summary.json").read_text()
+    lost = sorted((tmp_path / "ray" / "explanations.parquet").glob("part-*.parquet"))[2:4]
+    for part in lost:  # as if the run had been killed before these chunks were written
+        part.unlink()
+    argv = ["explain", "--states", str(states), "--out", str(tmp_path / "ray"), "--format", "parquet", "--engine",
+            "ray", "--workers", "2", "--chunk-size", "1000", "--resume"]
+    assert main(argv + ["--background-size", "31"]) == 2  # another background than the run's: refused
+    assert main(argv + ["--background-size", "30"]) == 0  # the same run (the sampler's 30 states): resumed
+    again = read_parquet(tmp_path / "ray" / "explanations.parquet")
+    assert np.array_equal(again.values, local.values)
+
+
+def test_the_local_engine_imports_no_ray(tmp_path):
+    code = ("import sys, numpy as np; from xairl.toy import toy_policy; from xairl.stream import explain_to_parquet; "
+            f"p = toy_policy(); explain_to_parquet(p, p.background(100), {str(tmp_path / 'o')!r}, progress=False); "
+            "print('ray' in sys.modules)")
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip() \
+        == "False"

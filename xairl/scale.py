@@ -1,0 +1,110 @@
+"""The Ray engine (``pip install 'xairl[scale]'``): the streaming pipeline of :mod:`xairl.stream`, its chunks spread
+over Ray workers. Only this module imports Ray; the local engine never does.
+
+Ray Data maps the chunks' first rows through an actor pool (``map_batches``): each actor holds the policy, the
+background and the attributor, reads its chunk from the states (a memory-mapped .npy on a file system the workers
+share, or an array put in Ray's object store), explains it and writes its Parquet part, whole or not at all. The
+chunks are those of the local engine, so the parts are the same bits, ``run.json`` and ``resume`` work alike, and
+the summary is computed by the driver from the written parts, in order.
+
+``ray.init()`` starts Ray on this machine with ``workers`` CPUs (loopback only); ``address`` joins a running cluster
+(``ray://host:10001`` or ``auto``).
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+from .files import write_text
+from .policy import Policy
+from .stream import (CHUNK, DATASET, RunningSummary, _existing_run, _part_name, count_states, part_meta,
+                     read_parquet, run_identity, state_chunks, write_part)
+
+
+class _ChunkWorker:
+    """A Ray actor: explains the chunks whose first rows it is given, each into its own part."""
+
+    def __init__(self, policy: Policy, states, background: np.ndarray, method: str, options: dict, chunk_size: int,
+                 parts: str, meta: dict, threads: int):
+        import torch
+
+        import ray
+
+        torch.set_num_threads(threads)  # one worker per core: no oversubscription
+        if isinstance(states, ray.ObjectRef):  # an array in the object store, shared by the workers of a node
+            states = ray.get(states)
+        self.policy, self.states, self.bg = policy, states, background
+        self.method, self.options, self.chunk_size = method, options, chunk_size
+        self.parts, self.meta = Path(parts), meta
+
+    def __call__(self, batch: dict) -> dict:
+        from .attributors import explain
+
+        states = self.states if isinstance(self.states, str) else np.asarray(self.states)
+        for first in batch["first"].tolist():
+            _, x = next(state_chunks(states, self.policy, self.chunk_size, start=first))
+            exp = explain(self.policy, x, background=self.bg, method=self.method, options=self.options)
+            write_part(self.parts, first, exp, self.meta)
+        return {"first": batch["first"]}
+
+
+def explain_on_ray(policy: Policy, states, out: str | Path, background=None, method: str = "deep_shap",
+                   options: dict | None = None, chunk_size: int = CHUNK, resume: bool = False, workers: int = 2,
+                   address: str | None = None, progress: bool | None = None) -> RunningSummary:
+    """:func:`xairl.explain_to_parquet` on Ray: the same folder, the same parts (bit for bit), ``workers`` actors.
+
+    :param states: a .npy file (memory-mapped by each worker: on a cluster, a path every node can read) or an array.
+    :param address: a running Ray cluster; None starts Ray on this machine with ``workers`` CPUs.
+    """
+    try:
+        import ray
+    except ImportError:
+        raise InputError("the Ray engine needs Ray: pip install 'xairl[scale]'.") from None
+    from tqdm import tqdm
+
+    from .plugins import get_attributor
+
+    if isinstance(states, (str, Path)):
+        if Path(states).suffix.lower() != ".npy":
+            raise InputError(f"{states}: the Ray engine reads .npy files (memory-mapped by each worker); convert it, "
+                             "or use the local engine, which also reads .parquet and .csv.")
+        source = str(Path(states).resolve())
+    else:
+        source = policy.check_states(states)
+    out = Path(out)
+    parts = out / DATASET
+    options = get_attributor(method)(options).options.model_dump()
+    bg = policy.background() if background is None else policy.check_states(background, "background")
+    identity = run_identity(policy, states, bg, method, options, chunk_size)
+    done = _existing_run(out, identity, resume)
+    parts.mkdir(parents=True, exist_ok=True)
+    write_text(out / "run.json", json.dumps(identity, indent=2))
+    total = count_states(states, policy)
+    todo = [first for first in range(0, total, chunk_size) if first not in done]
+    started = not ray.is_initialized()
+    if started:
+        ray.init(address=address, num_cpus=None if address else workers, include_dashboard=False,
+                 log_to_driver=False, logging_level="ERROR", configure_logging=False,
+                 **({} if address else {"_node_ip_address": "127.0.0.1"}))
+    try:
+        ctx = ray.data.DataContext.get_current()
+        ctx.enable_progress_bars = False
+        ref = ray.put(source) if not isinstance(source, str) else source
+        if todo:
+            ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo)).map_batches(
+                _ChunkWorker, batch_size=1, concurrency=workers, num_cpus=1,
+                fn_constructor_kwargs={"policy": policy, "states": ref, "background": bg, "method": method,
+                                       "options": options, "chunk_size": chunk_size, "parts": str(parts),
+                                       "meta": part_meta(policy, method, options, identity), "threads": 1},
+            ).materialize()
+    finally:
+        if started:
+            ray.shutdown()
+    summary = RunningSummary()
+    for first in tqdm(range(0, total, chunk_size), desc="summing", unit="chunk", disable=not progress):
+        summary.add(first, read_parquet(parts / _part_name(first)))
+    write_text(out / "summary.json", json.dumps(summary.to_dict(policy.feature_names), indent=2))
+    return summary
