@@ -1,8 +1,8 @@
 """Property-based fuzzing: whatever the input, the API raises only our errors and the CLI never shows a traceback.
 
-Case counts (max_examples) add up to 3,400 generated cases per run, 2,100 of them for the CLI's input readers
-(.npy, .npz, CSV, JSON, command-line values) and Explanation.from_json (issue 27); hypothesis is seeded so runs
-repeat.
+Case counts (max_examples) add up to 3,600 generated cases per run, 2,300 of them for the CLI's input readers
+(.npy, .npz, CSV, JSON, command-line values, the streaming engine's CSV and Parquet) and Explanation.from_json
+(issues 27 and 28); hypothesis is seeded so runs repeat.
 """
 import json
 import string
@@ -185,3 +185,30 @@ def _cli_ok(argv):
     assert "Traceback" not in text and "internal error" not in text, text
     if rc == 2:
         assert text.count("\n") == 1 and text.startswith("xairl: error: ")
+
+
+@fast(200)
+@given(header=st.lists(st.sampled_from(list(FEATURES) + ["junk", ""]), max_size=7),
+       rows=st.lists(st.lists(cell, max_size=7), max_size=5), as_parquet=st.booleans(), chunk=st.integers(1, 4))
+def test_streamed_readers_of_any_csv_or_parquet(tmp_path_factory, header, rows, as_parquet, chunk):
+    """The streaming engine's readers (pyarrow's CSV and Parquet): chunks of checked states, or one InputError line."""
+    from xairl.stream import state_chunks
+
+    folder = tmp_path_factory.mktemp("stream")
+    path = folder / "s.csv"
+    path.write_text(",".join(header) + "\n" + "\n".join(",".join(r) for r in rows))
+    if as_parquet:
+        import pyarrow.csv
+        import pyarrow.parquet
+
+        try:
+            table = pyarrow.csv.read_csv(path)
+        except Exception:  # not even a table: nothing to convert
+            return
+        path = folder / "s.parquet"
+        pyarrow.parquet.write_table(table, path)
+    try:
+        for first, x in state_chunks(path, POLICY, chunk_size=chunk):
+            assert x.dtype == np.float32 and x.shape[1] == 5 and np.isfinite(x).all() and first % chunk == 0
+    except XairlError as exc:
+        assert "\n" not in str(exc)

@@ -306,6 +306,8 @@ def explain_to_parquet(policy: Policy, states, out: str | Path, background=None,
                 write_part(parts, first, explain(policy, x, background=bg, method=method, options=options), meta)
             summary.add(first, read_parquet(parts / _part_name(first)))  # as written: a resumed run sums the same
             bar.update(len(x))
+    if not summary.n:
+        raise InputError(f"{states if isinstance(states, (str, Path)) else 'the states'} holds no state to explain.")
     write_text(out / "summary.json", json.dumps(summary.to_dict(policy.feature_names), indent=2))
     return summary
 
