@@ -45,7 +45,7 @@ def count_states(source, policy: Policy) -> int | None:
         return len(policy.check_states(source)) if not hasattr(source, "shape") else int(source.shape[0])
     path = Path(source)
     if path.suffix.lower() == ".npy":
-        return int(_npy(path).shape[0])
+        return len(_npy(path))
     if path.suffix.lower() == ".parquet":
         import pyarrow.parquet as pq
 
@@ -79,11 +79,43 @@ def state_chunks(source, policy: Policy, chunk_size: int = CHUNK, start: int = 0
         yield a, policy.check_states(np.asarray(rows[a:a + chunk_size]), what)
 
 
-def _npy(path: Path) -> np.ndarray:
-    try:
-        return np.load(path, mmap_mode="r", allow_pickle=False)  # pages are read as chunks need them
-    except (ValueError, OSError, EOFError) as exc:
-        raise InputError(f"{path}: cannot read it as .npy ({' '.join(str(exc).split())[:120]}).") from None
+class _NpyRows:
+    """The rows of a .npy file, read slice by slice with plain file reads: the system's page cache holds the file,
+    not this process (a memory map would count every page read towards its resident memory, 320 MB at 10^7 states
+    of 8 floats)."""
+
+    def __init__(self, path: Path):
+        try:
+            with path.open("rb") as fh:
+                version = np.lib.format.read_magic(fh)
+                self.shape, fortran, self.dtype = (np.lib.format.read_array_header_1_0(fh) if version == (1, 0) else
+                                                   np.lib.format.read_array_header_2_0(fh))
+                self.offset = fh.tell()
+        except (ValueError, OSError, EOFError) as exc:
+            raise InputError(f"{path}: cannot read it as .npy ({' '.join(str(exc).split())[:120]}).") from None
+        if self.dtype.hasobject or not self.shape:
+            raise InputError(f"{path}: holds {'Python objects' if self.dtype.hasobject else 'a single number'}, not "
+                             "rows of states.")
+        self.path, self.fortran = path, fortran
+        self.row = int(np.prod(self.shape[1:], dtype=np.int64))
+        if path.stat().st_size - self.offset < len(self) * self.row * self.dtype.itemsize:
+            raise InputError(f"{path}: shorter than its header says (shape {self.shape}); it is truncated.")
+
+    def __len__(self) -> int:
+        return int(self.shape[0])
+
+    def __getitem__(self, rows: slice) -> np.ndarray:
+        a, b, _ = rows.indices(len(self))
+        if self.fortran:  # column-major: rows are not contiguous; the memory map reads them
+            return np.array(np.load(self.path, mmap_mode="r", allow_pickle=False)[a:b])
+        with self.path.open("rb") as fh:
+            fh.seek(self.offset + a * self.row * self.dtype.itemsize)
+            return np.fromfile(fh, self.dtype, count=max(b - a, 0) * self.row).reshape(max(b - a, 0),
+                                                                                       *self.shape[1:])
+
+
+def _npy(path: Path) -> _NpyRows:
+    return _NpyRows(path)
 
 
 def _table_batches(path: Path, policy: Policy, chunk_size: int) -> Iterator[np.ndarray]:
@@ -256,10 +288,11 @@ class RunningSummary:
 
 
 def _rows(exp: Explanation, i: int) -> Explanation:
+    """State ``i`` alone, copied: a view would keep its whole chunk in memory as long as the sample holds it."""
     s = slice(i, i + 1)
-    return Explanation(**{**exp.__dict__, "values": exp.values[s], "base_values": exp.base_values[s],
-                          "outputs": exp.outputs[s], "states": exp.states[s],
-                          "available": None if exp.available is None else exp.available[s]})
+    return Explanation(**{**exp.__dict__, "values": exp.values[s].copy(), "base_values": exp.base_values[s].copy(),
+                          "outputs": exp.outputs[s].copy(), "states": exp.states[s].copy(),
+                          "available": None if exp.available is None else exp.available[s].copy()})
 
 
 def run_identity(policy: Policy, source, background: np.ndarray, method: str, options: dict, chunk_size: int
