@@ -2,8 +2,8 @@
 over Ray workers. Only this module imports Ray; the local engine never does.
 
 Ray Data maps the chunks' first rows through an actor pool (``map_batches``): each actor holds the policy, the
-background and the attributor, reads its chunk from the states (a memory-mapped .npy on a file system the workers
-share, or an array put in Ray's object store), explains it and writes its Parquet part, whole or not at all. The
+background and the attributor, reads its chunk from the states (a .npy file on a file system the workers share, or
+an array put in Ray's object store), explains it and writes its Parquet part, whole or not at all. The
 chunks are those of the local engine, so the parts are the same bits, ``run.json`` and ``resume`` work alike, and
 the summary is computed by the driver from the written parts, in order.
 
@@ -12,16 +12,14 @@ the summary is computed by the driver from the written parts, in order.
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
 from .errors import InputError
-from .files import write_text
 from .policy import Policy
-from .stream import (CHUNK, DATASET, RunningSummary, _existing_run, _part_name, count_states, part_meta,
-                     read_parquet, run_identity, state_chunks, write_part)
+from .stream import (CHUNK, RunningSummary, _part_name, count_states, finish_run, read_parquet, start_run,
+                     state_chunks, write_part)
 
 
 class _ChunkWorker:
@@ -56,7 +54,7 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
                    address: str | None = None, progress: bool | None = None) -> RunningSummary:
     """:func:`xairl.explain_to_parquet` on Ray: the same folder, the same parts (bit for bit), ``workers`` actors.
 
-    :param states: a .npy file (memory-mapped by each worker: on a cluster, a path every node can read) or an array.
+    :param states: a .npy file (each worker reads its chunks: on a cluster, a path every node can read) or an array.
     :param address: a running Ray cluster; None starts Ray on this machine with ``workers`` CPUs.
     """
     try:
@@ -65,25 +63,16 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
         raise InputError("the Ray engine needs Ray: pip install 'xairl[scale]'.") from None
     from tqdm import tqdm
 
-    from .plugins import get_attributor
-
     if isinstance(states, (str, Path)):
         if Path(states).suffix.lower() != ".npy":
-            raise InputError(f"{states}: the Ray engine reads .npy files (memory-mapped by each worker); convert it, "
+            raise InputError(f"{states}: the Ray engine reads .npy files (each worker reads its chunks); convert it, "
                              "or use the local engine, which also reads .parquet and .csv.")
         source = str(Path(states).resolve())
     else:
         source = policy.check_states(states)
-    out = Path(out)
-    parts = out / DATASET
-    options = get_attributor(method)(options).options.model_dump()
-    bg = policy.background() if background is None else policy.check_states(background, "background")
-    identity = run_identity(policy, states, bg, method, options, chunk_size)
-    done = _existing_run(out, identity, resume)
-    parts.mkdir(parents=True, exist_ok=True)
-    write_text(out / "run.json", json.dumps(identity, indent=2))
+    run = start_run(policy, states, out, background, method, options, chunk_size, resume)
     total = count_states(states, policy)
-    todo = [first for first in range(0, total, chunk_size) if first not in done]
+    todo = [first for first in range(0, total, chunk_size) if first not in run.done]
     started = not ray.is_initialized()
     if started:
         ray.init(address=address, num_cpus=None if address else workers, include_dashboard=False,
@@ -96,15 +85,14 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
         if todo:
             ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo)).map_batches(
                 _ChunkWorker, batch_size=1, concurrency=workers, num_cpus=1,
-                fn_constructor_kwargs={"policy": policy, "states": ref, "background": bg, "method": method,
-                                       "options": options, "chunk_size": chunk_size, "parts": str(parts),
-                                       "meta": part_meta(policy, method, options, identity), "threads": 1},
+                fn_constructor_kwargs={"policy": policy, "states": ref, "background": run.background,
+                                       "method": method, "options": run.options, "chunk_size": chunk_size,
+                                       "parts": str(run.parts), "meta": run.meta, "threads": 1},
             ).materialize()
     finally:
         if started:
             ray.shutdown()
     summary = RunningSummary()
     for first in tqdm(range(0, total, chunk_size), desc="summing", unit="chunk", disable=not progress):
-        summary.add(first, read_parquet(parts / _part_name(first)))
-    write_text(out / "summary.json", json.dumps(summary.to_dict(policy.feature_names), indent=2))
-    return summary
+        summary.add(first, read_parquet(run.parts / _part_name(first)))
+    return finish_run(run, summary, states)

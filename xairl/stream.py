@@ -318,30 +318,59 @@ def explain_to_parquet(policy: Policy, states, out: str | Path, background=None,
     from tqdm import tqdm
 
     from .attributors import explain
+
+    run = start_run(policy, states, out, background, method, options, chunk_size, resume)
+    summary = RunningSummary()
+    bar = tqdm(total=count_states(states, policy), unit="states", desc=f"explaining ({method})",
+               disable=False if progress else None if progress is None else True, smoothing=0.1)
+    with bar:
+        for first, x in state_chunks(states, policy, chunk_size):
+            if first not in run.done:  # (a whole chunk from an interrupted run is not explained again)
+                exp = explain(policy, x, background=run.background, method=method, options=run.options)
+                write_part(run.parts, first, exp, run.meta)
+            summary.add(first, read_parquet(run.parts / _part_name(first)))  # as written: resumed runs sum the same
+            bar.update(len(x))
+    return finish_run(run, summary, states)
+
+
+@dataclass
+class Run:
+    """A run's folder, once checked: its validated options, background, identity, the parts' metadata, and the
+    first rows of the chunks an interrupted run already wrote."""
+
+    out: Path
+    options: dict
+    background: np.ndarray
+    identity: dict
+    meta: dict
+    done: set[int]
+
+    @property
+    def parts(self) -> Path:
+        return self.out / DATASET
+
+
+def start_run(policy: Policy, states, out: str | Path, background, method: str, options: dict | None,
+              chunk_size: int, resume: bool) -> Run:
+    """Checks the folder (a new run, or the same run with ``resume``) and records the run in ``run.json``; shared by
+    the local and the Ray engine."""
     from .plugins import get_attributor
 
     out = Path(out)
-    parts = out / DATASET
     options = get_attributor(method)(options).options.model_dump()
     bg = policy.background() if background is None else policy.check_states(background, "background")
     identity = run_identity(policy, states, bg, method, options, chunk_size)
     done = _existing_run(out, identity, resume)
-    parts.mkdir(parents=True, exist_ok=True)
+    (out / DATASET).mkdir(parents=True, exist_ok=True)
     write_text(out / "run.json", json.dumps(identity, indent=2))
-    meta = part_meta(policy, method, options, identity)
-    summary = RunningSummary()
-    total = count_states(states, policy)
-    bar = tqdm(total=total, unit="states", desc=f"explaining ({method})", disable=False if progress else
-               None if progress is None else True, smoothing=0.1)
-    with bar:
-        for first, x in state_chunks(states, policy, chunk_size):
-            if first not in done:  # (a whole chunk from an interrupted run is not explained again)
-                write_part(parts, first, explain(policy, x, background=bg, method=method, options=options), meta)
-            summary.add(first, read_parquet(parts / _part_name(first)))  # as written: a resumed run sums the same
-            bar.update(len(x))
+    return Run(out, options, bg, identity, part_meta(policy, method, options, identity), done)
+
+
+def finish_run(run: Run, summary: RunningSummary, states) -> RunningSummary:
+    """Writes ``summary.json``; a run without a single state is an error."""
     if not summary.n:
         raise InputError(f"{states if isinstance(states, (str, Path)) else 'the states'} holds no state to explain.")
-    write_text(out / "summary.json", json.dumps(summary.to_dict(policy.feature_names), indent=2))
+    write_text(run.out / "summary.json", json.dumps(summary.to_dict(run.meta["feature_names"]), indent=2))
     return summary
 
 
