@@ -37,7 +37,7 @@ def timed(fn, *args, **kwargs) -> float:
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--states", type=int, default=200_000)
-    ap.add_argument("--kernel-states", type=int, default=1_000)
+    ap.add_argument("--kernel-states", type=int, default=1_000, help="0: skip the kernel_shap part")
     ap.add_argument("--chunk-size", type=int, default=50_000)
     args = ap.parse_args()
     policy = mlp_policy()
@@ -56,6 +56,8 @@ def main():
               f"workers {ray:.1f} s ({args.states / ray:,.0f} states/s); Ray / local = {ray / local:.2f} (target <= "
               f"1.5); values identical: {same}")
         m = args.kernel_states
+        if not m:
+            return
         np.save(tmp / "k.npy", rng.normal(size=(m, 8)).astype(np.float32))
         chunk = max(1, m // 8)  # enough chunks to keep 2 workers busy
         one = timed(explain_on_ray, policy, tmp / "k.npy", tmp / "k1", background=bg, method="kernel_shap",
