@@ -14,7 +14,16 @@ ray = pytest.importorskip("ray", reason="the Ray engine is the 'scale' extra (ma
 POLICY = toy_policy()
 
 
-def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path):
+@pytest.fixture(scope="module")
+def local_ray():
+    """One local Ray for the module (2 CPUs, loopback only): the engine uses a running Ray and leaves it running."""
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level="ERROR",
+             _node_ip_address="127.0.0.1")
+    yield
+    ray.shutdown()
+
+
+def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ray):
     from xairl.scale import explain_on_ray
 
     states = tmp_path / "s.npy"
@@ -24,7 +33,7 @@ def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path):
     summary = explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=1000, workers=2)
     local, distributed = (read_parquet(tmp_path / d / "explanations.parquet") for d in ("local", "ray"))
     assert np.array_equal(local.values, distributed.values) and np.array_equal(local.outputs, distributed.outputs)
-    assert summary.n == 6_000 and not ray.is_initialized()  # the Ray it started is stopped
+    assert summary.n == 6_000 and ray.is_initialized()  # a running Ray is used, and left running
     assert (tmp_path / "local" / "summary.json").read_text() == (tmp_path / "ray" / "summary.json").read_text()
     lost = sorted((tmp_path / "ray" / "explanations.parquet").glob("part-*.parquet"))[2:4]
     for part in lost:  # as if the run had been killed before these chunks were written
