@@ -159,7 +159,7 @@ def test_bad_paths_are_one_line_errors(capsys, tmp_path):
     missing = tmp_path / "missing" / "deeper"
     for argv, words in [
         (["explain", "--out", str(a_file)], "is a file, not a folder"),
-        (["explain", "--out", str(missing / "report")], "does not exist"),
+        (["explain", "--out", str(a_file / "report")], "is a file, so no folder can be made under it"),
         (["explain", "--narrate", "--feedback-db", str(missing / "f.sqlite")], "does not exist"),
         (["review", "--db", str(missing / "f.sqlite")], "does not exist"),
         (["review", "--export", str(missing / "c.jsonl"), "--db", str(tmp_path / "f.sqlite")], "does not exist"),
@@ -170,6 +170,9 @@ def test_bad_paths_are_one_line_errors(capsys, tmp_path):
         rc, _, err = run(capsys, *argv)
         one_line_error(rc, err, words)
     assert not (tmp_path / "missing").exists()  # nothing was created on the way
+    # a report folder is made with the folders above it, as mkdir -p does (make demo writes out/report)
+    assert main(["explain", "--n", "2", "--method", "exact", "--no-robustness", "--out", str(missing / "r")]) == 0
+    assert (missing / "r" / "report.html").exists()
 
 
 def test_a_model_folder_holding_a_pickle_is_refused_without_loading_it(tmp_path, capsys):

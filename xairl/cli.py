@@ -70,11 +70,12 @@ def _new_file(path) -> str | None:
 
 @_path
 def _out_dir(path) -> str | None:
-    """A folder to write into, new or existing, whose parent exists."""
+    """A folder to write into, new or existing (missing folders above it are created, as mkdir -p does)."""
     if path.exists() and not path.is_dir():
         return f"{_short(str(path))} is a file, not a folder; give a folder for the report"
-    if not path.exists() and not path.parent.is_dir():
-        return f"the folder {_short(str(path.parent))} does not exist; create it first"
+    above = next((p for p in path.absolute().parents if p.exists()), None)
+    if above is not None and not above.is_dir():
+        return f"{_short(str(above))} is a file, so no folder can be made under it"
     return None
 
 
