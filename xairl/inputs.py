@@ -89,15 +89,20 @@ def _check_size(shape: tuple[int, ...], name: str = "") -> None:
     if need > _limit():
         where = f" '{name}'" if name else ""
         raise InputError(f"the array{where} has shape {shape} and would take {need / 1024 ** 3:.3g} GiB in memory, "
-                         f"more than the {_limit() / 1024 ** 3:.3g} GiB limit; explain it in parts, or raise the limit "
-                         f"with ${LIMIT_ENV}=BYTES.")
+                         f"more than the {_limit() / 1024 ** 3:.3g} GiB limit; stream it (--format parquet --out DIR), or "
+                         f"raise the limit with ${LIMIT_ENV}=BYTES.")
+
+
+def npy_header(fh) -> tuple[tuple[int, ...], bool, np.dtype]:
+    """(shape, Fortran order, dtype) from the header of a .npy file open at its start; the file is left at the data."""
+    version = np.lib.format.read_magic(fh)
+    return (np.lib.format.read_array_header_1_0(fh) if version == (1, 0) else
+            np.lib.format.read_array_header_2_0(fh))
 
 
 def _header(fh, name: str = "") -> tuple[tuple[int, ...], np.dtype]:
     """Shape and dtype from a .npy header, refused when the array would exceed the memory limit."""
-    version = np.lib.format.read_magic(fh)
-    shape, _, dtype = (np.lib.format.read_array_header_1_0(fh) if version == (1, 0) else
-                       np.lib.format.read_array_header_2_0(fh))
+    shape, _, dtype = npy_header(fh)
     _check_size(shape, name)
     return shape, dtype
 

@@ -30,7 +30,7 @@ import numpy as np
 from .errors import InputError
 from .explanation import Explanation
 from .files import write_text
-from .inputs import read_states
+from .inputs import npy_header, read_states
 from .policy import Policy, model_hash
 
 CHUNK = 50_000  # states per chunk: a few MB of results, and bounded memory whatever the attributor
@@ -87,9 +87,7 @@ class _NpyRows:
     def __init__(self, path: Path):
         try:
             with path.open("rb") as fh:
-                version = np.lib.format.read_magic(fh)
-                self.shape, fortran, self.dtype = (np.lib.format.read_array_header_1_0(fh) if version == (1, 0) else
-                                                   np.lib.format.read_array_header_2_0(fh))
+                self.shape, fortran, self.dtype = npy_header(fh)
                 self.offset = fh.tell()
         except (ValueError, OSError, EOFError) as exc:
             raise InputError(f"{path}: cannot read it as .npy ({' '.join(str(exc).split())[:120]}).") from None
