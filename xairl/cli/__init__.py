@@ -1,0 +1,248 @@
+"""The ``xairl`` command. ``main(argv) -> int``; user errors print one line and return 2, never a traceback.
+
+Only argparse and the plugin registry are imported here; torch and shap load inside the commands that need them.
+``args`` holds the argument types shared by the commands, ``explain`` the biggest command with its four outputs.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from typing import Sequence
+
+from .. import plugins
+from ..errors import InputError, XairlError
+from .args import MARKS, Parser, count, narration_arguments, new_file, out_dir, parse_options
+from .explain import explain_parser
+
+
+def cmd_plugins(args) -> int:
+    summary, failed = plugins.summary(), plugins.failures()
+    for plugin in sorted(set(summary) | set(failed)):
+        print(plugin)
+        if plugin in failed:
+            print(f"  LEFT OUT: {failed[plugin]}")
+            continue
+        for kind, names in sorted(summary[plugin].items()):
+            print(f"  {kind}: {', '.join(sorted(names))}")
+        if not summary[plugin]:
+            print("  (registers nothing)")
+    if os.environ.get(plugins.LOAD_ENV) is not None:
+        print(f"(only the plugins named in ${plugins.LOAD_ENV} were loaded)")
+    return 0
+
+
+def cmd_attributors(args) -> int:
+    reg = plugins.registry("attributor")
+    rows = []
+    for name in reg.names():
+        entry = reg.entry(name)
+        schema = entry.load().Options.model_json_schema()
+        rows.append({"name": name, "plugin": entry.plugin, "description": entry.description, "options": schema})
+    if args.json:
+        print(json.dumps(rows, indent=2))
+        return 0
+    for row in rows:
+        print(f"{row['name']}  ({row['plugin']}): {row['description']}")
+        for key, spec in row["options"].get("properties", {}).items():
+            kind = spec.get("type") or "|".join(str(a.get("type", a.get("const", a.get("enum", "?"))))
+                                                for a in spec.get("anyOf", []))
+            if "enum" in spec:
+                kind = "|".join(spec["enum"])
+            print(f"    -o {key}=  {kind}, default {spec.get('default')!r}: {spec.get('description', '')}")
+    return 0
+
+
+def cmd_report(args) -> int:
+    from pathlib import Path
+
+    from ..report import ReportRequest, write_report
+
+    report = plugins.registry("report").load(args.plugin)(parse_options(args.option))
+    method_options = plugins.get_attributor(args.method)(parse_options(args.method_option)).options.model_dump()
+    req = ReportRequest(out=Path(args.out), method=args.method, options=method_options, narrate=args.narrate,
+                        narrator=args.narrator, narrator_options=parse_options(args.narrator_option),
+                        template=args.template, prompt_dirs=args.prompts, seed=args.seed, n_states=args.n,
+                        robustness=not args.no_robustness)
+    req.out.mkdir(parents=True, exist_ok=True)
+    path = write_report(req, report.build(req))
+    print(f"report: {path.resolve()}")
+    return 0
+
+
+def cmd_prompts(args) -> int:
+    from .. import prompts
+
+    if args.action == "list":
+        for name, path in sorted(prompts.available(args.prompts).items()):
+            tpl = prompts.parse(path)
+            print(f"{name:<18} {tpl.spec.kind:<9} {path}\n    {tpl.spec.description}")
+        return 0
+    if not args.target:
+        raise InputError(f"`xairl prompts {args.action}` needs a template {'name' if args.action == 'show' else 'path'}.")
+    if args.action == "show":
+        tpl = prompts.load(args.target, args.prompts)
+        print(f"# {tpl.path}")
+        print(tpl.path.read_text(), end="")
+        return 0
+    from ..narrators import check_template
+
+    problems = check_template(args.target)
+    for p in problems:
+        print(p)
+    print(f"{args.target}: {'ok' if not problems else f'{len(problems)} problem(s)'}")
+    return 0 if not problems else 1
+
+
+def cmd_verify(args) -> int:
+    """Check a text against an explanation; with --trace, every claim with the words it was read from and the
+    reading (rule) that bound it."""
+    from ..explanation import Explanation
+    from ..narrators.verify import verify
+
+    text = args.text if args.text != "-" else sys.stdin.read()
+    try:
+        with open(args.explanation, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        raise InputError(f"cannot read --explanation {args.explanation}: {exc.strerror}; give the JSON that "
+                         f"Explanation.to_json() writes.") from None
+    try:
+        exp = Explanation.from_json(raw)
+    except InputError as exc:
+        raise InputError(f"--explanation {args.explanation}: {exc}") from None
+    try:
+        exp.check_index(args.index)
+    except InputError as exc:
+        raise InputError(f"--index {args.index}: {exc}") from None
+    result = verify(text, exp, args.index)
+    for sentence in result.sentences:
+        print(f"[{sentence.status}] {sentence.text}")
+        for c in sentence.claims if args.trace else ():
+            print(f"    {c.status:<12} {c.kind:<9} {c.text!r:<28} {c.rule or '-':<22} {c.detail}")
+    print(f"accurate: {'yes' if result.accurate else 'no'}; ok: {'yes' if result.ok else 'no'} "
+          f"(coverage {result.coverage:.0%}){'; ' + result.note if result.note else ''}")
+    return 0 if result.accurate else 1
+
+
+def cmd_review(args) -> int:
+    from ..feedback import FeedbackStore
+
+    store = FeedbackStore(args.db)
+    if args.serve:
+        from ..review import serve
+
+        serve(store, args.port)
+        return 0
+    if args.export:
+        from ..files import atomic_write
+
+        with atomic_write(args.export) as fh:
+            n = store.export_corrections(fh)
+        print(f"wrote {n} correction(s) to {args.export}")
+        return 0
+    pending = store.records("pending")
+    print(f"{len(pending)} narrative(s) to review in {store.path}")
+    for r in pending:
+        bad = [c for c in r.claims if c["status"] != "verified"]
+        print(f"\n#{r.id} [{r.template}, {r.source}, confidence {r.confidence:.2f}, "
+              f"{'verified' if r.verified else f'{len(bad)} unverified claim(s)'}]")
+        marked = (r.evidence or {}).get("sentences") or []
+        print("\n".join(f"    {MARKS.get(st, st):<13} {t}" for t, st in marked) or f"    {r.text}")
+        while True:
+            try:
+                answer = input("[a]ccept  [r]eject  [c]orrect  [s]kip  [q]uit > ").strip().lower()[:1]
+            except EOFError:
+                return 0
+            if answer == "q":
+                return 0
+            if answer == "s":
+                break
+            if answer in ("a", "r"):
+                store.review(r.id, "accepted" if answer == "a" else "rejected")
+                break
+            if answer == "c":
+                try:
+                    text = input("corrected text > ").strip()
+                except EOFError:
+                    return 0
+                if text:
+                    store.review(r.id, "corrected", text)
+                    break
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = Parser(prog="xairl", description="Explain what a reinforcement-learning policy decided "
+                                     "and why.")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    p = sub.add_parser("plugins", help="list installed plugins and what each registers")
+    p.set_defaults(run=cmd_plugins)
+    p = sub.add_parser("attributors", help="list attribution methods and their options")
+    p.add_argument("--json", action="store_true", help="print names and JSON schemas of the options")
+    p.set_defaults(run=cmd_attributors)
+    explain_parser(sub.add_parser("explain", help="explain a registered policy's decisions on states from a file"))
+    _report_parser(sub.add_parser("report", help="write a plugin's report (HTML, JSONL, figures) into a folder"))
+    p = sub.add_parser("prompts", help="list, show or check prompt templates")
+    p.add_argument("action", choices=("list", "show", "check"))
+    p.add_argument("target", nargs="?", help="template name (show) or .yaml path (check)")
+    p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder")
+    p.set_defaults(run=cmd_prompts)
+    p = sub.add_parser("verify", help="check a text's claims against an explanation (exit 1 when one is "
+                       "contradicted)")
+    p.add_argument("text", help="the text to check, or - to read it from standard input")
+    p.add_argument("--explanation", required=True, metavar="FILE", help="the explanation, as Explanation.to_json() "
+                   "writes it")
+    p.add_argument("--index", type=count(0), default=0, help="which state of the explanation the text is about")
+    p.add_argument("--trace", action="store_true", help="every claim: status, kind, words, rule, reason")
+    p.set_defaults(run=cmd_verify)
+    p = sub.add_parser("review", help="accept, reject or correct recorded narratives in the terminal, or in a local "
+                       "web page with the evidence (--serve)")
+    p.add_argument("--db", type=new_file, default=None, help="feedback store (default: in the user dir)")
+    p.add_argument("--serve", action="store_true", help="serve the review page on http://127.0.0.1:PORT/")
+    p.add_argument("--port", type=count(0, 65535), default=8765, help="port of the review page (default 8765; 0: "
+                   "any free port)")
+    p.add_argument("--export", type=new_file, metavar="FILE", help="write the corrections as JSON lines instead of reviewing")
+    p.set_defaults(run=cmd_review)
+    commands = plugins.registry("command")
+    for name in commands.names():
+        entry = commands.entry(name)
+        entry.load()(sub.add_parser(name, help=entry.description))
+    return parser
+
+
+def _report_parser(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--plugin", required=True, help="the report's name (see `xairl plugins`), e.g. uav-handover")
+    p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",
+                   help="an option of the plugin's report, validated against its schema (e.g. -o real=PATH)")
+    p.add_argument("--out", type=out_dir, default="xairl-report", help="report folder (default xairl-report)")
+    p.add_argument("--n", type=count(1, 1_000_000), default=500, help="states explained per dataset")
+    p.add_argument("--seed", type=count(0, 2 ** 32 - 1), default=0, help="seed of everything the report samples")
+    p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
+    p.add_argument("-m", "--method-option", action="append", default=[], metavar="KEY=VALUE",
+                   help="an option of the attribution method; repeatable")
+    narration_arguments(p)
+    p.set_defaults(run=cmd_report)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        if not getattr(args, "run", None):
+            parser.print_help()
+            return 0
+        return int(args.run(args) or 0)
+    except XairlError as exc:
+        print(f"xairl: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("xairl: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # a bug of ours or a plugin's: one line, the traceback only on request
+        if os.environ.get("XAIRL_DEBUG"):
+            raise
+        print(f"xairl: internal error: {type(exc).__name__}: {exc} (set XAIRL_DEBUG=1 for the traceback; please "
+              "report it)", file=sys.stderr)
+        return 1

@@ -1,0 +1,190 @@
+"""``xairl explain``: a policy's decisions on states from a file or its sampler, printed as a table or JSON lines,
+narrated, written as a report (``--out``), or streamed chunk by chunk into Parquet (``--format parquet``)."""
+from __future__ import annotations
+
+import argparse
+import json
+
+from .. import plugins
+from ..errors import InputError
+from .args import MARKS, count, narration_arguments, new_file, out_dir, parse_options
+
+
+def cmd_explain(args) -> int:
+    import numpy as np
+
+    from ..attributors import explain
+    from ..inputs import read_states
+
+    policy = plugins.load_policy(args.policy, parse_options(args.policy_arg), _state_shape(args.states))
+    method = plugins.get_attributor(args.method)  # unknown names fail before any file is read
+    options = method(parse_options(args.option)).options
+    if args.format == "parquet" and not args.out:
+        raise InputError("--format parquet writes a folder: give it with --out DIR.")
+    if args.engine == "ray" and args.format != "parquet":
+        raise InputError("--engine ray streams into a folder: add --format parquet --out DIR.")
+    if args.states and args.format == "parquet":
+        states = None  # streamed from the file, chunk by chunk
+    elif args.states:
+        states = read_states(args.states, policy.feature_names, policy.observation)
+    else:
+        states = policy.background(args.n, seed=args.seed + 1)
+    bg = read_states(args.background, policy.feature_names, policy.observation, "background") if args.background else \
+        policy.background(args.background_size, seed=args.seed)
+    if args.format == "parquet":
+        return _stream(args, policy, args.states or states, bg, options.model_dump())
+    exp = explain(policy, states, background=bg, method=args.method, options=options.model_dump())
+    if args.out:
+        return _write_report(args, exp, policy, bg)
+    if args.narrate:
+        return _print_narratives(args, exp, policy, bg)
+    if args.format == "jsonl":
+        for rec in exp.records():
+            print(rec.model_dump_json())
+        return 0
+    decides = exp.output == "actions"
+    for i, rec in enumerate(exp.records()):
+        scores = ", ".join(f"{a}={v:.3f}" for a, v in rec.scores.items())
+        print(f"state {i}: chose {rec.chosen} (runner-up {rec.runner_up}); scores {scores}" if decides else
+              f"state {i}: {exp.output} {scores}")
+        for a in ([int(exp.chosen[i])] if decides else range(exp.values.shape[2])):
+            contrib = exp.values[i, :, a]
+            if not decides:
+                print(f"  {exp.action_names[a]}:")
+            for j in np.argsort(-np.abs(contrib))[: args.top]:
+                print(f"    {exp.feature_names[j]:<24} = {exp.states[i, j]:>10.4g}   contribution {contrib[j]:+.4f}")
+            print(f"    base {exp.base_values[i, a]:.4f}, additivity gap {exp.additivity_gap[i, a]:.2e} ({exp.method})")
+    return 0
+
+
+def _state_shape(path):
+    """The shape of one state in a .npy file (what a bare torch module given as --policy takes), else None."""
+    import numpy as np
+
+    if not path or not str(path).lower().endswith(".npy"):
+        return None
+    try:
+        shape = np.load(path, mmap_mode="r", allow_pickle=False).shape
+    except Exception:  # a peek only: read_states reports whatever is wrong with the file
+        return None
+    return shape[1:] if len(shape) > 1 else shape
+
+
+def _write_report(args, exp, policy, bg) -> int:
+    """explanations.jsonl, figures and report.html for any policy (``--out DIR``)."""
+    from pathlib import Path
+
+    from ..report import ReportContent, ReportRequest, write_report
+
+    req = ReportRequest(out=Path(args.out), method=args.method, options=dict(exp.options), narrate=args.narrate,
+                        narrator=args.narrator, narrator_options=parse_options(args.narrator_option),
+                        template=args.template, prompt_dirs=args.prompts, seed=args.seed, n_states=len(exp.values),
+                        robustness=not args.no_robustness, progress=False)
+    content = ReportContent(title=f"xairl: {policy.name}", policy=policy, background=bg,
+                            datasets=[("states", exp.states)])
+    path = write_report(req, content, explained={"states": exp})
+    print(f"report: {path.resolve()}")
+    return 0
+
+
+def _stream(args, policy, states, bg, options: dict) -> int:
+    """``--format parquet``: explained chunk by chunk into DIR/explanations.parquet (resumable), with a progress bar
+    on a terminal, and a report whose figures show a uniform sample of the states."""
+    import time
+    from pathlib import Path
+
+    from ..report import ReportContent, ReportRequest, table_html, write_report
+    from ..stream import explain_to_parquet
+
+    out = Path(args.out)
+    t0 = time.time()
+    if args.engine == "ray":
+        from ..scale import explain_on_ray
+
+        summary = explain_on_ray(policy, states, out, background=bg, method=args.method, options=options,
+                                 chunk_size=args.chunk_size, resume=args.resume, workers=args.workers,
+                                 address=args.ray_address)
+    else:
+        summary = explain_to_parquet(policy, states, out, background=bg, method=args.method, options=options,
+                                     chunk_size=args.chunk_size, resume=args.resume)
+    seconds = time.time() - t0
+    means = summary.to_dict(policy.feature_names)["mean_abs_contribution"]
+    order = sorted(policy.feature_names, key=lambda f: -means["margin"][f])
+    table = table_html(["feature", "mean |contribution| to the margin", "to the chosen score"],
+                       [[f, f"{means['margin'][f]:.4g}", f"{means['chosen_score'][f]:.4g}"] for f in order])
+    req = ReportRequest(out=out, method=args.method, options=options, narrate=args.narrate, narrator=args.narrator,
+                        narrator_options=parse_options(args.narrator_option), template=args.template,
+                        prompt_dirs=args.prompts, seed=args.seed, n_states=summary.n,
+                        robustness=not args.no_robustness, progress=False, records=False)
+    content = ReportContent(title=f"xairl: {policy.name}", policy=policy, background=bg,
+                            datasets=[("states", summary.sample_explanation().states)],
+                            tables=[(f"Mean |contribution| over all {summary.n} states", table)],
+                            notes=[f"{summary.n} states explained in {seconds:.1f} s ({summary.n / max(seconds, 1e-9):.0f}"
+                                   f" states/s) into {out / 'explanations.parquet'}; the figures show a uniform "
+                                   f"sample of {len(summary.sample)} of them."])
+    path = write_report(req, content, explained={"states": summary.sample_explanation()})
+    print(f"explanations: {(out / 'explanations.parquet').resolve()} ({summary.n} states)\nreport: {path.resolve()}")
+    return 0
+
+
+def _print_narratives(args, exp, policy, bg) -> int:
+    from ..feedback import FeedbackStore
+    from ..narrators import narrate
+
+    store = None if args.no_record else FeedbackStore(args.feedback_db)
+    options = parse_options(args.narrator_option)
+    if args.examples_from_feedback and store is not None:
+        options.setdefault("examples", store.examples())
+    for i in range(len(exp.values)):
+        n = narrate(exp, i, narrator=args.narrator, template=args.template, policy=policy, background=bg,
+                    robustness=not args.no_robustness,
+                    options=options, prompt_dirs=args.prompts, store=store)
+        if args.format == "jsonl":
+            print(json.dumps({"index": i, "text": n.text, "verified": n.verified, "confidence": n.confidence,
+                              "components": n.components, "source": n.source, "template": n.template,
+                              "sentences": [{"text": t, "status": st} for t, st in n.sentences]}))
+            continue
+        mark = "verified" if n.verified else "NOT VERIFIED"
+        parts = ", ".join(f"{k} {v:.2f}" for k, v in n.components.items() if v is not None)
+        print(f"state {i} [{mark}, confidence {n.confidence:.2f}: {parts}; {n.source}]")
+        print("\n".join(f"    {MARKS[status]:<13} {text}" for text, status in n.sentences) or f"    {n.text}")
+    return 0
+
+
+def explain_parser(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--policy", default="toy", help="registered policy name (see `xairl plugins`), or with nothing "
+                   "installed package.module:attr or path/file.py:attr (a Policy, a torch module, or a function "
+                   "returning one, called with the --policy-arg values); default: toy. A module:attr or file.py:attr "
+                   "imports and runs that code, as any Python entry point does: give only code you trust")
+    p.add_argument("--policy-arg", action="append", default=[], metavar="KEY=VALUE",
+                   help="argument of a module:attr policy function, e.g. --policy-arg checkpoint=my_q.pt")
+    p.add_argument("--out", type=out_dir, default=None, metavar="DIR",
+                   help="write explanations.jsonl, figures and report.html into DIR instead of printing")
+    p.add_argument("--states", help="states to explain: .csv with a header naming the features, .npy "
+                   "(n, *obs_shape), .npz (dict observations) or .json; "
+                   "default: --n states from the policy's sampler")
+    p.add_argument("--background", help="background states file (default: the policy's sampler)")
+    p.add_argument("--background-size", type=count(1, 1_000_000), default=100, help="background states drawn from the sampler")
+    p.add_argument("--n", type=count(1, 10_000_000), default=5, help="states to sample when --states is not given")
+    p.add_argument("--seed", type=count(0, 2 ** 32 - 1), default=0, help="seed of the sampled states and background")
+    p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
+    p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",
+                   help="an option of the method, validated against its schema; repeatable")
+    p.add_argument("--format", choices=("table", "jsonl", "parquet"), default="table",
+                   help="table or jsonl on the terminal; parquet: streamed chunk by chunk into --out DIR (any number "
+                   "of states, resumable with --resume)")
+    p.add_argument("--chunk-size", type=count(1, 10_000_000), default=50_000, help="states per chunk with --format "
+                   "parquet (memory grows with it)")
+    p.add_argument("--resume", action="store_true", help="with --format parquet: continue an interrupted run in --out")
+    p.add_argument("--engine", choices=("local", "ray"), default="local", help="with --format parquet: this process "
+                   "(local) or Ray workers (pip install 'xairl[scale]'; states from a .npy file)")
+    p.add_argument("--workers", type=count(1, 100_000), default=2, help="Ray workers (one CPU each; default 2)")
+    p.add_argument("--ray-address", default=None, metavar="ADDRESS", help="a running Ray cluster (e.g. auto or "
+                   "ray://host:10001); default: Ray started on this machine")
+    p.add_argument("--top", type=count(1), default=5, help="features shown per state in the table")
+    narration_arguments(p)
+    p.add_argument("--feedback-db", type=new_file, default=None, help="SQLite store of shown narratives (default: in the user dir)")
+    p.add_argument("--no-record", action="store_true", help="do not record the narratives for review")
+    p.add_argument("--examples-from-feedback", action="store_true",
+                   help="give the local LM the operators' latest accepted or corrected narratives as examples")
+    p.set_defaults(run=cmd_explain)
