@@ -67,80 +67,89 @@ def page(store: FeedbackStore, token: str, show_all: bool = False, message: str 
             f"</head><body>{head}{note}{body}</body></html>")
 
 
+class _Handler(BaseHTTPRequestHandler):
+    """One request; the store, the form token and the allowed Hosts are the server's (:func:`make_server`)."""
+
+    def _send(self, status: int, body: str = "", location: str | None = None) -> None:
+        data = body.encode()
+        self.send_response(status)
+        if location:
+            self.send_header("Location", location)
+        self.send_header("Content-Type", f"text/{'plain' if status >= 400 else 'html'}; charset=utf-8")
+        self.send_header("Content-Length", str(len(data)))
+        self.end_headers()
+        self.wfile.write(data)
+
+    def _misdirected(self) -> bool:
+        """DNS rebinding: a hostile name resolved to 127.0.0.1 arrives with that name as Host; answer 421."""
+        sent = self.headers.get_all("Host") or []
+        if len(sent) == 1 and sent[0].strip().lower() in self.server.hosts:
+            return False
+        self._send(HTTPStatus.MISDIRECTED_REQUEST, "misdirected request: this page answers only to "
+                   f"http://{HOST}:{self.server.server_address[1]}/")
+        return True
+
+    def do_GET(self):  # noqa: N802 (http.server's naming)
+        if self._misdirected():
+            return
+        url = urlparse(self.path)
+        if url.path != "/":
+            return self._send(HTTPStatus.NOT_FOUND, "not found")
+        q = parse_qs(url.query)
+        self._send(HTTPStatus.OK, page(self.server.store, self.server.token, bool(q.get("all")),
+                                       q.get("msg", [""])[0]))
+
+    def _form(self) -> dict | None:
+        """The posted form, once the Origin, the length and the token are checked; None after an error answer."""
+        origin = self.headers.get("Origin")  # browsers send it; a client without one is judged by the token
+        if origin is not None and origin.strip().lower() not in {f"http://{h}" for h in self.server.hosts}:
+            return self._send(HTTPStatus.FORBIDDEN, "this form is not from this review page")
+        length = self.headers.get("Content-Length")
+        if length is None:
+            return self._send(HTTPStatus.LENGTH_REQUIRED, "Content-Length required")
+        if not _NUMBER.fullmatch(length.strip()):
+            return self._send(HTTPStatus.BAD_REQUEST, "bad Content-Length")
+        if int(length) > MAX_BODY:  # refused unread: cutting it would store part of a correction
+            return self._send(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"payload too large (over {MAX_BODY} bytes)")
+        raw = self.rfile.read(int(length))
+        if len(raw) < int(length):
+            return self._send(HTTPStatus.BAD_REQUEST, "body shorter than its Content-Length")
+        form = {k: v[0] for k, v in parse_qs(raw.decode("utf-8", "replace")).items()}
+        sent = form.get("token", "").encode()  # bytes: compare_digest raises on non-ASCII str
+        if not secrets.compare_digest(sent, self.server.token.encode()):
+            return self._send(HTTPStatus.FORBIDDEN, "this form is not from this review page; reload it")
+        if not _NUMBER.fullmatch(form.get("id", "")):
+            return self._send(HTTPStatus.BAD_REQUEST, "id must be a narrative's number")
+        return form
+
+    def do_POST(self):  # noqa: N802
+        if self._misdirected():
+            return
+        if urlparse(self.path).path != "/review":
+            return self._send(HTTPStatus.NOT_FOUND, "not found")
+        form = self._form()
+        if form is None:
+            return
+        status = form.get("status", "")
+        correction = form.get("correction", "").strip() if status == "corrected" else None
+        try:
+            self.server.store.review(int(form["id"]), status, correction)
+            msg = f"#{form['id']} {status}"
+        except (InputError, ValueError) as exc:
+            msg = f"not stored: {exc}"
+        self._send(HTTPStatus.SEE_OTHER, location="/?" + urlencode({"msg": msg}))
+
+    def log_message(self, *args):  # quiet (log_error too): the terminal shows only the address
+        pass
+
+
 def make_server(store: FeedbackStore, port: int = 0, timeout: float = TIMEOUT) -> ThreadingHTTPServer:
     """A review server for ``store`` on 127.0.0.1 (``port`` 0: any free port; ``server.server_address`` says);
-    ``timeout``: seconds a client may stall."""
-    token = secrets.token_urlsafe(16)
-    hosts: set[str] = set()  # filled once the port is bound
-
-    class Handler(BaseHTTPRequestHandler):
-        def _send(self, status: int, body: str = "", location: str | None = None) -> None:
-            data = body.encode()
-            self.send_response(status)
-            if location:
-                self.send_header("Location", location)
-            self.send_header("Content-Type", f"text/{'plain' if status >= 400 else 'html'}; charset=utf-8")
-            self.send_header("Content-Length", str(len(data)))
-            self.end_headers()
-            self.wfile.write(data)
-
-        def _misdirected(self) -> bool:
-            """DNS rebinding: a hostile name resolved to 127.0.0.1 arrives with that name as Host; answer 421."""
-            sent = self.headers.get_all("Host") or []
-            if len(sent) == 1 and sent[0].strip().lower() in hosts:
-                return False
-            self._send(HTTPStatus.MISDIRECTED_REQUEST, "misdirected request: this page answers only to "
-                       f"http://{HOST}:{self.server.server_address[1]}/")
-            return True
-
-        def do_GET(self):  # noqa: N802 (http.server's naming)
-            if self._misdirected():
-                return
-            url = urlparse(self.path)
-            if url.path != "/":
-                return self._send(HTTPStatus.NOT_FOUND, "not found")
-            q = parse_qs(url.query)
-            self._send(HTTPStatus.OK, page(store, token, bool(q.get("all")), q.get("msg", [""])[0]))
-
-        def do_POST(self):  # noqa: N802
-            if self._misdirected():
-                return
-            if urlparse(self.path).path != "/review":
-                return self._send(HTTPStatus.NOT_FOUND, "not found")
-            origin = self.headers.get("Origin")  # browsers send it; a client without one is judged by the token
-            if origin is not None and origin.strip().lower() not in {f"http://{h}" for h in hosts}:
-                return self._send(HTTPStatus.FORBIDDEN, "this form is not from this review page")
-            length = self.headers.get("Content-Length")
-            if length is None:
-                return self._send(HTTPStatus.LENGTH_REQUIRED, "Content-Length required")
-            if not _NUMBER.fullmatch(length.strip()):
-                return self._send(HTTPStatus.BAD_REQUEST, "bad Content-Length")
-            if int(length) > MAX_BODY:  # refused unread: cutting it would store part of a correction
-                return self._send(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"payload too large (over {MAX_BODY} bytes)")
-            raw = self.rfile.read(int(length))
-            if len(raw) < int(length):
-                return self._send(HTTPStatus.BAD_REQUEST, "body shorter than its Content-Length")
-            form = {k: v[0] for k, v in parse_qs(raw.decode("utf-8", "replace")).items()}
-            sent = form.get("token", "").encode()  # bytes: compare_digest raises on non-ASCII str
-            if not secrets.compare_digest(sent, token.encode()):
-                return self._send(HTTPStatus.FORBIDDEN, "this form is not from this review page; reload it")
-            if not _NUMBER.fullmatch(form.get("id", "")):
-                return self._send(HTTPStatus.BAD_REQUEST, "id must be a narrative's number")
-            status = form.get("status", "")
-            correction = form.get("correction", "").strip() if status == "corrected" else None
-            try:
-                store.review(int(form["id"]), status, correction)
-                msg = f"#{form['id']} {status}"
-            except (InputError, ValueError) as exc:
-                msg = f"not stored: {exc}"
-            self._send(HTTPStatus.SEE_OTHER, location="/?" + urlencode({"msg": msg}))
-
-        def log_message(self, *args):  # quiet (log_error too): the terminal shows only the address
-            pass
-
-    Handler.timeout = timeout  # a socket timeout: a client that stalls is dropped and its thread freed
-    server = _Server((HOST, port), Handler)
-    hosts.update(f"{name}:{server.server_address[1]}" for name in (HOST, "localhost"))
+    ``timeout``: seconds a client may stall before its connection is dropped and its thread freed."""
+    handler = type("Handler", (_Handler,), {"timeout": timeout})  # a socket timeout per server
+    server = _Server((HOST, port), handler)
+    server.store, server.token = store, secrets.token_urlsafe(16)
+    server.hosts = {f"{name}:{server.server_address[1]}" for name in (HOST, "localhost")}
     return server
 
 
