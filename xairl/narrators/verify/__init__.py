@@ -36,7 +36,7 @@ import numpy as np
 from ...errors import InputError
 from ...explanation import Explanation
 from ...policy import Policy
-from . import background, binding, checks, comparisons, directions, parse, quantities, ranks
+from . import background, binding, checks, comparisons, directions, parse, quantities, ranks, sums
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, named_features, split_words, vocabulary
@@ -295,10 +295,10 @@ def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None
     words = [w for w in split_words(ident) if len(w) >= 3]
     ours = any(words and all(any(k.startswith(w) for k in own) for w in words) for own in known.values())
     spaced = ident.replace("_", " ")
-    sums = list(book.aggregates.values()) if quantities.AGGREGATE_CUE.search(spaced) else []
+    totals = list(book.aggregates.values()) if sums.AGGREGATE_CUE.search(spaced) else []
     decision = book.decision_numbers if _DECISION_KEY.search(spaced) else []
     if ours or (number is None and pushes is None) or (number is not None and any(
-            matches(number, x, magnitude_ok=False) for x in [*decision, *sums])):
+            matches(number, x, magnitude_ok=False) for x in [*decision, *totals])):
         return Claim("feature", ident, "unchecked", "an identifier that names nothing of this explanation",
                      "identifier.other")
     said = f"given {number.text}" if number is not None else f"'{pushes.group(0)}' is said of it"
@@ -342,7 +342,7 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
     for n in numbers:
         if summed and n is tail[0]:
             members = list(dict.fromkeys(m.keys for m in said_names))
-            out.append(binding.named(quantities.sum_number(n, members, ctx, book), "number.sum"))
+            out.append(binding.named(sums.sum_number(n, members, ctx, book), "number.sum"))
             continue
         c = binding.bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure

@@ -8,7 +8,7 @@ import functools
 import re
 from dataclasses import replace
 
-from . import background, checks, quantities
+from . import background, checks, quantities, sums
 from .book import FactBook
 from .checks import Claim
 from .names import split_words, stem
@@ -146,7 +146,7 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     phrase or list item starts between them; else none."""
     if id(n) in paired:
         return named(quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of), "number.respectively")
-    summed = quantities.aggregate_number(n, masked, book)
+    summed = sums.aggregate_number(n, masked, book)
     if summed is not None:  # 'the positives add up to about +0.39', 'total absolute attribution of 1.62'
         return named(summed, "number.aggregate")
     if quantities.is_change(n, masked):  # '$91,462 above the baseline', 'net uplift: +$86,046', 'below base by $34,184'

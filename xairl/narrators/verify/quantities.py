@@ -1,6 +1,6 @@
 """What a number in a text states and its check: a feature's value, contribution or share, an action's score, the
-margin, the prediction, the baseline, the change from it, a sum of contributions, or a domain comparison in its
-unit. The cue words around the number decide which (:func:`feature_number`, :func:`free_number`); :func:`skip_number`
+margin, the prediction, the baseline, the change from it, or a domain comparison in its unit (sums over several
+features are :mod:`.sums`). The cue words around the number decide which (:func:`feature_number`, :func:`free_number`); :func:`skip_number`
 says which numbers are no claim (list markers, identifiers, counts of the method's inputs, ratios)."""
 from __future__ import annotations
 
@@ -238,40 +238,6 @@ def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, si
     return None
 
 
-def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book: FactBook) -> Claim:
-    """'A and B together add x': x is the sum of their contributions (in the sentence's view, any when it names none);
-    a member that may mean several features counts only when every meaning agrees."""
-    contexts = book.contexts if ctx in (EITHER, None) else (ctx,)
-    combos = [()]
-    for keys in members:
-        combos = [c + (k,) for c in combos for k in keys]
-
-    def close(total: float, k: int) -> bool:  # a sum of k rounded figures may be off by k half-steps
-        return matches(n, total) or (not n.hedge and abs(abs(n.value) - abs(total)) <= k * n.unit / 2 + 1e-9
-                                     and (not n.sign or (n.value < 0) == (total < 0)))
-
-    if n.percent and not n.points:  # 'A and B together explain about 70 % of the attribution': their shares
-        results = [any(all(view in book.features[k].shares for k in combo)
-                       and matches(n, sum(book.features[k].shares[view] for k in combo)) for view in contexts)
-                   for combo in combos]
-        total = sum(book.features[k].shares.get(contexts[0], 0.0) for k in combos[0])
-        text = f"the sum of {', '.join(combos[0])}'s shares is {total:.3g} %"
-        return _sum_claim(n, results, text)
-    results = [any(all(view in book.features[k].contribs for k in combo)
-                   and close(sum(book.features[k].contribs[view] for k in combo), len(combo)) for view in contexts)
-               for combo in combos]
-    total = sum(book.features[k].contribs.get(contexts[0], 0.0) for k in combos[0])
-    return _sum_claim(n, results, f"the sum of {', '.join(combos[0])}'s contributions is {total:.4g}")
-
-
-def _sum_claim(n: Number, results: list[bool], text: str) -> Claim:
-    """Verified when every reading of the members holds, contradicted when none does, else ambiguous."""
-    if all(results):
-        return Claim("number", n.text, "verified", text)
-    return Claim("number", n.text, "unchecked" if any(results) else "contradicted",
-                 "ambiguous: a member may mean several features" if any(results) else text)
-
-
 def comparison(n: Number, after: str, book: FactBook) -> bool:
     unit = re.match(r"\s*([A-Za-z]+)", after)
     values = book.by_unit.get(unit.group(1).lower(), []) if unit else []
@@ -379,27 +345,3 @@ def _owners(n: Number, book: FactBook) -> list[str]:
         if len(found) == 1:
             return found
     return found
-
-
-#: words that say a number sums over the features: 'the positives add up to', 'total absolute attribution',
-#: 'sum_shap=', 'net', 'n_features='
-AGGREGATE_CUE = re.compile(r"\b(?:total|sum\w*|add(?:s|ed)?\s+up|altogether|combined|in all|overall|net|positives|"
-                           r"negatives|(?:positive|negative|upward|downward)\s+(?:side|factors|contributions|push|"
-                           r"pressure|drivers|ones)|absolute|pos|neg|pos_\w+|neg_\w+|n_features)\b", re.IGNORECASE)
-
-
-#: 'x of y': the whole a part is of ('11.3 of 21.9 points', '$665 of roughly $806')
-_PART_OF = re.compile(r"\d[\d.,]*\s*(?:points?|pts|%)?\s+of\s+(?:roughly\s+|about\s+|around\s+|some\s+)?[$€£]?\s*$",
-                      re.IGNORECASE)
-
-
-def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
-    """A number after words that sum over the features, equal to one such sum (:attr:`FactBook.aggregates`):
-    verified; otherwise None (its other readings decide)."""
-    before = masked[max(0, n.start - 50):n.start]
-    if not book.aggregates or not (AGGREGATE_CUE.search(before) or _PART_OF.search(before)):
-        return None
-    for what, v in book.aggregates.items():
-        if (matches(n, v) and not n.percent) or (n.points and percent_reading(n, v)):  # ('50 %' is a share)
-            return Claim("number", n.text, "verified", what)
-    return None

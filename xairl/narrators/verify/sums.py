@@ -1,0 +1,67 @@
+"""Numbers that sum over several features: 'A and B together add x' (:func:`sum_number`), and totals or side
+sums after words that say so, 'the positives add up to x', '11.3 of 21.9 points' (:func:`aggregate_number`)."""
+from __future__ import annotations
+
+import re
+
+from .book import FactBook
+from .checks import EITHER, Claim
+from .numbers import Number, matches, percent_reading
+
+
+#: words that say a number sums over the features: 'the positives add up to', 'total absolute attribution',
+#: 'sum_shap=', 'net', 'n_features='
+AGGREGATE_CUE = re.compile(r"\b(?:total|sum\w*|add(?:s|ed)?\s+up|altogether|combined|in all|overall|net|positives|"
+                           r"negatives|(?:positive|negative|upward|downward)\s+(?:side|factors|contributions|push|"
+                           r"pressure|drivers|ones)|absolute|pos|neg|pos_\w+|neg_\w+|n_features)\b", re.IGNORECASE)
+
+
+#: 'x of y': the whole a part is of ('11.3 of 21.9 points', '$665 of roughly $806')
+_PART_OF = re.compile(r"\d[\d.,]*\s*(?:points?|pts|%)?\s+of\s+(?:roughly\s+|about\s+|around\s+|some\s+)?[$€£]?\s*$",
+                      re.IGNORECASE)
+
+
+def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
+    """A number after words that sum over the features, equal to one such sum (:attr:`FactBook.aggregates`):
+    verified; otherwise None (its other readings decide)."""
+    before = masked[max(0, n.start - 50):n.start]
+    if not book.aggregates or not (AGGREGATE_CUE.search(before) or _PART_OF.search(before)):
+        return None
+    for what, v in book.aggregates.items():
+        if (matches(n, v) and not n.percent) or (n.points and percent_reading(n, v)):  # ('50 %' is a share)
+            return Claim("number", n.text, "verified", what)
+    return None
+
+
+def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book: FactBook) -> Claim:
+    """'A and B together add x': x is the sum of their contributions (in the sentence's view, any when it names none);
+    a member that may mean several features counts only when every meaning agrees."""
+    contexts = book.contexts if ctx in (EITHER, None) else (ctx,)
+    combos = [()]
+    for keys in members:
+        combos = [c + (k,) for c in combos for k in keys]
+
+    def close(total: float, k: int) -> bool:  # a sum of k rounded figures may be off by k half-steps
+        return matches(n, total) or (not n.hedge and abs(abs(n.value) - abs(total)) <= k * n.unit / 2 + 1e-9
+                                     and (not n.sign or (n.value < 0) == (total < 0)))
+
+    if n.percent and not n.points:  # 'A and B together explain about 70 % of the attribution': their shares
+        results = [any(all(view in book.features[k].shares for k in combo)
+                       and matches(n, sum(book.features[k].shares[view] for k in combo)) for view in contexts)
+                   for combo in combos]
+        total = sum(book.features[k].shares.get(contexts[0], 0.0) for k in combos[0])
+        text = f"the sum of {', '.join(combos[0])}'s shares is {total:.3g} %"
+        return _sum_claim(n, results, text)
+    results = [any(all(view in book.features[k].contribs for k in combo)
+                   and close(sum(book.features[k].contribs[view] for k in combo), len(combo)) for view in contexts)
+               for combo in combos]
+    total = sum(book.features[k].contribs.get(contexts[0], 0.0) for k in combos[0])
+    return _sum_claim(n, results, f"the sum of {', '.join(combos[0])}'s contributions is {total:.4g}")
+
+
+def _sum_claim(n: Number, results: list[bool], text: str) -> Claim:
+    """Verified when every reading of the members holds, contradicted when none does, else ambiguous."""
+    if all(results):
+        return Claim("number", n.text, "verified", text)
+    return Claim("number", n.text, "unchecked" if any(results) else "contradicted",
+                 "ambiguous: a member may mean several features" if any(results) else text)
