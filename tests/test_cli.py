@@ -79,7 +79,22 @@ def test_explain_table_and_options(capsys):
     rc, out, err = run(capsys, "explain", "--n", "2", "--method", "integrated_gradients", "-o", "n_steps=16",
                        "-o", "method=riemann_left", "--top", "2")
     assert rc == 0, err
-    assert out.count("chose") == 2 and "integrated_gradients" in out
+    assert out.count(": chose ") == 2 and "integrated_gradients" in out
+    assert out.startswith("contributions to the margin") and out.count("expected margin") == 2
+    rc, out, err = run(capsys, "explain", "--n", "2", "--top", "2", "--view", "score")
+    assert out.startswith("contributions to the chosen action's score") and out.count("additivity gap") == 2
+
+
+def test_version_and_examples(capsys):
+    from importlib.metadata import version
+
+    with pytest.raises(SystemExit):
+        main(["--version"])
+    assert capsys.readouterr().out.strip().startswith(f"xairl {version('xairl')}")
+    for argv in (["--help"], ["explain", "--help"], ["verify", "--help"]):
+        with pytest.raises(SystemExit):
+            main(argv)
+        assert "examples:" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("argv, match", [

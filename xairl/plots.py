@@ -1,26 +1,73 @@
-"""Figures with matplotlib, written as PNG files. Contributions are to the chosen action (or, where nothing is
-chosen, to the first output)."""
+"""Figures of explanations, with matplotlib: each function returns a ``matplotlib.figure.Figure`` (shown inline
+in a notebook; :func:`save` writes it atomically). Nothing here imports shap.
+
+Every figure about a decision says what its contributions add up to (its ``view``): ``"margin"`` (default for
+discrete actions) is the chosen action's score minus the runner-up's, the view of the narratives and the evidence
+cards, why this action and not the next best; ``"score"`` is the chosen action's own score (Q-value or logit).
+Policies without a choice (values, continuous actions) show their first output.
+
+    >>> from xairl import plots
+    >>> plots.beeswarm(exp)                      # every state, the strongest features
+    >>> plots.waterfall(exp, index=3)            # one decision, from the expected margin to this one
+    >>> plots.save(plots.image(exp, 0), "frame.png")
+"""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Sequence, Union
 
 import numpy as np
 
 from .explanation import Explanation
 from .files import save_figure
 
+#: more features than this are plotted in groups (image patches, dict keys) or only the strongest are shown
+MAX_SHOWN = 40
+#: an Explanation, or titled explanations side by side: ``[("simulated", e1), ("real", e2)]``
+Panels = Union[Explanation, Sequence[tuple[str, Explanation]]]
+
 
 def _plt():
     import matplotlib
 
-    matplotlib.use("Agg")
+    if matplotlib.get_backend().lower() not in ("module://matplotlib_inline.backend_inline", "inline"):
+        matplotlib.use("Agg")  # no screen here; a notebook keeps its inline backend
     import matplotlib.pyplot as plt
 
     return plt
 
 
-#: more features than this are plotted in groups (image patches, dict keys) or only the strongest are shown
-MAX_SHOWN = 40
+def save(fig, path: str | Path, dpi: int = 90) -> Path:
+    """Write ``fig`` to ``path`` (format from the suffix) atomically and close it; returns the path."""
+    path = save_figure(fig, path, dpi=dpi)
+    _plt().close(fig)
+    return path
+
+
+def _view(exp: Explanation, view: str) -> str:
+    if view not in ("margin", "score"):
+        from .errors import InputError
+
+        raise InputError(f"view {view!r} is not one of margin, score.")
+    return view if exp.output == "actions" and exp.values.shape[2] > 1 else "output"
+
+
+def contributions(exp: Explanation, view: str = "margin") -> np.ndarray:
+    """(n_states, n_features) contributions in ``view``: to the margin over the runner-up, or to the chosen
+    action's score (the first output when nothing is chosen)."""
+    if _view(exp, view) == "margin":
+        return exp.margin()
+    return exp.values[np.arange(len(exp.values)), :, exp.focus]
+
+
+def view_label(exp: Explanation, view: str = "margin") -> str:
+    """What the contributions of ``view`` add up to, in words for an axis or a title."""
+    kind = _view(exp, view)
+    if kind == "margin":
+        return "contribution to the margin (chosen - runner-up score)"
+    if kind == "score":
+        return "contribution to the chosen action's score"
+    return f"contribution to {exp.action_names[0]}"
 
 
 def readable(exp: Explanation) -> Explanation:
@@ -37,13 +84,114 @@ def readable(exp: Explanation) -> Explanation:
     return exp.grouped(by_part) if len(by_part) > 1 else exp
 
 
-def images(exp: Explanation, index: int, path: Path) -> Path:
-    """The state's frame (mean over channels) and, per output, its contributions summed over channels."""
+def _panels(explanations: Panels) -> list[tuple[str, Explanation]]:
+    return [("", explanations)] if isinstance(explanations, Explanation) else list(explanations)
+
+
+def importance_order(exp: Explanation, view: str = "margin") -> np.ndarray:
+    """Feature indices by mean |contribution| in ``view``, largest first."""
+    return np.argsort(-np.abs(contributions(exp, view)).mean(axis=0), kind="stable")
+
+
+def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | None = None,
+             max_display: int = 20):
+    """One dot per state and feature at its contribution, coloured by the feature's value (low blue, high red);
+    several titled explanations side by side share one feature order (the first's importance unless ``order``).
+    Images and dict observations are shown by patch and by key."""
+    plt = _plt()
+    panels = [(t, readable(e)) for t, e in _panels(explanations)]
+    order = (importance_order(panels[0][1], view) if order is None else order)[:max_display]
+    rng = np.random.default_rng(0)
+    fig, axes = plt.subplots(1, len(panels), figsize=(7.5 * len(panels), 0.3 * len(order) + 2), squeeze=False)
+    for ax, (title, exp) in zip(axes[0], panels):
+        c = contributions(exp, view)
+        keep = rng.choice(len(c), size=min(len(c), 2000), replace=False)  # enough dots to show the spread
+        for row, j in enumerate(order):
+            colour = "0.4"
+            if exp.states is not None:
+                colour = plt.cm.coolwarm(np.argsort(np.argsort(exp.states[keep, j])) / max(len(keep) - 1, 1))
+            ax.scatter(c[keep, j], row + rng.uniform(-0.3, 0.3, len(keep)), s=4, c=colour, alpha=0.7, linewidths=0)
+        ax.axvline(0, color="0.5", lw=0.8)
+        ax.set_yticks(range(len(order)), [exp.feature_names[j] for j in order])
+        ax.invert_yaxis()
+        ax.set_xlabel(view_label(exp, view))
+        ax.set_title(title)
+    if panels[0][1].states is not None:
+        bar = fig.colorbar(plt.cm.ScalarMappable(cmap="coolwarm"), ax=axes[0, -1], ticks=[0, 1], fraction=0.03)
+        bar.ax.set_yticklabels(["low", "high"])
+        bar.set_label("feature value")
+    fig.tight_layout()
+    return fig
+
+
+def importance(explanations: Panels, view: str = "margin", max_display: int = MAX_SHOWN):
+    """Mean |contribution| per feature, one bar per titled explanation, in the first one's order."""
+    plt = _plt()
+    panels = _panels(explanations)
+    order = importance_order(panels[0][1], view)[:max_display]
+    names = [panels[0][1].feature_names[j] for j in order]
+    fig, ax = plt.subplots(figsize=(8, 0.35 * len(names) + 1.5))
+    h = 0.8 / len(panels)
+    for k, (title, exp) in enumerate(panels):
+        ax.barh(np.arange(len(names)) + k * h, np.abs(contributions(exp, view)).mean(axis=0)[order], height=h,
+                label=title or None)
+    ax.set_yticks(np.arange(len(names)) + 0.4 - h / 2, names)
+    ax.invert_yaxis()
+    ax.set_xlabel("mean |" + view_label(panels[0][1], view) + "|")
+    if any(t for t, _ in panels):
+        ax.legend()
+    fig.tight_layout()
+    return fig
+
+
+def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int = 10, title: str = ""):
+    """From the expected value (over the background) to state ``index``'s: the ``shown`` largest contributions as
+    steps, the rest as one step. In the margin view the numbers are those of the narrative's evidence card."""
+    plt = _plt()
+    i = exp.check_index(index)
+    c, a = contributions(exp, view)[i], int(exp.focus[i])
+    base, end = float(exp.base_values[i, a]), float(exp.outputs[i, a])
+    if _view(exp, view) == "margin":
+        r = int(exp.runner_up[i])
+        base, end = base - float(exp.base_values[i, r]), end - float(exp.outputs[i, r])
+    order = np.argsort(-np.abs(c), kind="stable")
+    top, rest = order[:shown], order[shown:]
+    labels = [exp.feature_names[j] + ("" if exp.states is None else f" = {exp.states[i, j]:.3g}") for j in top]
+    steps = list(c[top])
+    if len(rest):
+        labels.append(f"{len(rest)} other features")
+        steps.append(float(c[rest].sum()))
+    start = base + np.concatenate([[0.0], np.cumsum(steps[::-1])])[:-1][::-1]
+    fig, ax = plt.subplots(figsize=(8, 0.4 * len(steps) + 1.8))
+    y = np.arange(len(steps))
+    ax.barh(y, steps, left=start, color=["#d62728" if v >= 0 else "#1f77b4" for v in steps])
+    for yi, v, x0 in zip(y, steps, start):
+        ax.text(x0 + v, yi, f" {v:+.3g}", va="center", ha="left" if v >= 0 else "right", fontsize=8)
+    ax.set_yticks(y, labels)
+    ax.invert_yaxis()
+    ax.axvline(base, color="0.5", ls=":", lw=0.8)
+    what = {"margin": f"margin of {exp.action_names[a]} over {exp.action_names[int(exp.runner_up[i])]}",
+            "score": f"{exp.action_names[a]}'s score (chosen)", "output": exp.action_names[a]}[_view(exp, view)]
+    ax.set_xlabel(f"{what}: expected {base:.3g} -> this state {end:.3g}")
+    ax.set_title(title or f"state {i}: {view_label(exp, view)}", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def image(exp: Explanation, index: int = 0):
+    """An image policy's frame (mean over channels) and, per output, its contributions summed over channels
+    (red raises the output, blue lowers it)."""
+    from .errors import InputError
+
     plt = _plt()
     shape = exp.image_shape
-    frame = exp.states[index].reshape(shape)
+    if shape is None:
+        raise InputError("plots.image needs an image observation (Observation with an image shape); use "
+                         "plots.waterfall or plots.beeswarm for flat features.")
+    i = exp.check_index(index)
+    frame = exp.states[i].reshape(shape)
     frame = frame.mean(axis=0) if len(shape) == 3 else frame
-    heat = [exp.image(a)[index] for a in range(exp.values.shape[2])]
+    heat = [exp.image(a)[i] for a in range(exp.values.shape[2])]
     heat = [h.sum(axis=0) if len(shape) == 3 else h for h in heat]
     lim = max(float(np.abs(h).max()) for h in heat) or 1.0
     n = len(heat) + 1
@@ -53,108 +201,45 @@ def images(exp: Explanation, index: int, path: Path) -> Path:
     for ax, h, name in zip(axes[1:], heat, exp.action_names):
         ax.imshow(frame, cmap="gray", alpha=0.35)
         ax.imshow(h, cmap="bwr", vmin=-lim, vmax=lim, alpha=0.8)
-        chosen = exp.output == "actions" and name == exp.action_names[exp.chosen[index]]
+        chosen = exp.output == "actions" and name == exp.action_names[exp.chosen[i]]
         ax.set_title(f"{name}{' (chosen)' if chosen else ''}", fontsize=9)
     for ax in axes:
         ax.axis("off")
     fig.tight_layout()
-    save_figure(fig, path, dpi=90)
-    plt.close(fig)
-    return path
+    return fig
 
 
-def contributions(exp: Explanation) -> np.ndarray:
-    """(n_states, n_features) contributions to the plotted output of each state."""
-    return exp.values[np.arange(len(exp.values)), :, exp.focus]
-
-
-def importance_order(exp: Explanation) -> np.ndarray:
-    """Feature indices by mean |contribution to the chosen action|, largest first."""
-    return np.argsort(-np.abs(contributions(exp)).mean(axis=0), kind="stable")
-
-
-def beeswarms(panels: list[tuple[str, Explanation]], path: Path, order: np.ndarray | None = None) -> Path:
-    """Beeswarms side by side with one feature order (the first panel's importance unless ``order`` is given):
-    one dot per state and feature at its contribution, coloured by the feature's value (low blue, high red).
-
-    Drawn with matplotlib alone: importing shap for its plots costs ~3 s, half the CLI's budget for 10k states.
-    """
+def timeline(exp: Explanation, view: str = "margin", top: int = 5, title: str = ""):
+    """States in order (an episode, a flight): the ``top`` features' contributions over the steps, and above
+    them the decision at each step, so a reader sees when a feature started to decide."""
     plt = _plt()
-    order = (importance_order(panels[0][1]) if order is None else order)[:MAX_SHOWN]
-    rng = np.random.default_rng(0)
-    fig, axes = plt.subplots(1, len(panels), figsize=(7.5 * len(panels), 0.3 * len(order) + 2), squeeze=False)
-    for ax, (title, exp) in zip(axes[0], panels):
-        c = contributions(exp)
-        keep = rng.choice(len(c), size=min(len(c), 2000), replace=False)  # enough dots to show the spread
-        for row, j in enumerate(order):
-            vals = c[keep, j]
-            if exp.states is not None:
-                ranks = np.argsort(np.argsort(exp.states[keep, j])) / max(len(keep) - 1, 1)
-                colour = plt.cm.coolwarm(ranks)
-            else:
-                colour = "0.4"
-            ax.scatter(vals, row + rng.uniform(-0.3, 0.3, len(vals)), s=4, c=colour, alpha=0.7, linewidths=0)
-        ax.axvline(0, color="0.5", lw=0.8)
-        ax.set_yticks(range(len(order)), [exp.feature_names[j] for j in order])
-        ax.invert_yaxis()
-        ax.set_xlabel("contribution (SHAP value)")
-        ax.set_title(title)
-    if panels[0][1].states is not None:
-        bar = fig.colorbar(plt.cm.ScalarMappable(cmap="coolwarm"), ax=axes[0, -1], ticks=[0, 1], fraction=0.03)
-        bar.ax.set_yticklabels(["low", "high"])
-        bar.set_label("feature value")
+    c = contributions(exp, view)
+    order = importance_order(exp, view)[:top]
+    steps = np.arange(len(c))
+    fig, (ax_act, ax) = plt.subplots(2, 1, figsize=(9, 4.2), sharex=True, gridspec_kw={"height_ratios": [1, 4]})
+    decided = exp.chosen if exp.output == "actions" else np.zeros(len(c), dtype=int)
+    ax_act.scatter(steps, decided, s=8, c=decided, cmap="tab10", vmin=0, vmax=9)
+    ax_act.set_yticks(range(len(exp.action_names)), exp.action_names, fontsize=7)
+    ax_act.set_ylabel("chosen" if exp.output == "actions" else "", fontsize=8)
+    for j in order:
+        ax.plot(steps, c[:, j], lw=1.2, label=exp.feature_names[j])
+    ax.axhline(0, color="0.5", lw=0.8)
+    ax.set_xlabel("step (state index)")
+    ax.set_ylabel(view_label(exp, view), fontsize=8)
+    ax.legend(fontsize=7, ncol=min(len(order), 3), loc="upper left")
+    ax_act.set_title(title or f"{len(c)} states in order", fontsize=10)
     fig.tight_layout()
-    save_figure(fig, path, dpi=90)
-    plt.close(fig)
-    return path
+    return fig
 
 
-def waterfall(exp: Explanation, index: int, path: Path, title: str = "", shown: int = 10) -> Path:
-    """From the base value to the output of state ``index``: the ``shown`` largest contributions as steps, the
-    rest as one step."""
-    plt = _plt()
-    a = int(exp.focus[index])
-    c = exp.values[index, :, a]
-    order = np.argsort(-np.abs(c), kind="stable")
-    top, rest = order[:shown], order[shown:]
-    labels = [exp.feature_names[j] + ("" if exp.states is None else f" = {exp.states[index, j]:.3g}") for j in top]
-    steps = list(c[top])
-    if len(rest):
-        labels.append(f"{len(rest)} other features")
-        steps.append(float(c[rest].sum()))
-    start = float(exp.base_values[index, a]) + np.concatenate([[0.0], np.cumsum(steps[::-1])])[:-1][::-1]
-    fig, ax = plt.subplots(figsize=(8, 0.4 * len(steps) + 1.8))
-    y = np.arange(len(steps))
-    ax.barh(y, steps, left=start, color=["#d62728" if v >= 0 else "#1f77b4" for v in steps])
-    for yi, v, x0 in zip(y, steps, start):
-        ax.text(x0 + v, yi, f" {v:+.3g}", va="center", ha="left" if v >= 0 else "right", fontsize=8)
-    ax.set_yticks(y, labels)
-    ax.invert_yaxis()
-    ax.axvline(exp.base_values[index, a], color="0.5", ls=":", lw=0.8)
-    ax.set_xlabel(f"{exp.action_names[a]}: base {exp.base_values[index, a]:.3g} -> output {exp.outputs[index, a]:.3g}")
-    if title:
-        ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    save_figure(fig, path, dpi=90)
-    plt.close(fig)
-    return path
+# The report's file-writing figures (kept until the report moves to the functions above).
+def beeswarms(panels, path: Path, order: np.ndarray | None = None) -> Path:
+    return save(beeswarm(panels, view="score", order=order, max_display=MAX_SHOWN), path)
 
 
-def importance_bars(panels: list[tuple[str, Explanation]], path: Path) -> Path:
-    """Mean |contribution| per feature, one bar group per panel, in the first panel's order."""
-    plt = _plt()
-    order = importance_order(panels[0][1])[:MAX_SHOWN]
-    names = [panels[0][1].feature_names[j] for j in order]
-    fig, ax = plt.subplots(figsize=(8, 0.35 * len(names) + 1.5))
-    h = 0.8 / len(panels)
-    for k, (title, exp) in enumerate(panels):
-        vals = np.abs(contributions(exp)).mean(axis=0)[order]
-        ax.barh(np.arange(len(names)) + k * h, vals, height=h, label=title)
-    ax.set_yticks(np.arange(len(names)) + 0.4 - h / 2, names)
-    ax.invert_yaxis()
-    ax.set_xlabel("mean |contribution to the chosen action's Q-value|")
-    ax.legend()
-    fig.tight_layout()
-    save_figure(fig, path, dpi=90)
-    plt.close(fig)
-    return path
+def importance_bars(panels, path: Path) -> Path:
+    return save(importance(panels, view="score"), path)
+
+
+def images(exp: Explanation, index: int, path: Path) -> Path:
+    return save(image(exp, index), path)

@@ -50,6 +50,12 @@ def _load_entry_points(pm: pluggy.PluginManager) -> None:
         _failures[name] = f"is named in ${LOAD_ENV} but not installed"
 
 
+def distributions() -> list[tuple[str, str]]:
+    """(distribution, version) of each installed plugin, read from its metadata without importing it."""
+    found = {(ep.dist.name, ep.dist.version) for ep in importlib.metadata.entry_points(group="xairl") if ep.dist}
+    return sorted(found)
+
+
 def get_plugin_manager() -> pluggy.PluginManager:
     """The process-wide plugin manager: the selected entry points of group ``xairl``, then the built-ins."""
     global _pm

@@ -173,23 +173,87 @@ def cmd_review(args) -> int:
     return 0
 
 
+#: the top-level help's examples: one line per task a newcomer comes with
+EXAMPLES = """examples:
+  xairl explain                                   the example policy's decisions on 5 sampled states
+  xairl explain --policy uav-dqn --narrate        the UAV reference policy's decisions, in verified words
+  xairl explain --policy my_pkg.pol:make_policy --states s.npy --background bg.npy --out report/
+                                                  your own policy: an HTML report with figures
+  xairl explain --states big.npy --format parquet --out run/    any number of states, streamed, resumable
+  xairl verify "The buffer raised the score by 0.4." --explanation exp.json --trace
+  xairl report --plugin uav-handover -o real=ukm --out out/report    the paper's report, with real flights
+  xairl <command> --help                          each command's options and examples
+"""
+
+
+#: each command's examples, shown under its --help
+COMMAND_EXAMPLES = {
+    "explain": """examples:
+  xairl explain --n 3 --top 4                     three sampled states of the example policy, 4 features each
+  xairl explain --policy uav-dqn --view score     contributions to the chosen action's score, not the margin
+  xairl explain --policy pol.py:make_policy --states s.csv --background bg.csv --narrate
+  xairl explain --policy my_pkg.policies:make_policy --states s.npy --out report/   an HTML report
+  xairl explain --states big.npy --background bg.npy --format parquet --out run/ [--resume] [--engine ray]
+""",
+    "verify": """examples:
+  (the --explanation file is what Explanation.to_json() writes in Python)
+  xairl verify "Speed lowered the score by 0.52." --explanation exp.json --index 0 --trace
+  echo "..." | xairl verify - --explanation exp.json
+""",
+    "report": """examples:
+  xairl report --plugin uav-handover --out out/report                 Table I and SHAP on simulated flights
+  xairl report --plugin uav-handover -o real=ukm --narrate --out out/report    with the real UKM flights
+""",
+    "review": """examples:
+  xairl review                                    review recorded narratives in the terminal
+  xairl review --serve --port 8765                the review page, with each narrative's evidence
+  xairl review --export corrections.jsonl
+""",
+    "prompts": """examples:
+  xairl prompts list
+  xairl prompts show explain_action
+  xairl prompts check my_template.yaml
+""",
+}
+
+
+def _command(sub, name: str, **kwargs) -> argparse.ArgumentParser:
+    """A subcommand's parser, with its examples under --help when it has some."""
+    if name in COMMAND_EXAMPLES:
+        kwargs.update(epilog=COMMAND_EXAMPLES[name], formatter_class=argparse.RawDescriptionHelpFormatter)
+    return sub.add_parser(name, **kwargs)
+
+
+def version_line() -> str:
+    """``xairl 0.1.0`` and the installed plugins' distributions with their versions."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        own = version("xairl")
+    except PackageNotFoundError:  # running from a source tree that was never installed
+        own = "unknown (not installed)"
+    extra = [f"{dist} {ver}" for dist, ver in plugins.distributions()]
+    return f"xairl {own}" + (f" (plugins: {', '.join(extra)})" if extra else "")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = Parser(prog="xairl", description="Explain what a reinforcement-learning policy decided "
-                                     "and why.")
+    parser = Parser(prog="xairl", description="Explain what a reinforcement-learning policy decided and why.",
+                    epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=version_line())
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     p = sub.add_parser("plugins", help="list installed plugins and what each registers")
     p.set_defaults(run=cmd_plugins)
     p = sub.add_parser("attributors", help="list attribution methods and their options")
     p.add_argument("--json", action="store_true", help="print names and JSON schemas of the options")
     p.set_defaults(run=cmd_attributors)
-    explain_parser(sub.add_parser("explain", help="explain a registered policy's decisions on states from a file"))
-    _report_parser(sub.add_parser("report", help="write a plugin's report (HTML, JSONL, figures) into a folder"))
-    p = sub.add_parser("prompts", help="list, show or check prompt templates")
+    explain_parser(_command(sub, "explain", help="explain a registered policy's decisions on states from a file"))
+    _report_parser(_command(sub, "report", help="write a plugin's report (HTML, JSONL, figures) into a folder"))
+    p = _command(sub, "prompts", help="list, show or check prompt templates")
     p.add_argument("action", choices=("list", "show", "check"))
     p.add_argument("target", nargs="?", help="template name (show) or .yaml path (check)")
     p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder")
     p.set_defaults(run=cmd_prompts)
-    p = sub.add_parser("verify", help="check a text's claims against an explanation (exit 1 when one is "
+    p = _command(sub, "verify", help="check a text's claims against an explanation (exit 1 when one is "
                        "contradicted)")
     p.add_argument("text", help="the text to check, or - to read it from standard input")
     p.add_argument("--explanation", required=True, metavar="FILE", help="the explanation, as Explanation.to_json() "
@@ -197,7 +261,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--index", type=count(0), default=0, help="which state of the explanation the text is about")
     p.add_argument("--trace", action="store_true", help="every claim: status, kind, words, rule, reason")
     p.set_defaults(run=cmd_verify)
-    p = sub.add_parser("review", help="accept, reject or correct recorded narratives in the terminal, or in a local "
+    p = _command(sub, "review", help="accept, reject or correct recorded narratives in the terminal, or in a local "
                        "web page with the evidence (--serve)")
     p.add_argument("--db", type=new_file, default=None, help="feedback store (default: in the user dir)")
     p.add_argument("--serve", action="store_true", help="serve the review page on http://127.0.0.1:PORT/")
