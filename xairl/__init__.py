@@ -16,6 +16,7 @@ _LAZY = {
     "from_sb3": "xairl.sb3",
     "Observation": "xairl.observation",
     "patches": "xairl.observation",
+    "in_regions": "xairl.regions",
     "FeatureInfo": "xairl.policy",
     "Explanation": "xairl.explanation",
     "StateRecord": "xairl.explanation",

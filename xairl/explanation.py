@@ -85,6 +85,36 @@ class Explanation:
             if arr is not None:
                 arr.setflags(write=False)
 
+    def __repr__(self) -> str:  # counts and the first few names, never every feature (the arrays are the fields)
+        from .observation import names_preview
+
+        feats, acts = (names_preview(self.feature_names, "features"),
+                       names_preview(self.action_names, "actions" if self.output == "actions" else "outputs"))
+        return (f"Explanation({self.method!r}, {len(self.values)} states; {feats}; {acts}; output {self.output}, "
+                f"largest additivity gap {self.additivity_gap.max(initial=0.0):.2g})")
+
+    def _repr_html_(self, states: int = 5, top: int = 6) -> str:
+        """Jupyter's view: the summary line, then the first ``states`` decisions with their ``top`` contributions to
+        the margin over the runner-up (to each output's score when nothing is chosen), the view named."""
+        import html
+
+        n, f, _ = self.values.shape
+        deciding = self.output == "actions" and self.values.shape[2] > 1
+        view = self.margin() if deciding else self.values[np.arange(n), :, self.focus]
+        rows = []
+        for i in range(min(n, states)):
+            c, r = int(self.chosen[i]), int(self.runner_up[i])
+            what = (f"chose <b>{html.escape(self.action_names[c])}</b> over {html.escape(self.action_names[r])} by "
+                    f"{self.outputs[i, c] - self.outputs[i, r]:.4g}" if deciding else
+                    f"{html.escape(self.action_names[c])} = {self.outputs[i, c]:.4g}")
+            top_j = np.argsort(-np.abs(view[i]), kind="stable")[:top]
+            cells = ", ".join(f"{html.escape(self.feature_names[j])} {view[i, j]:+.3g}" for j in top_j)
+            rows.append(f"<tr><td>{i}</td><td>{what}</td><td>{cells}</td></tr>")
+        target = "the margin over the runner-up" if deciding else "the output"
+        more = f"<p>... and {n - states} more states</p>" if n > states else ""
+        return (f"<div class=xairl-explanation><p><code>{html.escape(repr(self))}</code></p><table><tr><th>state</th>"
+                f"<th>decision</th><th>largest contributions to {target}</th></tr>{''.join(rows)}</table>{more}</div>")
+
     @property
     def shape(self) -> tuple[int, int, int]:
         return self.values.shape

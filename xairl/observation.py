@@ -7,6 +7,7 @@ method sees through them).
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from itertools import product
 from typing import Any, Mapping, Sequence
@@ -195,6 +196,25 @@ class Observation:
             return self.parts[0].shape
         return None
 
+    def regions(self) -> dict[str, np.ndarray]:
+        """Named patches of each channel of each image part (2-D or 3-D), for :meth:`Explanation.grouped`: what
+        narration speaks of instead of pixels (:func:`region_name`); empty when no image part has patches larger than
+        one pixel (a small image is narrated pixel by pixel)."""
+        out, single = {}, len(self.parts) == 1
+        for p, cols in zip(self.parts, self.slices().values()):
+            if p.categories or len(p.shape) not in (2, 3):
+                continue
+            c, h, w = (1, *p.shape) if len(p.shape) == 2 else p.shape
+            size = region_size(h, w)
+            if size == 1:
+                continue
+            idx = np.arange(cols.start, cols.stop).reshape(c, h, w)
+            for ch, r, q in product(range(c), range(0, h, size), range(0, w, size)):
+                rows, columns = (r, min(r + size, h) - 1), (q, min(q + size, w) - 1)
+                name = region_name(rows, columns, ch if c > 1 else None, None if single else p.key)
+                out[name] = idx[ch, r:r + size, q:q + size].ravel()
+        return out
+
     def to_dict(self) -> dict:
         return {"kind": self.kind, "parts": [{"key": p.key, "shape": list(p.shape), "categories": p.categories}
                                              for p in self.parts]}
@@ -216,6 +236,40 @@ def patches(shape: Sequence[int], size: int | Sequence[int], prefix: str = "patc
     idx = np.arange(c * h * w).reshape(c, h, w)
     return {f"{prefix}[{r // ph},{q // pw}]": idx[:, r:r + ph, q:q + pw].ravel()
             for r in range(0, h, ph) for q in range(0, w, pw)}
+
+
+#: how a region is named: 'the 8x8 patch at rows 24 to 31, columns 32 to 39 of channel 2' (rows, columns and channels
+#: count from 0, as in the pixels' names 'obs[2,24,32]'; ' of KEY' ends the name in a dict of several inputs)
+REGION_FORMAT = "the {h}x{w} patch at rows {r0} to {r1}, columns {c0} to {c1}"
+#: any phrase shaped like a region's name, written as :data:`REGION_FORMAT` or close to it ('rows 3-8')
+_SPAN = r"\d+(?:\s*(?:to|-|–|through)\s*\d+)?"
+REGION_RE = re.compile(rf"\b(?:\d+\s*[x×]\s*\d+\s+)?(?:patch|region|block)\s+(?:at|spanning|covering|over)\s+rows?\s+"
+                       rf"{_SPAN}\s*,?\s*(?:and\s+)?columns?\s+{_SPAN}(?:\s+(?:of|in)\s+(?:channel|frame)\s+\d+)?",
+                       re.IGNORECASE)
+
+
+def region_size(h: int, w: int) -> int:
+    """The side of a region's square patch in an h x w image: about a tenth of the longer side (at most ~100 patches
+    per channel), rounded up to a divisor of both sides when one is near (64 -> 8, 84 -> 12), so patches are even."""
+    target = max(1, -(-max(h, w) // 10))
+    even = [s for s in range(target, 2 * target + 1) if h % s == 0 and w % s == 0]
+    return even[0] if even else target
+
+
+def region_name(rows: tuple[int, int], columns: tuple[int, int], channel: int | None = None,
+                key: str | None = None) -> str:
+    """A region's name in words (:data:`REGION_FORMAT`), from its first and last row and column (inclusive)."""
+    name = REGION_FORMAT.format(h=rows[1] - rows[0] + 1, w=columns[1] - columns[0] + 1, r0=rows[0], r1=rows[1],
+                                c0=columns[0], c1=columns[1])
+    return name + (f" of channel {channel}" if channel is not None else "") + (f" of {key}" if key else "")
+
+
+def names_preview(names: Sequence[str], what: str, shown: int = 3) -> str:
+    """'12288 features: obs[0,0,0], obs[0,0,1], obs[0,0,2], ...': a count and the first ``shown`` names (all of them
+    when there are at most ``shown + 2``), for reprs of policies and explanations."""
+    names = list(names)
+    head = names if len(names) <= shown + 2 else [*names[:shown], "..."]
+    return f"{len(names)} {what}: {', '.join(head)}"
 
 
 def _numeric(data, what: str) -> np.ndarray:

@@ -20,6 +20,7 @@ import numpy as np
 
 from .explanation import Explanation
 from .files import save_figure
+from .regions import in_regions
 
 #: more features than this are plotted in groups (image patches, dict keys) or only the strongest are shown
 MAX_SHOWN = 40
@@ -71,15 +72,12 @@ def view_label(exp: Explanation, view: str = "margin") -> str:
 
 
 def readable(exp: Explanation) -> Explanation:
-    """An explanation a beeswarm can show: images grouped into at most ~100 patches, dicts by key."""
-    from .observation import patches
-
+    """An explanation a beeswarm can show: images in the regions their narratives name (:func:`xairl.in_regions`),
+    dicts by key."""
     if exp.values.shape[1] <= MAX_SHOWN or exp.observation is None:
         return exp
-    shape = exp.image_shape
-    if shape is not None:
-        side = max(1, int(np.ceil(max(shape[-2:]) / 10)))
-        return exp.grouped(patches(shape, side))
+    if exp.image_shape is not None:
+        return in_regions(exp)
     by_part = exp.groups_by_part()
     return exp.grouped(by_part) if len(by_part) > 1 else exp
 
@@ -124,7 +122,7 @@ def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | Non
     return fig
 
 
-def importance(explanations: Panels, view: str = "margin", max_display: int = MAX_SHOWN):
+def importance(explanations: Panels, view: str = "margin", max_display: int = 20):
     """Mean |contribution| per feature, one bar per titled explanation, in the first one's order."""
     plt = _plt()
     panels = _panels(explanations)
@@ -230,16 +228,3 @@ def timeline(exp: Explanation, view: str = "margin", top: int = 5, title: str = 
     ax_act.set_title(title or f"{len(c)} states in order", fontsize=10)
     fig.tight_layout()
     return fig
-
-
-# The report's file-writing figures (kept until the report moves to the functions above).
-def beeswarms(panels, path: Path, order: np.ndarray | None = None) -> Path:
-    return save(beeswarm(panels, view="score", order=order, max_display=MAX_SHOWN), path)
-
-
-def importance_bars(panels, path: Path) -> Path:
-    return save(importance(panels, view="score"), path)
-
-
-def images(exp: Explanation, index: int, path: Path) -> Path:
-    return save(image(exp, index), path)

@@ -10,7 +10,7 @@ import numpy as np
 import torch
 
 from .errors import InputError, XairlError
-from .observation import Observation
+from .observation import Observation, names_preview
 
 
 @dataclass(frozen=True)
@@ -152,6 +152,13 @@ class Policy:
         if len(members) != len(set(members)):
             raise InputError("a feature belongs to two groups narrated as one reason (kind='group'); keep them apart.")
 
+    def __repr__(self) -> str:
+        """Counts and the first few names, never thousands: ``Policy('cnn', 12288 features: obs[0,0,0], ... ;
+        4 actions: ...; output actions, observation (n, 3, 64, 64))``."""
+        return (f"Policy({self.name!r}, {names_preview(self.feature_names, 'features')}; "
+                f"{names_preview(self.action_names, 'actions' if self.output == 'actions' else 'outputs')}; "
+                f"output {self.output}, observation {self.observation.describe()})")
+
     @property
     def n_features(self) -> int:
         return len(self.feature_names)
@@ -220,7 +227,8 @@ class Policy:
     def background(self, n: int = 100, seed: int = 0) -> np.ndarray:
         """`n` typical states from the policy's sampler; raises when it has none."""
         if self.background_sampler is None:
-            raise InputError(f"policy '{self.name}' has no background sampler; pass background states explicitly.")
+            raise InputError(f"policy '{self.name}' has no background sampler; give background states: --background FILE "
+                             "on the command line, background=array in Python.")
         return self.check_states(self.background_sampler(n, seed), "background")
 
 

@@ -21,6 +21,12 @@ from .explanation import Explanation, StateRecord
 from .files import atomic_write, write_text
 from .options import Options, parse_options
 from .policy import Policy
+from .regions import in_regions
+
+
+#: an image's report lists this many regions by importance (its cards list every region, sorted)
+TOP_REGIONS = 20
+REGIONS_ARE = "regions (patches of one channel; rows, columns and channels count from 0)"
 
 
 @dataclass
@@ -103,21 +109,52 @@ def table_html(header: list[str], rows: list[list]) -> str:
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def importance_table(exps: list[tuple[str, Explanation]]) -> tuple[str, str]:
-    """Each feature's rank by mean |contribution to the chosen action| per dataset, and the Spearman rank
-    correlation of every dataset's global importance with the first's."""
-    from scipy.stats import spearmanr
-
+def importance_table(exps: list[tuple[str, Explanation]], top: int | None = None, what: str = "features"
+                     ) -> tuple[str, str]:
+    """Each feature's rank by mean |contribution to the chosen action| per dataset (the ``top`` first only, when
+    given), and the Spearman rank correlation of every dataset's global importance with the first's."""
     imp = [np.abs(e.for_chosen()).mean(axis=0) for _, e in exps]
     ranks = [np.argsort(np.argsort(-v)) + 1 for v in imp]
     names = exps[0][1].feature_names
     rows = [[f, *[int(r[j]) for r in ranks], *[float(v[j]) for v in imp]] for j, f in
-            sorted(enumerate(names), key=lambda t: ranks[0][t[0]])]
-    rhos = [float(spearmanr(imp[0], v).statistic) for v in imp[1:]]
-    title = "Global importance by dataset" + "".join(f"; Spearman rank correlation {label} vs {exps[0][0]}: {rho:.2f}"
-                                                    for (label, _), rho in zip(exps[1:], rhos))
+            sorted(enumerate(names), key=lambda t: ranks[0][t[0]])][:top]
+    rhos = [float(_spearman(imp[0], v)) for v in imp[1:]]
+    title = ("Global importance by dataset" if len(rows) == len(names) else
+             f"The {len(rows)} most important of {len(names)} {what} ({exps[0][0]})") + "".join(
+        f"; Spearman rank correlation {label} vs {exps[0][0]}: {rho:.2f}" for (label, _), rho in zip(exps[1:], rhos))
     header = ["feature", *[f"rank ({label})" for label, _ in exps], *[f"mean |contribution| ({label})" for label, _ in exps]]
     return title, table_html(header, rows)
+
+
+def _spearman(a: np.ndarray, b: np.ndarray) -> float:
+    from scipy.stats import spearmanr  # seconds to import: only for a report of several datasets
+
+    return spearmanr(a, b).statistic
+
+
+def _figures(exps: list[tuple[str, Explanation]], pick: int, groups: dict, out: Path) -> list[tuple[str, Path]]:
+    """The report's figures, each captioned with what its contributions add up to. Images are plotted in the regions
+    their narratives name and dicts by key (thousands of pixels are no beeswarm); the image plot shows the pixels."""
+    from . import plots
+
+    (ref_label, ref), decides = exps[0], exps[0][1].output == "actions"
+    shown = [(label, plots.readable(e)) for label, e in exps]
+    target = "the chosen action's score" if decides else f"output {ref.action_names[0]}"
+    what = f"{ref_label} state {pick}" + (f": {ref.action_names[ref.chosen[pick]]}" if decides else "")
+    figures = [(f"SHAP values of {target}, {' vs '.join(l for l, _ in exps)} (same feature order, by {ref_label} "
+                "importance)", plots.save(plots.beeswarm(shown, view="score"), out / "beeswarm.png")),
+               (f"Global importance: mean |contribution| to {target}",
+                plots.save(plots.importance(shown, view="score"), out / "importance.png")),
+               (f"One {'decision' if decides else 'state'} ({what}){': contributions to the margin over the runner-up, as in its card' if decides else ''}",
+                plots.save(plots.waterfall(shown[0][1], pick), out / "waterfall.png"))]
+    if ref.image_shape is not None:
+        figures.append((f"Contributions over the frame, per output ({ref_label} state {pick}; red raises the output, "
+                        "blue lowers it; summed over channels)", plots.save(plots.image(ref, pick), out / "image.png")))
+    if groups:
+        figures.append((f"Global importance by group ({'; '.join(g + ' = ' + ', '.join(m) for g, m in groups.items())})",
+                        plots.save(plots.importance([(l, e.grouped(groups)) for l, e in exps], view="score"),
+                                   out / "importance_groups.png")))
+    return figures
 
 
 def _interesting(exp: Explanation) -> int:
@@ -140,7 +177,6 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     """
     from tqdm import tqdm
 
-    from . import plots
     from .attributors import explain
 
     t0 = time.time()
@@ -158,29 +194,16 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
                 for rec in exp.records(dataset=label):
                     fh.write(rec.model_dump_json() + "\n")
         write_text(out / "explanations.schema.json", json.dumps(StateRecord.model_json_schema(), indent=2))
-    ref_label, ref = exps[0]
+    ref = exps[0][1]
     pick = _interesting(ref)
-    # images and dicts are plotted by patch / by key (thousands of pixels are no beeswarm); the image plot shows
-    # the pixels themselves
-    shown = [(label, plots.readable(e)) for label, e in exps]
-    target = "the chosen action's score" if ref.output == "actions" else f"output {ref.action_names[0]}"
-    figures = [(f"SHAP values of {target}, {' vs '.join(l for l, _ in exps)} (same feature "
-                f"order, by {ref_label} importance)", plots.beeswarms(shown, out / "beeswarm.png")),
-               ("Global importance: mean |contribution|", plots.importance_bars(shown, out / "importance.png")),
-               (f"One {'decision' if ref.output == 'actions' else 'state'} ({ref_label} state {pick}"
-                f"{': ' + ref.action_names[ref.chosen[pick]] if ref.output == 'actions' else ''})",
-                plots.waterfall(shown[0][1], pick, out / "waterfall.png"))]
-    if ref.image_shape is not None:
-        figures.append((f"Contributions over the frame, per output ({ref_label} state {pick}; red raises the "
-                        "output, blue lowers it; summed over channels)", plots.images(ref, pick, out / "image.png")))
-    groups = dict(content.policy.groups)
-    if groups:
-        figures.append((f"Global importance by group ({'; '.join(g + ' = ' + ', '.join(m) for g, m in groups.items())})",
-                        plots.importance_bars([(l, e.grouped(groups)) for l, e in exps], out / "importance_groups.png")))
-    figures += content.figures
-    tables = list(content.tables) + ([importance_table(exps)] if len(exps) > 1 else [])
+    figures = _figures(exps, pick, dict(content.policy.groups), out) + list(content.figures)
+    # an image's importance by region (the top ones), not by pixel; its narratives' cards list regions too
+    regioned = [(label, in_regions(e)) for label, e in exps]
+    image = regioned[0][1] is not ref
+    tables = list(content.tables) + ([importance_table(regioned, TOP_REGIONS, REGIONS_ARE) if image else
+                                      importance_table(exps)] if len(exps) > 1 or image else [])
     notes = (content.commentary({label: e for label, e in exps}) if content.commentary else []) + content.notes
-    narratives = _narratives(req, content, ref, pick) if req.narrate else []
+    narratives = _narratives(req, content, ref, regioned[0][1], pick) if req.narrate else []
     settings = {"method": req.method, "options": req.options, "narrator": req.narrator, "seed": req.seed,
                 "background states": len(content.background), "seconds to explain, plot and narrate": round(time.time() - t0, 1),
                 **content.settings}
@@ -189,9 +212,10 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     return path
 
 
-def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, pick: int) -> list:
+def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, shown: Explanation, pick: int) -> list:
     """(narrative, evidence) for narrated decisions of the reference dataset (``pick`` first), its global summary
-    and, with groups, the summary with each group as one reason."""
+    and, with groups, the summary with each group as one reason; the evidence is of ``shown`` (``ref`` in regions,
+    for an image: what the narratives speak of)."""
     from tqdm import tqdm
 
     from .narrators import narrate
@@ -202,7 +226,7 @@ def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, pi
                    robustness=req.robustness)
            for i in tqdm(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)]
     out.append(narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs))
-    pairs = [(n, evidence(ref, n)) for n in out]
+    pairs = [(n, evidence(shown, n)) for n in out]
     if content.policy.groups:
         grouped = ref.grouped(dict(content.policy.groups))
         n = narrate(grouped, None, policy=content.policy, prompt_dirs=req.prompt_dirs)

@@ -6,17 +6,20 @@ words fail verification, and the confidence score (xairl.narrators.confidence).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import html
+from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Iterable
 
 import numpy as np
 
 from ..errors import InputError
+from ..evidence import CARD_STYLE, card_html, evidence
 from ..explanation import Explanation
 from ..options import Options, parse_options
 from ..policy import Policy
 from .confidence import confidence
 from .facts import DomainFacts, decision_facts, global_facts
+from ..regions import in_regions
 from .verify import Claim, verify
 
 
@@ -28,6 +31,8 @@ class Narrative:
     :param rejected: the narrator's own text when it failed verification and the template's was shown instead.
     :param sentences: (sentence, status) per sentence of ``text``: 'verified', 'contradicted' or 'unchecked' (no
         checkable claim), as the verifier found them; the report and the review page mark each.
+    :param evidence: what an operator checks the words against (:func:`xairl.evidence.evidence`: the state, the
+        contributions to the margin, the sentences' statuses); a notebook shows it as the report's card.
     """
 
     text: str
@@ -41,6 +46,13 @@ class Narrative:
     rejected: str | None = None
     extras: dict = field(default_factory=dict)
     sentences: tuple[tuple[str, str], ...] = ()
+    evidence: dict | None = field(default=None, repr=False, compare=False)
+
+    def _repr_html_(self) -> str:
+        """Jupyter's view: the evidence card of the HTML report (each sentence marked, the state, the waterfall)."""
+        meta = html.escape(f"{self.source}, template {self.template}, state {self.index}")
+        return f"<style>{CARD_STYLE}</style>" + card_html(self.text, self.evidence or {
+            "sentences": [list(s) for s in self.sentences], "confidence": self.confidence}, meta)
 
 
 def first_phrasings(variants: list[list[str]]) -> str:
@@ -88,9 +100,11 @@ class Narrator:
         if index is not None and explanation.output not in tpl.spec.outputs:
             raise InputError(f"template '{tpl.name}' narrates {' or '.join(tpl.spec.outputs)} outputs; this policy's "
                              f"output is {explanation.output}: use template '{default}'.")
-        # a continuous action: each dimension is its own output, narrated and verified on its own
-        views = [explanation.output_slice(j) for j in range(explanation.values.shape[2])] \
-            if index is not None and explanation.output == "continuous" else [explanation]
+        # an image is narrated in regions, not pixels (the confidence's robustness still reads the pixels); a
+        # continuous action: each dimension is its own output, narrated and verified on its own
+        narrated = in_regions(explanation)
+        views = [narrated.output_slice(j) for j in range(narrated.values.shape[2])] \
+            if index is not None and explanation.output == "continuous" else [narrated]
         texts, claims, ok, sources, rejected, scores, comps, sentences = [], [], True, [], [], [], [], []
         for j, view in enumerate(views):
             text, check, source, bad = self._words(view, index, tpl, policy, k, history)
@@ -105,10 +119,11 @@ class Narrator:
             scores.append(score)
             comps.append(comp)
         worst = int(np.argmin(scores))  # a continuous action is as trustworthy as its least trustworthy dimension
-        return Narrative(text=" ".join(texts), claims=tuple(claims), verified=ok, confidence=scores[worst],
+        told = Narrative(text=" ".join(texts), claims=tuple(claims), verified=ok, confidence=scores[worst],
                          components=comps[worst], source=next((s for s in sources if s != self.name), self.name),
                          template=tpl.name, index=index, rejected=" ".join(rejected) or None,
                          extras={"method": explanation.method}, sentences=tuple(sentences))
+        return replace(told, evidence=evidence(narrated, told))
 
     def _words(self, explanation: Explanation, index: int | None, tpl, policy: Policy | None, k: int,
                history=None):

@@ -280,8 +280,9 @@ def _takes_history(hook) -> bool:
 
 def _domain_facts(policy: Policy | None, state: np.ndarray, chosen: int, runner_up: int,
                   history: np.ndarray | None = None) -> DomainFacts:
-    """The policy plugin's ``facts_hook`` output, checked for its type; ``history`` goes to hooks that take it."""
-    if policy is None or policy.facts_hook is None:
+    """The policy plugin's ``facts_hook`` output, checked for its type; ``history`` goes to hooks that take it. An
+    image narrated in regions (:mod:`xairl.regions`) has no pixel state to give the hook: it is not called there."""
+    if policy is None or policy.facts_hook is None or len(state) != policy.n_features:
         return DomainFacts()
     if history is not None and len(history) and _takes_history(policy.facts_hook):
         out = policy.facts_hook(state, chosen, runner_up, history=policy.check_states(history, "history"))

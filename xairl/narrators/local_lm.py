@@ -30,6 +30,7 @@ from .base import Narrator, first_phrasings
 
 SYSTEM = ("You write short, factual explanations of an automated controller's decisions for the engineers who "
           "operate it. Keep every number, name and direction exactly as given.")
+LM_EXTRA = "the local language model needs the lm extra: pip install 'xairl[lm]'"
 _LOADED: dict[str, tuple] = {}
 
 
@@ -41,6 +42,18 @@ class LocalLMOptions(Options):
     max_new_tokens: int = Field(200, ge=8, le=1024, description="rewrite mode: generation budget")
     examples: list[str] = Field(default_factory=list, description="operator-approved narratives used as examples")
     threads: int | None = Field(None, ge=1, description="torch CPU threads (default: torch's choice)")
+
+
+def _transformers():
+    """The transformers module, imported only here (``import xairl`` and the template narrator never import it);
+    InputError with the one-line install hint when it, or a package it needs, is missing."""
+    try:
+        import transformers
+    except ImportError as exc:
+        missing = getattr(exc, "name", None)
+        hint = "" if (missing or "transformers").split(".")[0] == "transformers" else f" ({missing} is missing)"
+        raise InputError(LM_EXTRA + hint) from None
+    return transformers
 
 
 def default_gguf() -> Path:
@@ -61,10 +74,9 @@ def _converted_copy(gguf: Path) -> Path:
     target = model_cache_dir() / f"{gguf.stem}-{key}"
     if (target / "config.json").is_file():
         return target
-    from transformers import AutoModelForCausalLM, AutoTokenizer
-
-    tok = AutoTokenizer.from_pretrained(str(gguf.parent), gguf_file=gguf.name)
-    model = AutoModelForCausalLM.from_pretrained(str(gguf.parent), gguf_file=gguf.name)
+    tf = _transformers()
+    tok = tf.AutoTokenizer.from_pretrained(str(gguf.parent), gguf_file=gguf.name)
+    model = tf.AutoModelForCausalLM.from_pretrained(str(gguf.parent), gguf_file=gguf.name)
     model.hf_quantizer = None  # the GGUF weights are dequantised on load; save them as plain tensors
     model.config.__dict__.pop("quantization_config", None)
     tmp = target.with_name(target.name + f".tmp{os.getpid()}")
@@ -80,6 +92,7 @@ def _converted_copy(gguf: Path) -> Path:
 def load_model(spec: str | None = None):
     """(model, tokenizer) for a model folder, a .gguf file, or the default; cached in this process."""
     os.environ.setdefault("HF_HUB_OFFLINE", "1")
+    tf = _transformers()  # before looking for the model: without the extra, its install hint is the useful error
     path = Path(spec) if spec else default_gguf()
     key = str(path.resolve())
     if key in _LOADED:
@@ -92,11 +105,9 @@ def load_model(spec: str | None = None):
         folder = path
     else:
         raise InputError(f"{path}: not a transformers model folder (no config.json) nor a .gguf file.")
-    from transformers import AutoModelForCausalLM, AutoTokenizer
-
     try:  # safetensors only: pickled weights (pytorch_model.bin) can run code when loaded
-        tok = AutoTokenizer.from_pretrained(str(folder), local_files_only=True)
-        model = AutoModelForCausalLM.from_pretrained(str(folder), local_files_only=True, use_safetensors=True).eval()
+        tok = tf.AutoTokenizer.from_pretrained(str(folder), local_files_only=True)
+        model = tf.AutoModelForCausalLM.from_pretrained(str(folder), local_files_only=True, use_safetensors=True).eval()
     except Exception as exc:  # transformers raises many kinds on a broken or foreign folder
         raise InputError(f"{folder}: cannot load the model ({' '.join(str(exc).split())[:200]}); give a folder with "
                          "config.json and .safetensors weights, or a .gguf file.") from None

@@ -27,4 +27,4 @@ def register_commands(register):
 @hookimpl
 def register_reports(register):
     register("uav-handover", "xairl_uav_handover.report:UAVReport",
-             "Table I, real-flight replay (-o real=PATH), handover rate vs altitude, SHAP figures, narrated handovers")
+             "Table I, real-flight replay (-o real=PATH, or -o real=ukm to fetch the UKM flights), handover rate vs altitude, SHAP figures, narrated handovers")

@@ -1,17 +1,19 @@
-"""The reference plugin's report (``xairl report --plugin uav-handover [-o real=PATH]``): Table I; with real flights,
-the calibration against them (handover rates per altitude band, the buffer, sim vs real state quantiles), open-loop
-agreement with the live network, and which of the paper's findings hold. xairl's report does the explanations,
-figures (beeswarms sim vs real, importance, groups) and narration.
+"""The reference plugin's report (``xairl report --plugin uav-handover [-o real=PATH|ukm]``): Table I; with real
+flights, the calibration against them (handover rates per altitude band, the buffer, sim vs real state quantiles),
+open-loop agreement with the live network, and which of the paper's findings hold. xairl's report does the
+explanations, figures (beeswarms sim vs real, importance, groups) and narration. Where real flights come from:
+:func:`real_source` (``ukm``: ukm.py).
 """
 from __future__ import annotations
 
+import sys
 from dataclasses import astuple, dataclass
 from pathlib import Path
 
 import numpy as np
 from pydantic import Field
 
-from xairl import Explanation, Options, Report, ReportContent, ReportRequest, save_figure, table_html
+from xairl import Explanation, InputError, Options, Report, ReportContent, ReportRequest, save_figure, table_html
 
 from .baselines import CHM, SAMRO, CHMOnSamples, SAMROOnSamples
 from .evaluate import PAPER, chm_rate_by_altitude, table_one
@@ -25,8 +27,10 @@ BANDS = ((20.0, 60.0), (60.0, 100.0), (100.0, 160.0))
 class UAVReportOptions(Options):
     """The UAV report's own settings (``-o key=value``)."""
 
-    real: str | None = Field(None, description="folder of real flight exports (Nemo CSV), e.g. "
-                                               "../shared/data/ukm-uav-lte/raw")
+    real: str | None = Field(None, description="folder of real flight exports (Nemo CSV) or a zip of them, e.g. "
+                                               "../shared/data/ukm-uav-lte/raw; or 'ukm': the UKM flights "
+                                               "($XAIRL_UKM_DATA, else the copy cached in the user data folder, else "
+                                               "downloaded once; skipped with a note when they cannot be had)")
     flights: int = Field(100, ge=1, le=10_000, description="held-out simulated flights for Table I")
     timelines: int = Field(2, ge=0, le=20, description="simulated flights shown at a glance (timeline and summary; "
                                                        "with real data, its first flight too)")
@@ -113,6 +117,7 @@ class UAVReport(Report):
     Options = UAVReportOptions
 
     def build(self, req: ReportRequest) -> ReportContent:
+        real, real_setting = real_source(self.options.real)
         ckpt = load_checkpoint()
         cfg = ckpt.sim_config
         content = ReportContent(
@@ -121,14 +126,14 @@ class UAVReport(Report):
             datasets=[("simulated", dqn_decision_states(ckpt, req.n_states, seed=req.seed + 1))],
             tables=[self._table_one(ckpt, req.seed)],
             settings={"checkpoint": ckpt.path.name, "training command": ckpt.meta.get("command"),
-                      "simulated states": req.n_states, "real data": self.options.real or "not given (-o real=PATH)",
+                      "simulated states": req.n_states, "real data": real_setting,
                       "video rate Mbit/s": cfg.buffer.video_rate_mbps,
                       "x, y quantised to (m)": cfg.observation.position_grid_m or "not quantised"},
             template="handover", commentary=findings,
             notes=["Simulated states: the DQN's own decision states on held-out flights (TR 36.777 UMa-AV, the "
                    "calibrated link and load of config.py). Contributions are to the chosen action's Q-value; the "
                    "background is 100 states after 10 s of flight under conventional handover."])
-        flights = self._add_real_flights(content, ckpt, req) if self.options.real else []
+        flights = self._add_real_flights(content, ckpt, req, real) if real is not None else []
         self._add_timelines(content, ckpt, req, flights[:1])
         return content
 
@@ -158,13 +163,13 @@ class UAVReport(Report):
         return (f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s (ping-pong window "
                 f"{cfg.handover.min_time_of_stay_s:g} s)", _table(rows))
 
-    def _add_real_flights(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest) -> list:
-        """The calibration and agreement tables against the real flights; returns the flights loaded."""
+    def _add_real_flights(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest, real: Path) -> list:
+        """The calibration and agreement tables against the real flights in folder ``real``; returns the flights."""
         from tqdm import tqdm
 
         from .real_data import chm_handovers, load_folder, walk
 
-        flights, bad = load_folder(self.options.real)
+        flights, bad = load_folder(real)
         cfg = ckpt.sim_config
         walks = [walk(f, cfg, seed=req.seed) for f in tqdm(flights, desc="real flights", disable=not req.progress)]
         chm_real = [chm_handovers(f, sim_config=cfg) for f in flights]
@@ -173,7 +178,7 @@ class UAVReport(Report):
         content.datasets.append(("real", states[np.sort(pick)]))
         sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=256)
         queue = np.concatenate([w.queue_bits for w in walks])
-        where = f"{len(flights)} real flights from {self.options.real}" + (f" ({len(bad)} skipped)" if bad else "")
+        where = f"{len(flights)} real flights from {real}" + (f" ({len(bad)} skipped)" if bad else "")
         content.tables += [
             (f"Calibration: handovers per minute by altitude band ({where})", _table(band_rows(flights, chm_real, cfg, req.seed))),
             (f"Real states in the training distribution: buffer full in {100 * np.mean(queue >= cfg.buffer.q_max_bits):.1f} "
@@ -183,8 +188,26 @@ class UAVReport(Report):
             (f"Open-loop agreement with the live network's decisions ({where})",
              _table(agreement_rows(walks, ckpt, cfg)))]
         content.notes += [f"skipped file: {b}" for b in bad] + REAL_NOTES
-        content.figures.append(_altitude_figure(req.out, self.options.real, cfg, flights, chm_real, req.seed))
+        content.figures.append(_altitude_figure(req.out, str(real), cfg, flights, chm_real, req.seed))
         return flights
+
+
+def real_source(real: str | None) -> tuple[Path | None, str]:
+    """The folder of real flights for ``-o real=VALUE`` and the report's "real data" setting. A PATH is used as
+    given (a zip extracted once; a wrong one fails when loaded); ``ukm`` locates or fetches the UKM flights
+    (ukm.py) and, when they cannot be had, prints one line to stderr and returns None with the reason."""
+    from . import ukm
+
+    if real is None:
+        return None, f"not given (-o real=PATH, or -o real={ukm.KEYWORD} to fetch the UKM flights)"
+    if real.strip().lower() != ukm.KEYWORD:
+        return ukm.flights_folder(real), real
+    try:
+        folder = ukm.flights_folder()
+    except InputError as exc:
+        print(f"xairl: report: real-data half skipped: {exc}", file=sys.stderr)
+        return None, f"not available: {exc}"
+    return folder, f"{folder} (-o real={ukm.KEYWORD}: UKM flights, {ukm.LICENCE}, {ukm.REPO} at {ukm.COMMIT[:12]})"
 
 
 REAL_NOTES = [

@@ -36,7 +36,8 @@ import numpy as np
 from ...errors import InputError
 from ...explanation import Explanation
 from ...policy import Policy
-from . import background, binding, checks, comparisons, directions, parse, quantities, ranks, sums
+from ...regions import in_regions
+from . import background, binding, checks, comparisons, directions, parse, quantities, ranks, regions, sums
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, named_features, split_words, vocabulary
@@ -175,6 +176,7 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
         raise InputError(f"verify() reads text (a str), not {type(text).__name__}: decode it first, "
                          f"e.g. data.decode('utf-8').")
     index = None if index is None else explanation.check_index(index)
+    explanation = in_regions(explanation)  # an image is read in regions, as it is narrated
     text = normalise(text)
     if len(text) > MAX_CHARS:
         text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
@@ -267,7 +269,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
     if hypothetical:
         claims += [binding.named(c, "direction.without") for c in directions.without(masked, mentions, book, ctx)]
     claims += [c for m in _IDENT_RE.finditer(masked) if (c := _identifier(m, masked, book, vocab.words))]
-    return claims
+    return claims + regions.unknown_regions(masked)
 
 
 #: an identifier's word that names a decision-level quantity ('p_churn', 'y_hat', 'sum_shap', 'base_value')

@@ -15,6 +15,7 @@ import re
 from dataclasses import dataclass
 
 from ...explanation import Explanation
+from ...observation import REGION_RE
 from ...policy import Policy
 from .book import legend
 
@@ -98,7 +99,7 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
             if form and clean(form):
                 exact.setdefault(_phrase(form), set()).add(f)
         for form in [f] + ([_head(described)] if described else []):
-            if clean(form):
+            if clean(form) and not REGION_RE.match(f.removeprefix("the ")):  # a region: only by its whole name
                 for run in _runs(form, f):
                     phrases.setdefault(run, set()).add(f)
     shared: dict[str, set[str]] = {}
