@@ -232,7 +232,7 @@ def test_errors_about_the_background_file_say_background(tmp_path, capsys):
 
 def test_top_prints_as_many_features_as_asked(capsys):
     rc, out, _ = run(capsys, "explain", "--n", "1", "--top", "5", "--method", "exact")
-    assert rc == 0 and out.count("contribution") == 5
+    assert rc == 0 and out.count("   contribution ") == 5
 
 
 # 7. atomic writes ---------------------------------------------------------------------------------------------------
@@ -266,7 +266,7 @@ def test_a_failed_report_leaves_neither_partial_files_nor_the_last_runs_report(t
     def broken(*args, **kwargs):
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(plots, "beeswarms", broken)
+    monkeypatch.setattr(plots, "beeswarm", broken)
     monkeypatch.setenv("XAIRL_DEBUG", "")
     rc, _, err = run(capsys, "explain", "--n", "4", "--method", "exact", "--out", str(out))
     assert rc == 1 and "disk full" in err

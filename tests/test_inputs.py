@@ -56,7 +56,7 @@ def test_policy_checks_names_and_module():
         xairl.TorchPolicy(lambda x: x, ["a", "b"], ["x", "y"])
     with pytest.raises(InputError, match="returned shape"):
         xairl.TorchPolicy(net, ["a", "b"], ["x", "y", "z"]).scores(np.zeros((1, 2)))
-    with pytest.raises(InputError, match="no background sampler"):
+    with pytest.raises(InputError, match="no background sampler; give background states: --background FILE"):
         xairl.explain(xairl.TorchPolicy(net, ["a", "b"], ["x", "y"]), np.zeros((1, 2)))
 
 

@@ -97,3 +97,10 @@ def test_import_and_template_narrator_never_import_transformers():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_default_mode_is_choose_and_rewrite_stays_an_option():
+    """bench_lm_modes.py: choose changes the wording (always verified) in 90 % / 20 % of narratives (toy / UAV);
+    rewrite verifies on the first try in 17 % / 25 % at 10-17 s a text, so it is opt-in only."""
+    assert local_lm.LocalLMOptions().mode == "choose"
+    assert local_lm.LocalLMOptions(mode="rewrite").mode == "rewrite"

