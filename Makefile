@@ -50,8 +50,10 @@ demo: setup-demo
 	$(VENV)/bin/xairl explain --policy uav-dqn --n 2 --narrate --template handover --no-record
 	@echo "the report: $(CURDIR)/out/report/report.html"
 
+# two workers, one torch thread each: the suite's files shared over two cores (one thread per worker, as two
+# workers with torch's default threads each slow each other down)
 test: setup
-	$(PY) -m pytest
+	OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 $(PY) -m pytest -n 2 --dist loadfile
 
 docs: setup
 	$(PY) -m mkdocs build --strict --site-dir site

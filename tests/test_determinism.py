@@ -1,7 +1,6 @@
-"""Seeded runs give bit-identical explanations and narratives: across processes (with different hash seeds) for
-every attribution method and the template narrator, and twice in one process for the local language model (its
-load is what costs time, so it is loaded once)."""
-import hashlib
+"""Seeded runs give bit-identical explanations and narratives across processes (with different hash seeds), for
+every attribution method and the template narrator. The local language model's runs repeat in one process
+(tests/test_local_lm.py): its load is what costs time, so it is loaded once."""
 import os
 import subprocess
 import sys
@@ -26,14 +25,3 @@ def test_two_processes_same_bits():
     runs = [subprocess.run([sys.executable, "-c", CODE], capture_output=True, text=True, check=True,
                            env={**os.environ, "PYTHONHASHSEED": seed}).stdout.strip() for seed in ("1", "2")]
     assert len(runs[0]) == 64 and runs[0] == runs[1]
-
-
-def test_local_lm_narration_repeats_in_process():
-    import xairl
-    from xairl.toy import toy_policy
-
-    p = toy_policy()
-    e = xairl.explain(p, p.background(2, seed=3), background=p.background(40, seed=4))
-    texts = [hashlib.sha256(xairl.narrate(e, 0, narrator="local_lm", policy=p).text.encode()).hexdigest()
-             for _ in range(2)]
-    assert texts[0] == texts[1]

@@ -78,11 +78,12 @@ def test_a3_sentence_verifies_when_the_compared_candidate_is_not_the_strongest_n
 
 def test_mutation_corpus_on_the_reference_policy(uav):
     policy, exp, _ = uav
-    cases = corpus(exp, policy, ("explain_action", "explain_score", "why_not", "handover"), range(40),
+    # 20 states keep every kind of mutation (the full corpus of 7,641: benchmarks/bench_narration.py --verifier-only)
+    cases = corpus(exp, policy, ("explain_action", "explain_score", "why_not", "handover"), range(20),
                    label_words=LABEL_WORDS)
     wrongly = [(c.kind, c.text) for c in cases if xairl.verify(c.text, exp, c.index, policy).ok != c.should_pass]
     kinds = collections.Counter(c.kind for c in cases)
-    assert len(cases) > 3000 and len(kinds) >= 8
+    assert len(cases) > 1500 and len(kinds) >= 8
     assert not wrongly, wrongly[:3]
 
 

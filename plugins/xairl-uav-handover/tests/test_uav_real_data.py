@@ -119,9 +119,16 @@ def test_baltaci_rates():
     assert list(bins) == list(range(0, 130, 10)) and n > 2000 and (rate >= 0).all() and rate.sum() > 0
 
 
-def test_report_without_real_data(tmp_path, capsys):
-    out = tmp_path / "rep"
+@pytest.fixture(scope="module")
+def sim_report(tmp_path_factory):
+    """One report without real data, read by the tests below (a report costs seconds)."""
+    out = tmp_path_factory.mktemp("sim") / "rep"
     assert main(["report", "--plugin", "uav-handover", "--n", "40", "-o", "flights=20", "--narrate", "--out", str(out)]) == 0
+    return out
+
+
+def test_report_without_real_data(sim_report):
+    out = sim_report
     html = (out / "report.html").read_text()
     assert "Table I" in html and html.count("data:image/png;base64,") >= 3
     assert "&#10003; verified" in html and "confidence" in html
@@ -152,11 +159,10 @@ def test_report_with_real_data(tmp_path):
 
 
 @pytest.mark.skipif(not shutil.which("chromium"), reason="chromium is not installed")
-def test_report_renders_in_headless_chromium(tmp_path):
+def test_report_renders_in_headless_chromium(sim_report, tmp_path):
     import subprocess
 
-    out = tmp_path / "rep"
-    assert main(["report", "--plugin", "uav-handover", "--n", "20", "-o", "flights=20", "--out", str(out)]) == 0
+    out = sim_report
     shot = tmp_path / "shot.png"
     subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
                     "--disable-background-networking", "--disable-component-update", "--disable-sync",
