@@ -142,21 +142,23 @@ def test_vector_env_steps_flights_together():
 
 
 def test_chm_and_samro_behaviour_on_flights():
-    """Table I compares medians: SA-MRO raises its margin where service is fine (most flights) and hands over less
-    there; where the link cannot carry the video it lowers the margin and may hand over more than CHM."""
-    cfg, n = SimConfig(), 100  # medians of a few flights swing: with 20, SA-MRO's low-capacity flights can lead
-    medians = {}
+    """SA-MRO (mobility robustness optimisation) starts from CHM's offset and moves the offsets of the cell pairs
+    where handovers came too early or ping-ponged up, and too late down: on the same flights it hands over and
+    ping-pongs less than CHM, its offsets raised where they came too early."""
+    cfg, n = SimConfig(), 100
+    means = {}
     for ctl in (CHM(), SAMRO()):
         env = HandoverVecEnv(cfg, n_flights=n, decision_every=1)
         env.reset(seed=2)
         ctl.reset(env)
-        hos, truncated = np.zeros(n), np.zeros(n, bool)
+        hos, pps, truncated = np.zeros(n), np.zeros(n), np.zeros(n, bool)
         while not truncated.all():
             *_, truncated, info = env.step(ctl(env))
             hos += info["handover"]
-        medians[ctl.name] = np.median(hos)
-    assert medians["CHM"] > medians["SA-MRO"] > 0
-    assert (ctl.margin > 2.0).mean() > 0.5  # service was fine, so SA-MRO raised most margins
+            pps += info["pingpong_5s"]
+        means[ctl.name] = (hos.mean(), pps.mean())
+    assert means["CHM"][0] > means["SA-MRO"][0] > 0 and means["CHM"][1] >= means["SA-MRO"][1]
+    assert ctl.mro.cio.max() > 0 and (ctl.mro.cio != 0).sum() < ctl.mro.cio.size / 4  # a few pairs, not all
 
 
 @pytest.mark.parametrize("data, field", [

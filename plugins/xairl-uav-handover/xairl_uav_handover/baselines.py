@@ -7,13 +7,10 @@ report. :class:`A3Trigger` runs on time stamps, so the same rule also runs on re
 
 - :class:`CHM`: the conventional A3 handover: hand over to the strongest neighbour once its RSRP has exceeded the
   serving RSRP by ``offset_db`` continuously for ``ttt_s`` (TR 36.777 Table A.2.1-1: 2 dB, 160 ms).
-- :class:`SAMRO`: the same A3 mechanism, with its margin and TTT tuned per UAV from measured service availability
-  (the idea of Meer et al., IEEE TNSM 2024; their exact rule is not public). The rule we implement, every
-  ``window_s``: if the radio service availability in the window (share of steps with uplink SINR >= minimum; the
-  interruptions that handovers cause themselves are left out, else the rule would feed on its own handovers) fell
-  below ``target_availability`` the UAV needs better cells sooner, so margin -= step and TTT moves one value down the 3GPP TTT list; if availability met the target but
-  the UAV still handed over in the window, those handovers bought nothing, so margin += step and TTT one value up.
-  Margin stays in ``margin_range_db``. Mobility robustness is thus driven by the service the UAV actually got.
+- :class:`SAMRO`: self-adaptive mobility robustness optimisation, as 3GPP describes MRO (TS 36.300 sec. 22.4.2,
+  TS 36.902 sec. 4.5): A3 with a cell individual offset per (serving, neighbour) pair, which the network raises after
+  too-early handovers and ping-pongs on that pair and lowers after too-late ones, once per window
+  (:class:`MobilityRobustness` has the events' definitions). Offsets are the network's, shared by every UAV it serves.
 """
 from __future__ import annotations
 
@@ -22,8 +19,6 @@ import numpy as np
 from .config import CHMConfig, SAMROConfig
 from .features import RSRP
 
-#: 3GPP TS 36.331 timeToTrigger values, seconds
-TTT_VALUES = np.array([0, 40, 64, 80, 100, 128, 160, 256, 320, 480, 512, 640, 1024, 1280, 2560, 5120]) / 1000.0
 
 
 class A3Trigger:
@@ -41,11 +36,12 @@ class A3Trigger:
 
     def targets(self, rsrp: np.ndarray, serving: np.ndarray, offset_db, ttt_s, now: float | None = None) -> np.ndarray:
         """Target cell per UAV (the serving one when no neighbour fired) for measurements ``rsrp`` (k, n) at time
-        ``now`` (default: measurement count x dt)."""
+        ``now`` (default: measurement count x dt); ``offset_db`` one per UAV, or (k, n) one per UAV and cell."""
         now = self.t * self.dt if now is None else float(now)
         k = np.arange(len(serving))
         ms = rsrp[k, serving][:, None]
-        cond = rsrp > ms + np.asarray(offset_db, dtype=float).reshape(-1, 1)
+        offset = np.asarray(offset_db, dtype=float)
+        cond = rsrp > ms + (offset if offset.ndim == 2 else offset.reshape(-1, 1))  # per UAV, or per UAV and cell
         cond[k, serving] = False
         self.since = np.where(cond, np.where(np.isnan(self.since), now, self.since), np.nan)
         fired = cond & (now - self.since >= np.asarray(ttt_s, dtype=float).reshape(-1, 1) - 1e-9)
@@ -88,8 +84,54 @@ class CHM:
                                                self.cfg.ttt_s))
 
 
+class MobilityRobustness:
+    """The network's MRO state: a cell individual offset (dB, added to the A3 offset) per (serving, neighbour) pair.
+
+    Events, per UAV: a radio link failure (RLF) is uplink SINR below the minimum for ``rlf_s`` (counted once per
+    failure). An RLF within ``early_s`` of a handover makes that handover too early (on its source, target pair); any
+    other RLF while a neighbour is stronger than the serving cell is a too-late handover (on the serving, strongest
+    neighbour pair: the one that should have happened); a handover back to the source within ``pingpong_s`` counts
+    on the first handover's pair as too early. Every ``window_s`` each pair with more too-early than too-late events
+    gets ``margin_step_db`` more offset (hand over later), one with more too-late ones that much less; the total
+    offset stays in ``margin_range_db``.
+    """
+
+    def __init__(self, cfg: SAMROConfig, k: int, n: int):
+        self.cfg = cfg
+        self.cio = np.zeros((n, n))
+        self.early, self.late = np.zeros((n, n)), np.zeros((n, n))
+        self.fail_since = np.full(k, np.nan)
+        self.ho_time, self.source = np.full(k, -np.inf), np.full(k, -1)
+        self.window_start = 0.0
+
+    def offsets(self, serving: np.ndarray) -> np.ndarray:
+        """(k, n) A3 offsets of each UAV towards each cell, from its serving cell."""
+        return self.cfg.offset_db + self.cio[serving]
+
+    def observe(self, now: float, serving, radio_ok, stronger, handed, previous) -> None:
+        """One step's outcome: ``serving`` cells now, ``radio_ok`` uplink SINR at least the minimum, ``stronger``
+        the strongest neighbour when it beats the serving cell (-1: none), ``handed`` handovers from ``previous``."""
+        c = self.cfg
+        back = handed & (serving == self.source) & (now - self.ho_time < c.pingpong_s)
+        np.add.at(self.early, (serving[back], previous[back]), 1)
+        self.source, self.ho_time = np.where(handed, previous, self.source), np.where(handed, now, self.ho_time)
+        failing = ~np.asarray(radio_ok, dtype=bool)
+        self.fail_since = np.where(failing, np.where(np.isnan(self.fail_since), now, self.fail_since), np.nan)
+        rlf = failing & (now - self.fail_since >= c.rlf_s)
+        self.fail_since[rlf] = np.inf  # one event per failure
+        early = rlf & (now - self.ho_time <= c.early_s) & (self.source >= 0)
+        np.add.at(self.early, (self.source[early], serving[early]), 1)
+        late = rlf & ~early & (stronger >= 0)
+        np.add.at(self.late, (serving[late], stronger[late]), 1)
+        if now - self.window_start >= c.window_s:
+            step = c.margin_step_db * ((self.early > self.late).astype(float) - (self.late > self.early))
+            low, high = c.margin_range_db
+            self.cio = np.clip(self.cio + step, low - c.offset_db, high - c.offset_db)
+            self.early[:], self.late[:], self.window_start = 0, 0, now
+
+
 class SAMRO:
-    """A3 handover whose margin and TTT adapt per UAV to measured service availability (rule in the module doc)."""
+    """A3 handover with the network's per-pair offsets adapted by mobility robustness optimisation (module doc)."""
 
     name = "SA-MRO"
     decision_every = 1
@@ -98,31 +140,20 @@ class SAMRO:
         self.cfg = config or SAMROConfig()
 
     def reset(self, env) -> None:
-        sim, c = env.sim, self.cfg
+        sim = env.sim
         self.a3 = A3Trigger(sim.K, sim.N, sim.dt)
-        self.margin = np.full(sim.K, c.offset_db)
-        self.ttt_idx = np.full(sim.K, int(np.abs(TTT_VALUES - c.ttt_s).argmin()))
-        self.window = max(1, int(round(c.window_s / sim.dt)))
-        self.avail = np.zeros(sim.K)
-        self.hos = np.zeros(sim.K)
-        self.n = 0
+        self.mro = MobilityRobustness(self.cfg, sim.K, sim.N)
+        self.previous = sim.serving.copy()
 
     def __call__(self, env) -> np.ndarray:
-        sim = env.sim
+        sim, rsrp = env.sim, _candidate_rsrp(env)
         if sim.last is not None:
-            self.avail += sim.last.radio_ok
-            self.hos += sim.last.handover
-            self.n += 1
-        if self.n == self.window:
-            c = self.cfg
-            poor = self.avail / self.n < c.target_availability
-            wasted = ~poor & (self.hos > 0)
-            self.margin = np.clip(self.margin - c.margin_step_db * poor + c.margin_step_db * wasted,
-                                  *c.margin_range_db)
-            self.ttt_idx = np.clip(self.ttt_idx - poor + wasted, 0, len(TTT_VALUES) - 1)
-            self.avail[:], self.hos[:], self.n = 0, 0, 0
-        return _action_of(env, self.a3.targets(_candidate_rsrp(env), sim.serving, self.margin,
-                                               TTT_VALUES[self.ttt_idx]))
+            k, nb = np.arange(sim.K), env.candidates[:, 1]
+            stronger = np.where((nb >= 0) & (rsrp[k, np.maximum(nb, 0)] > rsrp[k, sim.serving]), nb, -1)
+            self.mro.observe(sim.t * sim.dt, sim.serving, sim.last.radio_ok, stronger,
+                             sim.last.handover.astype(bool), self.previous)
+        self.previous = sim.serving.copy()
+        return _action_of(env, self.a3.targets(rsrp, sim.serving, self.mro.offsets(sim.serving), self.cfg.ttt_s))
 
 
 class CHMOnSamples:
@@ -142,35 +173,34 @@ class CHMOnSamples:
         self.a3 = A3Trigger(1, len(self.cells))
         self.serving = None
 
-    def _margin_ttt(self, state, network_handed: bool, t: float) -> tuple[float, float]:
+    def _margin_ttt(self, state, candidates, previous, t: float):
+        """A3's offset (a number, or (1, cells) per cell) and time-to-trigger at this sample; ``previous``: the
+        serving cell at the sample before (None at the first)."""
         return self.cfg.offset_db, self.cfg.ttt_s
 
     def __call__(self, state, candidates, t: float) -> int:
-        network_handed = self.serving is not None and candidates[0] != self.serving
+        previous = self.serving
         if candidates[0] != self.serving:
             self.a3.since[:] = np.nan
             self.serving = candidates[0]
         rsrp = np.full((1, len(self.cells)), -np.inf)
         for k, cell in enumerate(candidates):
             rsrp[0, self.col[cell]] = state[RSRP][k]
-        margin, ttt = self._margin_ttt(state, network_handed, t)
+        margin, ttt = self._margin_ttt(state, candidates, previous, t)
         target = self.a3.targets(rsrp, np.array([self.col[candidates[0]]]), margin, ttt, now=t)[0]
         return list(candidates).index(self.cells[target])
 
 
 class SAMROOnSamples(CHMOnSamples):
-    """SA-MRO on real samples: the rule of :class:`SAMRO`, with radio availability from the uplink model at the
-    sample's serving RSRP and altitude, and the network's own handovers counted in the window."""
+    """SA-MRO on real samples: :class:`MobilityRobustness` for one UAV over the flight's cells, fed with the network's
+    own handovers and with radio availability from the uplink model at the sample's serving RSRP and altitude."""
 
     name = "SA-MRO"
 
     def __init__(self, cells, sim_config, config: SAMROConfig | None = None):
         super().__init__(cells, None)
         self.sa, self.sim_cfg = config or SAMROConfig(), sim_config
-        self.margin = self.sa.offset_db
-        self.ttt_idx = int(np.abs(TTT_VALUES - self.sa.ttt_s).argmin())
-        self.window: list[tuple[bool, bool]] = []  # (radio ok, handed over) per sample
-        self.window_start: float | None = None
+        self.mro = MobilityRobustness(self.sa, 1, len(self.cells))
         self.interference: dict[float, float] = {}
 
     def _radio_ok(self, state) -> bool:
@@ -184,15 +214,11 @@ class SAMROOnSamples(CHMOnSamples):
         sinr = sinr_db(cfg, rsrp_offset_db(cfg) - float(state[RSRP][0]), self.interference[h])
         return bool(sinr >= cfg.handover.sinr_min_db)
 
-    def _margin_ttt(self, state, network_handed: bool, t: float) -> tuple[float, float]:
-        self.window.append((self._radio_ok(state), network_handed))
-        self.window_start = t if self.window_start is None else self.window_start
-        if t - self.window_start >= self.sa.window_s:
-            ok = np.array(self.window)
-            poor = ok[:, 0].mean() < self.sa.target_availability
-            wasted = not poor and ok[:, 1].any()
-            step = self.sa.margin_step_db
-            self.margin = float(np.clip(self.margin - step * poor + step * wasted, *self.sa.margin_range_db))
-            self.ttt_idx = int(np.clip(self.ttt_idx - poor + wasted, 0, len(TTT_VALUES) - 1))
-            self.window, self.window_start = [], None
-        return self.margin, TTT_VALUES[self.ttt_idx]
+    def _margin_ttt(self, state, candidates, previous, t: float):
+        serving = np.array([self.col[candidates[0]]])
+        rsrp = state[RSRP]
+        stronger = self.col[candidates[1]] if len(candidates) > 1 and rsrp[1] > rsrp[0] else -1
+        handed = previous is not None and previous != candidates[0]
+        self.mro.observe(t, serving, np.array([self._radio_ok(state)]), np.array([stronger]), np.array([handed]),
+                         np.array([self.col[previous] if previous is not None else serving[0]]))
+        return self.mro.offsets(serving), self.sa.ttt_s

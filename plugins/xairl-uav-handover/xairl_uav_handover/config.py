@@ -125,8 +125,9 @@ class HandoverConfig(_Strict):
 
 
 class RewardConfig(_Strict):
-    """r = w_buffer / (1 + q) - w_handover*[handover] - w_rsrp*[RSRP<thr] - w_rsrq*[RSRQ<thr] per decision, q in
-    Mbit (the paper's buffer term omega1 / (1 + q))."""
+    """r = w_buffer / (1 + q) - w_handover*[handover] - w_rsrp*[RSRP<thr] - w_rsrq*[RSRQ<thr] - w_lost*lost
+    - w_pingpong*[back within 5 s] per decision, q and lost in Mbit (the paper's buffer term omega1 / (1 + q); the
+    lost-data and ping-pong terms are ours)."""
 
     w_handover: float = Field(20.0, ge=0, description="measured (30 training episodes, 100 held-out flights of "
                                                        "120 s, L3 k=4): 3 leaves the DQN at a median 3 handovers per "
@@ -138,6 +139,10 @@ class RewardConfig(_Strict):
                                                    "CHM (-1 to 0 %)")
     w_rsrp: float = Field(0.5, ge=0)
     w_rsrq: float = Field(0.5, ge=0)
+    w_lost: float = Field(0.0, ge=0, description="per Mbit of uplink data lost to buffer overflow in the decision "
+                                                 "period (0: the paper's reward, which never sees lost data)")
+    w_pingpong: float = Field(0.0, ge=0, description="per handover back to the previous BS within 5 s (a ping-pong "
+                                                     "as operators count it; 0: the paper's reward)")
 
 
 class SimConfig(_Strict):
@@ -175,11 +180,14 @@ class CHMConfig(_Strict):
 
 
 class SAMROConfig(_Strict):
-    """Service-availability-driven MRO (see baselines.SAMRO for the rule)."""
+    """Mobility robustness optimisation (see baselines.SAMRO): A3 with a cell individual offset per (serving,
+    neighbour) pair, adapted from too-late, too-early and ping-pong handovers (3GPP TS 36.300 sec. 22.4.2)."""
 
-    offset_db: float = Field(2.0, description="starting handover margin")
-    ttt_s: float = Field(0.16, ge=0, description="starting time-to-trigger")
-    window_s: float = Field(2.0, gt=0, description="measurement window of service availability")
-    target_availability: float = Field(0.99, gt=0, le=1)
-    margin_step_db: float = Field(1.0, gt=0)
-    margin_range_db: tuple[float, float] = (0.0, 10.0)
+    offset_db: float = Field(2.0, description="A3 offset every pair starts from (CHM's)")
+    ttt_s: float = Field(0.16, ge=0, description="time-to-trigger (CHM's; MRO tunes offsets only)")
+    window_s: float = Field(10.0, gt=0, description="the network adapts the offsets from the events of each window")
+    rlf_s: float = Field(0.5, gt=0, description="radio link failure: uplink SINR below the minimum this long")
+    early_s: float = Field(2.0, gt=0, description="a failure this soon after a handover makes it too early")
+    pingpong_s: float = Field(1.0, gt=0, description="back to the source this soon: a ping-pong (as in Table I)")
+    margin_step_db: float = Field(1.0, gt=0, description="change of a pair's offset per window")
+    margin_range_db: tuple[float, float] = (-4.0, 10.0)

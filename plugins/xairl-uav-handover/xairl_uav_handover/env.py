@@ -24,6 +24,8 @@ from .simulator import Simulator
 
 #: per-flight quantities summed over each decision's simulator steps (StepInfo fields)
 METRICS = ("handover", "pingpong", "available", "queue_bits", "lost_bits", "rsrp_violation", "rsrq_violation")
+#: ping-pong windows counted beside the configured one (``pingpong_1s`` ...: back to the previous BS within w s)
+PINGPONG_WINDOWS_S = (1.0, 2.0, 5.0, 10.0)
 
 
 class HandoverVecEnv(gym.vector.VectorEnv):
@@ -60,7 +62,7 @@ class HandoverVecEnv(gym.vector.VectorEnv):
         sim, w = self.sim, self.cfg.reward
         target = self.candidates[np.arange(sim.K), np.asarray(actions, dtype=np.int64)]
         target = np.where(target < 0, sim.serving, target)
-        sums = {key: np.zeros(sim.K) for key in METRICS}
+        sums = {key: np.zeros(sim.K) for key in METRICS + tuple(f"pingpong_{w:g}s" for w in PINGPONG_WINDOWS_S)}
         gain = np.zeros(sim.K)
         n = 0
         while n < self.decision_every and not sim.done:
@@ -69,8 +71,11 @@ class HandoverVecEnv(gym.vector.VectorEnv):
                      - w.w_rsrq * info.rsrq_violation)
             for key in METRICS:
                 sums[key] += getattr(info, key)
+            for window in PINGPONG_WINDOWS_S:
+                sums[f"pingpong_{window:g}s"] += info.back_after_s < window
             n += 1
-        reward = -w.w_handover * sums["handover"] + gain / max(n, 1)
+        reward = (-w.w_handover * sums["handover"] - w.w_lost * sums["lost_bits"] / 1e6
+                  - w.w_pingpong * sums["pingpong_5s"] + gain / max(n, 1))
         self.obs, self.candidates = sim.observe()
         ended = np.full(sim.K, sim.done)
         return self.obs, reward, np.zeros(sim.K, dtype=bool), ended, sums | {"candidates": self.candidates}

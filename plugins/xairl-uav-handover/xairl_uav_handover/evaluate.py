@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .config import SimConfig
-from .env import METRICS, HandoverVecEnv
+from .env import METRICS, PINGPONG_WINDOWS_S, HandoverVecEnv
 from .features import FEATURES
 
 BUFFER = FEATURES.index("buffer_queue_size")
@@ -21,7 +21,8 @@ def run_flights(controller, config: SimConfig, n_flights: int, seed: int) -> dic
     env = HandoverVecEnv(config, n_flights, decision_every=controller.decision_every)
     env.reset(seed=HELD_OUT_SEED + seed)
     controller.reset(env)
-    tot = {k: np.zeros(n_flights) for k in METRICS}
+    windows = tuple(f"pingpong_{w:g}s" for w in PINGPONG_WINDOWS_S)
+    tot = {k: np.zeros(n_flights) for k in METRICS + windows}
     nonempty, decisions, ended = np.zeros(n_flights), 0, False
     ho_nonempty, ho_full = np.zeros(n_flights), np.zeros(n_flights)
     while not ended:
@@ -29,7 +30,7 @@ def run_flights(controller, config: SimConfig, n_flights: int, seed: int) -> dic
         nonempty += queue > 0
         decisions += 1
         *_, truncated, info = env.step(controller(env))
-        for key in METRICS:
+        for key in METRICS + windows:
             tot[key] += info[key]
         ho_nonempty += info["handover"] * (queue > 0)
         ho_full += info["handover"] * (queue >= config.buffer.q_max_bits)
@@ -41,6 +42,8 @@ def run_flights(controller, config: SimConfig, n_flights: int, seed: int) -> dic
         "handovers_buffer_full": ho_full,           # and with a full one
         "buffer_nonempty_pct": 100 * nonempty / decisions,
         "pingpongs": tot["pingpong"],
+        **{f"pingpongs_{w:g}s": tot[f"pingpong_{w:g}s"] for w in PINGPONG_WINDOWS_S},
+        "minutes": np.full(n_flights, n * env.sim.dt / 60.0),
         "service_availability_pct": 100 * tot["available"] / n,
         "mean_buffer_kbit": tot["queue_bits"] / n / 1e3,
         "lost_data_kbit": tot["lost_bits"] / 1e3,

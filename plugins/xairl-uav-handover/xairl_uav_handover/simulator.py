@@ -59,6 +59,7 @@ class StepInfo:
     queue_bits: np.ndarray
     lost_bits: np.ndarray
     sinr_db: np.ndarray
+    back_after_s: np.ndarray  # a handover back to the previous BS: the seconds spent at the one left; else inf
 
 
 class Simulator:
@@ -168,7 +169,9 @@ class Simulator:
         target = np.asarray(target, dtype=np.int64)
         ho = target != self.serving
         stay_steps = self.t - self.entered
-        pingpong = ho & (target == self.prev_serving) & (stay_steps * self.dt < cfg.handover.min_time_of_stay_s)
+        back = ho & (target == self.prev_serving)
+        pingpong = back & (stay_steps * self.dt < cfg.handover.min_time_of_stay_s)
+        back_after_s = np.where(back, stay_steps * self.dt, np.inf)  # ping-pongs at any window (evaluate.py)
         self.prev_serving = np.where(ho, self.serving, self.prev_serving)
         self.entered = np.where(ho, self.t, self.entered)
         self.serving = target
@@ -186,7 +189,8 @@ class Simulator:
         radio_ok = sinr >= hc.sinr_min_db
         info = StepInfo(ho, pingpong, serving_now & radio_ok, radio_ok,
                         self.meas_rsrp[k, self.serving] < hc.rsrp_threshold_dbm,
-                        self.meas_rsrq[k, self.serving] < hc.rsrq_threshold_db, self.q.copy(), lost, sinr)
+                        self.meas_rsrq[k, self.serving] < hc.rsrq_threshold_db, self.q.copy(), lost, sinr,
+                        back_after_s)
         self._move()
         self._measure()
         self._report()

@@ -1,0 +1,58 @@
+"""Rewards that price what operators pay for: train one DQN per weight set and seed, then Table I with intervals
+against CHM and SA-MRO and the targets of the issue "A reference DQN that beats the A3 rule on what operators pay
+for" (benchmarks/table_one.py), per weight set.
+
+A weight set is w_lost,w_rsrq,w_handover,w_pingpong (per Mbit lost, per decision below the RSRQ threshold, per
+handover, per handover back to the previous BS within 5 s); the other weights are the simulator's defaults. Training
+takes about 2 minutes per set and seed on 2 cores (40 episodes of 64 flights).
+Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reward_sweep.py --sets 1,2,20,40 0.5,2,30,60
+     [--seeds 0] [--episodes 40] [--flights 100] [--eval-seeds 0] [--keep DIR]
+"""
+import argparse
+import tempfile
+from pathlib import Path
+
+from table_one import targets
+from xairl_uav_handover.baselines import CHM, SAMRO
+from xairl_uav_handover.config import SimConfig
+from xairl_uav_handover.policy import DQNController, load_checkpoint
+from xairl_uav_handover.table import flights, format_rows, with_intervals
+from xairl_uav_handover.train import TrainConfig, train_checkpoint
+
+
+def config(weights: str) -> SimConfig:
+    w_lost, w_rsrq, w_handover, w_pingpong = (float(x) for x in weights.split(","))
+    data = SimConfig().model_dump()
+    data["reward"].update(w_lost=w_lost, w_rsrq=w_rsrq, w_handover=w_handover, w_pingpong=w_pingpong)
+    return SimConfig.model_validate(data)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sets", nargs="+", required=True, help="w_lost,w_rsrq,w_handover,w_pingpong per set")
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0], help="training seeds")
+    ap.add_argument("--episodes", type=int, default=40)
+    ap.add_argument("--flights", type=int, default=100, help="held-out flights per evaluation seed")
+    ap.add_argument("--eval-seeds", type=int, nargs="+", default=[0])
+    ap.add_argument("--keep", default=None, help="folder for the checkpoints (default: a temporary one)")
+    args = ap.parse_args()
+    folder = Path(args.keep or tempfile.mkdtemp())
+    folder.mkdir(parents=True, exist_ok=True)
+    cfg = SimConfig()
+    res = {c.name: with_intervals(flights(c, cfg, args.flights, args.eval_seeds)) for c in (CHM(), SAMRO())}
+    for weights in args.sets:
+        for seed in args.seeds:
+            path = folder / f"w{weights.replace(',', '_')}_seed{seed}.safetensors"
+            train_checkpoint(TrainConfig(episodes=args.episodes, seed=seed), config(weights), str(path), progress=False)
+            net = load_checkpoint(path).net
+            res[f"{weights} s{seed}"] = with_intervals(flights(DQNController(net), cfg, args.flights, args.eval_seeds))
+    print(f"w_lost,w_rsrq,w_handover,w_pingpong per column; {args.flights} held-out flights x {args.eval_seeds}")
+    print(format_rows(res))
+    for name in [k for k in res if k not in ("CHM", "SA-MRO")]:
+        met = [label for label, ok, _ in targets({"CHM": res["CHM"], "DQN": res[name]}, args.flights)
+               if ok]
+        print(f"{name}: {len(met)} of 9 targets met ({'; '.join(m.split('.')[0] for m in met)})")
+
+
+if __name__ == "__main__":
+    main()
