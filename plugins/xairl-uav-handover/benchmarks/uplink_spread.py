@@ -7,6 +7,7 @@ Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/uplink_spread.py [--
      [--states 400]   (about 2 minutes of training per spread on 2 cores)
 """
 import argparse
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -34,7 +35,7 @@ def main():
     ap.add_argument("--states", type=int, default=400)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
-    folder = Path(tempfile.mkdtemp())
+    folder = Path(tempfile.mkdtemp())  # the checkpoints of this run; removed at the end
     print(f"{'spread dB':>9} {'buffer rank (margin)':>21} {'(chosen score)':>15}  top 3 by margin")
     for spread in args.spreads:
         data = SimConfig().model_dump()
@@ -42,8 +43,9 @@ def main():
         path = folder / f"spread{spread:g}.safetensors"
         train_checkpoint(TrainConfig(episodes=args.episodes, seed=args.seed), SimConfig.model_validate(data),
                          str(path), progress=False)
-        by_margin, by_score, top = ranks(load_checkpoint(path), args.states)
+        by_margin, by_score, top = ranks(load_checkpoint(path), args.states, args.seed)
         print(f"{spread:>9g} {by_margin:>21} {by_score:>15}  {', '.join(top)}")
+    shutil.rmtree(folder, ignore_errors=True)
 
 
 if __name__ == "__main__":

@@ -171,7 +171,5 @@ def test_report_skips_the_real_half_when_ukm_cannot_be_had(monkeypatch, capsys, 
     folder, setting = real_source("ukm")
     assert folder is not None and str(folder) in setting and "GPL-3.0" in setting
     assert real_source(None)[0] is None
-    missing, setting = real_source(str(tmp_path / "nowhere"))
-    assert setting == str(missing)
-    with pytest.raises(InputError, match="no such folder of flight exports"):
-        load_folder(missing)
+    with pytest.raises(InputError, match="nowhere: no such folder or zip of flight exports"):
+        real_source(str(tmp_path / "nowhere"))  # refused before Table I is computed

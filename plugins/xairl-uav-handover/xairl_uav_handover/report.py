@@ -176,14 +176,18 @@ class UAVReport(Report):
 
 def real_source(real: str | None) -> tuple[Path | None, str]:
     """The folder of real flights for ``-o real=VALUE`` and the report's "real data" setting. A PATH is used as
-    given (a zip extracted once; a wrong one fails when loaded); ``ukm`` locates or fetches the UKM flights
+    given (a zip extracted once; one that is neither is refused at once); ``ukm`` locates or fetches the UKM flights
     (ukm.py) and, when they cannot be had, prints one line to stderr and returns None with the reason."""
     from . import ukm
 
     if real is None:
         return None, f"not given (-o real=PATH, or -o real={ukm.KEYWORD} to fetch the UKM flights)"
     if real.strip().lower() != ukm.KEYWORD:
-        return ukm.flights_folder(real), real
+        folder = ukm.flights_folder(real)
+        if not folder.is_dir():  # before Table I's minutes are spent
+            raise InputError(f"-o real={real}: no such folder or zip of flight exports; give the folder of the "
+                             f"Nemo CSVs, the UKM zip, or -o real={ukm.KEYWORD} to fetch the UKM flights.")
+        return folder, real
     try:
         folder = ukm.flights_folder()
     except InputError as exc:

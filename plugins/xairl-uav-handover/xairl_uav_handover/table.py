@@ -24,10 +24,10 @@ def _rows():
         return lambda m, i: np.sort(m[key][i])[: max(1, len(i) // 20)].mean()
 
     rows = [("handovers", "handovers per flight", mean("handovers")),
-            ("pp_per_min", "ping-pongs per flight-minute", lambda m, i: m["pingpongs"][i].sum() / m["minutes"][i].sum())]
+            ("pp_per_min", "ping-pongs per flight-minute (1 s window)", lambda m, i: m["pingpongs"][i].sum() / m["minutes"][i].sum())]
     rows += [(f"pp_{w:g}s", f"ping-pong share, {w:g} s window (%)", pooled(f"pingpongs_{w:g}s", "handovers"))
              for w in PINGPONG_WINDOWS_S]
-    rows += [("pp_over_5", "flights with > 5 ping-pongs (%)", lambda m, i: 100 * (m["pingpongs"][i] > 5).mean()),
+    rows += [("pp_over_5", "flights with > 5 ping-pongs, 1 s window (%)", lambda m, i: 100 * (m["pingpongs"][i] > 5).mean()),
              ("lost_mbit", "lost data per flight (Mbit)", mean("lost_data_kbit", 1e-3)),
              ("availability", "service availability, mean (%)", mean("service_availability_pct")),
              ("availability_worst5", "service availability, worst 5 % of flights (%)",
