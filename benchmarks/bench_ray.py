@@ -14,18 +14,9 @@ import time
 from pathlib import Path
 
 import numpy as np
-import torch
-
-import xairl
+from fleet_mlp import make_policy
 from xairl.scale import explain_on_ray
 from xairl.stream import explain_to_parquet, read_parquet
-
-
-def mlp_policy() -> xairl.Policy:
-    torch.manual_seed(0)
-    net = torch.nn.Sequential(torch.nn.Linear(8, 64), torch.nn.ReLU(), torch.nn.Linear(64, 64), torch.nn.ReLU(),
-                              torch.nn.Linear(64, 4))
-    return xairl.Policy(net, [f"s{i}" for i in range(8)], ["a0", "a1", "a2", "a3"])
 
 
 def timed(fn, *args, **kwargs) -> float:
@@ -40,7 +31,7 @@ def main():
     ap.add_argument("--kernel-states", type=int, default=1_000, help="0: skip the kernel_shap part")
     ap.add_argument("--chunk-size", type=int, default=50_000)
     args = ap.parse_args()
-    policy = mlp_policy()
+    policy = make_policy()
     rng = np.random.default_rng(0)
     bg = rng.normal(size=(100, 8)).astype(np.float32)
     with tempfile.TemporaryDirectory() as tmp:

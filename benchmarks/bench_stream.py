@@ -12,20 +12,10 @@ import resource
 import subprocess
 import sys
 import tempfile
-import textwrap
 import time
 from pathlib import Path
 
-POLICY = textwrap.dedent('''
-    import torch
-    import xairl
-
-    def make_policy():
-        torch.manual_seed(0)
-        net = torch.nn.Sequential(torch.nn.Linear(8, 64), torch.nn.ReLU(), torch.nn.Linear(64, 64), torch.nn.ReLU(),
-                                  torch.nn.Linear(64, 4))
-        return xairl.Policy(net, [f"s{i}" for i in range(8)], ["a0", "a1", "a2", "a3"])
-''')
+POLICY = Path(__file__).with_name("fleet_mlp.py")  # make_policy: the 8-64-64-4 MLP
 
 
 def run(cmd: list[str]) -> tuple[float, float]:
@@ -51,10 +41,9 @@ def main():
     xairl = str(Path(sys.executable).with_name("xairl"))
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        (tmp / "pol.py").write_text(POLICY)
         rng = np.random.default_rng(0)
         np.save(tmp / "bg.npy", rng.normal(size=(100, 8)).astype(np.float32))
-        common = ["--policy", f"{tmp / 'pol.py'}:make_policy", "--background", str(tmp / "bg.npy")]
+        common = ["--policy", f"{POLICY}:make_policy", "--background", str(tmp / "bg.npy")]
         peaks = {}
         for n in sorted({args.states, args.states * args.scale}):
             states = np.lib.format.open_memmap(tmp / f"s{n}.npy", mode="w+", dtype=np.float32, shape=(n, 8))

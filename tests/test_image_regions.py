@@ -7,7 +7,7 @@ import pytest
 import torch
 
 import xairl
-from xairl.narrators import in_regions
+from xairl.regions import in_regions
 from xairl.report import ReportContent, ReportRequest, write_report
 
 REGION = "the 8x8 patch at rows "

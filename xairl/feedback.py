@@ -87,11 +87,13 @@ class FeedbackStore:
             db.close()
 
     def record(self, narrative, policy=None, explanation=None) -> int:
-        """Store a shown :class:`xairl.Narrative` (with ``explanation``, its evidence for the review page); returns
-        its id."""
+        """Store a shown :class:`xairl.Narrative` with its evidence for the review page (the one it carries, else
+        computed from ``explanation``); returns its id."""
         from .evidence import evidence
 
-        ev = evidence(explanation, narrative) if explanation is not None else None
+        ev = getattr(narrative, "evidence", None)
+        if ev is None and explanation is not None:
+            ev = evidence(explanation, narrative)
         row = (time.time(), getattr(policy, "name", None), model_hash(policy.module) if policy is not None else None,
                narrative.template, narrative.source, narrative.extras.get("method"), narrative.index, narrative.text,
                json.dumps([c.__dict__ for c in narrative.claims]), int(narrative.verified), narrative.confidence,

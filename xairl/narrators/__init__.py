@@ -8,7 +8,6 @@ from ..explanation import Explanation
 from ..policy import Policy
 from .base import Narrative, Narrator
 from .confidence import confidence
-from ..regions import in_regions
 from .verify import Verification, verify
 
 
@@ -30,7 +29,7 @@ def narrate(explanation: Explanation, index: int | None = 0, narrator: str = "te
     writer: Narrator = registry("narrator").load(narrator)(options)
     narrative = writer.narrate(explanation, index, template, policy, background, prompt_dirs, k, robustness, history)
     if store is not None:
-        store.record(narrative, policy=policy, explanation=in_regions(explanation))  # the evidence of what it says
+        store.record(narrative, policy=policy)  # with its evidence: the numbers of what it says
     return narrative
 
 
@@ -43,4 +42,4 @@ def check_template(path: str | Path) -> list[str]:
     return prompts.check(path, sample_context)
 
 
-__all__ = ["Narrative", "Narrator", "Verification", "check_template", "confidence", "in_regions", "narrate", "verify"]
+__all__ = ["Narrative", "Narrator", "Verification", "check_template", "confidence", "narrate", "verify"]
