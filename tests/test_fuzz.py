@@ -192,7 +192,7 @@ def _cli_ok(argv):
        rows=st.lists(st.lists(cell, max_size=7), max_size=5), as_parquet=st.booleans(), chunk=st.integers(1, 4))
 def test_streamed_readers_of_any_csv_or_parquet(tmp_path_factory, header, rows, as_parquet, chunk):
     """The streaming engine's readers (pyarrow's CSV and Parquet): chunks of checked states, or one InputError line."""
-    from xairl.stream import state_chunks
+    from xairl.chunks import state_chunks
 
     folder = tmp_path_factory.mktemp("stream")
     path = folder / "s.csv"

@@ -46,6 +46,28 @@ def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ra
     assert np.array_equal(again.values, local.values)
 
 
+def test_ray_reads_parquet_by_row_group_and_csv_once_rewritten(tmp_path, local_ray):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from xairl.scale import STAGED, explain_on_ray
+    from xairl.toy import FEATURES
+
+    states, bg = POLICY.background(2_500, seed=5), POLICY.background(20)
+    pq.write_table(pa.table({f: states[:, j] for j, f in enumerate(FEATURES)}), tmp_path / "s.parquet",
+                   row_group_size=300)  # row groups that do not fall on the chunks' bounds
+    (tmp_path / "s.csv").write_text(",".join(FEATURES) + "\n" + "\n".join(",".join(repr(float(v)) for v in row)
+                                                                          for row in states))
+    local = explain_to_parquet(POLICY, states, tmp_path / "local", background=bg, chunk_size=1000, progress=False)
+    for name in ("s.parquet", "s.csv"):
+        summary = explain_on_ray(POLICY, tmp_path / name, tmp_path / name.replace(".", "_"), background=bg,
+                                 chunk_size=1000, workers=2)
+        assert summary.n == local.n == 2_500
+        assert np.array_equal(read_parquet(tmp_path / name.replace(".", "_") / "explanations.parquet").values,
+                              read_parquet(tmp_path / "local" / "explanations.parquet").values), name
+        assert not (tmp_path / name.replace(".", "_") / STAGED).exists()  # the CSV's rewrite is removed
+
+
 def test_the_local_engine_imports_no_ray(tmp_path):
     code = ("import sys, numpy as np; from xairl.toy import toy_policy; from xairl.stream import explain_to_parquet; "
             f"p = toy_policy(); explain_to_parquet(p, p.background(100), {str(tmp_path / 'o')!r}, progress=False); "

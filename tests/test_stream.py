@@ -15,7 +15,8 @@ import pytest
 import xairl
 from xairl.cli import main
 from xairl.errors import InputError
-from xairl.stream import explain_chunks, explain_to_parquet, read_parquet, state_chunks
+from xairl.chunks import stage_parquet, state_chunks
+from xairl.stream import explain_chunks, explain_to_parquet, read_parquet
 from xairl.toy import FEATURES, toy_policy
 
 POLICY = toy_policy()
@@ -43,8 +44,18 @@ def test_every_source_gives_the_same_chunks(tmp_path):
         chunks = list(state_chunks(source, POLICY, chunk_size=1000))
         assert [first for first, _ in chunks] == [0, 1000, 2000] and [len(c) for _, c in chunks] == [1000, 1000, 345]
         assert np.array_equal(np.concatenate([c for _, c in chunks]), STATES), source
-        later = list(state_chunks(source, POLICY, chunk_size=1000, start=1000))
-        assert [first for first, _ in later] == [1000, 2000]
+        for start in (1000, 1999, 2000):  # Parquet: the row groups before the chunk (700 rows each) are not read
+            later = list(state_chunks(source, POLICY, chunk_size=1000, start=start))
+            assert [first for first, _ in later] == list(range(start - start % 1000, 2345, 1000)), (source, start)
+            assert np.array_equal(np.concatenate([c for _, c in later]), STATES[start - start % 1000:]), (source, start)
+
+
+def test_staged_parquet_has_one_row_group_per_chunk(tmp_path):
+    csv = _sources(tmp_path)[2]
+    assert stage_parquet(csv, POLICY, tmp_path / "staged.parquet", chunk_size=1000) == 2345
+    assert [pq.ParquetFile(tmp_path / "staged.parquet").metadata.row_group(g).num_rows for g in range(3)] == \
+        [1000, 1000, 345]
+    assert np.array_equal(next(state_chunks(tmp_path / "staged.parquet", POLICY, 1000, start=2000))[1], STATES[2000:])
 
 
 def test_chunks_equal_one_explanation_of_all_states(reference):

@@ -2,10 +2,13 @@
 over Ray workers. Only this module imports Ray; the local engine never does.
 
 Ray Data maps the chunks' first rows through an actor pool (``map_batches``): each actor holds the policy, the
-background and the attributor, reads its chunk from the states (a .npy file on a file system the workers share, or
-an array put in Ray's object store), explains it and writes its Parquet part, whole or not at all. The
-chunks are those of the local engine, so the parts are the same bits, ``run.json`` and ``resume`` work alike, and
-the summary is computed by the driver from the written parts, in order.
+background and the attributor, reads only its chunk's rows from the states, explains them and writes its Parquet
+part, whole or not at all. The states are read where they are when each chunk can be read alone: a .npy file (by
+slice) or a Parquet file (by row group) on a file system the workers share, or an array put in Ray's object store.
+A CSV, .npz or .json file is first rewritten by the driver as a Parquet file of one row group per chunk, in the
+output folder (which the workers write to, so they share it), and removed at the end. The chunks are those of the
+local engine, so the parts are the same bits, ``run.json`` and ``resume`` work alike, and the summary is computed by
+the driver from the written parts, in order.
 
 ``ray.init()`` starts Ray on this machine with ``workers`` CPUs (loopback only); ``address`` joins a running cluster
 (``ray://host:10001`` or ``auto``).
@@ -16,10 +19,12 @@ from pathlib import Path
 
 import numpy as np
 
+from .chunks import CHUNK, count_states, stage_parquet, state_chunks
 from .errors import InputError
 from .policy import Policy
-from .stream import (CHUNK, RunningSummary, _part_name, count_states, finish_run, read_parquet, start_run,
-                     state_chunks, write_part)
+from .stream import RunningSummary, _part_name, finish_run, read_parquet, start_run, write_part
+
+STAGED = ".states.parquet"  # a CSV, .npz or .json file's states, rewritten for the workers (then removed)
 
 
 class _ChunkWorker:
@@ -54,7 +59,8 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
                    address: str | None = None, progress: bool | None = None) -> RunningSummary:
     """:func:`xairl.explain_to_parquet` on Ray: the same folder, the same parts (bit for bit), ``workers`` actors.
 
-    :param states: a .npy file (each worker reads its chunks: on a cluster, a path every node can read) or an array.
+    :param states: a .npy or .parquet file (each worker reads its chunks: on a cluster, a path every node can read),
+        a .csv, .npz or .json file (rewritten first as Parquet in ``out``), or an array.
     :param address: a running Ray cluster; None starts Ray on this machine with ``workers`` CPUs.
     """
     try:
@@ -63,15 +69,14 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
         raise InputError("the Ray engine needs Ray: pip install 'xairl[scale]'.") from None
     from tqdm import tqdm
 
-    if isinstance(states, (str, Path)):
-        if Path(states).suffix.lower() != ".npy":
-            raise InputError(f"{states}: the Ray engine reads .npy files (each worker reads its chunks); convert it, "
-                             "or use the local engine, which also reads .parquet and .csv.")
-        source = str(Path(states).resolve())
-    else:
-        source = policy.check_states(states)
+    source = str(Path(states).resolve()) if isinstance(states, (str, Path)) else policy.check_states(states)
     run = start_run(policy, states, out, background, method, options, chunk_size, resume)
-    total = count_states(states, policy)
+    staged = isinstance(source, str) and Path(source).suffix.lower() not in (".npy", ".parquet")
+    if staged:  # no reading of one chunk alone: rewritten once, one row group per chunk
+        source = str((run.out / STAGED).resolve())
+        total = stage_parquet(states, policy, Path(source), chunk_size)
+    else:
+        total = count_states(states, policy)
     todo = [first for first in range(0, total, chunk_size) if first not in run.done]
     started = not ray.is_initialized()
     if started:
@@ -92,6 +97,8 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
     finally:
         if started:
             ray.shutdown()
+        if staged:
+            Path(source).unlink(missing_ok=True)
     summary = RunningSummary()
     for first in tqdm(range(0, total, chunk_size), desc="summing", unit="chunk", disable=not progress):
         summary.add(first, read_parquet(run.parts / _part_name(first)))

@@ -73,13 +73,15 @@ def _print_table(exp, top: int, view: str) -> int:
 
 
 def _state_shape(path):
-    """The shape of one state in a .npy file (what a bare torch module given as --policy takes), else None."""
-    import numpy as np
+    """The shape of one state in a .npy file (what a bare torch module given as --policy takes), from its header;
+    else None."""
+    from ..inputs import npy_header
 
     if not path or not str(path).lower().endswith(".npy"):
         return None
     try:
-        shape = np.load(path, mmap_mode="r", allow_pickle=False).shape
+        with open(path, "rb") as fh:
+            shape = npy_header(fh)[0]
     except Exception:  # a peek only: read_states reports whatever is wrong with the file
         return None
     return shape[1:] if len(shape) > 1 else shape
@@ -192,7 +194,7 @@ def explain_parser(p: argparse.ArgumentParser) -> None:
                    "parquet (memory grows with it)")
     p.add_argument("--resume", action="store_true", help="with --format parquet: continue an interrupted run in --out")
     p.add_argument("--engine", choices=("local", "ray"), default="local", help="with --format parquet: this process "
-                   "(local) or Ray workers (pip install 'xairl[scale]'; states from a .npy file)")
+                   "(local) or Ray workers (pip install 'xairl[scale]')")
     p.add_argument("--workers", type=count(1, 100_000), default=2, help="Ray workers (one CPU each; default 2)")
     p.add_argument("--ray-address", default=None, metavar="ADDRESS", help="a running Ray cluster (e.g. auto or "
                    "ray://host:10001); default: Ray started on this machine")
