@@ -68,6 +68,18 @@ def test_ray_reads_parquet_by_row_group_and_csv_once_rewritten(tmp_path, local_r
         assert not (tmp_path / name.replace(".", "_") / STAGED).exists()  # the CSV's rewrite is removed
 
 
+def test_narrations_on_ray_are_the_narrations_here_in_order(local_ray):
+    import xairl
+    from xairl.scale import narrate_on_ray
+
+    bg = POLICY.background(20)
+    exp = xairl.explain(POLICY, POLICY.background(6, seed=8), background=bg)
+    here = [xairl.narrate(exp, i, policy=POLICY, background=bg) for i in (5, 0, 3)]
+    there = narrate_on_ray(exp, [5, 0, 3], narrator="template", workers=2, policy=POLICY, background=bg)
+    assert [n.text for n in there] == [n.text for n in here] and [n.index for n in there] == [5, 0, 3]
+    assert all(n.verified for n in there) and [n.confidence for n in there] == [n.confidence for n in here]
+
+
 def test_the_local_engine_imports_no_ray(tmp_path):
     code = ("import sys, numpy as np; from xairl.toy import toy_policy; from xairl.stream import explain_to_parquet; "
             f"p = toy_policy(); explain_to_parquet(p, p.background(100), {str(tmp_path / 'o')!r}, progress=False); "

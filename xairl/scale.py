@@ -10,11 +10,15 @@ output folder (which the workers write to, so they share it), and removed at the
 local engine, so the parts are the same bits, ``run.json`` and ``resume`` work alike, and the summary is computed by
 the driver from the written parts, in order.
 
+:func:`narrate_on_ray` narrates many states of an Explanation on a pool of Ray actors, each holding one narrator
+(a local language model is loaded once per actor), the narratives returned in order.
+
 ``ray.init()`` starts Ray on this machine with ``workers`` CPUs (loopback only); ``address`` joins a running cluster
 (``ray://host:10001`` or ``auto``).
 """
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +29,24 @@ from .policy import Policy
 from .stream import RunningSummary, _part_name, finish_run, read_parquet, start_run, write_part
 
 STAGED = ".states.parquet"  # a CSV, .npz or .json file's states, rewritten for the workers (then removed)
+
+
+def _ray():
+    try:
+        import ray
+    except ImportError:
+        raise InputError("the Ray engine needs Ray: pip install 'xairl[scale]'.") from None
+    return ray
+
+
+def _start(ray, address: str | None, workers: int) -> bool:
+    """Starts Ray unless it runs (this machine with ``workers`` CPUs on loopback, or the cluster at ``address``);
+    True when started here (and so to be shut down here)."""
+    if ray.is_initialized():
+        return False
+    ray.init(address=address, num_cpus=None if address else workers, include_dashboard=False, log_to_driver=False,
+             logging_level="ERROR", configure_logging=False, **({} if address else {"_node_ip_address": "127.0.0.1"}))
+    return True
 
 
 class _ChunkWorker:
@@ -63,10 +85,7 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
         a .csv, .npz or .json file (rewritten first as Parquet in ``out``), or an array.
     :param address: a running Ray cluster; None starts Ray on this machine with ``workers`` CPUs.
     """
-    try:
-        import ray
-    except ImportError:
-        raise InputError("the Ray engine needs Ray: pip install 'xairl[scale]'.") from None
+    ray = _ray()
     from tqdm import tqdm
 
     source = str(Path(states).resolve()) if isinstance(states, (str, Path)) else policy.check_states(states)
@@ -78,18 +97,15 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
     else:
         total = count_states(states, policy)
     todo = [first for first in range(0, total, chunk_size) if first not in run.done]
-    started = not ray.is_initialized()
-    if started:
-        ray.init(address=address, num_cpus=None if address else workers, include_dashboard=False,
-                 log_to_driver=False, logging_level="ERROR", configure_logging=False,
-                 **({} if address else {"_node_ip_address": "127.0.0.1"}))
+    started = _start(ray, address, workers)
     try:
         ctx = ray.data.DataContext.get_current()
         ctx.enable_progress_bars = False
+        logging.getLogger("ray.data").setLevel(logging.WARNING)  # no plan and timing lines on the user's terminal
         ref = ray.put(source) if not isinstance(source, str) else source
         if todo:
             ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo)).map_batches(
-                _ChunkWorker, batch_size=1, concurrency=workers, num_cpus=1,
+                _ChunkWorker, batch_size=1, compute=ray.data.ActorPoolStrategy(size=workers), num_cpus=1,
                 fn_constructor_kwargs={"policy": policy, "states": ref, "background": run.background,
                                        "method": method, "options": run.options, "chunk_size": chunk_size,
                                        "parts": str(run.parts), "meta": run.meta, "threads": 1},
@@ -103,3 +119,43 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
     for first in tqdm(range(0, total, chunk_size), desc="summing", unit="chunk", disable=not progress):
         summary.add(first, read_parquet(run.parts / _part_name(first)))
     return finish_run(run, summary, states)
+
+
+class _NarrationWorker:
+    """A Ray actor: one narrator (a local language model is loaded once per actor) narrating states of one
+    Explanation."""
+
+    def __init__(self, explanation, narrator: str, kwargs: dict, threads: int):
+        import ray
+        import torch
+
+        torch.set_num_threads(threads)
+        self.exp = ray.get(explanation) if isinstance(explanation, ray.ObjectRef) else explanation
+        self.narrator, self.kwargs = narrator, kwargs
+
+    def narrate(self, index: int):
+        from .narrators import narrate
+
+        return narrate(self.exp, index, narrator=self.narrator, **self.kwargs)
+
+
+def narrate_on_ray(explanation, indices=None, narrator: str = "local_lm", workers: int = 2,
+                   address: str | None = None, threads: int = 1, **kwargs) -> list:
+    """:func:`xairl.narrate` for many states of ``explanation`` on ``workers`` Ray actors (each loads the narrator
+    once): the narratives of ``indices`` (default: every state), in their order. ``kwargs`` are
+    :func:`xairl.narrate`'s (``policy``, ``background``, ``options``, ``template``, ...); ``store`` is not taken
+    (record the returned narratives in the driver). ``threads``: torch threads per actor.
+    """
+    ray = _ray()
+    if "store" in kwargs:
+        raise InputError("narrate_on_ray records nothing: record its narratives with store.record in this process.")
+    indices = list(range(len(explanation.values)) if indices is None else indices)
+    started = _start(ray, address, workers)
+    try:
+        ref = ray.put(explanation)
+        actor = ray.remote(num_cpus=1)(_NarrationWorker)
+        pool = ray.util.ActorPool([actor.remote(ref, narrator, kwargs, threads) for _ in range(workers)])
+        return list(pool.map(lambda a, i: a.narrate.remote(i), indices))
+    finally:
+        if started:
+            ray.shutdown()
