@@ -23,7 +23,7 @@ def count_states(source, policy: Policy) -> int | None:
         return len(policy.check_states(source)) if not hasattr(source, "shape") else int(source.shape[0])
     path = Path(source)
     if path.suffix.lower() == ".npy":
-        return len(_npy(path))
+        return len(_NpyRows(path))
     if path.suffix.lower() == ".parquet":
         import pyarrow.parquet as pq
 
@@ -36,8 +36,8 @@ def count_states(source, policy: Policy) -> int | None:
 def state_chunks(source, policy: Policy, chunk_size: int = CHUNK, start: int = 0) -> Iterator[tuple[int, np.ndarray]]:
     """(first row, checked float32 states) for each chunk of ``chunk_size`` rows from row ``start`` on.
 
-    :param source: an array (any form the policy's observation takes), or a file: .npy (memory-mapped), .parquet
-        (read by record batch; one column per feature, named as the features), .csv (read by block; a header naming
+    :param source: an array (any form the policy's observation takes), or a file: .npy (read by slice), .parquet
+        (read by record batch, skipping the row groups before ``start``; one column per feature, named as the features), .csv (read by block; a header naming
         the features), or .npz/.json (read whole, then chunked).
     """
     if chunk_size < 1:
@@ -50,7 +50,7 @@ def state_chunks(source, policy: Policy, chunk_size: int = CHUNK, start: int = 0
         first, batches = _table_batches(path, policy, chunk_size, start - start % chunk_size)
         yield from _rechunk(batches, policy, chunk_size, start, str(path), first)
         return
-    rows = _npy(path) if suffix == ".npy" else read_states(path, policy.feature_names, policy.observation) \
+    rows = _NpyRows(path) if suffix == ".npy" else read_states(path, policy.feature_names, policy.observation) \
         if path is not None else policy.check_states(source)
     n = len(rows)
     for a in range(start - start % chunk_size, n, chunk_size):
@@ -89,10 +89,6 @@ class _NpyRows:
             fh.seek(self.offset + a * self.row * self.dtype.itemsize)
             return np.fromfile(fh, self.dtype, count=max(b - a, 0) * self.row).reshape(max(b - a, 0),
                                                                                        *self.shape[1:])
-
-
-def _npy(path: Path) -> _NpyRows:
-    return _NpyRows(path)
 
 
 def _table_batches(path: Path, policy: Policy, chunk_size: int, start: int) -> tuple[int, Iterator[np.ndarray]]:
