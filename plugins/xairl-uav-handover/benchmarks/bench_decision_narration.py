@@ -42,7 +42,7 @@ def simulated(ckpt, n: int, seed: int = 0):
         seen.append(obs)
         obs, _, _, truncated, _ = env.step(greedy(ckpt.net, obs, ckpt.sim_config))
         ended = bool(truncated.all())
-    traj = np.stack(seen, axis=1)  # (flights, T, 13)
+    traj = np.stack(seen, axis=1)  # (flights, T, features)
     rng = np.random.default_rng(seed)
     picks = [(int(rng.integers(len(traj))), int(rng.integers(1, traj.shape[1]))) for _ in range(n)]
     return np.array([traj[f, t] for f, t in picks]), [traj[f, max(0, t - 10):t] for f, t in picks]

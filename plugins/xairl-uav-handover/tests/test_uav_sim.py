@@ -76,7 +76,7 @@ def test_env_passes_gymnasium_checker():
     env = UAVHandoverEnv(SimConfig(**SHORT))
     check_env(env, skip_render_check=True)
     obs, info = env.reset(seed=3)
-    assert env.action_space.n == len(ACTIONS) and obs.shape == (13,)
+    assert env.action_space.n == len(ACTIONS) and obs.shape == (len(FEATURES),)
     rewards, handovers, done = [], 0, False
     while not done:
         obs, r, term, trunc, info = env.step(0)
@@ -120,7 +120,7 @@ def test_a3_on_time_stamps_fires_at_the_first_sample_after_ttt():
 
 
 def test_chm_on_samples_uses_the_same_trigger():
-    state = np.zeros(13, dtype=np.float32)
+    state = np.zeros(len(FEATURES), dtype=np.float32)
     chm = CHMOnSamples(cells=[101.0, 202.0, 303.0])
     state[5:9] = [-80, -76, -90, -140]  # candidate 1 (cell 202) 4 dB above the serving cell 101
     assert chm(state, [101.0, 202.0, 303.0], 0.0) == 0  # the condition just started
@@ -130,7 +130,7 @@ def test_chm_on_samples_uses_the_same_trigger():
 def test_vector_env_steps_flights_together():
     env = HandoverVecEnv(SimConfig(**SHORT), n_flights=4)
     obs, info = env.reset(seed=3)
-    assert obs.shape == (4, 13) and info["candidates"].shape == (4, 4) and env.action_space.shape == (4,)
+    assert obs.shape == (4, len(FEATURES)) and info["candidates"].shape == (4, 4) and env.action_space.shape == (4,)
     steps, truncated = 0, np.zeros(4, bool)
     while not truncated.all():
         obs, reward, terminated, truncated, info = env.step(np.zeros(4, int))

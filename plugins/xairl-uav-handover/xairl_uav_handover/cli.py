@@ -15,17 +15,18 @@ def configure(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default="uav-dqn.safetensors", help="checkpoint path (metadata holds the configs)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(run=run_train)
-    p = sub.add_parser("evaluate", help="CHM, SA-MRO and the DQN on the same held-out flights (Table I)")
-    p.add_argument("--flights", type=int, default=100, help="held-out flights")
-    p.add_argument("--seed", type=int, default=0, help="seed of the held-out flights")
+    p = sub.add_parser("evaluate", help="CHM, SA-MRO and the DQN on the same held-out flights: Table I, each figure "
+                       "with its bootstrap 95 %% interval")
+    p.add_argument("--flights", type=int, default=100, help="held-out flights per evaluation seed")
+    p.add_argument("--seeds", type=int, nargs="+", default=[0], help="evaluation seeds (their flights pooled)")
     p.add_argument("--duration", type=float, default=None, help="seconds per flight")
-    p.add_argument("--min-stay", type=float, default=None, help="ping-pong window in seconds (default 1)")
     p.add_argument("--checkpoint", default=None, help="DQN checkpoint (default: the plugin's pretrained one)")
-    p.add_argument("--json", action="store_true", help="print the table as JSON, keys per policy")
+    p.add_argument("--json", action="store_true", help="print the table as JSON: per policy, per figure, "
+                   "[value, low, high]")
     p.set_defaults(run=run_evaluate)
 
 
-def _sim_config(base, duration=None, min_stay=None):
+def _sim_config(base, duration=None):
     from pydantic import ValidationError
     from xairl import InputError, validation_message
 
@@ -34,8 +35,6 @@ def _sim_config(base, duration=None, min_stay=None):
     data = (base or SimConfig()).model_dump()
     if duration is not None:
         data["flight"]["duration_s"] = duration
-    if min_stay is not None:
-        data["handover"]["min_time_of_stay_s"] = min_stay
     try:
         return SimConfig.model_validate(data)
     except ValidationError as exc:
@@ -59,17 +58,20 @@ def run_evaluate(args) -> int:
     from xairl import InputError
 
     from .baselines import CHM, SAMRO
-    from .evaluate import format_table, table_one
     from .policy import DQNController, load_checkpoint
+    from .table import flights, format_rows, verdict, with_intervals
 
     if args.flights < 1:
         raise InputError("--flights must be at least 1.")
     ckpt = load_checkpoint(args.checkpoint)
-    cfg = _sim_config(ckpt.sim_config, args.duration, args.min_stay)
-    rows = table_one([CHM(), SAMRO(), DQNController(ckpt.net)], cfg, args.flights, args.seed)
+    cfg = _sim_config(ckpt.sim_config, args.duration)
+    res = {c.name: with_intervals(flights(c, cfg, args.flights, args.seeds))
+           for c in (CHM(), SAMRO(), DQNController(ckpt.net))}
     if args.json:
-        print(json.dumps({"flights": args.flights, "seed": args.seed,
-                          "min_time_of_stay_s": cfg.handover.min_time_of_stay_s, "policies": rows}, indent=2))
+        print(json.dumps({"flights": args.flights, "seeds": args.seeds, "policies": res}, indent=2))
     else:
-        print(format_table(rows, cfg, args.flights))
+        print(f"Table I: {args.flights} held-out flights of {cfg.flight.duration_s:g} s x evaluation seeds "
+              f"{args.seeds}, value [bootstrap 95 % interval]; a ping-pong is a handover back to the previous BS "
+              f"within the window its row names\n{format_rows(res)}\n"
+              f"{verdict(res)}")
     return 0

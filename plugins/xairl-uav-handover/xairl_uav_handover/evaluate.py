@@ -1,4 +1,4 @@
-"""Run controllers on the same held-out flights and summarise them as the paper's Table I."""
+"""Run controllers on the same held-out flights (per-flight metrics; table.py makes them Table I)."""
 from __future__ import annotations
 
 import numpy as np
@@ -52,56 +52,24 @@ def run_flights(controller, config: SimConfig, n_flights: int, seed: int) -> dic
     }
 
 
-def summarise(m: dict[str, np.ndarray]) -> dict[str, float]:
-    """Table I row: medians per flight for handovers and ping-pong share (as the paper), the mean handovers per flight
-    (a median of a few handovers per flight moves in whole steps), pooled ping-pong share
-    (all ping-pongs / all handovers), mean ping-pong share over flights with a handover, and means per flight for
-    the rest (``buffer_nonempty_pct``: share of decision states with a non-empty buffer)."""
-    pp_share = 100 * m["pingpongs"] / np.maximum(m["handovers"], 1)
-    handed = m["handovers"] > 0
-    row = {"handovers_median": float(np.median(m["handovers"])), "handovers_mean": float(np.mean(m["handovers"])),
-           "pingpong_pct_median": float(np.median(pp_share)),
-           "pingpong_pct_pooled": float(100 * m["pingpongs"].sum() / max(m["handovers"].sum(), 1)),
-           "pingpong_pct_mean": float(pp_share[handed].mean()) if handed.any() else 0.0}
-    for key in ("service_availability_pct", "mean_buffer_kbit", "buffer_nonempty_pct", "lost_data_kbit",
-                "rsrp_violation_pct", "rsrq_violation_pct"):
-        row[f"{key}_mean"] = float(np.mean(m[key]))
-    return row
-
-
-def table_one(controllers, config: SimConfig, n_flights: int, seed: int) -> dict[str, dict[str, float]]:
-    """{policy name: Table I row} with every controller flying the same held-out flights."""
-    return {c.name: summarise(run_flights(c, config, n_flights, seed)) for c in controllers}
-
-
-def format_table(rows: dict[str, dict[str, float]], config: SimConfig, n_flights: int) -> str:
-    cols = [("handovers_median", "HO/flight", "{:.1f}"), ("handovers_mean", "HO (mean)", "{:.2f}"),
-            ("pingpong_pct_median", "PP % (med)", "{:.1f}"),
-            ("pingpong_pct_pooled", "PP % (pool)", "{:.1f}"), ("pingpong_pct_mean", "PP % (mean)", "{:.1f}"),
-            ("service_availability_pct_mean", "SA %", "{:.2f}"), ("mean_buffer_kbit_mean", "buffer kbit", "{:.1f}"),
-            ("buffer_nonempty_pct_mean", "buf>0 %", "{:.1f}"), ("lost_data_kbit_mean", "lost kbit", "{:.1f}"),
-            ("rsrp_violation_pct_mean", "RSRP<thr %", "{:.1f}"), ("rsrq_violation_pct_mean", "RSRQ<thr %", "{:.1f}")]
-    f = config.flight
-    lines = [f"Table I on {n_flights} held-out flights of {f.duration_s:g} s (dt {f.dt_s * 1000:g} ms); ping-pong: "
-             f"back to the previous BS within {config.handover.min_time_of_stay_s:g} s (minimum time of stay)",
-             f"{'policy':<8}" + "".join(f"{name:>13}" for _, name, _ in cols) + f"{'paper HO / PP %':>18}"]
-    for policy, row in rows.items():
-        paper = PAPER.get(policy)
-        lines.append(f"{policy:<8}" + "".join(f"{fmt.format(row[key]):>13}" for key, _, fmt in cols)
-                     + (f"{paper[0]:>12} / {paper[1]}" if paper else ""))
-    return "\n".join(lines)
-
-
-def margin_ranking(ckpt, n_states: int, seed: int) -> list[str]:
-    """Features by mean |contribution to the margin over the runner-up| (deep_shap) on the DQN's own decision states
-    of held-out flights, most important first (the reproduction's check of the paper's Figure 2)."""
+def importance(ckpt, states: np.ndarray, seed: int = 0) -> dict[str, np.ndarray]:
+    """Mean |contribution| per feature (deep_shap) on ``states``: ``margin`` to the margin over the runner-up (the
+    paper's Figure 2 as the cards read it) and ``score`` to the chosen action's score."""
     import xairl
 
-    from .policy import background_states, dqn_decision_states, uav_policy
+    from .policy import background_states, uav_policy
 
-    exp = xairl.explain(uav_policy(ckpt), dqn_decision_states(ckpt, n_states, seed),
+    exp = xairl.explain(uav_policy(ckpt), states,
                         background=background_states(100, seed=seed + 7, config=ckpt.sim_config))
-    return [FEATURES[j] for j in np.argsort(-np.abs(exp.margin()).mean(axis=0))]
+    return {"margin": np.abs(exp.margin()).mean(axis=0), "score": np.abs(exp.for_chosen()).mean(axis=0)}
+
+
+def rankings(ckpt, n_states: int, seed: int) -> dict[str, list[str]]:
+    """Features by :func:`importance` on the DQN's own decision states of held-out flights, most important first."""
+    from .policy import dqn_decision_states
+
+    return {view: [FEATURES[j] for j in np.argsort(-imp)]
+            for view, imp in importance(ckpt, dqn_decision_states(ckpt, n_states, seed), seed).items()}
 
 
 def chm_rate_by_altitude(altitudes, config: SimConfig, n_flights: int = 40, duration_s: float = 60.0,

@@ -134,16 +134,13 @@ class UAVReport(Report):
 
     def _table_one(self, ckpt: Checkpoint, seed: int) -> tuple[str, str]:
         """Table I with bootstrap 95 % intervals (table.py), and in words where the DQN loses to CHM."""
-        from .table import flights, html_table, with_intervals, worse
+        from .table import flights, html_table, verdict, with_intervals
 
         n, cfg = self.options.flights, ckpt.sim_config
         res = {c.name: with_intervals(flights(c, cfg, n, [seed])) for c in (CHM(), SAMRO(), DQNController(ckpt.net))}
-        losses = worse(res, "DQN", "CHM")
-        verdict = ("The DQN is worse than CHM beyond the intervals on: " + "; ".join(losses) + "." if losses else
-                   "The DQN is worse than CHM beyond the intervals on no figure.")
         paper = ", ".join(f"{name} {ho} handovers and {pp} % ping-pongs" for name, (ho, pp) in PAPER.items())
         return (f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s, value [bootstrap 95 % "
-                f"interval]. {verdict} (The paper's medians per flight: {paper}.)", table_html(*html_table(res)))
+                f"interval]. {verdict(res)} (The paper's medians per flight: {paper}.)", table_html(*html_table(res)))
 
     def _add_real_flights(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest, real: Path) -> list:
         """The calibration and agreement tables against the real flights in folder ``real``; returns the flights."""

@@ -89,3 +89,10 @@ def html_table(res: dict) -> tuple[list[str], list[list[str]]]:
     names = list(res)
     return (["", *names], [[label, *(f"{res[n][key][0]:.2f} [{res[n][key][1]:.2f}, {res[n][key][2]:.2f}]"
                                      for n in names)] for key, label, _ in ROWS])
+
+
+def verdict(res: dict, a: str = "DQN", b: str = "CHM") -> str:
+    """In words, where policy ``a`` loses to ``b`` beyond the intervals (:func:`worse`)."""
+    losses = worse(res, a, b)
+    return (f"The {a} is worse than {b} beyond the intervals on: " + "; ".join(losses) + "." if losses else
+            f"The {a} is worse than {b} beyond the intervals on no figure.")
