@@ -78,6 +78,10 @@ def test_narrations_on_ray_are_the_narrations_here_in_order(local_ray):
     there = narrate_on_ray(exp, [5, 0, 3], narrator="template", workers=2, policy=POLICY, background=bg)
     assert [n.text for n in there] == [n.text for n in here] and [n.index for n in there] == [5, 0, 3]
     assert all(n.verified for n in there) and [n.confidence for n in there] == [n.confidence for n in here]
+    with pytest.raises(xairl.XairlError, match=r"indices must lie in 0\.\.5"):
+        narrate_on_ray(exp, [6], narrator="template", policy=POLICY)  # refused here, before any worker starts
+    with pytest.raises(xairl.XairlError, match="unknown narrator 'nope'"):
+        narrate_on_ray(exp, narrator="nope")
 
 
 def test_the_local_engine_imports_no_ray(tmp_path):

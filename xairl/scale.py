@@ -149,7 +149,13 @@ def narrate_on_ray(explanation, indices=None, narrator: str = "local_lm", worker
     ray = _ray()
     if "store" in kwargs:
         raise InputError("narrate_on_ray records nothing: record its narratives with store.record in this process.")
-    indices = list(range(len(explanation.values)) if indices is None else indices)
+    from .plugins import registry
+
+    registry("narrator").load(narrator)  # an unknown name fails here, in one line, not in a worker
+    n = len(explanation.values)
+    indices = list(range(n)) if indices is None else [int(i) for i in indices]
+    if any(not 0 <= i < n for i in indices):
+        raise InputError(f"narrate_on_ray: indices must lie in 0..{n - 1} (the explanation's states).")
     started = _start(ray, address, workers)
     try:
         ref = ray.put(explanation)
