@@ -36,7 +36,8 @@ def _rows():
              ("rsrp_violation", "time below the RSRP threshold (%)", mean("rsrp_violation_pct")),
              ("ho_empty", "handovers taken with an empty buffer (%)",
               lambda m, i: 100 - pooled("handovers_buffer_nonempty", "handovers")(m, i)),
-             ("ho_full", "handovers taken with a full buffer (%)", pooled("handovers_buffer_full", "handovers"))]
+             ("ho_full", "handovers taken with a full buffer (%)", pooled("handovers_buffer_full", "handovers")),
+             ("buffer_in_use", "decisions taken with a non-empty buffer (%)", mean("buffer_nonempty_pct"))]
     return rows
 
 
