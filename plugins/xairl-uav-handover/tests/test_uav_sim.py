@@ -30,6 +30,9 @@ def test_observation_layout():
     assert (np.diff(rsrp[:, 1:], axis=1) <= 0).all(), "neighbour candidates are sorted by RSRP"
     assert (obs[:, 4] == sim.serving).all()
     np.testing.assert_allclose(obs[:, 5], sim.rsrp[np.arange(8), sim.serving], rtol=1e-5)
+    hidden = SimConfig.model_validate({"observation": {"position_hidden": True}})
+    blind, _ = Simulator(hidden, n_uavs=8, seed=1).observe()  # the same flights, without their position
+    assert (blind[:, :3] == 0).all() and np.array_equal(blind[:, 3:], obs[:, 3:]) and (obs[:, 2] > 0).all()
 
 
 def test_empty_slots_are_masked_actions():

@@ -114,6 +114,8 @@ class ObservationConfig(_Strict):
     detection_rsrq_db: float = Field(-24.0, ge=-40, le=0, description="weakest RSRQ at which a neighbour is "
                                                                      "measured: the real UKM neighbours' 1st percentile")
     position_grid_m: float = Field(0.0, ge=0, le=1000, description="quantise x, y to this grid (0: not quantised)")
+    position_hidden: bool = Field(False, description="report x, y, z as 0: what a DQN learns without its position "
+                                                     "(benchmarks/position_ablation.py)")
 
 
 class HandoverConfig(_Strict):

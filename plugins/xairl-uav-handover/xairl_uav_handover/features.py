@@ -20,7 +20,8 @@ LABEL_WORDS = ("BS", "candidate")
 
 def state_rows(position, queue_bits, serving_id, rsrp, rsrq, observation) -> np.ndarray:
     """States (K, 13) float32 in :data:`FEATURES` order, as the UE reports them (``ObservationConfig``): x, y
-    quantised to ``position_grid_m`` when it is set; an empty candidate slot (NaN) reported at the detection limit.
+    quantised to ``position_grid_m`` when it is set (x, y, z all 0 when ``position_hidden``); an empty candidate
+    slot (NaN) reported at the detection limit.
 
     :param position: (K, 3) x, y, z in metres: x east and y north of the centre of the area the UAVs fly in (the
         grid's centre site in simulation, the campaign area's centre for real flights); ``queue_bits`` (K,);
@@ -29,6 +30,8 @@ def state_rows(position, queue_bits, serving_id, rsrp, rsrq, observation) -> np.
     """
     position = np.array(position, dtype=float).reshape(-1, 3)
     k = len(position)
+    if observation.position_hidden:
+        position[:] = 0.0
     if observation.position_grid_m > 0:
         position[:, :2] = np.round(position[:, :2] / observation.position_grid_m) * observation.position_grid_m
     rsrp = np.array(rsrp, dtype=float).reshape(k, N_CANDIDATES)
