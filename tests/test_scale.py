@@ -68,6 +68,30 @@ def test_ray_reads_parquet_by_row_group_and_csv_once_rewritten(tmp_path, local_r
         assert not (tmp_path / name.replace(".", "_") / STAGED).exists()  # the CSV's rewrite is removed
 
 
+def test_ray_reports_a_users_error_in_one_line_and_keeps_what_was_written(tmp_path, local_ray):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from xairl.errors import InputError
+    from xairl.scale import STAGED, explain_on_ray
+    from xairl.toy import FEATURES
+
+    states = POLICY.background(2_500, seed=6).astype(float)
+    states[1_700, 2] = np.nan  # found by the worker that reads rows 1000..1999, not by the driver
+    pq.write_table(pa.table({f: states[:, j] for j, f in enumerate(FEATURES)}), tmp_path / "s.parquet",
+                   row_group_size=500)
+    with pytest.raises(InputError, match=r"rows 1000\.\.1999 contain 1 NaN/inf value") as err:
+        explain_on_ray(POLICY, tmp_path / "s.parquet", tmp_path / "o", background=POLICY.background(20),
+                       chunk_size=1000, workers=2)
+    assert "\n" not in str(err.value) and "Ray" not in str(err.value)
+    assert sorted(p.name for p in (tmp_path / "o" / "explanations.parquet").glob("*.parquet")) == \
+        ["part-000000000000.parquet", "part-000000002000.parquet"]  # the good chunks stay, for --resume
+    (tmp_path / "s.csv").write_text(",".join(FEATURES) + "\n")  # a header and no state
+    with pytest.raises(InputError, match="holds no state"):
+        explain_on_ray(POLICY, tmp_path / "s.csv", tmp_path / "o2", background=POLICY.background(20))
+    assert not (tmp_path / "o2" / STAGED).exists() and not list((tmp_path / "o2").glob(".*.part"))
+
+
 def test_narrations_on_ray_are_the_narrations_here_in_order(local_ray):
     import xairl
     from xairl.scale import narrate_on_ray
@@ -82,6 +106,8 @@ def test_narrations_on_ray_are_the_narrations_here_in_order(local_ray):
         narrate_on_ray(exp, [6], narrator="template", policy=POLICY)  # refused here, before any worker starts
     with pytest.raises(xairl.XairlError, match="unknown narrator 'nope'"):
         narrate_on_ray(exp, narrator="nope")
+    with pytest.raises(xairl.XairlError, match="unknown template 'nope'"):  # raised in a worker, shown as itself
+        narrate_on_ray(exp, [0], narrator="template", template="nope", policy=POLICY)
 
 
 def test_the_local_engine_imports_no_ray(tmp_path):

@@ -15,7 +15,7 @@ import pytest
 import xairl
 from xairl.cli import main
 from xairl.errors import InputError
-from xairl.chunks import stage_parquet, state_chunks
+from xairl.chunks import _table_batches, stage_parquet, state_chunks
 from xairl.stream import explain_chunks, explain_to_parquet, read_parquet
 from xairl.toy import FEATURES, toy_policy
 
@@ -50,11 +50,16 @@ def test_every_source_gives_the_same_chunks(tmp_path):
             assert np.array_equal(np.concatenate([c for _, c in later]), STATES[start - start % 1000:]), (source, start)
 
 
+def test_parquet_is_read_from_the_row_group_that_holds_the_first_row_wanted(tmp_path):
+    parquet = _sources(tmp_path)[1]  # row groups of 700 rows
+    assert [_table_batches(parquet, POLICY, 1000, start)[0] for start in (0, 699, 700, 2000)] == [0, 0, 700, 1400]
+
+
 def test_staged_parquet_has_one_row_group_per_chunk(tmp_path):
     csv = _sources(tmp_path)[2]
     assert stage_parquet(csv, POLICY, tmp_path / "staged.parquet", chunk_size=1000) == 2345
-    assert [pq.ParquetFile(tmp_path / "staged.parquet").metadata.row_group(g).num_rows for g in range(3)] == \
-        [1000, 1000, 345]
+    meta = pq.ParquetFile(tmp_path / "staged.parquet").metadata
+    assert [meta.row_group(g).num_rows for g in range(meta.num_row_groups)] == [1000, 1000, 345]
     assert np.array_equal(next(state_chunks(tmp_path / "staged.parquet", POLICY, 1000, start=2000))[1], STATES[2000:])
 
 

@@ -25,9 +25,7 @@ def count_states(source, policy: Policy) -> int | None:
     if path.suffix.lower() == ".npy":
         return len(_NpyRows(path))
     if path.suffix.lower() == ".parquet":
-        import pyarrow.parquet as pq
-
-        return int(pq.ParquetFile(path).metadata.num_rows)
+        return int(_parquet_file(path, policy).metadata.num_rows)
     if path.suffix.lower() == ".csv":
         return None
     return len(read_states(path, policy.feature_names, policy.observation))
@@ -36,12 +34,13 @@ def count_states(source, policy: Policy) -> int | None:
 def state_chunks(source, policy: Policy, chunk_size: int = CHUNK, start: int = 0) -> Iterator[tuple[int, np.ndarray]]:
     """(first row, checked float32 states) for each chunk of ``chunk_size`` rows from row ``start`` on.
 
-    :param source: an array (any form the policy's observation takes), or a file: .npy (read by slice), .parquet
-        (read by record batch, skipping the row groups before ``start``; one column per feature, named as the features), .csv (read by block; a header naming
-        the features), or .npz/.json (read whole, then chunked).
+    :param source: an array (any form the policy's observation takes), or a file: .npy (read by slice; a Fortran-
+        order file through a memory map), .parquet (by record batch from the row group that holds ``start``; one
+        column per feature, named as the features), .csv (by block; a header naming the features), or .npz/.json
+        (read whole, then chunked).
     """
-    if chunk_size < 1:
-        raise InputError(f"chunk size must be at least 1, got {chunk_size}.")
+    if chunk_size < 1 or start < 0:
+        raise InputError(f"chunk size must be at least 1 and the first row at least 0, got {chunk_size} and {start}.")
     path = Path(source) if isinstance(source, (str, Path)) else None
     suffix = path.suffix.lower() if path else ""
     if path is not None and not path.is_file():
@@ -54,7 +53,7 @@ def state_chunks(source, policy: Policy, chunk_size: int = CHUNK, start: int = 0
         if path is not None else policy.check_states(source)
     n = len(rows)
     for a in range(start - start % chunk_size, n, chunk_size):
-        what = f"{path}: rows {a}..{min(a + chunk_size, n) - 1}" if path else f"states {a}..{min(a + chunk_size, n) - 1}"
+        what = f"{path or 'states'}: rows {a}..{min(a + chunk_size, n) - 1}"
         yield a, policy.check_states(np.asarray(rows[a:a + chunk_size]), what)
 
 
@@ -91,32 +90,46 @@ class _NpyRows:
                                                                                        *self.shape[1:])
 
 
+def _unreadable(path: Path, exc: Exception) -> InputError:
+    return InputError(f"{path}: cannot read it ({' '.join(str(exc).split())[:160]}).")
+
+
+def _parquet_file(path: Path, policy: Policy):
+    """The opened Parquet file, checked to hold one column per feature; one-line InputError otherwise."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    try:
+        pf = pq.ParquetFile(path)
+    except (pa.ArrowException, OSError) as exc:
+        raise _unreadable(path, exc) from None
+    missing = [f for f in policy.feature_names if f not in pf.schema_arrow.names]
+    if missing:
+        raise InputError(f"{path}: lacks column(s) {', '.join(missing[:5])}; one column per feature, named as the "
+                         "features.")
+    return pf
+
+
 def _table_batches(path: Path, policy: Policy, chunk_size: int, start: int) -> tuple[int, Iterator[np.ndarray]]:
     """Record batches of a Parquet or CSV file as float64 arrays, the features' columns in the policy's order, and
-    the row the first batch starts at: a Parquet file's row groups before row ``start`` are not read."""
+    the row the first batch starts at: a Parquet file is read from the row group that holds row ``start``."""
     import pyarrow as pa
 
     names = list(policy.feature_names)
-    try:
-        if path.suffix.lower() == ".parquet":
-            import pyarrow.parquet as pq
+    if path.suffix.lower() == ".parquet":
+        pf = _parquet_file(path, policy)
+        first, skip, groups = 0, 0, pf.metadata.num_row_groups
+        while skip < groups and first + pf.metadata.row_group(skip).num_rows <= start:
+            first, skip = first + pf.metadata.row_group(skip).num_rows, skip + 1
+        batches = pf.iter_batches(batch_size=chunk_size, row_groups=range(skip, groups), columns=names)
+    else:
+        from pyarrow import csv
 
-            pf = pq.ParquetFile(path)
-            missing = [f for f in names if f not in pf.schema_arrow.names]
-            if missing:
-                raise InputError(f"{path}: lacks column(s) {', '.join(missing[:5])}; one column per feature, named as "
-                                 "the features.")
-            first, skip, groups = 0, 0, pf.metadata.num_row_groups
-            while skip < groups and first + pf.metadata.row_group(skip).num_rows <= start:
-                first, skip = first + pf.metadata.row_group(skip).num_rows, skip + 1
-            batches = pf.iter_batches(batch_size=chunk_size, row_groups=range(skip, groups), columns=names)
-        else:
-            from pyarrow import csv
-
+        try:
             first, batches = 0, iter(csv.open_csv(path, convert_options=csv.ConvertOptions(
                 include_columns=names, column_types={f: pa.float64() for f in names})))
-    except (pa.ArrowException, OSError) as exc:
-        raise InputError(f"{path}: cannot read it ({' '.join(str(exc).split())[:160]}).") from None
+        except (pa.ArrowException, OSError) as exc:
+            raise _unreadable(path, exc) from None
 
     def arrays() -> Iterator[np.ndarray]:
         try:
@@ -124,7 +137,7 @@ def _table_batches(path: Path, policy: Policy, chunk_size: int, start: int) -> t
                 yield np.column_stack([batch.column(f).to_numpy(zero_copy_only=False) for f in names]) \
                     if batch.num_rows else np.empty((0, len(names)))
         except (pa.ArrowException, OSError) as exc:
-            raise InputError(f"{path}: cannot read it ({' '.join(str(exc).split())[:160]}).") from None
+            raise _unreadable(path, exc) from None
 
     return first, arrays()
 
@@ -160,11 +173,15 @@ def stage_parquet(source, policy: Policy, path: Path, chunk_size: int = CHUNK) -
 
     names, n, writer = list(policy.feature_names), 0, None
     with atomic_write(path, "wb") as fh:
-        for _, x in state_chunks(source, policy, chunk_size):
-            table = pa.table({f: x[:, j] for j, f in enumerate(names)})
-            writer = writer or pq.ParquetWriter(fh, table.schema, compression="zstd")
-            writer.write_table(table, row_group_size=chunk_size)
-            n += len(x)
-        if writer is not None:
-            writer.close()
+        try:
+            for _, x in state_chunks(source, policy, chunk_size):
+                table = pa.table({f: x[:, j] for j, f in enumerate(names)})
+                writer = writer or pq.ParquetWriter(fh, table.schema, compression="zstd")
+                writer.write_table(table, row_group_size=chunk_size)
+                n += len(x)
+        finally:
+            if writer is not None:
+                writer.close()
+        if not n:
+            raise InputError(f"{source}: holds no state to explain.")
     return n

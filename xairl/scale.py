@@ -18,13 +18,14 @@ the driver from the written parts, in order.
 """
 from __future__ import annotations
 
+import contextlib
 import logging
 from pathlib import Path
 
 import numpy as np
 
 from .chunks import CHUNK, count_states, stage_parquet, state_chunks
-from .errors import InputError
+from .errors import InputError, XairlError
 from .policy import Policy
 from .stream import RunningSummary, _part_name, finish_run, read_parquet, start_run, write_part
 
@@ -49,6 +50,37 @@ def _start(ray, address: str | None, workers: int) -> bool:
     return True
 
 
+def _usable(ray, workers: int) -> int:
+    """``workers`` actors of one CPU each, refused in one line when the Ray cluster cannot hold one of them (they
+    would wait for ever); as many as its CPUs allow otherwise."""
+    cpus = int(ray.cluster_resources().get("CPU", 0))
+    if workers < 1 or cpus < 1:
+        raise InputError(f"the Ray engine needs at least one worker and one CPU: asked for {workers} worker(s), the "
+                         f"cluster has {cpus} CPU(s).")
+    return min(workers, cpus)
+
+
+@contextlib.contextmanager
+def _unwrapped(ray):
+    """A user's error raised in a worker (a missing column, a bad template) comes out as itself, in one line, not as
+    Ray's traceback of the worker; ray.data's notices (its plan, timings, progress bars) stay off the terminal
+    meanwhile, and its logger is restored after."""
+    logger = logging.getLogger("ray.data")
+    level = logger.level
+    logger.setLevel(logging.ERROR)
+    try:
+        yield
+    except Exception as exc:  # Ray's task errors (a RayError that may also subclass the user's error) or Ray Data's
+        cause = exc
+        while cause is not None and (isinstance(cause, ray.exceptions.RayError) or not isinstance(cause, XairlError)):
+            cause = getattr(cause, "cause", None) or cause.__cause__
+        if cause is None:
+            raise
+        raise cause.with_traceback(None) from None
+    finally:
+        logger.setLevel(level)
+
+
 class _ChunkWorker:
     """A Ray actor: explains the chunks whose first rows it is given, each into its own part."""
 
@@ -66,14 +98,22 @@ class _ChunkWorker:
         self.parts, self.meta = Path(parts), meta
 
     def __call__(self, batch: dict) -> dict:
+        """Each chunk explained and written; a user's error (NaN in the states, ...) is returned as its message, for
+        the driver to report in one line (Ray Data would only pass on its traceback)."""
         from .attributors import explain
 
         states = self.states if isinstance(self.states, str) else np.asarray(self.states)
+        errors = []
         for first in batch["first"].tolist():
-            _, x = next(state_chunks(states, self.policy, self.chunk_size, start=first))
-            exp = explain(self.policy, x, background=self.bg, method=self.method, options=self.options)
+            try:
+                _, x = next(state_chunks(states, self.policy, self.chunk_size, start=first))
+                exp = explain(self.policy, x, background=self.bg, method=self.method, options=self.options)
+            except XairlError as exc:
+                errors.append(str(exc))
+                continue
             write_part(self.parts, first, exp, self.meta)
-        return {"first": batch["first"]}
+            errors.append("")
+        return {"first": batch["first"], "error": np.array(errors, dtype=object)}
 
 
 def explain_on_ray(policy: Policy, states, out: str | Path, background=None, method: str = "deep_shap",
@@ -91,25 +131,29 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
     source = str(Path(states).resolve()) if isinstance(states, (str, Path)) else policy.check_states(states)
     run = start_run(policy, states, out, background, method, options, chunk_size, resume)
     staged = isinstance(source, str) and Path(source).suffix.lower() not in (".npy", ".parquet")
-    if staged:  # no reading of one chunk alone: rewritten once, one row group per chunk
-        source = str((run.out / STAGED).resolve())
-        total = stage_parquet(states, policy, Path(source), chunk_size)
-    else:
-        total = count_states(states, policy)
-    todo = [first for first in range(0, total, chunk_size) if first not in run.done]
-    started = _start(ray, address, workers)
+    started = False
     try:
-        ctx = ray.data.DataContext.get_current()
-        ctx.enable_progress_bars = False
-        logging.getLogger("ray.data").setLevel(logging.WARNING)  # no plan and timing lines on the user's terminal
+        if staged:  # no reading of one chunk alone: rewritten once, one row group per chunk
+            source = str((run.out / STAGED).resolve())
+            total = stage_parquet(states, policy, Path(source), chunk_size)
+        else:
+            total = count_states(states, policy)
+        todo = [first for first in range(0, total, chunk_size) if first not in run.done]
+        started = _start(ray, address, workers)
         ref = ray.put(source) if not isinstance(source, str) else source
         if todo:
-            ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo)).map_batches(
-                _ChunkWorker, batch_size=1, compute=ray.data.ActorPoolStrategy(size=workers), num_cpus=1,
-                fn_constructor_kwargs={"policy": policy, "states": ref, "background": run.background,
-                                       "method": method, "options": run.options, "chunk_size": chunk_size,
-                                       "parts": str(run.parts), "meta": run.meta, "threads": 1},
-            ).materialize()
+            with _unwrapped(ray):
+                ray.data.DataContext.get_current().enable_progress_bars = False
+                done = ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo)).map_batches(
+                    _ChunkWorker, batch_size=1, num_cpus=1,
+                    compute=ray.data.ActorPoolStrategy(size=_usable(ray, workers)),
+                    fn_constructor_kwargs={"policy": policy, "states": ref, "background": run.background,
+                                           "method": method, "options": run.options, "chunk_size": chunk_size,
+                                           "parts": str(run.parts), "meta": run.meta, "threads": 1},
+                ).materialize()
+                failed = [row["error"] for row in done.select_columns(["error"]).take_all() if row["error"]]
+            if failed:  # the chunks written so far stay: fix the states and --resume
+                raise InputError(failed[0])
     finally:
         if started:
             ray.shutdown()
@@ -126,12 +170,10 @@ class _NarrationWorker:
     Explanation."""
 
     def __init__(self, explanation, narrator: str, kwargs: dict, threads: int):
-        import ray
         import torch
 
         torch.set_num_threads(threads)
-        self.exp = ray.get(explanation) if isinstance(explanation, ray.ObjectRef) else explanation
-        self.narrator, self.kwargs = narrator, kwargs
+        self.exp, self.narrator, self.kwargs = explanation, narrator, kwargs  # (Ray hands over the object itself)
 
     def narrate(self, index: int):
         from .narrators import narrate
@@ -160,8 +202,9 @@ def narrate_on_ray(explanation, indices=None, narrator: str = "local_lm", worker
     try:
         ref = ray.put(explanation)
         actor = ray.remote(num_cpus=1)(_NarrationWorker)
-        pool = ray.util.ActorPool([actor.remote(ref, narrator, kwargs, threads) for _ in range(workers)])
-        return list(pool.map(lambda a, i: a.narrate.remote(i), indices))
+        pool = ray.util.ActorPool([actor.remote(ref, narrator, kwargs, threads) for _ in range(_usable(ray, workers))])
+        with _unwrapped(ray):
+            return list(pool.map(lambda a, i: a.narrate.remote(i), indices))
     finally:
         if started:
             ray.shutdown()
