@@ -93,5 +93,6 @@ def narrations(k: int) -> None:
           f"{times[1]:.1f} s, 2 workers {times[2]:.1f} s: speed-up per added worker {times[1] / times[2]:.2f}x; the "
           "same texts")
 
+
 if __name__ == "__main__":
     main()

@@ -18,23 +18,20 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-
-import xairl
+from reproduce import real_sample, real_walks
 from xairl_uav_handover.baselines import CHM
 from xairl_uav_handover.config import SimConfig
+from xairl_uav_handover.evaluate import importance
 from xairl_uav_handover.features import GROUPS
-from xairl_uav_handover.policy import (DQNController, background_states, dqn_decision_states, load_checkpoint,
-                                       uav_policy)
-from xairl_uav_handover.table import flights, format_rows, with_intervals, worse
+from xairl_uav_handover.policy import DQNController, dqn_decision_states, load_checkpoint
+from xairl_uav_handover.table import flights, format_rows, verdict, with_intervals
 from xairl_uav_handover.train import TrainConfig, train_checkpoint
 
 
 def ranks(ckpt, states: np.ndarray) -> str:
     """The position group's and the buffer's rank by mean |contribution to the margin|, and the top four."""
-    exp = xairl.explain(uav_policy(ckpt), states,
-                        background=background_states(100, seed=7, config=ckpt.sim_config))
-    grouped = exp.grouped({"position": GROUPS["position"]})
-    order = [grouped.feature_names[j] for j in np.argsort(-np.abs(grouped.margin()).mean(axis=0))]
+    imp = importance(ckpt, states, groups={"position": GROUPS["position"]})
+    order = list(imp["names"][np.argsort(-imp["margin"])])
     return (f"position {order.index('position') + 1} of {len(order)}, buffer {order.index('buffer_queue_size') + 1}"
             f" (top four: {', '.join(order[:4])})")
 
@@ -58,19 +55,15 @@ def main():
     for name, ckpt in dqns.items():
         print(f"{name}, simulated decision states: {ranks(ckpt, dqn_decision_states(ckpt, args.states, 0))}")
         if args.real:
-            from xairl_uav_handover.real_data import load_folder, walk
-
-            states = np.concatenate([walk(f, ckpt.sim_config).states for f in load_folder(args.real)[0]])
-            pick = np.sort(np.random.default_rng(0).choice(len(states), min(args.states, len(states)), replace=False))
-            print(f"{name}, real states: {ranks(ckpt, states[pick])}")
+            real = real_sample(real_walks(args.real, ckpt.sim_config), args.states)
+            print(f"{name}, real states: {ranks(ckpt, real)}")
     res = {"CHM": with_intervals(flights(CHM(), committed.sim_config, args.flights, args.eval_seeds))}
     for name, ckpt in dqns.items():
         res[name] = with_intervals(flights(DQNController(ckpt.net), ckpt.sim_config, args.flights, args.eval_seeds))
     print(f"\nTable I: {args.flights} held-out flights x evaluation seeds {args.eval_seeds}, value [bootstrap 95 % "
           "interval]\n" + format_rows(res))
     for a, b in (("DQN without position", "DQN"), ("DQN", "DQN without position")):
-        rows = worse(res, a, b)
-        print(f"{a} worse than {b} beyond the intervals on: {'; '.join(rows) if rows else 'no figure'}")
+        print(verdict(res, a, b))
 
 
 if __name__ == "__main__":

@@ -4,19 +4,20 @@ checked per seed (benchmarks/table_one.py), and the rank of buffer_queue_size by
 and to the chosen score (deep_shap) on each DQN's own decision states. With --real DIR (the UKM flights), also the
 open-loop new handover proposals per minute on the real flights against the live network's handovers (target 5:
 at most 2x), the buffer's ranks on real states and the Spearman correlation of the features' mean |margin
-contribution| between simulated and real states (target 6: buffer in the top 2, Spearman >= 0.6). Training takes about 2 minutes per seed on 2
-cores; the committed checkpoint is seed 0 of this command (`xairl uav train --seed 0` writes the same).
+contribution| between simulated and real states (target 6: buffer in the top 2, Spearman >= 0.6). Training takes
+about 2 minutes per seed on 2 cores; the committed checkpoint is seed 0 of this command (`xairl uav train --seed 0`
+writes the same).
 
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reproduce.py [--seeds 0 1 2] [--episodes 40]
-     [--flights 200] [--eval-seeds 0] [--states 400] [--real ../shared/data/...] [--out-dir DIR] [--json OUT]
-or:  ... reproduce.py --checkpoints A.safetensors B.safetensors ...       measures existing checkpoints
+     [--flights 200] [--eval-seeds 0] [--states 400] [--real DIR] [--out-dir DIR] [--json OUT]
+or:  ... reproduce.py --checkpoints A.safetensors B.safetensors ...   measures existing checkpoints
 """
 import argparse
 import json
 import tempfile
 from pathlib import Path
 
-from table_one import targets
+from table_one import print_targets, targets
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.config import SimConfig
 import numpy as np
@@ -46,16 +47,20 @@ def main():
     if not paths:
         paths = [str(folder / f"seed{seed}.safetensors") for seed in args.seeds]
         for seed, path in zip(args.seeds, paths):
-            seconds = train_checkpoint(TrainConfig(episodes=args.episodes, seed=seed), SimConfig(), path, progress=False)
+            seconds = train_checkpoint(TrainConfig(episodes=args.episodes, seed=seed), SimConfig(), path,
+                                       progress=False)
             print(f"seed {seed}: trained in {seconds} s -> {path}")
     cfg = load_checkpoint(paths[0]).sim_config
+    if any(load_checkpoint(p).sim_config != cfg for p in paths[1:]):
+        raise SystemExit("the checkpoints were trained on different simulator settings; compare them one at a time "
+                         "(CHM, SA-MRO and the real walks use one setting)")
     walks = real_walks(args.real, cfg) if args.real else None
     n = args.flights * len(args.eval_seeds)
     res = {c.name: with_intervals(flights(c, cfg, args.flights, args.eval_seeds)) for c in (CHM(), SAMRO())}
     per_seed = []
-    for path in paths:
+    for k, path in enumerate(paths):
         ckpt = load_checkpoint(path)
-        name = f"DQN seed {ckpt.meta.get('seed')}"
+        name = f"DQN seed {ckpt.meta.get('seed')}" if not args.checkpoints else f"DQN {k + 1}: {Path(path).stem}"
         res[name] = with_intervals(flights(DQNController(ckpt.net), ckpt.sim_config, args.flights, args.eval_seeds))
         imp = {"simulated": importance(ckpt, dqn_decision_states(ckpt, args.states, 0))}
         met = [(label, bool(ok), detail) for label, ok, detail in targets({"CHM": res["CHM"], "DQN": res[name]}, n)]
@@ -63,8 +68,8 @@ def main():
             imp["real"], target5 = real_figures(ckpt, walks, args.states)
             rho = float(spearmanr(imp["simulated"]["margin"], imp["real"]["margin"]).statistic)
             met += [target5, ("6b. Spearman sim vs real (margin) >= 0.6", bool(rho >= 0.6), f"{rho:.2f}")]
-        ranks = {f"{data} {view}": [FEATURES[j] for j in np.argsort(-v)] for data, views in imp.items()
-                 for view, v in views.items()}
+        ranks = {f"{data} {view}": [FEATURES[j] for j in np.argsort(-views[view])] for data, views in imp.items()
+                 for view in ("margin", "score")}
         buffer = {k: r.index("buffer_queue_size") + 1 for k, r in ranks.items()}
         met.append(("6a. buffer in the top 2 everywhere", bool(max(buffer.values()) <= 2), str(buffer)))
         per_seed.append({"checkpoint": path, "name": name, "train_seconds": ckpt.meta.get("train_seconds"),
@@ -76,8 +81,7 @@ def main():
         print(f"\n{s['name']} ({s['train_seconds']} s of training): "
               f"{sum(ok for _, ok, _ in s['targets'])} of {len(s['targets'])} targets met; first four by the margin "
               f"on simulated states: {', '.join(s['rankings']['simulated margin'][:4])}")
-        for label, ok, detail in s["targets"]:
-            print(f"  {'met' if ok else 'NOT met':<8} {label:<50} {detail}")
+        print_targets(s["targets"])
     if args.json:
         with open(args.json, "w") as fh:
             json.dump({"table": res, "seeds": per_seed}, fh, indent=1)
@@ -90,14 +94,18 @@ def real_walks(folder: str, cfg) -> list:
     return [walk(f, cfg) for f in load_folder(folder)[0]]
 
 
+def real_sample(walks: list, n: int) -> np.ndarray:
+    """``n`` of the walks' states, drawn uniformly (seeded), in their order."""
+    states = np.concatenate([w.states for w in walks])
+    return states[np.sort(np.random.default_rng(0).choice(len(states), size=min(n, len(states)), replace=False))]
+
+
 def real_figures(ckpt, walks: list, n_states: int) -> tuple[dict, tuple[str, bool, str]]:
     """(importance on a sample of the real states, target 5: new proposals per minute <= 2 x the network's rate)."""
     from xairl_uav_handover.report import agreement_rows
 
     dqn = agreement_rows(walks, ckpt, ckpt.sim_config)[0]
-    states = np.concatenate([w.states for w in walks])
-    pick = np.sort(np.random.default_rng(0).choice(len(states), size=min(n_states, len(states)), replace=False))
-    return importance(ckpt, states[pick]), (
+    return importance(ckpt, real_sample(walks, n_states)), (
         "5. real: new proposals <= 2 x the network's rate", bool(dqn.new_proposals_per_min <= 2 * dqn.network_per_min),
         f"{dqn.new_proposals_per_min:.2f} vs 2 x {dqn.network_per_min:.2f} per minute")
 

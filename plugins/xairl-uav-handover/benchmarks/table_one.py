@@ -38,6 +38,12 @@ def targets(res: dict, n_flights: int) -> list[tuple[str, bool, str]]:
     ]
 
 
+def print_targets(met: list[tuple[str, bool, str]]) -> None:
+    """One line per target: met or NOT met, and the figures compared."""
+    for label, ok, detail in met:
+        print(f"  {'met' if ok else 'NOT met':<8} {label:<50} {detail}")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--flights", type=int, default=200, help="held-out flights per evaluation seed")
@@ -58,8 +64,7 @@ def main():
     print(format_rows(res))
     for name in [k for k in res if k.startswith("DQN")]:
         print(f"\ntargets, {name}:")
-        for label, met, detail in targets({"CHM": res["CHM"], "DQN": res[name]}, n):
-            print(f"  {'met' if met else 'NOT met':<8} {label:<50} {detail}")
+        print_targets(targets({"CHM": res["CHM"], "DQN": res[name]}, n))
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(res, fh, indent=1)

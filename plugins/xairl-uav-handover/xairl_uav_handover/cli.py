@@ -18,7 +18,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     p = sub.add_parser("evaluate", help="CHM, SA-MRO and the DQN on the same held-out flights: Table I, each figure "
                        "with its bootstrap 95 %% interval")
     p.add_argument("--flights", type=int, default=100, help="held-out flights per evaluation seed")
-    p.add_argument("--seeds", type=int, nargs="+", default=[0], help="evaluation seeds (their flights pooled)")
+    p.add_argument("--seeds", type=int, nargs="+", default=[0], help="evaluation seeds, distinct and >= 0 (their "
+                   "flights pooled)")
     p.add_argument("--duration", type=float, default=None, help="seconds per flight")
     p.add_argument("--checkpoint", default=None, help="DQN checkpoint (default: the plugin's pretrained one)")
     p.add_argument("--json", action="store_true", help="print the table as JSON: per policy, per figure, "
@@ -63,6 +64,9 @@ def run_evaluate(args) -> int:
 
     if args.flights < 1:
         raise InputError("--flights must be at least 1.")
+    if min(args.seeds) < 0 or len(set(args.seeds)) < len(args.seeds):
+        raise InputError(f"--seeds must be distinct and at least 0 (the same flights twice would narrow the "
+                         f"intervals falsely), got {' '.join(map(str, args.seeds))}.")
     ckpt = load_checkpoint(args.checkpoint)
     cfg = _sim_config(ckpt.sim_config, args.duration)
     res = {c.name: with_intervals(flights(c, cfg, args.flights, args.seeds))

@@ -52,24 +52,27 @@ def run_flights(controller, config: SimConfig, n_flights: int, seed: int) -> dic
     }
 
 
-def importance(ckpt, states: np.ndarray, seed: int = 0) -> dict[str, np.ndarray]:
+def importance(ckpt, states: np.ndarray, seed: int = 0, groups: dict | None = None) -> dict[str, np.ndarray]:
     """Mean |contribution| per feature (deep_shap) on ``states``: ``margin`` to the margin over the runner-up (the
-    paper's Figure 2 as the cards read it) and ``score`` to the chosen action's score."""
+    paper's Figure 2 as the cards read it) and ``score`` to the chosen action's score; ``names`` the features, or
+    with ``groups`` ({name: members}) each group summed per state in place of its members."""
     import xairl
 
     from .policy import background_states, uav_policy
 
     exp = xairl.explain(uav_policy(ckpt), states,
                         background=background_states(100, seed=seed + 7, config=ckpt.sim_config))
-    return {"margin": np.abs(exp.margin()).mean(axis=0), "score": np.abs(exp.for_chosen()).mean(axis=0)}
+    exp = exp.grouped(groups) if groups else exp
+    return {"margin": np.abs(exp.margin()).mean(axis=0), "score": np.abs(exp.for_chosen()).mean(axis=0),
+            "names": np.array(exp.feature_names)}
 
 
 def rankings(ckpt, n_states: int, seed: int) -> dict[str, list[str]]:
     """Features by :func:`importance` on the DQN's own decision states of held-out flights, most important first."""
     from .policy import dqn_decision_states
 
-    return {view: [FEATURES[j] for j in np.argsort(-imp)]
-            for view, imp in importance(ckpt, dqn_decision_states(ckpt, n_states, seed), seed).items()}
+    imp = importance(ckpt, dqn_decision_states(ckpt, n_states, seed), seed)
+    return {view: [FEATURES[j] for j in np.argsort(-imp[view])] for view in ("margin", "score")}
 
 
 def chm_rate_by_altitude(altitudes, config: SimConfig, n_flights: int = 40, duration_s: float = 60.0,
