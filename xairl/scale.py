@@ -19,7 +19,6 @@ the driver from the written parts, in order.
 from __future__ import annotations
 
 import contextlib
-import logging
 from pathlib import Path
 
 import numpy as np
@@ -62,12 +61,9 @@ def _usable(ray, workers: int) -> int:
 
 @contextlib.contextmanager
 def _unwrapped(ray):
-    """A user's error raised in a worker (a missing column, a bad template) comes out as itself, in one line, not as
-    Ray's traceback of the worker; ray.data's notices (its plan, timings, progress bars) stay off the terminal
-    meanwhile, and its logger is restored after."""
-    logger = logging.getLogger("ray.data")
-    level = logger.level
-    logger.setLevel(logging.ERROR)
+    """A user's error raised in a worker (a bad template) comes out as itself, in one line, not as Ray's traceback of
+    the worker. (Ray Data's own notices, its plan and timings, still reach the terminal: Ray sets up its loggers
+    when a dataset runs.)"""
     try:
         yield
     except Exception as exc:  # Ray's task errors (a RayError that may also subclass the user's error) or Ray Data's
@@ -77,8 +73,6 @@ def _unwrapped(ray):
         if cause is None:
             raise
         raise cause.with_traceback(None) from None
-    finally:
-        logger.setLevel(level)
 
 
 class _ChunkWorker:
