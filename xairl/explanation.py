@@ -183,12 +183,11 @@ class Explanation:
         if view not in ("margin", "score"):
             raise InputError(f"view {view!r} is not one of margin, score.")
         idx, c = np.arange(len(self.values)), self.focus
-        values, expected, value = self.values[idx, :, c], self.base_values[idx, c], self.outputs[idx, c]
-        if view == "margin" and self.decides:
+        expected, value = self.base_values[idx, c], self.outputs[idx, c]
+        if view == "margin" and self.decides:  # (focus is the chosen action here)
             r = self.runner_up
-            values = values - self.values[idx, :, r]
-            expected, value = expected - self.base_values[idx, r], value - self.outputs[idx, r]
-        return values, expected, value
+            return self.margin(), expected - self.base_values[idx, r], value - self.outputs[idx, r]
+        return self.values[idx, :, c], expected, value
 
     def grouped(self, groups: Mapping[str, Sequence[str] | np.ndarray]) -> "Explanation":
         """Sum the contributions of each group into one feature named after it; other features stay as they are.

@@ -21,7 +21,7 @@ import numpy as np
 from reproduce import real_sample, real_walks
 from xairl_uav_handover.baselines import CHM
 from xairl_uav_handover.config import SimConfig
-from xairl_uav_handover.evaluate import importance
+from xairl_uav_handover.evaluate import importance, ranked
 from xairl_uav_handover.features import GROUPS
 from xairl_uav_handover.policy import DQNController, dqn_decision_states, load_checkpoint
 from xairl_uav_handover.table import flights, format_rows, verdict, with_intervals
@@ -31,7 +31,7 @@ from xairl_uav_handover.train import TrainConfig, train_checkpoint
 def ranks(ckpt, states: np.ndarray) -> str:
     """The position group's and the buffer's rank by mean |contribution to the margin|, and the top four."""
     imp = importance(ckpt, states, groups={"position": GROUPS["position"]})
-    order = list(imp["names"][np.argsort(-imp["margin"])])
+    order = ranked(imp)
     return (f"position {order.index('position') + 1} of {len(order)}, buffer {order.index('buffer_queue_size') + 1}"
             f" (top four: {', '.join(order[:4])})")
 

@@ -22,8 +22,7 @@ from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.config import SimConfig
 import numpy as np
 from scipy.stats import spearmanr
-from xairl_uav_handover.evaluate import importance
-from xairl_uav_handover.features import FEATURES
+from xairl_uav_handover.evaluate import importance, ranked
 from xairl_uav_handover.policy import DQNController, dqn_decision_states, load_checkpoint
 from xairl_uav_handover.table import flights, format_rows, with_intervals
 from xairl_uav_handover.train import TrainConfig, train_checkpoint
@@ -50,16 +49,16 @@ def main():
             seconds = train_checkpoint(TrainConfig(episodes=args.episodes, seed=seed), SimConfig(), path,
                                        progress=False)
             print(f"seed {seed}: trained in {seconds} s -> {path}")
-    cfg = load_checkpoint(paths[0]).sim_config
-    if any(load_checkpoint(p).sim_config != cfg for p in paths[1:]):
+    ckpts = [load_checkpoint(p) for p in paths]
+    cfg = ckpts[0].sim_config
+    if any(c.sim_config != cfg for c in ckpts[1:]):
         raise SystemExit("the checkpoints were trained on different simulator settings; compare them one at a time "
                          "(CHM, SA-MRO and the real walks use one setting)")
     walks = real_walks(args.real, cfg) if args.real else None
     n = args.flights * len(args.eval_seeds)
     res = {c.name: with_intervals(flights(c, cfg, args.flights, args.eval_seeds)) for c in (CHM(), SAMRO())}
     per_seed = []
-    for k, path in enumerate(paths):
-        ckpt = load_checkpoint(path)
+    for k, (path, ckpt) in enumerate(zip(paths, ckpts)):
         name = f"DQN seed {ckpt.meta.get('seed')}" if not args.checkpoints else f"DQN {k + 1}: {Path(path).stem}"
         res[name] = with_intervals(flights(DQNController(ckpt.net), ckpt.sim_config, args.flights, args.eval_seeds))
         imp = {"simulated": importance(ckpt, dqn_decision_states(ckpt, args.states, 0))}
@@ -68,8 +67,7 @@ def main():
             imp["real"], target5 = real_figures(ckpt, walks, args.states)
             rho = float(spearmanr(imp["simulated"]["margin"], imp["real"]["margin"]).statistic)
             met += [target5, ("6b. Spearman sim vs real (margin) >= 0.6", bool(rho >= 0.6), f"{rho:.2f}")]
-        ranks = {f"{data} {view}": [FEATURES[j] for j in np.argsort(-views[view])] for data, views in imp.items()
-                 for view in ("margin", "score")}
+        ranks = {f"{data} {view}": ranked(views, view) for data, views in imp.items() for view in ("margin", "score")}
         buffer = {k: r.index("buffer_queue_size") + 1 for k, r in ranks.items()}
         met.append(("6a. buffer in the top 2 everywhere", bool(max(buffer.values()) <= 2), str(buffer)))
         per_seed.append({"checkpoint": path, "name": name, "train_seconds": ckpt.meta.get("train_seconds"),

@@ -67,12 +67,17 @@ def importance(ckpt, states: np.ndarray, seed: int = 0, groups: dict | None = No
             "names": np.array(exp.feature_names)}
 
 
+def ranked(imp: dict[str, np.ndarray], view: str = "margin") -> list[str]:
+    """The names of :func:`importance`, most important first in ``view`` ('margin' or 'score')."""
+    return [str(f) for f in imp["names"][np.argsort(-imp[view])]]
+
+
 def rankings(ckpt, n_states: int, seed: int) -> dict[str, list[str]]:
     """Features by :func:`importance` on the DQN's own decision states of held-out flights, most important first."""
     from .policy import dqn_decision_states
 
     imp = importance(ckpt, dqn_decision_states(ckpt, n_states, seed), seed)
-    return {view: [FEATURES[j] for j in np.argsort(-imp[view])] for view in ("margin", "score")}
+    return {view: ranked(imp, view) for view in ("margin", "score")}
 
 
 def chm_rate_by_altitude(altitudes, config: SimConfig, n_flights: int = 40, duration_s: float = 60.0,
