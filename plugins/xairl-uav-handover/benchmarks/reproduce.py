@@ -10,6 +10,7 @@ writes the same).
 
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reproduce.py [--seeds 0 1 2] [--episodes 40]
      [--flights 200] [--eval-seeds 0] [--states 400] [--real DIR] [--out-dir DIR] [--json OUT]
+     [--reward w_lost=2 w_pingpong=80 ...]   trains with these RewardConfig weights instead of the defaults
 or:  ... reproduce.py --checkpoints A.safetensors B.safetensors ...   measures existing checkpoints
 """
 import argparse
@@ -39,6 +40,8 @@ def main():
     ap.add_argument("--states", type=int, default=400, help="decision states explained for the feature ranks")
     ap.add_argument("--real", default=None, help="a folder of real UKM flight exports (targets 5 and 6)")
     ap.add_argument("--json", default=None, help="also write the per-seed results here")
+    ap.add_argument("--reward", nargs="+", default=[], metavar="KEY=VALUE",
+                    help="train with these reward weights (RewardConfig) instead of the defaults")
     args = ap.parse_args()
     folder = Path(args.out_dir or tempfile.mkdtemp(prefix="xairl-reproduce-"))
     folder.mkdir(parents=True, exist_ok=True)
@@ -46,8 +49,8 @@ def main():
     if not paths:
         paths = [str(folder / f"seed{seed}.safetensors") for seed in args.seeds]
         for seed, path in zip(args.seeds, paths):
-            seconds = train_checkpoint(TrainConfig(episodes=args.episodes, seed=seed), SimConfig(), path,
-                                       progress=False)
+            seconds = train_checkpoint(TrainConfig(episodes=args.episodes, seed=seed), with_reward(args.reward),
+                                       path, progress=False)
             print(f"seed {seed}: trained in {seconds} s -> {path}")
     ckpts = [load_checkpoint(p) for p in paths]
     cfg = ckpts[0].sim_config
@@ -83,6 +86,17 @@ def main():
     if args.json:
         with open(args.json, "w") as fh:
             json.dump({"table": res, "seeds": per_seed}, fh, indent=1)
+
+
+def with_reward(pairs: list[str]) -> SimConfig:
+    """The default simulator with the reward weights ``KEY=VALUE`` changed (an unknown key is RewardConfig's
+    error); the flights, CHM and SA-MRO do not depend on the reward, so every DQN still meets them on one setting."""
+    data = SimConfig().model_dump()
+    try:
+        data["reward"].update({k: float(v) for k, v in (p.split("=", 1) for p in pairs)})
+    except ValueError:
+        raise SystemExit(f"--reward takes KEY=VALUE pairs of numbers, e.g. w_lost=2; got {' '.join(pairs)}") from None
+    return SimConfig.model_validate(data)
 
 
 def real_walks(folder: str, cfg) -> list:
