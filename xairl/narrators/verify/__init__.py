@@ -351,6 +351,8 @@ def _check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fa
             c = binding.unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
         if c.status == "contradicted" and id(n) not in paired:
             c = binding.by_parse(c, n, masked, book, ctx, unit_of, parsed, vocab)
+        if c.status == "contradicted" and id(n) not in paired:
+            c = binding.unless_elsewhere(c, n, masked, mentions, book, ctx, parsed, unit_of, sentence_keys)
         out.append(c)
     first = numbers[0] if numbers else None
     if first is not None and first.sign and not any(m.start < first.start for m in mentions):

@@ -104,6 +104,35 @@ AGGREGATE_NOUNS = frozenset({"total", "sum", "net", "gap", "difference", "change
                              "baseline", "margin", "lead", "output", "delta"})
 
 
+def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, parsed, unit_of, keys) -> Claim:
+    """A number bound by position alone (:data:`GUESSED`), contradicted, that states another fact of the explanation:
+    the position was a guess, so it is unchecked. The binding is sure, and the number stays contradicted, when it
+    comes right after its name ('A +0.3', 'A (0.3)', 'A: 0.3', 'A=0.3') or the parse ties it to a name ('A lowered
+    it by about 5 points': the verb's subject); so does a number that states no fact at all."""
+    if c.rule not in GUESSED or quantities.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
+        return c  # ('4.0 dB above': a difference in a unit, bound for sure)
+    owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
+    if owner is not None and re.fullmatch(r"\s?[:=(]?\s?|\s?[:=]\s*", masked[owner.end:n.start]):
+        return c
+    units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
+    q = quantified(parsed(), n.start, n.end, units)
+    if q.key:
+        return c
+    # a push by its cue words ('by -0.22') or by the noun it measures ('a bump of 19.1'): not a decision-level number
+    pushes = bool(quantities.CONTRIB_BEFORE.search(masked[max(0, n.start - 40):n.start])) or (
+        q.noun in FACT_NOUNS and q.noun not in AGGREGATE_NOUNS and not q.subject)
+    if q.subject and q.noun not in FACT_NOUNS:  # said of 'claim', a noun the vocabulary lacks: any feature it may name in words of its own
+        other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes,
+                                    signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
+        if other is not None:
+            return Claim("number", n.text, "unchecked", f"said of '{q.noun}', which names no "
+                                             f"feature; it states {other}", "parse.said-of-other")
+    other = quantities.any_fact(n, book, keys, ctx, strict=True, contribution=pushes,
+                                signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
+    return c if other is None else Claim("number", n.text, "unchecked",
+                                         f"read by position as {c.detail}, but it states {other}", "number.elsewhere")
+
+
 def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, vocab) -> Claim:
     """A second reading of a number bound by position alone (:data:`GUESSED`) and contradicted, from the sentence's
     parse (:func:`.parse.quantified`): a number that measures another name (or a noun of one feature's name only)
@@ -115,6 +144,8 @@ def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, voc
         return c  # bound by its cue words or a list: sure
     units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
     q = quantified(parsed(), n.start, n.end, units)
+    if q.subject:
+        return c  # said of a subject that names nothing: :func:`unless_elsewhere` decides
     if "|" in q.key:
         return c  # an ambiguous name: the first reading stands
     if q.key in book.features:

@@ -345,3 +345,39 @@ def _owners(n: Number, book: FactBook) -> list[str]:
         if len(found) == 1:
             return found
     return found
+
+
+def any_fact(n: Number, book: FactBook, keys, ctx: str | None, strict: bool = False, contribution: bool = False,
+             signed: bool = False) -> str | None:
+    """Another fact of the sentence the number states: a value, contribution (either view, its size) or share of a
+    feature named in it (``keys``); a decision-level number; an action's score. ``None``
+    when it states none (then it is wrong wherever it is bound). A feature the sentence does not name is no
+    candidate: with a dozen features, some fact would match any rounded number by chance. ``strict``: any feature
+    may be meant, so only an unhedged number of two significant digits or more may match.
+    ``contribution``: the words say the number is a push ('by -0.22'): no decision-level number or score.
+    ``signed``: the words name a signed quantity ('a SHAP value of 0.3'): a contribution only with its sign.
+    ``ctx``: the sentence's view (contributions and shares in it only), or None / either view."""
+    if strict and (n.hedge or abs(n.value) < 10 * n.unit):
+        return None  # ('0.06' or 'about 0.1' may match by chance)
+    def states(v: float | None, size_ok: bool = True) -> bool:
+        return v is not None and (matches(n, v, magnitude_ok=size_ok) or (n.percent and percent_reading(n, v)) or (
+            n.points and percent_reading(n, abs(v))))
+
+    views = book.contexts if ctx in (None, EITHER) else (ctx,)
+    for key, e in ((k, book.features[k]) for k in sorted(keys) if k in book.features):
+        shares = [("fill", e.fill), *((f"share ({c})", e.shares.get(c)) for c in views),
+                  *((f"share of its side ({c})", e.side_shares.get(c)) for c in views)] if n.percent and not \
+            n.points else []  # (a share is a percentage)
+        for what, v in (("value", e.value), *shares):
+            if states(v, size_ok=False):
+                return f"{key}'s {what}"
+        for c, x in ((c, e.contribs.get(c)) for c in views):
+            if states(x, size_ok=not signed):
+                return f"{key}'s contribution ({c})"
+    if contribution:
+        return None
+    for what, v in (*(("a decision-level fact", x) for x in book.decision_numbers),
+                    *((f"{a}'s score", x) for a, x in book.scores.items())):  # (a sum needs its cue words)
+        if states(v):
+            return what
+    return None

@@ -1,0 +1,41 @@
+"""A number bound by position alone is a guess: when the words or the parse show that it states another fact of the
+explanation, it is unchecked, not wrong (rules ``number.elsewhere`` and ``parse.said-of-other``); each rule's
+example is outside prose (the held-out tuning voices), and each has a wrong twin that stays contradicted."""
+import numpy as np
+import pytest
+
+import xairl
+
+
+def _air():
+    """Next-day PM2.5 (µg/m³): the average forecast 22.0, this one 53.0."""
+    names = ("precip_mm_24h", "wind_speed_ms", "pm2_5_lag1", "traffic_index")
+    contrib = np.array([2.2, 6.9, 14.7, 7.2])
+    return xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.array([[22.0]]),
+                             outputs=np.array([[22.0 + contrib.sum()]]), states=np.array([[0.0, 0.8, 48.2, 2.4]]),
+                             feature_names=names, action_names=("pm2_5",), method="given", output="value")
+
+
+def _numbers(text):
+    return [c for c in xairl.verify(text, _air(), 0).claims if c.kind == "number"]
+
+
+@pytest.mark.parametrize("number,status,rule", [
+    ("53", "unchecked", "number.elsewhere"),      # the forecast itself, after a name it is not about
+    ("35", "contradicted", "number.name-before"),  # no fact at all: wrong wherever it is bound
+])
+def test_a_decision_level_number_after_a_name_is_not_that_names(number, status, rule):
+    text = f"Tomorrow's PM2.5 forecast with 0 mm of rain is {number} µg/m³."
+    claim = next(c for c in _numbers(text) if c.text.startswith(number))
+    assert (claim.status, claim.rule) == (status, rule), claim
+
+
+@pytest.mark.parametrize("number,status", [("14.7", "unchecked"), ("11.3", "contradicted")])
+def test_a_number_said_of_a_noun_that_names_nothing(number, status):
+    """'yesterday's reading' is pm2_5_lag1 in words the vocabulary lacks: its exact contribution is unchecked (the
+    reading may mean it), a number no feature holds stays contradicted."""
+    text = f"Heavy traffic adds about 7.2, and yesterday's high reading adds {number}."
+    claim = next(c for c in _numbers(text) if c.text == number)
+    assert claim.status == status, claim
+    if status == "unchecked":
+        assert claim.rule == "parse.said-of-other" and "pm2_5_lag1" in claim.detail
