@@ -39,3 +39,11 @@ def test_a_number_said_of_a_noun_that_names_nothing(number, status):
     assert claim.status == status, claim
     if status == "unchecked":
         assert claim.rule == "parse.said-of-other" and "pm2_5_lag1" in claim.detail
+
+
+@pytest.mark.parametrize("text,status", [
+    ("pred=53.0 base=22.0 pm2_5_lag1=+14.7 run_id=7781 latency_ms=42", "verified"),  # the run's record: no claim
+    ("pred=53.0 base=22.0 pm2_5_lag1=+14.7 humidity_pct=+3.1", "contradicted"),       # a push of no feature
+])
+def test_a_log_field_is_no_invented_feature(text, status):
+    assert xairl.verify(text, _air(), 0).status == status

@@ -299,7 +299,10 @@ def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None
     spaced = ident.replace("_", " ")
     totals = list(book.aggregates.values()) if sums.AGGREGATE_CUE.search(spaced) else []
     decision = book.decision_numbers if _DECISION_KEY.search(spaced) else []
-    if ours or (number is None and pushes is None) or (number is not None and any(
+    # a log's field ('run_id=7781', 'latency_ms=42', 'n_features=10'): an unsigned value given with '=' or ':' is a
+    # record of the run, not a push; an invented feature is given a signed contribution ('battery_temp=+0.3')
+    field = number is not None and not number.sign and re.match(r"\s?[:=]", masked[m.end():m.end() + 2])
+    if ours or field or (number is None and pushes is None) or (number is not None and any(
             matches(number, x, magnitude_ok=False) for x in [*decision, *totals])):
         return Claim("feature", ident, "unchecked", "an identifier that names nothing of this explanation",
                      "identifier.other")

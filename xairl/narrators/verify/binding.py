@@ -104,6 +104,10 @@ AGGREGATE_NOUNS = frozenset({"total", "sum", "net", "gap", "difference", "change
                              "baseline", "margin", "lead", "output", "delta"})
 
 
+#: an identifier that is no name, then '=' or ':', right before a number ('run_id=7781', 'latency_ms: 42')
+_LOG_KEY = re.compile(r"(?<![\w\0])([A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+)\s?[:=]\s?$")
+
+
 def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, parsed, unit_of, keys) -> Claim:
     """A number bound by position alone (:data:`GUESSED`), contradicted, that states another fact of the explanation:
     the position was a guess, so it is unchecked. The binding is sure, and the number stays contradicted, when it
@@ -114,6 +118,9 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
     owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
     if owner is not None and re.fullmatch(r"\s?[:=(]?\s?|\s?[:=]\s*", masked[owner.end:n.start]):
         return c
+    key = _LOG_KEY.search(masked, max(0, n.start - 40), n.start)
+    if key is not None and not n.sign:  # 'run_id=7781' after a name: the value of a field of the log, not the name's
+        return Claim("number", n.text, "unchecked", f"the value of the log's field {key.group(1)!r}", "number.log-field")
     units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
     q = quantified(parsed(), n.start, n.end, units)
     if q.key:
