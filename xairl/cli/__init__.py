@@ -121,6 +121,11 @@ def cmd_verify(args) -> int:
         print(f"[{sentence.status}] {sentence.text}")
         for c in sentence.claims if args.trace else ():
             print(f"    {c.status:<12} {c.kind:<9} {c.text!r:<28} {c.rule or '-':<22} {c.detail}")
+    if args.trace:  # what each reading that fired reads, from its entry in the rules' table
+        from ..narrators.verify.rules import BY_ID
+
+        fired = sorted({c.rule for c in result.claims if c.rule in BY_ID})
+        print("rules:" if fired else "rules: none fired", *(f"  {r}: {BY_ID[r].reads}" for r in fired), sep="\n")
     print(f"accurate: {'yes' if result.accurate else 'no'}; ok: {'yes' if result.ok else 'no'} "
           f"(coverage {result.coverage:.0%}){'; ' + result.note if result.note else ''}")
     return 0 if result.accurate else 1

@@ -82,7 +82,7 @@ def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ct
         other = quantities.other_reading(n, sentence_keys, book, ctx,
                                          signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
     return c if other is None else Claim("number", n.text, "unchecked",
-                                         f"read as {c.detail}, but it is {other}: which is unclear")
+                                         f"read as {c.detail}, but it is {other}: which is unclear", "number.unclear")
 
 
 #: nouns a number may measure that are facts of an explanation (a score, the margin, a contribution, the output):

@@ -1,0 +1,141 @@
+"""Every reading of the verifier as named data: its id (what ``Claim.rule`` and ``xairl verify --trace`` show), the
+kind of claim it makes, what it reads, and sentences it must fire on and must not fire on, each against one of two
+small explanations defined here (:func:`example`). ``tests/test_verify_rules.py`` generates one test per example,
+and fails when the code names a rule that is not here (or this table one that the code no longer makes).
+
+How to add a rule: docs/verifier.md ("Adding a rule").
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...explanation import Explanation
+
+
+@dataclass(frozen=True)
+class Rule:
+    """One reading: ``fires`` are (explanation, sentence) pairs whose verification holds a claim made by this rule,
+    ``silent`` pairs whose verification holds none (a near miss: the phrasing another rule, or none, reads)."""
+
+    id: str
+    claims: str   # the kind of claim it makes: feature, number, direction, rank, action, category
+    reads: str    # what it reads, in words
+    fires: tuple[tuple[str, str], ...]
+    silent: tuple[tuple[str, str], ...] = ()
+
+
+@functools.lru_cache(maxsize=None)
+def example(name: str) -> Explanation:
+    """The two explanations the examples are read against.
+
+    ``air``: next-day PM2.5 in µg/m³ (one output): base 22.0, prediction 52.1; precip_mm_24h 0 (+2.2),
+    wind_speed_ms 0.8 (+6.9), pm2_5_lag1 48.2 (+14.7), traffic_index 2.4 (+7.2), season winter (-1.0), road
+    '4 lanes' (+0.1).
+
+    ``robot``: a discrete policy; turn (3.2) chosen over recharge (2.0) and forward (-0.5), base 1.0 each; on the
+    chosen score speed +0.5, battery -0.3, obstacle +2.0; on the margin over recharge speed +0.7, battery -1.5,
+    obstacle +2.0.
+    """
+    if name == "air":
+        c = np.array([2.2, 6.9, 14.7, 7.2, -1.0, 0.1])
+        return Explanation(values=c.reshape(1, -1, 1), base_values=np.array([[22.0]]),
+                           outputs=np.array([[22.0 + c.sum()]]), states=np.array([[0.0, 0.8, 48.2, 2.4, 0.0, 1.0]]),
+                           feature_names=("precip_mm_24h", "wind_speed_ms", "pm2_5_lag1", "traffic_index", "season",
+                                          "road"), action_names=("forecast",), method="given", output="value",
+                           categories={"season": ("winter", "summer"), "road": ("2 lanes", "4 lanes")})
+    c = np.array([[0.5, -0.2, 0.1], [-0.3, 1.2, -0.1], [2.0, 0.0, -1.5]])
+    return Explanation(values=c[None], base_values=np.ones((1, 3)), outputs=(1 + c.sum(axis=0))[None],
+                       states=np.array([[0.4, 0.3, 0.9]]), feature_names=("speed", "battery", "obstacle"),
+                       action_names=("turn", "recharge", "forward"), method="given")
+
+
+RULES: tuple[Rule, ...] = (
+    Rule("names.mention", "feature", "a feature named, in any spelling or by its description's words (no claim by "
+         "itself)", fires=(("air", "Traffic mattered."),), silent=(("air", "The weather mattered."),)),
+    Rule("action.choice", "action", "a statement of the chosen action or the runner-up",
+         fires=(("robot", "The agent chose to turn."),), silent=(("robot", "Speed mattered."),)),
+    Rule("category.label", "category", "a categorical value named: it must be the state's",
+         fires=(("air", "It is winter."),), silent=(("air", "It is cold."),)),
+    Rule("number.respectively", "number", "'A and B ... by x and y, respectively': the numbers pair with the names",
+         fires=(("air", "Traffic and wind add 7.2 and 6.9, respectively."),),
+         silent=(("air", "Traffic adds 7.2."),)),
+    Rule("number.sum", "number", "'A and B together add x': the sum of their contributions",
+         fires=(("air", "Traffic and wind together add 14.1."),), silent=(("air", "Traffic and wind add 7.2 and "
+                                                                                   "6.9, respectively."),)),
+    Rule("number.aggregate", "number", "a sum over all features after its cue words ('the positives add up to')",
+         fires=(("air", "The positives add up to 31.1."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("number.change", "number", "the change from the baseline ('30.0 above the average')",
+         fires=(("air", "The forecast is 30.1 above the average."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("number.cue", "number", "a number its cue words bind: the prediction, the baseline, a typical value, the "
+         "margin", fires=(("air", "pred=52.1 base=22.0"),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("number.action-scores", "number", "'turn beat recharge 3.2 to 2.0': one number per action",
+         fires=(("robot", "Turn beat recharge 3.2 to 2.0."),), silent=(("robot", "Turn scored 3.2."),)),
+    Rule("number.for-action", "number", "a number right before 'for' or 'by' and an action: that action's score",
+         fires=(("robot", "The agent scored 3.2 for turn."),), silent=(("robot", "Turn scored 3.2."),)),
+    Rule("number.push-for", "number", "'+x for the action' after a feature: its push for one option over the other",
+         fires=(("robot", "Obstacle gave +2.0 for turn."),), silent=(("robot", "Obstacle adds 2.0."),)),
+    Rule("number.action-before", "number", "an action, then its score ('turn scored 3.2')",
+         fires=(("robot", "Turn scored 3.2."),), silent=(("robot", "Obstacle adds 2.0."),)),
+    Rule("number.gives-runner-up", "number", "'speed gives recharge -0.7' when turn was chosen: the margin, flipped",
+         fires=(("robot", "Speed gives recharge -0.7."),), silent=(("robot", "Speed gives turn +0.5."),)),
+    Rule("number.output-after", "number", "a number right before the output's own name ('52 in pm2_5')",
+         fires=(("air", "Traffic leaves 52.1 in the forecast."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("number.name-after", "number", "a number bound by position: the name right after it ('a 48.2 lag-1 "
+         "reading')", fires=(("air", "A 2.4 traffic index adds to it."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("number.name-before", "number", "a number bound by position: the name before it in its clause",
+         fires=(("air", "Traffic adds 7.2."),), silent=(("air", "The forecast is 52 µg/m³."),)),
+    Rule("number.free", "number", "a number tied to no name: a decision-level fact or nothing",
+         fires=(("air", "In all, 52.1."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("number.elsewhere", "number", "a number bound by position that states another fact of its sentence "
+         "exactly (a decision-level number, a named feature's fact): a guess, unchecked",
+         fires=(("air", "Traffic is heavy, so the forecast is 52.1."),),
+         silent=(("air", "Traffic is heavy, so the forecast is 35.5."),)),
+    Rule("number.unclear", "number", "a number bound by position that states another named feature's fact exactly "
+         "(unhedged, two significant digits): which one is unclear, unchecked",
+         fires=(("air", "The wind was calm, which, with the traffic, added 6.9."),),
+         silent=(("air", "The wind was calm, which, with the traffic, added 5.5."),)),
+    Rule("number.log-field", "number", "an unsigned value of a log's field that names nothing ('run_id=7781')",
+         fires=(("air", "pm2_5_lag1=+14.7 run_id=7781"),), silent=(("air", "pm2_5_lag1=+14.7 humidity_pct=+3.1"),)),
+    Rule("parse.measures-name", "number", "the parse: a number measures another name than its position says",
+         fires=(("air", "The precip, which unlike the traffic was nil, added about 2.2."),),
+         silent=(("air", "Traffic adds 7.2."),)),
+    Rule("parse.counts-other", "number", "the parse: a number counts a noun the explanation holds no fact of "
+         "('30 days'): unchecked", fires=(("air", "Traffic over the last 30 days adds 7.2."),),
+         silent=(("air", "Traffic adds 7.2."),)),
+    Rule("parse.measures-whole", "number", "the parse: a number measures a whole ('the net change of 30.0')",
+         fires=(("air", "Traffic matters: of the 30.1 net change, it gives 7.2."),),
+         silent=(("air", "Traffic adds 7.2."),)),
+    Rule("parse.label-number", "category", "the parse: a number inside a categorical label ('a two-year contract')",
+         fires=(("air", "The road has four lanes."),), silent=(("air", "The road matters little."),)),
+    Rule("parse.said-of-other", "number", "the parse: a number said of a subject noun that names nothing, stating "
+         "another feature's exact fact: unchecked",
+         fires=(("air", "Heavy traffic adds about 7.2, and yesterday's high reading adds 14.7."),),
+         silent=(("air", "Heavy traffic adds about 7.2, and yesterday's high reading adds 11.3."),)),
+    Rule("direction.subject", "direction", "a direction word and the names it is said of",
+         fires=(("air", "Traffic raised the forecast."),), silent=(("air", "Traffic mattered."),)),
+    Rule("direction.unknown-name", "direction", "a signed number after a label that names no feature",
+         fires=(("air", "humidity +3.1; traffic +7.2"),), silent=(("air", "traffic +7.2"),)),
+    Rule("direction.without", "direction", "'without X it would be lower': what X did, by taking it away",
+         fires=(("air", "Without the traffic, the forecast would be lower."),),
+         silent=(("air", "With the traffic, the forecast is higher."),)),
+    Rule("rank.words", "rank", "'the biggest', 'second', 'the main reason' of a name",
+         fires=(("air", "Traffic is the second biggest factor."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("rank.comparison", "rank", "'A mattered more than B', ratios ('twice as much as')",
+         fires=(("air", "Traffic mattered more than wind."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("rank.minor", "rank", "'barely mattered' of a name",
+         fires=(("air", "The season barely mattered."),), silent=(("air", "The season mattered."),)),
+    Rule("identifier.claimed", "feature", "an identifier that is no name, given a number or a direction word: an "
+         "invented feature", fires=(("air", "humidity_pct=+3.1"),), silent=(("air", "run_id=7781"),)),
+    Rule("identifier.q-of-action", "action", "'Q_x' of no action", fires=(("robot", "Q_jump was high."),),
+         silent=(("robot", "Q_turn was high."),)),
+    Rule("identifier.other", "feature", "any other identifier: unchecked", fires=(("air", "run_id=7781"),),
+         silent=(("air", "Traffic adds 7.2."),)),
+    Rule("region.unknown", "feature", "an image region's name that names no region of the explanation",
+         fires=(("air", "The 8x8 patch at rows 0 to 7, columns 0 to 7 of channel 0 mattered."),),
+         silent=(("air", "Traffic mattered."),)),
+)
+
+BY_ID = {r.id: r for r in RULES}
