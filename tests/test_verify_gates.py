@@ -47,3 +47,13 @@ def test_a_number_said_of_a_noun_that_names_nothing(number, status):
 ])
 def test_a_log_field_is_no_invented_feature(text, status):
     assert xairl.verify(text, _air(), 0).status == status
+
+
+def test_a_name_that_only_qualifies_another_noun_is_not_what_a_rank_is_about():
+    """'the wind queue' is a queue (no feature of this explanation), not the wind: its rank is unchecked; said of
+    the wind itself, the wrong rank is contradicted; a question asserts nothing."""
+    def rank(text):
+        return next(c for c in xairl.verify(text, _air(), 0).claims if c.kind == "rank")
+    assert rank("The main reason is the wind queue at the junction.").status == "unchecked"
+    assert rank("The main reason is the wind.").status == "contradicted"
+    assert xairl.verify("Is the wind the main reason?", _air(), 0).accurate

@@ -204,6 +204,10 @@ def _read_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]
     tests/test_verify_robust.py requires that none happens)."""
     if not re.search(r"[^\W\d_]{2}", sentence):
         return []
+    if sentence.rstrip().endswith("?"):  # 'Is the competitor offer the main reason?': a question asserts nothing
+        mentions, _ = find_mentions(sentence, vocab)
+        return [Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys), "names.mention")
+                for m in mentions if m.kind == "feature"]
     try:
         return _check_sentence(sentence, book, vocab, unit_of)
     except Exception as e:  # noqa: BLE001 - a verifier bug must not take the narration down with it
@@ -265,11 +269,40 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
         own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'
         found = _check_clause(masked, a, b, inside, book, own or ctx, unit_of, parsed, vocab,
                               {k for m in named_features(mentions) for k in m.keys})
+        found = [_unless_modifier(c, inside, book, parsed) for c in found]
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     if hypothetical:
         claims += [binding.named(c, "direction.without") for c in directions.without(masked, mentions, book, ctx)]
     claims += [c for m in _IDENT_RE.finditer(masked) if (c := _identifier(m, masked, book, vocab.words))]
     return claims + regions.unknown_regions(masked)
+
+
+#: (not a direction word: 'the number of credit cards push up' is an invented feature said to push, and a noun's
+#: direction could be any feature's)
+_BY_POSITION = frozenset({*binding.GUESSED, "rank.words"})
+
+
+def _unless_modifier(c: Claim, mentions: list[Mention], book: FactBook, parsed) -> Claim:
+    """A claim bound by position to a feature and contradicted, when every mention of that feature in the clause only
+    qualifies another noun that names nothing ('the main reason is the 19-vehicle queue on the east approach':
+    'vehicle' qualifies 'queue', which is not emergency_vehicle): the claim is about that noun, unchecked (rule
+    parse.modifier)."""
+    if c.status != "contradicted" or c.rule not in _BY_POSITION:
+        return c
+    keys = [k for k in book.features if c.detail.startswith((k + " ", k + "'s", k + ":")) or f"not {k}'s" in c.detail
+            or c.detail.startswith(f"|{k}|")]
+    own = [m for m in mentions if m.kind == "feature" and set(m.keys) & set(keys)]
+    if not own or len(keys) != 1:
+        return c
+    nouns = [parse.modified_noun(parsed(), m.start, m.end) for m in own]
+    if not all(nouns):
+        return c
+    if c.kind == "number":  # the noun may be a feature in words the vocabulary lacks, or an invented one: only a
+        n = next(iter(find_numbers(c.text)), None)  # number that states some feature's fact exactly is let go
+        if n is None or quantities.any_fact(n, book, book.features, None, strict=True) is None:
+            return c
+    return Claim(c.kind, c.text, "unchecked", f"'{nouns[0]}' is what the words are about, and "
+                 f"{keys[0]} only qualifies it (first read as {c.detail})", "parse.modifier")
 
 
 #: an identifier's word that names a decision-level quantity ('p_churn', 'y_hat', 'sum_shap', 'base_value')

