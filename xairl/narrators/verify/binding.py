@@ -125,6 +125,9 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
     q = quantified(parsed(), n.start, n.end, units)
     if q.key:
         return c
+    if n.text.isalpha():  # 'one and a half times', 'a factor of two', 'semester one': a count or an idiom
+        return Claim("number", n.text, "unchecked", f"a number word that the words tie to no name (first read as "
+                                                    f"{c.detail})", "number.word")
     # a push by its cue words ('by -0.22') or by the noun it measures ('a bump of 19.1'): not a decision-level number
     pushes = bool(quantities.CONTRIB_BEFORE.search(masked[max(0, n.start - 40):n.start])) or (
         q.noun in FACT_NOUNS and q.noun not in AGGREGATE_NOUNS and not q.subject)

@@ -97,6 +97,10 @@ RULES: tuple[Rule, ...] = (
          "(unhedged, two significant digits): which one is unclear, unchecked",
          fires=(("air", "The wind was calm, which, with the traffic, added 6.9."),),
          silent=(("air", "The wind was calm, which, with the traffic, added 5.5."),)),
+    Rule("number.word", "number", "a number word bound by position alone, that the parse ties to no name ('a "
+         "factor of two', 'one and a half times'): a count or an idiom, unchecked",
+         fires=(("air", "The wind mattered by a factor of two."),),
+         silent=(("air", "Traffic adds seven."),)),
     Rule("number.log-field", "number", "an unsigned value of a log's field that names nothing ('run_id=7781')",
          fires=(("air", "pm2_5_lag1=+14.7 run_id=7781"),), silent=(("air", "pm2_5_lag1=+14.7 humidity_pct=+3.1"),)),
     Rule("parse.measures-name", "number", "the parse: a number measures another name than its position says",
