@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import xairl
+from xairl.narrators.verify import rules
 
 
 def _air():
@@ -57,3 +58,13 @@ def test_a_name_that_only_qualifies_another_noun_is_not_what_a_rank_is_about():
     assert rank("The main reason is the wind queue at the junction.").status == "unchecked"
     assert rank("The main reason is the wind.").status == "contradicted"
     assert xairl.verify("Is the wind the main reason?", _air(), 0).accurate
+
+
+@pytest.mark.parametrize("text,status", [
+    ("The season adds -1.0.", "verified"),                          # the signed amount says the way
+    ("The season adds a small penalty of about 1.", "verified"),    # so does a noun of loss
+    ("The season adds about 1.", "contradicted"),                   # a plain 'adds' raises: the season lowered it
+    ("Traffic adds a small penalty of about 7.", "contradicted"),   # traffic raised it
+])
+def test_what_an_amount_verb_adds_says_its_way(text, status):
+    assert xairl.verify(text, rules.example("air"), 0).status == status  # (the season: -1.0)

@@ -133,6 +133,7 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if _no_push(m, masked, mentions, book):
             continue
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
+        polarity = _as_said_after(masked, m, polarity)
         if re.match(r"\s+to\s+(?:the\s+)?(?:negative|downside|risks?|concerns?|worries)\b", masked[m.end():]) \
                 and _good_outcome(book):
             polarity = -polarity  # 'added to the negative outlook' of a good-credit probability (of a diabetes
@@ -177,6 +178,27 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
         bare, prev = not subjects and not flipped, m.end()
     return out
+
+
+#: a neutral verb of amount ('adds', 'contributes', 'gives') followed by what it adds: a signed number ('adds -0.04')
+#: or a noun of loss ('adds a smaller penalty of about 0.07', 'gives a reduction'): the object says the way
+_AMOUNT_VERB = re.compile(r"^(?:add(?:s|ed|ing)?|contribut\w*|giv\w*|brings?|brought|supplies|provides?)$", re.IGNORECASE)
+_LOSS_OBJECT = re.compile(r"\s+(?:(?:a|an|the|its|another|further|small\w*|slight\w*|modest|large\w*|big\w*|"
+                          r"sizeable|hefty|noticeable|minor|mild)\s+){0,3}(?:penalty|penalties|reduction|discount|"
+                          r"deduction|drag|decrease|drop|loss|cut|downgrade|drawback|malus|haircut)\b", re.IGNORECASE)
+_SIGNED_OBJECT = re.compile(r"\s+(?:about|around|roughly|only|just|nearly|almost|some)?\s*(?P<sign>[+\-])\s?[$€£]?\d")
+
+
+def _as_said_after(masked: str, m: re.Match, polarity: int) -> int:
+    """The way an amount verb says, read from what follows it: 'adds a penalty' lowers, 'adds -0.04' lowers, 'adds
+    +0.3' raises; any other direction word keeps its own way."""
+    if not _AMOUNT_VERB.match(m.group(0)):
+        return polarity
+    after = masked[m.end():m.end() + 60]
+    signed = _SIGNED_OBJECT.match(after)
+    if signed is not None:
+        return 1 if signed.group("sign") == "+" else -1
+    return -abs(polarity) if _LOSS_OBJECT.match(after) else polarity
 
 
 def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) -> bool:
