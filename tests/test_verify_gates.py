@@ -68,3 +68,12 @@ def test_a_name_that_only_qualifies_another_noun_is_not_what_a_rank_is_about():
 ])
 def test_what_an_amount_verb_adds_says_its_way(text, status):
     assert xairl.verify(text, rules.example("air"), 0).status == status  # (the season: -1.0)
+
+
+@pytest.mark.parametrize("text,status", [
+    ("With the traffic heavy, the forecast is pushed up by the wind.", "verified"),     # said of the agent
+    ("With the season cold, the forecast is pushed up by the wind.", "verified"),       # not of the name before
+    ("With the traffic heavy, the forecast is pushed down by the wind.", "contradicted"),
+])
+def test_a_passive_direction_is_said_of_its_agent(text, status):
+    assert xairl.verify(text, rules.example("air"), 0).status == status

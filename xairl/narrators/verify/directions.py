@@ -139,6 +139,9 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             polarity = -polarity  # 'added to the negative outlook' of a good-credit probability (of a diabetes
             # probability, 'contributed positively to the risk' raises it)
         subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
+        agents = _passive_agents(masked, m, names, found[i + 1].start() if i + 1 < len(found) else b)
+        if agents:
+            subjects = agents  # 'it is pushed up by the battery level': the battery
         if _PARTICIPLE_AFTER_COMMA.match(m.group(0)) and re.search(r",\s*$", masked[a:m.start()]) and names and \
                 names[0].start < m.start():
             subjects = [names[0]]  # 'Retirement offsets the push from age and debt, taking 12.3 pp off': retirement
@@ -199,6 +202,21 @@ def _as_said_after(masked: str, m: re.Match, polarity: int) -> int:
     if signed is not None:
         return 1 if signed.group("sign") == "+" else -1
     return -abs(polarity) if _LOSS_OBJECT.match(after) else polarity
+
+
+_BE_BEFORE = re.compile(r"\b(?:is|are|was|were|be|been|being|gets?|got)\s+(?:\w+ly\s+)?$", re.IGNORECASE)
+
+
+def _passive_agents(masked: str, m: re.Match, names: list[Mention], end: int) -> list[Mention]:
+    """The names after 'by' of a direction word in the passive ('the value is pushed up by the battery level'):
+    what it is said of; [] when the word is not in the passive or no name follows its 'by'."""
+    if not _BE_BEFORE.search(masked, max(0, m.start() - 24), m.start()):
+        return []
+    by = re.match(r"\s+(?:\w+\s+){0,2}?by\s+", masked[m.end():end])
+    if by is None:
+        return []
+    start = m.end() + by.end()
+    return [x for x in names if start <= x.start < min(end, start + 40)][:1]
 
 
 def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) -> bool:
