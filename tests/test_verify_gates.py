@@ -77,3 +77,11 @@ def test_what_an_amount_verb_adds_says_its_way(text, status):
 ])
 def test_a_passive_direction_is_said_of_its_agent(text, status):
     assert xairl.verify(text, rules.example("air"), 0).status == status
+
+
+@pytest.mark.parametrize("text,status", [
+    ("The lag-one reading's pm2_5_lag1 effect is roughly twice that of traffic (14.7 vs 7.2).", "verified"),
+    ("The lag-one reading's pm2_5_lag1 effect is roughly twice that of traffic (7.2 vs 14.7).", "contradicted"),
+])
+def test_a_bracket_of_two_numbers_pairs_with_the_two_names_in_order(text, status):
+    assert xairl.verify(text, rules.example("air"), 0).status == status

@@ -132,7 +132,9 @@ _SIDE_BY_SIDE = re.compile(r"\s*\(\s*[^()\0]{0,20}?\s+(?:vs\.?|versus|against|co
 
 def compared_pairs(masked: str, a: int, b: int, names: list[Mention], numbers) -> dict:
     """'A mattered about twice as much as B (0.88 vs 0.49)': the bracket's first number is A's, the second B's
-    (A the comparison's subject as :func:`find_comparisons` reads it); id(number) -> mention."""
+    (A the comparison's subject as :func:`find_comparisons` reads it); with no comparison word it knows, a clause
+    that names two features and ends in such a bracket pairs them in order ('A's effect is roughly twice that of B
+    (0.188 vs 0.097)'); id(number) -> mention."""
     out = {}
     for m in COMPARE_RE.finditer(masked, a, b):
         b_name = next((x for x in names if x.start >= m.end()), None)
@@ -143,4 +145,9 @@ def compared_pairs(masked: str, a: int, b: int, names: list[Mention], numbers) -
         inside = [n for n in numbers if bracket and b_name.end <= n.start and n.end <= bracket.end()]
         if bracket and subjects and len(inside) == 2:
             out[id(inside[0])], out[id(inside[1])] = subjects[0], b_name
+    if not out and len({x.keys for x in names}) == 2 and len(names) == 2:  # 'A's effect is twice that of B (x vs y)'
+        bracket = _SIDE_BY_SIDE.match(masked, names[1].end)
+        inside = [n for n in numbers if bracket and names[1].end <= n.start and n.end <= bracket.end()]
+        if bracket and len(inside) == 2 and not re.search(r"\d", masked[names[0].end:names[1].start]):
+            out[id(inside[0])], out[id(inside[1])] = names[0], names[1]
     return out
