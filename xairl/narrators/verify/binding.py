@@ -113,8 +113,9 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
     the position was a guess, so it is unchecked. The binding is sure, and the number stays contradicted, when it
     comes right after its name ('A +0.3', 'A (0.3)', 'A: 0.3', 'A=0.3') or the parse ties it to a name ('A lowered
     it by about 5 points': the verb's subject); so does a number that states no fact at all."""
-    if c.rule not in GUESSED or quantities.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
-        return c  # ('4.0 dB above': a difference in a unit, bound for sure)
+    if c.rule not in GUESSED[:2] or quantities.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
+        return c  # ('4.0 dB above': a difference in a unit, bound for sure; a number tied to no name is contradicted
+        # only by the quantity its words name: '(4.45 vs 4.44)' after 'rather than recharge')
     owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
     if owner is not None and re.fullmatch(r"\s?[:=(]?\s?|\s?[:=]\s*", masked[owner.end:n.start]):
         return c
