@@ -121,3 +121,38 @@ def test_narratives_lead_with_reasons_for_the_decision(uav):
             assert d.reasons[0].label in n.text.split(". ")[1] and d.reasons[0].contribution > 0
         if d.concession:
             assert f"despite {d.concession.label}" in n.text and margin[i].min() < 0
+
+
+def _claim(result, text):
+    return next(c for s in result.sentences for c in s.claims if c.kind == "number" and c.text == text)
+
+
+def test_wrong_numbers_that_equal_another_fact_stay_contradicted(uav):
+    """Mutations the corpus found with the priced-reward checkpoint: an identifier's wrong value that equals its
+    contribution, a push copied from the clause before, a score that equals another action's score."""
+    policy, exp, _ = uav
+    j, r1, r2 = (exp.feature_names.index(f) for f in ("serving_bs", "rsrp_1", "rsrp_2"))
+    checked = 0
+    for i in range(exp.values.shape[0]):
+        chosen, runner = int(exp.chosen[i]), int(exp.runner_up[i])
+        contrib = exp.values[i, j, chosen]
+        if abs(contrib) >= 1 and round(float(contrib)) != round(float(exp.states[i, j])):
+            text = f"The decision was taken with the serving BS's id at {contrib:.0f}."
+            assert _claim(xairl.verify(text, exp, i, policy), f"{contrib:.0f}").status == "contradicted", text
+            checked += 1
+        margin = exp.values[i, :, chosen] - exp.values[i, :, runner]
+        if chosen != runner and abs(margin[r1] - margin[r2]) > 1:
+            c = f"{margin[r1]:+.1f}"
+            text = (f"The strongest neighbour's RSRP pushed toward {exp.action_names[chosen]} over "
+                    f"{exp.action_names[runner]} by {c}; the second strongest neighbour's RSRP pushed toward "
+                    f"{exp.action_names[chosen]} over {exp.action_names[runner]} by {c}.")
+            claims = [cl for s in xairl.verify(text, exp, i, policy).sentences for cl in s.claims
+                      if cl.kind == "number" and cl.text == c]
+            assert [cl.status for cl in claims] == ["verified", "contradicted"], (text, claims)
+            checked += 1
+        other = float(exp.outputs[i, runner])
+        if chosen != runner and abs(other - float(exp.outputs[i, chosen])) > 1:
+            text = f"The policy chose {exp.action_names[chosen]}, the only available action (score {other:.1f})."
+            assert _claim(xairl.verify(text, exp, i, policy), f"{other:.1f}").status == "contradicted", text
+            checked += 1
+    assert checked >= 10

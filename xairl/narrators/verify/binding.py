@@ -66,6 +66,14 @@ _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact
                      r"shift\w*|worth)\b", re.IGNORECASE)
 
 
+def _one_name_pushes(n, masked: str, mentions) -> bool:
+    """'...; B (-86.1 dBm) pushed against stay by -32.0': a number its cue words call a push, in a clause that names
+    one feature before it, is that feature's push for sure."""
+    names = {m.keys for m in mentions if m.kind == "feature"}
+    return len(names) == 1 and any(m.kind == "feature" and m.end <= n.start for m in mentions) and bool(
+        quantities.CONTRIB_BEFORE.search(masked[max(0, n.start - 40):n.start]))
+
+
 def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, sentence_keys) -> Claim:
     """A contradicted number that states another fact of a feature named in the sentence exactly (not truncated): the
     binding was a guess, so it is unchecked ('which is unclear'). A difference in a unit ('4.0 dB above') and a number
@@ -76,6 +84,8 @@ def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ct
     owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
     if owner in names and re.fullmatch(r" ?", masked[owner.end:n.start]) and n.sign:
         return c  # 'battery +1.70': a signed number right after its name, a sure binding
+    if _one_name_pushes(n, masked, names):
+        return c
     if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
         other = quantities.other_reading(n, set(owner.keys), book, ctx, signed=True)
     else:
@@ -124,7 +134,7 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
         return Claim("number", n.text, "unchecked", f"the value of the log's field {key.group(1)!r}", "number.log-field")
     units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
     q = quantified(parsed(), n.start, n.end, units)
-    if q.key:
+    if q.key or (not q.subject and _one_name_pushes(n, masked, mentions)):
         return c
     if n.text.isalpha():  # 'one and a half times', 'a factor of two', 'semester one': a count or an idiom
         return Claim("number", n.text, "unchecked", f"a number word that the words tie to no name (first read as "
@@ -157,6 +167,8 @@ def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, voc
     q = quantified(parsed(), n.start, n.end, units)
     if q.subject:
         return c  # said of a subject that names nothing: :func:`unless_elsewhere` decides
+    if quantities.SCORE_BEFORE.search(masked[max(0, n.start - 24):n.start]):
+        return c  # 'the only available action (score -74.6)': a score by its own word
     if "|" in q.key:
         return c  # an ambiguous name: the first reading stands
     if q.key in book.features:

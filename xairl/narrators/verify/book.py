@@ -35,6 +35,7 @@ class FeatureFacts:
     fill: float | None = None                                 # % of the feature's capacity
     quartiles: tuple[float, float, float] | None = None       # the background's 25th, 50th and 75th percentiles
     legend: dict[int, str] = field(default_factory=dict)      # code -> its meaning, from the description's legend
+    identifier: bool = False                                  # an id (kind 'identifier'): its number is its value
 
 
 @dataclass
@@ -128,6 +129,7 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
             feats[f].quartiles = tuple(float(q) for q in exp.background_quantiles[:, j])
         if info is not None:
             feats[f].legend = legend(info.description)
+            feats[f].identifier = info.kind == "identifier"
     scores = {a: float(exp.outputs[index, k]) for k, a in enumerate(exp.action_names)}
     base = float(exp.base_values[index, chosen_i])
     numbers = [d.score, base, d.score - base, d.additivity_gap, *scores.values()]

@@ -36,7 +36,7 @@ MARGIN_AFTER = re.compile(r"^\s*(?:points?\s+)?(?:above|ahead|higher|more than)\
 _RUNNER_BEFORE = re.compile(r"(?<!bit )(?<!little )(?<!just )(?<!well )(?<!slightly )(?<!touch )(?<!hair )"
                             r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?[$€£]?\s*$",
                             re.IGNORECASE)
-_SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
+SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
 _BASE_AFTER = re.compile(r"^\s*(?!vs\b|versus\b|against\b|compared\b)(?:\w+\s+)?(baseline|base value|base rate|base|"
                          r"average|typical|expected|mean)\b", re.IGNORECASE)  # not '0.14 vs base 0.34'
 _BASE_WORDS = re.compile(r"\b(baseline|base value|base|average|typical|expected value|mean|on average)\b",
@@ -122,6 +122,11 @@ def window_of_name(n: Number, keys) -> bool:
     return any(str(int(n.value)) in re.findall(r"(\d+)[a-z]", k.lower()) for k in keys)
 
 
+#: words before a number that speak of contributions anywhere in its sentence
+_PUSH_WORDS = re.compile(r"\b(?:shap|contribut\w*|attribut\w*|push\w*|pull\w*|effect|impact|weight\w*|importan\w*|"
+                         r"influenc\w*|by)\b", re.IGNORECASE)
+
+
 def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook, ctx: str | None,
                    unit_of, name_after: bool = False) -> Claim:
     """A number tied to a feature: its value, its contribution (in the sentence's context, or any context when the
@@ -160,7 +165,9 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
             cands.append(("value" if scale == 1 else f"value in {prefix}{unit_of(key)}", e.value / scale))
         if n.percent and not contrib_cue and e.fill is not None:
             cands.append(("fill (% of capacity)", e.fill))
-        if not value_cue:
+        if not value_cue and (contrib_cue or not e.identifier or _PUSH_WORDS.search(masked[:n.start])):
+            # an identifier's number is its value ('the serving BS's id at 10'), unless the words before it speak of
+            # contributions ('the SHAP value of serving_bs is 0.00'): an identifier is never narrated as a reason
             cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
         for what, v in cands:
             contribution = what.startswith("contribution")
@@ -288,7 +295,7 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         named = ("the change from the baseline", [change, abs(change)])
     elif MARGIN_BEFORE.search(before) or MARGIN_AFTER.match(after):
         named = ("the margin", [book.margin if book.margin is not None else 0.0])  # one available action: 0
-    elif (_SCORE_BEFORE.search(before) or (book.output == "actions" and re.match(r"^\s*(vs\.?|versus)\s", after))) \
+    elif (SCORE_BEFORE.search(before) or (book.output == "actions" and re.match(r"^\s*(vs\.?|versus)\s", after))) \
             and book.chosen in book.scores:
         named = ("the chosen action's score", [book.scores[book.chosen]])
     elif _RUNNER_BEFORE.search(before) and book.runner_up:
