@@ -5,7 +5,7 @@ and to the chosen score (deep_shap) on each DQN's own decision states. With --re
 open-loop new handover proposals per minute on the real flights against the live network's handovers (target 5:
 at most 2x), the buffer's ranks on real states and the Spearman correlation of the features' mean |margin
 contribution| between simulated and real states (target 6: buffer in the top 2, Spearman >= 0.6). Training takes
-about 2 minutes per seed on 2 cores; the committed checkpoint is seed 0 of this command (`xairl uav train --seed 0`
+about 2 minutes per seed on 2 cores; the committed checkpoint is seed 2 of this command (`xairl uav train --seed 2`
 writes the same).
 
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reproduce.py [--seeds 0 1 2] [--episodes 40]

@@ -44,14 +44,17 @@ def test_pretrained_dqn_deep_shap_matches_shap():
 
 def test_pretrained_dqn_on_table_one():
     """The committed checkpoint on 100 held-out flights (Table I with intervals, table.py): CHM > SA-MRO > DQN in
-    handovers per flight, the DQN's interval wholly below half of CHM's value, SA-MRO ping-ponging no more per minute
+    handovers per flight, the DQN's mean at most half of CHM's (issue 26's target 1) and its interval wholly below
+    CHM's, ping-ponging no more per minute than CHM and losing no more data than CHM + 1 %, SA-MRO ping-ponging no more per minute
     than CHM (what MRO is for), the buffer in use in at least 30 % of the DQN's decisions, service kept. The rest of
     what the DQN pays is measured, not hidden: benchmarks/table_one.py and the report's Table I."""
     ckpt = load_checkpoint()
     res = {c.name: with_intervals(flights(c, ckpt.sim_config, 100, [0]), resamples=200)
            for c in (CHM(), SAMRO(), DQNController(ckpt.net))}
     chm, sa, dqn = ({k: v[0] for k, v in res[name].items()} for name in ("CHM", "SA-MRO", "DQN"))
-    assert chm["handovers"] > sa["handovers"] > dqn["handovers"] and res["DQN"]["handovers"][2] <= 0.5 * chm["handovers"]
+    assert chm["handovers"] > sa["handovers"] > dqn["handovers"] and dqn["handovers"] <= 0.5 * chm["handovers"]
+    assert res["DQN"]["handovers"][2] < res["CHM"]["handovers"][1]
+    assert dqn["pp_per_min"] <= chm["pp_per_min"] and dqn["lost_mbit"] <= 1.01 * chm["lost_mbit"]
     assert sa["pp_per_min"] <= chm["pp_per_min"] and dqn["buffer_in_use"] >= 30
     assert dqn["availability"] >= 0.95 * chm["availability"]
 

@@ -80,16 +80,18 @@ def test_env_passes_gymnasium_checker():
     check_env(env, skip_render_check=True)
     obs, info = env.reset(seed=3)
     assert env.action_space.n == len(ACTIONS) and obs.shape == (len(FEATURES),)
-    rewards, handovers, done = [], 0, False
+    rewards, lost, handovers, done = [], [], 0, False
     while not done:
         obs, r, term, trunc, info = env.step(0)
         rewards.append(r)
+        lost.append(info["lost_bits"] / 1e6)
         handovers += info["handover"]
         done = term or trunc
     w = SimConfig().reward
     assert handovers == 0  # staying never hands over
-    # without handovers each reward is w_buffer / (1 + q) minus violations: at most w_buffer, above -w_rsrp - w_rsrq
-    assert all(-w.w_rsrp - w.w_rsrq < r <= w.w_buffer for r in rewards)
+    # without handovers each reward is w_buffer / (1 + q) minus violations and lost data: at most w_buffer, above
+    # -w_rsrp - w_rsrq - w_lost * the Mbit lost
+    assert all(-w.w_rsrp - w.w_rsrq < r + w.w_lost * m <= w.w_buffer + 1e-9 for r, m in zip(rewards, lost))
 
 
 def test_chm_triggers_exactly_after_ttt():
