@@ -45,9 +45,10 @@ def test_pretrained_dqn_deep_shap_matches_shap():
 def test_pretrained_dqn_on_table_one():
     """The committed checkpoint on 100 held-out flights (Table I with intervals, table.py): CHM > SA-MRO > DQN in
     handovers per flight, the DQN's mean at most half of CHM's (issue 26's target 1) and its interval wholly below
-    CHM's, ping-ponging no more per minute than CHM and losing no more data than CHM + 1 %, SA-MRO ping-ponging no more per minute
-    than CHM (what MRO is for), the buffer in use in at least 30 % of the DQN's decisions, service kept. The rest of
-    what the DQN pays is measured, not hidden: benchmarks/table_one.py and the report's Table I."""
+    CHM's, the DQN ping-ponging no more per minute than CHM and losing no more data than CHM + 1 %, SA-MRO
+    ping-ponging no more per minute than CHM (what MRO is for), the buffer in use in at least 30 % of the DQN's
+    decisions, service kept. The rest of what the DQN pays is measured, not hidden: benchmarks/table_one.py and the
+    report's Table I."""
     ckpt = load_checkpoint()
     res = {c.name: with_intervals(flights(c, ckpt.sim_config, 100, [0]), resamples=200)
            for c in (CHM(), SAMRO(), DQNController(ckpt.net))}
