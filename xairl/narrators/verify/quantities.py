@@ -5,7 +5,7 @@ says which numbers are no claim (list markers, identifiers, counts of the method
 from __future__ import annotations
 
 import re
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 from .book import FactBook
 from .checks import EITHER, Claim, over_keys
@@ -122,9 +122,28 @@ def window_of_name(n: Number, keys) -> bool:
     return any(str(int(n.value)) in re.findall(r"(\d+)[a-z]", k.lower()) for k in keys)
 
 
-#: words before a number that speak of contributions anywhere in its sentence
-_PUSH_WORDS = re.compile(r"\b(?:shap|contribut\w*|attribut\w*|push\w*|pull\w*|effect|impact|weight\w*|importan\w*|"
-                         r"influenc\w*|by)\b", re.IGNORECASE)
+@dataclass(frozen=True)
+class _Cues:
+    """What the words around a number say it is, whichever feature it is tied to."""
+
+    after: str           # the 16 characters after it
+    contribution: bool   # 'by', 'adds', 'SHAP value of' right before it
+    signed: bool         # 'a SHAP value of 0.3' names the signed quantity: unsigned, it is positive
+    slot: bool           # an unsigned number in brackets right after a name: its value ('distance (0.84)'), unless
+    #                      the sentence lists contributions ('Top features by absolute SHAP value: A (0.11)')
+    fill: bool           # '8 % full': a fill of a capacity
+    in_points: bool      # a sentence that counts in points: points of a probability too
+    pushes: bool         # the words before it speak of contributions at all ('The SHAP value of serving_bs is 0.00')
+
+
+def _cues(n: Number, masked: str, book: FactBook) -> _Cues:
+    before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 16]
+    contribution, lists = bool(CONTRIB_BEFORE.search(before)), bool(_LISTS_CONTRIBUTIONS.search(masked[:n.start]))
+    slot = not n.sign and not n.currency and not n.percent and bool(re.search(r"\0\s?\($", before)) and \
+        masked[n.end:n.end + 1] in (")", ",") and not lists
+    fill = bool(n.percent and re.match(r"\s*(full|of (?:its |the )?capacity)\b", after, re.IGNORECASE))
+    in_points = book.output != "actions" and not n.percent and bool(re.search(r"\b(?:points?|pts|pp)\b", masked))
+    return _Cues(after, contribution, signed_named(before), slot, fill, in_points, contribution or lists)
 
 
 def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook, ctx: str | None,
@@ -132,30 +151,22 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     """A number tied to a feature: its value, its contribution (in the sentence's context, or any context when the
     sentence does not say), its share, or a percentage of a probability-like contribution. Cue words before it
     ('by', 'adds', 'SHAP value of') say it is a contribution; the feature's unit after it that it is a value.
-    ``name_after``: the name follows the number ('took 7 corners'): its value, whatever the verb before."""
-    before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 16]
-    contrib_cue = bool(CONTRIB_BEFORE.search(before))
-    # 'a SHAP value of 0.3' names the signed quantity: unsigned, it is positive (not 'a negative SHAP value of 0.3')
-    signed_cue = signed_named(before)
+    ``name_after``: the name follows the number ('took 7 corners'): its value, whatever the verb before. An
+    identifier's number is its value ('the serving BS's id at 10') unless the words before it speak of contributions:
+    an identifier is never narrated as a reason."""
+    cue = _cues(n, masked, book)
+    after, contrib_cue = cue.after, cue.contribution
     # a sentence that names no view, or weighs the two options without saying which ('argued against it'): either
     # view (the chosen action's score or the margin over the runner-up)
     contexts = book.contexts if ctx in (EITHER, None) else (ctx,)
 
-    # an unsigned number in brackets right after the name is its value ('distance (0.84)'); a signed one may be either
-    # ... unless the sentence has already said it lists contributions ('Top features by absolute SHAP value: A (0.11)')
-    slot = not n.sign and not n.currency and not n.percent and bool(re.search(r"\0\s?\($", before)) and \
-        masked[n.end:n.end + 1] in (")", ",") and not _LISTS_CONTRIBUTIONS.search(masked[:n.start])
-    fill_cue = n.percent and re.match(r"\s*(full|of (?:its |the )?capacity)\b", after, re.IGNORECASE)
-    # '..., the salaried job by a bit under 9' in a sentence that counts in points: points of a probability too
-    in_points = book.output != "actions" and not n.percent and bool(re.search(r"\b(?:points?|pts|pp)\b", masked))
-
     def test(key):
         e = book.features[key]
-        if fill_cue and e.fill is not None:  # '8 % full': the fill, nothing else
+        if cue.fill and e.fill is not None:  # '8 % full': the fill, nothing else
             return matches(n, e.fill), f"{key}'s fill is {e.fill:.3g} % of its capacity"
         unit = unit_of(key).lower()
         prefix, scale = _prefixed(after, unit_of(key))
-        value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or slot or bool(prefix)) \
+        value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or cue.slot or bool(prefix)) \
             and not contrib_cue
         meaning = None if contrib_cue or n.percent else _code_meaning(n, e)
         if meaning is not None:  # 'a balance above 200 DM' for status 4 ('200 DM or more'), before any rounding
@@ -165,14 +176,12 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
             cands.append(("value" if scale == 1 else f"value in {prefix}{unit_of(key)}", e.value / scale))
         if n.percent and not contrib_cue and e.fill is not None:
             cands.append(("fill (% of capacity)", e.fill))
-        if not value_cue and (contrib_cue or not e.identifier or _PUSH_WORDS.search(masked[:n.start])):
-            # an identifier's number is its value ('the serving BS's id at 10'), unless the words before it speak of
-            # contributions ('the SHAP value of serving_bs is 0.00'): an identifier is never narrated as a reason
+        if not value_cue and (cue.pushes or not e.identifier):
             cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
         for what, v in cands:
             contribution = what.startswith("contribution")
-            if matches(n, v, magnitude_ok=not (signed_cue and contribution)) or (
-                    (n.percent or (in_points and contribution)) and percent_reading(n, v)):
+            if matches(n, v, magnitude_ok=not (cue.signed and contribution)) or (
+                    (n.percent or (cue.in_points and contribution)) and percent_reading(n, v)):
                 return True, f"{key}: {what}"
         share = _share(n, e, contexts)
         if share:

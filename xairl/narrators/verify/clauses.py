@@ -1,0 +1,83 @@
+"""One clause's claims: each number bound (:mod:`.binding`) and checked, then its direction words
+(:mod:`.directions`), rank words (:mod:`.ranks`) and comparisons (:mod:`.comparisons`). The sentence reader in
+:mod:`xairl.narrators.verify` splits sentences into clauses and decides each clause's view."""
+from __future__ import annotations
+
+import re
+
+from . import background, binding, comparisons, directions, quantities, ranks, sums
+from .book import FactBook
+from .checks import Claim
+from .names import Mention, named_features
+from .numbers import find_numbers
+
+
+def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
+                 unit_of, parsed, vocab, sentence_keys=frozenset()) -> list[Claim]:
+    out: list[Claim] = []
+    name_words = vocab.name_words
+    names = named_features(mentions)
+    numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not quantities.skip_number(n, masked)
+               and not quantities.window_of_name(n, sentence_keys)]
+    # 'A and B ... by x and y, respectively': numbers after the last name pair up with the names in order
+    tail = [n for n in numbers if names and n.start > names[-1].end  # not the last name's own '(−22.5 dB)'
+            and not re.fullmatch(r"\s?\([^()]*", masked[names[-1].end:n.start])]
+    paired = {}
+    own_cue = any(background.statistic(masked[max(0, n.start - 60):n.start]) or binding.OUTPUT_BEFORE.search(
+        masked[max(0, n.start - 60):n.start]) for n in tail)  # '... worth about $316k instead of the usual $230k'
+    if len({m.keys for m in names}) >= 2 and len(tail) == len(names) and not own_cue and (
+            "respectively" in masked[a:b].lower() or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
+            or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
+                and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
+        paired = {id(n): m for n, m in zip(tail, names)}
+    paired |= comparisons.compared_pairs(masked, a, b, names, numbers)  # 'A mattered twice as much as B (0.88 vs 0.49)'
+    actions = [m for m in mentions if m.kind == "action"]
+    scored = {}
+    if not names and len(actions) >= 2 and len(numbers) == len(actions) and numbers[0].start >= actions[-1].end:
+        scored = {id(n): m for n, m in zip(numbers, actions)}  # 'turn beat recharge 6.30 to 2.37'
+    # 'A and B together add x': one number after the names (not B's own '(+5.31)', not a list 'x and y'), without a
+    # quantity of its own ('most of the $91,462 above the baseline')
+    # (with more numbers after: the cue between the names and the first, 'A, B and C together add x, y % of it', and
+    # not one number per name, '(+10.97 and +22.02)')
+    summed = len(tail) >= 1 and len(names) >= 2 and (_SUM_CUE.search(masked, a, b) if len(tail) == 1 else _SUM_CUE.search(
+        masked, names[-1].end, tail[0].start) and len(tail) != len({m.keys for m in names})) and not _OWN_QUANTITY.search(
+        masked[max(a, tail[0].start - 12):tail[0].start]) and not quantities.CHANGE_AFTER.match(masked[tail[0].end:b])
+    # 'not the garage but the quality', 'X, rather than Y, is ...': what is said of the sentence is not said of Y
+    said = [m for m in mentions if m.kind == "action" or not _NEGATED.search(masked[max(a, m.start - 40):m.start])]
+    said_names = named_features(said)
+    for n in numbers:
+        if summed and n is tail[0]:
+            members = list(dict.fromkeys(m.keys for m in said_names))
+            out.append(binding.named(sums.sum_number(n, members, ctx, book), "number.sum"))
+            continue
+        c = binding.bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
+        if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure
+            c = binding.unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
+        if c.status == "contradicted" and id(n) not in paired:
+            c = binding.by_parse(c, n, masked, book, ctx, unit_of, parsed, vocab)
+        if c.status == "contradicted" and id(n) not in paired:
+            c = binding.unless_elsewhere(c, n, masked, mentions, book, ctx, parsed, unit_of, sentence_keys)
+        out.append(c)
+    first = numbers[0] if numbers else None
+    if first is not None and first.sign and not any(m.start < first.start for m in mentions):
+        out += [binding.named(c, "direction.unknown-name") for c in directions.unknown_label(
+            masked[a:first.start], name_words)]  # '; roof condition -12.1k;'
+    out += [binding.named(c, "direction.subject") for c in directions.directions(masked, a, b, said, book, ctx,
+                                                                                name_words)]
+    out += [binding.named(c, "rank.words") for c in ranks.find_ranks(masked, a, b, said, book, ctx)]
+    out += [binding.named(c, "rank.comparison") for c in comparisons.find_comparisons(masked, a, b, said, book, ctx)]
+    for m in ranks.MINOR_RE.finditer(masked, a, b):
+        owner = next((x for x in reversed(said_names) if x.end <= m.start()), None) or next(
+            (x for x in said_names if x.start >= m.end()), None)
+        if owner is not None:
+            out.append(binding.named(ranks.check_minor(owner.keys, ctx, book, m.group(0)), "rank.minor"))
+    return out
+
+
+#: 'A and B together add x', 'combined', 'sum to', 'between them': the number is their sum
+_SUM_CUE = re.compile(r"\b(?:together|combined|jointly|in total|taken together|between them|sum(?:s|med)? to|add up to|"
+                      r"in sum)\b", re.IGNORECASE)
+_OWN_QUANTITY = re.compile(r"\bof\s+(?:the\s+)?[$€£]?$", re.IGNORECASE)
+_NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
+                      r"(?:(?:because of|due to|about|the|its|their|a|an)\s+){0,3}$", re.IGNORECASE)
+_PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
