@@ -153,6 +153,27 @@ def test_a_number_bound_to_the_wrong_name_is_unchecked_not_wrong():
     assert number("Odor beats the cap diameter by about 0.15.").status == "contradicted"
 
 
+def test_table_cells_are_items_and_an_unnamed_feature_is_not_wrong():
+    """A row of 'label number' cells (or cells after '||'): each is an item, so a cell whose label the vocabulary lacks ('lag reading')
+    does not lend its numbers to the name of the cell before; a field's name and its value stay one item. A number
+    bound by position that states an unnamed feature's exact fact is unchecked; one that states no fact, or measures
+    a fact noun of the name before it, stays contradicted."""
+    from xairl.narrators.verify import rules
+    air = rules.example("air")
+
+    def numbers(text):
+        return [(c.text, c.status) for c in xairl.verify(text, air, 0).claims if c.kind == "number"]
+    row = numbers("traffic 2.4 +7.2 | lag reading 48.2 +14.7 | wind 0.8 +6.9")
+    assert [s for _, s in row] == ["verified", "verified", "unchecked", "unchecked", "verified", "verified"]
+    assert ("+9.9", "contradicted") in numbers("traffic 2.4 +7.2 | wind 0.8 +9.9")
+    assert numbers("Top factors | traffic = 2.4 | +7.2 || wind 0.8 m/s | +6.9 || sheltered site | +3.3")[-1] == (
+        "+3.3", "unchecked")  # (not the wind's)
+    assert numbers("Feature: traffic_index | value: 2.4 | SHAP: +7.2") == [("2.4", "verified"), ("+7.2", "verified")]
+    assert numbers("Traffic is heavy, with yesterday's level at 14.7.") == [("14.7", "unchecked")]
+    assert numbers("Traffic is heavy, with yesterday's level at 12.3.") == [("12.3", "contradicted")]
+    assert numbers("Traffic is heavy, with an increase of 14.7.") == [("14.7", "contradicted")]
+
+
 @pytest.mark.parametrize("text", ["", " ", "x" * 1_000_000, "Die Geruchsnote erhöht die Vorhersage deutlich.",
                                   "odor adds 1.5e-1", "odor adds\u00a00.15 \u2212 wait", "\x00\x01"])
 def test_bad_input_gives_a_status_not_an_exception(text):

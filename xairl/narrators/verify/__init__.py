@@ -127,6 +127,20 @@ _APPOSITIVE = re.compile(r"\s(?:while|although|though)\s+(?:\w+ly\s+)?(?:[a-z]+e
 #: 'the house price decreases because A is x and B is y': the reason names what moved the output, in one clause
 _OUTPUT_MOVED = re.compile(rf"\b(?:{checks.OUTPUT_WORDS})\s+(?:\w+ly\s+)?{checks.DIRECTION_RE.pattern}$",
                            re.IGNORECASE)
+_CELL = re.compile(r"[^|]+")
+#: a table cell that is one item: a label, then a number ('price hike 12% +.141'), not a field's name and value
+#: ('value: 2,112 sq ft') nor a number first ('+4.6 season=winter' after 'blh_m=310|': the number is the last item's)
+_ITEM_CELL = re.compile(r"^[\s↑↓•*-]*(?![A-Za-z ]{1,20}:)[A-Za-z\0][^|]*\d")
+
+
+def _item_cells(masked: str) -> list[int]:
+    """Where a table row's items start: at a '||', and after a '|' between two cells that are items each
+    ('M2M +.188 | price hike 12% +.141'; not '| value: 2,112 | SHAP: +39,960', not 'blh_m=310|+4.6')."""
+    cells = list(_CELL.finditer(masked))
+    return [b.start() for a, b in zip(cells, cells[1:]) if masked[b.start() - 2:b.start()] == "||" or (
+        _ITEM_CELL.match(a.group(0)) and _ITEM_CELL.match(b.group(0)))]
+
+
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
 def sentences(text: str) -> list[tuple[int, int]]:
     """Sentence spans: split after . ! ? before a capital or a sign, and at line breaks and bullets."""
@@ -262,8 +276,8 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
             checks.check_label(sentence, m, book) if m.kind == "label" else None
         if c is not None:
             claims.append(binding.named(c, "action.choice" if m.kind == "action" else "category.label"))
-    bounds = [0] + [m.end() for m in _CLAUSE_RE.finditer(masked) if not _APPOSITIVE.match(masked, m.start())
-                    and not _OUTPUT_MOVED.search(sentence, 0, m.start())] + [len(masked)]
+    bounds = sorted([0] + [m.end() for m in _CLAUSE_RE.finditer(masked) if not _APPOSITIVE.match(masked, m.start())
+                           and not _OUTPUT_MOVED.search(sentence, 0, m.start())] + _item_cells(masked) + [len(masked)])
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'

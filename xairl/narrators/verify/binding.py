@@ -148,10 +148,18 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
         if other is not None:
             return Claim("number", n.text, "unchecked", f"said of '{q.noun}', which names no "
                                              f"feature; it states {other}", "parse.said-of-other")
-    other = quantities.any_fact(n, book, keys, ctx, strict=True, contribution=pushes,
-                                signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
-    return c if other is None else Claim("number", n.text, "unchecked",
-                                         f"read by position as {c.detail}, but it states {other}", "number.elsewhere")
+    signed = quantities.signed_named(masked[max(0, n.start - 40):n.start])
+    other = quantities.any_fact(n, book, keys, ctx, strict=True, contribution=pushes, signed=signed)
+    if other is not None:
+        return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}",
+                     "number.elsewhere")
+    if q.noun in FACT_NOUNS:
+        return c  # 'A is responsible for an increase of 1.2': A's increase, whatever else 1.2 may be
+    # 'bill $109.9', 'its Q3 grade of 54 (+0.096)': a thing the vocabulary has no words for, or a wrong word match
+    other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes, signed=signed)
+    return c if other is None else Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it "
+                                         f"states {other}, a feature the sentence may name in words of its own",
+                                         "number.other-feature")
 
 
 def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, vocab) -> Claim:

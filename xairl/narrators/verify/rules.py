@@ -93,6 +93,12 @@ RULES: tuple[Rule, ...] = (
          "exactly (a decision-level number, a named feature's fact): a guess, unchecked",
          fires=(("air", "Traffic is heavy, so the forecast is 52.1."),),
          silent=(("air", "Traffic is heavy, so the forecast is 35.5."),)),
+    Rule("number.other-feature", "number", "a number bound by position alone, contradicted, that measures no fact "
+         "noun and states exactly (unhedged, two significant digits) a fact of a feature its sentence does not name: "
+         "the text may name that feature in words the vocabulary lacks ('bill $109.9'), unchecked",
+         fires=(("air", "Traffic is heavy, with yesterday's level at 14.7."),),
+         silent=(("air", "Traffic is heavy, with yesterday's level at 12.3."),
+                 ("air", "Traffic is heavy, with an increase of 14.7."))),
     Rule("number.unclear", "number", "a number bound by position that states another named feature's fact exactly "
          "(unhedged, two significant digits): which one is unclear, unchecked",
          fires=(("air", "The wind was calm, which, with the traffic, added 6.9."),),
