@@ -174,6 +174,21 @@ def test_table_cells_are_items_and_an_unnamed_feature_is_not_wrong():
     assert numbers("Traffic is heavy, with an increase of 14.7.") == [("14.7", "contradicted")]
 
 
+def test_an_invented_feature_needs_the_parse_to_agree():
+    """The words before a direction word propose an invented feature; the parse must find a subject of the word's
+    verb that names nothing: not the model itself after an opener, not a participle's missing subject."""
+    from xairl.narrators.verify import rules
+    air = rules.example("air")
+
+    def invented(text):
+        return [c.text for c in xairl.verify(text, air, 0).claims if c.kind == "feature" and c.status == "contradicted"]
+    assert invented("With 0 mm of rain in the last day, the model adds about 2.2.") == []
+    assert invented("A pedestrian pressed the button at the crossing, costing about 0.7.") == []
+    assert invented("The wet pavement reported by the weather feed lowered the forecast by 0.5.") == [
+        "The wet pavement reported by the weather feed"]
+    assert invented("The depot's smoke added 0.5.") == ["The depot's smoke"]
+
+
 @pytest.mark.parametrize("text", ["", " ", "x" * 1_000_000, "Die Geruchsnote erhöht die Vorhersage deutlich.",
                                   "odor adds 1.5e-1", "odor adds\u00a00.15 \u2212 wait", "\x00\x01"])
 def test_bad_input_gives_a_status_not_an_exception(text):

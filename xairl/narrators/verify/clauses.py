@@ -63,7 +63,7 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
         out += [binding.named(c, "direction.unknown-name") for c in directions.unknown_label(
             masked[a:first.start], name_words)]  # '; roof condition -12.1k;'
     out += [binding.named(c, "direction.subject") for c in directions.directions(masked, a, b, said, book, ctx,
-                                                                                name_words)]
+                                                                                name_words, parsed)]
     out += [binding.named(c, "rank.words") for c in ranks.find_ranks(masked, a, b, said, book, ctx)]
     out += [binding.named(c, "rank.comparison") for c in comparisons.find_comparisons(masked, a, b, said, book, ctx)]
     for m in ranks.MINOR_RE.finditer(masked, a, b):

@@ -4,11 +4,13 @@ away ('without X, it would be higher'), and subjects that name no feature (inven
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 from . import checks
 from .book import FactBook
 from .checks import Claim
 from .names import GENERIC, Mention, named_features, split_words, stem
+from .parse import said_of
 from .ranks import NOUN
 
 _GENERIC_SUBJECT = re.compile(r"^\W*(?:[qa]\s*:\s*)?(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|"
@@ -124,7 +126,7 @@ _NEW_CLAUSE = re.compile(r",\s+(?:and|while|whereas|plus)\s+(?=(?:the|a|an|its|t
 
 
 def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
-                name_words=frozenset()) -> list[Claim]:
+                name_words=frozenset(), parsed=None) -> list[Claim]:
     """The direction claims of clause ``masked[a:b]``: each direction word with the names it is said of, checked."""
     out, prev, bare = [], a, False  # bare: the previous direction word found no subject at all
     names = named_features(mentions)
@@ -167,11 +169,13 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
                 reasoning = re.match(r"\W*(?:because|since|as)\b", masked[a:b], re.IGNORECASE)
                 if i == 0 and (book.output != "actions" or not pronoun) and not reasoning:  # (a 'because' clause:
                     # the writer's reasoning about the world, not about this model's features)
-                    out += _unknown_subject(subject, m.group(0), inside, name_words, opener)
+                    out += _parse_agrees(_unknown_subject(subject, m.group(0), inside, name_words, opener), m, parsed,
+                                         book)
                 elif i > 0 and (joined := _NEW_CLAUSE.search(subject)):  # '..., and the basement cost another $12,000'
                     rest = prev + joined.end()
-                    out += _unknown_subject(masked[rest:m.start()], m.group(0),
-                                            [x for x in inside if x.start >= rest], name_words)
+                    out += _parse_agrees(_unknown_subject(masked[rest:m.start()], m.group(0),
+                                                          [x for x in inside if x.start >= rest], name_words), m, parsed,
+                                         book)
         conceded = [x for x in subjects if _DESPITE.search(masked[max(prev, x.start - 40):x.start])
                     and "," in masked[x.end:m.start()]]
         subjects = [x for x in subjects if x not in conceded]  # 'Despite being unemployed (+0.128), ... pull it down'
@@ -291,6 +295,16 @@ def unknown_label(text: str, name_words=frozenset()) -> list[Claim]:
     if m is None or any(w.lower() in _QUANTITY_LABELS | _OWNERS for w in m.group("label").split()):
         return []  # ('Its signal quality of -3.2 dB': something named before, vaguely)
     return _unknown_subject(m.group("label"), "a signed number", [], name_words)
+
+
+def _parse_agrees(claims: list[Claim], m: re.Match, parsed, book: FactBook) -> list[Claim]:
+    """An invented feature found by the words before a direction word stands only when the parse agrees: the
+    word's verb has a subject of its own that names nothing (:func:`.parse.said_of`); that subject's words are the
+    claim's."""
+    if not claims or parsed is None:
+        return claims
+    subject = said_of(parsed(), m.start(), m.end(), frozenset(book.features))
+    return [replace(c, text=subject) for c in claims] if subject else []
 
 
 #: a reporting clause before the subject: 'The SHAP value says that ...', 'This shows that ...'

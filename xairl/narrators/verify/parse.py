@@ -151,6 +151,46 @@ def _subject(verb) -> Quantified:
     return Quantified()
 
 
+#: the decision's own actor as a subject ('the model adds 2.2'): no feature, invented or not
+_ACTORS = frozenset({"model", "agent", "policy", "system", "controller", "critic", "network", "algorithm", "classifier",
+                     "predictor", "dqn", "it", "this", "that", "which", "who", "they"})
+#: links from a direction word up to the verb whose subject it is said of ('confirms a haze and adds 9': 'confirms';
+#: 'puts the risk at 6%, against 18%': 'puts'; 'rewards with a reduction': 'rewards')
+_TO_VERB = frozenset({"conj", "prep", "pobj", "dobj", "xcomp", "acomp", "attr", "amod", "advmod", "compound", "oprd",
+                      "npadvmod", "prt", "dative"})
+
+
+def said_of(doc, start: int, end: int, features=frozenset()) -> str | None:
+    """What the direction word at characters [start, end) is said of, by the parse: the words of its verb's subject
+    when they name nothing ('the wet road surface reported by the weather feed'); None when the subject names
+    something, is a pronoun or the model itself ('With 0 mm of rain, the model adds 2.2'), or there is none (a
+    participle: 'A pedestrian has pressed the button, costing about 0.7'; a noun: 'a reduction of 2'). A relative
+    clause's 'which' stands for the noun it follows ('pays by mailed check, which nudged it up'); a direction word
+    inside a subject ('the UAV's heading toward candidate 1 added') is said of the words before it. Only a name of
+    ``features`` counts as naming something (an action or a label in the subject is what it is about)."""
+    span = doc.char_span(start, end, alignment_mode="expand")
+    if span is None:
+        return None
+    token = span.root
+    for _ in range(6):
+        subjects = [c for c in token.children if c.dep_ in ("nsubj", "nsubjpass", "csubj")]
+        if token.dep_ in ("nsubj", "nsubjpass"):
+            subjects = [token]
+        if subjects:
+            s = subjects[0]
+            if s.lower_ in ("which", "that") and token.dep_ == "relcl":
+                s = token.head
+            words = [t for t in s.subtree if t.idx < start]
+            if not words or s.pos_ in ("PRON", "DET", "NUM") or s.lower_ in _ACTORS or any(
+                    set(t.ent_id_.split("|")) & features for t in words if t.ent_id_):
+                return None
+            return doc[words[0].i:words[-1].i + 1].text
+        if token.dep_ not in _TO_VERB or token.head is token:
+            return None
+        token = token.head
+    return None
+
+
 #: nouns a name may qualify and still be the thing meant ('the speed value', 'the wind effect', 'tenure's 58 months')
 _OWN_NOUNS = frozenset({"value", "values", "level", "levels", "reading", "readings", "feature", "factor", "effect",
                         "effects", "contribution", "impact", "score", "term", "bar", "signal", "variable", "count",
