@@ -189,6 +189,26 @@ def test_an_invented_feature_needs_the_parse_to_agree():
     assert invented("The depot's smoke added 0.5.") == ["The depot's smoke"]
 
 
+@pytest.mark.parametrize("text,status", [
+    ("Traffic explains another 24%.", "verified"),  # 7.2 of the 30.1 net change
+    ("Traffic explains another 34%.", "contradicted"),
+    ("The precip effect is roughly 32% of the wind effect.", "verified"),  # 2.2 / 6.9
+    ("The precip effect is roughly 60% of the wind effect.", "contradicted"),
+    ("The wind effect is about 3 times the precip effect.", "verified"),
+    ("The wind effect is about 5 times the precip effect.", "contradicted"),
+    ("Wind and traffic together add 14.1, about 47% of it.", "verified"),  # 14.1 of 30.1
+    ("Wind and traffic together add 14.1, about 67% of it.", "contradicted"),
+    ("The three wind-and-traffic factors (wind, traffic and precip) add up.", "verified"),  # a count, no claim
+])
+def test_shares_ratios_and_counts_of_factors(text, status):
+    """A percentage of the net change, a ratio to another named feature ('% of', 'times'), the share of a sum, and a
+    count of the factors a sentence lists (no claim)."""
+    from xairl.narrators.verify import rules
+    result = xairl.verify(text, rules.example("air"), 0)
+    got = "contradicted" if not result.accurate else "verified"
+    assert got == status, [(c.status, c.text, c.detail) for c in result.claims]
+
+
 @pytest.mark.parametrize("text", ["", " ", "x" * 1_000_000, "Die Geruchsnote erhöht die Vorhersage deutlich.",
                                   "odor adds 1.5e-1", "odor adds\u00a00.15 \u2212 wait", "\x00\x01"])
 def test_bad_input_gives_a_status_not_an_exception(text):

@@ -32,6 +32,8 @@ class FeatureFacts:
     shares: dict[str, float] = field(default_factory=dict)    # context -> % of the sum of |contributions|
     side_shares: dict[str, float] = field(default_factory=dict)  # context -> % of its own side's sum ('57 % of the
     #                                                               positive push')
+    net_shares: dict[str, float] = field(default_factory=dict)  # context -> % of the net change, same sign ('43 % of
+    #                                                              the net drop')
     fill: float | None = None                                 # % of the feature's capacity
     quartiles: tuple[float, float, float] | None = None       # the background's 25th, 50th and 75th percentiles
     legend: dict[int, str] = field(default_factory=dict)      # code -> its meaning, from the description's legend
@@ -147,11 +149,15 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
 
 def _add_sums(book: FactBook, ctx: str, contrib: np.ndarray, names) -> None:
     """The sums over the features in view ``ctx`` ('the positives add up to +0.39') and each feature's share of its
-    own side ('57 % of all the positive push')."""
+    own side ('57 % of all the positive push') and of the net change when it has the net's sign ('43 % of the net
+    drop')."""
     for j, f in enumerate(names):
         side = float(np.abs(contrib[np.sign(contrib) == np.sign(contrib[j])]).sum())
         if side and contrib[j]:
             book.features[f].side_shares[ctx] = 100.0 * abs(float(contrib[j])) / side
+        net = float(contrib.sum())
+        if net and contrib[j] * net > 0:
+            book.features[f].net_shares[ctx] = 100.0 * float(contrib[j]) / net
     of = "" if ctx == "chosen" else " (margin)"
     book.aggregates |= {f"the sum of the positive contributions{of}": float(contrib[contrib > 0].sum()),
                         f"the sum of the negative contributions{of}": float(contrib[contrib < 0].sum()),

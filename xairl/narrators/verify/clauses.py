@@ -25,7 +25,8 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
     paired = {}
     own_cue = any(background.statistic(masked[max(0, n.start - 60):n.start]) or binding.OUTPUT_BEFORE.search(
         masked[max(0, n.start - 60):n.start]) for n in tail)  # '... worth about $316k instead of the usual $230k'
-    if len({m.keys for m in names}) >= 2 and len(tail) == len(names) and not own_cue and (
+    if len({m.keys for m in names}) >= 2 and len(tail) == len(names) and not own_cue and not _SUM_CUE.search(
+            masked, names[-1].end, tail[0].start) and (  # ('A and B together add x, y % of it': a sum)
             "respectively" in masked[a:b].lower() or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
             or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
                 and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
@@ -40,13 +41,14 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
     # (with more numbers after: the cue between the names and the first, 'A, B and C together add x, y % of it', and
     # not one number per name, '(+10.97 and +22.02)')
     summed = len(tail) >= 1 and len(names) >= 2 and (_SUM_CUE.search(masked, a, b) if len(tail) == 1 else _SUM_CUE.search(
-        masked, names[-1].end, tail[0].start) and len(tail) != len({m.keys for m in names})) and not _OWN_QUANTITY.search(
+        masked, names[-1].end, tail[0].start) and (len(tail) != len({m.keys for m in names}) or tail[1].percent)) \
+        and not _OWN_QUANTITY.search(
         masked[max(a, tail[0].start - 12):tail[0].start]) and not quantities.CHANGE_AFTER.match(masked[tail[0].end:b])
     # 'not the garage but the quality', 'X, rather than Y, is ...': what is said of the sentence is not said of Y
     said = [m for m in mentions if m.kind == "action" or not _NEGATED.search(masked[max(a, m.start - 40):m.start])]
     said_names = named_features(said)
     for n in numbers:
-        if summed and n is tail[0]:
+        if summed and (n is tail[0] or (n.percent and len(tail) == 2 and n is tail[1])):  # (', about 87 % of it')
             members = list(dict.fromkeys(m.keys for m in said_names))
             out.append(binding.named(sums.sum_number(n, members, ctx, book), "number.sum"))
             continue

@@ -14,7 +14,9 @@ from .names import Mention, named_features
 #: B', 'cuts it by about as much as B adds': how large |contribution| is beside another feature's
 COMPARE_RE = re.compile(r"\b(?:(?P<more>more|bigger|larger|greater|stronger|heavier)|(?P<less>less|smaller|weaker)|"
                         r"(?P<same>as much|as large|as big))\b(?P<gap>(?:\s+[\w'\-\0]+){0,6}?)\s+(?:than|as)\s+"
-                        r"|\b(?P<out>outweigh\w*|dwarf\w*|overshadow\w*)\s+", re.IGNORECASE)
+                        r"|\b(?P<out>outweigh\w*|dwarf\w*|overshadow\w*)\s+"
+                        r"|(?<=\d)\s*(?P<of>(?:%|percent)\s+of|times(?:\s+of)?)\s+(?=(?:the\s+|its\s+|their\s+)?\0)",
+                        re.IGNORECASE)  # ('60 % of the alcohol effect', '3.7 times the pedestrian-call penalty')
 SAME_WITHIN = 0.25  # 'about as much as': the two sizes within 25 % of the larger
 
 
@@ -60,6 +62,14 @@ def _ratio(before: str, way: int) -> float | None:
         share = float(m.group("pct")) / 100
         return 1 + share if way > 0 else 1 - share if way < 0 else share
     return float(m.group("num")) if m.group("num") else _RATIO_WORDS[m.group("word").lower()]
+
+
+def _of_ratio(before: str, unit: str) -> float | None:
+    """The ratio '60 % of B' (0.6) or '3.7 times B' (3.7) states, from the number right before the unit."""
+    m = re.search(r"(\d+(?:\.\d+)?)\s*$", before)
+    if m is None:
+        return None
+    return float(m.group(1)) / (1 if unit.lower().startswith("times") else 100)
 
 
 def check_ratio(a_keys: tuple[str, ...], b_key: str, ratio: float, ctx: str | None, book: FactBook,
@@ -108,10 +118,11 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
                 r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?", masked[m.end():b_name.start], re.IGNORECASE):
             continue  # 'more than $500', 'bigger than any other feature': no feature to compare with
         subjects = [x for x in names if start <= x.start and x.end <= m.start()]
-        if not subjects:
+        if not subjects or m.group("of"):  # ('A ..., and the B term is about 1.5 times the C term': B's)
             subjects = [x for x in names if x.end <= m.start()][-1:]
         way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
-        ratio = _ratio(masked[max(a, m.start() - 40):m.start()], way)
+        ratio = _ratio(masked[max(a, m.start() - 40):m.start()], way) if not m.group("of") else _of_ratio(
+            masked[max(a, m.start() - 12):m.start()], m.group("of"))
         if ratio is not None and not m.group("out"):  # 'roughly 1.7 times as much as B', '35 % more than B'
             out += [check_ratio(x.keys, b_name.keys[0], ratio, ctx, book, masked[m.start():m.end()].strip())
                     for x in subjects]

@@ -48,8 +48,9 @@ _OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability
                         re.IGNORECASE)
 _SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|features|narratives|coalitions|times|"
                          r"-fold|outcomes|options|classes|sides|factors|reasons|drivers|categories|possibilities|"
-                         r"scenarios|-?points?\s+scale|scale)\b|[x×](?![\w]))",
-                         re.IGNORECASE)
+                         r"scenarios|-?points?\s+scale|scale)\b|[x×](?![\w])|"
+                         r"(?:[A-Za-z\0][\w\0'-]*\s+){0,2}(?:factors|reasons|drivers|features|things|variables|inputs)\b)",
+                         re.IGNORECASE)  # ('the three upward drivers')
 _LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state|outcome|class|type|acct|account|ref|"
                            r"ticket|order|episode|ep|seed|run|version|customer|patient|flight|no\.)[\s\-=:#]*$",
                            re.IGNORECASE)
@@ -100,6 +101,8 @@ def skip_number(n: Number, masked: str) -> bool:
         return True
     if n.percent and _OF_PEOPLE.match(masked, n.end):  # 'unlike 95% of their peers': a share of the background
         return True
+    if n.percent and re.match(r"\s*of\s+(?:the\s+|its\s+|their\s+)?\0", masked[n.end:]):
+        return True  # '60 % of the alcohol effect': a ratio to that name (:mod:`.comparisons`)
     if re.match(r"^\s+(?:most|largest|biggest|main|top|strongest|key)\b", masked[n.end:]):  # 'the two largest'
         return True
     if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):
@@ -207,14 +210,17 @@ def _prefixed(after: str, unit: str) -> tuple[str, float]:
 
 
 def _share(n: Number, e, contexts) -> str:
-    """Which share of the total a percentage states: of all |contributions| ('share'), or of its own side's ('57 %
-    of all the positive push'); '' for none (percentage points are never a share)."""
+    """Which share of the total a percentage states: of all |contributions| ('share'), of its own side's ('57 %
+    of all the positive push'), of the net change ('explains another 32 %' of the net drop); '' for none
+    (percentage points are never a share)."""
     if not n.percent or n.points:
         return ""
     if any(matches(n, e.shares[c]) for c in contexts if c in e.shares):
         return "share"
     if any(matches(n, e.side_shares[c]) for c in contexts if c in e.side_shares):
         return "share of its side (the contributions of its sign)"
+    if any(matches(n, e.net_shares[c]) for c in contexts if c in e.net_shares):
+        return "share of the net change"
     return ""
 
 

@@ -62,8 +62,10 @@ RULES: tuple[Rule, ...] = (
     Rule("number.respectively", "number", "'A and B ... by x and y, respectively': the numbers pair with the names",
          fires=(("air", "Traffic and wind add 7.2 and 6.9, respectively."),),
          silent=(("air", "Traffic adds 7.2."),)),
-    Rule("number.sum", "number", "'A and B together add x': the sum of their contributions",
-         fires=(("air", "Traffic and wind together add 14.1."),), silent=(("air", "Traffic and wind add 7.2 and "
+    Rule("number.sum", "number", "'A and B together add x': the sum of their contributions (and a percentage "
+         "after it, 'about 47 % of it': the sum of their shares of all |contributions|, of their side or of the net "
+         "change)", fires=(("air", "Traffic and wind together add 14.1."),
+                           ("air", "Wind and traffic together add 14.1, about 47% of it.")), silent=(("air", "Traffic and wind add 7.2 and "
                                                                                    "6.9, respectively."),)),
     Rule("number.aggregate", "number", "a sum over all features after its cue words ('the positives add up to')",
          fires=(("air", "The positives add up to 31.1."),), silent=(("air", "Traffic adds 7.2."),)),
@@ -137,8 +139,11 @@ RULES: tuple[Rule, ...] = (
          silent=(("air", "With the traffic, the forecast is higher."),)),
     Rule("rank.words", "rank", "'the biggest', 'second', 'the main reason' of a name",
          fires=(("air", "Traffic is the second biggest factor."),), silent=(("air", "Traffic adds 7.2."),)),
-    Rule("rank.comparison", "rank", "'A mattered more than B', ratios ('twice as much as')",
-         fires=(("air", "Traffic mattered more than wind."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("rank.comparison", "rank", "'A mattered more than B', ratios ('twice as much as', 'about 3 times the B "
+         "effect', '32 % of the B effect')",
+         fires=(("air", "Traffic mattered more than wind."), ("air", "The precip effect is roughly 32% of the wind "
+                                                                     "effect.")),
+         silent=(("air", "Traffic adds 7.2."), ("air", "The precip effect is roughly 32% of the change."))),
     Rule("rank.minor", "rank", "'barely mattered' of a name",
          fires=(("air", "The season barely mattered."),), silent=(("air", "The season mattered."),)),
     Rule("identifier.claimed", "feature", "an identifier that is no name, given a number or a direction word: an "

@@ -45,9 +45,11 @@ def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book:
         return matches(n, total) or (not n.hedge and abs(abs(n.value) - abs(total)) <= k * n.unit / 2 + 1e-9
                                      and (not n.sign or (n.value < 0) == (total < 0)))
 
-    if n.percent and not n.points:  # 'A and B together explain about 70 % of the attribution': their shares
-        results = [any(all(view in book.features[k].shares for k in combo)
-                       and matches(n, sum(book.features[k].shares[view] for k in combo)) for view in contexts)
+    if n.percent and not n.points:  # 'A and B together explain about 70 % of the attribution': their shares (of
+        # all |contributions|, of their side's, of the net change: 'together add 34.1, about 87 % of it')
+        results = [any(all(view in getattr(book.features[k], kind) for k in combo)
+                       and matches(n, sum(getattr(book.features[k], kind)[view] for k in combo))
+                       for view in contexts for kind in ("shares", "side_shares", "net_shares"))
                    for combo in combos]
         total = sum(book.features[k].shares.get(contexts[0], 0.0) for k in combos[0])
         text = f"the sum of {', '.join(combos[0])}'s shares is {total:.3g} %"
