@@ -189,6 +189,19 @@ def test_an_invented_feature_needs_the_parse_to_agree():
     assert invented("The depot's smoke added 0.5.") == ["The depot's smoke"]
 
 
+def test_a_signed_number_ends_the_item_before_the_next_name():
+    """'pm2_5_lag1 +14.7 traffic_index +7.2': +14.7 is the lag's, not the traffic's that follows it; so is a field's
+    value after '=' ('E[Q]=1.20 battery_pct=31'); a wrong one is contradicted as its own item's."""
+    from xairl.narrators.verify import rules
+    air = rules.example("air")
+
+    def numbers(text):
+        return [(c.text, c.status, c.detail) for c in xairl.verify(text, air, 0).claims if c.kind == "number"]
+    assert [s for _, s, _ in numbers("pm2_5_lag1 +14.7 traffic_index +7.2")] == ["verified", "verified"]
+    wrong = numbers("the base of 22.0 wind -6.9 traffic +7.2")[1]
+    assert wrong[1] == "contradicted" and "wind_speed_ms" in wrong[2]
+
+
 @pytest.mark.parametrize("text,status", [
     ("Traffic explains another 24%.", "verified"),  # 7.2 of the 30.1 net change
     ("Traffic explains another 34%.", "contradicted"),

@@ -233,7 +233,9 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
                                                            masked[n.end:nxt.start]):
         return named(quantities.action_number(n, checks.resolve_action(nxt, book), masked, book), "number.for-action")
     gap = masked[n.end:nxt.start] if nxt is not None else ""
-    if nxt is not None and nxt.kind != "action" and re.match(r"^[\s-]*(?:[a-z]+[\s-]+){0,2}(?:of\s+)?$", gap,
+    ends_item = bool(n.sign) or bool(re.search(r"[=:]\s*$", masked[:n.start]))  # 'wait_max -2.31 elapsed -1.46',
+    # 'E[Q]=1.20 battery_pct=31': a signed number or a field's value ends the item before, it does not start the next
+    if nxt is not None and nxt.kind != "action" and not ends_item and re.match(r"^[\s-]*(?:[a-z]+[\s-]+){0,2}(?:of\s+)?$", gap,
                                                                re.IGNORECASE) \
             and not re.search(r"\b(and|or|but|while|with)\b", gap, re.IGNORECASE):
         return named(quantities.feature_number(n, nxt.keys, masked, book, ctx, unit_of, name_after=True),

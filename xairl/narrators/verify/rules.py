@@ -86,7 +86,9 @@ RULES: tuple[Rule, ...] = (
     Rule("number.output-after", "number", "a number right before the output's own name ('52 in pm2_5')",
          fires=(("air", "Traffic leaves 52.1 in the forecast."),), silent=(("air", "Traffic adds 7.2."),)),
     Rule("number.name-after", "number", "a number bound by position: the name right after it ('a 48.2 lag-1 "
-         "reading')", fires=(("air", "A 2.4 traffic index adds to it."),), silent=(("air", "Traffic adds 7.2."),)),
+         "reading'), unless it is signed or a field's value: then it ends the item before ('wait_max -2.31 elapsed')",
+         fires=(("air", "A 2.4 traffic index adds to it."),),
+         silent=(("air", "Traffic adds 7.2."), ("air", "pm2_5_lag1 +14.7 traffic_index +7.2"))),
     Rule("number.name-before", "number", "a number bound by position: the name before it in its clause",
          fires=(("air", "Traffic adds 7.2."),), silent=(("air", "The forecast is 52 µg/m³."),)),
     Rule("number.free", "number", "a number tied to no name: a decision-level fact or nothing",
