@@ -189,6 +189,19 @@ def test_an_invented_feature_needs_the_parse_to_agree():
     assert invented("The depot's smoke added 0.5.") == ["The depot's smoke"]
 
 
+@pytest.mark.parametrize("text,accurate", [
+    ("pm2_5_lag1 48.2 +14.7 and traffic 2.4 +7.2 dominate.", True),  # the top two
+    ("Precip 0 +2.2 and wind 0.8 +6.9 dominate.", False),
+    ("The season is the main thing holding the forecast down.", True),  # the largest negative
+    ("The road is the main thing holding the forecast down.", False),
+])
+def test_ranks_of_several_names_and_of_one_side(text, accurate):
+    from xairl.narrators.verify import rules
+    result = xairl.verify(text, rules.example("air"), 0)
+    assert result.accurate == accurate, [(c.status, c.text, c.detail) for c in result.claims]
+    assert all("\0" not in c.text for c in result.claims)  # the names as written, not masked
+
+
 def test_a_signed_number_ends_the_item_before_the_next_name():
     """'pm2_5_lag1 +14.7 traffic_index +7.2': +14.7 is the lag's, not the traffic's that follows it; so is a field's
     value after '=' ('E[Q]=1.20 battery_pct=31'); a wrong one is contradicted as its own item's."""

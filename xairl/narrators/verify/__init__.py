@@ -282,7 +282,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'
         found = clauses.check_clause(masked, a, b, inside, book, own or ctx, unit_of, parsed, vocab,
-                                      {k for m in named_features(mentions) for k in m.keys})
+                                      {k for m in named_features(mentions) for k in m.keys}, sentence)
         found = [_unless_modifier(c, inside, book, parsed) for c in found]
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     if hypothetical:

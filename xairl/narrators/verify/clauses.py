@@ -13,7 +13,7 @@ from .numbers import find_numbers
 
 
 def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
-                 unit_of, parsed, vocab, sentence_keys=frozenset()) -> list[Claim]:
+                 unit_of, parsed, vocab, sentence_keys=frozenset(), written: str = "") -> list[Claim]:
     out: list[Claim] = []
     name_words = vocab.name_words
     names = named_features(mentions)
@@ -66,7 +66,7 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
             masked[a:first.start], name_words)]  # '; roof condition -12.1k;'
     out += [binding.named(c, "direction.subject") for c in directions.directions(masked, a, b, said, book, ctx,
                                                                                 name_words, parsed)]
-    out += [binding.named(c, "rank.words") for c in ranks.find_ranks(masked, a, b, said, book, ctx)]
+    out += [binding.named(c, "rank.words") for c in ranks.find_ranks(masked, a, b, said, book, ctx, written)]
     out += [binding.named(c, "rank.comparison") for c in comparisons.find_comparisons(masked, a, b, said, book, ctx)]
     for m in ranks.MINOR_RE.finditer(masked, a, b):
         owner = next((x for x in reversed(said_names) if x.end <= m.start()), None) or next(

@@ -71,6 +71,9 @@ OWN_SIDE = 2
 #: 'the biggest factor working against default': a participle between the rank and its direction word
 _PARTICIPLE = re.compile(r"\s(?:working|pulling|pushing|acting|weighing|counting|going|tilting|leaning)\s+",
                          re.IGNORECASE)
+#: a participle with its object before the direction word: 'holding the number down', 'keeping the risk up'
+_HOLDING = re.compile(r"\s(?:holding|keeping|pulling|pushing|dragging|bringing|driving|taking)\s+(?:the|its|this|that|it)"
+                      r"(?:\s+[\w\0]+)?\s+(?P<way>down|up|low|high)\b", re.IGNORECASE)
 _OTHER_WAY = re.compile(r"\s(?:\w+ing\s+)?(?:in\s+)?the\s+(?:other|opposite)\s+(?:way|direction)\b", re.IGNORECASE)
 
 
@@ -159,9 +162,12 @@ def _items(masked: str, a: int, targets: list[Mention], m: re.Match) -> int:
     return len([x for x in re.split(r",\s*(?:and\s+|or\s+)?|\s+(?:and|or)\s+", span) if x.strip()])
 
 
-def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None) -> list[Claim]:
+def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
+               written: str = "") -> list[Claim]:
     """The rank phrases of clause ``masked[a:b]``, each bound to its names ('A was the main reason', 'the top three
-    were A, B and C', 'followed by B', 'A second') and checked."""
+    were A, B and C', 'followed by B', 'A second') and checked; ``written``: the sentence as written (the claims'
+    names as written)."""
+    written = written or masked
     out = []
     names = named_features(mentions)
     for m in RANK_RE.finditer(masked, a, b):
@@ -172,6 +178,9 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         count = _COUNTED.search(masked, max(a, m.start() - 30), m.start())
         if count and m.group(0).lower().startswith("dominat"):  # 'Two inputs dominate ...: A ..., B ...'
             rank, plural = COUNT.get(count.group(1).lower(), 2), True
+        elif m.group(0).lower().startswith("dominat") and len({x.keys for x in names if x.end <= m.start()}) >= 2 \
+                and not _COLLECTIVE.search(masked, a, m.start()):
+            rank, plural = 0, True  # 'A -0.152 and B -0.094 dominate': the top two
         sign = sign or _rank_sign(m, masked, a, b, mentions, book)
         if plural:  # 'A and B had the largest effects' (before) or 'The top three were A, B and C' (after)
             before = [x for x in names if x.end <= m.start()]
@@ -181,7 +190,7 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             k = rank or max(len(targets), _items(masked, a, targets, m))  # 'A, B and a balanced life were the key ...'
 
             for t in targets:
-                out.append(check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {masked[t.start:t.end]}"))
+                out.append(check_rank(t.keys, k, k, sign, ctx, book, f"{m.group(0)}: {written[t.start:t.end]}"))
             continue
         before = [x for x in names if x.end <= m.start()]
         if len(before) >= 2 and _COLLECTIVE.search(masked, a, m.start()):  # 'the combination of A, B and C dominated'
@@ -191,28 +200,28 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         if target is None:
             continue
         out.append(check_rank(target.keys, rank, None, sign, ctx, book, m.group(0)))
-        out += _followed(masked, a, m.end(), names, rank, sign, ctx, book)  # 'followed by B', 'B second'
+        out += _followed(masked, a, m.end(), names, rank, sign, ctx, book, written)  # 'followed by B', 'B second'
     for x in names:
         o = AFTER_ORD.match(masked[x.end:b])
         if o and not RANK_RE.match(masked[x.end:b].lstrip(" ,(")):
             rank = ORD[o.group("o").lower()]
-            out.append(check_rank(x.keys, rank, None, 0, ctx, book, f"{masked[x.start:x.end]} {o.group('o')}"))
+            out.append(check_rank(x.keys, rank, None, 0, ctx, book, f"{written[x.start:x.end]} {o.group('o')}"))
             if rank == 1:  # 'A first (+11.0), then B'
-                out += _followed(masked, a, x.end + 1, names, rank, 0, ctx, book)
+                out += _followed(masked, a, x.end + 1, names, rank, 0, ctx, book, written)
     out += _chain(masked, a, b, names, book, ctx)
     out += _in_order(masked, a, b, names, book, ctx)
     return out
 
 
 def _followed(masked: str, a: int, start: int, names: list[Mention], rank: int, sign: int, ctx: str | None,
-              book: FactBook) -> list[Claim]:
+              book: FactBook, written: str) -> list[Claim]:
     """'..., followed by B, then C' after a rank: the names after ``start`` with such a word before them, next in
     rank."""
     out = []
     for x in names:
         if x.start >= start and FOLLOWED.search(masked[max(a, x.start - 24):x.start]):
             rank += 1
-            out.append(check_rank(x.keys, rank, None, sign, ctx, book, f"then {masked[x.start:x.end]}"))
+            out.append(check_rank(x.keys, rank, None, sign, ctx, book, f"then {written[x.start:x.end]}"))
     return out
 
 
@@ -224,6 +233,9 @@ def _rank_sign(m: re.Match, masked: str, a: int, b: int, mentions: list[Mention]
     gap = _PARTICIPLE.match(masked, m.end(), b)
     said = DIRECTION_RE.match(masked, gap.end() if gap else m.end() + 1, b) \
         if masked[m.end():m.end() + 1] == " " else None
+    held = _HOLDING.match(masked, m.end(), b)
+    if said is None and held:  # 'the main thing holding the number down'
+        return 1 if held.group("way").lower() in ("up", "high") else -1
     if said and (said.group(0).lower() not in ("for", "against", "toward", "towards") or book.output != "actions"):
         return 1 if said.group("pos") else -1  # (one output: 'the biggest factor working against it')
     side = re.match(r"\s+(?:(for|in favou?r of|toward)|against)\b", masked[m.end():b])

@@ -139,8 +139,11 @@ RULES: tuple[Rule, ...] = (
     Rule("direction.without", "direction", "'without X it would be lower': what X did, by taking it away",
          fires=(("air", "Without the traffic, the forecast would be lower."),),
          silent=(("air", "With the traffic, the forecast is higher."),)),
-    Rule("rank.words", "rank", "'the biggest', 'second', 'the main reason' of a name",
-         fires=(("air", "Traffic is the second biggest factor."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("rank.words", "rank", "'the biggest', 'second', 'the main reason' of a name ('A and B dominate': the top "
+         "two; 'the main thing holding the number down': among the contributions of that sign)",
+         fires=(("air", "Traffic is the second biggest factor."), ("air", "The season is the main thing holding the "
+                                                                         "forecast down.")),
+         silent=(("air", "Traffic adds 7.2."),)),
     Rule("rank.comparison", "rank", "'A mattered more than B', ratios ('twice as much as', 'about 3 times the B "
          "effect', '32 % of the B effect')",
          fires=(("air", "Traffic mattered more than wind."), ("air", "The precip effect is roughly 32% of the wind "
