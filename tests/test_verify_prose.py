@@ -202,6 +202,26 @@ def test_ranks_of_several_names_and_of_one_side(text, accurate):
     assert all("\0" not in c.text for c in result.claims)  # the names as written, not masked
 
 
+@pytest.mark.parametrize("text,accurate", [
+    ("Claims on this policy are expected to cost around $2,600.", True),  # the output's own word: no push
+    ("Students like her drop out more often, so the model adds about 4.4 points.", True),
+    ("Her age, 44, works in your favour by roughly $88.", True),  # whose favour: the reader's, unsaid
+    ("Her age does the heaviest lifting.", True),  # an idiom of size, not of way
+    ("Her age raises the expected cost by roughly $88.", False),
+    ("The evening enrolment lowers the dropout probability.", False),
+    ("The risk factors add 21.9 points in total.", True),  # a sum in the explanation's own points
+    ("The risk factors add 25.9 points in total.", False),
+])
+def test_the_outputs_own_words_idioms_and_totals(text, accurate):
+    from benchmarks.bench_verifier import one_output
+    cost = one_output(["driver_age", "deductible_usd"], [44, 1000], [-88.0, -199.0], 1850.0, "expected claim cost")
+    dropout = one_output(["enrollment_type", "units_failed", "scholarship"], ["evening", 3, "yes"],
+                         [4.4, 17.5, -7.9], 18.4, "probability that the student drops out")
+    exp = dropout if "points" in text or "drop" in text else cost
+    result = xairl.verify(text, exp, 0)
+    assert result.accurate == accurate, [(c.status, c.text, c.detail) for c in result.claims]
+
+
 def test_a_signed_number_ends_the_item_before_the_next_name():
     """'pm2_5_lag1 +14.7 traffic_index +7.2': +14.7 is the lag's, not the traffic's that follows it; so is a field's
     value after '=' ('E[Q]=1.20 battery_pct=31'); a wrong one is contradicted as its own item's."""

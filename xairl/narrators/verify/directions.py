@@ -3,6 +3,7 @@ it ('A, B and C raise'), a list after it ('Raising risk: A, B'), 'everything but
 away ('without X, it would be higher'), and subjects that name no feature (invented, or only vague)."""
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import replace
 
@@ -246,7 +247,19 @@ def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) 
     if _good_outcome(book) and re.match(
             r"\s+(?:the\s+|their\s+|its\s+|default\s+|credit\s+)?risk\b", masked[m.end():]):
         return True
+    if one_output and {stem(w).rstrip("~") for w in split_words(m.group(0))} & _output_stems(book.chosen or ""):
+        return True  # the output's own word ('claims expected to cost $2,600' of a claim cost, 'students drop out
+        # more often' of a dropout probability): what is predicted, not a push
+    if re.search(r"\b(?:in|to)\s+(?:your|our|my|his|her|their)\s+(?:own\s+)?$|\bheav\w*\s+$",
+                 masked[max(0, m.start() - 16):m.start()], re.IGNORECASE):
+        return True  # 'works in your favour' (whose side is the reader's), 'does the heaviest lifting' (an idiom of
+        # size, not of way)
     return one_output and _unsaid_side(masked, m, mentions, book)
+
+
+@functools.lru_cache(maxsize=64)
+def _output_stems(output: str) -> frozenset[str]:
+    return frozenset(stem(w).rstrip("~") for w in split_words(output) if len(w) >= 4)
 
 
 #: 'against a typical 26 %', 'against the average of 5.6', 'against 26 %': 'against' as 'versus'

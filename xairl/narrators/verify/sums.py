@@ -21,14 +21,20 @@ _PART_OF = re.compile(r"\d[\d.,]*\s*(?:points?|pts|%)?\s+of\s+(?:roughly\s+|abou
                       re.IGNORECASE)
 
 
+#: a total's word right after it: '6.3 points in total', '$806 in total reductions'
+_TOTAL_AFTER = re.compile(r"\s*(?:points?|pts)?\s*(?:in total|in all|altogether|combined|overall)\b", re.IGNORECASE)
+
+
 def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
     """A number after words that sum over the features, equal to one such sum (:attr:`FactBook.aggregates`):
     verified; otherwise None (its other readings decide)."""
     before = masked[max(0, n.start - 50):n.start]
-    if not book.aggregates or not (AGGREGATE_CUE.search(before) or _PART_OF.search(before)):
+    if not book.aggregates or not (AGGREGATE_CUE.search(before) or _PART_OF.search(before)
+                                   or _TOTAL_AFTER.match(masked, n.end)):
         return None
     for what, v in book.aggregates.items():
-        if (matches(n, v) and not n.percent) or (n.points and percent_reading(n, v)):  # ('50 %' is a share)
+        if (matches(n, v) and (n.points or not n.percent)) or (n.points and percent_reading(n, v)):  # ('50 %' is
+            # a share; '21.9 points' a sum of contributions in points, or of probabilities read as points)
             return Claim("number", n.text, "verified", what)
     return None
 
