@@ -164,7 +164,8 @@ def test_table_cells_are_items_and_an_unnamed_feature_is_not_wrong():
     def numbers(text):
         return [(c.text, c.status) for c in xairl.verify(text, air, 0).claims if c.kind == "number"]
     row = numbers("traffic 2.4 +7.2 | lag reading 48.2 +14.7 | wind 0.8 +6.9")
-    assert [s for _, s in row] == ["verified", "verified", "unchecked", "unchecked", "verified", "verified"]
+    assert [s for _, s in row] == ["verified", "verified", "unchecked", "verified", "verified", "verified"]  # (+14.7:
+    # the one feature whose push it is)
     assert ("+9.9", "contradicted") in numbers("traffic 2.4 +7.2 | wind 0.8 +9.9")
     assert numbers("Top factors | traffic = 2.4 | +7.2 || wind 0.8 m/s | +6.9 || sheltered site | +3.3")[-1] == (
         "+3.3", "unchecked")  # (not the wind's)
@@ -220,6 +221,39 @@ def test_the_outputs_own_words_idioms_and_totals(text, accurate):
     exp = dropout if "points" in text or "drop" in text else cost
     result = xairl.verify(text, exp, 0)
     assert result.accurate == accurate, [(c.status, c.text, c.detail) for c in result.claims]
+
+
+@pytest.mark.parametrize("text,accurate", [
+    ("About 7.2 of that comes from the traffic, and 6.9 from the wind.", True),  # where a push comes from
+    ("About 7.2 of that comes from the traffic, and 4.9 from the wind.", False),
+    ("The traffic is about one and a half times the wind.", True),  # 'one': a ratio word, no value
+])
+def test_where_a_push_comes_from(text, accurate):
+    from xairl.narrators.verify import rules
+    result = xairl.verify(text, rules.example("air"), 0)
+    assert result.accurate == accurate, [(c.status, c.text, c.detail) for c in result.claims]
+
+
+def test_a_plus_sign_marks_a_push_not_the_output():
+    """'made the forecast higher (+2.2)' of a thing the vocabulary lacks: the one feature whose push it is, not the
+    forecast (52.1); a push no feature has is left unchecked (whose it is is unsaid), not read as the forecast."""
+    from xairl.narrators.verify import rules
+
+    def number(text):
+        return [(c.status, c.detail) for c in xairl.verify(text, rules.example("air"), 0).claims if c.kind == "number"]
+    assert number("Calm air, which on its own made the forecast higher (+2.2).") == [
+        ("verified", "precip_mm_24h's contribution (the only one it matches)")]
+    assert number("Calm air, which on its own made the forecast higher (+3.3).")[0][0] == "unchecked"
+
+
+def test_a_sum_of_probabilities_in_points():
+    from benchmarks.bench_verifier import one_output
+    churn = one_output(["Contract", "tenure_months", "MonthlyCharges"], ["Two year", 58, 80.0],
+                       [-0.152, -0.094, 0.051], 0.26, "churn probability")
+    assert xairl.verify("The contract and tenure together pull the estimate down by around 25 points.", churn,
+                        0).accurate
+    assert not xairl.verify("The contract and tenure together pull the estimate down by around 35 points.", churn,
+                            0).accurate
 
 
 def test_a_signed_number_ends_the_item_before_the_next_name():

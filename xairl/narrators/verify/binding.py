@@ -114,6 +114,13 @@ AGGREGATE_NOUNS = frozenset({"total", "sum", "net", "gap", "difference", "change
                              "baseline", "margin", "lead", "output", "delta"})
 
 
+#: what a push comes from, right after its number: '19 points of that come from the contract', 'about 14 from the
+#: 12% price increase' (a value of the name may stand before it)
+_FROM_NAME = re.compile(r"\s*(?:percentage points?|points?|pts|pp)?\s*(?:of (?:that|it|this)\s+)?(?:comes?\s+|came\s+)?"
+                        r"(?:from|due to|thanks to|because of)\s+(?:the\s+|its\s+|their\s+|his\s+|her\s+|a\s+|an\s+)?"
+                        r"(?:[\d.,]+\s*%?\s+)?(?=\0)", re.IGNORECASE)
+
+
 #: an identifier that is no name, then '=' or ':', right before a number ('run_id=7781', 'latency_ms: 42')
 _LOG_KEY = re.compile(r"(?<![\w\0])([A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+)\s?[:=]\s?$")
 
@@ -219,6 +226,10 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     by_cue = _by_cue(n, masked, mentions, names, book)
     if by_cue is not None:
         return named(by_cue, "number.cue")
+    src = _FROM_NAME.match(masked, n.end)
+    owner = next((m for m in names if src and m.start == src.end()), None)
+    if owner is not None:  # 'about 14 from the 12% price increase': that name's push
+        return named(quantities.feature_number(n, owner.keys, masked, book, ctx, unit_of), "number.from-name")
     nxt = next((m for m in mentions if m.start >= n.end and m.start - n.end <= 14), None)
     # '+22.0 for the handover' after a feature, 'worth 11.5 for ...': the feature's push, not the action's score
     pushes = (n.sign == "+" or re.search(r"\bworth\s*$", masked[:n.start])) and any(x.end <= n.start for x in names)

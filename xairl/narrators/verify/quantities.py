@@ -46,7 +46,8 @@ _BASE_BEFORE = re.compile(r"\b(?:baseline|average|typical|mean|expected)\s+(?:pr
                           r"\s*(?:of|is|was|:|=)?\s*[$€£]?\s*$", re.IGNORECASE)
 _OUT_WORDS = re.compile(r"\b(predict\w*|estimat\w*|valu\w*|puts|sits|probability|chance|risk|price|output|final)\b",
                         re.IGNORECASE)
-_SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|features|narratives|coalitions|times|"
+_SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|features|narratives|coalitions|"
+                         r"(?:and an? (?:half|third|quarter)\s+)?times|"
                          r"-fold|outcomes|options|classes|sides|factors|reasons|drivers|categories|possibilities|"
                          r"scenarios|-?points?\s+scale|scale)\b|[x×](?![\w])|"
                          r"(?:[A-Za-z\0][\w\0'-]*\s+){0,2}(?:factors|reasons|drivers|features|things|variables|inputs)\b)",
@@ -336,13 +337,17 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
                     n.percent and percent_reading(n, prediction))):
                 return Claim("number", n.text, "verified", "the prediction (next to a word for the average)")
             named = ("the baseline", [book.base])  # ('your risk is about average (33%)': the prediction)
-        elif _OUT_WORDS.search(before):
-            named = ("the prediction", [book.scores[book.chosen]])
+        elif _OUT_WORDS.search(before) and n.sign != "+":  # ('made extending more valuable (+1.0)', 'Price +0.051':
+            named = ("the prediction", [book.scores[book.chosen]])  # a plus sign marks a push, not where it ends)
     if named is not None and named[1]:
         ok = any(matches(n, v, magnitude_ok=False) or (n.percent and percent_reading(n, v)) for v in named[1])
         return Claim("number", n.text, "verified" if ok else "contradicted", f"{named[0]} is {named[1][0]:.4g}")
     if any(matches(n, v) or (n.percent and percent_reading(n, v)) for v in book.decision_numbers):
         return Claim("number", n.text, "verified", "a decision-level fact")
+    if n.sign == "+" and (owners := _owners(n, book)):  # '(+1.0)' of a thing the vocabulary lacks: whose push
+        return Claim("number", n.text, "verified" if len(owners) == 1 else "unchecked",
+                     f"{owners[0]}'s contribution (the only one it matches)" if len(owners) == 1 else
+                     f"a contribution of one of {', '.join(owners)}: which is unsaid")
     if book.closed:
         return Claim("number", n.text, "contradicted", "none of the facts the summary was made from")
     return Claim("number", n.text, "unchecked", "tied to no feature or quantity of this explanation")

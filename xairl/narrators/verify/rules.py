@@ -85,6 +85,10 @@ RULES: tuple[Rule, ...] = (
          fires=(("robot", "Speed gives recharge -0.7."),), silent=(("robot", "Speed gives turn +0.5."),)),
     Rule("number.output-after", "number", "a number right before the output's own name ('52 in pm2_5')",
          fires=(("air", "Traffic leaves 52.1 in the forecast."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("number.from-name", "number", "a push and where it comes from: 'about 14 from the 12% price increase', "
+         "'19 points of that come from the contract'",
+         fires=(("air", "About 7.2 of that comes from the traffic, and 6.9 from the wind."),),
+         silent=(("air", "Traffic adds 7.2."),)),
     Rule("number.name-after", "number", "a number bound by position: the name right after it ('a 48.2 lag-1 "
          "reading'), unless it is signed or a field's value: then it ends the item before ('wait_max -2.31 elapsed')",
          fires=(("air", "A 2.4 traffic index adds to it."),),

@@ -49,7 +49,8 @@ def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book:
 
     def close(total: float, k: int) -> bool:  # a sum of k rounded figures may be off by k half-steps
         return matches(n, total) or (not n.hedge and abs(abs(n.value) - abs(total)) <= k * n.unit / 2 + 1e-9
-                                     and (not n.sign or (n.value < 0) == (total < 0)))
+                                     and (not n.sign or (n.value < 0) == (total < 0))) or (
+            n.points and percent_reading(n, total if n.sign else abs(total)))  # ('25 points' of -0.246)
 
     if n.percent and not n.points:  # 'A and B together explain about 70 % of the attribution': their shares (of
         # all |contributions|, of their side's, of the net change: 'together add 34.1, about 87 % of it')
