@@ -204,7 +204,8 @@ def test_ranks_of_several_names_and_of_one_side(text, accurate):
 
 
 @pytest.mark.parametrize("text,accurate", [
-    ("Claims on this policy are expected to cost around $2,600.", True),  # the output's own word: no push
+    ("Claims on this policy are expected to cost around $1,560.", True),  # the output's own word: no push, but
+    ("Claims on this policy are expected to cost around $2,600.", False),  # the output (1,563)
     ("Students like her drop out more often, so the model adds about 4.4 points.", True),
     ("Her age, 44, works in your favour by roughly $88.", True),  # whose favour: the reader's, unsaid
     ("Her age does the heaviest lifting.", True),  # an idiom of size, not of way
@@ -254,6 +255,29 @@ def test_a_sum_of_probabilities_in_points():
                         0).accurate
     assert not xairl.verify("The contract and tenure together pull the estimate down by around 35 points.", churn,
                             0).accurate
+
+
+@pytest.mark.parametrize("text,accurate", [
+    ("Reviewed: traffic (+7.2), dry soil (+0.1), 31.5 °C (+2.2).", True),  # each '(x), ' starts a list's item
+    ("Reviewed: traffic (+7.2), wind (+6.1).", False),
+    ("22.0 baseline, 52.1 predicted.", True),
+    ("22.0 baseline, 48.1 predicted.", False),
+    ("The model starts from an average forecast of 22.0.", True),
+    ("Traffic plus the junction make up 9.9.", True),  # a sum over a thing the vocabulary lacks: unchecked
+    ("Traffic and wind together add 19.9.", False),
+])
+def test_list_items_outputs_named_after_and_sums_with_unknown_members(text, accurate):
+    from xairl.narrators.verify import rules
+    result = xairl.verify(text, rules.example("air"), 0)
+    assert result.accurate == accurate, [(c.status, c.text, c.detail) for c in result.claims]
+
+
+def test_a_heading_before_a_colon_is_no_invented_feature():
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["gpa", "scholarship"], [3.6, "yes"], [-7.0, -5.0], 18.0, "dropout risk")
+    claims = xairl.verify("Good news on Aisha: the model puts her dropout risk at just under 6%, against a cohort "
+                          "average of about 18%.", exp, 0).claims
+    assert not [c for c in claims if c.kind == "feature" and c.status == "contradicted"]
 
 
 def test_a_signed_number_ends_the_item_before_the_next_name():

@@ -27,7 +27,8 @@ _ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|land
                       r"(?<!up)(?<!next)(?<!compared)(?<!relative)(?<!similar)\s+to\s+(?:about|around|roughly|only|"
                       r"just)?\s*[$€£]?$", re.IGNORECASE)  # ('drags it well below the 34 % base, to about 14 %')
 _FROM = re.compile(r"\bfrom\s+(?:(?:an?|the|its)\s+)?(?:(?:average|base(?:line)?|base rate|starting point|typical)"
-                   r"(?:\s+(?:rate|value|estimate|prediction))?\s+(?:of\s+)?)?[$€£]?\s*$", re.IGNORECASE)
+                   r"(?:\s+(?:rate|value|estimate|prediction|q(?:[\s-]?value)?))?\s+(?:of\s+)?)?[$€£]?\s*$",
+                   re.IGNORECASE)
 _FROM_TO = re.compile(r"\bfrom\s+[^;]{1,40}?\s+(?:down\s+|up\s+)?to\s+(?:about|around|roughly)?\s*[$€£]?$",
                       re.IGNORECASE)
 #: 'the handover's lead of 3.9', 'turning's lead over going forward was 1.55'
@@ -59,7 +60,8 @@ OUTPUT_BEFORE = re.compile(r"\b(?:estimated\s+|predicted\s+)?q[\s-]?values?\s+(?
                            re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
 _OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
-                           r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)",
+                           r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)"
+                           r"|\s*(?:predicted|forecast)\s*(?:[.;,)]|$)",  # ('$1,850 baseline, $2,739 predicted.')
                            re.IGNORECASE)
 #: 'speed argued for X (-5.48)', 'obstacle barely affected the turn score (-0.09)': the feature's contribution
 _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact\w*|influenc\w*|matter\w*|"
@@ -279,9 +281,10 @@ def _output_is(before: str, book: FactBook) -> bool:
 @functools.lru_cache(maxsize=64)
 def _output_words(outputs: tuple[str, ...]) -> re.Pattern:
     words = {w for a in outputs for w in split_words(a) if len(w) >= 4} | {"forecast", "prediction", "estimate"}
-    return re.compile(rf"\b(?:{'|'.join(map(re.escape, sorted(words)))})\s+(?:is|was|stands at|stood at|comes out at|"
+    return re.compile(rf"\b(?:{'|'.join(map(re.escape, sorted(words)))})\s+(?:(?:is|was|stands at|stood at|comes out at|"
                       rf"came out at|sits at|=|:)\s*(?:about|around|roughly|approximately|just under|just over|"
-                      rf"nearly|almost)?\s*[$€£]?$", re.IGNORECASE)
+                      rf"nearly|almost)?|about|around|roughly|approximately)\s*[$€£]?$", re.IGNORECASE)  # (and 'to cost
+    # around $2,600' of a claim cost)
 
 
 def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
@@ -353,6 +356,12 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
                          "number.action-before")
         prev = next((m for m in reversed(names) if m.end <= n.start), None)
     gap_text = re.sub(r"\([^()]*\)", "()", masked[prev.end:n.start]) if prev is not None else ""
+    listed = re.search(r"\(\),\s(?P<rest>[^()]*)\(?$", gap_text)
+    if listed and not re.search(r"\b(?:by|which|that|who|with|at|of|and|to|for|worth|it|its)\b", listed.group("rest"),
+                                re.IGNORECASE) and not _ITEM_VERB.search(listed.group("rest")) and not \
+            checks.DIRECTION_RE.search(listed.group("rest")):
+        prev = None  # 'Tuesday (+0.3), 31.5 °C (+0.7)': a list's next item, its label the vocabulary lacks (not
+        # 'A (2.04), by +7.86', 'A (-0.45), which favoured B by 2.03': the same name's)
     item = _NEW_ITEM.search(gap_text)
     if item is not None and re.search(r"\d", gap_text[:item.start()]) and not _ITEM_VERB.search(item.group("words")) \
             and not checks.DIRECTION_RE.search(item.group("words")):  # '..., year 1945' (not '..., added 6.8')

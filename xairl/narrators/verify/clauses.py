@@ -59,6 +59,10 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
             c = binding.by_parse(c, n, masked, book, ctx, unit_of, parsed, vocab)
         if c.status == "contradicted" and id(n) not in paired:
             c = binding.unless_elsewhere(c, n, masked, mentions, book, ctx, parsed, unit_of, sentence_keys)
+        if c.status == "contradicted" and len({m.keys for m in said_names}) == 1 and id(n) not in paired and \
+                _SUM_CUE.search(masked, a, n.start) and re.search(r"\band\b|\bplus\b", masked[a:n.start]):
+            c = Claim("number", n.text, "unchecked", "a sum over things the words name but the vocabulary does not "
+                      "all know ('the mileage and garage offsets together')", "number.sum-unnamed")
         out.append(c)
     first = numbers[0] if numbers else None
     if first is not None and first.sign and not any(m.start < first.start for m in mentions):
@@ -78,7 +82,7 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
 
 #: 'A and B together add x', 'combined', 'sum to', 'between them': the number is their sum
 _SUM_CUE = re.compile(r"\b(?:together|combined|jointly|in total|taken together|between them|sum(?:s|med)? to|add up to|"
-                      r"in sum)\b", re.IGNORECASE)
+                      r"in sum|make up)\b", re.IGNORECASE)
 _OWN_QUANTITY = re.compile(r"\bof\s+(?:the\s+)?[$€£]?$", re.IGNORECASE)
 _NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
                       r"(?:(?:because of|due to|about|the|its|their|a|an)\s+){0,3}$", re.IGNORECASE)

@@ -181,6 +181,8 @@ def said_of(doc, start: int, end: int, features=frozenset()) -> str | None:
             if s.lower_ in ("which", "that") and token.dep_ == "relcl":
                 s = token.head
             words = [t for t in s.subtree if t.idx < start]
+            if words and any(t.text == ":" for t in doc[words[-1].i:token.i]) or any(t.text == ":" for t in words):
+                return None  # 'Good news on Aisha: the model puts ...': a heading, not a subject
             if not words or s.pos_ in ("PRON", "DET", "NUM") or s.lower_ in _ACTORS or any(
                     set(t.ent_id_.split("|")) & features for t in words if t.ent_id_):
                 return None

@@ -67,6 +67,11 @@ RULES: tuple[Rule, ...] = (
          "change)", fires=(("air", "Traffic and wind together add 14.1."),
                            ("air", "Wind and traffic together add 14.1, about 47% of it.")), silent=(("air", "Traffic and wind add 7.2 and "
                                                                                    "6.9, respectively."),)),
+    Rule("number.sum-unnamed", "number", "a number after a sum's cue word in a clause that joins one known name with "
+         "words the vocabulary lacks ('the mileage and garage offsets together claw back $294'), contradicted as the "
+         "name's own: a sum over things not all known, unchecked",
+         fires=(("air", "Traffic plus the junction make up 9.9."),),
+         silent=(("air", "Traffic and wind together add 14.1."),)),
     Rule("number.aggregate", "number", "a sum over all features after its cue words ('the positives add up to')",
          fires=(("air", "The positives add up to 31.1."),), silent=(("air", "Traffic adds 7.2."),)),
     Rule("number.change", "number", "the change from the baseline ('30.0 above the average')",
