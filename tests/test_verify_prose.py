@@ -210,6 +210,7 @@ def test_ranks_of_several_names_and_of_one_side(text, accurate):
     ("Her age, 44, works in your favour by roughly $88.", True),  # whose favour: the reader's, unsaid
     ("Her age does the heaviest lifting.", True),  # an idiom of size, not of way
     ("Her age raises the expected cost by roughly $88.", False),
+    ("Her age pushes the cost up.", False),  # the output named as the verb's object: still a push
     ("The evening enrolment lowers the dropout probability.", False),
     ("The risk factors add 21.9 points in total.", True),  # a sum in the explanation's own points
     ("The risk factors add 25.9 points in total.", False),

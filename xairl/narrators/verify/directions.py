@@ -247,7 +247,7 @@ def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) 
     if _good_outcome(book) and re.match(
             r"\s+(?:the\s+|their\s+|its\s+|default\s+|credit\s+)?risk\b", masked[m.end():]):
         return True
-    if one_output and {stem(w).rstrip("~") for w in split_words(m.group(0))} & _output_stems(book.chosen or ""):
+    if one_output and stem(split_words(m.group(0))[0]).rstrip("~") in _output_stems(book.chosen or ""):
         return True  # the output's own word ('claims expected to cost $2,600' of a claim cost, 'students drop out
         # more often' of a dropout probability): what is predicted, not a push
     if re.search(r"\b(?:in|to)\s+(?:your|our|my|his|her|their)\s+(?:own\s+)?$|\bheav\w*\s+$",
