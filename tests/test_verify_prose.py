@@ -273,6 +273,18 @@ def test_list_items_outputs_named_after_and_sums_with_unknown_members(text, accu
     assert result.accurate == accurate, [(c.status, c.text, c.detail) for c in result.claims]
 
 
+def test_one_word_of_a_long_name_is_no_sure_binding():
+    """'bill $109.9 +.097': 'bill' is one word of price_increase_last_bill_pct, and both numbers are the monthly
+    charge's exactly: unchecked, not wrong; a number that is no fact after that word stays contradicted."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["price_increase_last_bill_pct", "MonthlyCharges"], [12, 109.9], [0.141, 0.097], 0.4, "churn")
+
+    def numbers(text):
+        return [(c.text, c.status) for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    assert numbers("bill $109.9 +.097") == [("$109.9", "unchecked"), ("+.097", "unchecked")]
+    assert ("+.099", "contradicted") in numbers("bill $109.9 +.099")
+
+
 def test_a_heading_before_a_colon_is_no_invented_feature():
     from benchmarks.bench_verifier import one_output
     exp = one_output(["gpa", "scholarship"], [3.6, "yes"], [-7.0, -5.0], 18.0, "dropout risk")

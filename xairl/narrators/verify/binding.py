@@ -127,6 +127,12 @@ _FROM_NAME = re.compile(r"\s*(?:percentage points?|points?|pts|pp)?\s*(?:of (?:t
 _LOG_KEY = re.compile(r"(?<![\w\0])([A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+)\s?[:=]\s?$")
 
 
+def _one_word_of_many(m) -> bool:
+    """A mention that is one short word while every name it may mean has four words or more ('bill' of
+    price_increase_last_bill_pct): a word the text shares with the name, not the name."""
+    return m.kind == "feature" and m.end - m.start <= 9 and all(len(split_words(k)) >= 4 for k in m.keys)
+
+
 def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, parsed, unit_of, keys) -> Claim:
     """A number bound by position alone (:data:`GUESSED`), contradicted, that states another fact of the explanation:
     the position was a guess, so it is unchecked. The binding is sure, and the number stays contradicted, when it
@@ -136,6 +142,11 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
         return c  # ('4.0 dB above': a difference in a unit, bound for sure; a number tied to no name is contradicted
         # only by the quantity its words name: '(4.45 vs 4.44)' after 'rather than recharge')
     owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
+    if owner is not None and _one_word_of_many(owner) and c.detail.find(f" {owner.keys[0]}'s ") >= 0 and (
+            other := quantities.any_fact(n, book, set(book.features) - set(owner.keys), ctx, strict=True)):
+        return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}, and "
+                     f"the name before it is one word of a long name", "number.other-feature")  # ('bill $109.9' of
+        # price_increase_last_bill_pct, when $109.9 is the monthly charge)
     if owner is not None and re.fullmatch(r"\s?[:=(]?\s?|\s?[:=]\s*", masked[owner.end:n.start]):
         return c
     key = _LOG_KEY.search(masked, max(0, n.start - 40), n.start)

@@ -108,7 +108,8 @@ RULES: tuple[Rule, ...] = (
          silent=(("air", "Traffic is heavy, so the forecast is 35.5."),)),
     Rule("number.other-feature", "number", "a number bound by position alone, contradicted, that measures no fact "
          "noun and states exactly (unhedged, two significant digits) a fact of a feature its sentence does not name: "
-         "the text may name that feature in words the vocabulary lacks ('bill $109.9'), unchecked",
+         "the text may name that feature in words the vocabulary lacks, or name it by one word of a long name ('bill "
+         "$109.9' of price_increase_last_bill_pct when $109.9 is the monthly charge), unchecked",
          fires=(("air", "Traffic is heavy, with yesterday's level at 14.7."),),
          silent=(("air", "Traffic is heavy, with yesterday's level at 12.3."),
                  ("air", "Traffic is heavy, with an increase of 14.7."))),
