@@ -142,7 +142,7 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
         return c  # ('4.0 dB above': a difference in a unit, bound for sure; a number tied to no name is contradicted
         # only by the quantity its words name: '(4.45 vs 4.44)' after 'rather than recharge')
     owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
-    if owner is not None and _one_word_of_many(owner) and c.detail.find(f" {owner.keys[0]}'s ") >= 0 and (
+    if owner is not None and c.rule == GUESSED[1] and _one_word_of_many(owner) and (
             other := quantities.any_fact(n, book, set(book.features) - set(owner.keys), ctx, strict=True)):
         return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}, and "
                      f"the name before it is one word of a long name", "number.other-feature")  # ('bill $109.9' of

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import re
 
-from . import background, binding, comparisons, directions, quantities, ranks, sums
+from . import background, binding, comparisons, directions, noclaims, quantities, ranks, sums
 from .book import FactBook
 from .checks import Claim
 from .names import Mention, named_features
@@ -17,33 +17,14 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
     out: list[Claim] = []
     name_words = vocab.name_words
     names = named_features(mentions)
-    numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not quantities.skip_number(n, masked)
-               and not quantities.window_of_name(n, sentence_keys)]
-    # 'A and B ... by x and y, respectively': numbers after the last name pair up with the names in order
-    tail = [n for n in numbers if names and n.start > names[-1].end  # not the last name's own '(−22.5 dB)'
-            and not re.fullmatch(r"\s?\([^()]*", masked[names[-1].end:n.start])]
-    paired = {}
-    own_cue = any(background.statistic(masked[max(0, n.start - 60):n.start]) or binding.OUTPUT_BEFORE.search(
-        masked[max(0, n.start - 60):n.start]) for n in tail)  # '... worth about $316k instead of the usual $230k'
-    if len({m.keys for m in names}) >= 2 and len(tail) == len(names) and not own_cue and not _SUM_CUE.search(
-            masked, names[-1].end, tail[0].start) and (  # ('A and B together add x, y % of it': a sum)
-            "respectively" in masked[a:b].lower() or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
-            or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
-                and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
-        paired = {id(n): m for n, m in zip(tail, names)}
+    numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not noclaims.skip_number(n, masked)
+               and not noclaims.window_of_name(n, sentence_keys)]
+    tail, paired, summed = _lists(masked, a, b, names, numbers)
     paired |= comparisons.compared_pairs(masked, a, b, names, numbers)  # 'A mattered twice as much as B (0.88 vs 0.49)'
     actions = [m for m in mentions if m.kind == "action"]
     scored = {}
     if not names and len(actions) >= 2 and len(numbers) == len(actions) and numbers[0].start >= actions[-1].end:
         scored = {id(n): m for n, m in zip(numbers, actions)}  # 'turn beat recharge 6.30 to 2.37'
-    # 'A and B together add x': one number after the names (not B's own '(+5.31)', not a list 'x and y'), without a
-    # quantity of its own ('most of the $91,462 above the baseline')
-    # (with more numbers after: the cue between the names and the first, 'A, B and C together add x, y % of it', and
-    # not one number per name, '(+10.97 and +22.02)')
-    summed = len(tail) >= 1 and len(names) >= 2 and (_SUM_CUE.search(masked, a, b) if len(tail) == 1 else _SUM_CUE.search(
-        masked, names[-1].end, tail[0].start) and (len(tail) != len({m.keys for m in names}) or tail[1].percent)) \
-        and not _OWN_QUANTITY.search(
-        masked[max(a, tail[0].start - 12):tail[0].start]) and not quantities.CHANGE_AFTER.match(masked[tail[0].end:b])
     # 'not the garage but the quality', 'X, rather than Y, is ...': what is said of the sentence is not said of Y
     said = [m for m in mentions if m.kind == "action" or not _NEGATED.search(masked[max(a, m.start - 40):m.start])]
     said_names = named_features(said)
@@ -78,6 +59,33 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
         if owner is not None:
             out.append(binding.named(ranks.check_minor(owner.keys, ctx, book, m.group(0)), "rank.minor"))
     return out
+
+
+def _lists(masked: str, a: int, b: int, names: list[Mention], numbers) -> tuple[list, dict, bool]:
+    """The numbers after the clause's last name (``tail``), paired with the names in order when they list one number
+    per name ('A and B ... by x and y, respectively': id(number) -> mention), and whether the first of them is the
+    names' sum ('A and B together add x')."""
+    # 'A and B ... by x and y, respectively': numbers after the last name pair up with the names in order
+    tail = [n for n in numbers if names and n.start > names[-1].end  # not the last name's own '(−22.5 dB)'
+            and not re.fullmatch(r"\s?\([^()]*", masked[names[-1].end:n.start])]
+    paired = {}
+    own_cue = any(background.statistic(masked[max(0, n.start - 60):n.start]) or binding.OUTPUT_BEFORE.search(
+        masked[max(0, n.start - 60):n.start]) for n in tail)  # '... worth about $316k instead of the usual $230k'
+    if len({m.keys for m in names}) >= 2 and len(tail) == len(names) and not own_cue and not _SUM_CUE.search(
+            masked, names[-1].end, tail[0].start) and (  # ('A and B together add x, y % of it': a sum)
+            "respectively" in masked[a:b].lower() or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
+            or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
+                and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
+        paired = {id(n): m for n, m in zip(tail, names)}
+    # 'A and B together add x': one number after the names (not B's own '(+5.31)', not a list 'x and y'), without a
+    # quantity of its own ('most of the $91,462 above the baseline')
+    # (with more numbers after: the cue between the names and the first, 'A, B and C together add x, y % of it', and
+    # not one number per name, '(+10.97 and +22.02)')
+    summed = len(tail) >= 1 and len(names) >= 2 and (_SUM_CUE.search(masked, a, b) if len(tail) == 1 else _SUM_CUE.search(
+        masked, names[-1].end, tail[0].start) and (len(tail) != len({m.keys for m in names}) or tail[1].percent)) \
+        and not _OWN_QUANTITY.search(
+        masked[max(a, tail[0].start - 12):tail[0].start]) and not quantities.CHANGE_AFTER.match(masked[tail[0].end:b])
+    return tail, paired, bool(summed)
 
 
 #: 'A and B together add x', 'combined', 'sum to', 'between them': the number is their sum

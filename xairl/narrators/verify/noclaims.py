@@ -1,0 +1,56 @@
+"""Numbers in a text that are no claims: list markers, identifiers, counts of the method's inputs or of the factors
+a sentence lists, ratios read by :mod:`.comparisons`, the window a feature's name holds."""
+from __future__ import annotations
+
+import re
+
+from .numbers import Number
+
+_SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|features|narratives|coalitions|"
+                         r"(?:and an? (?:half|third|quarter)\s+)?times|"
+                         r"-fold|outcomes|options|classes|sides|factors|reasons|drivers|categories|possibilities|"
+                         r"scenarios|-?points?\s+scale|scale)\b|[x×](?![\w])|"
+                         r"(?:[A-Za-z\0][\w\0'-]*\s+){0,2}(?:factors|reasons|drivers|features|things|variables|inputs)\b)",
+                         re.IGNORECASE)  # ('the three upward drivers')
+_LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state|outcome|class|type|acct|account|ref|"
+                           r"ticket|order|episode|ep|seed|run|version|customer|patient|flight|no\.)[\s\-=:#]*$",
+                           re.IGNORECASE)
+_OF_PEOPLE = re.compile(r"\s+of\s+(?:the\s+|their\s+|its\s+|all\s+)?(?:[\w-]+\s+){0,2}?(?:peers|students|people|"
+                        r"customers|clients|applicants|borrowers|teams|players|cases|samples|population|dataset|"
+                        r"houses|homes|users|patients|rows|records)\b", re.IGNORECASE)
+
+
+def skip_number(n: Number, masked: str) -> bool:
+    """Numbers that are not claims: list markers ('1.' at a line start), identifiers ('candidate 2', 'top-3'),
+    counts of the method's inputs ('100 background rows')."""
+    before = masked[:n.start]
+    if re.search(r"(^|\n)\s*$", before) and re.match(r"^[.)]\s", masked[n.end:n.end + 2]):
+        return True
+    if (masked[n.start - 1:n.start] == "\0" and not masked[n.start].isspace()) or masked[n.end:n.end + 1] == "\0":
+        return True  # glued to a name: 'PM2.5' of a masked 'PM2', '2nd' of a name
+    if re.search(r"\bout of\s*$", before, re.IGNORECASE):  # 'rated 4 out of 5': the scale's top
+        return True
+    if n.percent and _OF_PEOPLE.match(masked, n.end):  # 'unlike 95% of their peers': a share of the background
+        return True
+    if n.percent and re.match(r"\s*of\s+(?:the\s+|its\s+|their\s+)?\0", masked[n.end:]):
+        return True  # '60 % of the alcohol effect': a ratio to that name (:mod:`.comparisons`)
+    if re.match(r"^\s+(?:most|largest|biggest|main|top|strongest|key)\b", masked[n.end:]):  # 'the two largest'
+        return True
+    if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):
+        return True  # all three
+    if n.text[0].isalpha() and re.search(r"\b(?:of|among) the\s+$", before, re.IGNORECASE):
+        return True  # 'the strongest of the three'
+    if n.text.lower() == "one" and re.match(r"\s+of\s+(?:the|its|their|our|these|those)\b", masked[n.end:]):
+        return True  # 'one of the pricier neighbourhoods'
+    if n.text.lower() == "one" and re.search(r"\b(this|that|the|which|each|every|any|no|a)\s+(?:[a-z]+\s+)?$", before,
+                                             re.IGNORECASE):
+        return True  # 'this one', 'the big one': a pronoun
+    return bool(_LABEL_BEFORE.search(before)) or bool(_SKIP_AFTER.match(masked[n.end:]))
+
+
+def window_of_name(n: Number, keys) -> bool:
+    """An integer that is the window or range a named feature's name holds ('fires within 200 km' of
+    ``fire_count_200km``, 'in the last 30 days' of ``data_usage_gb_30d``): a part of the name, not a claim."""
+    if n.sign or n.percent or n.currency or n.hedge or n.value != int(n.value):
+        return False
+    return any(str(int(n.value)) in re.findall(r"(\d+)[a-z]", k.lower()) for k in keys)
