@@ -994,3 +994,20 @@ def test_sums_and_scoped_ranks():
     assert _status("Among the positives, odor is the largest.") == "verified"
     assert _status("Among the positives, gill size is the largest.") == "contradicted"
     assert _status("Of the factors lowering the prediction, the cap diameter matters most.") == "verified"
+
+
+def test_a_qualifier_after_an_ambiguous_name_and_a_compound_modifier():
+    """'the queue on the east approach' is queue_east (its words qualify an ambiguous 'queue' after it, and the
+    'approach' of approach_speed inside it names nothing); 'the 19-vehicle queue' is a queue, not the emergency
+    vehicle; a wrong number for the qualified queue stays contradicted."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["queue_east", "queue_north", "emergency_vehicle", "approach_speed_avg_kmh"],
+                     [19, 2, "none", 31.4], [4.06, 1.73, 0.05, -0.27], -13.85, "Q-value of switching")
+
+    def claims(text):
+        return [(c.text, c.status, c.detail.split(":")[0]) for c in xairl.verify(text, exp, 0).claims
+                if c.kind == "number"]
+    assert claims("The main reason is the 19-vehicle queue on the east approach, worth about +4.1.") == [
+        ("19", "verified", "queue_east"), ("+4.1", "verified", "queue_east")]
+    assert claims("The queue to the north adds 1.7.") == [("1.7", "verified", "queue_north")]
+    assert claims("The queue on the north approach adds 4.1.")[0][1] == "contradicted"

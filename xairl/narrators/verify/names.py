@@ -335,12 +335,15 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
 def _modifiers(text: str, found: list[Mention]) -> list[Mention]:
     """A word of a longer feature name that only completes another feature's whole name: the head of a compound right
     after it ('corner kicks': Corners, not Free Kicks) or the object of 'on'/'of'/'per' after it ('attempts on goal':
-    Attempts, not Goal Scored)."""
+    Attempts, not Goal Scored); or that only qualifies the name right after it ('vehicle queue': a queue)."""
     out = []
     for prev, m in zip(found, found[1:]):
         if prev.kind == m.kind == "feature" and prev.form == "" and m.form == "part" and prev.keys != m.keys and \
                 re.fullmatch(r" |\s+(?:on|of|per)\s+", text[prev.end:m.start]):
             out.append(m)
+        elif prev.kind == m.kind == "feature" and prev.form == "part" and not set(prev.keys) & set(m.keys) and \
+                text[prev.end:m.start] == " " and " " not in text[prev.start:prev.end]:
+            out.append(prev)  # 'the 19-vehicle queue': a queue, not the emergency vehicle
     return out
 
 
@@ -354,6 +357,19 @@ _ORDINALS = frozenset({"second", "third", "fourth", "fifth", "2nd", "3rd", "4th"
 _IDIOM = re.compile(r"\b(?:on|of)\s+(?:its|their|his|her|my|our|your)\s+$", re.IGNORECASE)
 _QUALIFIER_STOP = re.compile(r"[,.;:!?()\[\]]|\b(?:the|a|an|and|or|of|with|by|to|was|is|were|are|than|from|while|"
                              r"for|at|as|on|in|its|their|his|her|that|which)\b", re.IGNORECASE)
+
+
+#: a qualifier after an ambiguous name: a preposition and a noun phrase of up to three words ('on the east approach')
+_AFTER_QUALIFIER = re.compile(r"\s+(?:on|to|in|at|of|from|for)\s+(?:the\s+)?((?:[^\W\d_]+\s+){0,2}[^\W\d_]+)\b",
+                              re.IGNORECASE)
+
+
+def _meant(keys: tuple[str, ...], qual: list[str], words: dict[str, frozenset[str]]) -> tuple[str, ...]:
+    """The meanings of an ambiguous name whose words hold every qualifying word; a meaning with an ordinal the
+    qualifier lacks goes ('the strongest neighbour' is not 'the second strongest neighbour')."""
+    meant = tuple(k for k in keys if qual and set(qual) <= words.get(k, frozenset()))
+    plain = tuple(k for k in meant if not (words.get(k, frozenset()) & _ORDINALS) - set(qual))
+    return plain or meant
 
 
 def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -> list[Mention]:
@@ -378,11 +394,17 @@ def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -
                 re.fullmatch(r"\s*(?:and|or|&|,)\s*", text[out[-1].end:m.start]):  # "candidate 1's RSRP and RSRQ"
             qual = [w for w in split_words(text[out[-1].start:out[-1].end]) if w in known]
             lo = m.start
-        keys = tuple(k for k in m.keys if qual and set(qual) <= words.get(k, frozenset()))
-        plain = tuple(k for k in keys if not (words.get(k, frozenset()) & _ORDINALS) - set(qual))
-        keys = plain or keys  # 'the strongest neighbour' is not 'the second strongest neighbour'
+        keys = _meant(m.keys, qual, words)
         if not keys or len(keys) == len(m.keys):
-            out.append(m)
+            after = _AFTER_QUALIFIER.match(text, m.end)  # 'the queue on the east approach': queue_east
+            qual = [w for w in split_words(after.group(1)) if w in known] if after else []
+            keys = _meant(m.keys, qual, words)
+            if keys and len(keys) < len(m.keys):
+                while found_after := [n for n in found if m.end < n.start < after.end()]:
+                    found.remove(found_after[0])  # 'approach' of approach_speed inside the qualifier
+                out.append(Mention(m.start, after.end(), "feature", keys))
+            else:
+                out.append(m)
             continue
         qualifier = text[lo:m.start]
         first = min(lo + len(qualifier) - len(qualifier.lstrip()), m.start)  # where the qualifying words begin
