@@ -1011,3 +1011,15 @@ def test_a_qualifier_after_an_ambiguous_name_and_a_compound_modifier():
         ("19", "verified", "queue_east"), ("+4.1", "verified", "queue_east")]
     assert claims("The queue to the north adds 1.7.") == [("1.7", "verified", "queue_north")]
     assert claims("The queue on the north approach adds 4.1.")[0][1] == "contradicted"
+
+
+def test_the_first_number_of_a_sentence_about_the_average_case_is_the_baseline():
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["Q3_grade", "attendance_pct"], [54, 71], [9.6, 7.2], 18.4, "probability of dropping out")
+
+    def numbers(text):
+        return [(c.text, c.status, c.detail) for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    assert numbers("On average, a student has about an 18% chance of dropping out.") == [
+        ("18%", "verified", "the baseline is 18.4")]
+    assert numbers("On average, a student has about a 25% chance of dropping out.")[0][1] == "contradicted"
+    assert numbers("For Marcus the model says about 35%.")[0][1] == "verified"

@@ -20,6 +20,14 @@ _STAT_BEFORE = re.compile(r"\b(?P<word>average|typical|median|mean|usual|normal|
 _OUTPUT_NOUN = re.compile(r"\b(?:predict\w*|estimat\w*|output|probabilit\w*|chances?|risk|rate|price|scores?|"
                           r"q[- ]?values?)\b", re.IGNORECASE)
 
+#: a sentence about the average case ('On average, a student has about an 18 % chance of dropping out')
+_OPENS_AVERAGE = re.compile(r"^\W*(?:on average|typically|in general|for the (?:average|typical) \w+)\b", re.IGNORECASE)
+
+
+def first_of_the_average(n: Number, masked: str) -> bool:
+    """Is ``n`` the first number of a sentence about the average case? Then it is the baseline."""
+    return bool(_OPENS_AVERAGE.match(masked)) and not re.search(r"\d", masked[:n.start])
+
 
 #: '(2 vs. ~5.75)', '(18 vs. 16.8)' after a feature's value: the background's typical value (with one output; with
 #: several, 'vs' sets a score against the runner-up's)

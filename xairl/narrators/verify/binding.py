@@ -304,10 +304,10 @@ def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
     8.32-point lead'); None when they say nothing."""
     span = max(0, n.start - 60)
     if book.output != "actions" and book.base is not None:
+        if background.first_of_the_average(n, masked) or _KEY_BASE.search(masked[span:n.start]):
+            return background.base_number(n, book)  # 'On average, a student has about an 18% chance', 'base=0.3'
         if _KEY_OUTPUT.search(masked[span:n.start]) or _output_is(masked[span:n.start], book):
             return quantities.output_number(n, book)
-        if _KEY_BASE.search(masked[span:n.start]):
-            return background.base_number(n, book)
     stat = background.statistic(masked[span:n.start], any(m.kind == "action" and span <= m.start < n.start
                                                           for m in mentions), book.output == "actions",
                                 bool(re.match(r"[^()]*?\b(?:vs\.?|versus|compared)\b", masked[n.end:n.end + 40])))
