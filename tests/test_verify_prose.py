@@ -1023,3 +1023,17 @@ def test_the_first_number_of_a_sentence_about_the_average_case_is_the_baseline()
         ("18%", "verified", "the baseline is 18.4")]
     assert numbers("On average, a student has about a 25% chance of dropping out.")[0][1] == "contradicted"
     assert numbers("For Marcus the model says about 35%.")[0][1] == "verified"
+
+
+def test_abbreviations_in_feature_names_are_read_as_the_words_people_write():
+    """'dist_to_charger_m' is 'the distance', 'battery_pct' 'the battery': a ranking in those words is checked."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["dist_to_charger_m", "pending_orders", "battery_pct"], [4.2, 2, 46], [0.88, 0.67, 0.49], 1.2,
+                     "Q-value of recharging")
+
+    def ranks(text):
+        return [c.status for c in xairl.verify(text, exp, 0).claims if c.kind == "rank"]
+    assert ranks("Ranking by magnitude: distance, pending orders, battery.") == ["verified"] * 3
+    assert "contradicted" in ranks("Ranking by magnitude: pending orders, distance, battery.")
+    assert [c.status for c in xairl.verify("The distance adds 0.5.", exp, 0).claims if c.kind == "number"] == [
+        "contradicted"]

@@ -29,6 +29,16 @@ GENERIC = {"size", "area", "number", "total", "rate", "ratio", "level", "value",
            "information", "prediction", "new", "old", "high", "low", "first", "second", "third", "average",
            "strongest", "weakest", "biggest", "largest", "main", "top", "overall",
            "other", "others"}  # rank words say which, not what
+#: abbreviations in feature names and the words people write for them ('dist_to_charger_m': 'the distance')
+ABBREVIATIONS = {"dist": "distance", "temp": "temperature", "avg": "average", "num": "number", "len": "length",
+                 "qty": "quantity", "pct": "percent", "perc": "percent", "max": "maximum", "min": "minimum",
+                 "cnt": "count", "amt": "amount", "freq": "frequency", "prev": "previous", "hr": "hour", "hrs": "hours",
+                 "yrs": "years", "yr": "year", "mins": "minutes", "sec": "seconds", "secs": "seconds",
+                 "wk": "week", "mo": "month", "mgmt": "management", "dept": "department", "emp": "employee",
+                 "std": "deviation", "vol": "volume", "bal": "balance", "inc": "income", "pop": "population",
+                 "elev": "elevation", "alt": "altitude", "lat": "latitude", "lon": "longitude", "lng": "longitude",
+                 "spd": "speed", "accel": "acceleration", "humid": "humidity", "precip": "precipitation",
+                 "batt": "battery", "conc": "concentration", "env": "environment", "cust": "customer"}
 #: participles that name a feature whose words are said the other way round ('year built' -> 'the build year')
 _BASE_FORM = {"built": "build", "sold": "sale", "made": "make", "paid": "pay", "owned": "own", "used": "use"}
 _IRREGULAR = {"keep": "kept", "go": "went", "choose": "chose", "hold": "held", "run": "ran", "stay": "stayed"}
@@ -98,7 +108,10 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
         for form in forms:
             if form and clean(form):
                 exact.setdefault(_phrase(form), set()).add(f)
-        for form in [f] + ([_head(described)] if described else []):
+        spelled = [" ".join(ABBREVIATIONS[w] if w in ABBREVIATIONS else w for w in name_words)]  # 'distance to ...'
+        spelled = spelled if spelled[0] != " ".join(name_words) else []
+        feature_words[f] |= frozenset(w for form in spelled for w in form.split() if w not in STOP)
+        for form in [f] + ([_head(described)] if described else []) + spelled:
             if clean(form) and not REGION_RE.match(f.removeprefix("the ")):  # a region: only by its whole name
                 for run in _runs(form, f):
                     phrases.setdefault(run, set()).add(f)
