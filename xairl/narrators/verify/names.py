@@ -18,30 +18,7 @@ from ...explanation import Explanation
 from ...observation import REGION_RE
 from ...policy import Policy
 from .book import legend
-
-STOP = {"the", "a", "an", "of", "in", "on", "to", "for", "and", "or", "s", "its", "it", "by", "with", "at", "from",
-        "per", "than", "is", "as", "out", "above", "below", "over", "under", "after", "before", "between", "within",
-        "into", "onto", "about"}
-#: words too generic to name a feature on their own
-GENERIC = {"size", "area", "number", "total", "rate", "ratio", "level", "value", "values", "score", "type", "years",
-           "year", "feature", "count", "amount", "length", "time", "state", "status", "quality", "id", "feet",
-           "square", "sq", "ft", "kb", "m", "db", "dbm", "bit", "bits", "percent", "one", "two", "model", "data",
-           "information", "prediction", "new", "old", "high", "low", "first", "second", "third", "average",
-           "strongest", "weakest", "biggest", "largest", "main", "top", "overall",
-           "other", "others"}  # rank words say which, not what
-#: abbreviations in feature names and the words people write for them ('dist_to_charger_m': 'the distance')
-ABBREVIATIONS = {"dist": "distance", "temp": "temperature", "avg": "average", "num": "number", "len": "length",
-                 "qty": "quantity", "pct": "percent", "perc": "percent", "max": "maximum", "min": "minimum",
-                 "cnt": "count", "amt": "amount", "freq": "frequency", "prev": "previous", "hr": "hour", "hrs": "hours",
-                 "yrs": "years", "yr": "year", "mins": "minutes", "sec": "seconds", "secs": "seconds",
-                 "wk": "week", "mo": "month", "mgmt": "management", "dept": "department", "emp": "employee",
-                 "std": "deviation", "vol": "volume", "bal": "balance", "inc": "income", "pop": "population",
-                 "elev": "elevation", "alt": "altitude", "lat": "latitude", "lon": "longitude", "lng": "longitude",
-                 "spd": "speed", "accel": "acceleration", "humid": "humidity", "precip": "precipitation",
-                 "batt": "battery", "conc": "concentration", "env": "environment", "cust": "customer"}
-#: participles that name a feature whose words are said the other way round ('year built' -> 'the build year')
-_BASE_FORM = {"built": "build", "sold": "sale", "made": "make", "paid": "pay", "owned": "own", "used": "use"}
-_IRREGULAR = {"keep": "kept", "go": "went", "choose": "chose", "hold": "held", "run": "ran", "stay": "stayed"}
+from .lexicon import ABBREVIATIONS, BASE_FORM as _BASE_FORM, GENERIC, IRREGULAR as _IRREGULAR, STOP  # noqa: F401
 
 
 @dataclass(frozen=True)
