@@ -369,7 +369,10 @@ def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -
     ('serving BS's') become part of the narrowed name. Nothing is guessed: without such words the name stays
     ambiguous."""
     out: list[Mention] = []
+    inside: set[int] = set()  # mentions inside a qualifier after an ambiguous name: part of the narrowed name
     for m in found:
+        if id(m) in inside:
+            continue
         if m.kind != "feature" or len(m.keys) < 2:
             out.append(m)
             continue
@@ -390,8 +393,7 @@ def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -
             qual = [w for w in split_words(after.group(1)) if w in known] if after else []
             keys = _meant(m.keys, qual, words)
             if keys and len(keys) < len(m.keys):
-                while found_after := [n for n in found if m.end < n.start < after.end()]:
-                    found.remove(found_after[0])  # 'approach' of approach_speed inside the qualifier
+                inside |= {id(n) for n in found if m.end < n.start < after.end()}  # 'approach' of approach_speed
                 out.append(Mention(m.start, after.end(), "feature", keys))
             else:
                 out.append(m)
