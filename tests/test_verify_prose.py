@@ -1023,6 +1023,7 @@ def test_the_first_number_of_a_sentence_about_the_average_case_is_the_baseline()
         ("18%", "verified", "the baseline is 18.4")]
     assert numbers("On average, a student has about a 25% chance of dropping out.")[0][1] == "contradicted"
     assert numbers("For Marcus the model says about 35%.")[0][1] == "verified"
+    assert numbers("On average, attendance at 71% adds about 7 points.")[0] == ("71%", "verified", "attendance_pct: value")
 
 
 def test_abbreviations_in_feature_names_are_read_as_the_words_people_write():

@@ -304,7 +304,8 @@ def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
     8.32-point lead'); None when they say nothing."""
     span = max(0, n.start - 60)
     if book.output != "actions" and book.base is not None:
-        if background.first_of_the_average(n, masked) or _KEY_BASE.search(masked[span:n.start]):
+        if (background.first_of_the_average(n, masked) and not any(m.start < n.start + 16 for m in names)) or \
+                _KEY_BASE.search(masked[span:n.start]):  # ('On average, 23-year-old drivers': a driver's age)
             return background.base_number(n, book)  # 'On average, a student has about an 18% chance', 'base=0.3'
         if _KEY_OUTPUT.search(masked[span:n.start]) or _output_is(masked[span:n.start], book):
             return quantities.output_number(n, book)
