@@ -9,7 +9,8 @@ import torch
 import pytest
 
 import xairl
-from xairl.narrators.verify.names import find_mentions, vocabulary
+from xairl.narrators.verify.names import find_mentions
+from xairl.narrators.verify.vocabulary import vocabulary
 from xairl.narrators.verify.numbers import find_numbers, matches, normalise
 from xairl.narrators.verify.book import clean_surface
 from benchmarks.bench_verifier import explanation_from_tuples, load_corpus, run, shapstories_case

