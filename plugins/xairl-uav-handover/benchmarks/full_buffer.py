@@ -16,7 +16,8 @@ import numpy as np
 import torch
 
 from xairl_uav_handover.env import HandoverVecEnv
-from xairl_uav_handover.evaluate import BUFFER, HELD_OUT_SEED
+from xairl_uav_handover.evaluate import HELD_OUT_SEED
+from xairl_uav_handover.features import BUFFER
 from xairl_uav_handover.policy import DQNController, load_checkpoint
 from xairl_uav_handover.uplink import capacity_bps, sinr_db
 

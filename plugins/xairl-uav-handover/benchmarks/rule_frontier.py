@@ -1,7 +1,7 @@
 """What a two-threshold rule reaches on the targets of Table I: where the handovers/RSRQ/availability frontier lies,
 so that a DQN's figures can be read against the best simple policy and not only against CHM.
 
-The rule (``RSRQRule``) stays unless the serving cell's reported RSRQ is below ``threshold_db`` while the buffer holds
+The rule (``baselines.RSRQRule``) stays unless the serving cell's reported RSRQ is below ``threshold_db`` while the buffer holds
 data, or the buffer is at least ``full_share`` of its size; then it hands over to the measured candidate with the best
 RSRQ, if that one is at least ``margin_db`` better than the serving cell. It sees the DQN's 13 inputs and acts at
 the DQN's decision period. One rule per combination of the values given.
@@ -12,37 +12,10 @@ Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/rule_frontier.py [--
 import argparse
 import itertools
 
-import numpy as np
 from table_one import print_targets, targets
-from xairl_uav_handover.baselines import CHM
+from xairl_uav_handover.baselines import CHM, RSRQRule
 from xairl_uav_handover.config import SimConfig
-from xairl_uav_handover.evaluate import BUFFER
-from xairl_uav_handover.features import RSRQ, available_actions
 from xairl_uav_handover.table import flights, format_rows, with_intervals
-
-
-class RSRQRule:
-    """Hand over on poor serving RSRQ with data waiting, or on a (nearly) full buffer, to the best-RSRQ candidate."""
-
-    decision_every = None  # the simulator config's, as the DQN's
-
-    def __init__(self, threshold_db: float, margin_db: float, full_share: float):
-        self.threshold_db, self.margin_db, self.full_share = threshold_db, margin_db, full_share
-        self.name = f"rule {threshold_db:g},{margin_db:g},{full_share:g}"
-
-    def reset(self, env) -> None:
-        pass
-
-    def __call__(self, env) -> np.ndarray:
-        obs = env.obs
-        rsrq = np.where(available_actions(obs, env.cfg.observation), obs[:, RSRQ], -np.inf)
-        rsrq[:, 0] = -np.inf
-        best = rsrq.argmax(axis=1)
-        serving = obs[:, RSRQ][:, 0]
-        better = rsrq[np.arange(len(obs)), best] > serving + self.margin_db
-        queue = obs[:, BUFFER]
-        trigger = ((serving < self.threshold_db) & (queue > 0)) | (queue >= self.full_share * env.cfg.buffer.q_max_bits)
-        return np.where(trigger & better, best, 0)
 
 
 def main():

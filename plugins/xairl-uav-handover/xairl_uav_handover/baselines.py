@@ -11,13 +11,17 @@ report. :class:`A3Trigger` runs on time stamps, so the same rule also runs on re
   TS 36.902 sec. 4.5): A3 with a cell individual offset per (serving, neighbour) pair, which the network raises after
   too-early handovers and ping-pongs on that pair and lowers after too-late ones, once per window
   (:class:`MobilityRobustness` has the events' definitions). Offsets are the network's, shared by every UAV it serves.
+- :class:`RSRQRule`: a two-threshold rule on the DQN's own 13 inputs, at its decision period (ours, not the paper's):
+  hand over to the best-RSRQ candidate on poor serving RSRQ with data waiting, or on a nearly full buffer. It marks
+  where the handovers/RSRQ/availability frontier lies (benchmarks/rule_frontier.py) and is the demonstrator a DQN can
+  learn from (``TrainConfig.demonstrations``).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .config import CHMConfig, SAMROConfig
-from .features import RSRP
+from .features import BUFFER, RSRP, RSRQ, available_actions
 
 
 
@@ -222,3 +226,32 @@ class SAMROOnSamples(CHMOnSamples):
         self.mro.observe(t, serving, np.array([self._radio_ok(state)]), np.array([stronger]), np.array([handed]),
                          np.array([self.col[previous] if previous is not None else serving[0]]))
         return self.mro.offsets(serving), self.sa.ttt_s
+
+
+class RSRQRule:
+    """Stay unless the serving cell's reported RSRQ is below ``threshold_db`` while the buffer holds data, or the
+    buffer holds at least ``full_share`` of its size; then hand over to the measured candidate with the best RSRQ, if
+    that one is at least ``margin_db`` better than the serving cell."""
+
+    decision_every = None  # the simulator config's, as the DQN's
+
+    def __init__(self, threshold_db: float = -14.0, margin_db: float = 3.0, full_share: float = 0.5):
+        self.threshold_db, self.margin_db, self.full_share = threshold_db, margin_db, full_share
+        self.name = f"rule {threshold_db:g},{margin_db:g},{full_share:g}"
+
+    def reset(self, env) -> None:
+        pass
+
+    def __call__(self, env) -> np.ndarray:
+        return self.act(env.obs, env.cfg)
+
+    def act(self, obs: np.ndarray, cfg) -> np.ndarray:
+        """The rule's action for each of the states ``obs`` (n, 13) under simulator config ``cfg``."""
+        rsrq = np.where(available_actions(obs, cfg.observation), obs[:, RSRQ], -np.inf)
+        rsrq[:, 0] = -np.inf
+        best = rsrq.argmax(axis=1)
+        serving = obs[:, RSRQ][:, 0]
+        better = rsrq[np.arange(len(obs)), best] > serving + self.margin_db
+        queue = obs[:, BUFFER]
+        trigger = ((serving < self.threshold_db) & (queue > 0)) | (queue >= self.full_share * cfg.buffer.q_max_bits)
+        return np.where(trigger & better, best, 0)

@@ -5,9 +5,7 @@ import numpy as np
 
 from .config import SimConfig
 from .env import METRICS, PINGPONG_WINDOWS_S, HandoverVecEnv
-from .features import FEATURES
-
-BUFFER = FEATURES.index("buffer_queue_size")
+from .features import BUFFER
 
 #: seeds of evaluation flights start here; training flights use seeds below it (see train.py)
 HELD_OUT_SEED = 1_000_000

@@ -12,6 +12,7 @@ FEATURES = ("x", "y", "z", "buffer_queue_size", "serving_bs",
             *(f"rsrp_{k}" for k in range(N_CANDIDATES)), *(f"rsrq_{k}" for k in range(N_CANDIDATES)))
 RSRP = slice(5, 5 + N_CANDIDATES)  # the candidates' RSRP columns, serving BS first
 RSRQ = slice(5 + N_CANDIDATES, 5 + 2 * N_CANDIDATES)  # and their RSRQ columns
+BUFFER = FEATURES.index("buffer_queue_size")
 #: action k: associate with candidate k; candidate 0 is the serving BS, so action 0 is "stay"
 ACTIONS = ("stay", *(f"handover_to_candidate_{k}" for k in range(1, N_CANDIDATES)))
 #: words followed by an identifier in this plugin's narratives ("BS 15", "candidate 2"), not by a quantity

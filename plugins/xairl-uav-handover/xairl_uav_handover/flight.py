@@ -23,10 +23,9 @@ from xairl import Comparison, DomainFacts, Explanation, Policy, decision_facts, 
 from xairl import format_number as fmt
 from xairl import narration_units as units
 
-from .features import FEATURES, RSRP
+from .features import BUFFER, RSRP
 from .policy import Checkpoint, greedy
 
-BUFFER = FEATURES.index("buffer_queue_size")
 HISTORY = 10  # earlier states a decision's facts may look back on
 
 
@@ -35,7 +34,7 @@ class FlightTimeline:
     """One flight: its decision states over time and whose handovers happened (or were proposed) when.
 
     :param label: 'simulated flight (seed 3)' or the real file's name.
-    :param t: seconds of each state; ``states`` (T, 13) in :data:`FEATURES` order.
+    :param t: seconds of each state; ``states`` (T, 13) in :data:`features.FEATURES` order.
     :param dqn_handover: (T,) True where the DQN handed over (simulated) or proposed a handover (real).
     :param chm_times: seconds at which CHM handed over (simulated, closed loop) or proposed one (real).
     :param live_times: the live network's handovers (real flights only).

@@ -6,12 +6,15 @@ Many flights fly in parallel through :class:`env.HandoverVecEnv`; transitions go
 lr0 / (1 + eta * episode) (:func:`learning_rate`); the target network is copied every ``target_every`` updates
 (:func:`dqn_update` is one gradient step). Actions are masked to the measured candidates when acting, exploring and
 bootstrapping (a handover to an empty slot is no action at all). The end of a flight is terminal (no bootstrap), as in the paper's
-episodic set-up.
+episodic set-up. With ``demonstrations`` > 0 it learns from :class:`baselines.RSRQRule`'s flights as DQfD does
+(Hester et al. 2018): :func:`margin_loss` on the rule's actions beside the TD loss, after ``pretrain_updates`` steps on
+the demonstrations alone.
 """
 from __future__ import annotations
 
 import time
 from contextlib import contextmanager
+from types import SimpleNamespace
 
 import numpy as np
 import torch
@@ -19,6 +22,7 @@ from pydantic import Field
 
 from xairl import Options
 
+from .baselines import RSRQRule
 from .config import SimConfig
 from .env import HandoverVecEnv
 from .features import available_actions
@@ -42,6 +46,14 @@ class TrainConfig(Options, frozen=True):
     eps_start: float = Field(1.0, ge=0, le=1)
     eps_end: float = Field(0.01, ge=0, le=1)
     eps_fraction: float = Field(0.5, gt=0, le=1)
+    demonstrations: int = Field(0, ge=0, description="episodes of the demonstrator's flights (baselines.RSRQRule) "
+                                                    "kept in a replay buffer of their own (DQfD, Hester et al. "
+                                                    "2018); 0: plain DQN")
+    pretrain_updates: int = Field(0, ge=0, description="gradient steps on the demonstrations alone before the DQN "
+                                                      "flies")
+    expert_margin: float = Field(5.0, ge=0, description="DQfD's large margin: how much higher the demonstrator's "
+                                                       "action must score than any other (reward units)")
+    expert_weight: float = Field(1.0, ge=0, description="weight of the margin loss against the TD loss")
     seed: int = 0
 
 
@@ -56,9 +68,11 @@ def learning_rate(tc: TrainConfig, episode: int) -> float:
 
 
 def dqn_update(q: torch.nn.Module, target: torch.nn.Module, opt: torch.optim.Optimizer, batch, gamma: float,
-               next_available: torch.Tensor | None = None) -> float:
+               next_available: torch.Tensor | None = None, expert=None, expert_margin: float = 0.0,
+               expert_weight: float = 0.0) -> float:
     """One gradient step on the Huber TD error of a replay batch; returns the loss. ``next_available`` (batch,
-    actions) bool restricts the bootstrap max to the actions available in the next state."""
+    actions) bool restricts the bootstrap max to the actions available in the next state. ``expert``: a batch of
+    demonstrations whose :func:`margin_loss` is added with ``expert_weight``."""
     with torch.no_grad():
         next_q = target(batch.next_observations)
         if next_available is not None:
@@ -67,11 +81,24 @@ def dqn_update(q: torch.nn.Module, target: torch.nn.Module, opt: torch.optim.Opt
         y = batch.rewards.flatten() + gamma * next_q * (1 - batch.dones.flatten())
     qa = q(batch.observations).gather(1, batch.actions.long()).flatten()
     loss = torch.nn.functional.smooth_l1_loss(qa, y)
+    if expert is not None:
+        loss = loss + expert_weight * margin_loss(q, expert, expert_margin)
     opt.zero_grad()
     loss.backward()
     torch.nn.utils.clip_grad_norm_(q.parameters(), 10.0)
     opt.step()
     return float(loss.detach())
+
+
+def margin_loss(q: torch.nn.Module, batch, margin: float) -> torch.Tensor:
+    """DQfD's supervised loss on a batch of demonstrations: max_a [Q(s, a) + margin * (a != a_E)] - Q(s, a_E), over
+    the actions available in s (a_E: the demonstrator's action)."""
+    ok = torch.as_tensor(batch.available)
+    scores = q(batch.observations)
+    a_e = batch.actions.long()
+    bonus = torch.full_like(scores, margin).scatter(1, a_e, 0.0)
+    best = (scores + bonus).masked_fill(~ok, -torch.inf).max(dim=1).values
+    return (best - scores.gather(1, a_e).flatten()).mean()
 
 
 def _networks(tc: TrainConfig, sim_cfg: SimConfig):
@@ -115,7 +142,21 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
     rb = ReplayBuffer(max(tc.replay_size // tc.n_flights, 1) * tc.n_flights, env.single_observation_space,
                       env.single_action_space, device="cpu", n_envs=tc.n_flights, handle_timeout_termination=False)
     total = tc.episodes * int(np.ceil(sim_cfg.flight.n_steps / env.decision_every))
+    demos = _demonstrations(tc, sim_cfg, env, rb)
     step = updates = 0
+
+    def update():
+        nonlocal updates
+        batch = rb.sample(tc.batch_size)
+        nxt_ok = torch.as_tensor(available_actions(batch.next_observations.numpy(), sim_cfg.observation))
+        expert = None if demos is None else demos.sample(rng, tc.batch_size)
+        dqn_update(q, target, opt, batch, tc.gamma, nxt_ok, expert, tc.expert_margin, tc.expert_weight)
+        updates += 1
+        if updates % tc.target_every == 0:
+            target.load_state_dict(q.state_dict())
+
+    for _ in range(tc.pretrain_updates if demos is not None else 0):
+        update()
     history = []
     bar = tqdm(total=total, desc="training DQN", unit="dec", disable=not progress)
     for ep in range(tc.episodes):
@@ -135,17 +176,45 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
             if rb.size() * tc.n_flights < max(tc.learning_starts, tc.batch_size):
                 continue
             for _ in range(tc.updates_per_decision):
-                batch = rb.sample(tc.batch_size)
-                nxt_ok = torch.as_tensor(available_actions(batch.next_observations.numpy(), sim_cfg.observation))
-                dqn_update(q, target, opt, batch, tc.gamma, nxt_ok)
-                updates += 1
-                if updates % tc.target_every == 0:
-                    target.load_state_dict(q.state_dict())
+                update()
         history.append({"episode": ep, "epsilon": round(eps, 4), "mean_return": float(ep_ret.mean()),
                         "median_handovers": float(np.median(ep_ho)), "seconds": round(time.time() - t0, 2)})
         bar.set_postfix(ho=history[-1]["median_handovers"], ret=round(history[-1]["mean_return"], 1))
     bar.close()
     return q.eval(), history
+
+
+class Demonstrations:
+    """The demonstrator's states and actions, sampled in batches for :func:`margin_loss`."""
+
+    def __init__(self, observations: np.ndarray, actions: np.ndarray, available: np.ndarray):
+        self.obs, self.act, self.ok = observations, actions, available
+
+    def sample(self, rng: np.random.Generator, n: int) -> SimpleNamespace:
+        i = rng.integers(len(self.obs), size=n)
+        return SimpleNamespace(observations=torch.as_tensor(self.obs[i]),
+                               actions=torch.as_tensor(self.act[i, None]), available=self.ok[i])
+
+
+def _demonstrations(tc: TrainConfig, sim_cfg: SimConfig, env: HandoverVecEnv, rb) -> Demonstrations | None:
+    """Fly ``tc.demonstrations`` episodes under :class:`baselines.RSRQRule`; their transitions go into the replay
+    buffer ``rb`` (for the TD loss) and their states and actions into the returned :class:`Demonstrations`."""
+    if not tc.demonstrations:
+        return None
+    rule, obs_seen, act_seen = RSRQRule(), [], []
+    for k in range(tc.demonstrations):
+        obs, _ = env.reset(seed=tc.seed * 100_003 + tc.episodes + k)
+        ended = False
+        while not ended:
+            act = rule.act(obs, sim_cfg)
+            nxt, reward, _, truncated, _ = env.step(act)
+            ended = bool(truncated.all())
+            rb.add(obs, nxt, act, reward, truncated, [{}] * tc.n_flights)
+            obs_seen.append(obs)
+            act_seen.append(act)
+            obs = nxt
+    obs = np.concatenate(obs_seen).astype(np.float32)
+    return Demonstrations(obs, np.concatenate(act_seen), available_actions(obs, sim_cfg.observation))
 
 
 def train_checkpoint(tc: TrainConfig, sim_cfg: SimConfig, out, progress: bool = True) -> float:
