@@ -1,10 +1,10 @@
 """What a two-threshold rule reaches on the targets of Table I: where the handovers/RSRQ/availability frontier lies,
 so that a DQN's figures can be read against the best simple policy and not only against CHM.
 
-The rule (``baselines.RSRQRule``) stays unless the serving cell's reported RSRQ is below ``threshold_db`` while the buffer holds
-data, or the buffer is at least ``full_share`` of its size; then it hands over to the measured candidate with the best
-RSRQ, if that one is at least ``margin_db`` better than the serving cell. It sees the DQN's 13 inputs and acts at
-the DQN's decision period. One rule per combination of the values given.
+The rule (``baselines.RSRQRule``) stays unless the serving cell's reported RSRQ is below ``threshold_db`` while the
+buffer holds data, or the buffer is at least ``full_share`` of its size; then it hands over to the measured candidate
+with the best RSRQ, if that one is at least ``margin_db`` better than the serving cell. It sees the DQN's 13 inputs
+and acts at the DQN's decision period. One rule per combination of the values given.
 
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/rule_frontier.py [--flights 100] [--seeds 0]
      [--thresholds -14 -10] [--margins 2 3] [--full-shares 0.5]

@@ -5,8 +5,8 @@ Many flights fly in parallel through :class:`env.HandoverVecEnv`; transitions go
 (:func:`linear_schedule`) from ``eps_start`` to ``eps_end`` over ``eps_fraction`` of training; the learning rate is
 lr0 / (1 + eta * episode) (:func:`learning_rate`); the target network is copied every ``target_every`` updates
 (:func:`dqn_update` is one gradient step). Actions are masked to the measured candidates when acting, exploring and
-bootstrapping (a handover to an empty slot is no action at all). The end of a flight is terminal (no bootstrap), as in the paper's
-episodic set-up. With ``demonstrations`` > 0 it learns from :class:`baselines.RSRQRule`'s flights as DQfD does
+bootstrapping (a handover to an empty slot is no action at all). The end of a flight is terminal (no bootstrap), as
+in the paper's episodic set-up. With ``demonstrations`` > 0 it learns from :class:`baselines.RSRQRule`'s flights as DQfD does
 (Hester et al. 2018): :func:`margin_loss` on the rule's actions beside the TD loss, after ``pretrain_updates`` steps on
 the demonstrations alone.
 """
