@@ -54,6 +54,8 @@ class TrainConfig(Options, frozen=True):
     expert_margin: float = Field(5.0, ge=0, description="DQfD's large margin: how much higher the demonstrator's "
                                                        "action must score than any other (reward units)")
     expert_weight: float = Field(1.0, ge=0, description="weight of the margin loss against the TD loss")
+    demonstrator_margin_db: float = Field(3.0, ge=0, description="how much better (RSRQ, dB) the demonstrator's "
+                                                                "target must be than the serving cell")
     seed: int = 0
 
 
@@ -201,7 +203,7 @@ def _demonstrations(tc: TrainConfig, sim_cfg: SimConfig, env: HandoverVecEnv, rb
     buffer ``rb`` (for the TD loss) and their states and actions into the returned :class:`Demonstrations`."""
     if not tc.demonstrations:
         return None
-    rule, obs_seen, act_seen = RSRQRule(), [], []
+    rule, obs_seen, act_seen = RSRQRule(margin_db=tc.demonstrator_margin_db), [], []
     for k in range(tc.demonstrations):
         obs, _ = env.reset(seed=tc.seed * 100_003 + tc.episodes + k)
         ended = False
