@@ -1,4 +1,5 @@
-"""The reference DQN reproduced in one command: one DQN per training seed (the simulator's default reward), each on
+"""The reference DQN reproduced in one command: one DQN per training seed (the simulator's default reward; learning
+from the RSRQ rule's demonstrations as TrainConfig's defaults say, or a plain DQN with --demonstrations 0), each on
 Table I with bootstrap 95 % intervals against CHM and SA-MRO on the same held-out flights, the issue's targets 1-4
 checked per seed (benchmarks/table_one.py), and the rank of buffer_queue_size by mean |contribution| to the margin
 and to the chosen score (deep_shap) on each DQN's own decision states. With --real DIR (the UKM flights), also the
@@ -10,7 +11,7 @@ writes the same).
 
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reproduce.py [--seeds 0 1 2] [--episodes 40]
      [--flights 200] [--eval-seeds 0] [--states 400] [--real DIR] [--out-dir DIR] [--json OUT]
-     [--reward w_lost=2 w_pingpong=80 ...]   trains with these RewardConfig weights instead of the defaults
+     [--demonstrations N] [--reward w_lost=2 w_pingpong=80 ...]   trains with these RewardConfig weights
 or:  ... reproduce.py --checkpoints A.safetensors B.safetensors ...   measures existing checkpoints
 """
 import argparse
@@ -40,6 +41,8 @@ def main():
     ap.add_argument("--states", type=int, default=400, help="decision states explained for the feature ranks")
     ap.add_argument("--real", default=None, help="a folder of real UKM flight exports (targets 5 and 6)")
     ap.add_argument("--json", default=None, help="also write the per-seed results here")
+    ap.add_argument("--demonstrations", type=int, default=TrainConfig().demonstrations,
+                    help="episodes of the RSRQ rule's flights to learn from (0: a plain DQN)")
     ap.add_argument("--reward", nargs="+", default=[], metavar="KEY=VALUE",
                     help="train with these reward weights (RewardConfig) instead of the defaults")
     args = ap.parse_args()
@@ -49,8 +52,8 @@ def main():
     if not paths:
         paths = [str(folder / f"seed{seed}.safetensors") for seed in args.seeds]
         for seed, path in zip(args.seeds, paths):
-            seconds = train_checkpoint(TrainConfig(episodes=args.episodes, seed=seed), with_reward(args.reward),
-                                       path, progress=False)
+            tc = TrainConfig(episodes=args.episodes, seed=seed, demonstrations=args.demonstrations)
+            seconds = train_checkpoint(tc, with_reward(args.reward), path, progress=False)
             print(f"seed {seed}: trained in {seconds} s -> {path}")
     ckpts = [load_checkpoint(p) for p in paths]
     cfg = ckpts[0].sim_config

@@ -11,6 +11,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--episodes", type=int, default=40, help="training episodes (each flies --flights flights)")
     p.add_argument("--flights", type=int, default=64, help="flights simulated in parallel per episode")
     p.add_argument("--duration", type=float, default=None, help="seconds per flight (default: the sim config's)")
+    p.add_argument("--demonstrations", type=int, default=None, help="episodes of the RSRQ rule's flights to learn "
+                   "from (DQfD; default: TrainConfig's 10); 0: a plain DQN, as in the paper")
+    p.add_argument("--pretrain-updates", type=int, default=None, help="gradient steps on the demonstrations alone "
+                   "before the DQN flies (default: TrainConfig's 3000)")
+    p.add_argument("--eps-start", type=float, default=None, help="exploration at the start (default: 0.2 with "
+                   "demonstrations, as the pretrained network already acts like the rule; 1 without)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", default="uav-dqn.safetensors", help="checkpoint path (metadata holds the configs)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -43,13 +49,16 @@ def _sim_config(base, duration=None):
 
 
 def run_train(args) -> int:
-    from xairl import InputError
+    from xairl import InputError, parse_options
 
     from .train import TrainConfig, train_checkpoint
 
     if args.episodes < 1 or args.flights < 1:
         raise InputError("--episodes and --flights must be at least 1.")
-    tc = TrainConfig(episodes=args.episodes, n_flights=args.flights, seed=args.seed)
+    given = {"episodes": args.episodes, "n_flights": args.flights, "seed": args.seed,
+             "demonstrations": args.demonstrations, "pretrain_updates": args.pretrain_updates,
+             "eps_start": args.eps_start}
+    tc = parse_options(TrainConfig, {k: v for k, v in given.items() if v is not None}, "training settings")
     seconds = train_checkpoint(tc, _sim_config(None, args.duration), args.out, progress=not args.no_progress)
     print(f"trained {args.episodes} episodes in {seconds} s; wrote {args.out}")
     return 0

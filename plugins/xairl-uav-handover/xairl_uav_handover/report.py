@@ -257,19 +257,23 @@ def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
 
 
 def findings(exps: dict[str, Explanation]) -> list[str]:
-    """Which of the paper's findings hold here, read off the explanations (mean |contribution to the margin|)."""
+    """Which of the paper's findings hold here, read off the explanations (mean |contribution to the margin|, and to
+    the chosen action's score)."""
     out = []
     for label, exp in exps.items():
         grouped = exp.grouped({"position": GROUPS["position"]})
         imp = np.abs(grouped.margin()).mean(axis=0)
         order = [grouped.feature_names[j] for j in np.argsort(-imp)]
+        by_score = [grouped.feature_names[j] for j in np.argsort(-np.abs(grouped.for_chosen()).mean(axis=0))]
         buf, pos = order.index("buffer_queue_size") + 1, order.index("position") + 1
         holds = "holds" if buf == 1 and pos == 2 else "does not hold"
         parts = (f"buffer first {'holds' if buf == 1 else 'does not'}, position second "
                  f"{'holds' if pos == 2 else 'does not'}")
         out.append(f"Paper's Figure 2 finding (buffer first, position second) {holds} on the {label} states "
                    f"({parts}): by mean |contribution to the margin over the runner-up| the buffer ranks {buf} and "
-                   f"position (x, y, z) {pos}; the top three are {', '.join(order[:3])}.")
+                   f"position (x, y, z) {pos}; the top three are {', '.join(order[:3])}. By mean |contribution to "
+                   f"the chosen action's score| the buffer ranks {by_score.index('buffer_queue_size') + 1} and "
+                   f"position {by_score.index('position') + 1}.")
     return out
 
 

@@ -78,14 +78,16 @@ def _one_name_pushes(n, masked: str, mentions) -> bool:
 
 def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, sentence_keys) -> Claim:
     """A contradicted number that states another fact of a feature named in the sentence exactly (not truncated): the
-    binding was a guess, so it is unchecked ('which is unclear'). A difference in a unit ('4.0 dB above') and a number
-    right after its name ('battery +1.70') bind for sure; a bracket right after a name ('distance (2.33)') may only be
+    binding was a guess, so it is unchecked ('which is unclear'). A difference in a unit ('4.0 dB above'), a number
+    right after its name ('battery +1.70') and a name 'at' a number bind for sure; a bracket right after a name ('distance (2.33)') may only be
     that name's own fact, with its sign."""
     if quantities.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
         return c
     owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
     if owner in names and re.fullmatch(r" ?", masked[owner.end:n.start]) and n.sign:
         return c  # 'battery +1.70': a signed number right after its name, a sure binding
+    if owner in names and masked[owner.end:n.start] == " at ":
+        return c  # "the serving BS's id at -12": its value, as sure
     if _one_name_pushes(n, masked, names):
         return c
     if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
@@ -147,8 +149,8 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
         return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}, and "
                      f"the name before it is one word of a long name", "number.other-feature")  # ('bill $109.9' of
         # price_increase_last_bill_pct, when $109.9 is the monthly charge)
-    if owner is not None and re.fullmatch(r"\s?[:=(]?\s?|\s?[:=]\s*", masked[owner.end:n.start]):
-        return c
+    if owner is not None and re.fullmatch(r"\s?[:=(]?\s?|\s?[:=]\s*| at ", masked[owner.end:n.start]):
+        return c  # ('the serving BS's id at -12': its value)
     key = _LOG_KEY.search(masked, max(0, n.start - 40), n.start)
     if key is not None and not n.sign:  # 'run_id=7781' after a name: the value of a field of the log, not the name's
         return Claim("number", n.text, "unchecked", f"the value of the log's field {key.group(1)!r}", "number.log-field")

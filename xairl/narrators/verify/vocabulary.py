@@ -103,6 +103,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     entries = [e for e in entries if e[0].split()]
     entries.sort(key=lambda e: -len(e[0]))
     names = {w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit()}
+    names |= {level.split()[-1].lower() for f in feature_words if (info := policy.features.get(f) if policy else None)
+              for level in (info.low, info.high) if len(level.split()) > 1}  # '(-27.5 dB, poor quality)'
     names |= {stem(w) for w in names} | {ws for ws in described_words if len(ws) >= 2}
     compiled = [(_literal(p), kind, keys, label, "") if form == "literal" else (_pattern(p, kind), kind, keys, label,
                                                                                  form)
