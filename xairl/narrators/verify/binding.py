@@ -233,6 +233,9 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     summed = sums.aggregate_number(n, masked, book)
     if summed is not None:  # 'the positives add up to about +0.39', 'total absolute attribution of 1.62'
         return named(summed, "number.aggregate")
+    removed = sums.without_number(n, masked, names, book)
+    if removed is not None:  # 'without the add-on's contribution it would sit at about 12.4%'
+        return named(removed, "number.without")
     if quantities.is_change(n, masked):  # '$91,462 above the baseline', 'net uplift: +$86,046', 'below base by $34,184'
         return named(quantities.free_number(n, masked, book), "number.change")
     if id(n) in scored:

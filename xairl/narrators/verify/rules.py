@@ -74,6 +74,12 @@ RULES: tuple[Rule, ...] = (
          silent=(("air", "Traffic and wind together add 14.1."),)),
     Rule("number.aggregate", "number", "a sum over all features after its cue words ('the positives add up to')",
          fires=(("air", "The positives add up to 31.1."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("number.without", "number", "a number in a clause that takes one named feature's push away ('without "
+         "traffic's contribution'): verified when it is the prediction, its change from the baseline or the margin "
+         "less that push, else its other readings decide",
+         fires=(("air", "Without traffic's contribution, the forecast would be about 44.9."),
+                ("air", "Even without the traffic term it would sit 22.9 above the average.")),
+         silent=(("air", "Traffic adds 7.2."), ("air", "Without traffic's contribution, the forecast would be 38."))),
     Rule("number.change", "number", "the change from the baseline ('30.0 above the average')",
          fires=(("air", "The forecast is 30.1 above the average."),), silent=(("air", "Traffic adds 7.2."),)),
     Rule("number.cue", "number", "a number its cue words bind: the prediction, the baseline, a typical value, the "

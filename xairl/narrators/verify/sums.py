@@ -74,3 +74,32 @@ def _sum_claim(n: Number, results: list[bool], text: str) -> Claim:
         return Claim("number", n.text, "verified", text)
     return Claim("number", n.text, "unchecked" if any(results) else "contradicted",
                  "ambiguous: a member may mean several features" if any(results) else text)
+
+
+#: a name removed from the decision: 'without the warranty add-on's contribution', 'even without the battery term'
+_WITHOUT = re.compile(r"\bwithout\s+(?:the\s+|its\s+|his\s+|her\s+|their\s+)?$", re.IGNORECASE)
+
+
+def without_number(n: Number, masked: str, names, book: FactBook) -> Claim | None:
+    """A number in a clause that takes one named feature's push away ('without the warranty add-on's contribution it
+    would sit at about 12.4%', 'even without the battery term, returning would still sit 1.55 above the average'):
+    verified when it is the prediction, its change from the baseline or the margin less that push; otherwise None
+    (its other readings decide)."""
+    removed = next((m for m in reversed(names) if m.end <= n.start and n.start - m.end <= 120
+                    and _WITHOUT.search(masked[max(0, m.start - 16):m.start])
+                    and not re.search(r"[.;]", masked[m.end:n.start])), None)
+    if removed is None or len(removed.keys) != 1 or removed.keys[0] not in book.features:
+        return None
+    contribs = book.features[removed.keys[0]].contribs
+    score = book.scores.get(book.chosen)
+    readings = []
+    if score is not None and "chosen" in contribs:
+        readings.append(("the prediction", score - contribs["chosen"]))
+        if book.base is not None:
+            readings.append(("the change from the baseline", score - book.base - contribs["chosen"]))
+    if book.margin is not None and "margin" in contribs:
+        readings.append(("the margin", book.margin - contribs["margin"]))
+    for what, v in readings:
+        if matches(n, v) or (n.percent and percent_reading(n, v)):
+            return Claim("number", n.text, "verified", f"{what} without {removed.keys[0]}'s contribution is {v:.4g}")
+    return None
