@@ -10,8 +10,9 @@ _SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|fea
                          r"(?:and an? (?:half|third|quarter)\s+)?times|"
                          r"-fold|outcomes|options|classes|sides|factors|reasons|drivers|categories|possibilities|"
                          r"scenarios|-?points?\s+scale|scale)\b|[x×](?![\w])|"
-                         r"(?:[A-Za-z\0][\w\0'-]*\s+){0,2}(?:factors|reasons|drivers|features|things|variables|inputs)\b)",
-                         re.IGNORECASE)  # ('the three upward drivers')
+                         r"(?:of\s+(?:the|its|these|those)\s+)?(?:[A-Za-z\0][\w\0'-]*\s+){0,2}(?:factors|reasons|"
+                         r"drivers|features|things|variables|inputs)\b)",
+                         re.IGNORECASE)  # ('the three upward drivers', 'any two of the other factors')
 _LABEL_BEFORE = re.compile(r"\b(candidates?|bs|cell|id|#|step|case|top|row|state|outcome|class|type|acct|account|ref|"
                            r"ticket|order|episode|ep|seed|run|version|customer|patient|flight|no\.)[\s\-=:#]*$",
                            re.IGNORECASE)

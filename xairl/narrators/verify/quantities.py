@@ -16,9 +16,9 @@ CONTRIB_BEFORE = re.compile(
     r"knock\w*|lifts?|lower\w*|rais\w*|reduc\w*|increas\w*|decreas\w*|shap(?: value)?(?: of| is| was|:|=)?|"
     r"contribution(?: of| was| is|:)?|attributions?:?|phi\([^)]*\)\s*=|\|φ\|:?|impact of|effect of|push\w*|"
     r"another|\banother|drops?|takes|took|loses|gains?|\bby a margin of|\|shap\|:?|"
-    r"edge of|favou?red \w+ by|for \w+ by|\bdown|\bup)\s*(?:\(|about|around|roughly|nearly|almost|"
-    r"approximately|some|only|just|a further|another|over|under|(?:somewhere |anywhere )?between)?"
-    r"\s*[+\-]?[$€£]?\s*$",
+    r"edge of|favou?red \w+ by|for \w+ by|\bdown|\bup)\s*(?:(?:\(|about|around|roughly|nearly|almost|"
+    r"approximately|some|only|just|a further|another|over|under|(?:somewhere |anywhere )?between)\s*){0,2}"
+    r"[+\-]?[$€£]?\s*$",
     re.IGNORECASE)
 _LISTS_CONTRIBUTIONS = re.compile(r"shap|attribution|contribut|impact|effect|φ|phi|importance|weight|push|margin",
                                   re.IGNORECASE)
