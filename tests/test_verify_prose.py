@@ -1039,3 +1039,17 @@ def test_abbreviations_in_feature_names_are_read_as_the_words_people_write():
     assert "contradicted" in ranks("Ranking by magnitude: pending orders, distance, battery.")
     assert [c.status for c in xairl.verify("The distance adds 0.5.", exp, 0).claims if c.kind == "number"] == [
         "contradicted"]
+
+
+def test_a_value_in_another_unit_of_the_one_its_name_ends_in():
+    """'next_drop_dist_km' is 0.6: '600 m away' states it, '900 m' does not; 'wait_s' of 90 is '1.5 minutes'."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["next_drop_dist_km", "wait_s"], [0.6, 90], [1.15, -0.4], 3.1, "Q-value of continuing")
+
+    def numbers(text):
+        return [(c.text, c.status, c.detail) for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    assert numbers("It kept going because the next drop is only 600 m away.") == [
+        ("600", "verified", "next_drop_dist_km: value in m (not km)")]
+    assert numbers("It kept going because the next drop is only 900 m away.")[0][1] == "contradicted"
+    assert numbers("The wait of 1.5 minutes counted against it.")[0][:2] == ("1.5", "verified")
+    assert numbers("The next drop is 0.6 km away.")[0] == ("0.6", "verified", "next_drop_dist_km: value")

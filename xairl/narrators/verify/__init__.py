@@ -204,7 +204,7 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
 
     def unit_of(f: str) -> str:
         info = policy.features.get(f) if policy else None
-        return info.unit if info else ""
+        return info.unit if info and info.unit else quantities.unit_in_name(f)
 
     out = []
     for a, b in sentences(text):
