@@ -1053,3 +1053,16 @@ def test_a_value_in_another_unit_of_the_one_its_name_ends_in():
     assert numbers("It kept going because the next drop is only 900 m away.")[0][1] == "contradicted"
     assert numbers("The wait of 1.5 minutes counted against it.")[0][:2] == ("1.5", "verified")
     assert numbers("The next drop is 0.6 km away.")[0] == ("0.6", "verified", "next_drop_dist_km: value")
+
+
+def test_a_period_that_is_the_window_of_a_features_name_is_no_claim():
+    """'in the past twelve months' of prior_returns_12m is the name's window even where the words bind the number
+    to customer_tenure_mo (71 months); a period no name holds is still checked."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["customer_tenure_mo", "prior_returns_12m"], [71, 0], [-2.3, -1.9], 14.0, "return probability")
+
+    def numbers(text):
+        return [(c.text, c.status) for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    assert numbers("A customer of 71 months who returned nothing in the past twelve months.") == [("71", "verified")]
+    assert numbers("A customer of 71 months who returned nothing in the past nine months.")[1] == ("nine",
+                                                                                                 "contradicted")

@@ -18,7 +18,7 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
     name_words = vocab.name_words
     names = named_features(mentions)
     numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not noclaims.skip_number(n, masked)
-               and not noclaims.window_of_name(n, sentence_keys)]
+               and not noclaims.window_of_name(n, sentence_keys, written or masked, book.features)]
     tail, paired, summed = _lists(masked, a, b, names, numbers)
     paired |= comparisons.compared_pairs(masked, a, b, names, numbers)  # 'A mattered twice as much as B (0.88 vs 0.49)'
     actions = [m for m in mentions if m.kind == "action"]

@@ -49,9 +49,18 @@ def skip_number(n: Number, masked: str) -> bool:
     return bool(_LABEL_BEFORE.search(before)) or bool(_SKIP_AFTER.match(masked[n.end:]))
 
 
-def window_of_name(n: Number, keys) -> bool:
+_PERIOD_AFTER = re.compile(r"\s*(days?|weeks?|months?|years?|hours?)\b", re.IGNORECASE)
+
+
+def window_of_name(n: Number, keys, masked: str = "", all_keys=()) -> bool:
     """An integer that is the window or range a named feature's name holds ('fires within 200 km' of
-    ``fire_count_200km``, 'in the last 30 days' of ``data_usage_gb_30d``): a part of the name, not a claim."""
+    ``fire_count_200km``, 'in the last 30 days' of ``data_usage_gb_30d``): a part of the name, not a claim. A period
+    ('the past twelve months') is also the window of a feature the sentence names in words of its own
+    (``prior_returns_12m``)."""
     if n.sign or n.percent or n.currency or n.hedge or n.value != int(n.value):
         return False
-    return any(str(int(n.value)) in re.findall(r"(\d+)[a-z]", k.lower()) for k in keys)
+    if any(str(int(n.value)) in re.findall(r"(\d+)[a-z]", k.lower()) for k in keys):
+        return True
+    period = _PERIOD_AFTER.match(masked, n.end)
+    return bool(period) and any((str(int(n.value)), period.group(1)[0].lower()) in re.findall(r"(\d+)([a-z])", k.lower())
+                                for k in all_keys)
