@@ -65,7 +65,8 @@ RULES: tuple[Rule, ...] = (
     Rule("number.sum", "number", "'A and B together add x': the sum of their contributions (and a percentage "
          "after it, 'about 47 % of it': the sum of their shares of all |contributions|, of their side or of the net "
          "change)", fires=(("air", "Traffic and wind together add 14.1."),
-                           ("air", "Wind and traffic together add 14.1, about 47% of it.")), silent=(("air", "Traffic and wind add 7.2 and "
+                           ("air", "Wind and traffic together add 14.1, about 47% of it."),
+                           ("air", "Traffic and wind push it up, and they add 14.1.")), silent=(("air", "Traffic and wind add 7.2 and "
                                                                                    "6.9, respectively."),)),
     Rule("number.sum-unnamed", "number", "a number after a sum's cue word in a clause that joins one known name with "
          "words the vocabulary lacks ('the mileage and garage offsets together claw back $294'), contradicted as the "
