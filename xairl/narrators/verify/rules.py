@@ -75,6 +75,10 @@ RULES: tuple[Rule, ...] = (
          silent=(("air", "Traffic and wind together add 14.1."),)),
     Rule("number.aggregate", "number", "a sum over all features after its cue words ('the positives add up to')",
          fires=(("air", "The positives add up to 31.1."),), silent=(("air", "Traffic adds 7.2."),)),
+    Rule("number.identifier-after-word", "number", "a bare whole number right after one word of a longer name, "
+         "after a preposition ('queued at charger 3'), contradicted as that name's: an identifier, unchecked",
+         fires=(("air", "The monitor at traffic 9 read high."),),
+         silent=(("air", "Traffic adds 7.2."), ("air", "The monitor at traffic 9 km away read high."))),
     Rule("number.without", "number", "a number in a clause that takes one named feature's push away ('without "
          "traffic's contribution'): verified when it is the prediction, its change from the baseline or the margin "
          "less that push, else its other readings decide",
