@@ -41,7 +41,7 @@ from . import binding, checks, clauses, directions, parse, quantities, regions, 
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, named_features
-from .numbers import NUMBER_RE, find_numbers, matches, normalise
+from .numbers import NUMBER_RE, find_numbers, matches, normalise, unit_in_name
 from .vocabulary import split_words, vocabulary
 
 MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
@@ -204,7 +204,7 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
 
     def unit_of(f: str) -> str:
         info = policy.features.get(f) if policy else None
-        return info.unit if info and info.unit else quantities.unit_in_name(f)
+        return info.unit if info and info.unit else unit_in_name(f)
 
     out = []
     for a, b in sentences(text):

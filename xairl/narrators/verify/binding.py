@@ -230,12 +230,9 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     phrase or list item starts between them; else none."""
     if id(n) in paired:
         return named(quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of), "number.respectively")
-    summed = sums.aggregate_number(n, masked, book)
-    if summed is not None:  # 'the positives add up to about +0.39', 'total absolute attribution of 1.62'
-        return named(summed, "number.aggregate")
-    removed = sums.without_number(n, masked, names, book)
-    if removed is not None:  # 'without the add-on's contribution it would sit at about 12.4%'
-        return named(removed, "number.without")
+    summed = sums.sum_reading(n, masked, names, book)
+    if summed is not None:  # 'the positives add up to +0.39', 'without the add-on's contribution it would be 12.4%'
+        return summed
     if quantities.is_change(n, masked):  # '$91,462 above the baseline', 'net uplift: +$86,046', 'below base by $34,184'
         return named(quantities.free_number(n, masked, book), "number.change")
     if id(n) in scored:

@@ -44,6 +44,8 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
                 _SUM_CUE.search(masked, a, n.start) and re.search(r"\band\b|\bplus\b", masked[a:n.start]):
             c = Claim("number", n.text, "unchecked", "a sum over things the words name but the vocabulary does not "
                       "all know ('the mileage and garage offsets together')", "number.sum-unnamed")
+        if c.status == "contradicted" and c.rule in binding.GUESSED:
+            c = quantities.owned_by_unit_or_place(n, masked, mentions, book, unit_of) or c
         if c.status == "contradicted" and noclaims.identifier_after_word(n, masked, mentions):
             c = Claim("number", n.text, "unchecked", f"an identifier after a word of a longer name ('charger 3'; "
                       f"first read as {c.detail})", "number.identifier-after-word")

@@ -9,7 +9,7 @@ from dataclasses import dataclass, replace
 
 from .book import FactBook
 from .checks import EITHER, Claim, over_keys
-from .numbers import Number, find_numbers, matches, percent_reading
+from .numbers import Number, find_numbers, matches, percent_reading, written_scale
 
 CONTRIB_BEFORE = re.compile(
     r"(?:\bby|\badds?|\badded|\badding|contribut\w*|\bworth|\bcosts?|\bcosting|subtract\w*|\boff|\baway|\bcut\w*|"
@@ -119,7 +119,7 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
         if cue.fill and e.fill is not None:  # '8 % full': the fill, nothing else
             return matches(n, e.fill), f"{key}'s fill is {e.fill:.3g} % of its capacity"
         unit = unit_of(key).lower()
-        prefix, scale = _prefixed(after, unit_of(key))
+        prefix, scale = written_scale(after, unit_of(key))
         value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or cue.slot or bool(prefix)) \
             and not contrib_cue
         meaning = None if contrib_cue or n.percent else _code_meaning(n, e)
@@ -152,41 +152,6 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
     if claim.status == "contradicted" and comparison(n, after, book):
         return Claim("number", n.text, "verified", "a domain comparison in its unit")
     return claim
-
-
-#: a unit a feature's name ends in ('next_drop_dist_km', 'wait_s'), when its policy gives none
-_UNIT_IN_NAME = re.compile(r"(?:^|_)(km|m|cm|mm|min|s|ms|h|kg|g)$", re.IGNORECASE)
-#: (the feature's unit, a unit written after its value) -> how many of the written unit make one of the feature's
-_CONVERSIONS = {("km", "m"): 1e3, ("m", "km"): 1e-3, ("m", "cm"): 1e2, ("m", "mm"): 1e3, ("cm", "mm"): 10,
-                ("h", "min"): 60, ("min", "s"): 60, ("s", "ms"): 1e3, ("min", "h"): 1 / 60, ("s", "min"): 1 / 60,
-                ("ms", "s"): 1e-3, ("kg", "g"): 1e3, ("g", "kg"): 1e-3}
-_WRITTEN_UNIT = re.compile(r"\s*(km|kilometres?|kilometers?|m|metres?|meters?|cm|mm|min|minutes?|s|seconds?|ms|h|"
-                           r"hours?|kg|g|grams?)\b", re.IGNORECASE)
-_UNIT_WORDS = {"kilometre": "km", "kilometer": "km", "metre": "m", "meter": "m", "minute": "min", "second": "s",
-               "hour": "h", "gram": "g"}
-
-
-def unit_in_name(name: str) -> str:
-    """The unit a feature's name ends in ('km' of 'next_drop_dist_km'), '' for none."""
-    m = _UNIT_IN_NAME.search(name)
-    return m.group(1).lower() if m else ""
-
-
-def _prefixed(after: str, unit: str) -> tuple[str, float]:
-    """The unit right after a number when it is a multiple of the feature's: a decimal prefix ('2 Mbit' for 2e6 bit,
-    '12 kB' for 12,000 B) or a unit of the same kind ('600 m' for 0.6 km, '90 s' for 1.5 min): the written unit (a
-    prefix alone for a prefixed one) and how many of the feature's unit make one of it; ('', 1.0) without one."""
-    prefix = re.match(rf"\s*([kMG])\s?{re.escape(unit)}\b", after) if unit else None
-    if prefix:
-        return prefix.group(1), {"k": 1e3, "M": 1e6, "G": 1e9}[prefix.group(1)]
-    written = _WRITTEN_UNIT.match(after) if unit else None
-    if written:
-        word = written.group(1).lower()
-        word = _UNIT_WORDS.get(word.rstrip("s") if len(word) > 3 else word, word)
-        factor = _CONVERSIONS.get((unit.lower(), word))
-        if factor:
-            return f"{word} (not {unit})", 1 / factor
-    return "", 1.0
 
 
 def _share(n: Number, e, contexts) -> str:
@@ -387,3 +352,28 @@ def any_fact(n: Number, book: FactBook, keys, ctx: str | None, strict: bool = Fa
         if states(v):
             return what
     return None
+
+
+#: a count of things a name after it holds: 'three robots in the charger queue', 'seven cars waiting at the junction'
+_COUNTED_IN = re.compile(r"^\s+(?:[a-z\0]+\s+){1,2}(?:(?:already|still|now|waiting|queued|parked)\s+)?(?:in|on|at|inside)"
+                         r"\s+(?:the\s+|a\s+|its\s+)?$", re.IGNORECASE)
+
+
+def owned_by_unit_or_place(n: Number, masked: str, mentions, book: FactBook, unit_of) -> Claim | None:
+    """A number first read as another name's and contradicted, that states exactly the value of the one feature its
+    unit belongs to ('parked barely 4 m from a charger' of dist_to_charger_m, 4.2) or of the name that holds the things
+    it counts ('three robots in the charger queue' of charger_queue_len, 3): verified as that value; else None."""
+    unit = re.match(r"\s*([A-Za-zµ°/%]+)\b", masked[n.end:])
+    owners = [f for f in book.features if unit and unit_of(f) and unit_of(f).lower() == unit.group(1).lower()]
+    nxt = next((m for m in mentions if m.kind == "feature" and m.start >= n.end and len(m.keys) == 1
+                and _COUNTED_IN.match(masked[n.end:m.start])), None)  # (past the counted noun's own mention)
+    if nxt is not None:
+        owners, rule = list(nxt.keys), "number.counted-in"
+    elif len(owners) == 1:
+        rule = "number.unit-owner"
+    else:
+        return None
+    e = book.features.get(owners[0])
+    if e is None or e.value is None or not matches(replace(n, hedge=""), e.value, magnitude_ok=False):
+        return None
+    return Claim("number", n.text, "verified", f"{owners[0]}: value", rule)

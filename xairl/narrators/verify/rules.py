@@ -35,6 +35,9 @@ def example(name: str) -> Explanation:
     wind_speed_ms 0.8 (+6.9), pm2_5_lag1 48.2 (+14.7), traffic_index 2.4 (+7.2), season winter (-1.0), road
     '4 lanes' (+0.1).
 
+    ``drone``: the Q-value of continuing (one output), base 3.1; next_drop_dist_km 0.6 (+1.15), charger_queue_len 3
+    (-0.27), battery_pct 46 (+0.49), drone_model X2 (+0.09); no policy, so units come from the names.
+
     ``robot``: a discrete policy; turn (3.2) chosen over recharge (2.0) and forward (-0.5), base 1.0 each; on the
     chosen score speed +0.5, battery -0.3, obstacle +2.0; on the margin over recharge speed +0.7, battery -1.5,
     obstacle +2.0.
@@ -46,6 +49,13 @@ def example(name: str) -> Explanation:
                            feature_names=("precip_mm_24h", "wind_speed_ms", "pm2_5_lag1", "traffic_index", "season",
                                           "road"), action_names=("forecast",), method="given", output="value",
                            categories={"season": ("winter", "summer"), "road": ("2 lanes", "4 lanes")})
+    if name == "drone":
+        c = np.array([1.15, -0.27, 0.49, 0.09])
+        return Explanation(values=c.reshape(1, -1, 1), base_values=np.array([[3.1]]), outputs=np.array([[3.1 + c.sum()]]),
+                           states=np.array([[0.6, 3.0, 46.0, 0.0]]), feature_names=(
+                               "next_drop_dist_km", "charger_queue_len", "battery_pct", "drone_model"),
+                           action_names=("continue",), method="given", output="value",
+                           categories={"drone_model": ("X2", "X3")})
     c = np.array([[0.5, -0.2, 0.1], [-0.3, 1.2, -0.1], [2.0, 0.0, -1.5]])
     return Explanation(values=c[None], base_values=np.ones((1, 3)), outputs=(1 + c.sum(axis=0))[None],
                        states=np.array([[0.4, 0.3, 0.9]]), feature_names=("speed", "battery", "obstacle"),
@@ -79,6 +89,15 @@ RULES: tuple[Rule, ...] = (
          "after a preposition ('queued at charger 3'), contradicted as that name's: an identifier, unchecked",
          fires=(("air", "The monitor at traffic 9 read high."),),
          silent=(("air", "Traffic adds 7.2."), ("air", "The monitor at traffic 9 km away read high."))),
+    Rule("number.unit-owner", "number", "a number first read by position as another name's and contradicted, "
+         "followed by a unit only one feature has ('0.6 km' of next_drop_dist_km): verified when it is that "
+         "feature's value",
+         fires=(("drone", "Battery at 46 and 0.6 km to go: continuing wins."),),
+         silent=(("drone", "Battery at 46 and 0.9 km to go: continuing wins."),)),
+    Rule("number.counted-in", "number", "a number first read by position as another name's and contradicted, that "
+         "counts things in a name after it ('three drones in the charger queue'): verified when it is that name's "
+         "value", fires=(("drone", "There are already three drones in the charger queue."),),
+         silent=(("drone", "There are already five drones in the charger queue."),)),
     Rule("number.without", "number", "a number in a clause that takes one named feature's push away ('without "
          "traffic's contribution'): verified when it is the prediction, its change from the baseline or the margin "
          "less that push, else its other readings decide",

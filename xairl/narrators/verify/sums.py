@@ -1,8 +1,10 @@
-"""Numbers that sum over several features: 'A and B together add x' (:func:`sum_number`), and totals or side
-sums after words that say so, 'the positives add up to x', '11.3 of 21.9 points' (:func:`aggregate_number`)."""
+"""Numbers that sum over several features: 'A and B together add x' (:func:`sum_number`), totals or side sums after
+words that say so, 'the positives add up to x', '11.3 of 21.9 points' (:func:`aggregate_number`), and the output less
+one feature's push, 'without A it would sit at x' (:func:`without_number`)."""
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 from .book import FactBook
 from .checks import EITHER, Claim
@@ -23,6 +25,15 @@ _PART_OF = re.compile(r"\d[\d.,]*\s*(?:points?|pts|%)?\s+of\s+(?:roughly\s+|abou
 
 #: a total's word right after it: '6.3 points in total', '$806 in total reductions'
 _TOTAL_AFTER = re.compile(r"\s*(?:points?|pts)?\s*(?:in total|in all|altogether|combined|overall)\b", re.IGNORECASE)
+
+
+def sum_reading(n: Number, masked: str, names, book: FactBook) -> Claim | None:
+    """:func:`aggregate_number`, else :func:`without_number`, each with its rule's id; None for neither."""
+    summed = aggregate_number(n, masked, book)
+    if summed is not None:  # 'the positives add up to about +0.39', 'total absolute attribution of 1.62'
+        return replace(summed, rule="number.aggregate")
+    removed = without_number(n, masked, names, book)  # 'without the add-on's contribution it would sit at 12.4%'
+    return replace(removed, rule="number.without") if removed is not None else None
 
 
 def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
