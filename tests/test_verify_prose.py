@@ -1066,3 +1066,18 @@ def test_a_period_that_is_the_window_of_a_features_name_is_no_claim():
     assert numbers("A customer of 71 months who returned nothing in the past twelve months.") == [("71", "verified")]
     assert numbers("A customer of 71 months who returned nothing in the past nine months.")[1] == ("nine",
                                                                                                  "contradicted")
+
+
+def test_fractions_state_a_probability_given_in_percent():
+    """A dropout probability of 46.9 (%) from 18.4 with Q3_grade +9.6: 'p_dropout=0.469 ... (+0.096)' states it; a
+    wrong fraction is caught; an output that is no probability does not read fractions as percentages."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["Q3_grade", "attendance_pct"], [54, 71], [9.6, 18.9], 18.4, "probability of dropping out")
+
+    def numbers(text, e=exp):
+        return [(c.text, c.status) for c in xairl.verify(text, e, 0).claims if c.kind == "number"]
+    assert numbers("p_dropout=0.469 base=0.184 Q3_grade=54(+0.096)") == [
+        ("0.469", "verified"), ("0.184", "verified"), ("54", "verified"), ("+0.096", "verified")]
+    assert ("+0.090", "contradicted") in numbers("p_dropout=0.469 base=0.184 Q3_grade=54(+0.090)")
+    cost = one_output(["Q3_grade", "attendance_pct"], [54, 71], [9.6, 18.9], 18.4, "claim cost")
+    assert ("+0.096", "verified") not in numbers("cost=46.9 base=18.4 Q3_grade=54(+0.096)", cost)

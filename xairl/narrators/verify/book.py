@@ -64,6 +64,15 @@ class FactBook:
         return ("chosen", "margin") if self.runner_up else ("chosen",)
 
     @property
+    def in_percent(self) -> bool:
+        """One probability-like output given in percent (base 18.4, prediction 46.9 of 'probability that ...'): a
+        text may write its numbers as fractions ('p_dropout=0.469', '+0.096')."""
+        if self.output == "actions" or self.base is None or self.chosen not in self.scores:
+            return False
+        score = self.scores[self.chosen]
+        return bool(_PROBABILITY.search(self.chosen or "")) and 0 <= self.base <= 100 and 1 < score <= 100
+
+    @property
     def outcome_sign(self) -> int:
         """Where one output went from the baseline: +1 up, -1 down, 0 unknown or several actions ('the primary
         reasons for the model's prediction' are the features that moved it that way)."""
@@ -72,6 +81,7 @@ class FactBook:
         return int(np.sign(self.scores[self.chosen] - self.base))
 
 
+_PROBABILITY = re.compile(r"probab|chance|risk|likelihood|odds|share|rate|percent|%", re.IGNORECASE)
 _LEGEND_ENTRY = re.compile(r"^\s*(\d+)\s*[:=]?\s+(\S.*?)\s*$")
 
 

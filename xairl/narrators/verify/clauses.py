@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 from . import background, binding, comparisons, directions, noclaims, quantities, ranks, sums
 from .book import FactBook
@@ -19,6 +20,9 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
     names = named_features(mentions)
     numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not noclaims.skip_number(n, masked)
                and not noclaims.window_of_name(n, sentence_keys, written or masked, book.features)]
+    if book.in_percent:  # 'p_dropout=0.469' of a prediction of 46.9 %: a fraction may state a percentage
+        numbers = [replace(n, alternatives=(*n.alternatives, 100 * n.value)) if not n.percent and abs(n.value) < 1
+                   and "." in n.text else n for n in numbers]
     tail, paired, summed = _lists(masked, a, b, names, numbers)
     paired |= comparisons.compared_pairs(masked, a, b, names, numbers)  # 'A mattered twice as much as B (0.88 vs 0.49)'
     actions = [m for m in mentions if m.kind == "action"]
