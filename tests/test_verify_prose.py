@@ -1081,3 +1081,14 @@ def test_fractions_state_a_probability_given_in_percent():
     assert ("+0.090", "contradicted") in numbers("p_dropout=0.469 base=0.184 Q3_grade=54(+0.090)")
     cost = one_output(["Q3_grade", "attendance_pct"], [54, 71], [9.6, 18.9], 18.4, "claim cost")
     assert ("+0.096", "verified") not in numbers("cost=46.9 base=18.4 Q3_grade=54(+0.096)", cost)
+
+
+def test_a_change_since_last_time_is_the_features_value_not_its_push():
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["gpa_trend", "units_failed"], [-0.4, 3], [3.1, 11.3], 18.4, "probability of dropping out")
+
+    def numbers(text):
+        return [(c.text, c.status, c.detail) for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    assert numbers("A falling GPA trend, down 0.4 since last term, adds another 3.")[0] == (
+        "0.4", "verified", "gpa_trend: value")
+    assert numbers("A falling GPA trend, down 0.9 since last term, adds another 3.")[0][1] == "contradicted"

@@ -90,9 +90,15 @@ class _Cues:
     pushes: bool         # the words before it speak of contributions at all ('The SHAP value of serving_bs is 0.00')
 
 
+#: a change of the feature itself over time, not a push: 'a GPA trend, down 0.4 since last term'
+_SINCE_AFTER = re.compile(r"\s*(?:points?\s+|[a-zA-Z%]{1,4}\s+)?(?:since|from last|on last|versus last|vs\.? last)\b",
+                          re.IGNORECASE)
+
+
 def _cues(n: Number, masked: str, book: FactBook) -> _Cues:
     before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 16]
-    contribution, lists = bool(CONTRIB_BEFORE.search(before)), bool(_LISTS_CONTRIBUTIONS.search(masked[:n.start]))
+    contribution = bool(CONTRIB_BEFORE.search(before)) and not _SINCE_AFTER.match(after)
+    lists = bool(_LISTS_CONTRIBUTIONS.search(masked[:n.start]))
     slot = not n.sign and not n.currency and not n.percent and bool(re.search(r"\0\s?\($", before)) and \
         masked[n.end:n.end + 1] in (")", ",") and not lists
     fill = bool(n.percent and re.match(r"\s*(full|of (?:its |the )?capacity)\b", after, re.IGNORECASE))
