@@ -1092,3 +1092,15 @@ def test_a_change_since_last_time_is_the_features_value_not_its_push():
     assert numbers("A falling GPA trend, down 0.4 since last term, adds another 3.")[0] == (
         "0.4", "verified", "gpa_trend: value")
     assert numbers("A falling GPA trend, down 0.9 since last term, adds another 3.")[0][1] == "contradicted"
+
+
+def test_the_words_of_one_names_window_do_not_bind_a_number_to_another_name():
+    """'in the last 90 days' spells num_support_calls_90d's window, not days_since_last_upgrade: the push after it
+    is the support calls'."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["num_support_calls_90d", "days_since_last_upgrade"], [7, 612], [0.133, 0.029], 0.26,
+                     "churn probability")
+    text = "The seven support calls logged in the last 90 days add roughly {} percentage points."
+    found = [(c.text, c.status, c.detail) for c in xairl.verify(text.format(13), exp, 0).claims if c.kind == "number"]
+    assert ("13 percentage points", "verified", "num_support_calls_90d: contribution (chosen)") in found
+    assert not xairl.verify(text.format(3), exp, 0).ok

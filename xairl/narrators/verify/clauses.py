@@ -17,6 +17,8 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
                  unit_of, parsed, vocab, sentence_keys=frozenset(), written: str = "") -> list[Claim]:
     out: list[Claim] = []
     name_words = vocab.name_words
+    if written:  # ('the last 90 days' of support_calls_90d: not days_since_last_upgrade)
+        mentions = noclaims.without_window_words(mentions, written, book.features)
     names = named_features(mentions)
     numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not noclaims.skip_number(n, masked)
                and not noclaims.window_of_name(n, sentence_keys, written or masked, book.features)]

@@ -78,3 +78,19 @@ def identifier_after_word(n: Number, masked: str, mentions) -> bool:
         return False  # '3.5', '3 km', '3%': a quantity
     return bool(re.search(r"(?:^|\b(?:at|on|in|to|near|from|by|with|for|though|when|while|and|unit))\s+$",
                           masked[:owner.start], re.IGNORECASE))
+
+
+def without_window_words(mentions, written: str, features) -> list:
+    """``mentions`` less the one-word parts of a name that only spell another name's window in the ``written``
+    sentence ('days' of days_since_last_upgrade in 'support calls in the last 90 days', the window of
+    support_calls_90d)."""
+    windows = {(m.group(1), m.group(2)) for f in features for m in re.finditer(r"(\d+)([a-z])", f.lower())}
+
+    def spells_window(m) -> bool:  # 'the last 90 days': both words of the window, next to its number
+        if m.kind != "feature" or m.form != "part":
+            return False
+        before, after = re.search(r"(\d+)\s*$", written[:m.start]), re.match(r"\s*(\d+)\s*([a-z])", written[m.end:])
+        window = (before.group(1), written[m.start:m.start + 1].lower()) if before else (
+            (after.group(1), after.group(2).lower()) if after else None)
+        return window in windows and not any("".join(window) in k.lower() for k in m.keys)
+    return [m for m in mentions if not spells_window(m)]
