@@ -79,8 +79,8 @@ def _one_name_pushes(n, masked: str, mentions) -> bool:
 def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, sentence_keys) -> Claim:
     """A contradicted number that states another fact of a feature named in the sentence exactly (not truncated): the
     binding was a guess, so it is unchecked ('which is unclear'). A difference in a unit ('4.0 dB above'), a number
-    right after its name ('battery +1.70') and a name 'at' a number bind for sure; a bracket right after a name ('distance (2.33)') may only be
-    that name's own fact, with its sign."""
+    right after its name ('battery +1.70') and a name 'at' a number bind for sure; a bracket right after a name
+    ('distance (2.33)') may only be that name's own fact, with its sign."""
     if quantities.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
         return c
     owner = next((m for m in reversed(mentions) if m.end <= n.start), None)

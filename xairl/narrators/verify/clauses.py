@@ -101,8 +101,8 @@ def _lists(masked: str, a: int, b: int, names: list[Mention], numbers) -> tuple[
 
 #: 'A and B together add x', 'combined', 'sum to', 'between them': the number is their sum
 _SUM_CUE = re.compile(r"\b(?:together|combined|jointly|in total|taken together|between them|sum(?:s|med)? to|add up to|"
-                      r"in sum|make up|(?:they|these|those)\s+(?:(?:only|just|all|three|two|four)\s+)?(?:add|contribute|"
-                      r"account for))\b", re.IGNORECASE)  # ('A, B and C, and they add just 1.85')
+                      r"in sum|make up|(?:they|these|those)\s+(?:(?:only|just|all|three|two|four)\s+)?"
+                      r"(?:add|contribute|account for))\b", re.IGNORECASE)  # ('A, B and C, and they add just 1.85')
 _OWN_QUANTITY = re.compile(r"\bof\s+(?:the\s+)?[$€£]?$", re.IGNORECASE)
 _NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
                       r"(?:(?:because of|due to|about|the|its|their|a|an)\s+){0,3}$", re.IGNORECASE)

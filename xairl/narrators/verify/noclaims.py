@@ -62,15 +62,15 @@ def window_of_name(n: Number, keys, masked: str = "", all_keys=()) -> bool:
     if any(str(int(n.value)) in re.findall(r"(\d+)[a-z]", k.lower()) for k in keys):
         return True
     period = _PERIOD_AFTER.match(masked, n.end)
-    return bool(period) and any((str(int(n.value)), period.group(1)[0].lower()) in re.findall(r"(\d+)([a-z])", k.lower())
-                                for k in all_keys)
+    window = (str(int(n.value)), period.group(1)[0].lower()) if period else None
+    return window is not None and any(window in re.findall(r"(\d+)([a-z])", k.lower()) for k in all_keys)
 
 
 def identifier_after_word(n: Number, masked: str, mentions) -> bool:
     """A bare whole number right after one word of a longer name that a preposition or the sentence's start comes
     before ('queued at charger 3', 'unit 5 on floor 2'): an identifier of a thing, not that name's value."""
     digits = masked.find(n.text, n.start)
-    owner = next((m for m in mentions if m.kind == "feature" and masked[m.end:digits] == " "), None)
+    owner = next((m for m in mentions if m.kind == "feature" and digits > 0 and masked[m.end:digits] == " "), None)
     if owner is None or owner.form != "part" or not n.text.isdigit():
         return False
     if re.match(r"[.,]\d|\s*(?:%|[a-zA-Z]{1,3}\b)", masked[n.end:]) and not re.match(

@@ -361,8 +361,8 @@ def any_fact(n: Number, book: FactBook, keys, ctx: str | None, strict: bool = Fa
 
 
 #: a count of things a name after it holds: 'three robots in the charger queue', 'seven cars waiting at the junction'
-_COUNTED_IN = re.compile(r"^\s+(?:[a-z\0]+\s+){1,2}(?:(?:already|still|now|waiting|queued|parked)\s+)?(?:in|on|at|inside)"
-                         r"\s+(?:the\s+|a\s+|its\s+)?$", re.IGNORECASE)
+_COUNTED_IN = re.compile(r"^\s+(?:[a-z\0]+\s+){1,2}(?:(?:already|still|now|waiting|queued|parked)\s+)?"
+                         r"(?:in|on|at|inside)\s+(?:the\s+|a\s+|its\s+)?$", re.IGNORECASE)
 
 
 def owned_by_unit_or_place(n: Number, masked: str, mentions, book: FactBook, unit_of) -> Claim | None:

@@ -51,9 +51,9 @@ def example(name: str) -> Explanation:
                            categories={"season": ("winter", "summer"), "road": ("2 lanes", "4 lanes")})
     if name == "drone":
         c = np.array([1.15, -0.27, 0.49, 0.09])
-        return Explanation(values=c.reshape(1, -1, 1), base_values=np.array([[3.1]]), outputs=np.array([[3.1 + c.sum()]]),
-                           states=np.array([[0.6, 3.0, 46.0, 0.0]]), feature_names=(
-                               "next_drop_dist_km", "charger_queue_len", "battery_pct", "drone_model"),
+        return Explanation(values=c.reshape(1, -1, 1), base_values=np.array([[3.1]]),
+                           outputs=np.array([[3.1 + c.sum()]]), states=np.array([[0.6, 3.0, 46.0, 0.0]]),
+                           feature_names=("next_drop_dist_km", "charger_queue_len", "battery_pct", "drone_model"),
                            action_names=("continue",), method="given", output="value",
                            categories={"drone_model": ("X2", "X3")})
     c = np.array([[0.5, -0.2, 0.1], [-0.3, 1.2, -0.1], [2.0, 0.0, -1.5]])
