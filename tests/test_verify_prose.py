@@ -1104,3 +1104,28 @@ def test_the_words_of_one_names_window_do_not_bind_a_number_to_another_name():
     found = [(c.text, c.status, c.detail) for c in xairl.verify(text.format(13), exp, 0).claims if c.kind == "number"]
     assert ("13 percentage points", "verified", "num_support_calls_90d: contribution (chosen)") in found
     assert not xairl.verify(text.format(3), exp, 0).ok
+
+
+def test_this_rounds_readings_do_not_let_wrong_numbers_through():
+    """Counterexamples a second review found for the readings above, each a wrong (or right) number that must keep
+    its status."""
+    from benchmarks.bench_verifier import one_output
+
+    def status(text, exp):
+        return [c.status for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    dist = one_output(["dist_m", "wait_s"], [12.0, 90], [-0.3, 0.4], 1.0, "Q-value of recharging")
+    assert status("Distance -0.3 means a lower score.", dist) == ["verified"]  # 'means' is no unit 'm'
+    assert status("The wait of 2 minutes counted for it.", dist) != ["verified"]  # 90 s is no '2 minutes'
+    drop = one_output(["next_drop_dist_km", "battery_pct"], [0.64, 46], [1.15, 0.49], 3.1, "Q-value of continuing")
+    assert status("The distance raises the Q-value by 0.6 since it is short.", drop) == ["contradicted"]
+    assert status("Battery 46, about 0.64 km to go.", drop) == ["verified", "verified"]  # its unit's one owner
+    assert status("Battery 46, about 0.94 km to go.", drop)[1] != "verified"
+    gpa = one_output(["gpa_trend", "units_failed"], [-0.4, 3], [3.1, 11.3], 18.4, "probability of dropping out")
+    assert status("A GPA trend of -0.004 adds about 3.1 points.", gpa)[0] == "contradicted"
+    speed = one_output(["speed", "gap"], [0.5, 12], [0.3, 0.2], 1.1, "Q-value of accelerate")
+    assert status("speed=0.005(+0.003)", speed) != ["verified", "verified"]
+    calls = one_output(["support_calls_90d", "days_since_last_upgrade"], [7, 612], [0.13, 0.03], 0.26,
+                       "churn probability")
+    assert status("It has been 90 days since the last upgrade.", calls) == ["contradicted"]
+    robots = one_output(["battery_pct", "charger_queue_len"], [46, 3], [0.5, -0.2], 1.0, "Q-value of recharging")
+    assert not xairl.verify("Battery 46 and queue 9 robots waiting.", robots, 0).ok

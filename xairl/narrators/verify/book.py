@@ -81,7 +81,7 @@ class FactBook:
         return int(np.sign(self.scores[self.chosen] - self.base))
 
 
-_PROBABILITY = re.compile(r"probab|chance|risk|likelihood|odds|share|rate|percent|%", re.IGNORECASE)
+_PROBABILITY = re.compile(r"\b(?:probab\w*|chances?|risk|likelihood|share|percent\w*)\b|%", re.IGNORECASE)
 _LEGEND_ENTRY = re.compile(r"^\s*(\d+)\s*[:=]?\s+(\S.*?)\s*$")
 
 

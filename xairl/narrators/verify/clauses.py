@@ -11,6 +11,7 @@ from .book import FactBook
 from .checks import Claim
 from .names import Mention, named_features
 from .numbers import find_numbers
+from .vocabulary import split_words, stem
 
 
 def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
@@ -21,7 +22,7 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
         mentions = noclaims.without_window_words(mentions, written, book.features)
     names = named_features(mentions)
     numbers = [n for n in find_numbers(masked[:b]) if n.start >= a and not noclaims.skip_number(n, masked)
-               and not noclaims.window_of_name(n, sentence_keys, written or masked, book.features)]
+               and not noclaims.window_of_name(n, sentence_keys, written or masked, _worded(book, written))]
     if book.in_percent:  # 'p_dropout=0.469' of a prediction of 46.9 %: a fraction may state a percentage
         numbers = [replace(n, alternatives=(*n.alternatives, 100 * n.value)) if not n.percent and abs(n.value) < 1
                    and "." in n.text else n for n in numbers]
@@ -97,6 +98,14 @@ def _lists(masked: str, a: int, b: int, names: list[Mention], numbers) -> tuple[
         and not _OWN_QUANTITY.search(
         masked[max(a, tail[0].start - 12):tail[0].start]) and not quantities.CHANGE_AFTER.match(masked[tail[0].end:b])
     return tail, paired, bool(summed)
+
+
+def _worded(book: FactBook, written: str) -> list[str]:
+    """The features with a window in their name ('prior_returns_12m') whose other words the sentence uses in some
+    form ('returned'): the ones a period in it ('the past twelve months') may be the window of."""
+    said = {stem(w) for w in split_words(written)}
+    return [f for f in book.features if re.search(r"\d+[a-z]", f.lower()) and said & {
+        stem(w) for w in split_words(f) if len(w) >= 4 and not any(c.isdigit() for c in w)}]
 
 
 #: 'A and B together add x', 'combined', 'sum to', 'between them': the number is their sum

@@ -67,17 +67,17 @@ def window_of_name(n: Number, keys, masked: str = "", all_keys=()) -> bool:
 
 
 def identifier_after_word(n: Number, masked: str, mentions) -> bool:
-    """A bare whole number right after one word of a longer name that a preposition or the sentence's start comes
-    before ('queued at charger 3', 'unit 5 on floor 2'): an identifier of a thing, not that name's value."""
+    """A bare whole number right after one word of a longer name that a preposition comes before, ending its phrase
+    ('queued at charger 3', 'even though charger 2 was free', 'unit 5 on floor 2'): an identifier of a thing, not that
+    name's value."""
     digits = masked.find(n.text, n.start)
     owner = next((m for m in mentions if m.kind == "feature" and digits > 0 and masked[m.end:digits] == " "), None)
     if owner is None or owner.form != "part" or not n.text.isdigit():
         return False
-    if re.match(r"[.,]\d|\s*(?:%|[a-zA-Z]{1,3}\b)", masked[n.end:]) and not re.match(
-            r"\s+(?:on|in|at|of|to|is|was|and|or)\b", masked[n.end:]):
-        return False  # '3.5', '3 km', '3%': a quantity
-    return bool(re.search(r"(?:^|\b(?:at|on|in|to|near|from|by|with|for|though|when|while|and|unit))\s+$",
-                          masked[:owner.start], re.IGNORECASE))
+    if not re.match(r"\s*(?:$|[,;:.)!?](?!\d)|(?:was|is|were|had|has|on|in|at|of|to|and|or|which|that|yesterday|"
+                    r"today)\b)", masked[n.end:], re.IGNORECASE):
+        return False  # '3.5', '3 km', '9 robots': a quantity
+    return bool(re.search(r"\b(?:at|on|in|to|near|from|by|for|though|unit)\s+$", masked[:owner.start], re.IGNORECASE))
 
 
 def without_window_words(mentions, written: str, features) -> list:
@@ -89,7 +89,9 @@ def without_window_words(mentions, written: str, features) -> list:
     def spells_window(m) -> bool:  # 'the last 90 days': both words of the window, next to its number
         if m.kind != "feature" or m.form != "part":
             return False
-        before, after = re.search(r"(\d+)\s*$", written[:m.start]), re.match(r"\s*(\d+)\s*([a-z])", written[m.end:])
+        before = re.search(r"(\d+)\s*$", written[:m.start])
+        after = re.match(r"\s*(\d+)\s*(?=(?:days?|weeks?|months?|years?|hours?|d|w|m|y|h)\b)([a-z])", written[m.end:],
+                         re.IGNORECASE)
         window = (before.group(1), written[m.start:m.start + 1].lower()) if before else (
             (after.group(1), after.group(2).lower()) if after else None)
         return window in windows and not any("".join(window) in k.lower() for k in m.keys)

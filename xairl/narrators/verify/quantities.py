@@ -91,8 +91,8 @@ class _Cues:
 
 
 #: a change of the feature itself over time, not a push: 'a GPA trend, down 0.4 since last term'
-_SINCE_AFTER = re.compile(r"\s*(?:points?\s+|[a-zA-Z%]{1,4}\s+)?(?:since|from last|on last|versus last|vs\.? last)\b",
-                          re.IGNORECASE)
+_SINCE_AFTER = re.compile(r"\s*(?:points?\s+|[a-zA-Z%]{1,4}\s+)?(?:since\s+(?:last|the last|the previous|"
+                          r"yesterday|\d)|from last|on last|versus last|vs\.? last)\b", re.IGNORECASE)
 
 
 def _cues(n: Number, masked: str, book: FactBook) -> _Cues:
@@ -126,7 +126,8 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
             return matches(n, e.fill), f"{key}'s fill is {e.fill:.3g} % of its capacity"
         unit = unit_of(key).lower()
         prefix, scale = written_scale(after, unit_of(key))
-        value_cue = (bool(unit) and after.strip().lower().startswith(unit.split()[0]) or cue.slot or bool(prefix)) \
+        value_cue = (bool(unit) and bool(re.match(rf"{re.escape(unit.split()[0])}(?![a-z])", after.strip().lower()))
+                     or cue.slot or bool(prefix)) \
             and not contrib_cue
         meaning = None if contrib_cue or n.percent else _code_meaning(n, e)
         if meaning is not None:  # 'a balance above 200 DM' for status 4 ('200 DM or more'), before any rounding
@@ -141,7 +142,10 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
             cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
         for what, v in cands:
             contribution = what.startswith("contribution")
-            if matches(n, v, magnitude_ok=not (cue.signed and contribution)) or (
+            m = n if contribution else replace(n, alternatives=tuple(x for x in n.alternatives if x != 100 * n.value))
+            if " (not " in what and abs(n.value - v) > 0.05 * abs(v):
+                continue  # a value in another unit: its rounding is not the coarser unit's ('2 minutes' is no 90 s)
+            if matches(m, v, magnitude_ok=not (cue.signed and contribution)) or (
                     (n.percent or (cue.in_points and contribution)) and percent_reading(n, v)):
                 return True, f"{key}: {what}"
         share = _share(n, e, contexts)
@@ -380,6 +384,8 @@ def owned_by_unit_or_place(n: Number, masked: str, mentions, book: FactBook, uni
     else:
         return None
     e = book.features.get(owners[0])
+    if n.hedge not in ("", "approx"):  # ('under 0.6 km', 'over 1000 DM': a bound, not this value)
+        return None
     if e is None or e.value is None or not matches(replace(n, hedge=""), e.value, magnitude_ok=False):
         return None
     return Claim("number", n.text, "verified", f"{owners[0]}: value", rule)

@@ -87,8 +87,8 @@ RULES: tuple[Rule, ...] = (
          fires=(("air", "The positives add up to 31.1."),), silent=(("air", "Traffic adds 7.2."),)),
     Rule("number.identifier-after-word", "number", "a bare whole number right after one word of a longer name, "
          "after a preposition ('queued at charger 3'), contradicted as that name's: an identifier, unchecked",
-         fires=(("air", "The monitor at traffic 9 read high."),),
-         silent=(("air", "Traffic adds 7.2."), ("air", "The monitor at traffic 9 km away read high."))),
+         fires=(("air", "The monitor at traffic 9 was busy."),),
+         silent=(("air", "Traffic adds 7.2."), ("air", "The monitor at traffic 9 km away was busy."))),
     Rule("number.unit-owner", "number", "a number first read by position as another name's and contradicted, "
          "followed by a unit only one feature has ('0.6 km' of next_drop_dist_km): verified when it is that "
          "feature's value",

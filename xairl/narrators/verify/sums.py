@@ -98,7 +98,7 @@ def without_number(n: Number, masked: str, names, book: FactBook) -> Claim | Non
     (its other readings decide)."""
     removed = next((m for m in reversed(names) if m.end <= n.start and n.start - m.end <= 120
                     and _WITHOUT.search(masked[max(0, m.start - 16):m.start])
-                    and not re.search(r"[.;]", masked[m.end:n.start])), None)
+                    and not re.search(r"(?<!\d)[.;]|[.;](?!\d)", masked[m.end:n.start])), None)
     if removed is None or len(removed.keys) != 1 or removed.keys[0] not in book.features:
         return None
     contribs = book.features[removed.keys[0]].contribs
