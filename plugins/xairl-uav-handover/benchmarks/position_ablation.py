@@ -48,7 +48,7 @@ def main():
     data["observation"]["position_hidden"] = True
     hidden_cfg = SimConfig.model_validate(data)
     path = Path(tempfile.mkdtemp()) / "no-position.safetensors"
-    tc = TrainConfig.model_validate(committed.meta["train_config"])
+    tc = TrainConfig.of_checkpoint(committed.meta)
     train_checkpoint(tc, hidden_cfg, str(path), progress=False)
     blind = load_checkpoint(path)
     dqns = {"DQN": committed, "DQN without position": blind}

@@ -6,7 +6,8 @@ A weight set is w_lost,w_rsrq,w_handover,w_pingpong (per Mbit lost, per decision
 handover, per handover back to the previous BS within 5 s); the other weights are the simulator's defaults. Training
 takes about 2 minutes per set and seed on 2 cores (40 episodes of 64 flights).
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reward_sweep.py [--sets 1,3,30,80 0.5,2,30,60 ...]
-     [--seeds 0] [--episodes 40] [--flights 100] [--eval-seeds 0] [--keep DIR]
+     [--seeds 0] [--episodes 40] [--flights 100] [--eval-seeds 0] [--keep DIR] [--demonstrations N]
+The sweeps in docs/uav-reference.md dated before 2026-12-03 evening trained plain DQNs: --demonstrations 0.
 """
 import argparse
 import tempfile
@@ -36,6 +37,8 @@ def main():
     ap.add_argument("--flights", type=int, default=100, help="held-out flights per evaluation seed")
     ap.add_argument("--eval-seeds", type=int, nargs="+", default=[0])
     ap.add_argument("--keep", default=None, help="folder for the checkpoints (default: a temporary one)")
+    ap.add_argument("--demonstrations", type=int, default=TrainConfig().demonstrations,
+                    help="episodes of the RSRQ rule's flights to learn from (0: a plain DQN)")
     args = ap.parse_args()
     folder = Path(args.keep or tempfile.mkdtemp())
     folder.mkdir(parents=True, exist_ok=True)
@@ -44,7 +47,8 @@ def main():
     for weights in args.sets:
         for seed in args.seeds:
             path = folder / f"w{weights.replace(',', '_')}_seed{seed}.safetensors"
-            train_checkpoint(TrainConfig(episodes=args.episodes, seed=seed), config(weights), str(path), progress=False)
+            tc = TrainConfig(episodes=args.episodes, seed=seed, demonstrations=args.demonstrations)
+            train_checkpoint(tc, config(weights), str(path), progress=False)
             net = load_checkpoint(path).net
             res[f"{weights} s{seed}"] = with_intervals(flights(DQNController(net), cfg, args.flights, args.eval_seeds))
     print(f"w_lost,w_rsrq,w_handover,w_pingpong per column; {args.flights} held-out flights x {args.eval_seeds}")

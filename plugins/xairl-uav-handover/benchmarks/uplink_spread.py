@@ -4,7 +4,8 @@ to the margin over the runner-up and to the chosen action's score (deep_shap) on
 held-out flights.
 
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/uplink_spread.py [--spreads 9 0] [--episodes 40]
-     [--states 400]   (about 2 minutes of training per spread on 2 cores)
+     [--states 400] [--demonstrations N]   (about 2 minutes of training per spread on 2 cores; the figures in
+     docs/uav-reference.md, 2026-12-02, trained plain DQNs: --demonstrations 0)
 """
 import argparse
 import shutil
@@ -34,6 +35,8 @@ def main():
     ap.add_argument("--episodes", type=int, default=40)
     ap.add_argument("--states", type=int, default=400)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--demonstrations", type=int, default=TrainConfig().demonstrations,
+                    help="episodes of the RSRQ rule's flights to learn from (0: a plain DQN)")
     args = ap.parse_args()
     folder = Path(tempfile.mkdtemp())  # the checkpoints of this run; removed at the end
     print(f"{'spread dB':>9} {'buffer rank (margin)':>21} {'(chosen score)':>15}  top 3 by margin")
@@ -41,8 +44,8 @@ def main():
         data = SimConfig().model_dump()
         data["radio"]["ul_interference_spread_db"] = spread
         path = folder / f"spread{spread:g}.safetensors"
-        train_checkpoint(TrainConfig(episodes=args.episodes, seed=args.seed), SimConfig.model_validate(data),
-                         str(path), progress=False)
+        tc = TrainConfig(episodes=args.episodes, seed=args.seed, demonstrations=args.demonstrations)
+        train_checkpoint(tc, SimConfig.model_validate(data), str(path), progress=False)
         by_margin, by_score, top = ranks(load_checkpoint(path), args.states, args.seed)
         print(f"{spread:>9g} {by_margin:>21} {by_score:>15}  {', '.join(top)}")
     shutil.rmtree(folder, ignore_errors=True)

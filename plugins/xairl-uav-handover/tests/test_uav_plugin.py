@@ -133,8 +133,8 @@ def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
     (["uav", "evaluate", "--duration", "-1"], "flight.duration_s"),
     (["uav", "evaluate", "--checkpoint", "/nope.safetensors"], "no such checkpoint"),
     (["uav", "train", "--episodes", "0"], "at least 1"),
-    (["uav", "train", "--demonstrations", "-1"], "demonstrations: Input should be greater than or equal to 0"),
-    (["uav", "train", "--eps-start", "2"], "eps_start: Input should be less than or equal to 1"),
+    (["uav", "train", "--demonstrations", "-1"], "--demonstrations: Input should be greater than or equal to 0"),
+    (["uav", "train", "--eps-start", "2"], "--eps-start: Input should be less than or equal to 1"),
     (["uav", "evaluate", "--seeds", "0", "0"], "distinct"),
     (["uav", "evaluate", "--seeds", "-1"], "at least 0"),
 ])

@@ -68,8 +68,9 @@ def test_calibration_targets_on_the_real_flights():
     """Issue 11's calibration, on all 29 UKM flights against the committed checkpoint (small simulated samples):
     simulated CHM within 2x of CHM on the real measurements in every altitude band; the modelled real buffer full in
     < 20 % of real states yet used; <= 5 % of real states outside the simulated training distribution; open loop,
-    the DQN starts new handover proposals at <= 2x the network's rate, and it and A3 propose the network's target cell
-    at some of its handovers (the committed DQN 7.5 %, A3 8.5 %: docs/uav-reference.md)."""
+    the DQN starts new handover proposals at <= 2x the network's rate, and proposes the network's target cell at its
+    handovers at least 0.8 times as often as A3 (the committed DQN 7.5 %, A3 8.5 %; the plain DQN before it beat A3,
+    11.7 %: docs/uav-reference.md)."""
     ckpt = load_checkpoint()
     cfg = ckpt.sim_config
     flights, _ = load_folder(UKM)
@@ -84,7 +85,7 @@ def test_calibration_targets_on_the_real_flights():
     assert outside(real, sim).any(axis=1).mean() <= 0.05
     dqn, a3, _ = agreement_rows(walks, ckpt, cfg)
     assert dqn.new_proposals_per_min <= 2 * dqn.network_per_min
-    assert dqn.target_agreement_pct > 0 and a3.target_agreement_pct > 0
+    assert dqn.target_agreement_pct >= 0.8 * a3.target_agreement_pct > 0  # (7.5 % against 8.5 %: no longer >= A3)
 
 
 @needs_data

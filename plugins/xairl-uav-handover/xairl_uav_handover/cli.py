@@ -48,17 +48,28 @@ def _sim_config(base, duration=None):
         raise InputError(validation_message(exc, "UAV simulator settings")) from None
 
 
+#: TrainConfig's fields that ``xairl uav train`` sets, by their flags
+_TRAIN_FLAGS = {"episodes": "--episodes", "n_flights": "--flights", "seed": "--seed",
+                "demonstrations": "--demonstrations", "pretrain_updates": "--pretrain-updates", "eps_start": "--eps-start"}
+
+
 def run_train(args) -> int:
-    from xairl import InputError, parse_options
+    import re
+
+    from pydantic import ValidationError
+    from xairl import InputError, validation_message
 
     from .train import TrainConfig, train_checkpoint
 
     if args.episodes < 1 or args.flights < 1:
         raise InputError("--episodes and --flights must be at least 1.")
-    given = {"episodes": args.episodes, "n_flights": args.flights, "seed": args.seed,
-             "demonstrations": args.demonstrations, "pretrain_updates": args.pretrain_updates,
-             "eps_start": args.eps_start}
-    tc = parse_options(TrainConfig, {k: v for k, v in given.items() if v is not None}, "training settings")
+    given = {field: getattr(args, flag[2:].replace("-", "_")) for field, flag in _TRAIN_FLAGS.items()}
+    try:
+        tc = TrainConfig.model_validate({k: v for k, v in given.items() if v is not None})
+    except ValidationError as exc:  # named by the flags the user typed
+        message = validation_message(exc, "training settings")
+        raise InputError(re.sub(r"\b(" + "|".join(_TRAIN_FLAGS) + r")\b", lambda m: _TRAIN_FLAGS[m.group(1)],
+                                message)) from None
     seconds = train_checkpoint(tc, _sim_config(None, args.duration), args.out, progress=not args.no_progress)
     print(f"trained {args.episodes} episodes in {seconds} s; wrote {args.out}")
     return 0

@@ -43,8 +43,8 @@ class TrainConfig(Options, frozen=True):
     learning_starts: int = Field(5_000, ge=0, description="transitions collected before the first update")
     updates_per_decision: int = Field(1, ge=1)
     target_every: int = Field(500, ge=1, description="gradient steps between target-network copies (M)")
-    eps_start: float = Field(None, ge=0, le=1, description="unset: 0.2 with demonstrations (the pretrained network "
-                             "already acts like the demonstrator), 1 without (a plain DQN)")
+    eps_start: float | None = Field(None, ge=0, le=1, description="unset: 0.2 with demonstrations (the pretrained "
+                                    "network already acts like the demonstrator), 1 without (a plain DQN)")
     eps_end: float = Field(0.01, ge=0, le=1)
     eps_fraction: float = Field(0.5, gt=0, le=1)
     demonstrations: int = Field(10, ge=0, description="episodes of the demonstrator's flights (baselines.RSRQRule) "
@@ -61,13 +61,16 @@ class TrainConfig(Options, frozen=True):
                                           "0.53-0.55x CHM's handovers; 3.5 dB: 8.1-8.4 % at 0.48x)")
     seed: int = 0
 
-    @model_validator(mode="before")
+    @model_validator(mode="after")
+    def _exploration(self):
+        if self.eps_start is None:
+            object.__setattr__(self, "eps_start", 0.2 if self.demonstrations else 1.0)  # (frozen: set once, here)
+        return self
+
     @classmethod
-    def _exploration(cls, data):
-        if isinstance(data, dict) and data.get("eps_start") is None:
-            demos = data.get("demonstrations", cls.model_fields["demonstrations"].default)
-            data = {**data, "eps_start": 0.2 if demos else 1.0}
-        return data
+    def of_checkpoint(cls, meta: dict) -> "TrainConfig":
+        """The settings a checkpoint was trained with; one written before demonstrations existed was a plain DQN."""
+        return cls.model_validate({"demonstrations": 0, **meta["train_config"]})
 
 
 def linear_schedule(start: float, end: float, duration: float, t: float) -> float:
