@@ -58,3 +58,11 @@ def test_pretraining_on_demonstrations_imitates_the_rule():
     plain, _ = train(tc.model_copy(update={"demonstrations": 0}), sim, progress=False)
     agree = (greedy(net, demos.obs, sim) == demos.act).mean()
     assert agree >= 0.95 > (greedy(plain, demos.obs, sim) == demos.act).mean()
+
+
+def test_exploration_follows_demonstrations_and_old_checkpoints_read_as_plain():
+    assert TrainConfig().eps_start == 0.2 and TrainConfig(demonstrations=0).eps_start == 1.0
+    assert TrainConfig(demonstrations="0").eps_start == 1.0 and TrainConfig(eps_start=0.5).eps_start == 0.5
+    assert TrainConfig.model_validate(TrainConfig().model_dump()) == TrainConfig()
+    old = TrainConfig.of_checkpoint({"train_config": {"episodes": 40, "n_flights": 64, "eps_start": 1.0, "seed": 2}})
+    assert old.demonstrations == 0 and old.eps_start == 1.0
