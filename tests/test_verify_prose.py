@@ -1129,3 +1129,15 @@ def test_this_rounds_readings_do_not_let_wrong_numbers_through():
     assert status("It has been 90 days since the last upgrade.", calls) == ["contradicted"]
     robots = one_output(["battery_pct", "charger_queue_len"], [46, 3], [0.5, -0.2], 1.0, "Q-value of recharging")
     assert not xairl.verify("Battery 46 and queue 9 robots waiting.", robots, 0).ok
+
+
+def test_words_people_write_for_a_names_word():
+    """'the charge' is battery_pct, 'the fever' temp_c (lexicon.SYNONYMS): their numbers are checked."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["battery_pct", "temp_c"], [76, 38.8], [0.92, 5.3], 3.1, "Q-value of continuing")
+
+    def numbers(text):
+        return [(c.text, c.status) for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    assert numbers("The healthy 76% charge added about 0.92.") == [("76%", "verified"), ("0.92", "verified")]
+    assert numbers("The healthy 76% charge added about 0.52.")[1] == ("0.52", "contradicted")
+    assert numbers("The fever of 38.8 adds about 5.3.") == [("38.8", "verified"), ("5.3", "verified")]

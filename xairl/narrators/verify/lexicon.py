@@ -21,6 +21,11 @@ ABBREVIATIONS = {"dist": "distance", "temp": "temperature", "avg": "average", "n
                  "elev": "elevation", "alt": "altitude", "lat": "latitude", "lon": "longitude", "lng": "longitude",
                  "spd": "speed", "accel": "acceleration", "humid": "humidity", "precip": "precipitation",
                  "batt": "battery", "conc": "concentration", "env": "environment", "cust": "customer"}
+#: words of feature names and other words people write for the same thing ('battery_pct': 'the charge'); each makes
+#: one more spelling of the name, so a word shared by two names ('charge') names both, ambiguously
+SYNONYMS = {"battery": ("charge",), "temperature": ("fever",), "heart": ("pulse",), "distance": ("far",),
+            "hr": ("heart rate", "pulse"), "bp": ("blood pressure",), "qty": ("quantity",), "price": ("cost",),
+            "cost": ("price",), "speed": ("velocity",), "velocity": ("speed",)}
 #: participles that name a feature whose words are said the other way round ('year built' -> 'the build year')
 BASE_FORM = {"built": "build", "sold": "sale", "made": "make", "paid": "pay", "owned": "own", "used": "use"}
 IRREGULAR = {"keep": "kept", "go": "went", "choose": "chose", "hold": "held", "run": "ran", "stay": "stayed"}

@@ -10,7 +10,7 @@ from ...explanation import Explanation
 from ...observation import REGION_RE
 from ...policy import Policy
 from .book import legend
-from .lexicon import ABBREVIATIONS, BASE_FORM as _BASE_FORM, GENERIC, IRREGULAR as _IRREGULAR, STOP
+from .lexicon import ABBREVIATIONS, BASE_FORM as _BASE_FORM, GENERIC, IRREGULAR as _IRREGULAR, STOP, SYNONYMS
 
 #: what a model's input describes: a word of a feature's description, never a feature on its own
 _INSTANCES = frozenset({"patient", "applicant", "borrower", "customer", "client", "person", "student", "team", "player",
@@ -72,6 +72,9 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
                 exact.setdefault(_phrase(form), set()).add(f)
         spelled = " ".join(ABBREVIATIONS.get(w, w) for w in name_words)  # 'dist_to_charger_m': 'distance to ...'
         spelled = [spelled] if spelled != " ".join(name_words) else []
+        spelled += [" ".join(w if k != i else other for k, w in enumerate(words)) for words in
+                    {tuple(name_words), *(tuple(s.split()) for s in spelled)} for i, w in enumerate(words)
+                    for other in SYNONYMS.get(w, ())]  # 'battery_pct': 'charge percent'; 'hr_mean_6h': 'pulse ...'
         feature_words[f] |= frozenset(w for form in spelled for w in form.split() if w not in STOP)
         for form in [f] + ([_head(described)] if described else []) + spelled:
             if clean(form) and not REGION_RE.match(f.removeprefix("the ")):  # a region: only by its whole name
