@@ -1141,3 +1141,15 @@ def test_words_people_write_for_a_names_word():
     assert numbers("The healthy 76% charge added about 0.92.") == [("76%", "verified"), ("0.92", "verified")]
     assert numbers("The healthy 76% charge added about 0.52.")[1] == ("0.52", "contradicted")
     assert numbers("The fever of 38.8 adds about 5.3.") == [("38.8", "verified"), ("5.3", "verified")]
+
+
+def test_a_push_equal_only_to_a_decision_level_number_is_not_verified():
+    """'piles on around 8 more' where the baseline is 8 and no feature pushes 8: not verified as 'a decision-level
+    fact' (the words say it is a push)."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["lactate", "heart_rate"], [4.2, 118], [9.6, 4.1], 8.0, "sepsis risk")
+
+    def numbers(text):
+        return [(c.text, c.status) for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    assert numbers("Lactate adds about 9.6.") == [("9.6", "verified")]
+    assert ("8", "verified") not in numbers("Something else piles on around 8 more.")

@@ -297,6 +297,9 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         ok = any(matches(n, v, magnitude_ok=False) or (n.percent and percent_reading(n, v)) for v in named[1])
         return Claim("number", n.text, "verified" if ok else "contradicted", f"{named[0]} is {named[1][0]:.4g}")
     if any(matches(n, v) or (n.percent and percent_reading(n, v)) for v in book.decision_numbers):
+        if CONTRIB_BEFORE.search(before) or re.match(r"\s*(?:points?\s+)?more\b", after):
+            return Claim("number", n.text, "unchecked", "a push by its words ('adds', '8 more'), equal to a "
+                                                        "decision-level number but to no feature's contribution")
         return Claim("number", n.text, "verified", "a decision-level fact")
     if n.sign == "+" and (owners := _owners(n, book)):  # '(+1.0)' of a thing the vocabulary lacks: whose push
         return Claim("number", n.text, "verified" if len(owners) == 1 else "unchecked",
