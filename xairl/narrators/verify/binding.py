@@ -1,7 +1,7 @@
 """Which fact a number states: the name it is bound to (a pair of a 'respectively' list, an action right before or
 after it, a name right after it, the name before it in its clause) or a decision-level quantity its cue words name
 (the change from the baseline, a typical value, the baseline, where the output starts or ends, the margin), then its
-check in :mod:`.quantities`; and when a contradicted binding was only a guess."""
+check in :mod:`.quantities` (a contradicted guess is read again in :mod:`.reread`)."""
 from __future__ import annotations
 
 import functools
@@ -11,9 +11,8 @@ from dataclasses import replace
 from . import background, checks, quantities, sums
 from .book import FactBook
 from .checks import Claim
-from .vocabulary import split_words, stem
-from .numbers import find_numbers, matches
-from .parse import quantified
+from .numbers import matches
+from .vocabulary import split_words
 
 _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of)?|scored|scores|score of|"
                         r"with a score of|came second at|"
@@ -68,54 +67,6 @@ _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact
                      r"shift\w*|worth)\b", re.IGNORECASE)
 
 
-def _one_name_pushes(n, masked: str, mentions) -> bool:
-    """'...; B (-86.1 dBm) pushed against stay by -32.0': a number its cue words call a push, in a clause that names
-    one feature before it, is that feature's push for sure."""
-    names = {m.keys for m in mentions if m.kind == "feature"}
-    return len(names) == 1 and any(m.kind == "feature" and m.end <= n.start for m in mentions) and bool(
-        quantities.CONTRIB_BEFORE.search(masked[max(0, n.start - 40):n.start]))
-
-
-def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, sentence_keys) -> Claim:
-    """A contradicted number that states another fact of a feature named in the sentence exactly (not truncated): the
-    binding was a guess, so it is unchecked ('which is unclear'). A difference in a unit ('4.0 dB above'), a number
-    right after its name ('battery +1.70') and a name 'at' a number bind for sure; a bracket right after a name
-    ('distance (2.33)') may only be that name's own fact, with its sign."""
-    if quantities.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
-        return c
-    owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
-    if owner in names and re.fullmatch(r" ?", masked[owner.end:n.start]) and n.sign:
-        return c  # 'battery +1.70': a signed number right after its name, a sure binding
-    if owner in names and masked[owner.end:n.start] == " at ":
-        return c  # "the serving BS's id at -12": its value, as sure
-    if _one_name_pushes(n, masked, names):
-        return c
-    if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
-        other = quantities.other_reading(n, set(owner.keys), book, ctx, signed=True)
-    else:
-        other = quantities.other_reading(n, sentence_keys, book, ctx,
-                                         signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
-    return c if other is None else Claim("number", n.text, "unchecked",
-                                         f"read as {c.detail}, but it is {other}: which is unclear", "number.unclear")
-
-
-#: nouns a number may measure that are facts of an explanation (a score, the margin, a contribution, the output):
-#: a number measuring one of these keeps its reading; any other noun ('30 days', '41 GB', 'the 47.5-point gap')
-#: is something the explanation does not hold
-FACT_NOUNS = frozenset({"score", "scores", "margin", "lead", "edge", "contribution", "contributions", "effect",
-                        "effects", "impact", "impacts", "attribution", "attributions", "value", "values", "shap",
-                        "prediction", "predictions", "probability", "chance", "risk", "estimate", "output", "baseline",
-                        "base", "average", "mean", "expectation", "price", "push", "boost", "penalty", "bonus", "drop",
-                        "rise", "increase", "decrease", "change", "gap", "difference", "weight", "share", "sum",
-                        "total", "q", "q-value", "importance", "influence", "gain", "loss", "uplift", "bump", "nudge",
-                        "hit", "swing", "cost", "lift", "pull", "drag", "net", "reason", "reasons", "driver",
-                        "drivers", "factor", "factors", "feature", "features", "variable", "variables", "signal",
-                        "mass", "magnitude", "deviation", "delta", "jump", "fall", "spread", "bar", "rank"})
-
-
-#: fact nouns that only name a decision-level quantity, never one feature's ('distance (score 1.15)' is no whole)
-AGGREGATE_NOUNS = frozenset({"total", "sum", "net", "gap", "difference", "change", "mass", "prediction", "predictions",
-                             "baseline", "margin", "lead", "output", "delta"})
 
 
 #: what a push comes from, right after its number: '19 points of that come from the contract', 'about 14 from the
@@ -123,103 +74,6 @@ AGGREGATE_NOUNS = frozenset({"total", "sum", "net", "gap", "difference", "change
 _FROM_NAME = re.compile(r"\s*(?:percentage points?|points?|pts|pp)?\s*(?:of (?:that|it|this)\s+)?(?:comes?\s+|came\s+)?"
                         r"(?:from|due to|thanks to|because of)\s+(?:the\s+|its\s+|their\s+|his\s+|her\s+|a\s+|an\s+)?"
                         r"(?:[\d.,]+\s*%?\s+)?(?=\0)", re.IGNORECASE)
-
-
-#: an identifier that is no name, then '=' or ':', right before a number ('run_id=7781', 'latency_ms: 42')
-_LOG_KEY = re.compile(r"(?<![\w\0])([A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+)\s?[:=]\s?$")
-
-
-def _one_word_of_many(m) -> bool:
-    """A mention that is one short word while every name it may mean has four words or more ('bill' of
-    price_increase_last_bill_pct): a word the text shares with the name, not the name."""
-    return m.kind == "feature" and m.end - m.start <= 9 and all(len(split_words(k)) >= 4 for k in m.keys)
-
-
-def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, parsed, unit_of, keys) -> Claim:
-    """A number bound by position alone (:data:`GUESSED`), contradicted, that states another fact of the explanation:
-    the position was a guess, so it is unchecked. The binding is sure, and the number stays contradicted, when it
-    comes right after its name ('A +0.3', 'A (0.3)', 'A: 0.3', 'A=0.3') or the parse ties it to a name ('A lowered
-    it by about 5 points': the verb's subject); so does a number that states no fact at all."""
-    if c.rule not in GUESSED[:2] or quantities.DIFFERENCE_AFTER.match(masked[n.end:n.end + 16]):
-        return c  # ('4.0 dB above': a difference in a unit, bound for sure; a number tied to no name is contradicted
-        # only by the quantity its words name: '(4.45 vs 4.44)' after 'rather than recharge')
-    owner = next((m for m in reversed(mentions) if m.end <= n.start), None)
-    if owner is not None and c.rule == GUESSED[1] and _one_word_of_many(owner) and (
-            other := quantities.any_fact(n, book, set(book.features) - set(owner.keys), ctx, strict=True)):
-        return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}, and "
-                     f"the name before it is one word of a long name", "number.other-feature")  # ('bill $109.9' of
-        # price_increase_last_bill_pct, when $109.9 is the monthly charge)
-    if owner is not None and re.fullmatch(r"\s?[:=(]?\s?|\s?[:=]\s*| at ", masked[owner.end:n.start]):
-        return c  # ('the serving BS's id at -12': its value)
-    key = _LOG_KEY.search(masked, max(0, n.start - 40), n.start)
-    if key is not None and not n.sign:  # 'run_id=7781' after a name: the value of a field of the log, not the name's
-        return Claim("number", n.text, "unchecked", f"the value of the log's field {key.group(1)!r}", "number.log-field")
-    units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
-    q = quantified(parsed(), n.start, n.end, units)
-    if q.key or (not q.subject and _one_name_pushes(n, masked, mentions)):
-        return c
-    if n.text.isalpha():  # 'one and a half times', 'a factor of two', 'semester one': a count or an idiom
-        return Claim("number", n.text, "unchecked", f"a number word that the words tie to no name (first read as "
-                                                    f"{c.detail})", "number.word")
-    # a push by its cue words ('by -0.22') or by the noun it measures ('a bump of 19.1'): not a decision-level number
-    pushes = bool(quantities.CONTRIB_BEFORE.search(masked[max(0, n.start - 40):n.start])) or (
-        q.noun in FACT_NOUNS and q.noun not in AGGREGATE_NOUNS and not q.subject)
-    if q.subject and q.noun not in FACT_NOUNS:  # said of 'claim', a noun the vocabulary lacks: any feature it may name in words of its own
-        other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes,
-                                    signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
-        if other is not None:
-            return Claim("number", n.text, "unchecked", f"said of '{q.noun}', which names no "
-                                             f"feature; it states {other}", "parse.said-of-other")
-    signed = quantities.signed_named(masked[max(0, n.start - 40):n.start])
-    other = quantities.any_fact(n, book, keys, ctx, strict=True, contribution=pushes, signed=signed)
-    if other is not None:
-        return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}",
-                     "number.elsewhere")
-    if q.noun in FACT_NOUNS:
-        return c  # 'A is responsible for an increase of 1.2': A's increase, whatever else 1.2 may be
-    # 'bill $109.9', 'its Q3 grade of 54 (+0.096)': a thing the vocabulary has no words for, or a wrong word match
-    other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes, signed=signed)
-    return c if other is None else Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it "
-                                         f"states {other}, a feature the sentence may name in words of its own",
-                                         "number.other-feature")
-
-
-def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, vocab) -> Claim:
-    """A second reading of a number bound by position alone (:data:`GUESSED`) and contradicted, from the sentence's
-    parse (:func:`.parse.quantified`): a number that measures another name (or a noun of one feature's name only)
-    is checked against that name; one inside a categorical label ('a two-year contract') against the label; one that
-    measures a noun the explanation holds no fact of ('30 days', '41 GB') is unchecked; one that measures a whole
-    ('the total effect (1.41)') is checked as a decision-level number; otherwise the first reading stands.
-    ``parsed()`` gives the sentence's parse, made only when asked for."""
-    if c.rule not in GUESSED:
-        return c  # bound by its cue words or a list: sure
-    units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
-    q = quantified(parsed(), n.start, n.end, units)
-    if q.subject:
-        return c  # said of a subject that names nothing: :func:`unless_elsewhere` decides
-    if quantities.SCORE_BEFORE.search(masked[max(0, n.start - 24):n.start]):
-        return c  # 'the only available action (score -74.6)': a score by its own word
-    if "|" in q.key:
-        return c  # an ambiguous name: the first reading stands
-    if q.key in book.features:
-        other = quantities.feature_number(n, (q.key,), masked, book, ctx, unit_of)
-        return replace(other, rule="parse.measures-name") if other.status != "contradicted" else c
-    if q.noun and (labelled := _label_number(n, q.noun, book)) is not None:
-        return labelled  # 'a two-year contract' when the contract is 'One year'
-    owners = [f for f, words in vocab.words.items() if f in book.features and q.noun and q.noun not in FACT_NOUNS
-              and stem(q.noun) in {stem(w) for w in words}]
-    if len(owners) == 1:  # 'twelve years without a claim': the one feature with years in its name (ncd_years)
-        other = quantities.feature_number(n, (owners[0],), masked, book, ctx, unit_of)
-        if other.status == "verified":
-            return replace(other, rule="parse.measures-name")
-    known = vocab.name_words
-    if q.noun and q.noun not in FACT_NOUNS and q.noun not in known and stem(q.noun) not in known:
-        return Claim("number", n.text, "unchecked", f"it counts '{q.noun}', which the explanation holds no fact of "
-                                                    f"(first read as {c.detail})", "parse.counts-other")
-    if q.noun in AGGREGATE_NOUNS or q.aggregate:  # 'the total effect (1.41)', 'the net drop of 1.21 points'
-        other = quantities.free_number(n, masked, book)
-        return replace(other, rule="parse.measures-whole") if other.status == "verified" else c
-    return c  # 'a bump of 19.1' after a name: that name's push, as first read
 
 
 def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:
@@ -389,14 +243,3 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
     return named(quantities.free_number(n, masked, book), "number.free")
 
 
-def _label_number(n, noun: str, book: FactBook) -> Claim | None:
-    """A number counting a word of one categorical value's label ('two-year' of the label 'One year', '24 months')
-    states that label: verified when the label holds the number, else contradicted; None when no single label has
-    the word and a number."""
-    held = [(f, ff.label) for f, ff in book.features.items() if ff.label and stem(noun) in {
-        stem(w) for w in split_words(ff.label)} and find_numbers(ff.label)]
-    if len(held) != 1:
-        return None
-    f, label = held[0]
-    ok = any(x.value == abs(n.value) for x in find_numbers(label))
-    return Claim("category", n.text, "verified" if ok else "contradicted", f"{f} is '{label}'", "parse.label-number")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
-from . import background, binding, comparisons, directions, noclaims, quantities, ranks, sums
+from . import background, binding, comparisons, directions, noclaims, quantities, ranks, reread, sums
 from .book import FactBook
 from .checks import Claim
 from .names import Mention, named_features
@@ -42,11 +42,11 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
             continue
         c = binding.bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure
-            c = binding.unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
+            c = reread.unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
         if c.status == "contradicted" and id(n) not in paired:
-            c = binding.by_parse(c, n, masked, book, ctx, unit_of, parsed, vocab)
+            c = reread.by_parse(c, n, masked, book, ctx, unit_of, parsed, vocab)
         if c.status == "contradicted" and id(n) not in paired:
-            c = binding.unless_elsewhere(c, n, masked, mentions, book, ctx, parsed, unit_of, sentence_keys)
+            c = reread.unless_elsewhere(c, n, masked, mentions, book, ctx, parsed, unit_of, sentence_keys)
         if c.status == "contradicted" and len({m.keys for m in said_names}) == 1 and id(n) not in paired and \
                 _SUM_CUE.search(masked, a, n.start) and re.search(r"\band\b|\bplus\b", masked[a:n.start]):
             c = Claim("number", n.text, "unchecked", "a sum over things the words name but the vocabulary does not "

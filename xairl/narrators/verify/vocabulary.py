@@ -70,11 +70,7 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
         for form in forms:
             if form and clean(form):
                 exact.setdefault(_phrase(form), set()).add(f)
-        spelled = " ".join(ABBREVIATIONS.get(w, w) for w in name_words)  # 'dist_to_charger_m': 'distance to ...'
-        spelled = [spelled] if spelled != " ".join(name_words) else []
-        spelled += [" ".join(w if k != i else other for k, w in enumerate(words)) for words in
-                    {tuple(name_words), *(tuple(s.split()) for s in spelled)} for i, w in enumerate(words)
-                    for other in SYNONYMS.get(w, ())]  # 'battery_pct': 'charge percent'; 'hr_mean_6h': 'pulse ...'
+        spelled = _spellings(name_words)
         feature_words[f] |= frozenset(w for form in spelled for w in form.split() if w not in STOP)
         for form in [f] + ([_head(described)] if described else []) + spelled:
             if clean(form) and not REGION_RE.match(f.removeprefix("the ")):  # a region: only by its whole name
@@ -113,6 +109,16 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
                                                                                  form)
                 for p, kind, keys, label, form in entries]
     return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, frozenset(names))
+
+
+def _spellings(name_words: list[str]) -> list[str]:
+    """Other spellings of a name's words: abbreviations written out ('dist_to_charger_m': 'distance to charger m')
+    and each word swapped for a synonym ('battery_pct': 'charge pct'; 'hr_mean_6h': 'pulse mean 6h')."""
+    spelled = " ".join(ABBREVIATIONS.get(w, w) for w in name_words)
+    out = [spelled] if spelled != " ".join(name_words) else []
+    return out + [" ".join(w if k != i else other for k, w in enumerate(words)) for words in
+                  {tuple(name_words), *(tuple(s.split()) for s in out)} for i, w in enumerate(words)
+                  for other in SYNONYMS.get(w, ())]
 
 
 def _runs(form: str, f: str) -> list[str]:
