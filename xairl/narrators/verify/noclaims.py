@@ -49,6 +49,11 @@ def skip_number(n: Number, masked: str) -> bool:
     return bool(_LABEL_BEFORE.search(before)) or bool(_SKIP_AFTER.match(masked[n.end:]))
 
 
+def _windows(keys) -> set[tuple[str, str]]:
+    """The windows the names hold, as (number, first letter of its unit): ('30', 'd') of ``data_usage_gb_30d``."""
+    return {(m.group(1), m.group(2)) for k in keys for m in re.finditer(r"(\d+)([a-z])", k.lower())}
+
+
 _PERIOD_AFTER = re.compile(r"\s*(days?|weeks?|months?|years?|hours?)\b", re.IGNORECASE)
 
 
@@ -59,11 +64,11 @@ def window_of_name(n: Number, keys, masked: str = "", all_keys=()) -> bool:
     (``prior_returns_12m``)."""
     if n.sign or n.percent or n.currency or n.hedge or n.value != int(n.value):
         return False
-    if any(str(int(n.value)) in re.findall(r"(\d+)[a-z]", k.lower()) for k in keys):
+    if any(number == str(int(n.value)) for number, _ in _windows(keys)):
         return True
     period = _PERIOD_AFTER.match(masked, n.end)
     window = (str(int(n.value)), period.group(1)[0].lower()) if period else None
-    return window is not None and any(window in re.findall(r"(\d+)([a-z])", k.lower()) for k in all_keys)
+    return window is not None and window in _windows(all_keys)
 
 
 def identifier_after_word(n: Number, masked: str, mentions) -> bool:
@@ -84,7 +89,7 @@ def without_window_words(mentions, written: str, features) -> list:
     """``mentions`` less the one-word parts of a name that only spell another name's window in the ``written``
     sentence ('days' of days_since_last_upgrade in 'support calls in the last 90 days', the window of
     support_calls_90d)."""
-    windows = {(m.group(1), m.group(2)) for f in features for m in re.finditer(r"(\d+)([a-z])", f.lower())}
+    windows = _windows(features)
 
     def spells_window(m) -> bool:  # 'the last 90 days': both words of the window, next to its number
         if m.kind != "feature" or m.form != "part":
