@@ -67,8 +67,6 @@ _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact
                      r"shift\w*|worth)\b", re.IGNORECASE)
 
 
-
-
 #: what a push comes from, right after its number: '19 points of that come from the contract', 'about 14 from the
 #: 12% price increase' (a value of the name may stand before it)
 _FROM_NAME = re.compile(r"\s*(?:percentage points?|points?|pts|pp)?\s*(?:of (?:that|it|this)\s+)?(?:comes?\s+|came\s+)?"
@@ -241,5 +239,3 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
                                           masked[prev.end:n.start], re.IGNORECASE):
         return quantities.feature_number(n, prev.keys, masked, book, ctx, unit_of)
     return named(quantities.free_number(n, masked, book), "number.free")
-
-

@@ -42,11 +42,7 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
             continue
         c = binding.bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure
-            c = reread.unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
-        if c.status == "contradicted" and id(n) not in paired:
-            c = reread.by_parse(c, n, masked, book, ctx, unit_of, parsed, vocab)
-        if c.status == "contradicted" and id(n) not in paired:
-            c = reread.unless_elsewhere(c, n, masked, mentions, book, ctx, parsed, unit_of, sentence_keys)
+            c = reread.read_again(c, n, masked, mentions, names, book, ctx, unit_of, parsed, vocab, sentence_keys)
         if c.status == "contradicted" and len({m.keys for m in said_names}) == 1 and id(n) not in paired and \
                 _SUM_CUE.search(masked, a, n.start) and re.search(r"\band\b|\bplus\b", masked[a:n.start]):
             c = Claim("number", n.text, "unchecked", "a sum over things the words name but the vocabulary does not "

@@ -14,6 +14,27 @@ from .numbers import find_numbers
 from .parse import quantified
 from .vocabulary import split_words, stem
 
+
+def read_again(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, unit_of, parsed, vocab,
+               sentence_keys) -> Claim:
+    """A contradicted number read again, each reading only while it stays contradicted: a fact of another name the
+    sentence holds (:func:`unless_guessed`), what the parse says it measures (:func:`by_parse`), a fact it states
+    elsewhere (:func:`unless_elsewhere`). ``parsed()`` gives the sentence's parse, made only when asked for."""
+    units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
+    found = []
+
+    def measured():  # what the parse says the number measures, read at most once
+        if not found:
+            found.append(quantified(parsed(), n.start, n.end, units))
+        return found[0]
+    c = unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
+    if c.status == "contradicted":
+        c = by_parse(c, n, masked, book, ctx, unit_of, measured, vocab)
+    if c.status == "contradicted":
+        c = unless_elsewhere(c, n, masked, mentions, book, ctx, measured, sentence_keys)
+    return c
+
+
 def _one_name_pushes(n, masked: str, mentions) -> bool:
     """'...; B (-86.1 dBm) pushed against stay by -32.0': a number its cue words call a push, in a clause that names
     one feature before it, is that feature's push for sure."""
@@ -44,6 +65,7 @@ def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ct
     return c if other is None else Claim("number", n.text, "unchecked",
                                          f"read as {c.detail}, but it is {other}: which is unclear", "number.unclear")
 
+
 #: nouns a number may measure that are facts of an explanation (a score, the margin, a contribution, the output):
 #: a number measuring one of these keeps its reading; any other noun ('30 days', '41 GB', 'the 47.5-point gap')
 #: is something the explanation does not hold
@@ -73,7 +95,7 @@ def _one_word_of_many(m) -> bool:
     return m.kind == "feature" and m.end - m.start <= 9 and all(len(split_words(k)) >= 4 for k in m.keys)
 
 
-def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, parsed, unit_of, keys) -> Claim:
+def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, measured, keys) -> Claim:
     """A number bound by position alone (:data:`GUESSED`), contradicted, that states another fact of the explanation:
     the position was a guess, so it is unchecked. The binding is sure, and the number stays contradicted, when it
     comes right after its name ('A +0.3', 'A (0.3)', 'A: 0.3', 'A=0.3') or the parse ties it to a name ('A lowered
@@ -92,8 +114,7 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
     key = _LOG_KEY.search(masked, max(0, n.start - 40), n.start)
     if key is not None and not n.sign:  # 'run_id=7781' after a name: the value of a field of the log, not the name's
         return Claim("number", n.text, "unchecked", f"the value of the log's field {key.group(1)!r}", "number.log-field")
-    units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
-    q = quantified(parsed(), n.start, n.end, units)
+    q = measured()
     if q.key or (not q.subject and _one_name_pushes(n, masked, mentions)):
         return c
     if n.text.isalpha():  # 'one and a half times', 'a factor of two', 'semester one': a count or an idiom
@@ -102,13 +123,13 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
     # a push by its cue words ('by -0.22') or by the noun it measures ('a bump of 19.1'): not a decision-level number
     pushes = bool(quantities.CONTRIB_BEFORE.search(masked[max(0, n.start - 40):n.start])) or (
         q.noun in FACT_NOUNS and q.noun not in AGGREGATE_NOUNS and not q.subject)
-    if q.subject and q.noun not in FACT_NOUNS:  # said of 'claim', a noun the vocabulary lacks: any feature it may name in words of its own
-        other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes,
-                                    signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
+    signed = quantities.signed_named(masked[max(0, n.start - 40):n.start])
+    if q.subject and q.noun not in FACT_NOUNS:  # said of 'claim', a noun the vocabulary lacks: any feature it may
+        # name in words of its own
+        other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes, signed=signed)
         if other is not None:
             return Claim("number", n.text, "unchecked", f"said of '{q.noun}', which names no "
                                              f"feature; it states {other}", "parse.said-of-other")
-    signed = quantities.signed_named(masked[max(0, n.start - 40):n.start])
     other = quantities.any_fact(n, book, keys, ctx, strict=True, contribution=pushes, signed=signed)
     if other is not None:
         return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}",
@@ -122,17 +143,16 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, pa
                                          "number.other-feature")
 
 
-def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, vocab) -> Claim:
+def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, measured, vocab) -> Claim:
     """A second reading of a number bound by position alone (:data:`GUESSED`) and contradicted, from the sentence's
     parse (:func:`.parse.quantified`): a number that measures another name (or a noun of one feature's name only)
     is checked against that name; one inside a categorical label ('a two-year contract') against the label; one that
     measures a noun the explanation holds no fact of ('30 days', '41 GB') is unchecked; one that measures a whole
     ('the total effect (1.41)') is checked as a decision-level number; otherwise the first reading stands.
-    ``parsed()`` gives the sentence's parse, made only when asked for."""
+    ``measured()`` gives what the parse says the number measures."""
     if c.rule not in GUESSED:
         return c  # bound by its cue words or a list: sure
-    units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
-    q = quantified(parsed(), n.start, n.end, units)
+    q = measured()
     if q.subject:
         return c  # said of a subject that names nothing: :func:`unless_elsewhere` decides
     if quantities.SCORE_BEFORE.search(masked[max(0, n.start - 24):n.start]):
@@ -158,6 +178,7 @@ def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, parsed, voc
         other = quantities.free_number(n, masked, book)
         return replace(other, rule="parse.measures-whole") if other.status == "verified" else c
     return c  # 'a bump of 19.1' after a name: that name's push, as first read
+
 
 def _label_number(n, noun: str, book: FactBook) -> Claim | None:
     """A number counting a word of one categorical value's label ('two-year' of the label 'One year', '24 months')
