@@ -200,7 +200,10 @@ _NOT_A_PUSH = re.compile(r"(?:on|to)\s+the\s+(?:positive|negative)\s+side|\blowe
 def is_frame(masked: str, m: re.Match) -> bool:
     """Not a direction: 'against' that compares ('7.53 against 7.38', 'Against recharge, ...', 'against that'), a
     word that names a side or a place ('on the positive side', 'the lower quartile', 'lower than the median'), an
-    adjective of the subject ('their lower efficiency') and an appearance ('might seem positive')."""
+    adjective of the subject ('their lower efficiency'), an appearance ('might seem positive') and the first word of a
+    compound ('add-on')."""
+    if re.match(r"-[^\W\d_]", masked[m.end():m.end() + 2]):
+        return True  # the first word of a compound ('the warranty add-on', 'a cut-off'): a thing, not a push
     near = _NOT_A_PUSH.search(masked, max(0, m.start() - 40), min(len(masked), m.end() + 16))
     if near is not None and near.start() <= m.start() < near.end():
         return True

@@ -12,7 +12,7 @@ from .book import FactBook
 from .checks import Claim
 from .lexicon import GENERIC
 from .names import Mention, named_features
-from .parse import said_of
+from .parse import said_of, same_clause
 from .ranks import NOUN
 from .vocabulary import split_words, stem
 
@@ -184,7 +184,8 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         subjects = [x for x in subjects if x not in conceded]  # 'Despite being unemployed (+0.128), ... pull it down'
         flipped = [x for x in subjects if _EXCEPT.search(masked, prev, x.start) or (  # 'everything but the kitchen'
             _EXCEPT_AFTER.search(masked, m.end(), x.start) and _ALL_RE.search(masked, a, m.start()))]
-        out += checks.check_direction([x for x in subjects if x not in flipped], polarity, where, m.group(0), book)
+        kept = [x for x in subjects if x not in flipped]
+        out += _unless_other_clause(checks.check_direction(kept, polarity, where, m.group(0), book), kept, m, masked, parsed)
         out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
         bare, prev = not subjects and not flipped, m.end()
     return out
@@ -310,6 +311,27 @@ def unknown_label(text: str, name_words=frozenset()) -> list[Claim]:
     if m is None or any(w.lower() in _QUANTITY_LABELS | _OWNERS for w in m.group("label").split()):
         return []  # ('Its signal quality of -3.2 dB': something named before, vaguely)
     return _unknown_subject(m.group("label"), "a signed number", [], name_words)
+
+
+#: a name right before its direction word: its own value in brackets and two words at most between ('speed (0.22)
+#: pushed toward', 'A slightly lowers')
+_RIGHT_BEFORE = re.compile(r"\s*(?:\([^()]*\)\s*)?(?:[A-Za-z]+\s+){0,2}")
+#: a list after its header's colon: 'Raising risk: A, B', 'push it up: A (+1.8), B'
+_HEADER = re.compile(r"(?:\W*[\w']+){0,3}\W*:")
+
+
+def _unless_other_clause(claims: list[Claim], subjects: list[Mention], m: re.Match, masked: str,
+                         parsed) -> list[Claim]:
+    """A direction contradicted of a name stands only when the parse puts the two in one clause
+    (:func:`.parse.same_clause`), or the name is right before the word ('speed (0.22) pushed toward') or in a list after
+    the word's colon ('Raising it: A, B'); else the name was only near the word, and the claim is unchecked."""
+    if parsed is None:
+        return claims
+    return [Claim("direction", c.text, "unchecked", f"the parse puts '{m.group(0)}' in another clause than "
+                  f"{'/'.join(x.keys)} (first read as: {c.detail})", "parse.direction-other-clause")
+            if c.status == "contradicted" and not _HEADER.match(masked, m.end(), x.start) and not
+            _RIGHT_BEFORE.fullmatch(masked, x.end, m.start()) and not same_clause(
+                parsed(), m.start(), m.end(), x.start, x.end) else c for c, x in zip(claims, subjects)]
 
 
 def _parse_agrees(claims: list[Claim], m: re.Match, parsed, book: FactBook) -> list[Claim]:

@@ -218,3 +218,65 @@ def modified_noun(doc, start: int, end: int) -> str:
     if any(ch.isdigit() for ch in head.text) and head.i > 0 and head.doc[head.i - 1].text == "(":
         return ""  # the name's own value in brackets ('RSRQ (-18.8 dB, poor quality)'): the name is the head
     return head.lower_
+
+
+#: links that open a clause of its own (a verb joined by 'conj' opens one too)
+_CLAUSE_LINKS = frozenset({"relcl", "acl", "advcl", "ccomp", "csubj", "csubjpass", "parataxis", "xcomp", "ROOT"})
+_SUBJECT_LINKS = frozenset({"nsubj", "nsubjpass", "csubj", "csubjpass", "expl"})
+_REASONS = frozenset({"because", "since", "as"})
+#: the output as a small clause's subject ('making the risk more high'): what the name moves, not another subject
+_OUTPUTS = frozenset({"risk", "price", "score", "estimate", "prediction", "probability", "chance", "odds", "output",
+                      "forecast", "value", "q", "q-value", "cost", "likelihood"})
+_PRONOUNS = frozenset({"it", "this", "that", "they", "these", "those", "which", "who"})
+
+
+def _clause(token):
+    """The head of the clause ``token`` belongs to."""
+    for _ in range(len(token.doc)):
+        if token.dep_ in _CLAUSE_LINKS or token.head.i == token.i or (
+                token.dep_ == "conj" and token.pos_ in ("VERB", "AUX")):
+            return token
+        token = token.head
+    return token
+
+
+def same_clause(doc, start: int, end: int, name_start: int, name_end: int) -> bool:
+    """Whether the parse ties the word or number at characters [start, end) to the name at [name_start, name_end).
+    Only positive evidence says no: the word's clause (or the clause it takes its subject from, when it has none:
+    'A raised it and cut the risk') has a subject of its own, neither a pronoun nor the output, that does not hold
+    the name ('A higher deductible means the insurer pays less per claim, so the model lowers the cost': not the
+    claims'). Ties: one clause; the name anywhere in the subject ('Being an X2 adds 0.09', 'the fact that the car is
+    a coupe adds $140'); the noun or value a relative clause is said of ('A, which added 0.4', 'A had dropped to -22.5
+    dB, which ...', 'A is the factor that raises it'); a 'because' clause with the name; a span the parse cannot
+    find."""
+    word, name = doc.char_span(start, end, alignment_mode="expand"), doc.char_span(name_start, name_end,
+                                                                                  alignment_mode="expand")
+    if word is None or name is None:
+        return True
+    n, own = name.root, _clause(name.root)
+    targets = {own.i}
+    if own.dep_ == "advcl" and any(c.dep_ == "mark" and c.lower_ in _REASONS for c in own.children):
+        targets.add(_clause(own.head).i)  # '... rises because A is high'
+    clause = _clause(word.root)
+    for _ in range(len(doc)):
+        if clause.i in targets or any(c.dep_ in _SUBJECT_LINKS and c.left_edge.i <= n.i <= c.right_edge.i
+                                      for c in clause.children):
+            return True  # (in the subject, at any depth: 'Being an X2 adds ...', 'the fact that the car is a
+            # sports coupe adds $140')
+        if clause.dep_ == "relcl" and clause.head.dep_ == "attr":  # 'A is the factor that raises it': A's
+            clause = _clause(clause.head)
+            continue
+        if clause.dep_ == "relcl":  # 'A, which added 0.4': the noun it is said of, without the clause itself
+            head = clause.head  # (or a value said in the name's clause: 'A had dropped to -22.5 dB, which ...')
+            return n.i == head.i or (_clause(head).i in targets and not head.ent_id_) or (
+                head.left_edge.i <= n.i <= head.right_edge.i and not clause.left_edge.i <= n.i <= clause.right_edge.i
+                and _clause(n).i == _clause(head).i)
+        if any(c.dep_ in ("nsubj", "nsubjpass") and c.lower_ in _PRONOUNS for c in clause.children):
+            return True  # 'A is reassuring: it lowers the score', '..., which pushed': whom it stands for is the
+            # words' to say
+        if any(c.dep_ in _SUBJECT_LINKS and c.lower_ not in _OUTPUTS for c in clause.children):
+            return False  # a subject of its own, without the name (not the output: 'A is making the risk higher')
+        if clause.head.i == clause.i:
+            return True  # no subject at all: the parse has nothing to say
+        clause = _clause(clause.head)  # a clause without a subject of its own: its head clause's subject
+    return True

@@ -11,7 +11,7 @@ from .binding import GUESSED
 from .book import FactBook
 from .checks import Claim
 from .numbers import find_numbers
-from .parse import quantified
+from .parse import quantified, same_clause
 from .vocabulary import split_words, stem
 
 
@@ -19,7 +19,8 @@ def read_again(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, u
                sentence_keys) -> Claim:
     """A contradicted number read again, each reading only while it stays contradicted: a fact of another name the
     sentence holds (:func:`unless_guessed`), what the parse says it measures (:func:`by_parse`), a fact it states
-    elsewhere (:func:`unless_elsewhere`). ``parsed()`` gives the sentence's parse, made only when asked for."""
+    elsewhere (:func:`unless_elsewhere`), a name in another clause (:func:`unless_other_clause`). ``parsed()``
+    gives the sentence's parse, made only when asked for."""
     units = frozenset(u.lower() for u in map(unit_of, book.features) if u)
     found = []
 
@@ -32,7 +33,28 @@ def read_again(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, u
         c = by_parse(c, n, masked, book, ctx, unit_of, measured, vocab)
     if c.status == "contradicted":
         c = unless_elsewhere(c, n, masked, mentions, book, ctx, measured, sentence_keys)
+    if c.status == "contradicted":
+        c = unless_other_clause(c, n, masked, names, parsed)
     return c
+
+
+def unless_other_clause(c: Claim, n, masked: str, names, parsed) -> Claim:
+    """A number bound by position to the name nearest before or after it, contradicted, that the parse puts in
+    another clause than that name ('A higher deductible means the insurer pays less per claim, so the model lowers
+    the cost by $200': not the claims'): the name was only near, so the claim is unchecked. A number right after its
+    name ('A +0.3', 'A (0.3)', 'A: 0.3') and a push by its cue words in a clause naming one feature are bound for
+    sure."""
+    if c.rule not in GUESSED[:2]:
+        return c
+    owner = next((m for m in reversed(names) if m.end <= n.start), None) if c.rule == GUESSED[1] else next(
+        (m for m in names if m.start >= n.end), None)
+    if owner is None or (c.rule == GUESSED[1] and re.fullmatch(r"\s?[:=(]?\s?|\s?[:=]\s*| at ",
+                                                               masked[owner.end:n.start])):
+        return c
+    if _one_name_pushes(n, masked, names) or same_clause(parsed(), n.start, n.end, owner.start, owner.end):
+        return c
+    return Claim("number", n.text, "unchecked", f"the parse puts it in another clause than {'/'.join(owner.keys)} "
+                                                f"(first read as {c.detail})", "parse.other-clause")
 
 
 def _one_name_pushes(n, masked: str, mentions) -> bool:

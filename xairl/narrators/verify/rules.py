@@ -168,6 +168,15 @@ RULES: tuple[Rule, ...] = (
          "another feature's exact fact: unchecked",
          fires=(("air", "Heavy traffic adds about 7.2, and yesterday's high reading adds 14.7."),),
          silent=(("air", "Heavy traffic adds about 7.2, and yesterday's high reading adds 11.3."),)),
+    Rule("parse.other-clause", "number", "the parse: a number bound by position to a name in another clause, "
+         "whose own subject is something else ('Traffic is heavy, so the count of buses reaches 3.0'): unchecked",
+         fires=(("air", "Traffic is heavy, so the count of buses reaches 3.0."),),
+         silent=(("air", "Traffic is heavy and adds 3.0."),)),
+    Rule("parse.direction-other-clause", "direction", "the parse: a direction word whose clause has a subject of "
+         "its own, and the name first read as its subject sits in another clause ('Heavy traffic means the buses "
+         "run late, so the model lowers it'): unchecked",
+         fires=(("air", "Heavy traffic means the buses run late, so the model lowers it by 3.0."),),
+         silent=(("air", "Traffic lowers the forecast by 3.0."),)),
     Rule("parse.modifier", "rank", "the parse: a rank (or a number stating some feature's exact fact) bound to a "
          "name that only qualifies a noun naming nothing ('the wind queue'): about that noun, unchecked",
          fires=(("air", "The main reason is the wind queue at the junction."),),
