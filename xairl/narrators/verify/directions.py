@@ -185,7 +185,8 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         flipped = [x for x in subjects if _EXCEPT.search(masked, prev, x.start) or (  # 'everything but the kitchen'
             _EXCEPT_AFTER.search(masked, m.end(), x.start) and _ALL_RE.search(masked, a, m.start()))]
         kept = [x for x in subjects if x not in flipped]
-        out += _unless_other_clause(checks.check_direction(kept, polarity, where, m.group(0), book), kept, m, masked, parsed)
+        out += _unless_other_clause(checks.check_direction(kept, polarity, where, m.group(0), book), kept, m, masked,
+                                    parsed)
         out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
         bare, prev = not subjects and not flipped, m.end()
     return out
