@@ -143,18 +143,17 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
                 and _good_outcome(book):
             polarity = -polarity  # 'added to the negative outlook' of a good-credit probability (of a diabetes
             # probability, 'contributed positively to the risk' raises it)
+        nxt = found[i + 1].start() if i + 1 < len(found) else b  # where the next direction word starts
         subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
-        agents = _passive_agents(masked, m, names, found[i + 1].start() if i + 1 < len(found) else b)
+        agents = _passive_agents(masked, m, names, nxt)
         if agents:
             subjects = agents  # 'it is pushed up by the battery level': the battery
         if _PARTICIPLE_AFTER_COMMA.match(m.group(0)) and re.search(r",\s*$", masked[a:m.start()]) and names and \
                 names[0].start < m.start():
             subjects = [names[0]]  # 'Retirement offsets the push from age and debt, taking 12.3 pp off': retirement
         if _OF_WHAT.match(masked, m.end()):  # 'the slightly positive contributions from corners and attempts'
-            nxt = found[i + 1].start() if i + 1 < len(found) else b
             subjects = [x for x in names if m.end() <= x.start < nxt]
         if not subjects:  # a header ('Raising risk: A, B') or a verb before its subject ('pushed up by A')
-            nxt = found[i + 1].start() if i + 1 < len(found) else b
             subjects = [x for x in names if m.end() <= x.start < nxt]
             sub = _SUBORDINATE.search(masked, m.end(), subjects[0].start) if subjects else None
             if sub is not None and _reason_moved_output(masked, prev, m, sub, subjects, mentions):
@@ -165,20 +164,7 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             if bare and subjects and ":" in masked[m.end():subjects[0].start]:
                 subjects = []  # 'Negative drivers outweighed positive ones: A, B': whose list is it? unsaid
             elif not subjects:
-                subject = masked[prev:m.start()]
-                inside = [x for x in mentions if prev <= x.start < m.start()]
-                pronoun = re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE)
-                opener = masked[max(0, prev - 12):prev] if i == 0 else ""
-                reasoning = re.match(r"\W*(?:because|since|as)\b", masked[a:b], re.IGNORECASE)
-                if i == 0 and (book.output != "actions" or not pronoun) and not reasoning:  # (a 'because' clause:
-                    # the writer's reasoning about the world, not about this model's features)
-                    out += _parse_agrees(_unknown_subject(subject, m.group(0), inside, name_words, opener), m, parsed,
-                                         book)
-                elif i > 0 and (joined := _NEW_CLAUSE.search(subject)):  # '..., and the basement cost another $12,000'
-                    rest = prev + joined.end()
-                    out += _parse_agrees(_unknown_subject(masked[rest:m.start()], m.group(0),
-                                                          [x for x in inside if x.start >= rest], name_words), m, parsed,
-                                         book)
+                out += _invented_subject(masked, a, b, prev, i == 0, m, mentions, book, name_words, parsed)
         conceded = [x for x in subjects if _DESPITE.search(masked[max(prev, x.start - 40):x.start])
                     and "," in masked[x.end:m.start()]]
         subjects = [x for x in subjects if x not in conceded]  # 'Despite being unemployed (+0.128), ... pull it down'
@@ -190,6 +176,29 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
         bare, prev = not subjects and not flipped, m.end()
     return out
+
+
+def _invented_subject(masked: str, a: int, b: int, prev: int, first: bool, m: re.Match, mentions: list[Mention],
+                      book: FactBook, name_words, parsed) -> list[Claim]:
+    """A direction word that no name is said of: an invented feature when the words before it (from the clause's
+    start, or after a new coordinated clause: '..., and the basement cost another $12,000') are a noun phrase of
+    their own and the parse agrees (:func:`_parse_agrees`). Not in a 'because' clause (the writer's reasoning about
+    the world, not about this model's features), nor a pronoun of a policy's actions."""
+    subject = masked[prev:m.start()]
+    inside = [x for x in mentions if prev <= x.start < m.start()]
+    if first:
+        pronoun = re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE)
+        if (book.output == "actions" and pronoun) or re.match(r"\W*(?:because|since|as)\b", masked[a:b],
+                                                               re.IGNORECASE):
+            return []
+        opener = masked[max(0, prev - 12):prev]
+        return _parse_agrees(_unknown_subject(subject, m.group(0), inside, name_words, opener), m, parsed, book)
+    joined = _NEW_CLAUSE.search(subject)
+    if joined is None:
+        return []
+    rest = prev + joined.end()
+    return _parse_agrees(_unknown_subject(masked[rest:m.start()], m.group(0), [x for x in inside if x.start >= rest],
+                                          name_words), m, parsed, book)
 
 
 #: a neutral verb of amount ('adds', 'contributes', 'gives') followed by what it adds: a signed number ('adds -0.04')

@@ -268,9 +268,8 @@ def same_clause(doc, start: int, end: int, name_start: int, name_end: int) -> bo
             continue
         if clause.dep_ == "relcl":  # 'A, which added 0.4': the noun it is said of, without the clause itself
             head = clause.head  # (or a value said in the name's clause: 'A had dropped to -22.5 dB, which ...')
-            return n.i == head.i or (_clause(head).i in targets and not head.ent_id_) or (
-                head.left_edge.i <= n.i <= head.right_edge.i and not clause.left_edge.i <= n.i <= clause.right_edge.i
-                and _clause(n).i == _clause(head).i)
+            return n.i == head.i or (_clause(head).i in targets and (
+                not head.ent_id_ or head.left_edge.i <= n.i <= head.right_edge.i))
         if any(c.dep_ in ("nsubj", "nsubjpass") and c.lower_ in _PRONOUNS for c in clause.children):
             return True  # 'A is reassuring: it lowers the score', '..., which pushed': whom it stands for is the
             # words' to say

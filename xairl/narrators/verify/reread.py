@@ -38,6 +38,10 @@ def read_again(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, u
     return c
 
 
+#: a number right after its name ('A +0.3', 'A (0.3)', 'A: 0.3', 'A=0.3', "the serving BS's id at -12"): bound for sure
+_RIGHT_AFTER = re.compile(r"\s?[:=(]?\s?|\s?[:=]\s*| at ")
+
+
 def unless_other_clause(c: Claim, n, masked: str, names, parsed) -> Claim:
     """A number bound by position to the name nearest before or after it, contradicted, that the parse puts in
     another clause than that name ('A higher deductible means the insurer pays less per claim, so the model lowers
@@ -48,8 +52,7 @@ def unless_other_clause(c: Claim, n, masked: str, names, parsed) -> Claim:
         return c
     owner = next((m for m in reversed(names) if m.end <= n.start), None) if c.rule == GUESSED[1] else next(
         (m for m in names if m.start >= n.end), None)
-    if owner is None or (c.rule == GUESSED[1] and re.fullmatch(r"\s?[:=(]?\s?|\s?[:=]\s*| at ",
-                                                               masked[owner.end:n.start])):
+    if owner is None or (c.rule == GUESSED[1] and _RIGHT_AFTER.fullmatch(masked, owner.end, n.start)):
         return c
     if _one_name_pushes(n, masked, names) or same_clause(parsed(), n.start, n.end, owner.start, owner.end):
         return c
@@ -131,7 +134,7 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, me
         return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}, and "
                      f"the name before it is one word of a long name", "number.other-feature")  # ('bill $109.9' of
         # price_increase_last_bill_pct, when $109.9 is the monthly charge)
-    if owner is not None and re.fullmatch(r"\s?[:=(]?\s?|\s?[:=]\s*| at ", masked[owner.end:n.start]):
+    if owner is not None and _RIGHT_AFTER.fullmatch(masked, owner.end, n.start):
         return c  # ('the serving BS's id at -12': its value)
     key = _LOG_KEY.search(masked, max(0, n.start - 40), n.start)
     if key is not None and not n.sign:  # 'run_id=7781' after a name: the value of a field of the log, not the name's
