@@ -73,6 +73,9 @@ def test_name_variants_and_ambiguity():
         assert m.keys == ("gill_size",), text
     (m,), _ = find_mentions("the cap diameter", vocab)
     assert m.keys == ("capDiameter",)
+    for text in ("GILL SIZE", "gıll ſize", "CAPDIAMETERS"):  # each name's regex runs only when its first word is there
+        (m,), _ = find_mentions(text, vocab)
+        assert m.keys[0] in ("gill_size", "capDiameter"), text
     (m,), _ = find_mentions("the gill", vocab)
     assert set(m.keys) == {"gill_size", "gill_color"}  # ambiguous, not guessed
     res = xairl.verify("The gill raised the prediction by 0.11.", exp, 0)  # true of gill_size only

@@ -3,6 +3,7 @@
 :mod:`xairl.narrators.verify` splits sentences into clauses and decides each clause's view."""
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import replace
 
@@ -100,8 +101,16 @@ def _worded(book: FactBook, written: str) -> list[str]:
     """The features with a window in their name ('prior_returns_12m') whose other words the sentence uses in some
     form ('returned'): the ones a period in it ('the past twelve months') may be the window of."""
     said = {stem(w) for w in split_words(written)}
-    return [f for f in book.features if re.search(r"\d+[a-z]", f.lower()) and said & {
-        stem(w) for w in split_words(f) if len(w) >= 4 and not any(c.isdigit() for c in w)}]
+    return [f for f in book.features if said & _window_words(f)]
+
+
+@functools.lru_cache(maxsize=4096)
+def _window_words(feature: str) -> frozenset[str]:
+    """The stems of the words beside the window in a feature's name ('prior_returns_12m': 'prior', 'return~'); none
+    where the name has no window."""
+    if not re.search(r"\d+[a-z]", feature.lower()):
+        return frozenset()
+    return frozenset(stem(w) for w in split_words(feature) if len(w) >= 4 and not any(c.isdigit() for c in w))
 
 
 #: 'A and B together add x', 'combined', 'sum to', 'between them': the number is their sum

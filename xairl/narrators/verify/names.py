@@ -47,7 +47,10 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
     so that digits inside names ('rsrp_1', 'candidate 2') are not read as numbers."""
     taken = bytearray(len(text))
     found: list[Mention] = []
-    for pattern, kind, keys, label, form in vocab.entries:
+    folded = text.lower().replace("ı", "i").replace("ſ", "s")  # the two letters a case-blind 'i' and 's' match
+    for pattern, kind, keys, label, form, needle in vocab.entries:
+        if needle not in folded:
+            continue  # the regex cannot match: much cheaper to know than to run it
         for m in pattern.finditer(text):
             if kind == "label" and _IDIOM.search(text, max(0, m.start() - 16), m.start()):
                 continue  # 'on its own' is no housing label

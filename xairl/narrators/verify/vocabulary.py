@@ -3,6 +3,7 @@ description, aliases and runs of their words; actions by name, alias and verb fo
 meanings. :mod:`.names` finds them in a text."""
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass
 
@@ -26,6 +27,7 @@ def split_words(name: str) -> list[str]:
     return re.findall(r"[a-z0-9]+", spaced.lower())
 
 
+@functools.lru_cache(maxsize=65536)
 def stem(word: str) -> str:
     """A crude English stem, enough for labels ('renting' -> 'rent', 'self-employment' -> 'self employ'); a word
     left whole is returned as is."""
@@ -38,9 +40,10 @@ def stem(word: str) -> str:
 
 @dataclass
 class Vocabulary:
-    """Every surface of an explanation's names, longest first: (regex, kind, keys, label, form)."""
+    """Every surface of an explanation's names, longest first: (regex, kind, keys, label, form, needle)."""
 
-    entries: list[tuple[re.Pattern, str, tuple[str, ...], str, str]]
+    #: ``needle``: lowercase text every match holds, looked for before the regex runs ('' where none is known)
+    entries: list[tuple[re.Pattern, str, tuple[str, ...], str, str, str]]
     #: feature -> [(label, pattern)] of labels named only right next to their feature: 1-2 characters ('Y', 'Ex') or
     #: plain words ('other', 'at_home')
     short_labels: dict[str, list[tuple[str, str]]]
@@ -105,9 +108,10 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     names |= {level.split()[-1].lower() for f in feature_words if (info := policy.features.get(f) if policy else None)
               for level in (info.low, info.high) if len(level.split()) > 1}  # '(-27.5 dB, poor quality)'
     names |= {stem(w) for w in names} | {ws for ws in described_words if len(ws) >= 2}
-    compiled = [(_literal(p), kind, keys, label, "") if form == "literal" else (_pattern(p, kind), kind, keys, label,
-                                                                                 form)
-                for p, kind, keys, label, form in entries]
+    compiled = []
+    for p, kind, keys, label, form in entries:
+        pattern, needle = (_literal(p), _needle(p)) if form == "literal" else _pattern(p, kind)
+        compiled.append((pattern, kind, keys, label, "" if form == "literal" else form, needle))
     return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, frozenset(names))
 
 
@@ -191,8 +195,8 @@ def _acronyms(features) -> list:
         words = split_words(f)
         if len(words) >= 3 and not any(w.isdigit() for w in words):
             owners.setdefault("".join(w[0] for w in words).upper(), []).append(f)
-    return [(re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "") for acr, fs in owners.items()
-            if len(fs) == 1]
+    return [(re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "", acr.lower())
+            for acr, fs in owners.items() if len(fs) == 1]
 
 
 def _phrase(text: str) -> str:
@@ -204,18 +208,27 @@ def _phrase(text: str) -> str:
 _STEM_ENDING = r"(?:e|es|ed|ing|ment|ments|ement|ements|ee|ees|er|ers|s|y|ies|ied|ion|ions|ive|al)?"
 
 
-def _pattern(phrase: str, kind: str) -> re.Pattern:
-    """Words in order, separated by spaces, hyphens, underscores or nothing; plural 's' and possessive allowed."""
-    parts = [re.escape(w) for w in phrase.split()]
+def _pattern(phrase: str, kind: str) -> tuple[re.Pattern, str]:
+    """Words in order, separated by spaces, hyphens, underscores or nothing; plural 's' and possessive allowed. With
+    the needle: the first word as it must appear."""
+    words = phrase.split()
     if kind == "label":  # a stem ('~') takes an inflection (_STEM_ENDING), a whole word a plural
-        body = r"[\s_\-]*".join(p.replace("\\~", "").replace("~", "") + _STEM_ENDING if "~" in p else
-                                  p + "(?:s|es|ing|ed|er|ers)?" for p in parts)
+        words = [w.replace("~", "") for w in words]
+        body = r"[\s_\-]*".join(re.escape(w) + _STEM_ENDING if "~" in p else re.escape(w) + "(?:s|es|ing|ed|er|ers)?"
+                                  for w, p in zip(words, phrase.split()))
     else:  # a plural name also in the singular ('Corners': 'a corner')
-        last = phrase.split()[-1]
+        last = words[-1]
         if len(last) > 4 and last.endswith("s") and not last.endswith(("ss", "us", "is")):
-            parts[-1] = re.escape(last[:-2] if last.endswith(("sses", "xes", "ches", "shes")) else last[:-1])
-        body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+)?|)".join(parts) + r"(?:s|es)?(?:'s|')?\)?"
-    return re.compile(rf"(?<![\w]){body}(?![\w])(?![.,]\d)", re.IGNORECASE)  # not 'RSRQ (-3' of 'RSRQ (-3.2 dB)'
+            words[-1] = last[:-2] if last.endswith(("sses", "xes", "ches", "shes")) else last[:-1]
+        body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+)?|)".join(map(re.escape, words)) + r"(?:s|es)?(?:'s|')?\)?"
+    pattern = re.compile(rf"(?<![\w]){body}(?![\w])(?![.,]\d)", re.IGNORECASE)  # not 'RSRQ (-3' of 'RSRQ (-3.2 dB)'
+    return pattern, _needle(words[0])
+
+
+def _needle(word: str) -> str:
+    """Lowercase text a case-blind match of ``word`` holds; '' where the word is not ASCII (case folding beyond ASCII
+    is left to the regex)."""
+    return word.lower() if word.isascii() else ""
 
 
 def _literal(name: str) -> re.Pattern:
