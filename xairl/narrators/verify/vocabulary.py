@@ -110,7 +110,7 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     names |= {stem(w) for w in names} | {ws for ws in described_words if len(ws) >= 2}
     compiled = []
     for p, kind, keys, label, form in entries:
-        pattern, needle = (_literal(p), _needle(p)) if form == "literal" else _pattern(p, kind)
+        pattern, needle = _literal(p) if form == "literal" else _pattern(p, kind)
         compiled.append((pattern, kind, keys, label, "" if form == "literal" else form, needle))
     return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, frozenset(names))
 
@@ -195,7 +195,7 @@ def _acronyms(features) -> list:
         words = split_words(f)
         if len(words) >= 3 and not any(w.isdigit() for w in words):
             owners.setdefault("".join(w[0] for w in words).upper(), []).append(f)
-    return [(re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "", acr.lower())
+    return [(re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "", _needle(acr))
             for acr, fs in owners.items() if len(fs) == 1]
 
 
@@ -213,9 +213,9 @@ def _pattern(phrase: str, kind: str) -> tuple[re.Pattern, str]:
     the needle: the first word as it must appear."""
     words = phrase.split()
     if kind == "label":  # a stem ('~') takes an inflection (_STEM_ENDING), a whole word a plural
+        endings = [_STEM_ENDING if "~" in w else "(?:s|es|ing|ed|er|ers)?" for w in words]
         words = [w.replace("~", "") for w in words]
-        body = r"[\s_\-]*".join(re.escape(w) + _STEM_ENDING if "~" in p else re.escape(w) + "(?:s|es|ing|ed|er|ers)?"
-                                  for w, p in zip(words, phrase.split()))
+        body = r"[\s_\-]*".join(re.escape(w) + ending for w, ending in zip(words, endings))
     else:  # a plural name also in the singular ('Corners': 'a corner')
         last = words[-1]
         if len(last) > 4 and last.endswith("s") and not last.endswith(("ss", "us", "is")):
@@ -231,13 +231,13 @@ def _needle(word: str) -> str:
     return word.lower() if word.isascii() else ""
 
 
-def _literal(name: str) -> re.Pattern:
+def _literal(name: str) -> tuple[re.Pattern, str]:
     """A name exactly as written, whatever its digits, brackets or script ('obs[1,32,35]', '速度'), not inside a
     longer word or name; a name of punctuation only ('?', '-') only between spaces (or a bracket or comma after it),
-    so that it is not every minus sign."""
+    so that it is not every minus sign. With the needle: the name."""
     if not re.search(r"[^\W_]", name):
-        return re.compile(rf"(?<![^\s(]){re.escape(name)}(?=[\s,;:)]|$)")
-    return re.compile(rf"(?<![\w\[]){re.escape(name)}(?![\w\]])", re.IGNORECASE)
+        return re.compile(rf"(?<![^\s(]){re.escape(name)}(?=[\s,;:)]|$)"), _needle(name)
+    return re.compile(rf"(?<![\w\[]){re.escape(name)}(?![\w\]])", re.IGNORECASE), _needle(name)
 
 
 def _inflect(head: str) -> list[tuple[str, str]]:
