@@ -215,8 +215,8 @@ def modified_noun(doc, start: int, end: int) -> str:
         return ""
     if head.pos_ not in ("NOUN", "PROPN") or head.lower_ in _OWN_NOUNS | UNIT_WORDS | GENERIC:
         return ""  # ('the debt ratio', 'its build year': the name's own generic word)
-    if any(ch.isdigit() for ch in head.text) and head.i > 0 and head.doc[head.i - 1].text == "(":
-        return ""  # the name's own value in brackets ('RSRQ (-18.8 dB, poor quality)'): the name is the head
+    if any(ch.isdigit() for ch in head.text):
+        return ""  # the name's own number ('RSRQ (-18.8 dB, poor quality)', 'Traffic +6.9'): the name is the head
     return head.lower_
 
 

@@ -82,13 +82,36 @@ def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ct
         return c  # "the serving BS's id at -12": its value, as sure
     if _one_name_pushes(n, masked, names):
         return c
+    signed = quantities.signed_named(masked[max(0, n.start - 40):n.start])
     if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
         other = quantities.other_reading(n, set(owner.keys), book, ctx, signed=True)
     else:
-        other = quantities.other_reading(n, sentence_keys, book, ctx,
-                                         signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
-    return c if other is None else Claim("number", n.text, "unchecked",
-                                         f"read as {c.detail}, but it is {other}: which is unclear", "number.unclear")
+        other = quantities.other_reading(n, sentence_keys, book, ctx, signed=signed)
+    if other is None:
+        return c
+    if c.rule == GUESSED[1] and owner in names and _crossed(n, owner, other[0], masked, mentions, book, ctx, signed):
+        return replace(c, detail=f"{c.detail}; it is {other[1]}, and the number after {other[0]} is "
+                                 f"{'/'.join(owner.keys)}'s: the two are swapped", rule="number.crossed")
+    return Claim("number", n.text, "unchecked", f"read as {c.detail}, but it is {other[1]}: which is unclear",
+                 "number.unclear")
+
+
+def _crossed(n, owner, other: str, masked: str, mentions, book: FactBook, ctx, signed: bool) -> bool:
+    """'contract +0.214, tenure +0.127' when the contract's contribution is 0.127 and the tenure's 0.214: the number
+    bound to one name states the other's fact, and a number after the other name (before the next name) states this
+    one's and not its own. Each name then holds the other's number: the two are swapped, not misread."""
+    if len(owner.keys) != 1:
+        return False
+    for m in mentions:
+        if m is owner or other not in m.keys or len(m.keys) != 1:
+            continue
+        end = next((k.start for k in mentions if k.start >= m.end), len(masked))
+        for y in find_numbers(masked[:end]):
+            if y.start >= m.end and y.start != n.start and quantities.other_reading(
+                    y, set(owner.keys), book, ctx, signed=signed) and not quantities.other_reading(
+                    y, {other}, book, ctx, signed=signed):
+                return True
+    return False
 
 
 #: nouns a number may measure that are facts of an explanation (a score, the margin, a contribution, the output):
@@ -112,6 +135,12 @@ AGGREGATE_NOUNS = frozenset({"total", "sum", "net", "gap", "difference", "change
 
 #: an identifier that is no name, then '=' or ':', right before a number ('run_id=7781', 'latency_ms: 42')
 _LOG_KEY = re.compile(r"(?<![\w\0])([A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+)\s?[:=]\s?$")
+
+
+#: an identifier that is no name right before a number, with or without its own value ('wait_max -2.31',
+#: 'blh_m=310|+4.6', 'humidity_pct=+3.1'): the number is given to it (:func:`._identifier` judges the identifier)
+_GIVEN_TO = re.compile(r"(?<![\w\0])([A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+)(?:\s?[:=]\s?[^\s|()\0]{1,16})?"
+                       r"(?:\s?[:=|(]\s?|\s)$")
 
 
 def _one_word_of_many(m) -> bool:
@@ -139,6 +168,10 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, me
     key = _LOG_KEY.search(masked, max(0, n.start - 40), n.start)
     if key is not None and not n.sign:  # 'run_id=7781' after a name: the value of a field of the log, not the name's
         return Claim("number", n.text, "unchecked", f"the value of the log's field {key.group(1)!r}", "number.log-field")
+    key = key or _GIVEN_TO.search(masked, max(0, n.start - 40), n.start)
+    if key is not None:  # 'wait_max -2.31', 'blh_m=310|+4.6': the identifier's, which its own claim judges
+        return Claim("number", n.text, "unchecked", f"given to {key.group(1)!r}, an identifier that names nothing "
+                     f"(first read as {c.detail})", "number.of-identifier")
     q = measured()
     if q.key or (not q.subject and _one_name_pushes(n, masked, mentions)):
         return c

@@ -147,12 +147,21 @@ RULES: tuple[Rule, ...] = (
          "(unhedged, two significant digits): which one is unclear, unchecked",
          fires=(("air", "The wind was calm, which, with the traffic, added 6.9."),),
          silent=(("air", "The wind was calm, which, with the traffic, added 5.5."),)),
+    Rule("number.crossed", "number", "a number bound by position that states another named feature's fact, while a "
+         "number after that other name states this one's: the two are swapped, contradicted",
+         fires=(("air", "Traffic adds 6.9 and wind adds 7.2."), ("air", "traffic_index=2.4 (+6.9) wind_speed_ms=0.8 (+7.2)")),
+         silent=(("air", "Traffic adds 7.2 and wind adds 6.9."), ("air", "Traffic adds 6.9, more than the wind."))),
     Rule("number.word", "number", "a number word bound by position alone, that the parse ties to no name ('a "
          "factor of two', 'one and a half times'): a count or an idiom, unchecked",
          fires=(("air", "The wind mattered by a factor of two."),),
          silent=(("air", "Traffic adds seven."),)),
     Rule("number.log-field", "number", "an unsigned value of a log's field that names nothing ('run_id=7781')",
          fires=(("air", "pm2_5_lag1=+14.7 run_id=7781"),), silent=(("air", "pm2_5_lag1=+14.7 humidity_pct=+3.1"),)),
+    Rule("number.of-identifier", "number", "a number right after an identifier that names nothing, with or without "
+         "the identifier's own value ('wait_max -2.31', 'blh_m=310|+4.6'): the identifier's, not the name's before "
+         "it; unchecked (the identifier's own claim judges it)",
+         fires=(("air", "pm2_5_lag1 +14.7 wind_gust -3.1"), ("air", "pm2_5_lag1=48.2|+14.7 blh_m=310|+4.6")),
+         silent=(("air", "pm2_5_lag1 +14.7 wind_speed_ms +6.9"), ("air", "pm2_5_lag1=+14.7 run_id=7781"))),
     Rule("parse.measures-name", "number", "the parse: a number measures another name than its position says",
          fires=(("air", "The precip, which unlike the traffic was nil, added about 2.2."),),
          silent=(("air", "Traffic adds 7.2."),)),
