@@ -23,6 +23,7 @@ from tests import narrative_domains as domains
     ("$12,757.84", 12757.84, 0.01, ""), (".9", 0.9, 0.1, ""), ("about $12,000", 12000, 1000, "approx"),
     ("262KB", 262, 1, ""), ("-4330.84", -4330.84, 0.01, ""), ("~$21k", 21000, 1000, "approx"),
     ("nearly 2 dB", 2, 1, "below"), ("1.2e-3", 0.0012, 1e-4, ""), ("five thousand dollars", 5000, 1000, ""),
+    ("up to 31.1", 31.1, 0.1, "at_most"), ("the positives add up to 31.1", 31.1, 0.1, ""),  # a sum, not a bound
 ])
 def test_numbers_as_people_write_them(text, value, unit, hedge):
     n = find_numbers(normalise(text))[0]

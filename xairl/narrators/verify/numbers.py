@@ -174,7 +174,13 @@ def _hedge(before: str) -> str:
     if _RANGE_HIGH.search(before[-40:]):
         return "at_most"
     m = _HEDGE_RE.search(before[-30:])
+    if m and m.group(1).lower() == "up to" and _ADDS_UP.search(before[-30:]):
+        return ""  # 'the positives add up to 0.39': a sum, not a bound
     return HEDGES[m.group(1).lower()] if m else ""
+
+
+_ADDS_UP = re.compile(r"\b(?:add(?:s|ed|ing)?|sum(?:s|med|ming)?|total(?:s|led|ling)?|com(?:e|es|ing)|came|"
+                      r"amount(?:s|ed|ing)?)\s+up\s+to\b", re.IGNORECASE)
 
 
 def matches(n: Number, fact: float, magnitude_ok: bool = True, truncated_ok: bool = True) -> bool:

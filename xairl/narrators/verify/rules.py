@@ -83,6 +83,10 @@ RULES: tuple[Rule, ...] = (
          "name's own: a sum over things not all known, unchecked",
          fires=(("air", "Traffic plus the junction make up 9.9."),),
          silent=(("air", "Traffic and wind together add 14.1."),)),
+    Rule("number.other-side", "number", "a sum after words naming one side ('the positives add up to', 'downward "
+         "ones about') that is the other side's sum in size: a sign error, contradicted",
+         fires=(("air", "The negatives add up to 31.1."), ("air", "Upward contributions total about +1.0.")),
+         silent=(("air", "The positives add up to 31.1."), ("air", "The negatives add up to 12.0."))),
     Rule("number.aggregate", "number", "a sum over all features after its cue words ('the positives add up to')",
          fires=(("air", "The positives add up to 31.1."),), silent=(("air", "Traffic adds 7.2."),)),
     Rule("number.identifier-after-word", "number", "a bare whole number right after one word of a longer name, "

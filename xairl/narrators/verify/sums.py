@@ -31,7 +31,7 @@ def sum_reading(n: Number, masked: str, names, book: FactBook) -> Claim | None:
     """:func:`aggregate_number`, else :func:`without_number`, each with its rule's id; None for neither."""
     summed = aggregate_number(n, masked, book)
     if summed is not None:  # 'the positives add up to about +0.39', 'total absolute attribution of 1.62'
-        return replace(summed, rule="number.aggregate")
+        return replace(summed, rule=summed.rule or "number.aggregate")
     removed = without_number(n, masked, names, book)  # 'without the add-on's contribution it would sit at 12.4%'
     return replace(removed, rule="number.without") if removed is not None else None
 
@@ -43,11 +43,30 @@ def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
     if not book.aggregates or not (AGGREGATE_CUE.search(before) or _PART_OF.search(before)
                                    or _TOTAL_AFTER.match(masked, n.end)):
         return None
+    def states(v: float) -> bool:  # ('50 %' is a share; '21.9 points' a sum of contributions in points, or of
+        return (matches(n, v) and (n.points or not n.percent)) or (n.points and percent_reading(n, v))  # probabilities
+    side = [m for m in _SIDE.finditer(before) if "\0" not in before[m.end():] and not re.search(r"\d", before[m.end():])]
+    if side:  # 'the positives add up to +0.39': that side's sum, in any view; the other side's is a sign error
+        said = "positive" if side[-1].group("pos") else "negative"
+        other = "negative" if said == "positive" else "positive"
+        own = {w: v for w, v in book.aggregates.items() if f" {said} " in w}
+        if any(states(v) for v in own.values()):
+            return Claim("number", n.text, "verified", next(w for w, v in own.items() if states(v)))
+        size = replace(n, value=abs(n.value), sign="", alternatives=())
+        wrong = [(w, v) for w, v in book.aggregates.items() if f" {other} " in w and matches(size, abs(v))]
+        if wrong:
+            said_sums = ", ".join(f"{w} is {v:+.4g}" for w, v in own.items())
+            return Claim("number", n.text, "contradicted", f"{said_sums}; {n.text} is the size of {wrong[0][0]}",
+                         "number.other-side")
     for what, v in book.aggregates.items():
-        if (matches(n, v) and (n.points or not n.percent)) or (n.points and percent_reading(n, v)):  # ('50 %' is
-            # a share; '21.9 points' a sum of contributions in points, or of probabilities read as points)
+        if states(v):
             return Claim("number", n.text, "verified", what)
     return None
+
+
+#: a side of the decision named right before its sum ('the positives add up to', 'downward ones about', 'pos_sum=')
+_SIDE = re.compile(r"\b(?:(?P<pos>positives?|upward|pos(?:_\w+)?|pushing (?:it |the \w+ )?up)|"
+                   r"(?P<neg>negatives?|downward|neg(?:_\w+)?|pulling (?:it |the \w+ )?down))\b", re.IGNORECASE)
 
 
 def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book: FactBook) -> Claim:
