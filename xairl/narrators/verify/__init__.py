@@ -37,7 +37,7 @@ from ...errors import InputError
 from ...explanation import Explanation
 from ...policy import Policy
 from ...regions import in_regions
-from . import binding, checks, clauses, directions, parse, quantities, regions, sums
+from . import binding, checks, clauses, directions, parse, quantities, regions, reread, sums
 from .book import add_facts, FactBook, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, named_features
@@ -206,11 +206,11 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
         info = policy.features.get(f) if policy else None
         return info.unit if info and info.unit else unit_in_name(f)
 
-    out = []
-    for a, b in sentences(text):
-        claims = _read_sentence(text[a:b], book, vocab, unit_of)
-        out.append(SentenceCheck(text[a:b].strip(), tuple(claims)))
-    return Verification(tuple(out), note)
+    spans = sentences(text)
+    read = [_read_sentence(text[a:b], book, vocab, unit_of) for a, b in spans]
+    claims = iter(reread.swapped([c for cs in read for c in cs]))  # (two numbers that cross, anywhere in the text)
+    return Verification(tuple(SentenceCheck(text[a:b].strip(), tuple(next(claims) for _ in cs))
+                              for (a, b), cs in zip(spans, read)), note)
 
 
 def _read_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]:

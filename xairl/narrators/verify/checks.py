@@ -4,7 +4,7 @@ clause (or sentence) already read into mentions and returns :class:`Claim`\\ s: 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -22,6 +22,9 @@ class Claim:
     status: str
     detail: str = ""
     rule: str = ""
+    #: (the feature a number was bound to, the feature whose fact it states instead), for a number left unchecked
+    #: because it states another feature's fact: two numbers of a text that cross this way are swapped
+    crosses: tuple[str, ...] = field(default=(), repr=False, compare=False)
 
 
 CHECKED = {"number", "direction", "rank", "action", "category", "magnitude"}

@@ -193,13 +193,11 @@ def _code_meaning(n: Number, e) -> tuple[bool, str] | None:
                    f"{here or 'nothing in the legend'}") if others else None
 
 
-def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None,
-                  signed: bool = False) -> tuple[str, str] | None:
+def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, signed: bool = False) -> str | None:
     """Another fact the number states exactly when the words bound it to the wrong one: the value, share or
-    contribution (in the sentence's view when it names one, else any) of a feature named in the same sentence, as
-    (its key, what it is). The binding was a guess, so the number is not called wrong; only unhedged numbers of two
-    significant digits or more qualify ('0.06' or 'about 0.1' may match by chance). ``signed``: a contribution only
-    with its sign."""
+    contribution (in the sentence's view when it names one, else any) of a feature named in the same sentence. The
+    binding was a guess, so the number is not called wrong; only unhedged numbers of two significant digits or more
+    qualify ('0.06' or 'about 0.1' may match by chance). ``signed``: a contribution only with its sign."""
     if n.hedge or abs(n.value) < 10 * n.unit:
         return None
     views = book.contexts if ctx in (None, EITHER) else (ctx,)
@@ -213,7 +211,7 @@ def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None,
         for what, v, size_ok in facts:
             if v is not None and (matches(replace(n, percent=False), v, magnitude_ok=size_ok, truncated_ok=False) or (
                     n.points and percent_reading(n, abs(v) if size_ok and not n.sign else v))):  # '12.3 pp'
-                return key, f"{key}'s {what}"
+                return f"{key}'s {what}"
     return None
 
 

@@ -82,36 +82,39 @@ def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ct
         return c  # "the serving BS's id at -12": its value, as sure
     if _one_name_pushes(n, masked, names):
         return c
-    signed = quantities.signed_named(masked[max(0, n.start - 40):n.start])
     if owner in names and re.fullmatch(r"\s?\(", masked[owner.end:n.start]):
         other = quantities.other_reading(n, set(owner.keys), book, ctx, signed=True)
     else:
-        other = quantities.other_reading(n, sentence_keys, book, ctx, signed=signed)
-    if other is None:
-        return c
-    if c.rule == GUESSED[1] and owner in names and _crossed(n, owner, other[0], masked, mentions, book, ctx, signed):
-        return replace(c, detail=f"{c.detail}; it is {other[1]}, and the number after {other[0]} is "
-                                 f"{'/'.join(owner.keys)}'s: the two are swapped", rule="number.crossed")
-    return Claim("number", n.text, "unchecked", f"read as {c.detail}, but it is {other[1]}: which is unclear",
-                 "number.unclear")
+        other = quantities.other_reading(n, sentence_keys, book, ctx,
+                                         signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
+    return c if other is None else Claim("number", n.text, "unchecked", f"read as {c.detail}, but it is {other}: "
+                                         f"which is unclear", "number.unclear", _crosses(c, other, book))
 
 
-def _crossed(n, owner, other: str, masked: str, mentions, book: FactBook, ctx, signed: bool) -> bool:
-    """'contract +0.214, tenure +0.127' when the contract's contribution is 0.127 and the tenure's 0.214: the number
-    bound to one name states the other's fact, and a number after the other name (before the next name) states this
-    one's and not its own. Each name then holds the other's number: the two are swapped, not misread."""
-    if len(owner.keys) != 1:
-        return False
-    for m in mentions:
-        if m is owner or other not in m.keys or len(m.keys) != 1:
-            continue
-        end = next((k.start for k in mentions if k.start >= m.end), len(masked))
-        for y in find_numbers(masked[:end]):
-            if y.start >= m.end and y.start != n.start and quantities.other_reading(
-                    y, set(owner.keys), book, ctx, signed=signed) and not quantities.other_reading(
-                    y, {other}, book, ctx, signed=signed):
-                return True
-    return False
+def _crosses(c: Claim, other: str, book: FactBook) -> tuple[str, str]:
+    """(the feature a number's first reading bound it to, the feature whose fact it states instead), for a text where
+    two numbers cross this way (:func:`swapped`); () when either is not one feature."""
+    bound = next((k for k in book.features if f" is not {k}'s " in c.detail), None)
+    stated = next((k for k in book.features if other.startswith(f"{k}'s ")), None)
+    return (bound, stated) if bound is not None and stated is not None and bound != stated else ()
+
+
+def swapped(claims: list[Claim]) -> list[Claim]:
+    """'contract +0.214, tenure +0.127' when the contract's contribution is 0.127 and the tenure's 0.214: a number
+    bound to A that states B's fact, left unchecked as unclear, and another bound to B that states A's. Each name
+    holds the other's number, anywhere in the text (two lines of a table): the two are swapped, not misread, so
+    both are contradicted."""
+    pairs = {c.crosses: c for c in claims if c.crosses}
+    out = []
+    for c in claims:
+        twin = pairs.get(c.crosses[::-1]) if c.crosses else None
+        if twin is not None and twin.text != c.text:
+            a, b = c.crosses
+            first = re.sub(r"^read (?:by position )?as ", "", c.detail.split(", but it ")[0])
+            c = replace(c, status="contradicted", rule="number.crossed", detail=f"{first}; it states {b}'s fact, and "
+                        f"{twin.text} (bound to {b}) states {a}'s: the two are swapped")
+        out.append(c)
+    return out
 
 
 #: nouns a number may measure that are facts of an explanation (a score, the margin, a contribution, the output):
@@ -161,7 +164,7 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, me
     if owner is not None and c.rule == GUESSED[1] and _one_word_of_many(owner) and (
             other := quantities.any_fact(n, book, set(book.features) - set(owner.keys), ctx, strict=True)):
         return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}, and "
-                     f"the name before it is one word of a long name", "number.other-feature")  # ('bill $109.9' of
+                     f"the name before it is one word of a long name", "number.other-feature", _crosses(c, other, book))  # ('bill $109.9' of
         # price_increase_last_bill_pct, when $109.9 is the monthly charge)
     if owner is not None and _RIGHT_AFTER.fullmatch(masked, owner.end, n.start):
         return c  # ('the serving BS's id at -12': its value)
@@ -187,18 +190,18 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, me
         other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes, signed=signed)
         if other is not None:
             return Claim("number", n.text, "unchecked", f"said of '{q.noun}', which names no "
-                                             f"feature; it states {other}", "parse.said-of-other")
+                                             f"feature; it states {other}", "parse.said-of-other", _crosses(c, other, book))
     other = quantities.any_fact(n, book, keys, ctx, strict=True, contribution=pushes, signed=signed)
     if other is not None:
         return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}",
-                     "number.elsewhere")
+                     "number.elsewhere", _crosses(c, other, book))
     if q.noun in FACT_NOUNS:
         return c  # 'A is responsible for an increase of 1.2': A's increase, whatever else 1.2 may be
     # 'bill $109.9', 'its Q3 grade of 54 (+0.096)': a thing the vocabulary has no words for, or a wrong word match
     other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes, signed=signed)
     return c if other is None else Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it "
                                          f"states {other}, a feature the sentence may name in words of its own",
-                                         "number.other-feature")
+                                         "number.other-feature", _crosses(c, other, book))
 
 
 def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, measured, vocab) -> Claim:
