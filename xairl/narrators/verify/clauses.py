@@ -61,7 +61,8 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
     out += [binding.named(c, "direction.subject") for c in directions.directions(masked, a, b, said, book, ctx,
                                                                                 name_words, parsed)]
     out += [binding.named(c, "rank.words") for c in ranks.find_ranks(masked, a, b, said, book, ctx, written)]
-    out += [binding.named(c, "rank.comparison") for c in comparisons.find_comparisons(masked, a, b, said, book, ctx)]
+    out += [binding.named(c, "rank.comparison")
+            for c in comparisons.find_comparisons(masked, a, b, said, book, ctx, written)]
     for m in ranks.MINOR_RE.finditer(masked, a, b):
         owner = next((x for x in reversed(said_names) if x.end <= m.start()), None) or next(
             (x for x in said_names if x.start >= m.end()), None)

@@ -17,6 +17,10 @@ COMPARE_RE = re.compile(r"\b(?:(?P<more>more|bigger|larger|greater|stronger|heav
                         r"|\b(?P<out>outweigh\w*|dwarf\w*|overshadow\w*)\s+"
                         r"|(?<=\d)\s*(?P<of>(?:%|percent)\s+of|times(?:\s+of)?)\s+(?=(?:the\s+|its\s+|their\s+)?\0)",
                         re.IGNORECASE)  # ('60 % of the alcohol effect', '3.7 times the pedestrian-call penalty')
+#: the words between 'than' and the name compared with: a determiner, a count's words ('the number of'), one more
+#: word ('than the number of browsing sessions'); not 'any other', 'all', 'the combined'
+_BEFORE_B = re.compile(r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?(?:(?:number|count|amount|level|size) of\s+"
+                       r"(?:the\s+|its\s+)?(?:(?!(?:any|all|other|combined|every|each)\b)[a-z-]+\s+)?)?", re.IGNORECASE)
 SAME_WITHIN = 0.25  # 'about as much as': the two sizes within 25 % of the larger
 
 
@@ -105,17 +109,17 @@ def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
     return (ctx,) if ctx and ctx != EITHER else book.contexts
 
 
-def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None
-                     ) -> list[Claim]:
+def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
+                     written: str = "") -> list[Claim]:
     """'A mattered more than B' (and 'which in turn mattered more than C'), 'A and B both mattered more than C', 'A
-    outweighs B': A's |contribution| against B's. B must be one feature named right after 'than'; A the names since
-    the previous comparison, else the last name before the comparative (a relative 'which')."""
-    out, start = [], a
+    outweighs B': A's |contribution| against B's. B must be one feature named right after 'than' ('than the number
+    of browsing sessions' allows a count's words and one more); A the names since the previous comparison, else the
+    last name before the comparative (a relative 'which'). ``written``: the sentence as written (claims quote it)."""
+    out, start, written = [], a, written or masked
     names = named_features(mentions)
     for m in COMPARE_RE.finditer(masked, a, b):
         b_name = next((x for x in names if x.start >= m.end()), None)
-        if b_name is None or len(b_name.keys) != 1 or not re.fullmatch(
-                r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?", masked[m.end():b_name.start], re.IGNORECASE):
+        if b_name is None or len(b_name.keys) != 1 or not _BEFORE_B.fullmatch(masked, m.end(), b_name.start):
             continue  # 'more than $500', 'bigger than any other feature': no feature to compare with
         subjects = [x for x in names if start <= x.start and x.end <= m.start()]
         if not subjects or m.group("of"):  # ('A ..., and the B term is about 1.5 times the C term': B's)
@@ -124,15 +128,16 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
         ratio = _ratio(masked[max(a, m.start() - 40):m.start()], way) if not m.group("of") else _of_ratio(
             masked[max(a, m.start() - 12):m.start()], m.group("of"))
         if ratio is not None and not m.group("out"):  # 'roughly 1.7 times as much as B', '35 % more than B'
-            out += [check_ratio(x.keys, b_name.keys[0], ratio, ctx, book, masked[m.start():m.end()].strip())
+            out += [check_ratio(x.keys, b_name.keys[0], ratio, ctx, book, written[m.start():m.end()].strip())
                     for x in subjects]
         elif m.group("out") and len(subjects) > 1 and all(len(x.keys) == 1 for x in subjects) and \
                 not re.search(r"\b(?:both|each|all|individually)\b", masked[subjects[0].start:m.start()],
                               re.IGNORECASE):
-            out.append(check_outweighs([x.keys[0] for x in subjects], [b_name.keys[0]], ctx, book, m.group(0).strip()))
+            out.append(check_outweighs([x.keys[0] for x in subjects], [b_name.keys[0]], ctx, book,
+                                       written[m.start():m.end()].strip()))
         else:
             for x in subjects:
-                out.append(check_comparison(x.keys, b_name.keys[0], way, ctx, book, m.group(0).strip()))
+                out.append(check_comparison(x.keys, b_name.keys[0], way, ctx, book, written[m.start():m.end()].strip()))
         start = b_name.end
     return out
 

@@ -211,8 +211,10 @@ RULES: tuple[Rule, ...] = (
     Rule("rank.comparison", "rank", "'A mattered more than B', ratios ('twice as much as', 'about 3 times the B "
          "effect', '32 % of the B effect')",
          fires=(("air", "Traffic mattered more than wind."), ("air", "The precip effect is roughly 32% of the wind "
-                                                                     "effect.")),
-         silent=(("air", "Traffic adds 7.2."), ("air", "The precip effect is roughly 32% of the change."))),
+                                                                     "effect."),
+                ("air", "Traffic had a bigger effect than the number of wind gusts did.")),
+         silent=(("air", "Traffic adds 7.2."), ("air", "The precip effect is roughly 32% of the change."),
+                 ("air", "Traffic mattered more than any other wind."))),
     Rule("rank.minor", "rank", "'barely mattered' of a name",
          fires=(("air", "The season barely mattered."),), silent=(("air", "The season mattered."),)),
     Rule("identifier.claimed", "feature", "an identifier that is no name, given a number or a direction word: an "
