@@ -10,6 +10,7 @@ import numpy as np
 
 from .book import FactBook
 from .names import Mention
+from .vocabulary import split_words, stem
 
 
 @dataclass(frozen=True)
@@ -141,6 +142,35 @@ def check_label(sentence: str, m: Mention, book: FactBook) -> Claim | None:
     ok = actual.lower() == m.label.lower()
     return Claim("category", text, "verified" if ok else "contradicted",
                  f"{f} is {actual}" if ok else f"{f} is {actual}, not {m.label}")
+
+
+#: a categorical feature's value stated in words right after its name: 'F is rated medium', "F was flagged as
+#: 'late'", 'F on the panels is listed as full', "F is 'returning'"
+_STATED = re.compile(r"(?:'s\s+\w+)?(?:\s+(?:on|of|for|in|at)\s+(?:the\s+|its\s+|her\s+|his\s+)?[\w-]+)?\s+"
+                     r"(?:is|was|were|are|came|comes|got)\s+(?:(?P<verb>rated|classed|classified|flagged|listed|"
+                     r"reported|marked|labell?ed|recorded|coded|set|registered|logged)\s+(?:as\s+|to\s+)?|(?=['\"‘“]))"
+                     r"(?:an?\s+|the\s+)?(?P<value>['\"‘“][^'\"’”\0]{1,30}['\"’”]|[A-Za-z][\w-]*)", re.IGNORECASE)
+_BOOLEAN = frozenset({"yes", "no", "true", "false", "0", "1", "y", "n", "none", "present", "absent", "on", "off"})
+
+
+def stated_category(masked: str, m: Mention, mentions: list[Mention], book: FactBook) -> Claim | None:
+    """'Aisle congestion is rated medium' when the state's label is 'low': a value the words give a categorical
+    feature right after its name ('is rated', 'was flagged as', 'is listed as', a quoted value) that shares no word
+    with its label (nor is the label's initials, 'SE' of 'south-east') is contradicted. Labels that are yes/no
+    answers are left to the direction words ('is missing' may mean 'No')."""
+    if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
+        return None
+    s = _STATED.match(masked, m.end)
+    if s is None or label.lower() in _BOOLEAN or any(x.start < s.end("value") and x.end > s.start("value")
+                                                     for x in mentions):
+        return None  # (a value that is a name of the vocabulary: a label the label reader checks)
+    said = s.group("value").strip("'\"‘’“”")
+    words, own = {stem(w) for w in split_words(said)}, {stem(w) for w in split_words(label)}
+    initials = ("".join(w[0] for w in split_words(said)), "".join(w[0] for w in split_words(label)))
+    ok = bool(words & own) or initials[0] == label.lower().replace(" ", "") or initials[1] == said.lower()
+    f = m.keys[0]
+    return Claim("category", said, "verified" if ok else "contradicted",
+                 f"{f} is {label}" if ok else f"{f} is {label}, not {said}", "category.stated")
 
 
 # -- directions --------------------------------------------------------------------------------------------------
