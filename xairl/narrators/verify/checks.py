@@ -150,17 +150,20 @@ _STATED = re.compile(r"(?:'s\s+\w+)?(?:\s+(?:on|of|for|in|at)\s+(?:the\s+|its\s+
                      r"(?:is|was|were|are|came|comes|got)\s+(?:(?P<verb>rated|classed|classified|flagged|listed|"
                      r"reported|marked|labell?ed|recorded|coded|set|registered|logged)\s+(?:as\s+|to\s+)?|(?=['\"‘“]))"
                      r"(?:an?\s+|the\s+)?(?P<value>['\"‘“][^'\"’”\0]{1,30}['\"’”]|[A-Za-z][\w-]*)", re.IGNORECASE)
+#: a capitalised value right before the name, after a determiner: 'the Midwifery course', 'the Cavado sub-region'
+_VALUE_BEFORE = re.compile(r"\b(?:the|a|an|her|his|their|its|your)\s+(?P<value>[A-Z][a-z]+(?:-[A-Z]?[a-z]+)?)\s+$")
 _BOOLEAN = frozenset({"yes", "no", "true", "false", "0", "1", "y", "n", "none", "present", "absent", "on", "off"})
 
 
 def stated_category(masked: str, m: Mention, mentions: list[Mention], book: FactBook) -> Claim | None:
     """'Aisle congestion is rated medium' when the state's label is 'low': a value the words give a categorical
-    feature right after its name ('is rated', 'was flagged as', 'is listed as', a quoted value) that shares no word
+    feature right after its name ('is rated', 'was flagged as', 'is listed as', a quoted value) or capitalised right
+    before it after a determiner ('the Midwifery course') that shares no word
     with its label (nor is the label's initials, 'SE' of 'south-east') is contradicted. Labels that are yes/no
     answers are left to the direction words ('is missing' may mean 'No')."""
     if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
         return None
-    s = _STATED.match(masked, m.end)
+    s = _STATED.match(masked, m.end) or _VALUE_BEFORE.search(masked, max(0, m.start - 40), m.start)
     if s is None or label.lower() in _BOOLEAN or any(x.start < s.end("value") and x.end > s.start("value")
                                                      for x in mentions):
         return None  # (a value that is a name of the vocabulary: a label the label reader checks)
