@@ -1157,3 +1157,23 @@ def test_a_push_equal_only_to_a_decision_level_number_is_not_verified():
         return [(c.text, c.status) for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
     assert numbers("Lactate adds about 9.6.") == [("9.6", "verified")]
     assert ("8", "verified") not in numbers("Something else piles on around 8 more.")
+
+
+def test_fronted_phrases_and_swaps():
+    """'Beyond A and B, the C added ...': C is the subject (an invented feature here), not A and B; 'Beyond A, B
+    lowered it' is said of B alone. Two numbers that cross (each name holding the other's, on two lines of a table)
+    are contradicted, one number that states another named fact stays unclear. A side's sum that is the other side's
+    is a sign error."""
+    from xairl.narrators.verify import rules
+    air = rules.example("air")  # traffic_index +7.2, wind_speed_ms +6.9; positives 31.1, negatives -1.0
+
+    def bad(text):
+        return [(c.kind, c.text) for c in xairl.verify(text, air, 0).claims if c.status == "contradicted"]
+    assert bad("Beyond traffic and the wind, the bus lane closure added roughly 0.09.") == [
+        ("feature", "the bus lane closure")]
+    assert bad("Beyond traffic, the wind lowered it.") == [("direction", "lowered")]
+    assert bad("- traffic 2.4 -> +6.9\n- wind 0.8 -> +7.2") == [("number", "+6.9"), ("number", "+7.2")]
+    assert bad("- traffic 2.4 -> +7.2\n- wind 0.8 -> +6.9") == []
+    assert bad("The wind was calm, which, with the traffic, added 7.2.") == []  # (unclear: which one is unsaid)
+    assert bad("The negatives add up to 31.1.") == [("number", "31.1")]
+    assert bad("The positives add up to 31.1 and the negatives to -1.0.") == []

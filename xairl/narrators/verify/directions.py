@@ -145,6 +145,10 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
             # probability, 'contributed positively to the risk' raises it)
         nxt = found[i + 1].start() if i + 1 < len(found) else b  # where the next direction word starts
         subjects = _subject_list([x for x in names if prev <= x.start < m.start()], masked, prev)
+        own = _FRONTED.match(masked, prev, subjects[0].start) and _OWN_SUBJECT.search(masked, subjects[-1].end,
+                                                                                     m.start()) if subjects else None
+        if own:  # 'Beyond alcohol and sulphates, the wine's tannin level added 0.09': the tannin level's push
+            subjects, prev = [], own.start() + 1
         agents = _passive_agents(masked, m, names, nxt)
         if agents:
             subjects = agents  # 'it is pushed up by the battery level': the battery
@@ -284,7 +288,13 @@ _JOIN = re.compile(r"^(?:\s|,|;|&|/|\band\b|\bor\b|\bplus\b|\bas well as\b|\b(?:
                    r"\b(?:of|at)\b|:|=)*$", re.IGNORECASE)
 
 
-_PREPOSITION = re.compile(r"\b(?:with|given|despite|after|because of|due to|thanks to|at|for|from|on|in|by)\s+"
+#: a clause that opens with a phrase of its own before its subject: 'Beyond A and B, ...', 'Alongside A, ...'
+_FRONTED = re.compile(r"\W*(?:beyond|besides|alongside|apart from|aside from|in addition to|on top of|as well as|next to|"
+                      r"other than|except for)\s", re.IGNORECASE)
+#: after the fronted phrase's names, a comma and a noun phrase that names nothing, right up to the direction word
+_OWN_SUBJECT = re.compile(r",\s+(?:the|a|an|his|her|its|their|this|that|these|those)\b[^,;\0]*$", re.IGNORECASE)
+_PREPOSITION = re.compile(r"\b(?:with|given|despite|after|because of|due to|thanks to|at|for|from|on|in|by|beyond|"
+                          r"besides|alongside|apart from|aside from|in addition to|on top of|other than|except for)\s+"
                           r"(?:a\s+|an\s+|the\s+|its\s+|their\s+)?$", re.IGNORECASE)
 
 
