@@ -58,7 +58,10 @@ OUTPUT_BEFORE = re.compile(r"\b(?:estimated\s+|predicted\s+)?q[\s-]?values?\s+(?
                            r"(?:about|around|roughly|only|just)?\s*$",  # 'a predicted probability of 66%'
                            re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
-_OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
+#: (one word may stand between: 'a 9.2% return chance', not '5 points of risk')
+_OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*"
+                           r"(?:(?!(?:of|in|to|for|the|a|an|and|or|at|by|on)\b)(?:[a-z]+|\0+)\s+)?"
+                           r"(?:probability|chance|likelihood|prediction|risk|"
                            r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)"
                            r"|\s*(?:predicted|forecast)\s*(?:[.;,)]|$)",  # ('$1,850 baseline, $2,739 predicted.')
                            re.IGNORECASE)
