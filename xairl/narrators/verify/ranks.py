@@ -25,7 +25,7 @@ RANK_RE = re.compile(
     rf"|(?P<because>(?:mostly|mainly|chiefly|largely|primarily) (?:because of|due to|thanks to|on|driven by))"
     rf"|(?:the\s+)?(?P<plural>(?:two|three|four|2|3|4)\s+(?:most important|largest|biggest|strongest|main)|"
     rf"(?:top|the)[\s-]+(?P<k>two|three|four|2|3|4)(?:\s+most important|\s+largest|\s+biggest)?)\s+{NOUN}"
-    rf"|(?P<top>{TOPWORD})(?:\s+single)?\s+(?:(?:risk|margin|score|shap)\s+)?(?P<noun>{NOUN})"
+    rf"|(?<!next-)(?<!next )(?P<top>{TOPWORD})(?:\s+single)?\s+(?:(?:risk|margin|score|shap)\s+)?(?P<noun>{NOUN})"
     rf"|(?:mattered|matters|matter|counted|counts|weighed) most|dominat\w+(?!\s+(?:the\s+)?(?:game|match|play|"
     rf"possession|opponents?|proceedings|the\s+ball))|ranks? (?P<rk>first|second|third)"
     rf"|(?:is|was|(?P<plverb>being|were|are)) the (?:single )?(?:largest|biggest|strongest|greatest|most important|"

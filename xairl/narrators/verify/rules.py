@@ -214,7 +214,7 @@ RULES: tuple[Rule, ...] = (
          "two; 'the main thing holding the number down': among the contributions of that sign)",
          fires=(("air", "Traffic is the second biggest factor."), ("air", "The season is the main thing holding the "
                                                                          "forecast down.")),
-         silent=(("air", "Traffic adds 7.2."),)),
+         silent=(("air", "Traffic adds 7.2."), ("air", "The wind adds 6.9, about half the next-biggest effect."))),
     Rule("rank.comparison", "rank", "'A mattered more than B', ratios ('twice as much as', 'about 3 times the B "
          "effect', '32 % of the B effect')",
          fires=(("air", "Traffic mattered more than wind."), ("air", "The precip effect is roughly 32% of the wind "
