@@ -37,9 +37,14 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
     said = [m for m in mentions if m.kind == "action" or not _NEGATED.search(masked[max(a, m.start - 40):m.start])]
     said_names = named_features(said)
     for n in numbers:
-        if summed and (n is tail[0] or (n.percent and len(tail) == 2 and n is tail[1])):  # (', about 87 % of it')
-            members = list(dict.fromkeys(m.keys for m in said_names))
-            out.append(binding.named(sums.sum_number(n, members, ctx, book), "number.sum"))
+        if summed and (n is tail[0] or (n.percent and not n.points and len(tail) == 2 and n is tail[1])):
+            members = list(dict.fromkeys(m.keys for m in said_names))  # (', about 87 % of it'; not 'of the
+            counted = _COUNTED.search(masked, a, n.start)  # 28.3-point rise')
+            if counted and _COUNTS.get(counted.group("k").lower()) != len(members):  # 'the four weather terms
+                out.append(Claim("number", n.text, "unchecked", f"a sum over {counted.group('k')} things, "  # (...)'
+                                 f"{len(members)} of them named", "number.sum-unnamed"))  # with three named
+            else:
+                out.append(binding.named(sums.sum_number(n, members, ctx, book), "number.sum"))
             continue
         c = binding.bind_number(n, masked, mentions, names, paired, scored, book, ctx, unit_of)
         if c.status == "contradicted" and id(n) not in paired:  # 'respectively' binds for sure
@@ -118,6 +123,11 @@ def _window_words(feature: str) -> frozenset[str]:
 _SUM_CUE = re.compile(r"\b(?:together|combined|jointly|in total|taken together|between them|sum(?:s|med)? to|add up to|"
                       r"in sum|make up|(?:they|these|those)\s+(?:(?:only|just|all|three|two|four)\s+)?"
                       r"(?:add|contribute|account for))\b", re.IGNORECASE)  # ('A, B and C, and they add just 1.85')
+#: how many things a sum is over, in words: 'the three vehicle-and-history factors', 'the two things'
+_COUNTS = {"two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "2": 2, "3": 3, "4": 4, "5": 5, "6": 6}
+_COUNTED = re.compile(r"\b(?P<k>two|three|four|five|six|[2-6])\s+(?:[\w-]+\s+){0,3}?(?:factors|things|terms|features|"
+                      r"drivers|inputs|reasons|variables|items|signals|effects|contributors|pushes|measures)\b",
+                      re.IGNORECASE)
 _OWN_QUANTITY = re.compile(r"\bof\s+(?:the\s+)?[$€£]?$", re.IGNORECASE)
 _NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
                       r"(?:(?:because of|due to|about|the|its|their|a|an)\s+){0,3}$", re.IGNORECASE)

@@ -87,9 +87,12 @@ RULES: tuple[Rule, ...] = (
                                                                                    "6.9, respectively."),)),
     Rule("number.sum-unnamed", "number", "a number after a sum's cue word in a clause that joins one known name with "
          "words the vocabulary lacks ('the mileage and garage offsets together claw back $294'), contradicted as the "
-         "name's own: a sum over things not all known, unchecked",
-         fires=(("air", "Traffic plus the junction make up 9.9."),),
-         silent=(("air", "Traffic and wind together add 14.1."),)),
+         "name's own, or a sum whose count of things ('the three factors') is not the count of names found: a sum "
+         "over things not all known, unchecked",
+         fires=(("air", "Traffic plus the junction make up 9.9."),
+                ("air", "The three weather terms (traffic, wind and the humidity) together add 20.0.")),
+         silent=(("air", "Traffic and wind together add 14.1."),
+                 ("air", "The two weather terms (traffic and wind) together add 14.1."))),
     Rule("number.other-side", "number", "a sum after words naming one side ('the positives add up to', 'downward "
          "ones about') that is the other side's sum in size: a sign error, contradicted",
          fires=(("air", "The negatives add up to 31.1."), ("air", "Upward contributions total about +1.0.")),
