@@ -17,10 +17,15 @@ COMPARE_RE = re.compile(r"\b(?:(?P<more>more|bigger|larger|greater|stronger|heav
                         r"|\b(?P<out>outweigh\w*|dwarf\w*|overshadow\w*)\s+"
                         r"|(?<=\d)\s*(?P<of>(?:%|percent)\s+of|times(?:\s+of)?)\s+(?=(?:the\s+|its\s+|their\s+)?\0)",
                         re.IGNORECASE)  # ('60 % of the alcohol effect', '3.7 times the pedestrian-call penalty')
-#: the words between 'than' and the name compared with: a determiner, a count's words ('the number of'), one more
-#: word ('than the number of browsing sessions'); not 'any other', 'all', 'the combined'
+#: the words between 'outweighs' (or 'than') and the name compared with: a determiner, a count's words ('than the
+#: number of browsing sessions')
 _BEFORE_B = re.compile(r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?(?:(?:number|count|amount|level|size) of\s+"
                        r"(?:the\s+|its\s+)?(?:(?!(?:any|all|other|combined|every|each)\b)[a-z-]+\s+)?)?", re.IGNORECASE)
+#: after 'than': also a determiner or owner and up to four words that are no name, number or word of a whole ("than
+#: the shopper's choice of", 'than being close to the', 'than the three size-related'); not 'any other', 'the rest'
+_AFTER_THAN = re.compile(r"\s*(?:the|its|their|his|her|a|an|being|[\w-]+'s)\s+(?:(?!(?:any|all|other|others|combined|"
+                         r"every|each|rest|remaining|half|twice|double|third|quarter|most|least|sum|total|expected|"
+                         r"usual|typical|average|previous|one|anything|everything)\b)[a-z'-]+\s+){0,4}", re.IGNORECASE)
 SAME_WITHIN = 0.25  # 'about as much as': the two sizes within 25 % of the larger
 
 
@@ -119,7 +124,8 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
     names = named_features(mentions)
     for m in COMPARE_RE.finditer(masked, a, b):
         b_name = next((x for x in names if x.start >= m.end()), None)
-        if b_name is None or len(b_name.keys) != 1 or not _BEFORE_B.fullmatch(masked, m.end(), b_name.start):
+        if b_name is None or len(b_name.keys) != 1 or not (_BEFORE_B.fullmatch(masked, m.end(), b_name.start) or (
+                not m.group("out") and _AFTER_THAN.fullmatch(masked, m.end(), b_name.start))):
             continue  # 'more than $500', 'bigger than any other feature': no feature to compare with
         subjects = [x for x in names if start <= x.start and x.end <= m.start()]
         if not subjects or m.group("of"):  # ('A ..., and the B term is about 1.5 times the C term': B's)

@@ -222,9 +222,11 @@ RULES: tuple[Rule, ...] = (
          "effect', '32 % of the B effect')",
          fires=(("air", "Traffic mattered more than wind."), ("air", "The precip effect is roughly 32% of the wind "
                                                                      "effect."),
-                ("air", "Traffic had a bigger effect than the number of wind gusts did.")),
+                ("air", "Traffic had a bigger effect than the number of wind gusts did."),
+                ("air", "Traffic weighs more in this forecast than the city's morning wind.")),
          silent=(("air", "Traffic adds 7.2."), ("air", "The precip effect is roughly 32% of the change."),
-                 ("air", "Traffic mattered more than any other wind."))),
+                 ("air", "Traffic mattered more than any other wind."),
+                 ("air", "The positives more than cancel the season's -1.0."))),
     Rule("rank.minor", "rank", "'barely mattered' of a name",
          fires=(("air", "The season barely mattered."),), silent=(("air", "The season mattered."),)),
     Rule("identifier.claimed", "feature", "an identifier that is no name, given a number or a direction word: an "
