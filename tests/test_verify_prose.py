@@ -1177,3 +1177,16 @@ def test_fronted_phrases_and_swaps():
     assert bad("The wind was calm, which, with the traffic, added 7.2.") == []  # (unclear: which one is unsaid)
     assert bad("The negatives add up to 31.1.") == [("number", "31.1")]
     assert bad("The positives add up to 31.1 and the negatives to -1.0.") == []
+
+
+def test_a_unit_or_statistic_in_a_name_is_no_mention_on_its_own():
+    """'14.7 min' names no hm_pr_min and 'avg 3.2' no AvgWait5m; the whole name, and a run of its words, still do."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["hm_pr_min", "AvgWait5m"], [121, 41], [11.2, 0.26], 252.0, "finish time")
+    vocab = vocabulary(exp, None, clean_surface)
+
+    def said(text):
+        return [m.keys for m in find_mentions(text, vocab)[0]]
+    assert said("The others add 14.7 min; avg 3.2.") == []
+    assert said("hm_pr_min adds 11.2 min, AvgWait5m 0.26.") == [("hm_pr_min",), ("AvgWait5m",)]
+    assert said("The hm pr min adds 11.2.") == [("hm_pr_min",)]

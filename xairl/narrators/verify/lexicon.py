@@ -11,6 +11,10 @@ GENERIC = {"size", "area", "number", "total", "rate", "ratio", "level", "value",
            "information", "prediction", "new", "old", "high", "low", "first", "second", "third", "average",
            "strongest", "weakest", "biggest", "largest", "main", "top", "overall",
            "other", "others"}  # rank words say which, not what
+#: units and statistics in names that never name a feature on their own ('14.7 min' is no mention of hm_pr_min, 'avg
+#: 3.2' none of AvgWait5m), though a run of words holding them may
+UNIT_PARTS = {"min", "max", "avg", "mean", "median", "pct", "num", "cnt", "yrs", "yr", "mins", "secs", "sec", "ms",
+              "kg", "kmh", "mph", "usd", "eur"}
 #: abbreviations in feature names and the words people write for them ('dist_to_charger_m': 'the distance')
 ABBREVIATIONS = {"dist": "distance", "temp": "temperature", "avg": "average", "num": "number", "len": "length",
                  "qty": "quantity", "pct": "percent", "perc": "percent", "max": "maximum", "min": "minimum",

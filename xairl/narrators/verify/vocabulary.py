@@ -11,7 +11,8 @@ from ...explanation import Explanation
 from ...observation import REGION_RE
 from ...policy import Policy
 from .book import legend
-from .lexicon import ABBREVIATIONS, BASE_FORM as _BASE_FORM, GENERIC, IRREGULAR as _IRREGULAR, STOP, SYNONYMS
+from .lexicon import (ABBREVIATIONS, BASE_FORM as _BASE_FORM, GENERIC, IRREGULAR as _IRREGULAR, STOP, SYNONYMS,
+                      UNIT_PARTS)
 
 #: what a model's input describes: a word of a feature's description, never a feature on its own
 _INSTANCES = frozenset({"patient", "applicant", "borrower", "customer", "client", "person", "student", "team", "player",
@@ -139,7 +140,7 @@ def _runs(form: str, f: str) -> list[str]:
             run = words[i:j]
             if not any(re.search(r"[a-z]", w) for w in run):
                 continue  # '2 2' of 'obs[0,2,2]' would name a pixel by any number '22'
-            if len(run) == 1 and (run[0] in GENERIC or len(run[0]) < 3 or run[0].isdigit() or (
+            if len(run) == 1 and (run[0] in GENERIC or run[0] in UNIT_PARTS or len(run[0]) < 3 or run[0].isdigit() or (
                     run[0] in owners and (form != f or len(words) >= 3)) or (
                     form != f and len(run[0]) < 5 and run[0] not in split_words(f))):
                 continue
