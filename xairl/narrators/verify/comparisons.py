@@ -26,6 +26,9 @@ _BEFORE_B = re.compile(r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?(?:(?:numb
 _AFTER_THAN = re.compile(r"\s*(?:the|its|their|his|her|a|an|being|[\w-]+'s)\s+(?:(?!(?:any|all|other|others|combined|"
                          r"every|each|rest|remaining|half|twice|double|third|quarter|most|least|sum|total|expected|"
                          r"usual|typical|average|previous|one|anything|everything)\b)[a-z'-]+\s+){0,4}", re.IGNORECASE)
+#: a ratio after the name compared with: '... than the pacing plan (-1.4) by a factor of ~2.6'
+_FACTOR_AFTER = re.compile(r"(?:\s*\([^()]*\))?\s*(?:did\s+|does\s+)?,?\s*by\s+a\s+factor\s+of\s+(?:about\s+|roughly\s+|"
+                           r"around\s+|nearly\s+|almost\s+|~\s*)?(\d+(?:\.\d+)?)\b", re.IGNORECASE)
 SAME_WITHIN = 0.25  # 'about as much as': the two sizes within 25 % of the larger
 
 
@@ -133,7 +136,11 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
         way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
         ratio = _ratio(masked[max(a, m.start() - 40):m.start()], way) if not m.group("of") else _of_ratio(
             masked[max(a, m.start() - 12):m.start()], m.group("of"))
-        if ratio is not None and not m.group("out"):  # 'roughly 1.7 times as much as B', '35 % more than B'
+        factor = _FACTOR_AFTER.match(masked, b_name.end, b)  # 'larger than B (-1.4) by a factor of ~2.6'
+        if ratio is None and factor is not None and way > 0:
+            ratio = float(factor.group(1))
+        if ratio is not None and (not m.group("out") or factor is not None):  # 'roughly 1.7 times as much as B',
+            # '35 % more than B', 'A outweighed B by a factor of 1.7'
             out += [check_ratio(x.keys, b_name.keys[0], ratio, ctx, book, written[m.start():m.end()].strip())
                     for x in subjects]
         elif m.group("out") and len(subjects) > 1 and all(len(x.keys) == 1 for x in subjects) and \

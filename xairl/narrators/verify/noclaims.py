@@ -21,6 +21,11 @@ _OF_PEOPLE = re.compile(r"\s+of\s+(?:the\s+|their\s+|its\s+|all\s+)?(?:[\w-]+\s+
                         r"houses|homes|users|patients|rows|records)\b", re.IGNORECASE)
 
 
+#: a ratio's words right before its number: 'by a factor of ~2.6'
+_FACTOR_BEFORE = re.compile(r"\bby\s+a\s+factor\s+of\s+(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|~\s*)?$",
+                            re.IGNORECASE)
+
+
 def skip_number(n: Number, masked: str) -> bool:
     """Numbers that are not claims: list markers ('1.' at a line start), identifiers ('candidate 2', 'top-3'),
     counts of the method's inputs ('100 background rows')."""
@@ -35,6 +40,8 @@ def skip_number(n: Number, masked: str) -> bool:
         return True
     if n.percent and re.match(r"\s*of\s+(?:the\s+|its\s+|their\s+)?\0", masked[n.end:]):
         return True  # '60 % of the alcohol effect': a ratio to that name (:mod:`.comparisons`)
+    if _FACTOR_BEFORE.search(before[-30:]) and not n.percent and not n.text.isalpha():
+        return True  # 'larger than B by a factor of ~2.6': a ratio (:mod:`.comparisons`)
     if re.match(r"^\s+(?:most|largest|biggest|main|top|strongest|key)\b", masked[n.end:]):  # 'the two largest'
         return True
     if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):

@@ -56,6 +56,7 @@ CHANGE_AFTER = re.compile(r"^\s*(?!(?:\w+\s+)?(?:is|was|are|were|sits|lies|stand
                            r"|^\W*(?:premium|uplift|markup|discount)\b", re.IGNORECASE)
 #: 'Net effect of the eight features: +0.089', 'Net uplift over the base value: +$86,046': the change from the baseline
 NET_BEFORE = re.compile(r"\b(?:net (?:effect|uplift|change|shift|push|contribution)|total (?:effect|shift|change)|"
+                        r"(?<![\w.])delta(?=\s*[=:])|"  # ('base=27.0 delta=-22.0')
                         r"(?:uplift|premium|change|shift) (?:over|above|from|relative to) (?:the )?(?:base(?:line)?|"
                         r"base value|base rate|average))\b(?:\s+(?:of|over|from|across)\s+[^.;:()\d]{1,30}?)?\s*"
                         r"(?:[:=]|\bis\b|\bwas\b|\bof\b)?\s*(?:about|around|roughly)?\s*[$€£]?$", re.IGNORECASE)
@@ -279,6 +280,8 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     elif book.output != "actions" and not book.global_view:
         near = before[-24:]
         base_at = max((m.end() for m in _BASE_WORDS.finditer(near)), default=-1)
+        if base_at >= 0 and re.search(r"\d", near[base_at:]):
+            base_at = -1  # ('base=22.0 delta=+30.1 n=6': the base word has its own number)
         out_at = max((m.end() for m in _OUT_WORDS.finditer(_BASE_WORDS.sub(lambda m: " " * len(m.group(0)), near))),
                      default=-1)  # 'value' inside 'base value' is the baseline's word
         if base_at > out_at or _BASE_AFTER.match(after) or _BASE_BEFORE.search(before):  # the nearer cue decides

@@ -223,7 +223,8 @@ RULES: tuple[Rule, ...] = (
          fires=(("air", "Traffic mattered more than wind."), ("air", "The precip effect is roughly 32% of the wind "
                                                                      "effect."),
                 ("air", "Traffic had a bigger effect than the number of wind gusts did."),
-                ("air", "Traffic weighs more in this forecast than the city's morning wind.")),
+                ("air", "Traffic weighs more in this forecast than the city's morning wind."),
+                ("air", "Traffic is larger than the season (-1.0) by a factor of ~7.")),
          silent=(("air", "Traffic adds 7.2."), ("air", "The precip effect is roughly 32% of the change."),
                  ("air", "Traffic mattered more than any other wind."),
                  ("air", "The positives more than cancel the season's -1.0."))),

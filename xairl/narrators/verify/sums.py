@@ -40,12 +40,14 @@ def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
     """A number after words that sum over the features, equal to one such sum (:attr:`FactBook.aggregates`):
     verified; otherwise None (its other readings decide)."""
     before = masked[max(0, n.start - 50):n.start]
+    after = _SIDE_AFTER.match(masked, n.end)  # ('about 57% of the 22.4 h upward push')
     if not book.aggregates or not (AGGREGATE_CUE.search(before) or _PART_OF.search(before)
-                                   or _TOTAL_AFTER.match(masked, n.end)):
+                                   or _TOTAL_AFTER.match(masked, n.end) or after):
         return None
     def states(v: float) -> bool:  # ('50 %' is a share; '21.9 points' a sum of contributions in points, or of
         return (matches(n, v) and (n.points or not n.percent)) or (n.points and percent_reading(n, v))  # probabilities
-    side = [m for m in _SIDE.finditer(before) if "\0" not in before[m.end():] and not re.search(r"\d", before[m.end():])]
+    side = [after] if after else [
+        m for m in _SIDE.finditer(before) if "\0" not in before[m.end():] and not re.search(r"\d", before[m.end():])]
     if side:  # 'the positives add up to +0.39': that side's sum, in any view; the other side's is a sign error
         said = "positive" if side[-1].group("pos") else "negative"
         other = "negative" if said == "positive" else "positive"
@@ -67,6 +69,11 @@ def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
 #: a side of the decision named right before its sum ('the positives add up to', 'downward ones about', 'pos_sum=')
 _SIDE = re.compile(r"\b(?:(?P<pos>positives?|upward|pos(?:_\w+)?|pushing (?:it |the \w+ )?up)|"
                    r"(?P<neg>negatives?|downward|neg(?:_\w+)?|pulling (?:it |the \w+ )?down))\b", re.IGNORECASE)
+
+
+#: a side named right after its sum: '22.4 h upward push', '2.84 of positive contributions'
+_SIDE_AFTER = re.compile(r"\s*(?:[a-zA-Z%]{1,6}\s+)?(?:of\s+)?(?:(?P<pos>upward|positive)|(?P<neg>downward|negative))\s+"
+                         r"(?:push|pressure|contributions?|side|total|factors|effects?)\b", re.IGNORECASE)
 
 
 def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book: FactBook) -> Claim:
