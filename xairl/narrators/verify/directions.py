@@ -59,7 +59,7 @@ _LINKS = {"but", "and", "also", "yet", "then", "still", "even", "only", "while",
 #: invented feature
 _VAGUE = {"small", "smaller", "large", "larger", "big", "bigger", "short", "long", "little", "bit", "lot", "the",
           "this", "that", "its", "their", "about", "around", "roughly", "nearly", "almost", "some", "over", "under",
-          "than"}
+          "than", "net", "combined", "whole", "entire", "final"}  # ('the net increase of 30.1': the whole's)
 #: the thing a model is about, as a possessor ('the house's', 'the applicant's'): not a feature of its own
 _POSSESSOR = re.compile(r"^\W*(?:the\s+|this\s+|its\s+|their\s+)?(?:house|home|property|file|document|applicant|"
                         r"borrower|customer|client|user|patient|loan|account|uav|drone|robot|agent|vehicle|device|"

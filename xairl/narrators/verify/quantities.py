@@ -55,7 +55,8 @@ CHANGE_AFTER = re.compile(r"^\s*(?!(?:\w+\s+)?(?:is|was|are|were|sits|lies|stand
                            r"(average|baseline|base|typical|expected|mean)"
                            r"|^\W*(?:premium|uplift|markup|discount)\b", re.IGNORECASE)
 #: 'Net effect of the eight features: +0.089', 'Net uplift over the base value: +$86,046': the change from the baseline
-NET_BEFORE = re.compile(r"\b(?:net (?:effect|uplift|change|shift|push|contribution)|total (?:effect|shift|change)|"
+NET_BEFORE = re.compile(r"\b(?:net (?:effect|uplift|change|shift|push|contribution|increase|decrease|rise|drop|gain|"
+                        r"reduction)|total (?:effect|shift|change)|"
                         r"(?<![\w.])delta(?=\s*[=:])|"  # ('base=27.0 delta=-22.0')
                         r"(?:uplift|premium|change|shift) (?:over|above|from|relative to) (?:the )?(?:base(?:line)?|"
                         r"base value|base rate|average))\b(?:\s+(?:of|over|from|across)\s+[^.;:()\d]{1,30}?)?\s*"

@@ -70,12 +70,13 @@ RULES: tuple[Rule, ...] = (
     Rule("category.label", "category", "a categorical value named: it must be the state's",
          fires=(("air", "It is winter."),), silent=(("air", "It is cold."),)),
     Rule("category.stated", "category", "a value given to a categorical feature right after its name ('is rated "
-         "medium', \"was flagged as 'late'\", a quoted value) or capitalised right before it ('the Midwifery course'): "
-         "it must share a word with the state's label (or be its initials); yes/no labels are left to the direction "
-         "words",
+         "medium', \"was flagged as 'late'\", 'F=flat', a quoted value) or capitalised right before it ('the Midwifery "
+         "course'): it must share a word with the state's label (or be its initials); yes/no labels are left to the "
+         "direction words",
          fires=(("air", "The season was listed as autumn."), ("air", "The road was recorded as 'four lanes'."),
-                ("air", "It was the Coastal road that mattered.")),
-         silent=(("air", "The season is cold."), ("air", "The season is 'summer'."))),
+                ("air", "It was the Coastal road that mattered."), ("air", "season=autumn traffic=+7.2")),
+         silent=(("air", "The season is cold."), ("air", "The season is 'summer'."),
+                 ("air", "A cold season: three signals point up."))),
     Rule("number.respectively", "number", "'A and B ... by x and y, respectively': the numbers pair with the names",
          fires=(("air", "Traffic and wind add 7.2 and 6.9, respectively."),),
          silent=(("air", "Traffic adds 7.2."),)),
