@@ -162,6 +162,12 @@ def _items(masked: str, a: int, targets: list[Mention], m: re.Match) -> int:
     return len([x for x in re.split(r",\s*(?:and\s+|or\s+)?|\s+(?:and|or)\s+", span) if x.strip()])
 
 
+#: 'After A (and B), the biggest / next most important factor is C': C ranks one below the names after 'after'
+_AFTER_TOP = re.compile(rf"\W*(?:after|behind)\s+(?P<lead>[^,;]{{1,80}}),\s+(?P<top>(?:the\s+)?(?:next[\s-]+)?(?:single\s+)?"
+                        rf"(?:biggest|largest|strongest|most important|most influential|main|key)\s+(?:single\s+)?"
+                        rf"{NOUN})", re.IGNORECASE)
+
+
 def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
                written: str = "") -> list[Claim]:
     """The rank phrases of clause ``masked[a:b]``, each bound to its names ('A was the main reason', 'the top three
@@ -170,6 +176,14 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
     written = written or masked
     out = []
     names = named_features(mentions)
+    after = _AFTER_TOP.match(masked, a, b)
+    if after:  # 'After A, the biggest single factor is B': B ranks second
+        lead = {x.keys for x in names if x.end <= after.end("lead")}
+        target = next((x for x in names if x.start >= after.end()), None)
+        if lead and target is not None:
+            out.append(check_rank(target.keys, len(lead) + 1, None, 0, ctx, book,
+                                  f"{written[after.start('top'):after.end()].strip()}: {written[target.start:target.end]}"))
+            a = after.end()
     for m in RANK_RE.finditer(masked, a, b):
         if _WOULD_MAKE.search(masked, max(a, m.start() - 50), m.start()) or re.search(
                 r"\b(?:another|one|a|an|other)\s+$", masked[max(a, m.start() - 10):m.start()], re.IGNORECASE):

@@ -217,7 +217,8 @@ RULES: tuple[Rule, ...] = (
     Rule("rank.words", "rank", "'the biggest', 'second', 'the main reason' of a name ('A and B dominate': the top "
          "two; 'the main thing holding the number down': among the contributions of that sign)",
          fires=(("air", "Traffic is the second biggest factor."), ("air", "The season is the main thing holding the "
-                                                                         "forecast down.")),
+                                                                         "forecast down."),
+                ("air", "After pm2_5_lag1, the biggest single factor is traffic.")),
          silent=(("air", "Traffic adds 7.2."), ("air", "The wind adds 6.9, about half the next-biggest effect."))),
     Rule("rank.comparison", "rank", "'A mattered more than B', ratios ('twice as much as', 'about 3 times the B "
          "effect', '32 % of the B effect')",
