@@ -19,8 +19,8 @@ _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of
                         r"second at|score|at|of|was|=)?\s*\(?(?:q\s*=\s*)?$", re.IGNORECASE)
 
 
-_ENDS_AT = re.compile(r"(?:,\s*|\bwhich\s+)(?:giving|gives|for a final|to give|yielding|yields)\s+(?:about\s+|roughly\s+|"
-                      r"around\s+)?[$€£]?$|"  # ('..., giving 39.5%': where it ends)
+_ENDS_AT = re.compile(r"(?:,\s*|\bwhich\s+)(?:giving|gives|for a final|to give|yielding|yields)\s+"
+                      r"(?:about\s+|roughly\s+|around\s+)?[$€£]?$|"  # ('..., giving 39.5%': where it ends)
                       r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
                       r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$|"
                       r"\b(?:drags?|dragged|pushe?s?|pushed|pulls?|pulled|brings?|brought|takes?|took|moves?|moved|"

@@ -148,8 +148,9 @@ def check_label(sentence: str, m: Mention, book: FactBook) -> Claim | None:
 #: 'late'", 'F on the panels is listed as full', "F is 'returning'"
 _STATED = re.compile(r"(?:'s\s+\w+)?(?:\s+(?:on|of|for|in|at)\s+(?:the\s+|its\s+|her\s+|his\s+)?[\w-]+)?\s+"
                      r"(?:is|was|were|are|came|comes|got)\s+(?:(?P<verb>rated|classed|classified|flagged|listed|"
-                     r"reported|marked|labell?ed|recorded|coded|set|registered|logged)\s+(?:as\s+|to\s+)?|(?=['\"‘“]))"
-                     r"(?:an?\s+|the\s+)?(?P<value>['\"‘“][^'\"’”\0]{1,30}['\"’”]|[A-Za-z][\w-]*)", re.IGNORECASE)
+                     r"reported|marked|labell?ed|recorded|coded|set|registered|logged)\s+(?:as\s+|to\s+)?|"
+                     r"(?=['\"‘“]))(?:an?\s+|the\s+)?(?P<value>['\"‘“][^'\"’”\0]{1,30}['\"’”]|[A-Za-z][\w-]*)",
+                     re.IGNORECASE)
 #: a capitalised value right before the name, after a determiner: 'the Midwifery course', 'the Cavado sub-region'
 _VALUE_BEFORE = re.compile(r"\b(?:the|a|an|her|his|their|its|your)\s+(?P<value>[A-Z][a-z]+(?:-[A-Z]?[a-z]+)?)\s+$")
 #: a log's field and its value: 'course_profile=flat', 'tier: gold' (one word, letters first)

@@ -27,8 +27,9 @@ _AFTER_THAN = re.compile(r"\s*(?:the|its|their|his|her|a|an|being|[\w-]+'s)\s+(?
                          r"every|each|rest|remaining|half|twice|double|third|quarter|most|least|sum|total|expected|"
                          r"usual|typical|average|previous|one|anything|everything)\b)[a-z'-]+\s+){0,4}", re.IGNORECASE)
 #: a ratio after the name compared with: '... than the pacing plan (-1.4) by a factor of ~2.6'
-_FACTOR_AFTER = re.compile(r"(?:\s*\([^()]*\))?\s*(?:did\s+|does\s+)?,?\s*by\s+a\s+factor\s+of\s+(?:about\s+|roughly\s+|"
-                           r"around\s+|nearly\s+|almost\s+|~\s*)?(\d+(?:\.\d+)?)\b", re.IGNORECASE)
+_FACTOR_AFTER = re.compile(r"(?:\s*\([^()]*\))?\s*(?:did\s+|does\s+)?,?\s*by\s+a\s+factor\s+of\s+"
+                           r"(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|~\s*)?(\d+(?:\.\d+)?)\b",
+                           re.IGNORECASE)
 SAME_WITHIN = 0.25  # 'about as much as': the two sizes within 25 % of the larger
 
 

@@ -289,8 +289,8 @@ _JOIN = re.compile(r"^(?:\s|,|;|&|/|\band\b|\bor\b|\bplus\b|\bas well as\b|\b(?:
 
 
 #: a clause that opens with a phrase of its own before its subject: 'Beyond A and B, ...', 'Alongside A, ...'
-_FRONTED = re.compile(r"\W*(?:beyond|besides|alongside|apart from|aside from|in addition to|on top of|as well as|next to|"
-                      r"other than|except for)\s", re.IGNORECASE)
+_FRONTED = re.compile(r"\W*(?:beyond|besides|alongside|apart from|aside from|in addition to|on top of|as well as|"
+                      r"next to|other than|except for)\s", re.IGNORECASE)
 #: after the fronted phrase's names, a comma and a noun phrase that names nothing, right up to the direction word
 _OWN_SUBJECT = re.compile(r",\s+(?:the|a|an|his|her|its|their|this|that|these|those)\b[^,;\0]*$", re.IGNORECASE)
 _PREPOSITION = re.compile(r"\b(?:with|given|despite|after|because of|due to|thanks to|at|for|from|on|in|by|beyond|"

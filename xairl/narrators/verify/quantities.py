@@ -250,6 +250,10 @@ def is_change(n: Number, masked: str) -> bool:
         _CHANGE_BEFORE.search(before[-40:]) and _BASE_WORDS.search(before[-40:])))
 
 
+#: a number after a base word: the base word's own ('base=22.0 delta=+30.1 n=6': no cue for the 6)
+_NUMBERED = re.compile(r"\d")
+
+
 def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     """A number tied to no name: a decision-level quantity when the words around it name one (margin, runner-up
     score, prediction, baseline, change from the baseline, a domain comparison in its unit), else any decision-level
@@ -280,9 +284,7 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         return Claim("number", n.text, "unchecked", f"a contribution of one of {', '.join(owners)}: which is unsaid")
     elif book.output != "actions" and not book.global_view:
         near = before[-24:]
-        base_at = max((m.end() for m in _BASE_WORDS.finditer(near)), default=-1)
-        if base_at >= 0 and re.search(r"\d", near[base_at:]):
-            base_at = -1  # ('base=22.0 delta=+30.1 n=6': the base word has its own number)
+        base_at = max((m.end() for m in _BASE_WORDS.finditer(near) if not _NUMBERED.search(near, m.end())), default=-1)
         out_at = max((m.end() for m in _OUT_WORDS.finditer(_BASE_WORDS.sub(lambda m: " " * len(m.group(0)), near))),
                      default=-1)  # 'value' inside 'base value' is the baseline's word
         if base_at > out_at or _BASE_AFTER.match(after) or _BASE_BEFORE.search(before):  # the nearer cue decides

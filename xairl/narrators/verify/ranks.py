@@ -163,9 +163,9 @@ def _items(masked: str, a: int, targets: list[Mention], m: re.Match) -> int:
 
 
 #: 'After A (and B), the biggest / next most important factor is C': C ranks one below the names after 'after'
-_AFTER_TOP = re.compile(rf"\W*(?:after|behind)\s+(?P<lead>[^,;]{{1,80}}),\s+(?P<top>(?:the\s+)?(?:next[\s-]+)?(?:single\s+)?"
-                        rf"(?:biggest|largest|strongest|most important|most influential|main|key)\s+(?:single\s+)?"
-                        rf"{NOUN})", re.IGNORECASE)
+_AFTER_TOP = re.compile(rf"\W*(?:after|behind)\s+(?P<lead>[^,;]{{1,80}}),\s+(?P<top>(?:the\s+)?(?:next[\s-]+)?"
+                        rf"(?:single\s+)?(?:biggest|largest|strongest|most important|most influential|main|key)\s+"
+                        rf"(?:single\s+)?{NOUN})", re.IGNORECASE)
 
 
 def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
@@ -181,8 +181,8 @@ def find_ranks(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         lead = {x.keys for x in names if x.end <= after.end("lead")}
         target = next((x for x in names if x.start >= after.end()), None)
         if lead and target is not None:
-            out.append(check_rank(target.keys, len(lead) + 1, None, 0, ctx, book,
-                                  f"{written[after.start('top'):after.end()].strip()}: {written[target.start:target.end]}"))
+            said = f"{written[after.start('top'):after.end()].strip()}: {written[target.start:target.end]}"
+            out.append(check_rank(target.keys, len(lead) + 1, None, 0, ctx, book, said))
             a = after.end()
     for m in RANK_RE.finditer(masked, a, b):
         if _WOULD_MAKE.search(masked, max(a, m.start() - 50), m.start()) or re.search(

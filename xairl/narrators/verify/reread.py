@@ -164,7 +164,8 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, me
     if owner is not None and c.rule == GUESSED[1] and _one_word_of_many(owner) and (
             other := quantities.any_fact(n, book, set(book.features) - set(owner.keys), ctx, strict=True)):
         return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}, and "
-                     f"the name before it is one word of a long name", "number.other-feature", _crosses(c, other, book))  # ('bill $109.9' of
+                     f"the name before it is one word of a long name", "number.other-feature",
+                     _crosses(c, other, book))  # ('bill $109.9' of
         # price_increase_last_bill_pct, when $109.9 is the monthly charge)
     if owner is not None and _RIGHT_AFTER.fullmatch(masked, owner.end, n.start):
         return c  # ('the serving BS's id at -12': its value)
@@ -189,8 +190,8 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, me
         # name in words of its own
         other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes, signed=signed)
         if other is not None:
-            return Claim("number", n.text, "unchecked", f"said of '{q.noun}', which names no "
-                                             f"feature; it states {other}", "parse.said-of-other", _crosses(c, other, book))
+            return Claim("number", n.text, "unchecked", f"said of '{q.noun}', which names no feature; it states "
+                         f"{other}", "parse.said-of-other", _crosses(c, other, book))
     other = quantities.any_fact(n, book, keys, ctx, strict=True, contribution=pushes, signed=signed)
     if other is not None:
         return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}",

@@ -166,7 +166,8 @@ RULES: tuple[Rule, ...] = (
          "number bound to that other feature states this one's, anywhere in the text: the two are swapped, "
          "contradicted",
          fires=(("air", "Traffic adds 6.9 and wind adds 7.2."), ("air", "traffic_index=2.4 (+6.9) wind_speed_ms=0.8 "
-                                                                        "(+7.2)"), ("air", "- traffic 2.4 -> +6.9\n- wind 0.8 -> +7.2")),
+                                                                        "(+7.2)"),
+                ("air", "- traffic 2.4 -> +6.9\n- wind 0.8 -> +7.2")),
          silent=(("air", "Traffic adds 7.2 and wind adds 6.9."), ("air", "Traffic adds 6.9, more than the wind."))),
     Rule("number.word", "number", "a number word bound by position alone, that the parse ties to no name ('a "
          "factor of two', 'one and a half times'): a count or an idiom, unchecked",

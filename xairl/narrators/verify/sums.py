@@ -72,8 +72,8 @@ _SIDE = re.compile(r"\b(?:(?P<pos>positives?|upward|pos(?:_\w+)?|pushing (?:it |
 
 
 #: a side named right after its sum: '22.4 h upward push', '2.84 of positive contributions'
-_SIDE_AFTER = re.compile(r"\s*(?:[a-zA-Z%]{1,6}\s+)?(?:of\s+)?(?:(?P<pos>upward|positive)|(?P<neg>downward|negative))\s+"
-                         r"(?:push|pressure|contributions?|side|total|factors|effects?)\b", re.IGNORECASE)
+_SIDE_AFTER = re.compile(r"\s*(?:[a-zA-Z%]{1,6}\s+)?(?:of\s+)?(?:(?P<pos>upward|positive)|(?P<neg>downward|negative))"
+                         r"\s+(?:push|pressure|contributions?|side|total|factors|effects?)\b", re.IGNORECASE)
 
 
 def sum_number(n: Number, members: list[tuple[str, ...]], ctx: str | None, book: FactBook) -> Claim:
