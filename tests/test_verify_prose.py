@@ -1177,6 +1177,20 @@ def test_fronted_phrases_and_swaps():
     assert bad("The wind was calm, which, with the traffic, added 7.2.") == []  # (unclear: which one is unsaid)
     assert bad("The negatives add up to 31.1.") == [("number", "31.1")]
     assert bad("The positives add up to 31.1 and the negatives to -1.0.") == []
+    # accurate phrasings a second review found contradicted by the first version of these readings
+    for text in ("Traffic outweighs wind with 7.2. Wind trails traffic with 6.9.",
+                 "Traffic, unlike wind, adds 7.2; wind, unlike traffic, adds 6.9.",
+                 "Even with the negatives, the contributions add up to about 30.",
+                 "Traffic and wind outweigh the season by a factor of 14.",
+                 "The road was set to 4 lanes.", "The road was listed as a minor factor.",
+                 "The season was flagged as a drag on the forecast.", "## How the Current Season Shapes the Forecast",
+                 "season: negative -1.0", "Traffic adds 7.2 extra risk.", "Wind is calm, which gives +6.9.",
+                 "Traffic gives a net increase of 7.2.", "Of the six factors traffic and wind together add 14.1.",
+                 "road traffic wind"):
+        assert bad(text) == [], text
+    assert bad("Wind is smaller than traffic by a factor of 5.") == [("rank", "smaller than")]
+    assert not [c for c in xairl.verify("road traffic wind", air, 0).claims if c.kind == "internal"]  # (a name
+    # that qualified two others was removed twice: ValueError)
 
 
 def test_a_unit_or_statistic_in_a_name_is_no_mention_on_its_own():

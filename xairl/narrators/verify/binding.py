@@ -19,9 +19,7 @@ _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of
                         r"second at|score|at|of|was|=)?\s*\(?(?:q\s*=\s*)?$", re.IGNORECASE)
 
 
-_ENDS_AT = re.compile(r"(?:,\s*|\bwhich\s+)(?:giving|gives|for a final|to give|yielding|yields)\s+"
-                      r"(?:about\s+|roughly\s+|around\s+)?[$€£]?$|"  # ('..., giving 39.5%': where it ends)
-                      r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
+_ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
                       r"settled)\s+(?:at|to)\s+(?:about|around|roughly|only|just)?\s*[$€£]?$|"
                       r"\b(?:drags?|dragged|pushe?s?|pushed|pulls?|pulled|brings?|brought|takes?|took|moves?|moved|"
                       r"lowers?|lowered|raises?|raised|lifts?|lifted)\b[^.;]{0,40},?(?<!close)(?<!due)(?<!thanks)"
@@ -32,6 +30,9 @@ _FROM = re.compile(r"\bfrom\s+(?:(?:an?|the|its)\s+)?(?:(?:average|base(?:line)?
                    re.IGNORECASE)
 _FROM_TO = re.compile(r"\bfrom\s+[^;]{1,40}?\s+(?:down\s+|up\s+)?to\s+(?:about|around|roughly)?\s*[$€£]?$",
                       re.IGNORECASE)
+#: '..., giving 39.5%': where the output ends (an unsigned number; '..., giving +14.7' is a push)
+_GIVING = re.compile(r"(?:,\s*|\bwhich\s+)(?:giving|gives|for a final|to give|yielding|yields)\s+(?:about\s+|"
+                     r"roughly\s+|around\s+)?[$€£]?$", re.IGNORECASE)
 #: 'the handover's lead of 3.9', 'turning's lead over going forward was 1.55'
 _LEAD_OF = re.compile(r"\b(?:lead|margin|edge|advantage)(?:\s+over\s+[^\d;]{0,30}?)?\s+(?:of|was|is|=|:)\s+"
                       r"(?:about|around|roughly|only|just)?\s*$", re.IGNORECASE)
@@ -60,13 +61,16 @@ OUTPUT_BEFORE = re.compile(r"\b(?:estimated\s+|predicted\s+)?q[\s-]?values?\s+(?
                            r"(?:about|around|roughly|only|just)?\s*$",  # 'a predicted probability of 66%'
                            re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
-#: (one word may stand between: 'a 9.2% return chance', not '5 points of risk')
-_OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*"
-                           r"(?:(?!(?:of|in|to|for|the|a|an|and|or|at|by|on)\b)(?:[a-z]+|\0+)\s+)?"
-                           r"(?:probability|chance|likelihood|prediction|risk|"
+_OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
                            r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)"
                            r"|\s*(?:predicted|forecast)\s*(?:[.;,)]|$)",  # ('$1,850 baseline, $2,739 predicted.')
                            re.IGNORECASE)
+#: a percentage, one word and the output's noun: 'a 9.2% return chance', '41.6% return risk' (not '5 points of
+#: risk', '7.2 extra risk')
+_PERCENT_OUTPUT = re.compile(r"\s*(?!(?:of|in|to|for|the|a|an|and|or|at|by|on|more|extra|additional|less|added|"
+                             r"points?|pp|pts|units?)\b)(?:[a-z]+|\0+)\s+(?:probability|chance|likelihood|risk)\b"
+                             r"(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)",
+                             re.IGNORECASE)
 #: 'speed argued for X (-5.48)', 'obstacle barely affected the turn score (-0.09)': the feature's contribution
 _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact\w*|influenc\w*|matter\w*|"
                      r"shift\w*|worth)\b", re.IGNORECASE)
@@ -189,12 +193,14 @@ def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
             n.value / (100 if n.percent else 1) / book.base) < 10:
         return Claim("number", n.text, "unchecked", "the typical value of something not named (not the output's "
                                                     "average: another order of magnitude)")
-    if book.output != "actions" and (_OUTPUT_AFTER.match(masked, n.end) or OUTPUT_BEFORE.search(
+    if book.output != "actions" and (_OUTPUT_AFTER.match(masked, n.end) or (
+            n.percent and not n.points and _PERCENT_OUTPUT.match(masked, n.end)) or OUTPUT_BEFORE.search(
             masked[span:n.start])):  # '... leading to a 43% predicted probability', "it's worth $316k"
         return quantities.output_number(n, book)
     if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
         return quantities.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
-    if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 70):n.start]) or _FROM_TO.search(
+    if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 70):n.start]) or (
+            not n.sign and _GIVING.search(masked[max(0, n.start - 40):n.start])) or _FROM_TO.search(
             masked[span:n.start])):
         return quantities.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
     if book.margin is not None and (_LEAD_OF.search(masked[max(0, n.start - 30):n.start]) or

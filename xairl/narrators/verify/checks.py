@@ -149,13 +149,16 @@ def check_label(sentence: str, m: Mention, book: FactBook) -> Claim | None:
 _STATED = re.compile(r"(?:'s\s+\w+)?(?:\s+(?:on|of|for|in|at)\s+(?:the\s+|its\s+|her\s+|his\s+)?[\w-]+)?\s+"
                      r"(?:is|was|were|are|came|comes|got)\s+(?:(?P<verb>rated|classed|classified|flagged|listed|"
                      r"reported|marked|labell?ed|recorded|coded|set|registered|logged)\s+(?:as\s+|to\s+)?|"
-                     r"(?=['\"‘“]))(?:an?\s+|the\s+)?(?P<value>['\"‘“][^'\"’”\0]{1,30}['\"’”]|[A-Za-z][\w-]*)",
-                     re.IGNORECASE)
+                     r"(?=['\"‘“]))(?:an?\s+|the\s+)?(?P<value>['\"‘“][^'\"’”\0]{1,30}['\"’”]|"
+                     r"(?!(?:as|to|by|a|an|the)\b)[A-Za-z][\w-]*(?=\s*(?:[,.;:!?)]|$|\s(?:and|but|yet|which|so|"
+                     r"while|though)\b)))", re.IGNORECASE)  # (a word as a value ends its clause: not 'listed as a
+#: minor factor')
 #: a capitalised value right before the name, after a determiner: 'the Midwifery course', 'the Cavado sub-region'
 _VALUE_BEFORE = re.compile(r"\b(?:the|a|an|her|his|their|its|your)\s+(?P<value>[A-Z][a-z]+(?:-[A-Z]?[a-z]+)?)\s+$")
 #: a log's field and its value: 'course_profile=flat', 'tier: gold' (one word, letters first)
 _FIELD_VALUE = re.compile(r"\s?(?:=\s?|:\s?(?=[A-Za-z][\w-]*\s*(?:[,;|)\]]|$|[+\-]?\d|\w+=)))"  # (':' only as a
-                          r"(?P<value>[A-Za-z][\w-]*)(?![\w'])")  # field: not 'a refundable deposit: three signals')
+                          r"(?!(?:negative|positive|up|down|plus|minus|na|n/a)\b)"  # field: not 'a deposit: three
+                          r"(?P<value>[A-Za-z][\w-]*)(?![\w'])", re.IGNORECASE)  # signals', 'season: negative -1.0')
 _BOOLEAN = frozenset({"yes", "no", "true", "false", "0", "1", "y", "n", "none", "present", "absent", "on", "off"})
 
 
@@ -167,8 +170,9 @@ def stated_category(masked: str, m: Mention, mentions: list[Mention], book: Fact
     answers are left to the direction words ('is missing' may mean 'No')."""
     if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
         return None
-    s = _STATED.match(masked, m.end) or _FIELD_VALUE.match(masked, m.end) or _VALUE_BEFORE.search(
-        masked, max(0, m.start - 40), m.start)
+    s = _STATED.match(masked, m.end) or _FIELD_VALUE.match(masked, m.end) or (_VALUE_BEFORE.search(
+        masked, max(0, m.start - 40), m.start) if not re.match(r"\s+[A-Z]", masked[m.end:]) else None)  # (not in a
+    # title: 'How the Current Season Shapes the Forecast')
     if s is None or label.lower() in _BOOLEAN or any(x.start < s.end("value") and x.end > s.start("value")
                                                      for x in mentions):
         return None  # (a value that is a name of the vocabulary: a label the label reader checks)

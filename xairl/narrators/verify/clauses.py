@@ -39,7 +39,7 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
     for n in numbers:
         if summed and (n is tail[0] or (n.percent and not n.points and len(tail) == 2 and n is tail[1])):
             members = list(dict.fromkeys(m.keys for m in said_names))  # (', about 87 % of it'; not 'of the
-            counted = _COUNTED.search(masked, a, n.start)  # 28.3-point rise')
+            counted = _counted(masked, a, said_names)  # 28.3-point rise')
             if counted and _COUNTS.get(counted.group("k").lower()) != len(members):  # 'the four weather terms
                 out.append(Claim("number", n.text, "unchecked", f"a sum over {counted.group('k')} things, "  # (...)'
                                  f"{len(members)} of them named", "number.sum-unnamed"))  # with three named
@@ -128,6 +128,20 @@ _COUNTS = {"two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "2": 2, "3": 3,
 _COUNTED = re.compile(r"\b(?P<k>two|three|four|five|six|[2-6])\s+(?:[\w-]+\s+){0,3}?(?:factors|things|terms|features|"
                       r"drivers|inputs|reasons|variables|items|signals|effects|contributors|pushes|measures)\b",
                       re.IGNORECASE)
+def _counted(masked: str, a: int, names):
+    """The count of a sum's things said right before its names ('the four weather terms (irradiance, ...)'), not a
+    partitive ('of the six factors, A and B together ...')."""
+    if not names:
+        return None
+    c = None
+    for c in _COUNTED.finditer(masked, a, names[0].start):
+        pass
+    if c is None or not re.fullmatch(r"\s*[(:,]?\s*(?:the\s+|its\s+)?", masked[c.end():names[0].start]) or re.search(
+            r"\b(?:of|among|out of|from)\s+(?:the\s+|all\s+|these\s+|those\s+)?$", masked[a:c.start()], re.IGNORECASE):
+        return None
+    return c
+
+
 _OWN_QUANTITY = re.compile(r"\bof\s+(?:the\s+)?[$€£]?$", re.IGNORECASE)
 _NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
                       r"(?:(?:because of|due to|about|the|its|their|a|an)\s+){0,3}$", re.IGNORECASE)

@@ -25,7 +25,8 @@ _BEFORE_B = re.compile(r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?(?:(?:numb
 #: the shopper's choice of", 'than being close to the', 'than the three size-related'); not 'any other', 'the rest'
 _AFTER_THAN = re.compile(r"\s*(?:the|its|their|his|her|a|an|being|[\w-]+'s)\s+(?:(?!(?:any|all|other|others|combined|"
                          r"every|each|rest|remaining|half|twice|double|third|quarter|most|least|sum|total|expected|"
-                         r"usual|typical|average|previous|one|anything|everything)\b)[a-z'-]+\s+){0,4}", re.IGNORECASE)
+                         r"usual|typical|average|previous|one|anything|everything|and|or|with|for|would|did|does|"
+                         r"base|baseline|prediction|forecast|output|score)\b)[a-z'-]+\s+){0,4}", re.IGNORECASE)
 #: a ratio after the name compared with: '... than the pacing plan (-1.4) by a factor of ~2.6'
 _FACTOR_AFTER = re.compile(r"(?:\s*\([^()]*\))?\s*(?:did\s+|does\s+)?,?\s*by\s+a\s+factor\s+of\s+"
                            r"(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|~\s*)?(\d+(?:\.\d+)?)\b",
@@ -137,9 +138,11 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
         way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
         ratio = _ratio(masked[max(a, m.start() - 40):m.start()], way) if not m.group("of") else _of_ratio(
             masked[max(a, m.start() - 12):m.start()], m.group("of"))
-        factor = _FACTOR_AFTER.match(masked, b_name.end, b)  # 'larger than B (-1.4) by a factor of ~2.6'
-        if ratio is None and factor is not None and way > 0:
-            ratio = float(factor.group(1))
+        factor = _FACTOR_AFTER.match(masked, b_name.end, b)  # 'larger than B (-1.4) by a factor of ~2.6' (of one
+        if ratio is None and factor is not None and way and len(subjects) == 1 and float(factor.group(1)) > 0:
+            ratio = float(factor.group(1)) ** way  # name; 'smaller than B by a factor of 5': a fifth)
+        else:
+            factor = None
         if ratio is not None and (not m.group("out") or factor is not None):  # 'roughly 1.7 times as much as B',
             # '35 % more than B', 'A outweighed B by a factor of 1.7'
             out += [check_ratio(x.keys, b_name.keys[0], ratio, ctx, book, written[m.start():m.end()].strip())

@@ -67,7 +67,7 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
                     found.append(Mention(m.start(), m.end(), "label", (f,), label))
                     taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
     found = sorted(found, key=lambda m: m.start)
-    for m in _modifiers(text, found):  # 'corner kicks', 'attempts on goal': one name, not two
+    for m in dict.fromkeys(_modifiers(text, found)):  # 'corner kicks', 'attempts on goal': one name, not two
         found.remove(m)
         taken[m.start:m.end] = bytes(m.end - m.start)
     merged: list[Mention] = []

@@ -55,8 +55,7 @@ CHANGE_AFTER = re.compile(r"^\s*(?!(?:\w+\s+)?(?:is|was|are|were|sits|lies|stand
                            r"(average|baseline|base|typical|expected|mean)"
                            r"|^\W*(?:premium|uplift|markup|discount)\b", re.IGNORECASE)
 #: 'Net effect of the eight features: +0.089', 'Net uplift over the base value: +$86,046': the change from the baseline
-NET_BEFORE = re.compile(r"\b(?:net (?:effect|uplift|change|shift|push|contribution|increase|decrease|rise|drop|gain|"
-                        r"reduction)|total (?:effect|shift|change)|"
+NET_BEFORE = re.compile(r"\b(?:net (?:effect|uplift|change|shift|push|contribution)|total (?:effect|shift|change)|"
                         r"(?<![\w.])delta(?=\s*[=:])|"  # ('base=27.0 delta=-22.0')
                         r"(?:uplift|premium|change|shift) (?:over|above|from|relative to) (?:the )?(?:base(?:line)?|"
                         r"base value|base rate|average))\b(?:\s+(?:of|over|from|across)\s+[^.;:()\d]{1,30}?)?\s*"
@@ -247,7 +246,14 @@ def is_change(n: Number, masked: str) -> bool:
     'below base by $34,184', 'Net uplift over the base value: +$86,046'."""
     before = masked[max(0, n.start - 60):n.start]
     return bool(CHANGE_AFTER.match(masked[n.end:n.end + 30]) or NET_BEFORE.search(before) or (
-        _CHANGE_BEFORE.search(before[-40:]) and _BASE_WORDS.search(before[-40:])))
+        _CHANGE_BEFORE.search(before[-40:]) and _BASE_WORDS.search(before[-40:])) or (
+        _NET_MOVE.search(before) and "\0" not in masked[:n.start]))
+
+
+#: 'a net increase of 18.7 h' in a sentence that names no feature before it (else it may be that name's push:
+#: 'Traffic gives a net increase of 7.2')
+_NET_MOVE = re.compile(r"\bnet (?:increase|decrease|rise|drop|gain|reduction)\s+(?:of\s+)?(?:about\s+|around\s+|"
+                       r"roughly\s+)?[$€£]?$", re.IGNORECASE)
 
 
 #: a number after a base word: the base word's own ('base=22.0 delta=+30.1 n=6': no cue for the 6)

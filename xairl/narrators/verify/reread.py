@@ -88,15 +88,24 @@ def unless_guessed(c: Claim, n, masked: str, mentions, names, book: FactBook, ct
         other = quantities.other_reading(n, sentence_keys, book, ctx,
                                          signed=quantities.signed_named(masked[max(0, n.start - 40):n.start]))
     return c if other is None else Claim("number", n.text, "unchecked", f"read as {c.detail}, but it is {other}: "
-                                         f"which is unclear", "number.unclear", _crosses(c, other, book))
+                                         f"which is unclear", "number.unclear",
+                                         _crosses(c, other, book, n, masked, mentions))
 
 
-def _crosses(c: Claim, other: str, book: FactBook) -> tuple[str, str]:
+def _crosses(c: Claim, other: str, book: FactBook, n, masked: str, mentions) -> tuple[str, str]:
     """(the feature a number's first reading bound it to, the feature whose fact it states instead), for a text where
-    two numbers cross this way (:func:`swapped`); () when either is not one feature."""
+    two numbers cross this way (:func:`swapped`); () when either is not one feature, or when the stated feature is
+    named before the bound one with no number of its own between them: it may be the subject the number is said of
+    ('Traffic outweighs wind with 7.2'), not a swapped item of a list ('contract +0.214, tenure +0.127')."""
     bound = next((k for k in book.features if f" is not {k}'s " in c.detail), None)
     stated = next((k for k in book.features if other.startswith(f"{k}'s ")), None)
-    return (bound, stated) if bound is not None and stated is not None and bound != stated else ()
+    if bound is None or stated is None or bound == stated:
+        return ()
+    near = next((m for m in reversed(mentions) if bound in m.keys and m.end <= n.start), None)
+    said = [m for m in mentions if stated in m.keys and near is not None and m.end <= near.start]
+    if said and not any(said[-1].end <= x.start < near.start for x in find_numbers(masked[:near.start])):
+        return ()
+    return bound, stated
 
 
 def swapped(claims: list[Claim]) -> list[Claim]:
@@ -165,7 +174,7 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, me
             other := quantities.any_fact(n, book, set(book.features) - set(owner.keys), ctx, strict=True)):
         return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}, and "
                      f"the name before it is one word of a long name", "number.other-feature",
-                     _crosses(c, other, book))  # ('bill $109.9' of
+                     _crosses(c, other, book, n, masked, mentions))  # ('bill $109.9' of
         # price_increase_last_bill_pct, when $109.9 is the monthly charge)
     if owner is not None and _RIGHT_AFTER.fullmatch(masked, owner.end, n.start):
         return c  # ('the serving BS's id at -12': its value)
@@ -191,18 +200,18 @@ def unless_elsewhere(c: Claim, n, masked: str, mentions, book: FactBook, ctx, me
         other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes, signed=signed)
         if other is not None:
             return Claim("number", n.text, "unchecked", f"said of '{q.noun}', which names no feature; it states "
-                         f"{other}", "parse.said-of-other", _crosses(c, other, book))
+                         f"{other}", "parse.said-of-other", _crosses(c, other, book, n, masked, mentions))
     other = quantities.any_fact(n, book, keys, ctx, strict=True, contribution=pushes, signed=signed)
     if other is not None:
         return Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it states {other}",
-                     "number.elsewhere", _crosses(c, other, book))
+                     "number.elsewhere", _crosses(c, other, book, n, masked, mentions))
     if q.noun in FACT_NOUNS:
         return c  # 'A is responsible for an increase of 1.2': A's increase, whatever else 1.2 may be
     # 'bill $109.9', 'its Q3 grade of 54 (+0.096)': a thing the vocabulary has no words for, or a wrong word match
     other = quantities.any_fact(n, book, book.features, ctx, strict=True, contribution=pushes, signed=signed)
     return c if other is None else Claim("number", n.text, "unchecked", f"read by position as {c.detail}, but it "
                                          f"states {other}, a feature the sentence may name in words of its own",
-                                         "number.other-feature", _crosses(c, other, book))
+                                         "number.other-feature", _crosses(c, other, book, n, masked, mentions))
 
 
 def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, measured, vocab) -> Claim:

@@ -46,20 +46,22 @@ def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
         return None
     def states(v: float) -> bool:  # ('50 %' is a share; '21.9 points' a sum of contributions in points, or of
         return (matches(n, v) and (n.points or not n.percent)) or (n.points and percent_reading(n, v))  # probabilities
-    side = [after] if after else [
-        m for m in _SIDE.finditer(before) if "\0" not in before[m.end():] and not re.search(r"\d", before[m.end():])]
+    side = [after] if after else [m for m in _SIDE.finditer(before) if not re.search(r"[\0\d,]", before[m.end():])]
     if side:  # 'the positives add up to +0.39': that side's sum, in any view; the other side's is a sign error
         said = "positive" if side[-1].group("pos") else "negative"
         other = "negative" if said == "positive" else "positive"
-        own = {w: v for w, v in book.aggregates.items() if f" {said} " in w}
-        if any(states(v) for v in own.values()):
+        own = {w: v for w, v in book.aggregates.items() if f" {other} " not in w}
+        if any(states(v) for v in own.values()):  # (its side's sum, or a whole the words may mean: the net)
             return Claim("number", n.text, "verified", next(w for w, v in own.items() if states(v)))
         size = replace(n, value=abs(n.value), sign="", alternatives=())
         wrong = [(w, v) for w, v in book.aggregates.items() if f" {other} " in w and matches(size, abs(v))]
-        if wrong:
+        own = {w: v for w, v in own.items() if f" {said} " in w}
+        if wrong and not after:  # (a side named after the number only verifies: 'adds 6.9 of positive ...')
             said_sums = ", ".join(f"{w} is {v:+.4g}" for w, v in own.items())
             return Claim("number", n.text, "contradicted", f"{said_sums}; {n.text} is the size of {wrong[0][0]}",
                          "number.other-side")
+        if wrong:
+            return None  # (not the other side's sum read as verified either)
     for what, v in book.aggregates.items():
         if states(v):
             return Claim("number", n.text, "verified", what)
