@@ -129,15 +129,13 @@ _COUNTED = re.compile(r"\b(?P<k>two|three|four|five|six|[2-6])\s+(?:[\w-]+\s+){0
                       r"drivers|inputs|reasons|variables|items|signals|effects|contributors|pushes|measures)\b",
                       re.IGNORECASE)
 def _counted(masked: str, a: int, names):
-    """The count of a sum's things said right before its names ('the four weather terms (irradiance, ...)'), not a
-    partitive ('of the six factors, A and B together ...')."""
-    if not names:
-        return None
+    """The count of a sum's things said before its names ('the four weather terms (irradiance, ...)', 'the two things
+    working against a return, the loyalty tier and ...'), not a partitive ('of the six factors, A and B ...')."""
     c = None
-    for c in _COUNTED.finditer(masked, a, names[0].start):
+    for c in _COUNTED.finditer(masked, a, names[0].start if names else a):
         pass
-    if c is None or not re.fullmatch(r"\s*[(:,]?\s*(?:the\s+|its\s+)?", masked[c.end():names[0].start]) or re.search(
-            r"\b(?:of|among|out of|from)\s+(?:the\s+|all\s+|these\s+|those\s+)?$", masked[a:c.start()], re.IGNORECASE):
+    if c is None or re.search(r"\b(?:of|among|out of|from)\s+(?:the\s+|all\s+|these\s+|those\s+)?$",
+                              masked[a:c.start()], re.IGNORECASE):
         return None
     return c
 
