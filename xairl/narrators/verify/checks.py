@@ -145,14 +145,14 @@ def check_label(sentence: str, m: Mention, book: FactBook) -> Claim | None:
 
 
 #: a categorical feature's value stated in words right after its name: 'F is rated medium', "F was flagged as
-#: 'late'", 'F on the panels is listed as full', "F is 'returning'"
+#: 'late'", 'F on the panels is listed as full', "F is 'returning'"; a word as a value ends its clause (not 'F was
+#: listed as a minor factor', 'F is set to lower it')
 _STATED = re.compile(r"(?:'s\s+\w+)?(?:\s+(?:on|of|for|in|at)\s+(?:the\s+|its\s+|her\s+|his\s+)?[\w-]+)?\s+"
                      r"(?:is|was|were|are|came|comes|got)\s+(?:(?P<verb>rated|classed|classified|flagged|listed|"
                      r"reported|marked|labell?ed|recorded|coded|set|registered|logged)\s+(?:as\s+|to\s+)?|"
                      r"(?=['\"‘“]))(?:an?\s+|the\s+)?(?P<value>['\"‘“][^'\"’”\0]{1,30}['\"’”]|"
                      r"(?!(?:as|to|by|a|an|the)\b)[A-Za-z][\w-]*(?=\s*(?:[,.;:!?)]|$|\s(?:and|but|yet|which|so|"
-                     r"while|though)\b)))", re.IGNORECASE)  # (a word as a value ends its clause: not 'listed as a
-#: minor factor')
+                     r"while|though)\b)))", re.IGNORECASE)
 #: a capitalised value right before the name, after a determiner: 'the Midwifery course', 'the Cavado sub-region'
 _VALUE_BEFORE = re.compile(r"\b(?:the|a|an|her|his|their|its|your)\s+(?P<value>[A-Z][a-z]+(?:-[A-Z]?[a-z]+)?)\s+$")
 #: a log's field and its value: 'course_profile=flat', 'tier: gold' (one word, letters first)
@@ -164,10 +164,10 @@ _BOOLEAN = frozenset({"yes", "no", "true", "false", "0", "1", "y", "n", "none", 
 
 def stated_category(masked: str, m: Mention, mentions: list[Mention], book: FactBook) -> Claim | None:
     """'Aisle congestion is rated medium' when the state's label is 'low': a value the words give a categorical
-    feature right after its name ('is rated', 'was flagged as', 'is listed as', a quoted value) or capitalised right
-    before it after a determiner ('the Midwifery course') that shares no word
-    with its label (nor is the label's initials, 'SE' of 'south-east') is contradicted. Labels that are yes/no
-    answers are left to the direction words ('is missing' may mean 'No')."""
+    feature right after its name ('is rated', 'was flagged as', 'is listed as', a quoted value, a log's 'F=flat') or
+    capitalised right before it after a determiner ('the Midwifery course', not in a title) that shares no word with
+    its label (nor is the label's initials, 'SE' of 'south-east') is contradicted. Labels that are yes/no answers are
+    left to the direction words ('is missing' may mean 'No')."""
     if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
         return None
     s = _STATED.match(masked, m.end) or _FIELD_VALUE.match(masked, m.end) or (_VALUE_BEFORE.search(

@@ -38,7 +38,8 @@ def sum_reading(n: Number, masked: str, names, book: FactBook) -> Claim | None:
 
 def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
     """A number after words that sum over the features, equal to one such sum (:attr:`FactBook.aggregates`):
-    verified; otherwise None (its other readings decide)."""
+    verified; after words naming one side ('the positives add up to'), the other side's sum in size is a sign error,
+    contradicted (``number.other-side``); otherwise None (its other readings decide)."""
     before = masked[max(0, n.start - 50):n.start]
     after = _SIDE_AFTER.match(masked, n.end)  # ('about 57% of the 22.4 h upward push')
     if not book.aggregates or not (AGGREGATE_CUE.search(before) or _PART_OF.search(before)
