@@ -122,9 +122,10 @@ def views(ctx: str | None, book: FactBook) -> tuple[str, ...]:
 def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book: FactBook, ctx: str | None,
                      written: str = "") -> list[Claim]:
     """'A mattered more than B' (and 'which in turn mattered more than C'), 'A and B both mattered more than C', 'A
-    outweighs B': A's |contribution| against B's. B must be one feature named right after 'than' ('than the number
-    of browsing sessions' allows a count's words and one more); A the names since the previous comparison, else the
-    last name before the comparative (a relative 'which'). ``written``: the sentence as written (claims quote it)."""
+    outweighs B': A's |contribution| against B's. B must be one feature named right after 'than' or 'outweighs'
+    (:data:`_BEFORE_B`, :data:`_AFTER_THAN`); A the names since the previous comparison, else the last name before the
+    comparative (a relative 'which'); 'by a factor of 2.6' after B is the ratio of one name to B. ``written``: the
+    sentence as written (claims quote it)."""
     out, start, written = [], a, written or masked
     names = named_features(mentions)
     for m in COMPARE_RE.finditer(masked, a, b):
