@@ -9,8 +9,8 @@ from dataclasses import replace
 from . import quantities
 from .binding import GUESSED
 from .book import FactBook
-from .checks import Claim
-from .numbers import find_numbers
+from .checks import EITHER, Claim
+from .numbers import find_numbers, matches
 from .parse import quantified, same_clause
 from .vocabulary import split_words, stem
 
@@ -28,6 +28,8 @@ def read_again(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, u
         if not found:
             found.append(quantified(parsed(), n.start, n.end, units))
         return found[0]
+    if n.percent and (share := side_share(c, n, masked, book, ctx, sentence_keys)) is not None:
+        return share
     c = unless_guessed(c, n, masked, mentions, names, book, ctx, sentence_keys)
     if c.status == "contradicted":
         c = by_parse(c, n, masked, book, ctx, unit_of, measured, vocab)
@@ -36,6 +38,34 @@ def read_again(c: Claim, n, masked: str, mentions, names, book: FactBook, ctx, u
     if c.status == "contradicted":
         c = unless_other_clause(c, n, masked, names, parsed)
     return c
+
+
+#: a percentage of one side's sum: '46% of all upward contributions', '40% of the downward total'
+_SIDE_SHARE = re.compile(r"\s*of\s+(?:all\s+)?(?:the\s+)?(?:total\s+)?"
+                         r"(?P<side>upward|positive|upside|downward|negative|downside)\b", re.IGNORECASE)
+
+
+def side_share(c: Claim, n, masked: str, book: FactBook, ctx, keys) -> Claim | None:
+    """'Lead time (+14.2) is roughly 1.5 times the deposit effect (-9.6) and about 46% of all upward contributions':
+    a percentage of one side is the share of its side of a feature the sentence names on that side: verified when
+    one has it; contradicted when the sentence names one feature of that side only (it is that one's); else
+    unchecked. None when the words name no side."""
+    m = _SIDE_SHARE.match(masked, n.end)
+    if m is None:
+        return None
+    up = m.group("side").lower() in ("upward", "positive", "upside")
+    views = book.contexts if ctx in (None, EITHER) else (ctx,)
+    sided = [(k, v) for k in sorted(keys) if k in book.features for v in views
+             if v in book.features[k].side_shares and (book.features[k].contribs.get(v, 0.0) > 0) == up]
+    for k, v in sided:
+        if matches(n, book.features[k].side_shares[v]):
+            return Claim("number", n.text, "verified", f"{k}: share of its side ({v})", "number.side-share")
+    if len({k for k, _ in sided}) == 1:
+        k, v = sided[0]
+        return Claim("number", n.text, "contradicted", f"{k}'s share of the {m.group('side')} side is "
+                     f"{book.features[k].side_shares[v]:.3g} % ({v})", "number.side-share")
+    return Claim("number", n.text, "unchecked", f"a share of the {m.group('side')} side, of no feature the sentence "
+                 f"names there (first read as {c.detail})", "number.side-share")
 
 
 #: a number right after its name ('A +0.3', 'A (0.3)', 'A: 0.3', 'A=0.3', "the serving BS's id at -12"): bound for sure

@@ -169,6 +169,10 @@ RULES: tuple[Rule, ...] = (
                                                                         "(+7.2)"),
                 ("air", "- traffic 2.4 -> +6.9\n- wind 0.8 -> +7.2")),
          silent=(("air", "Traffic adds 7.2 and wind adds 6.9."), ("air", "Traffic adds 6.9, more than the wind."))),
+    Rule("number.side-share", "number", "a percentage of one side ('46% of all upward contributions'): the share of "
+         "its side of a feature the sentence names there; contradicted when it names one such feature only",
+         fires=(("air", "The traffic is also about 47% of the upward push."),),
+         silent=(("air", "Traffic adds 7.2."), ("air", "Traffic is about 23% of the upward push."))),
     Rule("number.word", "number", "a number word bound by position alone, that the parse ties to no name ('a "
          "factor of two', 'one and a half times'): a count or an idiom, unchecked",
          fires=(("air", "The wind mattered by a factor of two."),),
