@@ -128,8 +128,9 @@ def _spellings(name_words: list[str]) -> list[str]:
 
 def _runs(form: str, f: str) -> list[str]:
     """The runs of words of feature ``f``'s name or description ``form`` that may name it: every run of two words or
-    more, single words unless generic, short, a number, or the instance the form is about ('the applicant's age', 'age
-    of the patient': not 'applicant', 'patient'; in a description, or a name that is a phrase)."""
+    more, single words unless generic, a unit or statistic (``UNIT_PARTS``: 'min', 'avg'), short, a number, or the
+    instance the form is about ('the applicant's age', 'age of the patient': not 'applicant', 'patient'; in a
+    description, or a name that is a phrase)."""
     lowered = form.lower()
     owners = set(re.findall(r"(\w+)'s\b", lowered)) | set(re.findall(r"\bof (?:the |a |an )?(\w+)$", lowered)) | \
         _INSTANCES
