@@ -1,14 +1,14 @@
 """Which fact a number states: the name it is bound to (a pair of a 'respectively' list, an action right before or
 after it, a name right after it, the name before it in its clause) or a decision-level quantity its cue words name
 (the change from the baseline, a typical value, the baseline, where the output starts or ends, the margin), then its
-check in :mod:`.quantities` (a contradicted guess is read again in :mod:`.reread`)."""
+check in :mod:`.quantities` or :mod:`.decision` (a contradicted guess is read again in :mod:`.reread`)."""
 from __future__ import annotations
 
 import functools
 import re
 from dataclasses import replace
 
-from . import background, checks, quantities, sums
+from . import background, checks, decision, quantities, sums
 from .book import FactBook
 from .checks import Claim
 from .numbers import matches
@@ -94,10 +94,10 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     summed = sums.sum_reading(n, masked, names, book)
     if summed is not None:  # 'the positives add up to +0.39', 'without the add-on's contribution it would be 12.4%'
         return summed
-    if quantities.is_change(n, masked):  # '$91,462 above the baseline', 'net uplift: +$86,046', 'below base by $34,184'
-        return named(quantities.free_number(n, masked, book), "number.change")
+    if decision.is_change(n, masked):  # '$91,462 above the baseline', 'net uplift: +$86,046', 'below base by $34,184'
+        return named(decision.free_number(n, masked, book), "number.change")
     if id(n) in scored:
-        return named(quantities.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book),
+        return named(decision.action_number(n, checks.resolve_action(scored[id(n)], book), masked, book),
                      "number.action-scores")
     by_cue = _by_cue(n, masked, mentions, names, book)
     if by_cue is not None:
@@ -115,10 +115,10 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
         return named(quantities.feature_number(n, owner.keys, masked, book, checks.EITHER, unit_of), "number.push-for")
     if nxt is not None and nxt.kind == "action" and book.output != "actions" and re.match(
             r"^\s*(?:in|of|as)?\s*(?:the\s+|an?\s+)?(?:predicted\s+|expected\s+|estimated\s+)?$", masked[n.end:nxt.start]):
-        return named(quantities.output_number(n, book), "number.output-after")  # '$2,603 in expected claim cost'
+        return named(decision.output_number(n, book), "number.output-after")  # '$2,603 in expected claim cost'
     if nxt is not None and nxt.kind == "action" and not pushes and re.match(r"^\s*(?:for|by)\s+(?:a\s+|an\s+|the\s+)?$",
                                                            masked[n.end:nxt.start]):
-        return named(quantities.action_number(n, checks.resolve_action(nxt, book), masked, book), "number.for-action")
+        return named(decision.action_number(n, checks.resolve_action(nxt, book), masked, book), "number.for-action")
     gap = masked[n.end:nxt.start] if nxt is not None else ""
     ends_item = bool(n.sign) or bool(re.search(r"[=:]\s*$", masked[:n.start]))  # 'wait_max -2.31 elapsed -1.46',
     # 'E[Q]=1.20 battery_pct=31': a signed number or a field's value ends the item before, it does not start the next
@@ -171,13 +171,13 @@ def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
                 _KEY_BASE.search(masked[span:n.start]):  # ('On average, 23-year-old drivers': a driver's age)
             return background.base_number(n, book)  # 'On average, a student has about an 18% chance', 'base=0.3'
         if _KEY_OUTPUT.search(masked[span:n.start]) or _output_is(masked[span:n.start], book):
-            return quantities.output_number(n, book)
+            return decision.output_number(n, book)
     stat = background.statistic(masked[span:n.start], any(m.kind == "action" and span <= m.start < n.start
                                                           for m in mentions), book.output == "actions",
                                 bool(re.match(r"[^()]*?\b(?:vs\.?|versus|compared)\b", masked[n.end:n.end + 40])))
     if stat == "output" and book.output != "actions":  # 'the average sale price of $230,061', 'the baseline of 0.34'
         c = background.base_number(n, book)  # ... unless it is the prediction ('at the average risk: 33 %')
-        if c.status == "verified" or quantities.output_number(n, book).status != "verified":
+        if c.status == "verified" or decision.output_number(n, book).status != "verified":
             return c
     owner = next((m for m in reversed(names) if m.end <= n.start), None) or next(
         (m for m in names if 0 <= m.start - n.end <= 2), None)  # '... typically scores around 1.3 goals'
@@ -196,16 +196,16 @@ def _by_cue(n, masked: str, mentions, names, book: FactBook) -> Claim | None:
     if book.output != "actions" and (_OUTPUT_AFTER.match(masked, n.end) or (
             n.percent and not n.points and _PERCENT_OUTPUT.match(masked, n.end)) or OUTPUT_BEFORE.search(
             masked[span:n.start])):  # '... leading to a 43% predicted probability', "it's worth $316k"
-        return quantities.output_number(n, book)
+        return decision.output_number(n, book)
     if book.output != "actions" and _FROM.search(masked[max(0, n.start - 40):n.start]):
-        return quantities.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
+        return decision.output_number(n, book, start=True)  # 'from 34.1 % to 43.0 %': where the output starts ...
     if book.output != "actions" and (_ENDS_AT.search(masked[max(0, n.start - 70):n.start]) or (
             not n.sign and _GIVING.search(masked[max(0, n.start - 40):n.start])) or _FROM_TO.search(
             masked[span:n.start])):
-        return quantities.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
+        return decision.output_number(n, book)  # ... and ends up ('pull it down to 0.142')
     if book.margin is not None and (_LEAD_OF.search(masked[max(0, n.start - 30):n.start]) or
-                                    quantities.MARGIN_AFTER.match(masked[n.end:n.end + 30])):  # 'the 8.32-point lead'
-        return quantities.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named
+                                    decision.MARGIN_AFTER.match(masked[n.end:n.end + 30])):  # 'the 8.32-point lead'
+        return decision.free_number(n, masked, book)  # "the handover's lead of 3.9": the margin, whatever is named
     return None
 
 
@@ -228,8 +228,8 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
                                                for r in (checks.DIRECTION_RE, _ARGUED)))):
         prev = feature_before  # '(+2.05)' after 'supported recharging': the feature's contribution
     if prev is not None and prev.kind == "action":
-        if _SCORE_GAP.match(masked[prev.end:n.start]) or quantities.MARGIN_BEFORE.search(masked[prev.end:n.start]):
-            return named(quantities.action_number(n, checks.resolve_action(prev, book), masked, book),
+        if _SCORE_GAP.match(masked[prev.end:n.start]) or decision.MARGIN_BEFORE.search(masked[prev.end:n.start]):
+            return named(decision.action_number(n, checks.resolve_action(prev, book), masked, book),
                          "number.action-before")
         prev = next((m for m in reversed(names) if m.end <= n.start), None)
     gap_text = re.sub(r"\([^()]*\)", "()", masked[prev.end:n.start]) if prev is not None else ""
@@ -249,4 +249,4 @@ def _by_name_before(n, masked: str, mentions, names, book: FactBook, ctx, unit_o
                                           # the same name's)
                                           masked[prev.end:n.start], re.IGNORECASE):
         return quantities.feature_number(n, prev.keys, masked, book, ctx, unit_of)
-    return named(quantities.free_number(n, masked, book), "number.free")
+    return named(decision.free_number(n, masked, book), "number.free")

@@ -7,7 +7,7 @@ import functools
 import re
 from dataclasses import replace
 
-from . import background, binding, comparisons, directions, noclaims, quantities, ranks, reread, sums
+from . import background, binding, comparisons, decision, directions, noclaims, quantities, ranks, reread, sums
 from .book import FactBook
 from .checks import Claim
 from .names import Mention, named_features
@@ -99,7 +99,7 @@ def _lists(masked: str, a: int, b: int, names: list[Mention], numbers) -> tuple[
     summed = len(tail) >= 1 and len(names) >= 2 and (_SUM_CUE.search(masked, a, b) if len(tail) == 1 else _SUM_CUE.search(
         masked, names[-1].end, tail[0].start) and (len(tail) != len({m.keys for m in names}) or tail[1].percent)) \
         and not _OWN_QUANTITY.search(
-        masked[max(a, tail[0].start - 12):tail[0].start]) and not quantities.CHANGE_AFTER.match(masked[tail[0].end:b])
+        masked[max(a, tail[0].start - 12):tail[0].start]) and not decision.CHANGE_AFTER.match(masked[tail[0].end:b])
     return tail, paired, bool(summed)
 
 

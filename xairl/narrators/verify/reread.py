@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
-from . import quantities
+from . import decision, quantities
 from .binding import GUESSED
 from .book import FactBook
 from .checks import EITHER, Claim
@@ -256,7 +256,7 @@ def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, measured, v
     q = measured()
     if q.subject:
         return c  # said of a subject that names nothing: :func:`unless_elsewhere` decides
-    if quantities.SCORE_BEFORE.search(masked[max(0, n.start - 24):n.start]):
+    if decision.SCORE_BEFORE.search(masked[max(0, n.start - 24):n.start]):
         return c  # 'the only available action (score -74.6)': a score by its own word
     if "|" in q.key:
         return c  # an ambiguous name: the first reading stands
@@ -276,7 +276,7 @@ def by_parse(c: Claim, n, masked: str, book: FactBook, ctx, unit_of, measured, v
         return Claim("number", n.text, "unchecked", f"it counts '{q.noun}', which the explanation holds no fact of "
                                                     f"(first read as {c.detail})", "parse.counts-other")
     if q.noun in AGGREGATE_NOUNS or q.aggregate:  # 'the total effect (1.41)', 'the net drop of 1.21 points'
-        other = quantities.free_number(n, masked, book)
+        other = decision.free_number(n, masked, book)
         return replace(other, rule="parse.measures-whole") if other.status == "verified" else c
     return c  # 'a bump of 19.1' after a name: that name's push, as first read
 
