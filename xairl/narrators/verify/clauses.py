@@ -40,7 +40,7 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
         if summed and (n is tail[0] or (n.percent and not n.points and len(tail) == 2 and n is tail[1])):
             members = list(dict.fromkeys(m.keys for m in said_names))  # (', about 87 % of it'; not 'of the
             counted = _counted(masked, a, said_names)  # 28.3-point rise')
-            if counted and _COUNTS.get(counted.group("k").lower()) != len(members):  # 'the four weather terms
+            if counted and ranks.COUNT[counted.group("k").lower()] != len(members):  # 'the four weather terms
                 out.append(Claim("number", n.text, "unchecked", f"a sum over {counted.group('k')} things, "  # (...)'
                                  f"{len(members)} of them named", "number.sum-unnamed"))  # with three named
             else:
@@ -123,11 +123,8 @@ def _window_words(feature: str) -> frozenset[str]:
 _SUM_CUE = re.compile(r"\b(?:together|combined|jointly|in total|taken together|between them|sum(?:s|med)? to|add up to|"
                       r"in sum|make up|(?:they|these|those)\s+(?:(?:only|just|all|three|two|four)\s+)?"
                       r"(?:add|contribute|account for))\b", re.IGNORECASE)  # ('A, B and C, and they add just 1.85')
-#: how many things a sum is over, in words: 'the three vehicle-and-history factors', 'the two things'
-_COUNTS = {"two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "2": 2, "3": 3, "4": 4, "5": 5, "6": 6}
-_COUNTED = re.compile(r"\b(?P<k>two|three|four|five|six|[2-6])\s+(?:[\w-]+\s+){0,3}?(?:factors|things|terms|features|"
-                      r"drivers|inputs|reasons|variables|items|signals|effects|contributors|pushes|measures)\b",
-                      re.IGNORECASE)
+#: how many things a sum is over, in words (:data:`.ranks.COUNT`): 'the three vehicle-and-history factors'
+_COUNTED = re.compile(rf"\b(?P<k>{'|'.join(ranks.COUNT)})\s+(?:[\w-]+\s+){{0,3}}?{ranks.NOUN}\b", re.IGNORECASE)
 def _counted(masked: str, a: int, names):
     """The count of a sum's things said before its names ('the four weather terms (irradiance, ...)', 'the two things
     working against a return, the loyalty tier and ...'), not a partitive ('of the six factors, A and B ...')."""

@@ -51,14 +51,13 @@ def aggregate_number(n: Number, masked: str, book: FactBook) -> Claim | None:
     if side:  # 'the positives add up to +0.39': that side's sum, in any view; the other side's is a sign error
         said = "positive" if side[-1].group("pos") else "negative"
         other = "negative" if said == "positive" else "positive"
-        own = {w: v for w, v in book.aggregates.items() if f" {other} " not in w}
-        if any(states(v) for v in own.values()):  # (its side's sum, or a whole the words may mean: the net)
-            return Claim("number", n.text, "verified", next(w for w, v in own.items() if states(v)))
+        stated = next((w for w, v in book.aggregates.items() if f" {other} " not in w and states(v)), None)
+        if stated is not None:  # (its side's sum, or a whole the words may mean: the net)
+            return Claim("number", n.text, "verified", stated)
         size = replace(n, value=abs(n.value), sign="", alternatives=())
         wrong = [(w, v) for w, v in book.aggregates.items() if f" {other} " in w and matches(size, abs(v))]
-        own = {w: v for w, v in own.items() if f" {said} " in w}
         if wrong and not after:  # (a side named after the number only verifies: 'adds 6.9 of positive ...')
-            said_sums = ", ".join(f"{w} is {v:+.4g}" for w, v in own.items())
+            said_sums = ", ".join(f"{w} is {v:+.4g}" for w, v in book.aggregates.items() if f" {said} " in w)
             return Claim("number", n.text, "contradicted", f"{said_sums}; {n.text} is the size of {wrong[0][0]}",
                          "number.other-side")
         if wrong:
