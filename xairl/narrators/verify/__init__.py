@@ -221,8 +221,7 @@ def _read_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]
         return []
     if sentence.rstrip().endswith("?"):  # 'Is the competitor offer the main reason?': a question asserts nothing
         mentions, _ = find_mentions(sentence, vocab)
-        return [Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys), "names.mention")
-                for m in mentions if m.kind == "feature"]
+        return [_mention_claim(sentence, m) for m in mentions if m.kind == "feature"]
     try:
         return _check_sentence(sentence, book, vocab, unit_of)
     except Exception as e:  # noqa: BLE001 - a verifier bug must not take the narration down with it
@@ -259,6 +258,12 @@ def _context(sentence: str, mentions: list[Mention], book: FactBook, offset: int
     return None
 
 
+def _mention_claim(sentence: str, m) -> Claim:
+    """A feature named: no claim by itself, but the trace shows which reading found it."""
+    rule = "names.shorthand" if m.form == "shorthand" else "names.mention"
+    return Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys), rule)
+
+
 def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]:
     mentions, masked = find_mentions(sentence, vocab)
     docs = []
@@ -268,8 +273,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
             docs.append(parse.read(sentence, [(m.start, m.end, "|".join(m.keys)) for m in mentions]))
         return docs[0]
     ctx = _context(sentence, mentions, book)
-    claims: list[Claim] = [Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys), "names.mention")
-                           for m in mentions if m.kind == "feature"]
+    claims: list[Claim] = [_mention_claim(sentence, m) for m in mentions if m.kind == "feature"]
     # 'had X been better, it would have stayed': not what happened; only its numbers are checked
     hypothetical = bool(_HYPOTHETICAL.search(masked.replace("\0", "X")))  # a name first is a word, not space
     for m in mentions:

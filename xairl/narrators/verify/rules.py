@@ -65,6 +65,10 @@ def example(name: str) -> Explanation:
 RULES: tuple[Rule, ...] = (
     Rule("names.mention", "feature", "a feature named, in any spelling or by its description's words (no claim by "
          "itself)", fires=(("air", "Traffic mattered."),), silent=(("air", "The weather mattered."),)),
+    Rule("names.shorthand", "feature", "a compact log's shorthand of a name, right before a number: the first letters "
+         "of a word ('alc' of alcohol), the word without vowels ('wknd'), a two-word name's capital initials ('VA')",
+         fires=(("air", "traf 2.4: +7.2; wnd 0.8: +6.9"), ("air", "TI 2.4 (+7.2)")),
+         silent=(("air", "The traf was bad."), ("air", "traffic_index 2.4 (+7.2)"))),
     Rule("action.choice", "action", "a statement of the chosen action or the runner-up",
          fires=(("robot", "The agent chose to turn."),), silent=(("robot", "Speed mattered."),)),
     Rule("category.label", "category", "a categorical value named: it must be the state's",

@@ -113,7 +113,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     for p, kind, keys, label, form in entries:
         pattern, needle = _literal(p) if form == "literal" else _pattern(p, kind)
         compiled.append((pattern, kind, keys, label, "" if form == "literal" else form, needle))
-    return Vocabulary(compiled + _acronyms(exp.feature_names), short, feature_words, frozenset(names))
+    return Vocabulary(compiled + _acronyms(exp.feature_names) + _shorthands(exp.feature_names), short, feature_words,
+                      frozenset(names))
 
 
 def _spellings(name_words: list[str]) -> list[str]:
@@ -199,6 +200,46 @@ def _acronyms(features) -> list:
             owners.setdefault("".join(w[0] for w in words).upper(), []).append(f)
     return [(re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "", _needle(acr))
             for acr, fs in owners.items() if len(fs) == 1]
+
+
+#: a number right after a shorthand ('alc 9.4', 'Wknd +3.2h', 'VA: -0.52'): the only place a shorthand names
+_NUMBER_AFTER = r"(?=\s*[:=]?\s*\(?\s*[+\-−±~≈]?\s?[$€£]?\d)"
+
+
+def _shorthands(features) -> list:
+    """Shorthands of compact logs, each only right before a number and only where one feature has it: the first 3
+    or more letters of a name's word of 5 or more ('alc' of ``alcohol``, 'sulph' of ``sulphates``), a word of 4 or
+    more without its vowels ('wknd' of ``weekend_flag``), the word with '-ing' ('mentoring' of ``mentor_meetings``), and the two
+    capital initials of a name of two words ('VA' of ``volatile_acidity``), as written."""
+    words = {w for f in features for w in split_words(f)}
+    owners: dict[str, set[str]] = {}
+    for f in features:
+        parts = split_words(f)
+        for w in parts:
+            if len(w) < 4 or not w.isalpha() or w in GENERIC or w in UNIT_PARTS:
+                continue
+            prefixes = (w[:k] for k in range(3, len(w))) if len(w) >= 5 else ()
+            skeleton = w[0] + re.sub(r"[aeiou]", "", w[1:])
+            for short in {*prefixes, skeleton, f"{w}ing", f"{w.removesuffix('e')}ing"}:
+                if len(short) >= 3 and short not in words and short not in STOP and short not in GENERIC and short not in _COMMON_SHORT:
+                    owners.setdefault(short, set()).add(f)
+        if len(parts) == 2 and all(w.isalpha() for w in parts):
+            owners.setdefault("".join(w[0] for w in parts).upper(), set()).add(f)
+    out = []
+    for short, fs in owners.items():
+        if len(fs) == 1:
+            flags = 0 if short.isupper() else re.IGNORECASE
+            out.append((re.compile(rf"(?<![\w]){re.escape(short)}(?![\w]){_NUMBER_AFTER}", flags), "feature",
+                        (next(iter(fs)),), "", "shorthand", _needle(short)))
+    return out
+
+
+#: English words a shorthand must not be, since they stand before numbers in any prose
+_COMMON_SHORT = {"sum", "net", "top", "all", "add", "and", "for", "was", "are", "but", "not", "now", "one", "two",
+                 "six", "ten", "pos", "neg", "see", "set", "get", "out", "off", "its", "has", "had", "got", "put", "say",
+                 "let", "use", "cut", "max", "min", "avg", "day", "days", "week", "year", "hour", "than", "then",
+                 "with", "from", "over", "only", "just", "each", "some", "more", "less", "most", "down", "gave",
+                 "give", "lift", "push", "drag", "pull", "base", "mean", "total", "score", "value", "shift", "plus"}
 
 
 def _phrase(text: str) -> str:
