@@ -209,9 +209,9 @@ _NUMBER_AFTER = r"(?=\s*[:=]?\s*\(?\s*[+\-−±~≈]?\s?[$€£]?\d)"
 def _shorthands(features) -> list:
     """Shorthands of compact logs, each only right before a number and only where one feature has it: the first 3
     or more letters of a name's word of 5 or more ('alc' of ``alcohol``, 'sulph' of ``sulphates``), a word of 4 or
-    more without its vowels ('wknd' of ``weekend_flag``), the word with '-ing' ('mentoring' of ``mentor_meetings``), and the two
-    capital initials of a name of two words ('VA' of ``volatile_acidity``), as written."""
-    words = {w for f in features for w in split_words(f)}
+    more without its vowels ('wknd' of ``weekend_flag``), the word with '-ing' ('mentoring' of ``mentor_meetings``),
+    and the two capital initials of a name of two words ('VA' of ``volatile_acidity``), as written."""
+    words = {w for f in features for w in split_words(f)} | STOP | GENERIC | _COMMON_SHORT
     owners: dict[str, set[str]] = {}
     for f in features:
         parts = split_words(f)
@@ -221,7 +221,7 @@ def _shorthands(features) -> list:
             prefixes = (w[:k] for k in range(3, len(w))) if len(w) >= 5 else ()
             skeleton = w[0] + re.sub(r"[aeiou]", "", w[1:])
             for short in {*prefixes, skeleton, f"{w}ing", f"{w.removesuffix('e')}ing"}:
-                if len(short) >= 3 and short not in words and short not in STOP and short not in GENERIC and short not in _COMMON_SHORT:
+                if len(short) >= 3 and short not in words:
                     owners.setdefault(short, set()).add(f)
         if len(parts) == 2 and all(w.isalpha() for w in parts):
             owners.setdefault("".join(w[0] for w in parts).upper(), set()).add(f)
