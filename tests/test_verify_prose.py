@@ -1204,3 +1204,23 @@ def test_a_unit_or_statistic_in_a_name_is_no_mention_on_its_own():
     assert said("The others add 14.7 min; avg 3.2.") == []
     assert said("hm_pr_min adds 11.2 min, AvgWait5m 0.26.") == [("hm_pr_min",), ("AvgWait5m",)]
     assert said("The hm pr min adds 11.2.") == [("hm_pr_min",)]
+
+
+def test_log_odds_given_as_a_probability_and_names_with_an_index_or_an_acronym():
+    """A log-odds output and its baseline may be written as the probabilities they stand for; an index in square
+    brackets ('forecast_price[+6h]') is part of a name, not a signed number; 'debt-to-income' is dti_ratio."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["dti_ratio", "forecast_price[+6h]", "FICO_score"], [0.41, 118.0, 648], [0.62, 0.56, 0.65],
+                     -2.1, "log-odds of default within 12 months")  # prediction -0.27: a probability of 43.3 %
+
+    def numbers(text):
+        return [(c.text, c.status) for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    said = "The log-odds rise from -2.10 at baseline to -0.27, which corresponds to a probability of roughly {}."
+    assert numbers(said.format("43%"))[-1] == ("43%", "verified")
+    assert numbers(said.format("60%"))[-1] == ("60%", "contradicted")
+    assert numbers("From about 11% to about 43%.") == [("11%", "verified"), ("43%", "verified")]
+    assert numbers("next=forecast_price[+6h](+0.56)") == [("+0.56", "verified")]
+    assert numbers("next=forecast_price[+6h](+0.65)") == [("+0.65", "contradicted")]
+    assert numbers("The debt-to-income ratio of 0.41 adds +0.62.") == [("0.41", "verified"), ("+0.62", "verified")]
+    prob = one_output(["dti_ratio"], [0.41], [0.62], -2.1, "probability of default")  # not log-odds: no reading
+    assert ("43%", "verified") not in [(c.text, c.status) for c in xairl.verify(said.format("43%"), prob, 0).claims]

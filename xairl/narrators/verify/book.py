@@ -16,10 +16,15 @@ _CLAIMY = re.compile(r"[+\-\u2212]\d|\d\.\d|%|\b(toward|towards|against|raises|l
                      r"first|second|third)\s+(feature|factor|driver|reason|contributor|influence)s?\b", re.IGNORECASE)
 
 
+#: an index in square brackets ('forecast_price[+6h]', 'lag[-1]', 'obs[0,-2]'): whole numbers, signs and letters
+_INDEX = re.compile(r"\[[\w+\-\u2212, ]*\]")
+
+
 def clean_surface(text: str) -> bool:
     """May this name or description hide its words from the verifier? Not if it carries claims itself (a signed or
-    decimal number, a percentage, a direction or rank word): text from data files or plugins cannot smuggle claims."""
-    return not _CLAIMY.search(text)
+    decimal number, a percentage, a direction or rank word) outside an index in square brackets: text from data
+    files or plugins cannot smuggle claims."""
+    return not _CLAIMY.search(_INDEX.sub(" ", text))
 
 
 @dataclass
@@ -73,6 +78,12 @@ class FactBook:
         return bool(_PROBABILITY.search(self.chosen or "")) and 0 <= self.base <= 100 and 1 < score <= 100
 
     @property
+    def log_odds(self) -> bool:
+        """One output in log-odds ('log-odds of default'): a text may give it, and its baseline, as the probability
+        it stands for ('-0.27, roughly 43 %')."""
+        return self.output != "actions" and bool(_LOG_ODDS.search(self.chosen or ""))
+
+    @property
     def outcome_sign(self) -> int:
         """Where one output went from the baseline: +1 up, -1 down, 0 unknown or several actions ('the primary
         reasons for the model's prediction' are the features that moved it that way)."""
@@ -82,6 +93,7 @@ class FactBook:
 
 
 _PROBABILITY = re.compile(r"\b(?:probab\w*|chances?|risk|likelihood|share|percent\w*)\b|%", re.IGNORECASE)
+_LOG_ODDS = re.compile(r"\blog[- ]?odds\b|\blogits?\b", re.IGNORECASE)
 _LEGEND_ENTRY = re.compile(r"^\s*(\d+)\s*[:=]?\s+(\S.*?)\s*$")
 
 

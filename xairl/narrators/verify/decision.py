@@ -4,6 +4,7 @@ tied to no name (:func:`free_number`: the quantity its cue words name, any decis
 whose contribution it is). Numbers tied to a feature are :mod:`.quantities`."""
 from __future__ import annotations
 
+import math
 import re
 
 from . import quantities
@@ -137,9 +138,12 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         elif _OUT_WORDS.search(before) and n.sign != "+":  # ('made extending more valuable (+1.0)', 'Price +0.051':
             named = ("the prediction", [book.scores[book.chosen]])  # a plus sign marks a push, not where it ends)
     if named is not None and named[1]:
-        ok = any(matches(n, v, magnitude_ok=False) or (n.percent and percent_reading(n, v)) for v in named[1])
+        ok = any(matches(n, v, magnitude_ok=False) or (n.percent and percent_reading(n, v)) for v in named[1]) or (
+            named[0] in ("the prediction", "the baseline") and probability(n, named[1][0], book))
         return Claim("number", n.text, "verified" if ok else "contradicted", f"{named[0]} is {named[1][0]:.4g}")
-    if any(matches(n, v) or (n.percent and percent_reading(n, v)) for v in book.decision_numbers):
+    if any(matches(n, v) or (n.percent and percent_reading(n, v)) for v in book.decision_numbers) or (
+            book.base is not None and book.chosen in book.scores and
+            any(probability(n, v, book) for v in (book.scores[book.chosen], book.base))):
         if quantities.CONTRIB_BEFORE.search(before) or re.match(r"\s*(?:points?\s+)?more\b", after):
             return Claim("number", n.text, "unchecked", "a push by its words ('adds', '8 more'), equal to a "
                                                         "decision-level number but to no feature's contribution")
@@ -158,5 +162,11 @@ def output_number(n: Number, book: FactBook, start: bool = False) -> Claim:
     """A number said to be where the output ends up ('pulls it down to 0.142'): the prediction; ``start``: where it
     starts ('from 34.1 % to ...'), the baseline."""
     v, what = (book.base, "baseline") if start else (book.scores[book.chosen], "prediction")
-    ok = matches(n, v, magnitude_ok=False) or (n.percent and percent_reading(n, v))
+    ok = matches(n, v, magnitude_ok=False) or (n.percent and percent_reading(n, v)) or probability(n, v, book)
     return Claim("number", n.text, "verified" if ok else "contradicted", f"the {what} is {v:.4g}")
+
+
+def probability(n: Number, v: float, book: FactBook) -> bool:
+    """Is ``n`` a percentage that states log-odds ``v`` of a log-odds output as the probability it stands for
+    ('the log-odds rise to -0.27, a probability of roughly 43 %')?"""
+    return n.percent and book.log_odds and percent_reading(n, 1.0 / (1.0 + math.exp(-min(max(v, -700.0), 700.0))))

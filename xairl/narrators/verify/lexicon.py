@@ -24,7 +24,10 @@ ABBREVIATIONS = {"dist": "distance", "temp": "temperature", "avg": "average", "n
                  "std": "deviation", "vol": "volume", "bal": "balance", "inc": "income", "pop": "population",
                  "elev": "elevation", "alt": "altitude", "lat": "latitude", "lon": "longitude", "lng": "longitude",
                  "spd": "speed", "accel": "acceleration", "humid": "humidity", "precip": "precipitation",
-                 "batt": "battery", "conc": "concentration", "env": "environment", "cust": "customer"}
+                 "batt": "battery", "conc": "concentration", "env": "environment", "cust": "customer",
+                 # acronyms of their fields that people write out
+                 "dti": "debt to income", "ltv": "loan to value", "soc": "state of charge", "bmi": "body mass index",
+                 "anc": "neutrophil count", "crcl": "creatinine clearance"}
 #: words of feature names and other words people write for the same thing ('battery_pct': 'the charge'); each makes
 #: one more spelling of the name, so a word shared by two names ('charge') names both, ambiguously
 SYNONYMS = {"battery": ("charge",), "temperature": ("fever",), "heart": ("pulse",), "distance": ("far",),
