@@ -1224,3 +1224,17 @@ def test_log_odds_given_as_a_probability_and_names_with_an_index_or_an_acronym()
     assert numbers("The debt-to-income ratio of 0.41 adds +0.62.") == [("0.41", "verified"), ("+0.62", "verified")]
     prob = one_output(["dti_ratio"], [0.41], [0.62], -2.1, "probability of default")  # not log-odds: no reading
     assert ("43%", "verified") not in [(c.text, c.status) for c in xairl.verify(said.format("43%"), prob, 0).claims]
+
+
+def test_a_span_of_time_names_no_feature():
+    """'in the last two years' names no months_since_last_record: its 'two' is not that feature's value; the
+    written-out acronym 'the antibiotics' still names abx_given_last_24h."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["delinq_2yrs", "months_since_last_record", "abx_given_last_24h"], [1, 14, 1], [2.6, 0.4, -3.3],
+                     12.0, "risk")
+
+    def claims(text):
+        return [(c.text, c.status) for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
+    assert ("two", "contradicted") not in claims("One delinquency in the last two years adds 2.6 points.")
+    assert ("2.6 points", "verified") in claims("One delinquency in the last two years adds 2.6 points.")
+    assert claims("The antibiotics take off about 3.3 points.") == [("3.3 points", "verified")]

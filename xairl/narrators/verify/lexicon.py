@@ -11,6 +11,10 @@ GENERIC = {"size", "area", "number", "total", "rate", "ratio", "level", "value",
            "information", "prediction", "new", "old", "high", "low", "first", "second", "third", "average",
            "strongest", "weakest", "biggest", "largest", "main", "top", "overall",
            "other", "others"}  # rank words say which, not what
+#: words of a span of time, generic too ('in the last two years' names no months_since_last_record), but never a
+#: shared mention of the names that hold them
+SPAN = {"last", "since", "today"}
+GENERIC |= SPAN
 #: units and statistics in names that never name a feature on their own ('14.7 min' is no mention of hm_pr_min, 'avg
 #: 3.2' none of AvgWait5m), though a run of words holding them may
 UNIT_PARTS = {"min", "max", "avg", "mean", "median", "pct", "num", "cnt", "yrs", "yr", "mins", "secs", "sec", "ms",
@@ -27,7 +31,8 @@ ABBREVIATIONS = {"dist": "distance", "temp": "temperature", "avg": "average", "n
                  "batt": "battery", "conc": "concentration", "env": "environment", "cust": "customer",
                  # acronyms of their fields that people write out
                  "dti": "debt to income", "ltv": "loan to value", "soc": "state of charge", "bmi": "body mass index",
-                 "anc": "neutrophil count", "crcl": "creatinine clearance"}
+                 "anc": "neutrophil count", "crcl": "creatinine clearance", "inq": "inquiries",
+                 "abx": "antibiotics"}
 #: words of feature names and other words people write for the same thing ('battery_pct': 'the charge'); each makes
 #: one more spelling of the name, so a word shared by two names ('charge') names both, ambiguously
 SYNONYMS = {"battery": ("charge",), "temperature": ("fever",), "heart": ("pulse",), "distance": ("far",),

@@ -11,8 +11,8 @@ from ...explanation import Explanation
 from ...observation import REGION_RE
 from ...policy import Policy
 from .book import legend
-from .lexicon import (ABBREVIATIONS, BASE_FORM as _BASE_FORM, GENERIC, IRREGULAR as _IRREGULAR, STOP, SYNONYMS,
-                      UNIT_PARTS)
+from .lexicon import (ABBREVIATIONS, BASE_FORM as _BASE_FORM, GENERIC, IRREGULAR as _IRREGULAR, SPAN, STOP,
+                      SYNONYMS, UNIT_PARTS)
 
 #: what a model's input describes: a word of a feature's description, never a feature on its own
 _INSTANCES = frozenset({"patient", "applicant", "borrower", "customer", "client", "person", "student", "team", "player",
@@ -83,7 +83,7 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     shared: dict[str, set[str]] = {}
     for f in [*exp.feature_names, *groups]:
         for w in split_words(f):
-            if w in GENERIC and len(w) >= 4:
+            if w in GENERIC and len(w) >= 4 and w not in SPAN:
                 shared.setdefault(w, set()).add(f)
     for w, keys in shared.items():  # 'quality' of overall_quality and kitchen_quality: named, but not which
         if len(keys) > 1 and w not in phrases and w not in exact:
