@@ -1238,3 +1238,20 @@ def test_a_span_of_time_names_no_feature():
     assert ("two", "contradicted") not in claims("One delinquency in the last two years adds 2.6 points.")
     assert ("2.6 points", "verified") in claims("One delinquency in the last two years adds 2.6 points.")
     assert claims("The antibiotics take off about 3.3 points.") == [("3.3 points", "verified")]
+
+
+def test_a_ratio_written_as_odds():
+    """'outweighed B by roughly 1.5 to 1', 'two to one (x vs y)', '3:1': the ratio of the two sizes, checked; its
+    numbers are no values (but 'fell from 3 to 1' states two)."""
+    from xairl.narrators.verify.rules import example
+    exp = example("air")  # traffic_index +7.2, wind_speed_ms +6.9: a ratio of 1.04
+
+    def claims(text):
+        return [(c.text, c.status) for c in xairl.verify(text, exp, 0).claims if c.kind != "feature"]
+    assert claims("Traffic outweighed wind by roughly 1 to 1.") == [("outweighed", "verified")]
+    assert claims("Traffic outweighed wind by roughly 3 to 1.") == [("outweighed", "contradicted")]
+    assert claims("Traffic outweighs wind 1:1.") == [("outweighs", "verified")]
+    assert claims("Traffic outweighs wind roughly one to one (7.2 vs 6.9).") == [
+        ("7.2", "verified"), ("6.9", "verified"), ("outweighs", "verified")]
+    assert ("outweighs", "contradicted") in claims("Traffic outweighs wind roughly two to one (7.2 vs 6.9).")
+    assert [s for _, s in claims("Traffic fell from 3 to 1.")] == ["contradicted", "contradicted"]

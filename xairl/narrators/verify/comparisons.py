@@ -28,9 +28,13 @@ _AFTER_THAN = re.compile(r"\s*(?:the|its|their|his|her|a|an|being|[\w-]+'s)\s+(?
                          r"usual|typical|average|previous|one|anything|everything|and|or|with|for|would|did|does|"
                          r"base|baseline|prediction|forecast|output|score)\b)[a-z'-]+\s+){0,4}", re.IGNORECASE)
 #: a ratio after the name compared with: '... than the pacing plan (-1.4) by a factor of ~2.6'
-_FACTOR_AFTER = re.compile(r"(?:\s*\([^()]*\))?\s*(?:did\s+|does\s+)?,?\s*by\s+a\s+factor\s+of\s+"
-                           r"(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|~\s*)?(\d+(?:\.\d+)?)\b",
+#: or 'outweighed the gusts by roughly 1.5 to 1', 'outweighs fever roughly two to one (1.46 vs 0.77)'
+_FACTOR_AFTER = re.compile(r"(?:\s*\([^()]*\))?\s*(?:did\s+|does\s+)?,?\s*(?:by\s+a\s+factor\s+of\s+"
+                           r"(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|~\s*)?(\d+(?:\.\d+)?)\b|"
+                           r"(?:by\s+)?(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|some\s+|~\s*)?"
+                           r"(\d+(?:\.\d+)?|one|two|three|four|five|ten)\s*(?:to|:)\s*(?:1|one)(?!\w|\.\d))",
                            re.IGNORECASE)
+_FACTOR_WORDS = {"one": 1.0, "two": 2.0, "three": 3.0, "four": 4.0, "five": 5.0, "ten": 10.0}
 SAME_WITHIN = 0.25  # 'about as much as': the two sizes within 25 % of the larger
 
 
@@ -140,8 +144,10 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
         ratio = _ratio(masked[max(a, m.start() - 40):m.start()], way) if not m.group("of") else _of_ratio(
             masked[max(a, m.start() - 12):m.start()], m.group("of"))
         factor = _FACTOR_AFTER.match(masked, b_name.end, b)  # 'larger than B (-1.4) by a factor of ~2.6' (of one
-        if ratio is None and factor is not None and way and len(subjects) == 1 and float(factor.group(1)) > 0:
-            ratio = float(factor.group(1)) ** way  # name; 'smaller than B by a factor of 5': a fifth)
+        stated = factor and (factor.group(1) or factor.group(2)).lower()
+        stated = _FACTOR_WORDS.get(stated) or float(stated) if stated else 0.0
+        if ratio is None and factor is not None and way and len(subjects) == 1 and stated > 0:
+            ratio = stated ** way  # name; 'smaller than B by a factor of 5': a fifth)
         else:
             factor = None
         if ratio is not None and (not m.group("out") or factor is not None):  # 'roughly 1.7 times as much as B',
@@ -174,7 +180,8 @@ def compared_pairs(masked: str, a: int, b: int, names: list[Mention], numbers) -
         b_name = next((x for x in names if x.start >= m.end()), None)
         if b_name is None or not re.fullmatch(r"\s*(?:the\s+|its\s+|their\s+)?", masked[m.end():b_name.start]):
             continue
-        bracket = _SIDE_BY_SIDE.match(masked, b_name.end)
+        factor = _FACTOR_AFTER.match(masked, b_name.end)  # ('A outweighs B roughly two to one (x vs y)')
+        bracket = _SIDE_BY_SIDE.match(masked, b_name.end) or (factor and _SIDE_BY_SIDE.match(masked, factor.end()))
         subjects = [x for x in names if x.end <= m.start()][-1:]
         inside = [n for n in numbers if bracket and b_name.end <= n.start and n.end <= bracket.end()]
         if bracket and subjects and len(inside) == 2:

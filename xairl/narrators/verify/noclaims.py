@@ -26,6 +26,12 @@ _FACTOR_BEFORE = re.compile(r"\bby\s+a\s+factor\s+of\s+(?:about\s+|roughly\s+|ar
                             re.IGNORECASE)
 
 
+#: a ratio written as odds: the number before 'to 1' ('1.5 to 1', 'two to one', '3:1'), and the 1 after it
+_TO_ONE = re.compile(r"\s*(?:to|:)\s*(?:1|one)(?!\w|\.\d)(?!\s*(?:%|percent|points?|pp)\b)", re.IGNORECASE)
+_TO_ONE_BEFORE = re.compile(r"(?<![\w.])(?<!from )(?<!between )(?:\d+(?:\.\d+)?|one|two|three|four|five|ten)\s*"
+                            r"(?:to|:)\s*$", re.IGNORECASE)  # (not 'fell from 3 to 1': a value)
+
+
 def skip_number(n: Number, masked: str) -> bool:
     """Numbers that are not claims: list markers ('1.' at a line start), identifiers ('candidate 2', 'top-3'),
     counts of the method's inputs ('100 background rows')."""
@@ -42,6 +48,9 @@ def skip_number(n: Number, masked: str) -> bool:
         return True  # '60 % of the alcohol effect': a ratio to that name (:mod:`.comparisons`)
     if _FACTOR_BEFORE.search(before[-30:]) and not n.percent and not n.text.isalpha():
         return True  # 'larger than B by a factor of ~2.6': a ratio (:mod:`.comparisons`)
+    if not (n.percent or n.currency or n.sign) and ((_TO_ONE.match(masked, n.end) and not re.search(
+            r"\b(?:from|between)\s+$", before, re.IGNORECASE)) or (n.value == 1 and _TO_ONE_BEFORE.search(before))):
+        return True  # 'outweighed B by roughly 1.5 to 1', 'two to one': a ratio (:mod:`.comparisons`)
     if re.match(r"^\s+(?:most|largest|biggest|main|top|strongest|key)\b", masked[n.end:]):  # 'the two largest'
         return True
     if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):
