@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .book import FactBook
+from .lexicon import CLOSED_CLASSES
 from .names import Mention
 from .vocabulary import split_words, stem
 
@@ -183,6 +184,26 @@ def stated_category(masked: str, m: Mention, mentions: list[Mention], book: Fact
     f = m.keys[0]
     return Claim("category", said, "verified" if ok else "contradicted",
                  f"{f} is {label}" if ok else f"{f} is {label}, not {said}", "category.stated")
+
+
+def closed_class_category(masked: str, m: Mention, mentions: list[Mention], book: FactBook) -> Claim | None:
+    """A member of a closed class (a month, weekday, season, compass point or time of day:
+    :data:`~.lexicon.CLOSED_CLASSES`) in a sentence that names a categorical feature whose label holds another member
+    of that class: contradicted ('The summer season added ...' when the season is winter). Not when another named
+    feature's label is of the same class (whose value would it be?), nor a member inside a name."""
+    if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
+        return None
+    own = set(split_words(label))
+    cls = next((c for c in CLOSED_CLASSES if own & c), None)
+    if cls is None or any(set(split_words(book.features[k].label or "")) & cls for x in mentions for k in x.keys
+                          if x.kind == "feature" and k != m.keys[0] and k in book.features):
+        return None
+    for w in re.finditer(r"[A-Za-z]+", masked):
+        said = w.group(0).lower()
+        if said in cls and said not in own:
+            return Claim("category", w.group(0), "contradicted", f"{m.keys[0]} is {label}, not {w.group(0)}",
+                         "category.closed-class")
+    return None
 
 
 # -- directions --------------------------------------------------------------------------------------------------

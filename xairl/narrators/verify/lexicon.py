@@ -41,3 +41,13 @@ SYNONYMS = {"battery": ("charge",), "temperature": ("fever",), "heart": ("pulse"
 #: participles that name a feature whose words are said the other way round ('year built' -> 'the build year')
 BASE_FORM = {"built": "build", "sold": "sale", "made": "make", "paid": "pay", "owned": "own", "used": "use"}
 IRREGULAR = {"keep": "kept", "go": "went", "choose": "chose", "hold": "held", "run": "ran", "stay": "stayed"}
+#: closed classes of categorical values: a label holding one member makes any other member, said in a sentence that
+#: names its feature, a wrong value ('Because it was June, the month term added ...' when the month is August)
+CLOSED_CLASSES = (
+    frozenset({"january", "february", "march", "april", "june", "july", "august", "september", "october", "november",
+               "december"}),  # (not 'may': a verb)
+    frozenset({"monday", "tuesday", "wednesday", "thursday", "friday", "saturday", "sunday"}),
+    frozenset({"winter", "spring", "summer", "autumn"}),  # (not 'fall': a verb)
+    frozenset({"north", "south", "east", "west", "northeast", "northwest", "southeast", "southwest"}),
+    frozenset({"morning", "afternoon", "evening", "night", "overnight"}),
+)

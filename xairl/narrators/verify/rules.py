@@ -38,6 +38,9 @@ def example(name: str) -> Explanation:
     ``drone``: the Q-value of continuing (one output), base 3.1; next_drop_dist_km 0.6 (+1.15), charger_queue_len 3
     (-0.27), battery_pct 46 (+0.49), drone_model X2 (+0.09); no policy, so units come from the names.
 
+    ``fire``: ignition risk (one output), base 4.0; month August (+1.9), aspect south-west (+0.6), days_since_rain
+    15 (+2.2); only the state's labels are known.
+
     ``robot``: a discrete policy; turn (3.2) chosen over recharge (2.0) and forward (-0.5), base 1.0 each; on the
     chosen score speed +0.5, battery -0.3, obstacle +2.0; on the margin over recharge speed +0.7, battery -1.5,
     obstacle +2.0.
@@ -56,6 +59,12 @@ def example(name: str) -> Explanation:
                            feature_names=("next_drop_dist_km", "charger_queue_len", "battery_pct", "drone_model"),
                            action_names=("continue",), method="given", output="value",
                            categories={"drone_model": ("X2", "X3")})
+    if name == "fire":
+        c = np.array([1.9, 0.6, 2.2])
+        return Explanation(values=c.reshape(1, -1, 1), base_values=np.array([[4.0]]),
+                           outputs=np.array([[4.0 + c.sum()]]), states=np.array([[0.0, 0.0, 15.0]]),
+                           feature_names=("month", "aspect", "days_since_rain"), action_names=("ignition risk",),
+                           method="given", output="value", categories={"month": ("August",), "aspect": ("south-west",)})
     c = np.array([[0.5, -0.2, 0.1], [-0.3, 1.2, -0.1], [2.0, 0.0, -1.5]])
     return Explanation(values=c[None], base_values=np.ones((1, 3)), outputs=(1 + c.sum(axis=0))[None],
                        states=np.array([[0.4, 0.3, 0.9]]), feature_names=("speed", "battery", "obstacle"),
@@ -73,6 +82,11 @@ RULES: tuple[Rule, ...] = (
          fires=(("robot", "The agent chose to turn."),), silent=(("robot", "Speed mattered."),)),
     Rule("category.label", "category", "a categorical value named: it must be the state's",
          fires=(("air", "It is winter."),), silent=(("air", "It is cold."),)),
+    Rule("category.closed-class", "category", "a month, weekday, season, compass point or time of day in a sentence "
+         "that names a categorical feature whose label is another of its class",
+         fires=(("fire", "Because it was June, the month term added +1.9."), ("fire", "The north-facing aspect added "
+                "a little.")), silent=(("fire", "The August month term added +1.9."), ("fire", "The south-facing "
+                                      "aspect added a little."), ("fire", "Fifteen dry days since June added 2.2."))),
     Rule("category.stated", "category", "a value given to a categorical feature right after its name ('is rated "
          "medium', \"was flagged as 'late'\", 'F=flat', a quoted value) or capitalised right before it ('the Midwifery "
          "course'): it must share a word with the state's label (or be its initials); yes/no labels are left to the "
