@@ -155,7 +155,8 @@ _STATED = re.compile(r"(?:'s\s+\w+)?(?:\s+(?:on|of|for|in|at)\s+(?:the\s+|its\s+
                      r"(?!(?:as|to|by|a|an|the)\b)[A-Za-z][\w-]*(?=\s*(?:[,.;:!?)]|$|\s(?:and|but|yet|which|so|"
                      r"while|though)\b)))", re.IGNORECASE)
 #: a capitalised value right before the name, after a determiner: 'the Midwifery course', 'the Cavado sub-region'
-_VALUE_BEFORE = re.compile(r"\b(?:the|a|an|her|his|their|its|your)\s+(?P<value>[A-Z][a-z]+(?:-[A-Z]?[a-z]+)?)\s+$")
+_VALUE_BEFORE = re.compile(r"\b(?:the|a|an|her|his|their|its|your)\s+(?P<value>[A-Z][a-z]+(?:-[A-Z]?[a-z]+)?|"
+                           r"[A-Z]{2,}\d*)\s+$")  # (or in capitals: 'a FOLFIRI regimen')
 #: a log's field and its value: 'course_profile=flat', 'tier: gold' (one word, letters first)
 _FIELD_VALUE = re.compile(r"\s?(?:=\s?|:\s?(?=[A-Za-z][\w-]*\s*(?:[,;|)\]]|$|[+\-]?\d|\w+=)))"  # (':' only as a
                           r"(?!(?:negative|positive|up|down|plus|minus|na|n/a)\b)"  # field: not 'a deposit: three
@@ -203,6 +204,34 @@ def closed_class_category(masked: str, m: Mention, mentions: list[Mention], book
         if said in cls and said not in own:
             return Claim("category", w.group(0), "contradicted", f"{m.keys[0]} is {label}, not {w.group(0)}",
                          "category.closed-class")
+    return None
+
+
+_NEGATOR = r"(?:\bno|\bnot|\bnon|\bnever|\bwithout|n't|\bun)"
+_NEGATED_BEFORE = re.compile(_NEGATOR + r"[\s-]*(?:the\s+|a\s+|an\s+|any\s+)?$", re.IGNORECASE)
+_YES = frozenset({"yes", "true", "y", "present"})
+
+
+def negated_category(masked: str, m: Mention, book: FactBook) -> Claim | None:
+    """A label said the other way: 'no fever' (or 'without the fever') when Fever_38C is 'yes'; 'the income was
+    verified' when verification_status is 'Not Verified'; 'unverified' or 'not verified' when it is 'Verified'."""
+    if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
+        return None
+    f, words = m.keys[0], split_words(label)
+    if label.lower() in _YES:
+        said = _NEGATED_BEFORE.search(masked, max(0, m.start - 16), m.start)
+        return Claim("category", masked[said.start():m.start].strip() + " " + f, "contradicted",
+                     f"{f} is {label}", "category.negated") if said else None
+    negated = words[0] in ("not", "no", "non") and len(words) == 2
+    core = words[-1] if negated or len(words) == 1 else None
+    if core is None or len(core) < 4 or core in _BOOLEAN:
+        return None
+    for w in re.finditer(rf"(?<![\w\0])(?:un|non-?)?{re.escape(stem(core).rstrip('~'))}\w*", masked, re.IGNORECASE):
+        said_not = bool(re.match(r"(?:un|non)", w.group(0), re.IGNORECASE) and not core.startswith(("un", "non"))) \
+            or bool(_NEGATED_BEFORE.search(masked, max(0, w.start() - 12), w.start())) or \
+            bool(re.search(r"\b(?:not|n't|never)\s+(?:\w+\s+)?$", masked[max(0, w.start() - 16):w.start()]))
+        if said_not != negated:
+            return Claim("category", w.group(0), "contradicted", f"{f} is {label}", "category.negated")
     return None
 
 

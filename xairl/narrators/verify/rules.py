@@ -39,7 +39,7 @@ def example(name: str) -> Explanation:
     (-0.27), battery_pct 46 (+0.49), drone_model X2 (+0.09); no policy, so units come from the names.
 
     ``fire``: ignition risk (one output), base 4.0; month August (+1.9), aspect south-west (+0.6), days_since_rain
-    15 (+2.2); only the state's labels are known.
+    15 (+2.2), campfire_ban yes (-0.4), patrol_status 'Not Staffed' (+0.3); only the state's labels are known.
 
     ``robot``: a discrete policy; turn (3.2) chosen over recharge (2.0) and forward (-0.5), base 1.0 each; on the
     chosen score speed +0.5, battery -0.3, obstacle +2.0; on the margin over recharge speed +0.7, battery -1.5,
@@ -60,11 +60,13 @@ def example(name: str) -> Explanation:
                            action_names=("continue",), method="given", output="value",
                            categories={"drone_model": ("X2", "X3")})
     if name == "fire":
-        c = np.array([1.9, 0.6, 2.2])
+        c = np.array([1.9, 0.6, 2.2, -0.4, 0.3])
         return Explanation(values=c.reshape(1, -1, 1), base_values=np.array([[4.0]]),
-                           outputs=np.array([[4.0 + c.sum()]]), states=np.array([[0.0, 0.0, 15.0]]),
-                           feature_names=("month", "aspect", "days_since_rain"), action_names=("ignition risk",),
-                           method="given", output="value", categories={"month": ("August",), "aspect": ("south-west",)})
+                           outputs=np.array([[4.0 + c.sum()]]), states=np.array([[0.0, 0.0, 15.0, 0.0, 0.0]]),
+                           feature_names=("month", "aspect", "days_since_rain", "campfire_ban", "patrol_status"),
+                           action_names=("ignition risk",), method="given", output="value",
+                           categories={"month": ("August",), "aspect": ("south-west",), "campfire_ban": ("yes",),
+                                       "patrol_status": ("Not Staffed",)})
     c = np.array([[0.5, -0.2, 0.1], [-0.3, 1.2, -0.1], [2.0, 0.0, -1.5]])
     return Explanation(values=c[None], base_values=np.ones((1, 3)), outputs=(1 + c.sum(axis=0))[None],
                        states=np.array([[0.4, 0.3, 0.9]]), feature_names=("speed", "battery", "obstacle"),
@@ -87,6 +89,11 @@ RULES: tuple[Rule, ...] = (
          fires=(("fire", "Because it was June, the month term added +1.9."), ("fire", "The north-facing aspect added "
                 "a little.")), silent=(("fire", "The August month term added +1.9."), ("fire", "The south-facing "
                                       "aspect added a little."), ("fire", "Fifteen dry days since June added 2.2."))),
+    Rule("category.negated", "category", "a label said the other way: 'no F' when F is 'yes'; the label's word "
+         "without a negation when the label is 'Not X', or with one when it is 'X'",
+         fires=(("fire", "With no campfire ban, the risk rose."), ("fire", "The tower was staffed, so patrol_status "
+                "added 0.3.")), silent=(("fire", "The campfire ban lowered it by 0.4."), ("fire", "The tower was not "
+                                       "staffed: patrol_status added 0.3."))),
     Rule("category.stated", "category", "a value given to a categorical feature right after its name ('is rated "
          "medium', \"was flagged as 'late'\", 'F=flat', a quoted value) or capitalised right before it ('the Midwifery "
          "course'): it must share a word with the state's label (or be its initials); yes/no labels are left to the "
