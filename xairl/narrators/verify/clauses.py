@@ -65,6 +65,9 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
             masked[a:first.start], name_words)]  # '; roof condition -12.1k;'
     out += [binding.named(c, "direction.subject") for c in directions.directions(masked, a, b, said, book, ctx,
                                                                                 name_words, parsed)]
+    if not said_names:  # '...; it actually raised the risk by 1.6 points': whose push the number says
+        out += [binding.named(c, "direction.by-number") for c in directions.by_number(masked, a, b, numbers, mentions,
+                                                                                     book, ctx)]
     out += [binding.named(c, "rank.words") for c in ranks.find_ranks(masked, a, b, said, book, ctx, written)]
     out += [binding.named(c, "rank.comparison")
             for c in comparisons.find_comparisons(masked, a, b, said, book, ctx, written)]

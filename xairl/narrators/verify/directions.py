@@ -12,7 +12,9 @@ from .book import FactBook
 from .checks import Claim
 from .lexicon import GENERIC
 from .names import Mention, named_features
+from .numbers import matches
 from .parse import said_of, same_clause
+from .quantities import contribution_owners
 from .ranks import NOUN
 from .vocabulary import split_words, stem
 
@@ -180,6 +182,31 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
         out += checks.check_direction(flipped, -polarity, where, f"{m.group(0)} (all but it)", book)
         bare, prev = not subjects and not flipped, m.end()
     return out
+
+
+_COST = re.compile(r"^cost", re.IGNORECASE)
+
+
+def by_number(masked: str, a: int, b: int, numbers, mentions: list[Mention], book: FactBook,
+              ctx: str | None) -> list[Claim]:
+    """The one direction word of a clause that names no feature, followed by one number that is one feature's
+    contribution and no decision-level number ('The ban did nothing to help; it actually raised the risk by 1.6
+    points', where only campfire_ban's contribution is 1.6 in size): that feature's push, checked."""
+    found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
+    if len(found) != 1 or _no_push(found[0], masked, mentions, book) or _COST.match(found[0].group(0)):
+        return []  # ('it costs him about 7 minutes' of a finish time: a cost may be what the output counts)
+    masked = " " * a + masked[a:]  # a negation before the clause is not its own ('did not hurt; it subtracted 0.16')
+    m = next(checks.DIRECTION_RE.finditer(masked, a, b))
+    after = [n for n in numbers if n.start >= m.end()]  # the first number after it, unsigned (a sign is its own
+    if not after or after[0].sign:  # claim: 'the positives add up to 31.1 and the negatives to -1.0')
+        return []
+    n, owners = after[0], contribution_owners(after[0], book)
+    if len(owners) != 1 or any(matches(n, v) for v in book.decision_numbers):
+        return []
+    owner = owners[0]
+    polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
+    return checks.check_direction([Mention(n.start, n.end, "feature", (owner,))], _as_said_after(masked, m, polarity),
+                                  where, f"{m.group(0)} (by {n.text}: {owner}'s contribution)", book)
 
 
 def _invented_subject(masked: str, a: int, b: int, prev: int, first: bool, m: re.Match, mentions: list[Mention],
