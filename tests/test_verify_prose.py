@@ -1255,3 +1255,21 @@ def test_a_ratio_written_as_odds():
         ("7.2", "verified"), ("6.9", "verified"), ("outweighs", "verified")]
     assert ("outweighs", "contradicted") in claims("Traffic outweighs wind roughly two to one (7.2 vs 6.9).")
     assert [s for _, s in claims("Traffic fell from 3 to 1.")] == ["contradicted", "contradicted"]
+
+
+def test_twice_the_size_of_and_more_than_twice_that_of():
+    """'twice the size of B', 'three times that of B' state a ratio; 'more than twice that of B' at least about 2;
+    a second comparison joined by 'and' keeps the first one's subject; the bracket after 'the B effect' pairs."""
+    from xairl.narrators.verify.rules import example
+    exp = example("air")  # pm2_5_lag1 14.7, traffic_index 7.2, wind_speed_ms 6.9
+
+    def ranks(text):
+        return [c.status for c in xairl.verify(text, exp, 0).claims if c.rule == "rank.comparison"]
+    assert ranks("The pm2_5_lag1 effect is roughly twice the size of the wind effect.") == ["verified"]
+    assert ranks("The wind effect is roughly twice the size of the traffic effect.") == ["contradicted"]
+    assert ranks("The pm2_5_lag1 effect is three times that of the wind.") == ["contradicted"]
+    assert ranks("The pm2_5_lag1 effect is more than three times that of the wind.") == ["contradicted"]
+    assert ranks("The pm2_5_lag1 effect is about 2 times that of traffic and twice that of the wind.") == [
+        "verified", "verified"]
+    said = xairl.verify("The pm2_5_lag1 effect is roughly twice the size of the wind effect (6.9 vs 14.7).", exp, 0)
+    assert [c.status for c in said.claims if c.kind == "number"] == ["contradicted", "contradicted"]

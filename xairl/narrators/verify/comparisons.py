@@ -15,8 +15,12 @@ from .names import Mention, named_features
 COMPARE_RE = re.compile(r"\b(?:(?P<more>more|bigger|larger|greater|stronger|heavier)|(?P<less>less|smaller|weaker)|"
                         r"(?P<same>as much|as large|as big))\b(?P<gap>(?:\s+[\w'\-\0]+){0,6}?)\s+(?:than|as)\s+"
                         r"|\b(?P<out>outweigh\w*|dwarf\w*|overshadow\w*)\s+"
-                        r"|(?<=\d)\s*(?P<of>(?:%|percent)\s+of|times(?:\s+of)?)\s+(?=(?:the\s+|its\s+|their\s+)?\0)",
-                        re.IGNORECASE)  # ('60 % of the alcohol effect', '3.7 times the pedestrian-call penalty')
+                        r"|(?<=\d)\s*(?P<of>(?:%|percent)\s+of|times(?:\s+of)?)\s+(?=(?:the\s+|its\s+|their\s+)?\0)"
+                        r"|\b(?P<sized>(?:about\s+|roughly\s+|nearly\s+|almost\s+)?(?:twice|double|half|"
+                        r"three times|four times|\d+(?:\.\d+)?\s*(?:times|x)))\s+(?:the\s+(?:size|magnitude|strength|"
+                        r"weight)|that)\s+of\s+(?=(?:the\s+|its\s+|their\s+)?\0)",
+                        re.IGNORECASE)  # ('60 % of the alcohol effect', '3.7 times the pedestrian-call penalty', 'roughly
+#                                          twice the size of the B effect', 'more than twice that of B')
 #: the words between 'outweighs' (or 'than') and the name compared with: a determiner, a count's words ('than the
 #: number of browsing sessions')
 _BEFORE_B = re.compile(r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?(?:(?:number|count|amount|level|size) of\s+"
@@ -39,14 +43,14 @@ SAME_WITHIN = 0.25  # 'about as much as': the two sizes within 25 % of the large
 
 
 def check_comparison(a_keys: tuple[str, ...], b_key: str, way: int, ctx: str | None, book: FactBook,
-                     text: str) -> Claim:
-    """|contribution| of A against B's in the sentence's view (any view when it names none): way +1 larger, -1
-    smaller, 0 about the same."""
+                     text: str, at_least: float = 1.0) -> Claim:
+    """|contribution| of A against B's in the sentence's view (any view when it names none): way +1 larger (by the
+    factor ``at_least``: 'more than twice that of B'), -1 smaller, 0 about the same."""
     def test(key):
         pairs = _sizes(key, b_key, ctx, book)
         if not pairs:
             return None
-        ok = [c for x, y, c in pairs if (x > y if way > 0 else x < y if way < 0 else
+        ok = [c for x, y, c in pairs if (x > at_least * y if way > 0 else x < y if way < 0 else
                                           abs(x - y) <= SAME_WITHIN * max(x, y))]
         x, y, c = pairs[0]
         return bool(ok), f"|{key}| {x:.3g} vs |{b_key}| {y:.3g} ({ok[0] if ok else c})"
@@ -80,6 +84,14 @@ def _ratio(before: str, way: int) -> float | None:
         share = float(m.group("pct")) / 100
         return 1 + share if way > 0 else 1 - share if way < 0 else share
     return float(m.group("num")) if m.group("num") else _RATIO_WORDS[m.group("word").lower()]
+
+
+def _sized(words: str) -> float:
+    """The ratio 'twice the size of B', 'roughly 1.7 times that of B' states: 2, 1.7."""
+    core = re.sub(r"^(?:about|roughly|nearly|almost)\s+", "", words.lower())
+    number = re.match(r"(\d+(?:\.\d+)?)", core)
+    return float(number.group(1)) if number else {"twice": 2.0, "double": 2.0, "half": 0.5, "three times": 3.0,
+                                                  "four times": 4.0}[core]
 
 
 def _of_ratio(before: str, unit: str) -> float | None:
@@ -130,7 +142,7 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
     (:data:`_BEFORE_B`, :data:`_AFTER_THAN`); A the names since the previous comparison, else the last name before the
     comparative (a relative 'which'); 'by a factor of 2.6' after B is the ratio of one name to B. ``written``: the
     sentence as written (claims quote it)."""
-    out, start, written = [], a, written or masked
+    out, start, written, earlier = [], a, written or masked, []
     names = named_features(mentions)
     for m in COMPARE_RE.finditer(masked, a, b):
         b_name = next((x for x in names if x.start >= m.end()), None)
@@ -138,11 +150,21 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
                 not m.group("out") and _AFTER_THAN.fullmatch(masked, m.end(), b_name.start))):
             continue  # 'more than $500', 'bigger than any other feature': no feature to compare with
         subjects = [x for x in names if start <= x.start and x.end <= m.start()]
-        if not subjects or m.group("of"):  # ('A ..., and the B term is about 1.5 times the C term': B's)
-            subjects = [x for x in names if x.end <= m.start()][-1:]
+        if not subjects or m.group("of") or m.group("sized"):  # ('A ..., and the B term is about 1.5 times the C
+            subjects = [x for x in names if x.end <= m.start()][-1:]  # term': B's)
+        if m.group("sized") and earlier and re.search(r"\band\b", masked[start:m.start()]) and not any(
+                start <= x.start < m.start() for x in names):  # 'A is 1.6 times that of B and three times that of C'
+            subjects = earlier
+        earlier = earlier or subjects
         way = 1 if m.group("more") or m.group("out") else -1 if m.group("less") else 0
-        ratio = _ratio(masked[max(a, m.start() - 40):m.start()], way) if not m.group("of") else _of_ratio(
-            masked[max(a, m.start() - 12):m.start()], m.group("of"))
+        ratio = _of_ratio(masked[max(a, m.start() - 12):m.start()], m.group("of")) if m.group("of") else \
+            _sized(m.group("sized")) if m.group("sized") else _ratio(masked[max(a, m.start() - 40):m.start()], way)
+        if m.group("sized") and re.search(r"\bmore than\s+$", masked[max(a, m.start() - 12):m.start()],
+                                          re.IGNORECASE):  # 'more than twice that of B':
+            out += [check_comparison(x.keys, b_name.keys[0], 1, ctx, book, written[m.start():m.end()].strip(),
+                                     at_least=ratio * (1 - RATIO_WITHIN)) for x in subjects]  # at least about 2x
+            start = b_name.end
+            continue
         factor = _FACTOR_AFTER.match(masked, b_name.end, b)  # 'larger than B (-1.4) by a factor of ~2.6' (of one
         stated = factor and (factor.group(1) or factor.group(2)).lower()
         stated = _FACTOR_WORDS.get(stated) or float(stated) if stated else 0.0
@@ -170,6 +192,9 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
 _SIDE_BY_SIDE = re.compile(r"\s*\(\s*[^()\0]{0,20}?\s+(?:vs\.?|versus|against|compared with|to)\s+[^()\0]{0,20}\)")
 
 
+_B_NOUN = re.compile(r"\s+(?:effect|term|contribution|push|impact|factor)s?\b", re.IGNORECASE)
+
+
 def compared_pairs(masked: str, a: int, b: int, names: list[Mention], numbers) -> dict:
     """'A mattered about twice as much as B (0.88 vs 0.49)': the bracket's first number is A's, the second B's
     (A the comparison's subject as :func:`find_comparisons` reads it); with no comparison word it knows, a clause
@@ -181,7 +206,9 @@ def compared_pairs(masked: str, a: int, b: int, names: list[Mention], numbers) -
         if b_name is None or not re.fullmatch(r"\s*(?:the\s+|its\s+|their\s+)?", masked[m.end():b_name.start]):
             continue
         factor = _FACTOR_AFTER.match(masked, b_name.end)  # ('A outweighs B roughly two to one (x vs y)')
-        bracket = _SIDE_BY_SIDE.match(masked, b_name.end) or (factor and _SIDE_BY_SIDE.match(masked, factor.end()))
+        noun = _B_NOUN.match(masked, b_name.end)  # ('twice the size of the B effect (x vs y)')
+        bracket = _SIDE_BY_SIDE.match(masked, noun.end() if noun else b_name.end) or (
+            factor and _SIDE_BY_SIDE.match(masked, factor.end()))
         subjects = [x for x in names if x.end <= m.start()][-1:]
         inside = [n for n in numbers if bracket and b_name.end <= n.start and n.end <= bracket.end()]
         if bracket and subjects and len(inside) == 2:

@@ -32,7 +32,7 @@ ABBREVIATIONS = {"dist": "distance", "temp": "temperature", "avg": "average", "n
                  # acronyms of their fields that people write out
                  "dti": "debt to income", "ltv": "loan to value", "soc": "state of charge", "bmi": "body mass index",
                  "anc": "neutrophil count", "crcl": "creatinine clearance", "inq": "inquiries",
-                 "abx": "antibiotics"}
+                 "abx": "antibiotics", "int": "interest"}
 #: words of feature names and other words people write for the same thing ('battery_pct': 'the charge'); each makes
 #: one more spelling of the name, so a word shared by two names ('charge') names both, ambiguously
 SYNONYMS = {"battery": ("charge",), "temperature": ("fever",), "heart": ("pulse",), "distance": ("far",),
