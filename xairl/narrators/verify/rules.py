@@ -138,11 +138,12 @@ RULES: tuple[Rule, ...] = (
          "counts things in a name after it ('three drones in the charger queue'): verified when it is that name's "
          "value", fires=(("drone", "There are already three drones in the charger queue."),),
          silent=(("drone", "There are already five drones in the charger queue."),)),
-    Rule("number.without", "number", "a number in a clause that takes one named feature's push away ('without "
-         "traffic's contribution'): verified when it is the prediction, its change from the baseline or the margin "
-         "less that push, else its other readings decide",
+    Rule("number.without", "number", "a number in a clause that takes named features' pushes away ('without "
+         "traffic's contribution', 'remove the traffic term and', 'ignoring A and B'): verified when it is the "
+         "prediction, its change from the baseline or the margin less those pushes, else its other readings decide",
          fires=(("air", "Without traffic's contribution, the forecast would be about 44.9."),
-                ("air", "Even without the traffic term it would sit 22.9 above the average.")),
+                ("air", "Even without the traffic term it would sit 22.9 above the average."),
+                ("air", "Remove the traffic and wind terms and the forecast would sit at about 38.")),
          silent=(("air", "Traffic adds 7.2."), ("air", "Without traffic's contribution, the forecast would be 38."))),
     Rule("number.change", "number", "the change from the baseline ('30.0 above the average')",
          fires=(("air", "The forecast is 30.1 above the average."),), silent=(("air", "Traffic adds 7.2."),)),

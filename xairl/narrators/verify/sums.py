@@ -116,19 +116,39 @@ def _sum_claim(n: Number, results: list[bool], text: str) -> Claim:
 
 
 #: a name removed from the decision: 'without the warranty add-on's contribution', 'even without the battery term'
-_WITHOUT = re.compile(r"\bwithout\s+(?:the\s+|its\s+|his\s+|her\s+|their\s+)?$", re.IGNORECASE)
+#: words that take features' pushes away: 'without the', 'remove the', 'ignoring', 'excluding', 'minus', 'but for'
+_WITHOUT = re.compile(r"\b(?:without|remov(?:e|ing)|ignor(?:e|ing)|exclud(?:e|ing)|minus|tak(?:e|ing) away|"
+                      r"leav(?:e|ing) out|set(?:ting)? aside|strip(?:ping)? out|but for|absent)\s+"
+                      r"(?:the\s+|its\s+|his\s+|her\s+|their\s+)?", re.IGNORECASE)
 
 
 def without_number(n: Number, masked: str, names, book: FactBook) -> Claim | None:
-    """A number in a clause that takes one named feature's push away ('without the warranty add-on's contribution it
-    would sit at about 12.4%', 'even without the battery term, returning would still sit 1.55 above the average'):
-    verified when it is the prediction, its change from the baseline or the margin less that push; otherwise None
-    (its other readings decide)."""
-    removed = next((m for m in reversed(names) if m.end <= n.start and n.start - m.end <= 120
-                    and _WITHOUT.search(masked[max(0, m.start - 16):m.start])
-                    and not re.search(r"(?<!\d)[.;]|[.;](?!\d)", masked[m.end:n.start])), None)
-    if removed is None or len(removed.keys) != 1 or removed.keys[0] not in book.features:
+    """A number in a clause that takes named features' pushes away ('without the warranty add-on's contribution it
+    would sit at about 12.4%', 'even without the battery term, returning would still sit 1.55 above the average',
+    'Remove the state-of-charge penalty and the Q-value would sit at about 0.77', 'Without A (-0.18) and B (-0.29),
+    it would have been about 2.97'): verified when it is the prediction, its change from the baseline or the margin
+    less those pushes; otherwise None (its other readings decide)."""
+    cue = next((c for c in reversed(list(_WITHOUT.finditer(masked, max(0, n.start - 120), n.start)))
+                if not re.search(r"(?<!\d)[.;]|[.;](?!\d)", masked[c.end():n.start])), None)
+    removed = [m for m in names if cue is not None and cue.end() <= m.start and m.end <= n.start]
+    if not removed or any(len(m.keys) != 1 or m.keys[0] not in book.features for m in removed):
         return None
+    keys = list(dict.fromkeys(m.keys[0] for m in removed))
+    contribs = [book.features[k].contribs for k in keys]
+    score = book.scores.get(book.chosen)
+    readings = []
+    if score is not None and all("chosen" in c for c in contribs):
+        pushed = sum(c["chosen"] for c in contribs)
+        readings.append(("the prediction", score - pushed))
+        if book.base is not None:
+            readings.append(("the change from the baseline", score - book.base - pushed))
+    if book.margin is not None and all("margin" in c for c in contribs):
+        readings.append(("the margin", book.margin - sum(c["margin"] for c in contribs)))
+    for what, v in readings:
+        if matches(n, v) or (n.percent and percent_reading(n, v)):
+            return Claim("number", n.text, "verified", f"{what} without {' and '.join(keys)}'s contribution is "
+                                                       f"{v:.4g}")
+    return None
     contribs = book.features[removed.keys[0]].contribs
     score = book.scores.get(book.chosen)
     readings = []

@@ -263,7 +263,8 @@ def _pattern(phrase: str, kind: str) -> tuple[re.Pattern, str]:
         last = words[-1]
         if len(last) > 4 and last.endswith("s") and not last.endswith(("ss", "us", "is")):
             words[-1] = last[:-2] if last.endswith(("sses", "xes", "ches", "shes")) else last[:-1]
-        body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+)?|)".join(map(re.escape, words)) + r"(?:s|es)?(?:'s|')?\)?"
+        body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+|(?:of|to|in|for)[\s_\-]+)?|)".join(map(re.escape, words)) + \
+            r"(?:s|es)?(?:'s|')?\)?"  # ('state-of-charge' of the run 'state charge' of soc_pct's spelling)
     pattern = re.compile(rf"(?<![\w]){body}(?![\w])(?![.,]\d)", re.IGNORECASE)  # not 'RSRQ (-3' of 'RSRQ (-3.2 dB)'
     return pattern, _needle(words[0])
 
