@@ -195,8 +195,8 @@ def by_number(masked: str, a: int, b: int, numbers, mentions: list[Mention], boo
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
     if len(found) != 1 or _no_push(found[0], masked, mentions, book) or _COST.match(found[0].group(0)):
         return []  # ('it costs him about 7 minutes' of a finish time: a cost may be what the output counts)
-    masked = " " * a + masked[a:]  # a negation before the clause is not its own ('did not hurt; it subtracted 0.16')
-    m = next(checks.DIRECTION_RE.finditer(masked, a, b))
+    m, masked = found[0], " " * a + masked[a:]  # a negation before the clause is not its own ('did not hurt; it
+    # subtracted 0.16')
     after = [n for n in numbers if n.start >= m.end()]  # the first number after it, unsigned (a sign is its own
     if not after or after[0].sign:  # claim: 'the positives add up to 31.1 and the negatives to -1.0')
         return []
