@@ -89,21 +89,33 @@ def _lists(masked: str, a: int, b: int, names: list[Mention], numbers) -> tuple[
     paired = {}
     own_cue = any(background.statistic(masked[max(0, n.start - 60):n.start]) or binding.OUTPUT_BEFORE.search(
         masked[max(0, n.start - 60):n.start]) for n in tail)  # '... worth about $316k instead of the usual $230k'
+    listed = all(_listed(masked[x.end:y.start]) for x, y in zip(tail, tail[1:]))  # 'x and y', not 'x, which is y'
+    respectively = "respectively" in masked[a:b].lower()
     if len({m.keys for m in names}) >= 2 and len(tail) == len(names) and not own_cue and not _SUM_CUE.search(
-            masked, names[-1].end, tail[0].start) and (  # ('A and B together add x, y % of it': a sum)
-            "respectively" in masked[a:b].lower() or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])
+            masked, names[-1].end, tail[0].start) and (respectively or listed) and (  # ('A and B together add x, y %
+            respectively or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])  # of it': a sum)
             or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
-                and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)' 
+                and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)'
         paired = {id(n): m for n, m in zip(tail, names)}
     # 'A and B together add x': one number after the names (not B's own '(+5.31)', not a list 'x and y'), without a
     # quantity of its own ('most of the $91,462 above the baseline')
     # (with more numbers after: the cue between the names and the first, 'A, B and C together add x, y % of it', and
     # not one number per name, '(+10.97 and +22.02)')
-    summed = len(tail) >= 1 and len(names) >= 2 and (_SUM_CUE.search(masked, a, b) if len(tail) == 1 else _SUM_CUE.search(
-        masked, names[-1].end, tail[0].start) and (len(tail) != len({m.keys for m in names}) or tail[1].percent)) \
+    summed = len(tail) >= 1 and len(names) >= 2 and not paired and (
+        _SUM_CUE.search(masked, a, b) if len(tail) == 1 else _SUM_CUE.search(masked, names[-1].end, tail[0].start) and (
+            not listed or len(tail) != len({m.keys for m in names}) or tail[1].percent) or (
+            not listed and _SUM_CUE.search(masked, a, names[0].start))) \
         and not _OWN_QUANTITY.search(
         masked[max(a, tail[0].start - 12):tail[0].start]) and not decision.CHANGE_AFTER.match(masked[tail[0].end:b])
     return tail, paired, bool(summed)
+
+
+def _listed(gap: str) -> bool:
+    """Is ``gap``, the text between two numbers, that of a list ('+1.3 and +0.8', '1.3, 0.8', '(queue +1.10,
+    forecast +0.72)' is not: a name between), not a new phrase ('22.4 points, which is roughly 84%')?"""
+    words = re.sub(r"\b(?:and|or|points?|pts|pp|min|mins|minutes|h|hours?|kw|kwh|mw|days?|dB|dBm)\b", "", gap,
+                   flags=re.IGNORECASE)
+    return len(gap) <= 24 and not re.search(r"[A-Za-z]{2}|\0", words)
 
 
 def _worded(book: FactBook, written: str) -> list[str]:

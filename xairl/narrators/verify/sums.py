@@ -149,16 +149,3 @@ def without_number(n: Number, masked: str, names, book: FactBook) -> Claim | Non
             return Claim("number", n.text, "verified", f"{what} without {' and '.join(keys)}'s contribution is "
                                                        f"{v:.4g}")
     return None
-    contribs = book.features[removed.keys[0]].contribs
-    score = book.scores.get(book.chosen)
-    readings = []
-    if score is not None and "chosen" in contribs:
-        readings.append(("the prediction", score - contribs["chosen"]))
-        if book.base is not None:
-            readings.append(("the change from the baseline", score - book.base - contribs["chosen"]))
-    if book.margin is not None and "margin" in contribs:
-        readings.append(("the margin", book.margin - contribs["margin"]))
-    for what, v in readings:
-        if matches(n, v) or (n.percent and percent_reading(n, v)):
-            return Claim("number", n.text, "verified", f"{what} without {removed.keys[0]}'s contribution is {v:.4g}")
-    return None
