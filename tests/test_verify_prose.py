@@ -1273,3 +1273,43 @@ def test_twice_the_size_of_and_more_than_twice_that_of():
         "verified", "verified"]
     said = xairl.verify("The pm2_5_lag1 effect is roughly twice the size of the wind effect (6.9 vs 14.7).", exp, 0)
     assert [c.status for c in said.claims if c.kind == "number"] == ["contradicted", "contradicted"]
+
+
+FIRE = (["month", "aspect", "days_since_rain", "campfire_ban", "wind_kmh"], ["August", "south-west", 15, "yes", 11],
+        [1.9, 0.6, 2.2, -1.6, -0.8], 4.0, "probability of ignition in %")
+LOAN = (["dti", "grade", "income", "term"], [28.0, "C", 52000, "60 months"], [0.9, 0.6, -0.2, 0.53], -2.1,
+        "log-odds of default")  # prediction -0.27: 43 %; baseline 10.9 %
+MED = (["fever", "cough", "age", "test_result"], ["yes", "no", 54, "negative"], [1.3, -0.4, 0.6, -0.9], 10.0, "risk")
+
+
+@pytest.mark.parametrize("case,text", [  # accurate sentences a second review wrote against this session's readings
+    (FIRE, "Since June, the month term has grown; in August it added +1.9."),
+    (FIRE, "The month (August, two months after June) added 1.9."),
+    (FIRE, "Fifteen dry days since early July raised the risk by 2.2, and the month added 1.9."),
+    (FIRE, "The month added 1.9, so fire crews will march in early."),
+    (FIRE, "The aspect added 0.6: south-west slopes dry out faster than north-facing ones."),
+    (FIRE, "The aspect added 0.6 while the wind, blowing from the north at 11 km/h, lowered risk by 0.8."),
+    (FIRE, "It would need to drop by 2.2 points to reach the alert threshold."),
+    (LOAN, "The baseline is about 11%."), (LOAN, "Up from a baseline of about 11%, the default probability is 43%."),
+    (MED, "The negative test lowered the risk by 0.9, not the fever."),
+    (MED, "The risk is high because of age, not fever alone."),
+    (MED, "The patient is not without fever: +1.3."),
+    ((["verification_status", "income"], ["Not Verified", 5], [0.4, 0.1], 1.0, "risk"),
+     "Verified or not, the verification status added 0.4."),
+    ((["verification_status", "income"], ["Verified", 5], [-0.4, 0.1], 1.0, "risk"),
+     "An unverified income would raise the risk; here the verification status lowered it by 0.4."),
+    ((["user_segment", "parties_involved", "bedrooms", "category"], ["premium", 2, 3, "toys"], [0.3, 0.2, 1.2, -1.3],
+      1.0, "sales"), "In the US 3 of 10 applicants were flagged; par 3 golf aside, a 3 bed house; Cat 3 storms too."),
+    ((["lag[-1]", "load_mw"], [48.5, 300], [-1.2, 0.8], 1.0, "load"), "The lag removed 1.2 [2]."),
+])
+def test_accurate_sentences_of_a_second_review_stay_accurate(case, text):
+    from benchmarks.bench_verifier import one_output
+    result = xairl.verify(text, one_output(*case), 0)
+    assert result.accurate, [(c.rule, c.text, c.detail) for c in result.claims if c.status == "contradicted"]
+
+
+def test_log_odds_are_no_percentages():
+    """'The probability of default is 27%' of log-odds -0.27 (a probability of 43 %): contradicted."""
+    from benchmarks.bench_verifier import one_output
+    claims = xairl.verify("The probability of default is 27%.", one_output(*LOAN), 0).claims
+    assert [c.status for c in claims if c.kind == "number"] == ["contradicted"]

@@ -282,7 +282,7 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
         if c is not None:
             claims.append(binding.named(c, "action.choice" if m.kind == "action" else "category.label"))
         elif not hypothetical and (c := checks.stated_category(masked, m, mentions, book) or
-                                   checks.closed_class_category(masked, m, mentions, book) or
+                                   checks.closed_class_category(masked, m, mentions, book, sentence) or
                                    checks.negated_category(masked, m, book)) is not None:
             claims.append(c)  # 'aisle congestion is rated medium', 'the summer season' (in winter)
     bounds = sorted([0] + [m.end() for m in _CLAUSE_RE.finditer(masked) if not _APPOSITIVE.match(masked, m.start())

@@ -187,11 +187,13 @@ def stated_category(masked: str, m: Mention, mentions: list[Mention], book: Fact
                  f"{f} is {label}" if ok else f"{f} is {label}, not {said}", "category.stated")
 
 
-def closed_class_category(masked: str, m: Mention, mentions: list[Mention], book: FactBook) -> Claim | None:
+def closed_class_category(masked: str, m: Mention, mentions: list[Mention], book: FactBook,
+                          written: str = "") -> Claim | None:
     """A member of a closed class (a month, weekday, season, compass point or time of day:
     :data:`~.lexicon.CLOSED_CLASSES`) in a sentence that names a categorical feature whose label holds another member
     of that class: contradicted ('The summer season added ...' when the season is winter). Not when another named
-    feature's label is of the same class (whose value would it be?), nor a member inside a name."""
+    feature's label is of the same class (whose value would it be?), nor a member inside a name, nor one the words
+    before it set aside (:data:`_ASIDE`, read in the ``written`` sentence)."""
     if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
         return None
     own = set(split_words(label))
@@ -199,17 +201,34 @@ def closed_class_category(masked: str, m: Mention, mentions: list[Mention], book
     if cls is None or any(set(split_words(book.features[k].label or "")) & cls for x in mentions for k in x.keys
                           if x.kind == "feature" and k != m.keys[0] and k in book.features):
         return None
-    for w in re.finditer(r"[A-Za-z]+", masked):
-        said = w.group(0).lower()
-        if said in cls and said not in own:
+    words = [w for w in re.finditer(r"[A-Za-z]+", masked) if w.group(0).lower() in cls]
+    if any(w.group(0).lower() in own for w in words):
+        return None  # the right value is said too: the other is a comparison ('more than in winter')
+    for w in words:
+        proper = cls & _PROPER and not w.group(0)[0].isupper()  # ('crews will march in early')
+        if not proper and not _ASIDE.search(written or masked, max(0, w.start() - 24), w.start()):
             return Claim("category", w.group(0), "contradicted", f"{m.keys[0]} is {label}, not {w.group(0)}",
                          "category.closed-class")
     return None
 
 
+#: months and weekdays are written with a capital; words before a member that make it no value of the state:
+#: 'since June', 'than in winter', 'unlike a Monday', 'from the north', 'not north-east', 'compared with last winter'
+_PROPER = CLOSED_CLASSES[0] | CLOSED_CLASSES[1]
+_ASIDE = re.compile(r"\b(?:since|than|from|unlike|not|until|till|before|after|last|next|ago|to|compared (?:with|to)|"
+                    r"versus|vs|through|between|of|in any|each|every)\s+(?:the\s+|a\s+|an\s+|early\s+|late\s+|"
+                    r"mid-?\s*)?(?:\w+\s+)?$", re.IGNORECASE)
+
+
 _NEGATOR = r"(?:\bno|\bnot|\bnon|\bnever|\bwithout|n't|\bun)"
 _NEGATED_BEFORE = re.compile(_NEGATOR + r"[\s-]*(?:the\s+|a\s+|an\s+|any\s+)?$", re.IGNORECASE)
 _YES = frozenset({"yes", "true", "y", "present"})
+#: a label's absence said right before its name ('no fever', 'without the fever'; not 'not the fever': a contrast)
+_NO_BEFORE = re.compile(r"\b(?:no|without|(?:is|was|are|were|be|been|being)\s+not|isn't|wasn't|aren't|weren't)\s+"
+                        r"(?:the\s+|any\s+)?$", re.IGNORECASE)  # ('was not oak-aged')
+#: a sentence that speaks of the value both ways, or of another case than this one
+_CONTRAST = re.compile(r"\bor not\b|\bunlike\b|\bwhereas\b|\bif\b|\bwould\b|\bnot\s+(?:un|non)|"
+                       r",\s*not\s+(?:the\s+)?\0", re.IGNORECASE)
 
 
 def negated_category(masked: str, m: Mention, book: FactBook) -> Claim | None:
@@ -218,10 +237,15 @@ def negated_category(masked: str, m: Mention, book: FactBook) -> Claim | None:
     if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
         return None
     f, words = m.keys[0], split_words(label)
+    if _CONTRAST.search(masked):
+        return None  # ('Verified or not, ...', 'unlike for unverified borrowers', 'if the income were unverified')
     if label.lower() in _YES:
-        said = _NEGATED_BEFORE.search(masked, max(0, m.start - 16), m.start)
+        said = _NO_BEFORE.search(masked, max(0, m.start - 16), m.start)
+        if said is None or re.match(r"[\w-]", masked[m.end:m.end + 1]) or _NEGATED_BEFORE.search(
+                masked, max(0, said.start() - 12), said.start()):
+            return None  # ('no fever-reducing medication', 'not without fever')
         return Claim("category", masked[said.start():m.start].strip() + " " + f, "contradicted",
-                     f"{f} is {label}", "category.negated") if said else None
+                     f"{f} is {label}", "category.negated")
     negated = words[0] in ("not", "no", "non") and len(words) == 2
     core = words[-1] if negated or len(words) == 1 else None
     if core is None or len(core) < 4 or core in _BOOLEAN:

@@ -138,8 +138,9 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
         elif _OUT_WORDS.search(before) and n.sign != "+":  # ('made extending more valuable (+1.0)', 'Price +0.051':
             named = ("the prediction", [book.scores[book.chosen]])  # a plus sign marks a push, not where it ends)
     if named is not None and named[1]:
-        ok = any(matches(n, v, magnitude_ok=False) or (n.percent and percent_reading(n, v)) for v in named[1]) or (
-            named[0] in ("the prediction", "the baseline") and probability(n, named[1][0], book))
+        ok = any(matches(n, v, magnitude_ok=False) or (n.percent and not book.log_odds and percent_reading(n, v))
+                 for v in named[1]) or (named[0] in ("the prediction", "the baseline") and
+                                        probability(n, named[1][0], book))  # (log-odds are no percentages)
         return Claim("number", n.text, "verified" if ok else "contradicted", f"{named[0]} is {named[1][0]:.4g}")
     if any(matches(n, v) or (n.percent and percent_reading(n, v)) for v in book.decision_numbers) or (
             book.base is not None and book.chosen in book.scores and
@@ -162,7 +163,8 @@ def output_number(n: Number, book: FactBook, start: bool = False) -> Claim:
     """A number said to be where the output ends up ('pulls it down to 0.142'): the prediction; ``start``: where it
     starts ('from 34.1 % to ...'), the baseline."""
     v, what = (book.base, "baseline") if start else (book.scores[book.chosen], "prediction")
-    ok = matches(n, v, magnitude_ok=False) or (n.percent and percent_reading(n, v)) or probability(n, v, book)
+    ok = matches(n, v, magnitude_ok=False) or (n.percent and not book.log_odds and percent_reading(n, v)) or \
+        probability(n, v, book)
     return Claim("number", n.text, "verified" if ok else "contradicted", f"the {what} is {v:.4g}")
 
 

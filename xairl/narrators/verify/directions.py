@@ -185,6 +185,7 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
 
 
 _COST = re.compile(r"^cost", re.IGNORECASE)
+_WOULD = re.compile(r"\b(?:would|could|might|should|must|need(?:s|ed)? to|has to|have to)\b", re.IGNORECASE)
 
 
 def by_number(masked: str, a: int, b: int, numbers, mentions: list[Mention], book: FactBook,
@@ -193,7 +194,8 @@ def by_number(masked: str, a: int, b: int, numbers, mentions: list[Mention], boo
     contribution and no decision-level number ('The ban did nothing to help; it actually raised the risk by 1.6
     points', where only campfire_ban's contribution is 1.6 in size): that feature's push, checked."""
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
-    if len(found) != 1 or _no_push(found[0], masked, mentions, book) or _COST.match(found[0].group(0)):
+    if len(found) != 1 or _no_push(found[0], masked, mentions, book) or _COST.match(found[0].group(0)) or \
+            _WOULD.search(masked, a, found[0].start()):  # ('It would need to drop by 2.2 to reach the threshold')
         return []  # ('it costs him about 7 minutes' of a finish time: a cost may be what the output counts)
     m, masked = found[0], " " * a + masked[a:]  # a negation before the clause is not its own ('did not hurt; it
     # subtracted 0.16')

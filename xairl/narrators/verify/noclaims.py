@@ -46,6 +46,8 @@ def skip_number(n: Number, masked: str) -> bool:
         return True
     if n.percent and re.match(r"\s*of\s+(?:the\s+|its\s+|their\s+)?\0", masked[n.end:]):
         return True  # '60 % of the alcohol effect': a ratio to that name (:mod:`.comparisons`)
+    if re.search(r"\[\s*$", before[-3:]) and re.match(r"\s*\]", masked[n.end:]) and n.text.isdigit():
+        return True  # a citation mark: 'the lag removed 1.2 [2]'
     if _FACTOR_BEFORE.search(before[-30:]) and not n.percent and not n.text.isalpha():
         return True  # 'larger than B by a factor of ~2.6': a ratio (:mod:`.comparisons`)
     if not (n.percent or n.currency or n.sign) and ((_TO_ONE.match(masked, n.end) and not re.search(

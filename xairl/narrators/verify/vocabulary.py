@@ -202,8 +202,12 @@ def _acronyms(features) -> list:
             for acr, fs in owners.items() if len(fs) == 1]
 
 
-#: a number right after a shorthand ('alc 9.4', 'Wknd +3.2h', 'VA: -0.52'): the only place a shorthand names
-_NUMBER_AFTER = r"(?=\s*[:=]?\s*\(?\s*[+\-−±~≈]?\s?[$€£]?\d)"
+#: a number right after a shorthand ('alc 9.4: -0.38', 'Wknd +3.2h'): the only place a shorthand names
+_NUMBER_AFTER = (r"(?=\s*[:=]?\s*\(?\s*(?:[+\-−±]\s?[$€£]?\d|[$€£]?\d[\d.,]*\s*[a-z%]{0,3}\s*(?::\s*[+\-−±]?|"
+                 r"\(?[+\-−±])\s?\d))")
+#: (a signed number, 'Wknd +3.2h', or a value and its push after a colon or with a sign, 'alc 9.4: -0.38', 'alc 13.6
+#: +0.79'; not 'par 3 golf',
+#: '3 bed 2 bath', 'Cat 3 storms', 'In the US 3 of 10')
 
 
 def _shorthands(features) -> list:
@@ -239,7 +243,8 @@ _COMMON_SHORT = {"sum", "net", "top", "all", "add", "and", "for", "was", "are", 
                  "six", "ten", "pos", "neg", "see", "set", "get", "out", "off", "its", "has", "had", "got", "put", "say",
                  "let", "use", "cut", "max", "min", "avg", "day", "days", "week", "year", "hour", "than", "then",
                  "with", "from", "over", "only", "just", "each", "some", "more", "less", "most", "down", "gave",
-                 "give", "lift", "push", "drag", "pull", "base", "mean", "total", "score", "value", "shift", "plus"}
+                 "give", "lift", "push", "drag", "pull", "base", "mean", "total", "score", "value", "shift", "plus",
+                 "per", "par", "bed", "rev", "est", "cat", "mar", "month", "us"}
 
 
 def _phrase(text: str) -> str:
