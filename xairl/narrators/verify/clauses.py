@@ -7,11 +7,11 @@ import functools
 import re
 from dataclasses import replace
 
-from . import background, binding, comparisons, decision, directions, noclaims, quantities, ranks, reread, sums
+from . import background, binding, checks, comparisons, decision, directions, noclaims, quantities, ranks, reread, sums
 from .book import FactBook
 from .checks import Claim
 from .names import Mention, named_features
-from .numbers import find_numbers
+from .numbers import find_numbers, matches
 from .vocabulary import split_words, stem
 
 
@@ -66,8 +66,8 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
     out += [binding.named(c, "direction.subject") for c in directions.directions(masked, a, b, said, book, ctx,
                                                                                 name_words, parsed)]
     if not said_names:  # '...; it actually raised the risk by 1.6 points': whose push the number says
-        out += [binding.named(c, "direction.by-number") for c in directions.by_number(masked, a, b, numbers, mentions,
-                                                                                     book, ctx)]
+        out += [binding.named(c, "direction.by-number") for c in _by_number(masked, a, b, numbers, mentions, book,
+                                                                                      ctx)]
     out += [binding.named(c, "rank.words") for c in ranks.find_ranks(masked, a, b, said, book, ctx, written)]
     out += [binding.named(c, "rank.comparison")
             for c in comparisons.find_comparisons(masked, a, b, said, book, ctx, written)]
@@ -77,6 +77,34 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
         if owner is not None:
             out.append(binding.named(ranks.check_minor(owner.keys, ctx, book, m.group(0)), "rank.minor"))
     return out
+
+
+_COST = re.compile(r"^cost", re.IGNORECASE)
+_WOULD = re.compile(r"\b(?:would|could|might|should|must|need(?:s|ed)? to|has to|have to)\b", re.IGNORECASE)
+
+
+def _by_number(masked: str, a: int, b: int, numbers, mentions: list[Mention], book: FactBook,
+               ctx: str | None) -> list[Claim]:
+    """The one direction word of a clause that names no feature, followed by one number that is one feature's
+    contribution and no decision-level number ('The ban did nothing to help; it actually raised the risk by 1.6
+    points', where only campfire_ban's contribution is 1.6 in size): that feature's push, checked."""
+    found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
+    if len(found) != 1 or directions.no_push(found[0], masked, mentions, book) or _COST.match(found[0].group(0)) or \
+            _WOULD.search(masked, a, found[0].start()):  # ('It would need to drop by 2.2 to reach the threshold')
+        return []  # ('it costs him about 7 minutes' of a finish time: a cost may be what the output counts)
+    m, masked = found[0], " " * a + masked[a:]  # a negation before the clause is not its own ('did not hurt; it
+    # subtracted 0.16')
+    after = [n for n in numbers if n.start >= m.end()]  # the first number after it, unsigned (a sign is its own
+    if not after or after[0].sign:  # claim: 'the positives add up to 31.1 and the negatives to -1.0')
+        return []
+    n, owners = after[0], quantities.contribution_owners(after[0], book)
+    if len(owners) != 1 or any(matches(n, v) for v in book.decision_numbers):
+        return []
+    owner = owners[0]
+    polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
+    return checks.check_direction([Mention(n.start, n.end, "feature", (owner,))],
+                                  directions.as_said_after(masked, m, polarity), where,
+                                  f"{m.group(0)} (by {n.text}: {owner}'s contribution)", book)
 
 
 def _lists(masked: str, a: int, b: int, names: list[Mention], numbers) -> tuple[list, dict, bool]:

@@ -19,8 +19,8 @@ COMPARE_RE = re.compile(r"\b(?:(?P<more>more|bigger|larger|greater|stronger|heav
                         r"|\b(?P<sized>(?:about\s+|roughly\s+|nearly\s+|almost\s+)?(?:twice|double|half|"
                         r"three times|four times|\d+(?:\.\d+)?\s*(?:times|x)))\s+(?:the\s+(?:size|magnitude|strength|"
                         r"weight)|that)\s+of\s+(?=(?:the\s+|its\s+|their\s+)?\0)",
-                        re.IGNORECASE)  # ('60 % of the alcohol effect', '3.7 times the pedestrian-call penalty', 'roughly
-#                                          twice the size of the B effect', 'more than twice that of B')
+                        re.IGNORECASE)  # ('60 % of the alcohol effect', '3.7 times the pedestrian-call penalty',
+#                                          'roughly twice the size of the B effect', 'more than twice that of B')
 #: the words between 'outweighs' (or 'than') and the name compared with: a determiner, a count's words ('than the
 #: number of browsing sessions')
 _BEFORE_B = re.compile(r"\s*(?:the\s+|its\s+|their\s+|the\s+\w+'s\s+)?(?:(?:number|count|amount|level|size) of\s+"

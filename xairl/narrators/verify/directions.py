@@ -12,9 +12,7 @@ from .book import FactBook
 from .checks import Claim
 from .lexicon import GENERIC
 from .names import Mention, named_features
-from .numbers import matches
 from .parse import said_of, same_clause
-from .quantities import contribution_owners
 from .ranks import NOUN
 from .vocabulary import split_words, stem
 
@@ -137,10 +135,10 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
     names = named_features(mentions)
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
     for i, m in enumerate(found):
-        if _no_push(m, masked, mentions, book):
+        if no_push(m, masked, mentions, book):
             continue
         polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
-        polarity = _as_said_after(masked, m, polarity)
+        polarity = as_said_after(masked, m, polarity)
         if re.match(r"\s+to\s+(?:the\s+)?(?:negative|downside|risks?|concerns?|worries)\b", masked[m.end():]) \
                 and _good_outcome(book):
             polarity = -polarity  # 'added to the negative outlook' of a good-credit probability (of a diabetes
@@ -184,33 +182,6 @@ def directions(masked: str, a: int, b: int, mentions: list[Mention], book: FactB
     return out
 
 
-_COST = re.compile(r"^cost", re.IGNORECASE)
-_WOULD = re.compile(r"\b(?:would|could|might|should|must|need(?:s|ed)? to|has to|have to)\b", re.IGNORECASE)
-
-
-def by_number(masked: str, a: int, b: int, numbers, mentions: list[Mention], book: FactBook,
-              ctx: str | None) -> list[Claim]:
-    """The one direction word of a clause that names no feature, followed by one number that is one feature's
-    contribution and no decision-level number ('The ban did nothing to help; it actually raised the risk by 1.6
-    points', where only campfire_ban's contribution is 1.6 in size): that feature's push, checked."""
-    found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
-    if len(found) != 1 or _no_push(found[0], masked, mentions, book) or _COST.match(found[0].group(0)) or \
-            _WOULD.search(masked, a, found[0].start()):  # ('It would need to drop by 2.2 to reach the threshold')
-        return []  # ('it costs him about 7 minutes' of a finish time: a cost may be what the output counts)
-    m, masked = found[0], " " * a + masked[a:]  # a negation before the clause is not its own ('did not hurt; it
-    # subtracted 0.16')
-    after = [n for n in numbers if n.start >= m.end()]  # the first number after it, unsigned (a sign is its own
-    if not after or after[0].sign:  # claim: 'the positives add up to 31.1 and the negatives to -1.0')
-        return []
-    n, owners = after[0], contribution_owners(after[0], book)
-    if len(owners) != 1 or any(matches(n, v) for v in book.decision_numbers):
-        return []
-    owner = owners[0]
-    polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
-    return checks.check_direction([Mention(n.start, n.end, "feature", (owner,))], _as_said_after(masked, m, polarity),
-                                  where, f"{m.group(0)} (by {n.text}: {owner}'s contribution)", book)
-
-
 def _invented_subject(masked: str, a: int, b: int, prev: int, first: bool, m: re.Match, mentions: list[Mention],
                       book: FactBook, name_words, parsed) -> list[Claim]:
     """A direction word that no name is said of: an invented feature when the words before it (from the clause's
@@ -243,7 +214,7 @@ _LOSS_OBJECT = re.compile(r"\s+(?:(?:a|an|the|its|another|further|small\w*|sligh
 _SIGNED_OBJECT = re.compile(r"\s+(?:about|around|roughly|only|just|nearly|almost|some)?\s*(?P<sign>[+\-])\s?[$€£]?\d")
 
 
-def _as_said_after(masked: str, m: re.Match, polarity: int) -> int:
+def as_said_after(masked: str, m: re.Match, polarity: int) -> int:
     """The way an amount verb says, read from what follows it: 'adds a penalty' lowers, 'adds -0.04' lowers, 'adds
     +0.3' raises; any other direction word keeps its own way."""
     if not _AMOUNT_VERB.match(m.group(0)):
@@ -270,7 +241,7 @@ def _passive_agents(masked: str, m: re.Match, names: list[Mention], end: int) ->
     return [x for x in names if start <= x.start < min(end, start + 40)][:1]
 
 
-def _no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) -> bool:
+def no_push(m: re.Match, masked: str, mentions: list[Mention], book: FactBook) -> bool:
     """A direction word that claims no checkable push here: 'helps'/'hurts' without a named action ('a salaried job
     helps': the applicant?; but 'It turned, helped by X'), a side of a person ('working against the applicant'), a
     value said of a feature ('relatively lower glucose levels'), 'driven by' of one output (what mattered, either way),

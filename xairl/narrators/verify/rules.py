@@ -242,8 +242,8 @@ RULES: tuple[Rule, ...] = (
          fires=(("air", "Traffic raised the forecast."),), silent=(("air", "Traffic mattered."),)),
     Rule("direction.unknown-name", "direction", "a signed number after a label that names no feature",
          fires=(("air", "humidity +3.1; traffic +7.2"),), silent=(("air", "traffic +7.2"),)),
-    Rule("direction.by-number", "direction", "the one direction word of a clause that names no feature, with one number "
-         "after it that is one feature's contribution in size and no decision-level number: that feature's push",
+    Rule("direction.by-number", "direction", "the one direction word of a clause that names no feature, with one "
+         "number after it that is one feature's contribution in size and no decision-level number: that feature's push",
          fires=(("air", "Something else was at work; it raised the forecast by 14.7."),),
          silent=(("air", "Something else was at work; it raised the forecast by 30.1."),
                  ("air", "Something else was at work; it costs about 14.7."))),

@@ -240,7 +240,8 @@ def _shorthands(features) -> list:
 
 #: English words a shorthand must not be, since they stand before numbers in any prose
 _COMMON_SHORT = {"sum", "net", "top", "all", "add", "and", "for", "was", "are", "but", "not", "now", "one", "two",
-                 "six", "ten", "pos", "neg", "see", "set", "get", "out", "off", "its", "has", "had", "got", "put", "say",
+                 "six", "ten", "pos", "neg", "see", "set", "get", "out", "off", "its", "has", "had", "got", "put",
+                 "say",
                  "let", "use", "cut", "max", "min", "avg", "day", "days", "week", "year", "hour", "than", "then",
                  "with", "from", "over", "only", "just", "each", "some", "more", "less", "most", "down", "gave",
                  "give", "lift", "push", "drag", "pull", "base", "mean", "total", "score", "value", "shift", "plus",
