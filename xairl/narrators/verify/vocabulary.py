@@ -229,12 +229,15 @@ def _shorthands(features) -> list:
                     owners.setdefault(short, set()).add(f)
         if len(parts) == 2 and all(w.isalpha() for w in parts):
             owners.setdefault("".join(w[0] for w in parts).upper(), set()).add(f)
-    out = []
+    groups: dict[tuple[str, str], list[str]] = {}  # one regex per feature and first three letters (fewer to compile)
     for short, fs in owners.items():
         if len(fs) == 1:
-            flags = 0 if short.isupper() else re.IGNORECASE
-            out.append((re.compile(rf"(?<![\w]){re.escape(short)}(?![\w]){_NUMBER_AFTER}", flags), "feature",
-                        (next(iter(fs)),), "", "shorthand", _needle(short)))
+            groups.setdefault((next(iter(fs)), short if short.isupper() else short[:3]), []).append(short)
+    out = []
+    for (f, head), shorts in groups.items():
+        body = "|".join(re.escape(x) for x in sorted(shorts, key=len, reverse=True))
+        out.append((re.compile(rf"(?<![\w])(?:{body})(?![\w]){_NUMBER_AFTER}", 0 if head.isupper() else re.IGNORECASE),
+                    "feature", (f,), "", "shorthand", _needle(head)))
     return out
 
 
