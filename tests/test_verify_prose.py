@@ -1313,3 +1313,14 @@ def test_log_odds_are_no_percentages():
     from benchmarks.bench_verifier import one_output
     claims = xairl.verify("The probability of default is 27%.", one_output(*LOAN), 0).claims
     assert [c.status for c in claims if c.kind == "number"] == ["contradicted"]
+
+
+def test_odds_of_a_larger_number_to_a_smaller_one():
+    """'outweighs B by about 3 to 2' is a ratio of 1.5, checked; its numbers are no values; '2 to 3' is no odds."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["income", "late_payments"], [52000, 3], [1.46, -1.0], 3.0, "credit score")
+
+    def claims(text):
+        return [(c.rule, c.status) for c in xairl.verify(text, exp, 0).claims if c.kind != "feature"]
+    assert claims("Income outweighs the late payments by about 3 to 2.") == [("rank.comparison", "verified")]
+    assert claims("Income outweighs the late payments by about 5 to 2.") == [("rank.comparison", "contradicted")]

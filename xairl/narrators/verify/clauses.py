@@ -85,26 +85,30 @@ _WOULD = re.compile(r"\b(?:would|could|might|should|must|need(?:s|ed)? to|has to
 
 def _by_number(masked: str, a: int, b: int, numbers, mentions: list[Mention], book: FactBook,
                ctx: str | None) -> list[Claim]:
-    """The one direction word of a clause that names no feature, followed by one number that is one feature's
-    contribution and no decision-level number ('The ban did nothing to help; it actually raised the risk by 1.6
-    points', where only campfire_ban's contribution is 1.6 in size): that feature's push, checked."""
+    """Each direction word of a clause that names no feature, followed (before the next one) by an unsigned number
+    that is one feature's contribution in size and no decision-level number ('The ban did nothing to help; it
+    actually raised the risk by 1.6 points', where only campfire_ban's contribution is 1.6 in size): that feature's
+    push, checked. Not in a clause of what would or needs to happen, nor for a cost word (a cost may be what the
+    output counts: 'it costs him about 7 minutes' of a finish time)."""
     found = [m for m in checks.DIRECTION_RE.finditer(masked, a, b) if not checks.is_frame(masked, m)]
-    if len(found) != 1 or directions.no_push(found[0], masked, mentions, book) or _COST.match(found[0].group(0)) or \
-            _WOULD.search(masked, a, found[0].start()):  # ('It would need to drop by 2.2 to reach the threshold')
-        return []  # ('it costs him about 7 minutes' of a finish time: a cost may be what the output counts)
-    m, masked = found[0], " " * a + masked[a:]  # a negation before the clause is not its own ('did not hurt; it
-    # subtracted 0.16')
-    after = [n for n in numbers if n.start >= m.end()]  # the first number after it, unsigned (a sign is its own
-    if not after or after[0].sign:  # claim: 'the positives add up to 31.1 and the negatives to -1.0')
+    if not found or _WOULD.search(masked, a, found[0].start()):  # ('It would need to drop by 2.2 to reach ...')
         return []
-    n, owners = after[0], quantities.contribution_owners(after[0], book)
-    if len(owners) != 1 or any(matches(n, v) for v in book.decision_numbers):
-        return []
-    owner = owners[0]
-    polarity, where = checks.direction_target(masked, m, mentions, book, ctx)
-    return checks.check_direction([Mention(n.start, n.end, "feature", (owner,))],
-                                  directions.as_said_after(masked, m, polarity), where,
-                                  f"{m.group(0)} (by {n.text}: {owner}'s contribution)", book)
+    blanked = " " * a + masked[a:]  # a negation before the clause is not its own ('did not hurt; it subtracted 0.16')
+    out = []
+    for m, nxt in zip(found, [x.start() for x in found[1:]] + [b]):
+        if directions.no_push(m, masked, mentions, book) or _COST.match(m.group(0)):
+            continue
+        after = [n for n in numbers if m.end() <= n.start < nxt]  # the first number after it, unsigned (a sign is
+        if not after or after[0].sign:  # its own claim: 'the positives add up to 31.1 and the negatives to -1.0')
+            continue
+        n, owners = after[0], quantities.contribution_owners(after[0], book)
+        if len(owners) != 1 or any(matches(n, v) for v in book.decision_numbers):
+            continue
+        polarity, where = checks.direction_target(blanked, m, mentions, book, ctx)
+        out += checks.check_direction([Mention(n.start, n.end, "feature", (owners[0],))],
+                                      directions.as_said_after(blanked, m, polarity), where,
+                                      f"{m.group(0)} (by {n.text}: {owners[0]}'s contribution)", book)
+    return out
 
 
 def _lists(masked: str, a: int, b: int, names: list[Mention], numbers) -> tuple[list, dict, bool]:

@@ -36,8 +36,8 @@ _AFTER_THAN = re.compile(r"\s*(?:the|its|their|his|her|a|an|being|[\w-]+'s)\s+(?
 _FACTOR_AFTER = re.compile(r"(?:\s*\([^()]*\))?\s*(?:did\s+|does\s+)?,?\s*(?:by\s+a\s+factor\s+of\s+"
                            r"(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|~\s*)?(\d+(?:\.\d+)?)\b|"
                            r"(?:by\s+)?(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|some\s+|~\s*)?"
-                           r"(\d+(?:\.\d+)?|one|two|three|four|five|ten)\s*(?:to|:)\s*(?:1|one)(?!\w|\.\d))",
-                           re.IGNORECASE)
+                           r"(\d+(?:\.\d+)?|one|two|three|four|five|ten)\s*(?:to|:)\s*(1|one|[2-9]|two|three|four)"
+                           r"(?!\w|\.\d))", re.IGNORECASE)  # ('by about 3 to 2': 1.5)
 _FACTOR_WORDS = {"one": 1.0, "two": 2.0, "three": 3.0, "four": 4.0, "five": 5.0, "ten": 10.0}
 SAME_WITHIN = 0.25  # 'about as much as': the two sizes within 25 % of the larger
 
@@ -84,6 +84,17 @@ def _ratio(before: str, way: int) -> float | None:
         share = float(m.group("pct")) / 100
         return 1 + share if way > 0 else 1 - share if way < 0 else share
     return float(m.group("num")) if m.group("num") else _RATIO_WORDS[m.group("word").lower()]
+
+
+def _factor(m: re.Match) -> float:
+    """The ratio a factor after B states: 'by a factor of 2.6', 'roughly 1.5 to 1', 'two to one', 'about 3 to 2'
+    (0 for odds of a smaller number to a larger one: a range, '2 to 3', not odds)."""
+    def value(text: str) -> float:
+        return _FACTOR_WORDS.get(text.lower()) or float(text)
+    if m.group(1):
+        return float(m.group(1))
+    over = value(m.group(3))
+    return value(m.group(2)) / over if value(m.group(2)) >= over else 0.0
 
 
 def _sized(words: str) -> float:
@@ -166,8 +177,7 @@ def find_comparisons(masked: str, a: int, b: int, mentions: list[Mention], book:
             start = b_name.end
             continue
         factor = _FACTOR_AFTER.match(masked, b_name.end, b)  # 'larger than B (-1.4) by a factor of ~2.6' (of one
-        stated = factor and (factor.group(1) or factor.group(2)).lower()
-        stated = _FACTOR_WORDS.get(stated) or float(stated) if stated else 0.0
+        stated = _factor(factor) if factor else 0.0
         if ratio is None and factor is not None and way and len(subjects) == 1 and stated > 0:
             ratio = stated ** way  # name; 'smaller than B by a factor of 5': a fifth)
         else:

@@ -30,6 +30,9 @@ _FACTOR_BEFORE = re.compile(r"\bby\s+a\s+factor\s+of\s+(?:about\s+|roughly\s+|ar
 _TO_ONE = re.compile(r"\s*(?:to|:)\s*(?:1|one)(?!\w|\.\d)(?!\s*(?:%|percent|points?|pp)\b)", re.IGNORECASE)
 _TO_ONE_BEFORE = re.compile(r"(?<![\w.])(?<!from )(?<!between )(?:\d+(?:\.\d+)?|one|two|three|four|five|ten)\s*"
                             r"(?:to|:)\s*$", re.IGNORECASE)  # (not 'fell from 3 to 1': a value)
+#: odds of a larger whole number to a smaller one after a comparison's 'by': 'outweighs B by about 3 to 2'
+_ODDS = re.compile(r"\bby\s+(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|some\s+|~\s*)?(\d)\s*(?:to|:)\s*(\d)"
+                   r"(?!\w|\.\d|\s*(?:%|percent|points?|pp)\b)", re.IGNORECASE)
 
 
 def skip_number(n: Number, masked: str) -> bool:
@@ -53,6 +56,11 @@ def skip_number(n: Number, masked: str) -> bool:
     if not (n.percent or n.currency or n.sign) and ((_TO_ONE.match(masked, n.end) and not re.search(
             r"\b(?:from|between)\s+$", before, re.IGNORECASE)) or (n.value == 1 and _TO_ONE_BEFORE.search(before))):
         return True  # 'outweighed B by roughly 1.5 to 1', 'two to one': a ratio (:mod:`.comparisons`)
+    odds = next((m for m in _ODDS.finditer(masked, max(0, n.start - 20), n.end + 8)
+                 if m.start(1) <= n.start < m.end(2) and int(m.group(1)) > int(m.group(2))), None)
+    if odds is not None:
+        return True  # 'outweighs B by about 3 to 2'
+
     if re.match(r"^\s+(?:most|largest|biggest|main|top|strongest|key)\b", masked[n.end:]):  # 'the two largest'
         return True
     if not n.text[0].isdigit() and re.search(r"\b(all|these|those|the other)\s+$", before, re.IGNORECASE):

@@ -242,9 +242,11 @@ RULES: tuple[Rule, ...] = (
          fires=(("air", "Traffic raised the forecast."),), silent=(("air", "Traffic mattered."),)),
     Rule("direction.unknown-name", "direction", "a signed number after a label that names no feature",
          fires=(("air", "humidity +3.1; traffic +7.2"),), silent=(("air", "traffic +7.2"),)),
-    Rule("direction.by-number", "direction", "the one direction word of a clause that names no feature, with one "
-         "number after it that is one feature's contribution in size and no decision-level number: that feature's push",
-         fires=(("air", "Something else was at work; it raised the forecast by 14.7."),),
+    Rule("direction.by-number", "direction", "a direction word of a clause that names no feature, with a number "
+         "after it (before the next one) that is one feature's contribution in size and no decision-level number: "
+         "that feature's push",
+         fires=(("air", "Something else was at work; it raised the forecast by 14.7."),
+                ("air", "Something raised it by 14.7 and something else lowered it by 1.0.")),
          silent=(("air", "Something else was at work; it raised the forecast by 30.1."),
                  ("air", "Something else was at work; it costs about 14.7."))),
     Rule("direction.without", "direction", "'without X it would be lower': what X did, by taking it away",
