@@ -1,6 +1,7 @@
 """One clause's claims: each number bound (:mod:`.binding`) and checked, then its direction words
-(:mod:`.directions`), rank words (:mod:`.ranks`) and comparisons (:mod:`.comparisons`). The sentence reader in
-:mod:`xairl.narrators.verify` splits sentences into clauses and decides each clause's view."""
+(:mod:`.directions`; in a clause that names no feature, by the feature its number is: :func:`_by_number`), rank words
+(:mod:`.ranks`) and comparisons (:mod:`.comparisons`). The sentence reader in :mod:`xairl.narrators.verify` splits
+sentences into clauses and decides each clause's view."""
 from __future__ import annotations
 
 import functools
