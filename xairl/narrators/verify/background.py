@@ -8,8 +8,8 @@ import re
 
 from .book import FactBook
 from .checks import Claim, over_keys
-from .decision import probability
-from .numbers import Number, matches, percent_reading
+from .decision import reads_output
+from .numbers import Number, matches
 
 #: 'the typical borrower of about 48', 'the median home from 1966', 'the dataset average of 0.8', 'the average sale
 #: price of $230,061', 'the baseline of 0.34': a statistic of the background, of a feature or of the output
@@ -80,6 +80,5 @@ def typical_number(n: Number, keys: tuple[str, ...], book: FactBook) -> Claim:
 
 def base_number(n: Number, book: FactBook) -> Claim:
     """'the average prediction of $230,061', 'a base rate of 0.34': the baseline (the background's average output)."""
-    ok = book.base is not None and (matches(n, book.base, magnitude_ok=False) or (
-        n.percent and not book.log_odds and percent_reading(n, book.base)) or probability(n, book.base, book))
+    ok = book.base is not None and reads_output(n, book.base, book)
     return Claim("number", n.text, "verified" if ok else "contradicted", f"the baseline is {book.base:.4g}")

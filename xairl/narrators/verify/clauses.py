@@ -60,6 +60,15 @@ def check_clause(masked: str, a: int, b: int, mentions: list[Mention], book: Fac
             c = Claim("number", n.text, "unchecked", f"an identifier after a word of a longer name ('charger 3'; "
                       f"first read as {c.detail})", "number.identifier-after-word")
         out.append(c)
+    return out + _word_claims(masked, a, b, mentions, said, numbers, book, ctx, name_words, parsed, written)
+
+
+def _word_claims(masked: str, a: int, b: int, mentions: list[Mention], said: list[Mention], numbers, book: FactBook,
+                 ctx: str | None, name_words, parsed, written: str) -> list[Claim]:
+    """The clause's claims in words: direction words (with their names, or by the feature their number is), rank
+    words, comparisons and 'barely mattered'; ``said`` the mentions the clause says something of."""
+    out: list[Claim] = []
+    said_names = named_features(said)
     first = numbers[0] if numbers else None
     if first is not None and first.sign and not any(m.start < first.start for m in mentions):
         out += [binding.named(c, "direction.unknown-name") for c in directions.unknown_label(

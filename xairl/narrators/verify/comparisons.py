@@ -7,6 +7,7 @@ import re
 
 from .book import FactBook
 from .checks import EITHER, Claim, over_keys
+from .lexicon import RATIO_HEDGE
 from .names import Mention, named_features
 
 
@@ -35,7 +36,7 @@ _AFTER_THAN = re.compile(r"\s*(?:the|its|their|his|her|a|an|being|[\w-]+'s)\s+(?
 #: or 'outweighed the gusts by roughly 1.5 to 1', 'outweighs fever roughly two to one (1.46 vs 0.77)'
 _FACTOR_AFTER = re.compile(r"(?:\s*\([^()]*\))?\s*(?:did\s+|does\s+)?,?\s*(?:by\s+a\s+factor\s+of\s+"
                            r"(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|~\s*)?(\d+(?:\.\d+)?)\b|"
-                           r"(?:by\s+)?(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|some\s+|~\s*)?"
+                           rf"(?:by\s+)?{RATIO_HEDGE}"
                            r"(\d+(?:\.\d+)?|one|two|three|four|five|ten)\s*(?:to|:)\s*(1|one|[2-9]|two|three|four)"
                            r"(?!\w|\.\d))", re.IGNORECASE)  # ('by about 3 to 2': 1.5)
 _FACTOR_WORDS = {"one": 1.0, "two": 2.0, "three": 3.0, "four": 4.0, "five": 5.0, "ten": 10.0}

@@ -121,26 +121,13 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
             return Claim("number", n.text, "verified", f"{owners[0]}'s contribution (the only one it matches)")
         return Claim("number", n.text, "unchecked", f"a contribution of one of {', '.join(owners)}: which is unsaid")
     elif book.output != "actions" and not book.global_view:
-        near = before[-24:]
-        base_at = max((m.end() for m in _BASE_WORDS.finditer(near) if not _NUMBERED.search(near, m.end())), default=-1)
-        out_at = max((m.end() for m in _OUT_WORDS.finditer(_BASE_WORDS.sub(lambda m: " " * len(m.group(0)), near))),
-                     default=-1)  # 'value' inside 'base value' is the baseline's word
-        if base_at > out_at or _BASE_AFTER.match(after) or _BASE_BEFORE.search(before):  # the nearer cue decides
-            if book.base and not 0.1 < abs(n.value / (100 if n.percent else 1) / book.base) < 10 and not re.search(
-                    r"\bbase", near, re.IGNORECASE):  # 'older than average (18 vs. 16.8)': not the output's average
-                return Claim("number", n.text, "unchecked", "an average of another order of magnitude than the "
-                                                            "output's: of something not named")
-            prediction = book.scores[book.chosen]
-            if not re.search(r"\bbase", near, re.IGNORECASE) and (matches(n, prediction, magnitude_ok=False) or (
-                    n.percent and percent_reading(n, prediction))):
-                return Claim("number", n.text, "verified", "the prediction (next to a word for the average)")
-            named = ("the baseline", [book.base])  # ('your risk is about average (33%)': the prediction)
-        elif _OUT_WORDS.search(before) and n.sign != "+":  # ('made extending more valuable (+1.0)', 'Price +0.051':
-            named = ("the prediction", [book.scores[book.chosen]])  # a plus sign marks a push, not where it ends)
+        named = _by_output_words(n, before, after, book)
+        if isinstance(named, Claim):
+            return named
     if named is not None and named[1]:
-        ok = any(matches(n, v, magnitude_ok=False) or (n.percent and not book.log_odds and percent_reading(n, v))
-                 for v in named[1]) or (named[0] in ("the prediction", "the baseline") and
-                                        probability(n, named[1][0], book))  # (log-odds are no percentages)
+        ok = reads_output(n, named[1][0], book) if named[0] in ("the prediction", "the baseline") else any(
+            matches(n, v, magnitude_ok=False) or (n.percent and not book.log_odds and percent_reading(n, v))
+            for v in named[1])  # (log-odds are no percentages)
         return Claim("number", n.text, "verified" if ok else "contradicted", f"{named[0]} is {named[1][0]:.4g}")
     if any(matches(n, v) or (n.percent and percent_reading(n, v)) for v in book.decision_numbers) or (
             book.base is not None and book.chosen in book.scores and
@@ -159,13 +146,43 @@ def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     return Claim("number", n.text, "unchecked", "tied to no feature or quantity of this explanation")
 
 
+def _by_output_words(n: Number, before: str, after: str, book: FactBook) -> Claim | tuple | None:
+    """One output's number by the nearer of its cue words: a word for the average ('the typical 8 percent') names
+    the baseline (or the prediction it equals, or an average of something else when far from the output's size); a
+    word of the output ('puts the risk at') names the prediction. A Claim when that settles it, else (what, [value])
+    or None."""
+    near = before[-24:]
+    base_at = max((m.end() for m in _BASE_WORDS.finditer(near) if not _NUMBERED.search(near, m.end())), default=-1)
+    out_at = max((m.end() for m in _OUT_WORDS.finditer(_BASE_WORDS.sub(lambda m: " " * len(m.group(0)), near))),
+                 default=-1)  # 'value' inside 'base value' is the baseline's word
+    if base_at > out_at or _BASE_AFTER.match(after) or _BASE_BEFORE.search(before):  # the nearer cue decides
+        if book.base and not 0.1 < abs(n.value / (100 if n.percent else 1) / book.base) < 10 and not re.search(
+                r"\bbase", near, re.IGNORECASE):  # 'older than average (18 vs. 16.8)': not the output's average
+            return Claim("number", n.text, "unchecked", "an average of another order of magnitude than the "
+                                                        "output's: of something not named")
+        prediction = book.scores[book.chosen]
+        if not re.search(r"\bbase", near, re.IGNORECASE) and (matches(n, prediction, magnitude_ok=False) or (
+                n.percent and percent_reading(n, prediction))):
+            return Claim("number", n.text, "verified", "the prediction (next to a word for the average)")
+        return ("the baseline", [book.base])  # ('your risk is about average (33%)': the prediction)
+    if _OUT_WORDS.search(before) and n.sign != "+":  # ('made extending more valuable (+1.0)', 'Price +0.051': a
+        return ("the prediction", [book.scores[book.chosen]])  # plus sign marks a push, not where it ends)
+    return None
+
+
 def output_number(n: Number, book: FactBook, start: bool = False) -> Claim:
     """A number said to be where the output ends up ('pulls it down to 0.142'): the prediction; ``start``: where it
     starts ('from 34.1 % to ...'), the baseline."""
     v, what = (book.base, "baseline") if start else (book.scores[book.chosen], "prediction")
-    ok = matches(n, v, magnitude_ok=False) or (n.percent and not book.log_odds and percent_reading(n, v)) or \
+    return Claim("number", n.text, "verified" if reads_output(n, v, book) else "contradicted", f"the {what} is {v:.4g}")
+
+
+def reads_output(n: Number, v: float, book: FactBook) -> bool:
+    """Does ``n`` state the output's value ``v`` (the prediction or the baseline): as written, as the percentage of
+    a probability-like output, or, for a log-odds output, as the probability ``v`` stands for (:func:`probability`;
+    log-odds are no percentages)?"""
+    return matches(n, v, magnitude_ok=False) or (n.percent and not book.log_odds and percent_reading(n, v)) or \
         probability(n, v, book)
-    return Claim("number", n.text, "verified" if ok else "contradicted", f"the {what} is {v:.4g}")
 
 
 def probability(n: Number, v: float, book: FactBook) -> bool:

@@ -51,3 +51,5 @@ CLOSED_CLASSES = (
     frozenset({"north", "south", "east", "west", "northeast", "northwest", "southeast", "southwest"}),
     frozenset({"morning", "afternoon", "evening", "night", "overnight"}),
 )
+#: hedges before a ratio's number ('by roughly 1.5 to 1', 'by about 3 to 2'), as a regex group
+RATIO_HEDGE = r"(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|some\s+|~\s*)?"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 
+from .lexicon import RATIO_HEDGE
 from .numbers import Number
 
 _SKIP_AFTER = re.compile(r"^\s*(?:(?:background|samples?|rows?|states?|draws|features|narratives|coalitions|"
@@ -31,8 +32,8 @@ _TO_ONE = re.compile(r"\s*(?:to|:)\s*(?:1|one)(?!\w|\.\d)(?!\s*(?:%|percent|poin
 _TO_ONE_BEFORE = re.compile(r"(?<![\w.])(?<!from )(?<!between )(?:\d+(?:\.\d+)?|one|two|three|four|five|ten)\s*"
                             r"(?:to|:)\s*$", re.IGNORECASE)  # (not 'fell from 3 to 1': a value)
 #: odds of a larger whole number to a smaller one after a comparison's 'by': 'outweighs B by about 3 to 2'
-_ODDS = re.compile(r"\bby\s+(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|some\s+|~\s*)?(\d)\s*(?:to|:)\s*(\d)"
-                   r"(?!\w|\.\d|\s*(?:%|percent|points?|pp)\b)", re.IGNORECASE)
+_ODDS = re.compile(rf"\bby\s+{RATIO_HEDGE}(\d)\s*(?:to|:)\s*(\d)(?!\w|\.\d|\s*(?:%|percent|points?|pp)\b)",
+                   re.IGNORECASE)
 
 
 def skip_number(n: Number, masked: str) -> bool:

@@ -206,8 +206,7 @@ def _acronyms(features) -> list:
 _NUMBER_AFTER = (r"(?=\s*[:=]?\s*\(?\s*(?:[+\-−±]\s?[$€£]?\d|[$€£]?\d[\d.,]*\s*[a-z%]{0,3}\s*(?::\s*[+\-−±]?|"
                  r"\(?[+\-−±])\s?\d))")
 #: (a signed number, 'Wknd +3.2h', or a value and its push after a colon or with a sign, 'alc 9.4: -0.38', 'alc 13.6
-#: +0.79'; not 'par 3 golf',
-#: '3 bed 2 bath', 'Cat 3 storms', 'In the US 3 of 10')
+#: +0.79'; not 'par 3 golf', '3 bed 2 bath', 'Cat 3 storms', 'In the US 3 of 10')
 
 
 def _shorthands(features) -> list:
