@@ -1324,3 +1324,53 @@ def test_odds_of_a_larger_number_to_a_smaller_one():
         return [(c.rule, c.status) for c in xairl.verify(text, exp, 0).claims if c.kind != "feature"]
     assert claims("Income outweighs the late payments by about 3 to 2.") == [("rank.comparison", "verified")]
     assert claims("Income outweighs the late payments by about 5 to 2.") == [("rank.comparison", "contradicted")]
+
+
+FIRE = (["wind_kmh", "humidity_pct", "crew_size"], [35, 20, 4], [1.5, 0.8, -0.6], 2.0, "fire risk")
+GATE = (["queue_len", "eta_min"], [5, 12.0], [0.4, -0.2], 1.0, "Q-value of the action 'open gate 4'")
+DAIRY = (["temp_c", "rain_mm", "lag[-1] yield (L)"], [31, 0, 30.5], [-1.4, 0.5, 2.1], 20.0, "milk yield")
+
+
+@pytest.mark.parametrize("case, text", [
+    (FIRE, "If the wind had contributed nothing, the fire risk would be about 2.2."),
+    (FIRE, "Had the crew size been removed (its -0.6), the risk would sit near 4.3."),
+    (GATE, "Opening gate 4 scores 1.2, mostly for the queue (+0.4)."),
+    (GATE, "Despite that, the Q-value ends above the baseline because of several positive terms."),
+    (DAIRY, "pred=21.2 lag[-1]=+2.1 temp=-1.4"),
+    (DAIRY, "The heat itself (-1.4) hurt more than twice as much as the rain (+0.5) helped."),
+    (FIRE, "Most of the positive push (1.5 of 2.3) came from the wind."),
+])
+def test_counterfactuals_output_names_and_pushes_in_other_words_stay_accurate(case, text):
+    """A removal said after the name ('if A had contributed nothing'), a number of the output's name ('gate 4'), an
+    index in brackets ('lag[-1]'), a subject in other words with its push in brackets, 'positive terms' and 'most of
+    the positive push' (no subject of their own)."""
+    from benchmarks.bench_verifier import one_output
+    result = xairl.verify(text, one_output(*case), 0)
+    assert result.accurate, [(c.rule, c.text, c.detail) for c in result.claims if c.status == "contradicted"]
+
+
+@pytest.mark.parametrize("case, text", [
+    (GATE, "If the queue had contributed nothing, the Q-value would be about 2.0."),
+    (FIRE, "The drought index (+0.9) raised the risk."),
+    (GATE, "Opening gate 4 scores 2.2."),
+])
+def test_their_near_misses_are_contradicted(case, text):
+    """The same readings with a wrong counterfactual, an invented name whose bracketed number is no contribution, a
+    wrong score beside the output's number."""
+    from benchmarks.bench_verifier import one_output
+    assert not xairl.verify(text, one_output(*case), 0).accurate
+
+
+def test_an_opposite_of_the_label_is_a_wrong_category():
+    """A label's opposite said in a sentence naming its feature, or its label's word in capitals ('outside the ECA'
+    of 'inside_ECA'): contradicted; the label itself, or its opposite said beside it, is not."""
+    from benchmarks.bench_verifier import one_output
+    exp = one_output(["stage", "zone", "yield_lag"], ["early", "inside_ECA", 30.0], [2.4, -0.3, 1.1], 20.0, "yield")
+
+    def accurate(text):
+        return xairl.verify(text, exp, 0).accurate
+    assert not accurate("Being in late lactation, she got a 2.4 boost from the stage feature.")
+    assert not accurate("Because the ship is outside the ECA, the zone feature lowered it by 0.3.")
+    assert accurate("Being in early lactation, she got a 2.4 boost from the stage feature.")
+    assert accurate("Inside the ECA, the zone feature lowered it by 0.3.")
+    assert accurate("Early lactation, not late, is what the stage term rewarded with 2.4.")

@@ -281,6 +281,8 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
             checks.check_label(sentence, m, book) if m.kind == "label" else None
         if c is not None:
             claims.append(binding.named(c, "action.choice" if m.kind == "action" else "category.label"))
+            if m.kind == "label" and (c := checks.closed_class_category(masked, m, mentions, book, sentence)):
+                claims.append(c)  # 'outside the ECA' of 'inside_ECA': its word right, its opposite said
         elif not hypothetical and (c := checks.stated_category(masked, m, mentions, book) or
                                    checks.closed_class_category(masked, m, mentions, book, sentence) or
                                    checks.negated_category(masked, m, book)) is not None:

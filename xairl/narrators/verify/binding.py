@@ -91,6 +91,8 @@ def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook,
     phrase or list item starts between them; else none."""
     if id(n) in paired:
         return named(quantities.feature_number(n, paired[id(n)].keys, masked, book, ctx, unit_of), "number.respectively")
+    if decision.in_output_name(n, masked, book):  # 'sending unit 7' of "Q-value of the action 'send unit 7'"
+        return Claim("number", n.text, "unchecked", "a number of the output's name", "number.output-name")
     summed = sums.sum_reading(n, masked, names, book)
     if summed is not None:  # 'the positives add up to +0.39', 'without the add-on's contribution it would be 12.4%'
         return summed

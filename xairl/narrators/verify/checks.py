@@ -50,8 +50,8 @@ OUTPUT_WORDS = r"price|prediction|probability|risk|estimate|output|score"
 VALENCE_RE = re.compile(r"^(?:help|hurt)", re.IGNORECASE)  # whose side? a direction only toward a named action
 DIRECTION_RE = re.compile(rf"\b(?:(?P<pos>{_POS})|(?P<neg>{_NEG}))\b", re.IGNORECASE)
 #: a negation before a direction word ('does not increase', 'not effective in increasing', 'failed to raise')
-_NEGATION = re.compile(r"\b(not|n't|never|no longer|neither|nor)\b[^.]{0,12}$|"
-                       r"\b(?:not|n't)\s+(?:\w+\s+){1,2}(?:in|at)\s+$|"
+_NEGATION = re.compile(r"(?:\b(?:not|never|no longer|neither|nor)|n't)\b[^.]{0,12}$|"  # ("didn't": no \b before n)
+                       r"(?:\bnot|n't)\s+(?:\w+\s+){1,2}(?:in|at)\s+$|"
                        r"\b(?:fail\w*|unable|insufficient)\s+(?:\w+\s+)?(?:to|in)\s+$", re.IGNORECASE)
 
 
@@ -114,7 +114,7 @@ def check_action(sentence: str, m: Mention, book: FactBook) -> Claim | None:
         return Claim("action", text, "verified" if ok else "contradicted",
                      f"the runner-up was {book.runner_up}")
     if choice:
-        if re.search(r"\b(not|n't|instead of|rather than|over)\s*$", sentence[:m.start], re.IGNORECASE):
+        if re.search(r"(?:\b(?:not|instead of|rather than|over)|n't)\s*$", sentence[:m.start], re.IGNORECASE):
             return None
         ok = a == book.chosen
         return Claim("action", text, "verified" if ok else "contradicted",
@@ -170,7 +170,8 @@ def stated_category(masked: str, m: Mention, mentions: list[Mention], book: Fact
     capitalised right before it after a determiner ('the Midwifery course', not in a title) that shares no word with
     its label (nor is the label's initials, 'SE' of 'south-east') is contradicted. Labels that are yes/no answers are
     left to the direction words ('is missing' may mean 'No')."""
-    if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
+    if m.kind not in ("feature", "label") or len(m.keys) != 1 or m.keys[0] not in book.features or \
+            not (label := book.features[m.keys[0]].label):  # (a label's word names its feature: 'outside the ECA')
         return None
     s = _STATED.match(masked, m.end) or _FIELD_VALUE.match(masked, m.end) or (_VALUE_BEFORE.search(
         masked, max(0, m.start - 40), m.start) if not re.match(r"\s+[A-Z]", masked[m.end:]) else None)  # (not in a
@@ -194,7 +195,8 @@ def closed_class_category(masked: str, m: Mention, mentions: list[Mention], book
     of that class: contradicted ('The summer season added ...' when the season is winter). Not when another named
     feature's label is of the same class (whose value would it be?), nor a member inside a name, nor one the words
     before it set aside (:data:`_ASIDE`, read in the ``written`` sentence)."""
-    if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
+    if m.kind not in ("feature", "label") or len(m.keys) != 1 or m.keys[0] not in book.features or \
+            not (label := book.features[m.keys[0]].label):  # (a label's word names its feature: 'outside the ECA')
         return None
     own = set(split_words(label))
     cls = next((c for c in CLOSED_CLASSES if own & c), None)
@@ -234,7 +236,8 @@ _CONTRAST = re.compile(r"\bor not\b|\bunlike\b|\bwhereas\b|\bif\b|\bwould\b|\bno
 def negated_category(masked: str, m: Mention, book: FactBook) -> Claim | None:
     """A label said the other way: 'no fever' (or 'without the fever') when Fever_38C is 'yes'; 'the income was
     verified' when verification_status is 'Not Verified'; 'unverified' or 'not verified' when it is 'Verified'."""
-    if m.kind != "feature" or len(m.keys) != 1 or not (label := book.features[m.keys[0]].label):
+    if m.kind not in ("feature", "label") or len(m.keys) != 1 or m.keys[0] not in book.features or \
+            not (label := book.features[m.keys[0]].label):  # (a label's word names its feature: 'outside the ECA')
         return None
     f, words = m.keys[0], split_words(label)
     if _CONTRAST.search(masked):
@@ -253,7 +256,7 @@ def negated_category(masked: str, m: Mention, book: FactBook) -> Claim | None:
     for w in re.finditer(rf"(?<![\w\0])(?:un|non-?)?{re.escape(stem(core).rstrip('~'))}\w*", masked, re.IGNORECASE):
         said_not = bool(re.match(r"(?:un|non)", w.group(0), re.IGNORECASE) and not core.startswith(("un", "non"))) \
             or bool(_NEGATED_BEFORE.search(masked, max(0, w.start() - 12), w.start())) or \
-            bool(re.search(r"\b(?:not|n't|never)\s+(?:\w+\s+)?$", masked[max(0, w.start() - 16):w.start()]))
+            bool(re.search(r"(?:\bnot|n't|\bnever)\s+(?:\w+\s+)?$", masked[max(0, w.start() - 16):w.start()]))
         if said_not != negated:
             return Claim("category", w.group(0), "contradicted", f"{f} is {label}", "category.negated")
     return None

@@ -1,5 +1,6 @@
 """One clause's claims: each number bound (:mod:`.binding`) and checked, then its direction words
-(:mod:`.directions`; in a clause that names no feature, by the feature its number is: :func:`_by_number`), rank words
+(:mod:`.directions`; in a clause that names no feature, by the feature its number is: :func:`_by_number`; a list
+item's label that names no feature: :func:`unknown_label`), rank words
 (:mod:`.ranks`) and comparisons (:mod:`.comparisons`). The sentence reader in :mod:`xairl.narrators.verify` splits
 sentences into clauses and decides each clause's view."""
 from __future__ import annotations
@@ -70,8 +71,11 @@ def _word_claims(masked: str, a: int, b: int, mentions: list[Mention], said: lis
     out: list[Claim] = []
     said_names = named_features(said)
     first = numbers[0] if numbers else None
-    if first is not None and first.sign and not any(m.start < first.start for m in mentions):
-        out += [binding.named(c, "direction.unknown-name") for c in directions.unknown_label(
+    bracketed = first is not None and re.search(r"\(\s*$", masked[a:first.start]) and directions.is_fact(first, book)
+    if first is not None and first.sign and not any(m.start < first.start for m in mentions) and not bracketed:
+        # ('The heat itself (-2.35) hurt ...': a feature in other words, its push beside it; 'roof condition -12.1k'
+        # with another feature's number is still an invented name)
+        out += [binding.named(c, "direction.unknown-name") for c in unknown_label(
             masked[a:first.start], name_words)]  # '; roof condition -12.1k;'
     out += [binding.named(c, "direction.subject") for c in directions.directions(masked, a, b, said, book, ctx,
                                                                                 name_words, parsed)]
@@ -137,7 +141,9 @@ def _lists(masked: str, a: int, b: int, names: list[Mention], numbers) -> tuple[
             masked, names[-1].end, tail[0].start) and (respectively or listed) and (  # ('A and B together add x, y %
             respectively or quantities.CONTRIB_BEFORE.search(masked[a:tail[0].start][-40:])  # of it': a sum)
             or (_PAIR_RE.match(masked[tail[0].start - 1:tail[-1].end + 1])
-                and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))):  # not 'A (26, SHAP -0.07)'
+                and re.search(r"[A-Za-z]{2}", masked[names[-1].end:tail[0].start]))  # not 'A (26, SHAP -0.07)'
+            or (masked[names[-1].end:tail[0].start].rstrip().endswith(":") and all(n.sign for n in tail))):
+        # ('A and B hardly matter: +0.03 and -0.02')
         paired = {id(n): m for n, m in zip(tail, names)}
     # 'A and B together add x': one number after the names (not B's own '(+5.31)', not a list 'x and y'), without a
     # quantity of its own ('most of the $91,462 above the baseline')
@@ -195,6 +201,23 @@ def _counted(masked: str, a: int, names):
 
 
 _OWN_QUANTITY = re.compile(r"\bof\s+(?:the\s+)?[$€£]?$", re.IGNORECASE)
-_NEGATED = re.compile(r"\b(?:rather than|instead of|unlike|not(?! only)|n't)\s+"
+_NEGATED = re.compile(r"(?:\b(?:rather than|instead of|unlike|not(?! only))|n't)\s+"
                       r"(?:(?:because of|due to|about|the|its|their|a|an)\s+){0,3}$", re.IGNORECASE)
 _PAIR_RE = re.compile(r"^\((?:[^()\0]*?(?:,|\band\b|/)\s*)+[^()\0]*\)$")  # '(+9.45 and +8.66)' after 'A and B'
+
+
+#: a list item's label before its signed number: 'roof condition -12.1k', 'Pool: +6,500'
+_LIST_LABEL = re.compile(r"\W*(?P<label>(?:[A-Za-z][A-Za-z'-]*\s+){0,3}[A-Za-z][A-Za-z'-]*)\s*[:=(]?\s*")
+#: labels of decision-level quantities, not features
+_QUANTITY_LABELS = {"net", "sum", "total", "delta", "change", "diff", "difference", "base", "baseline", "risk", "price",
+                    "estimate", "probability", "prediction", "output", "score", "gap", "margin", "lead", "effect",
+                    "shap", "phi", "value", "contribution", "attribution", "result", "overall", "uplift", "premium"}
+_OWNERS = {"its", "their", "your", "his", "her", "our", "my"}
+
+
+def unknown_label(text: str, name_words=frozenset()) -> list[Claim]:
+    """A list item named by a label that is no feature and carries a signed number ('; roof condition -12.1k')."""
+    m = _LIST_LABEL.fullmatch(text)
+    if m is None or any(w.lower() in _QUANTITY_LABELS | _OWNERS for w in m.group("label").split()):
+        return []  # ('Its signal quality of -3.2 dB': something named before, vaguely)
+    return directions.unknown_subject(m.group("label"), "a signed number", [], name_words)

@@ -92,6 +92,25 @@ _NET_MOVE = re.compile(r"\bnet (?:increase|decrease|rise|drop|gain|reduction)\s+
 _NUMBERED = re.compile(r"\d")
 
 
+def in_output_name(n: Number, masked: str, book: FactBook) -> bool:
+    """The number is one of the output's name, written with a word it has there: 'sending unit 7' of "Q-value of the
+    action 'send unit 7'", 'slowing to 12 knots' of "... 'reduce to 12 knots'" (a one-output model's name holds the
+    action it scores): no fact of the explanation."""
+    if book.output == "actions" or not book.chosen or not _NUMBERED.search(book.chosen):
+        return False
+    before = re.search(r"([^\W\d_]+)\W{0,2}$", masked[max(0, n.start - 30):n.start])
+    after = re.match(r"\W{0,2}([^\W\d_]+)", masked[n.end:n.end + 30])
+    for m in re.finditer(r"\d+(?:\.\d+)?", book.chosen):
+        if float(m.group()) != abs(n.value) or n.percent:
+            continue
+        word_before = re.search(r"([^\W\d_]+)\W{0,2}$", book.chosen[:m.start()])
+        word_after = re.match(r"\W{0,2}([^\W\d_]+)", book.chosen[m.end():])
+        if (before and word_before and before.group(1).lower() == word_before.group(1).lower()) or (
+                after and word_after and after.group(1).lower() == word_after.group(1).lower()):
+            return True
+    return False
+
+
 def free_number(n: Number, masked: str, book: FactBook) -> Claim:
     """A number tied to no name: a decision-level quantity when the words around it name one (margin, runner-up
     score, prediction, baseline, change from the baseline, a domain comparison in its unit), else any decision-level

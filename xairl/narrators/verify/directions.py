@@ -11,6 +11,7 @@ from . import checks
 from .book import FactBook
 from .checks import Claim
 from .lexicon import GENERIC
+from .numbers import find_numbers, matches
 from .names import Mention, named_features
 from .parse import said_of, same_clause
 from .ranks import NOUN
@@ -23,7 +24,7 @@ _GENERIC_SUBJECT = re.compile(r"^\W*(?:[qa]\s*:\s*)?(?:and\s+|but\s+|also\s+|so\
                               r"|the policy|the agent|the dqn|the uav|another|what|overall|together|in total"
                               r"|the prediction|the predicted \w+|the estimate|the output|the model's \w+"
                               r"|(?:the|its|their)\s+(?:(?:house|home|property|patient|applicant|customer|student|"
-                              r"team)(?:'s)?\s+)?(?:sale\s+)?(?:price|value|cost|risk|probability|chance|odds|"
+                              r"team)(?:'s)?\s+)?(?:sale\s+)?(?:price|(?:q[- ]?)?value|cost|risk|probability|chance|odds|"
                               r"likelihood)"
                               r"|(?:the )?(?:q[- ]?value |score )?(?:gap|margin|lead|difference))\b(?!'s)",
                               re.IGNORECASE)
@@ -59,7 +60,8 @@ _LINKS = {"but", "and", "also", "yet", "then", "still", "even", "only", "while",
 #: invented feature
 _VAGUE = {"small", "smaller", "large", "larger", "big", "bigger", "short", "long", "little", "bit", "lot", "the",
           "this", "that", "its", "their", "about", "around", "roughly", "nearly", "almost", "some", "over", "under",
-          "than", "net", "combined", "whole", "entire", "final"}  # ('the net increase of 30.1': the whole's)
+          "than", "net", "combined", "whole", "entire", "final",  # ('the net increase of 30.1': the whole's)
+          "half", "third", "quarter", "most", "much", "part", "share", "bulk", "majority", "all"}  # (of a whole)
 #: the thing a model is about, as a possessor ('the house's', 'the applicant's'): not a feature of its own
 _POSSESSOR = re.compile(r"^\W*(?:the\s+|this\s+|its\s+|their\s+)?(?:house|home|property|file|document|applicant|"
                         r"borrower|customer|client|user|patient|loan|account|uav|drone|robot|agent|vehicle|device|"
@@ -190,19 +192,34 @@ def _invented_subject(masked: str, a: int, b: int, prev: int, first: bool, m: re
     the world, not about this model's features), nor a pronoun of a policy's actions."""
     subject = masked[prev:m.start()]
     inside = [x for x in mentions if prev <= x.start < m.start()]
+    if re.match(rf"\s+{NOUN}\b", masked[m.end():], re.IGNORECASE):
+        return []  # 'because of several positive terms': the word says which terms, of no subject
     if first:
         pronoun = re.search(r"\b(it|this|that)\b", subject, re.IGNORECASE)
         if (book.output == "actions" and pronoun) or re.match(r"\W*(?:because|since|as)\b", masked[a:b],
                                                                re.IGNORECASE):
             return []
         opener = masked[max(0, prev - 12):prev]
-        return _parse_agrees(_unknown_subject(subject, m.group(0), inside, name_words, opener), m, parsed, book)
+        if _fact_in_brackets(masked[prev:m.end() + 16], book):
+            return []  # 'The heat itself (-2.35) hurt ...': a feature in other words, its push beside it
+        return _parse_agrees(unknown_subject(subject, m.group(0), inside, name_words, opener), m, parsed, book)
     joined = _NEW_CLAUSE.search(subject)
     if joined is None:
         return []
     rest = prev + joined.end()
-    return _parse_agrees(_unknown_subject(masked[rest:m.start()], m.group(0), [x for x in inside if x.start >= rest],
+    return _parse_agrees(unknown_subject(masked[rest:m.start()], m.group(0), [x for x in inside if x.start >= rest],
                                           name_words), m, parsed, book)
+
+
+def is_fact(n, book: FactBook) -> bool:
+    """The number is some feature's contribution as written (a value is not enough: an invented name is often given
+    a value a feature has)."""
+    return any(matches(n, v) for f in book.features.values() for v in f.contribs.values())
+
+
+def _fact_in_brackets(words: str, book: FactBook) -> bool:
+    """A number in brackets that is a feature's contribution ('the heat itself (-2.35) hurt ...')."""
+    return any(is_fact(n, book) for inner in re.findall(r"\(([^()]{1,24})\)", words) for n in find_numbers(inner))
 
 
 #: a neutral verb of amount ('adds', 'contributes', 'gives') followed by what it adds: a signed number ('adds -0.04')
@@ -316,23 +333,6 @@ _ELLIPTIC = re.compile(r"^\W*(?:while|although|though|whereas|if|when)\b(?![^,;]
                        r"that|these|those)\b)", re.IGNORECASE)
 
 
-#: a list item's label before its signed number: 'roof condition -12.1k', 'Pool: +6,500'
-_LIST_LABEL = re.compile(r"\W*(?P<label>(?:[A-Za-z][A-Za-z'-]*\s+){0,3}[A-Za-z][A-Za-z'-]*)\s*[:=(]?\s*")
-#: labels of decision-level quantities, not features
-_QUANTITY_LABELS = {"net", "sum", "total", "delta", "change", "diff", "difference", "base", "baseline", "risk", "price",
-                    "estimate", "probability", "prediction", "output", "score", "gap", "margin", "lead", "effect",
-                    "shap", "phi", "value", "contribution", "attribution", "result", "overall", "uplift", "premium"}
-_OWNERS = {"its", "their", "your", "his", "her", "our", "my"}
-
-
-def unknown_label(text: str, name_words=frozenset()) -> list[Claim]:
-    """A list item named by a label that is no feature and carries a signed number ('; roof condition -12.1k')."""
-    m = _LIST_LABEL.fullmatch(text)
-    if m is None or any(w.lower() in _QUANTITY_LABELS | _OWNERS for w in m.group("label").split()):
-        return []  # ('Its signal quality of -3.2 dB': something named before, vaguely)
-    return _unknown_subject(m.group("label"), "a signed number", [], name_words)
-
-
 #: a name right before its direction word: its own value in brackets and two words at most between ('speed (0.22)
 #: pushed toward', 'A slightly lowers')
 _RIGHT_BEFORE = re.compile(r"\s*(?:\([^()]*\)\s*)?(?:[A-Za-z]+\s+){0,2}")
@@ -369,7 +369,7 @@ _REPORTED = re.compile(r"^.*\b(?:says?|shows?|indicates?|suggests?|means?|tells?
                        r"that\s+", re.IGNORECASE)
 
 
-def _unknown_subject(subject: str, word: str, mentions: list[Mention], name_words=frozenset(),
+def unknown_subject(subject: str, word: str, mentions: list[Mention], name_words=frozenset(),
                      opener: str = "") -> list[Claim]:
     """A direction claimed for something that names no feature ('the swimming pool adds ...'): contradicted when
     the subject is a noun phrase of its own, not a pronoun or the decision itself, and has no word of a feature's

@@ -42,7 +42,8 @@ SYNONYMS = {"battery": ("charge",), "temperature": ("fever",), "heart": ("pulse"
 BASE_FORM = {"built": "build", "sold": "sale", "made": "make", "paid": "pay", "owned": "own", "used": "use"}
 IRREGULAR = {"keep": "kept", "go": "went", "choose": "chose", "hold": "held", "run": "ran", "stay": "stayed"}
 #: closed classes of categorical values: a label holding one member makes any other member, said in a sentence that
-#: names its feature, a wrong value ('Because it was June, the month term added ...' when the month is August)
+#: names its feature, a wrong value ('Because it was June, the month term added ...' when the month is August; 'in
+#: late lactation' when the stage is early)
 CLOSED_CLASSES = (
     frozenset({"january", "february", "march", "april", "june", "july", "august", "september", "october", "november",
                "december"}),  # (not 'may': a verb)
@@ -50,6 +51,9 @@ CLOSED_CLASSES = (
     frozenset({"winter", "spring", "summer", "autumn"}),  # (not 'fall': a verb)
     frozenset({"north", "south", "east", "west", "northeast", "northwest", "southeast", "southwest"}),
     frozenset({"morning", "afternoon", "evening", "night", "overnight"}),
+    # opposites: a label of one is the other said wrongly ('in late lactation' when the stage is early)
+    frozenset({"early", "late"}), frozenset({"inside", "outside"}), frozenset({"open", "closed"}),
+    frozenset({"fixed", "flexible"}), frozenset({"indoor", "outdoor"}), frozenset({"urban", "rural"}),
 )
 #: hedges before a ratio's number ('by roughly 1.5 to 1', 'by about 3 to 2'), as a regex group
 RATIO_HEDGE = r"(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|some\s+|~\s*)?"

@@ -106,8 +106,10 @@ _WHEN_RE = re.compile(r"\b\d{4}-\d{2}-\d{2}(?:[T ]\d{1,2}:\d{2}(?::\d{2}(?:\.\d+
                       r"\b\d{1,2}(?:[:.]\d{2})?\s?(?:a\.m\.|p\.m\.|am\b|pm\b)|\b\d{1,2}/\d{1,2}/\d{2,4}\b|"
                       rf"\b\d{{1,2}}(?:st|nd|rd|th)?\s+(?:of\s+)?{_MONTH}(?:\s+\d{{4}})?\b|\b{_MONTH}\s+\d{{1,2}}(?:st|nd|rd|th)?"
                       rf"(?:,?\s+\d{{4}})?\b", re.IGNORECASE)
-#: a code: letters joined to digits by a hyphen ('QX-20931', '4471-B', 'Y-19-553'), a long number-number ('2024-0387')
-_CODE_RE = re.compile(r"\b[A-Za-z]+(?:-\d+)+[A-Za-z]?\b|\b\d+-[A-Z]{1,3}\b|\b\d{3,}-\d{3,}\b")
+#: a code: letters joined to digits by a hyphen ('QX-20931', '4471-B', 'Y-19-553'), a long number-number ('2024-0387'),
+#: an index in square brackets right after a word ('lag[-1]', 'forecast[+6h]': a name shortened around its index)
+_CODE_RE = re.compile(r"\b[A-Za-z]+(?:-\d+)+[A-Za-z]?\b|\b\d+-[A-Z]{1,3}\b|\b\d{3,}-\d{3,}\b|"
+                      r"(?<=[A-Za-z_\0])\[[+\-]?\d+[a-z]{0,3}\]")
 
 
 def find_numbers(text: str) -> list[Number]:

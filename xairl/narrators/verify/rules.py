@@ -35,8 +35,9 @@ def example(name: str) -> Explanation:
     wind_speed_ms 0.8 (+6.9), pm2_5_lag1 48.2 (+14.7), traffic_index 2.4 (+7.2), season winter (-1.0), road
     '4 lanes' (+0.1).
 
-    ``drone``: the Q-value of continuing (one output), base 3.1; next_drop_dist_km 0.6 (+1.15), charger_queue_len 3
-    (-0.27), battery_pct 46 (+0.49), drone_model X2 (+0.09); no policy, so units come from the names.
+    ``drone``: the Q-value of continuing to drop 2 (one output), base 3.1; next_drop_dist_km 0.6 (+1.15),
+    charger_queue_len 3 (-0.27), battery_pct 46 (+0.49), drone_model X2 (+0.09); no policy, so units come from the
+    names.
 
     ``fire``: ignition risk (one output), base 4.0; month August (+1.9), aspect south-west (+0.6), days_since_rain
     15 (+2.2), campfire_ban yes (-0.4), patrol_status 'Not Staffed' (+0.3); only the state's labels are known.
@@ -57,7 +58,7 @@ def example(name: str) -> Explanation:
         return Explanation(values=c.reshape(1, -1, 1), base_values=np.array([[3.1]]),
                            outputs=np.array([[3.1 + c.sum()]]), states=np.array([[0.6, 3.0, 46.0, 0.0]]),
                            feature_names=("next_drop_dist_km", "charger_queue_len", "battery_pct", "drone_model"),
-                           action_names=("continue",), method="given", output="value",
+                           action_names=("continue to drop 2",), method="given", output="value",
                            categories={"drone_model": ("X2", "X3")})
     if name == "fire":
         c = np.array([1.9, 0.6, 2.2, -0.4, 0.3])
@@ -139,12 +140,19 @@ RULES: tuple[Rule, ...] = (
          "value", fires=(("drone", "There are already three drones in the charger queue."),),
          silent=(("drone", "There are already five drones in the charger queue."),)),
     Rule("number.without", "number", "a number in a clause that takes named features' pushes away ('without "
-         "traffic's contribution', 'remove the traffic term and', 'ignoring A and B'): verified when it is the "
+         "traffic's contribution', 'remove the traffic term and', 'ignoring A and B', 'if A had contributed nothing', "
+         "'had A been removed'): verified when it is the "
          "prediction, its change from the baseline or the margin less those pushes, else its other readings decide",
          fires=(("air", "Without traffic's contribution, the forecast would be about 44.9."),
                 ("air", "Even without the traffic term it would sit 22.9 above the average."),
-                ("air", "Remove the traffic and wind terms and the forecast would sit at about 38.")),
+                ("air", "Remove the traffic and wind terms and the forecast would sit at about 38."),
+                ("air", "If traffic had contributed nothing, the forecast would be about 44.9."),
+                ("air", "Had the traffic term been removed (its +7.2), the forecast would sit near 44.9.")),
          silent=(("air", "Traffic adds 7.2."), ("air", "Without traffic's contribution, the forecast would be 38."))),
+    Rule("number.output-name", "number", "a number of a one-output model's name, written with a word it has "
+         "there ('sending unit 7' of \"Q-value of the action 'send unit 7'\"): no fact, unchecked",
+         fires=(("drone", "Flying on to drop 2 scores 4.56."),),
+         silent=(("drone", "Continuing scores 4.56 with 3 drones queued."),)),
     Rule("number.change", "number", "the change from the baseline ('30.0 above the average')",
          fires=(("air", "The forecast is 30.1 above the average."),), silent=(("air", "Traffic adds 7.2."),)),
     Rule("number.cue", "number", "a number its cue words bind: the prediction, the baseline, a typical value, the "

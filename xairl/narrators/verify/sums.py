@@ -122,15 +122,42 @@ _WITHOUT = re.compile(r"\b(?:without|remov(?:e|ing)|ignor(?:e|ing)|exclud(?:e|in
                       r"(?:the\s+|its\s+|his\s+|her\s+|their\s+)?", re.IGNORECASE)
 
 
+#: a hypothetical that takes the names after it away once its removal is said: 'if A had contributed nothing', 'had
+#: A been removed', 'if the A term were removed (its -0.47)', 'had A matched (no contribution from that feature)'
+_IF = re.compile(r"\b(?:if|had|were|suppose|imagine|assuming)\b", re.IGNORECASE)
+_REMOVED_AFTER = re.compile(r"\b(?:(?:had|has|have)\s+)?(?:contributed|added|counted)\s+(?:nothing|zero|0)\b|"
+                            r"\b(?:were|was|is|are|be|been)\s+(?:removed|dropped|taken out|zeroed|excluded|ignored|"
+                            r"left out|set to (?:zero|0)|switched off|turned off)\b|\bno contribution\b|"
+                            r"\bremoving (?:its|their|that)\b|\((?:its|their)\s+[+\-−]?\d", re.IGNORECASE)
+
+
+def _removed(n: Number, masked: str, names) -> list:
+    """The names a clause before ``n`` takes away: those after a cue of :data:`_WITHOUT`, or, in a hypothetical
+    (:data:`_IF`), those between its word and the removal said after them (:data:`_REMOVED_AFTER`)."""
+    def unbroken(a: int) -> bool:  # no sentence break between there and the number
+        return not re.search(r"(?<!\d)[.;]|[.;](?!\d)", masked[a:n.start])
+
+    cue = next((c for c in reversed(list(_WITHOUT.finditer(masked, max(0, n.start - 120), n.start)))
+                if unbroken(c.end())), None)
+    after = [m for m in names if cue is not None and cue.end() <= m.start and m.end <= n.start]
+    if after:
+        return after
+    said = next((c for c in reversed(list(_REMOVED_AFTER.finditer(masked, max(0, n.start - 120), n.start)))
+                 if unbroken(c.end())), None)
+    for word in reversed(list(_IF.finditer(masked, max(0, n.start - 160), said.start()) if said else [])):
+        inside = [m for m in names if word.end() <= m.start and m.end <= said.start()]
+        if inside or not unbroken(word.end()):
+            return inside
+    return []
+
+
 def without_number(n: Number, masked: str, names, book: FactBook) -> Claim | None:
     """A number in a clause that takes named features' pushes away ('without the warranty add-on's contribution it
     would sit at about 12.4%', 'even without the battery term, returning would still sit 1.55 above the average',
     'Remove the state-of-charge penalty and the Q-value would sit at about 0.77', 'Without A (-0.18) and B (-0.29),
     it would have been about 2.97'): verified when it is the prediction, its change from the baseline or the margin
     less those pushes; otherwise None (its other readings decide)."""
-    cue = next((c for c in reversed(list(_WITHOUT.finditer(masked, max(0, n.start - 120), n.start)))
-                if not re.search(r"(?<!\d)[.;]|[.;](?!\d)", masked[c.end():n.start])), None)
-    removed = [m for m in names if cue is not None and cue.end() <= m.start and m.end <= n.start]
+    removed = _removed(n, masked, names)
     if not removed or any(len(m.keys) != 1 or m.keys[0] not in book.features for m in removed):
         return None
     keys = list(dict.fromkeys(m.keys[0] for m in removed))

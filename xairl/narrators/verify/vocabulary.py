@@ -113,8 +113,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     for p, kind, keys, label, form in entries:
         pattern, needle = _literal(p) if form == "literal" else _pattern(p, kind)
         compiled.append((pattern, kind, keys, label, "" if form == "literal" else form, needle))
-    return Vocabulary(compiled + _acronyms(exp.feature_names) + _shorthands(exp.feature_names), short, feature_words,
-                      frozenset(names))
+    return Vocabulary(compiled + _acronyms(exp.feature_names, exp.categories) + _shorthands(exp.feature_names), short,
+                      feature_words, frozenset(names))
 
 
 def _spellings(name_words: list[str]) -> list[str]:
@@ -190,16 +190,26 @@ def _head(description: str) -> str:
     return re.split(r"\s*[(:;\[]", description or "", maxsplit=1)[0].strip()
 
 
-def _acronyms(features) -> list:
+def _acronyms(features, categories=None) -> list:
     """'DTI' for ``debt_to_income``: the capital initials of a name of three words or more, matched as written (so
-    that 'NOR' of ``number_of_rooms`` is not the word 'nor'); only an acronym one feature has."""
+    that 'NOR' of ``number_of_rooms`` is not the word 'nor'); only an acronym one feature has. And a label's word
+    in capitals ('ECA' of ``inside_ECA``: 'without the ECA effect' names that label's feature)."""
     owners: dict[str, list[str]] = {}
     for f in features:
         words = split_words(f)
         if len(words) >= 3 and not any(w.isdigit() for w in words):
             owners.setdefault("".join(w[0] for w in words).upper(), []).append(f)
-    return [(re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "", _needle(acr))
-            for acr, fs in owners.items() if len(fs) == 1]
+    out = [(re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "", _needle(acr))
+           for acr, fs in owners.items() if len(fs) == 1]
+    labelled: dict[str, list[tuple[str, str]]] = {}
+    for f, labels in (categories or {}).items():
+        for label in labels:
+            words = re.split(r"[\s_\-/]+", label)
+            for w in words if len(words) >= 2 else ():
+                if re.fullmatch(r"[A-Z]{3,}", w):
+                    labelled.setdefault(w, []).append((f, label))
+    return out + [(re.compile(rf"(?<![\w]){w}(?![\w])"), "label", (fl[0][0],), fl[0][1], "", _needle(w))
+                  for w, fl in labelled.items() if len(fl) == 1]
 
 
 #: a number right after a shorthand ('alc 9.4: -0.38', 'Wknd +3.2h'): the only place a shorthand names
