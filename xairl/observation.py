@@ -118,8 +118,9 @@ class Observation:
             return "{" + ", ".join(f"{p.key}: {s}" for p, s in zip(self.parts, shapes)) + "}"
         return "(" + ", ".join(shapes) + ")"
 
-    def flatten(self, states: Any, what: str = "states") -> np.ndarray:
-        """States in any form this observation accepts -> a checked float32 matrix (n, n_features).
+    def flatten(self, states: Any, what: str = "states", dtype=np.float32) -> np.ndarray:
+        """States in any form this observation accepts -> a checked matrix (n, n_features) of ``dtype`` (the
+        network's: float32, or float64 for a float64 network), finite after the cast.
 
         Accepted: the flat matrix itself (n, F) or one flat row (F,); for 'array' also (n, *shape) or one state
         (*shape); for 'dict' a mapping of key -> (n, *shape) (integers for categorical keys); for 'tuple' a
@@ -130,11 +131,11 @@ class Observation:
         if isinstance(states, Mapping):
             if self.kind != "dict":
                 raise InputError(f"{what}: got a dict but this policy takes {self.describe()}; pass an array.")
-            return _finite(np.concatenate(self._columns(states, what), axis=1), what)
+            return _finite(np.concatenate(self._columns(states, what), axis=1), what, dtype)
         if isinstance(states, (tuple, list)) and self.kind == "tuple" and len(states) == len(self.parts) and \
                 all(hasattr(s, "shape") for s in states):
             return _finite(np.concatenate(self._columns(dict(zip([p.key for p in self.parts], states)), what),
-                                          axis=1), what)
+                                          axis=1), what, dtype)
         arr = _numeric(states, what)
         f = self.n_features
         if self.kind == "array":
@@ -153,7 +154,7 @@ class Observation:
         if arr.shape[1] != f:
             raise InputError(f"{what} has {arr.shape[1]} features but the policy expects {f}"
                              f"{' as ' + self.describe() if self.kind != 'flat' else ''}; check the column order/count.")
-        return _finite(arr, what)
+        return _finite(arr, what, dtype)
 
     def _columns(self, states: Mapping, what: str) -> list[np.ndarray]:
         missing = [p.key for p in self.parts if p.key not in states]
@@ -292,13 +293,21 @@ def _numeric(data, what: str) -> np.ndarray:
 _REFUSED_KINDS = {"c": "complex numbers", "M": "dates", "m": "time spans"}
 
 
-def _finite(arr: np.ndarray, what: str) -> np.ndarray:
-    with np.errstate(over="ignore"):  # reported below as inf, in one line, not as a numpy warning
-        arr = arr.astype(np.float32)  # check after the cast: values beyond float32's range become inf here
+def _finite(arr: np.ndarray, what: str, dtype=np.float32) -> np.ndarray:
     bad = ~np.isfinite(arr)
     if bad.any():
         r, c = np.argwhere(bad)[0]
         raise InputError(
             f"{what} contain {int(bad.sum())} NaN/inf value(s), first at row {r}, column {c}; clean or drop them."
         )
-    return arr
+    with np.errstate(over="ignore"):  # reported below in one line, not as a numpy warning
+        out = arr.astype(dtype)
+    over = ~np.isfinite(out)  # finite numbers beyond float32's range (~3.4e38) become inf in the cast
+    if over.any():
+        r, c = np.argwhere(over)[0]
+        raise InputError(
+            f"{what} hold {int(over.sum())} value(s) beyond the {np.dtype(dtype).name} range (±"
+            f"{np.finfo(dtype).max:.2g}) the network computes in, first at row {r}, column {c} ({arr[r, c]:.3g}); "
+            "scale those inputs down, or give a float64 network (module.double())."
+        )
+    return out
