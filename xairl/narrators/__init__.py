@@ -11,8 +11,8 @@ from .confidence import confidence
 from .verify import Verification, verify
 
 
-def narrate(explanation: Explanation, index: int | None = 0, narrator: str = "template", template: str | None = None,
-            policy: Policy | None = None, background=None, options: dict | None = None,
+def narrate(explanation: Explanation, index: int | None = 0, *, narrator: str = "template",
+            template: str | None = None, policy: Policy | None = None, background=None, options: dict | None = None,
             prompt_dirs: Iterable[str] = (), k: int = 3, store=None, robustness: bool = True,
             history=None) -> Narrative:
     """Words for decision ``index`` (``None``: a global summary over all states), checked against the numbers.
@@ -27,7 +27,8 @@ def narrate(explanation: Explanation, index: int | None = 0, narrator: str = "te
     from ..plugins import registry
 
     writer: Narrator = registry("narrator").load(narrator)(options)
-    narrative = writer.narrate(explanation, index, template, policy, background, prompt_dirs, k, robustness, history)
+    narrative = writer.narrate(explanation, index, template=template, policy=policy, background=background,
+                               prompt_dirs=prompt_dirs, k=k, robustness=robustness, history=history)
     if store is not None:
         store.record(narrative, policy=policy)  # with its evidence: the numbers of what it says
     return narrative
