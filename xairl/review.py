@@ -6,8 +6,9 @@ review.
 The server is Python's own (http.server), bound to 127.0.0.1 only. Defended against pages on other sites open in
 the same browser and against hostile clients: a Host allow-list (``127.0.0.1:PORT``, ``localhost:PORT``; else 421)
 against DNS rebinding, the Origin of a POST checked when sent (else 403), a token made at start-up in every form,
-a body limit (413, decided before reading), socket timeouts that drop stalled clients, and 400 for malformed
-forms, all without tracebacks. Not defended: anyone with a shell on this machine (they can read the store
+a body limit (413, decided before reading), a socket timeout per read or write, a total deadline per connection
+(a client trickling one byte at a time is hung up on when it passes), a cap on open connections (503 beyond it),
+and 400 for malformed forms, all without tracebacks. Not defended: anyone with a shell on this machine (they can read the store
 anyway); there is no TLS and no authentication beyond the token.
 """
 from __future__ import annotations
@@ -15,8 +16,10 @@ from __future__ import annotations
 import html
 import re
 import secrets
+import socket
 import sys
 import threading
+import time
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from urllib.parse import parse_qs, urlencode, urlparse
@@ -28,11 +31,95 @@ from .feedback import FeedbackStore, Record
 HOST = "127.0.0.1"
 MAX_BODY = 1_000_000  # a correction is a few sentences; more than this is not from the page
 TIMEOUT = 10.0  # seconds a client may stall before its connection is dropped
+DEADLINE = 20.0  # seconds a connection may last in all (one request: HTTP/1.0), however it trickles
+MAX_CONNECTIONS = 16  # open at once (a browser opens about 6); beyond it a connection is answered 503 and closed
+_BUSY_TEXT = b"too many connections; retry shortly\n"
+_BUSY = (b"HTTP/1.0 503 Service Unavailable\r\nContent-Type: text/plain; charset=utf-8\r\nRetry-After: 5\r\n"
+         b"Content-Length: %d\r\nConnection: close\r\n\r\n%s" % (len(_BUSY_TEXT), _BUSY_TEXT))
 _NUMBER = re.compile(r"[0-9]{1,18}")  # fits SQLite's 64-bit integer and stays under int()'s digit limit
 
 
 class _Server(ThreadingHTTPServer):
+    """A thread per connection, at most ``max_connections`` of them, each hung up on ``deadline`` seconds after it was
+    accepted by one reaper thread (a socket timeout bounds one read, not a client that sends a byte per timeout)."""
+
     daemon_threads = True  # shutdown does not wait for a stalled client
+
+    def __init__(self, address, handler, deadline: float = DEADLINE, max_connections: int = MAX_CONNECTIONS):
+        super().__init__(address, handler)
+        self.deadline, self.max_connections = float(deadline), int(max_connections)
+        self._lock = threading.Condition()
+        self._open: dict[socket.socket, float] = {}  # connection -> when it is hung up on (time.monotonic)
+        self._expired: set[socket.socket] = set()
+        self._serving = False
+
+    def serve_forever(self, poll_interval: float = 0.5) -> None:
+        with self._lock:
+            self._serving = True
+        reaper = threading.Thread(target=self._reap, name="xairl-review-reaper", daemon=True)
+        reaper.start()
+        try:
+            super().serve_forever(poll_interval)
+        finally:
+            with self._lock:
+                self._serving = False
+                self._lock.notify_all()
+            reaper.join()
+
+    def _reap(self) -> None:
+        """Hang up on every connection past its deadline: its thread's blocked read or write returns and it ends."""
+        with self._lock:
+            while self._serving:
+                now = time.monotonic()
+                for conn, end in self._open.items():
+                    if end <= now and conn not in self._expired:
+                        self._expired.add(conn)
+                        try:
+                            conn.shutdown(socket.SHUT_RDWR)
+                        except OSError:  # closed meanwhile
+                            pass
+                waiting = [end for conn, end in self._open.items() if conn not in self._expired]
+                self._lock.wait(max(min(waiting) - now, 0.0) if waiting else None)
+
+    def expired(self, conn: socket.socket) -> bool:
+        with self._lock:
+            return conn in self._expired
+
+    @property
+    def open_connections(self) -> int:
+        with self._lock:
+            return len(self._open)
+
+    def process_request(self, request, client_address):
+        with self._lock:
+            full = len(self._open) >= self.max_connections
+            if not full:
+                self._open[request] = time.monotonic() + self.deadline
+                self._lock.notify_all()
+        if full:  # answered at once, from the accepting thread: a fresh socket's buffer takes these bytes
+            try:
+                request.setblocking(False)
+                request.send(_BUSY)
+            except OSError:
+                pass
+            self.shutdown_request(request)
+            return
+        try:
+            super().process_request(request, client_address)
+        except BaseException:  # no thread started: free the slot
+            self._forget(request)
+            raise
+
+    def process_request_thread(self, request, client_address):
+        try:
+            super().process_request_thread(request, client_address)
+        finally:
+            self._forget(request)
+
+    def _forget(self, request) -> None:
+        with self._lock:
+            self._open.pop(request, None)
+            self._expired.discard(request)
 
     def handle_error(self, request, client_address):
         """A client that vanished or stalled (OSError) is its own affair; a bug of ours still shows."""
@@ -79,6 +166,14 @@ class _Handler(BaseHTTPRequestHandler):
         self.send_header("Content-Length", str(len(data)))
         self.end_headers()
         self.wfile.write(data)
+
+    def parse_request(self) -> bool:
+        """A request completed only by the hang-up at its deadline (its lines cut short) is not answered."""
+        ok = not self.server.expired(self.connection) and super().parse_request()
+        if self.server.expired(self.connection):
+            self.close_connection = True
+            return False
+        return ok
 
     def _misdirected(self) -> bool:
         """DNS rebinding: a hostile name resolved to 127.0.0.1 arrives with that name as Host; answer 421."""
@@ -143,11 +238,19 @@ class _Handler(BaseHTTPRequestHandler):
         pass
 
 
-def make_server(store: FeedbackStore, port: int = 0, timeout: float = TIMEOUT) -> ThreadingHTTPServer:
-    """A review server for ``store`` on 127.0.0.1 (``port`` 0: any free port; ``server.server_address`` says);
-    ``timeout``: seconds a client may stall before its connection is dropped and its thread freed."""
+def make_server(store: FeedbackStore, port: int = 0, timeout: float = TIMEOUT, deadline: float = DEADLINE,
+                max_connections: int = MAX_CONNECTIONS) -> ThreadingHTTPServer:
+    """A review server for ``store`` on 127.0.0.1 (``port`` 0: any free port; ``server.server_address`` says).
+
+    :param timeout: seconds a client may stall in one read or write before its connection is dropped.
+    :param deadline: seconds a connection may last in all before it is hung up on and its thread freed.
+    :param max_connections: connections served at once; one more is answered 503 and closed.
+    """
+    if not (deadline > 0 and timeout > 0 and max_connections >= 1):
+        raise InputError(f"the review server needs a positive timeout and deadline and at least one connection, got "
+                         f"timeout={timeout}, deadline={deadline}, max_connections={max_connections}.")
     handler = type("Handler", (_Handler,), {"timeout": timeout})  # a socket timeout per server
-    server = _Server((HOST, port), handler)
+    server = _Server((HOST, port), handler, deadline, max_connections)
     server.store, server.token = store, secrets.token_urlsafe(16)
     server.hosts = {f"{name}:{server.server_address[1]}" for name in (HOST, "localhost")}
     return server
@@ -166,8 +269,10 @@ def serve(store: FeedbackStore, port: int = 8765) -> None:
         server.server_close()
 
 
-def serve_in_thread(store: FeedbackStore, timeout: float = TIMEOUT) -> tuple[ThreadingHTTPServer, str]:
-    """A server on a free port in a daemon thread, and its address (for tests and notebooks)."""
-    server = make_server(store, 0, timeout)
+def serve_in_thread(store: FeedbackStore, timeout: float = TIMEOUT, deadline: float = DEADLINE,
+                    max_connections: int = MAX_CONNECTIONS) -> tuple[ThreadingHTTPServer, str]:
+    """A server on a free port in a daemon thread, and its address (for tests and notebooks); the parameters are
+    :func:`make_server`'s."""
+    server = make_server(store, 0, timeout, deadline, max_connections)
     threading.Thread(target=server.serve_forever, daemon=True).start()
     return server, f"http://{HOST}:{server.server_address[1]}/"
