@@ -1,4 +1,4 @@
-"""Turning user data (arrays, .csv/.npy/.json files) into checked float32 state matrices."""
+"""Turning user data (arrays, .csv/.npy/.npz/.json/.parquet files) into checked state matrices."""
 from __future__ import annotations
 
 import csv
@@ -72,8 +72,8 @@ def read_states(path: str | Path, feature_names: Sequence[str], observation: Obs
         raise InputError(f"{path}: nested too deeply to hold {what}; give rows of numbers.") from None
     except (ValueError, OSError, UnicodeDecodeError, EOFError, zipfile.BadZipFile) as exc:
         raise InputError(f"{path}: cannot read it ({' '.join(str(exc).split())[:160]}).") from None
-    try:
-        return observation.flatten(data, what)
+    try:  # float64: the network's own dtype is cast to (and checked) when it is explained
+        return observation.flatten(data, what, np.float64)
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
 

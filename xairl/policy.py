@@ -178,10 +178,17 @@ class Policy:
         p = next(self.module.parameters(), None)
         return p.device if p is not None else torch.device("cpu")
 
+    @property
+    def dtype(self) -> type:
+        """The numpy dtype the network computes in, as its first floating-point parameter: float64 for a float64
+        network (its states are explained in float64), float32 otherwise (a float16 network is refused in one line
+        when it runs)."""
+        return np.float64 if _module_dtype(self.module) == torch.float64 else np.float32
+
     def check_states(self, states, what: str = "states") -> np.ndarray:
-        """States in any form the observation takes -> validated float32 (n, n_features); raises
-        :class:`InputError` with a one-line reason."""
-        return self.observation.flatten(states, what)
+        """States in any form the observation takes -> validated (n, n_features) in the network's :attr:`dtype`;
+        raises :class:`InputError` with a one-line reason."""
+        return self.observation.flatten(states, what, self.dtype)
 
     def scores(self, states) -> np.ndarray:
         """Outputs (n, n_actions) of the module in eval mode, without gradients."""
@@ -199,7 +206,7 @@ class Policy:
         self.module.eval()
         try:
             with torch.no_grad():
-                out = self.network(torch.as_tensor(x, dtype=torch.float32, device=self.device))
+                out = self.network(torch.as_tensor(x, dtype=_TORCH[self.dtype], device=self.device))
         finally:
             self.module.train(was_training)
         return out.detach().cpu().numpy().astype(np.float64)
@@ -266,6 +273,12 @@ class PolicyNetwork(torch.nn.Module):
             raise
         except Exception as exc:  # the user's code: say where, in one line, without its traceback
             detail = " ".join(str(exc).split())[:300]
+            own = _module_dtype(self.module)
+            if own is not None and own != x.dtype:  # e.g. a float16 network: the dtype, not the shape, is wrong
+                raise InputError(f"policy '{self.policy_name}': its module {type(self.module).__name__} computes in "
+                                 f"{str(own).removeprefix('torch.')} and failed on {str(x.dtype).removeprefix('torch.')}"
+                                 f" states ({type(exc).__name__}: {detail[:160]}); xairl explains float32 and float64 "
+                                 "networks: convert it with module.float() or module.double().") from None
             shape = tuple(x.shape[:1]) + tuple(inp.shape[1:]) if isinstance(inp, torch.Tensor) else \
                 f"{self.observation.describe().replace('(n', f'({len(x)}')}"
             raise InputError(f"policy '{self.policy_name}': its module {type(self.module).__name__} raised "
@@ -281,6 +294,17 @@ class PolicyNetwork(torch.nn.Module):
             raise InputError(f"policy '{self.policy_name}': the module returned shape {tuple(out.shape)} for "
                              f"{len(x)} states; it must return (batch, n_outputs).")
         return out
+
+
+_TORCH = {np.float32: torch.float32, np.float64: torch.float64}
+
+
+def _module_dtype(module: torch.nn.Module) -> torch.dtype | None:
+    """The dtype of the module's first floating-point parameter or buffer; None when it has none."""
+    for t in (*module.parameters(), *module.buffers()):
+        if t.is_floating_point():
+            return t.dtype
+    return None
 
 
 def _observation(obs, feature_names) -> Observation:

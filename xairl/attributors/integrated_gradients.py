@@ -34,7 +34,7 @@ class IntegratedGradients(Attributor):
 
         dev = policy.device
         xt = torch.as_tensor(x, device=dev)
-        ref = bg.mean(axis=0) if self.options.baseline == "mean" else np.zeros(x.shape[1], dtype=np.float32)
+        ref = bg.mean(axis=0) if self.options.baseline == "mean" else np.zeros(x.shape[1], dtype=x.dtype)
         baseline = torch.as_tensor(ref, device=dev)[None, :].expand_as(xt).contiguous()
         ig = CaptumIG(policy.network)
         values = np.empty((len(x), x.shape[1], policy.n_actions))

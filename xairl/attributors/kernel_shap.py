@@ -30,7 +30,7 @@ class KernelShap(Attributor):
         dev = policy.device
 
         def f(rows: np.ndarray) -> np.ndarray:
-            t = torch.as_tensor(np.asarray(rows, dtype=np.float32), device=dev)
+            t = torch.as_tensor(np.asarray(rows, dtype=policy.dtype), device=dev)
             return self._forward(policy, t, 65_536).numpy()
 
         explainer = shap.KernelExplainer(f, bg)

@@ -1,0 +1,79 @@
+"""Issue 51, hardening round 3 (items 4, 6, 9, 10, 16, 17): what a user brings (a saved explanation, a Parquet file,
+a float64 network, huge numbers, an episode to slice out, a parametrised action space) is explained correctly or
+refused in one line that says what to do, never a raw exception or a silent wrong answer."""
+import json
+
+import numpy as np
+import pytest
+import torch
+
+import xairl
+from xairl.cli import main
+from xairl.errors import InputError
+from xairl.toy import FEATURES, toy_policy
+
+from .conftest import ReusedActivations, mlp
+
+POLICY = toy_policy()
+METHODS = ["deep_shap", "integrated_gradients", "kernel_shap", "exact"]
+
+
+def run(capsys, *argv):
+    rc = main(list(argv))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def one_line_error(rc, err, *words):
+    assert rc == 2 and err.startswith("xairl: error: ") and err.count("\n") == 1, err
+    assert "Traceback" not in err and "internal error" not in err
+    for w in words:
+        assert w in err, (w, err)
+
+
+# 9. float64 networks ----------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("net", [lambda: mlp([6, 12, 3]), ReusedActivations], ids=["sequential", "forward"])
+@pytest.mark.parametrize("method", METHODS)
+def test_a_float64_network_is_explained_in_float64(method, net):
+    """A float64 network failed with 'mat1 and mat2 must have the same dtype ... check that it takes (n, 6)': the
+    states were cast to float32. Now it runs in float64, with float64 precision in every method."""
+    module = net().double()
+    policy = xairl.Policy(module, feature_names=[f"f{i}" for i in range(6)], action_names=["a", "b", "c"])
+    r = np.random.default_rng(0)
+    x, bg = r.normal(size=(3, 6)), r.normal(size=(12, 6))
+    exp = xairl.explain(policy, x, background=bg, method=method)
+    with torch.no_grad():
+        expected = module(torch.as_tensor(x)).numpy()
+    np.testing.assert_allclose(exp.outputs, expected, rtol=0, atol=1e-12)  # float32 states would be off by ~1e-7
+    np.testing.assert_array_equal(exp.states, x)
+    if method != "integrated_gradients":  # a quadrature, not exact
+        assert exp.additivity_gap.max() < 1e-9
+
+
+def test_a_network_of_another_dtype_is_refused_naming_the_dtype():
+    policy = xairl.Policy(mlp([5, 4, 2]).half(), feature_names=FEATURES, action_names=["a", "b"])
+    with pytest.raises(InputError, match=r"computes in float16 .* convert it with module.float\(\)") as err:
+        xairl.explain(policy, POLICY.background(2), background=POLICY.background(4))
+    assert "check that it takes" not in str(err.value)
+
+
+# 10. numbers beyond float32 -----------------------------------------------------------------------------------------
+def test_a_finite_number_beyond_float32_is_named_an_overflow():
+    """1e300 is finite; it was reported as a 'NaN/inf value', which the user's file does not hold."""
+    states = POLICY.background(2).astype(np.float64)
+    states[1, 2] = 1e300
+    with pytest.raises(InputError, match=r"1 value\(s\) beyond the float32 range .* row 1, column 2 \(1e\+300\); "
+                                         r"scale those inputs down, or give a float64 network") as err:
+        xairl.explain(POLICY, states, background=POLICY.background(4))
+    assert "NaN" not in str(err.value)
+    states[1, 2] = np.nan
+    with pytest.raises(InputError, match="NaN/inf"):
+        POLICY.check_states(states)
+
+
+def test_a_float64_network_takes_numbers_beyond_float32(tmp_path, capsys):
+    policy = xairl.Policy(torch.nn.Linear(5, 2).double(), feature_names=FEATURES)
+    states = np.zeros((1, 5))
+    states[0, 0] = 1e300
+    exp = xairl.explain(policy, states, background=np.zeros((3, 5)), method="exact")
+    assert exp.states[0, 0] == 1e300 and np.isfinite(exp.values).all()
