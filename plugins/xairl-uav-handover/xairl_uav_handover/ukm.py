@@ -47,6 +47,7 @@ MAX_DOWNLOAD = 64 << 20    # bytes; the pinned zip is a few MB
 MAX_MEMBER = 16 << 20      # uncompressed bytes per CSV (the largest is 1.2 MB)
 MAX_TOTAL = 128 << 20      # uncompressed bytes extracted in all (the 29 CSVs: 22 MB)
 MAX_MEMBERS = 1000
+NAME_MAX = 255             # bytes of a file name on the usual file systems (ext4, APFS, NTFS in UTF-16 units)
 
 
 def data_home() -> Path:
@@ -61,13 +62,17 @@ def flights_folder(path: str | Path | None = None, *, root: str | Path | None = 
     else the UKM copy cached under ``root`` (default :func:`data_home`), else downloaded there from ``url`` (default
     :data:`URL`), checked against ``sha256`` (default :data:`SHA256`).
 
-    An explicit ``path`` that is neither a folder nor a zip is returned as given, for the loader to report.
+    An explicit ``path`` that does not exist is returned as given, for the caller to report; one that exists but is
+    no readable zip (empty, truncated, encrypted, unreadable, another kind of file) raises :class:`InputError`.
     """
     root = Path(root) if root is not None else data_home()
     if path is not None:
         return _given(Path(path).expanduser(), root) or Path(path)
     if os.environ.get(ENV):
-        found = _given(Path(os.environ[ENV]).expanduser(), root)
+        try:
+            found = _given(Path(os.environ[ENV]).expanduser(), root)
+        except InputError as exc:
+            raise InputError(f"{ENV}={os.environ[ENV]}: {exc}") from None
         if found is None:
             raise InputError(f"{ENV}={os.environ[ENV]}: no such folder or zip of flight exports; fix or unset it.")
         return found
@@ -77,17 +82,44 @@ def flights_folder(path: str | Path | None = None, *, root: str | Path | None = 
 
 
 def _given(path: Path, root: Path) -> Path | None:
-    """A folder as is; a zip extracted once into ``root`` (the pinned one into the UKM cache); otherwise None."""
+    """A folder as is; a zip extracted once into ``root`` (the pinned one into the UKM cache); None where nothing is
+    there. A file that is there but no readable zip raises :class:`InputError` saying what it is."""
     if path.is_dir():
         return path
-    if not (path.is_file() and zipfile.is_zipfile(path)):
+    if not path.exists():
         return None
+    _check_zip_file(path)
     digest = _sha256_file(path)
     pinned = digest == SHA256
     final = root / (FOLDER if pinned else f"{FOLDER}-zip-{digest[:12]}")
     if not _has_csv(final):
         _install(path, final, _note(str(path.resolve()), digest, pinned))
     return final
+
+
+def _check_zip_file(path: Path) -> None:
+    """Refuse, in one line, a path that exists but is not a zip that can be opened: not a plain file, unreadable,
+    empty, truncated (a zip's directory is at its end), or some other kind of file."""
+    if not path.is_file():
+        raise InputError(f"{path}: neither a folder nor a zip of flight exports (not a plain file); {_GIVE}")
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4)
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read it ({_reason(exc, 0)}); {_GIVE}") from None
+    if not head:
+        raise InputError(f"{path}: the file is empty (0 bytes), not a zip of flight exports; download it again "
+                         f"or {_GIVE}")
+    if zipfile.is_zipfile(path):
+        return
+    if head == b"PK\x03\x04":  # a zip's first member, but no directory at the end
+        raise InputError(f"{path}: a zip without its directory at the end ({path.stat().st_size} bytes): truncated "
+                         f"(an interrupted download or copy); download it again.")
+    raise InputError(f"{path}: a file, but neither a folder nor a zip of flight exports; {_GIVE}")
+
+
+#: what a user can pass instead, ending every refusal of a given path
+_GIVE = "give a folder of the Nemo CSVs or the UKM zip."
 
 
 def download(root: str | Path, url: str = URL, sha256: str = SHA256, timeout: float = TIMEOUT_S) -> Path:
@@ -180,6 +212,8 @@ def _extract_csvs(zip_path: Path, dest: Path) -> int:
             return total
     except (zipfile.BadZipFile, zipfile.LargeZipFile, zlib.error, EOFError, NotImplementedError) as exc:
         raise InputError(f"{zip_path}: not a readable zip archive ({' '.join(str(exc).split())}).") from None
+    except OSError as exc:  # reading the zip, or writing beside the data folder (disk full, read-only)
+        raise InputError(f"{zip_path}: cannot extract it into {dest.parent} ({_reason(exc, 0)}).") from None
 
 
 def _flight_members(zf: zipfile.ZipFile, zip_path: Path) -> list[zipfile.ZipInfo]:
@@ -190,7 +224,7 @@ def _flight_members(zf: zipfile.ZipFile, zip_path: Path) -> list[zipfile.ZipInfo
     for info in infos:
         parts = PurePosixPath(info.filename.replace("\\", "/"))
         if parts.is_absolute() or ".." in parts.parts or ":" in info.filename:
-            raise InputError(f"{zip_path}: unsafe member name '{info.filename}' (absolute or '..'); refused.")
+            raise InputError(f"{zip_path}: unsafe member name '{_short(info.filename)}' (absolute or '..'); refused.")
     csvs = [i for i in infos if not i.is_dir() and i.filename.lower().endswith(".csv")
             and "__MACOSX" not in PurePosixPath(i.filename).parts
             and not PurePosixPath(i.filename).name.startswith(".")]
@@ -200,12 +234,26 @@ def _flight_members(zf: zipfile.ZipFile, zip_path: Path) -> list[zipfile.ZipInfo
         raise InputError(f"{zip_path}: no CSV in the zip (expected '{MEMBER_DIR}/*.csv').")
     if len(set(names)) < len(names):
         raise InputError(f"{zip_path}: two CSVs share a file name; extract it yourself and pass the folder.")
+    for info, name in zip(chosen, names):
+        if info.flag_bits & 0x1:
+            raise InputError(f"{zip_path}: '{_short(info.filename)}' is encrypted (password-protected); extract "
+                             f"the zip yourself with its password and pass the folder.")
+        if len(name.encode("utf-8", "surrogateescape")) > NAME_MAX:
+            raise InputError(f"{zip_path}: the member '{_short(info.filename)}' has a file name longer than "
+                             f"the {NAME_MAX} bytes a file system allows; extract its CSVs under shorter names and "
+                             f"pass the folder.")
     return chosen
+
+
+def _short(name: str, limit: int = 80) -> str:
+    """A member name on one line, at most ``limit`` characters (a hostile one can be thousands)."""
+    name = " ".join(name.split())
+    return name if len(name) <= limit else f"{name[:limit // 2]}...{name[-limit // 2:]}"
 
 
 def _copy_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, target: Path, zip_path: Path, budget: int) -> int:
     limit = min(MAX_MEMBER, budget)
-    too_big = InputError(f"{zip_path}: '{info.filename}' unpacks to more than {limit} bytes (limits: "
+    too_big = InputError(f"{zip_path}: '{_short(info.filename)}' unpacks to more than {limit} bytes (limits: "
                          f"{MAX_MEMBER} a file, {MAX_TOTAL} in all); refused.")
     if info.file_size > limit:
         raise too_big
