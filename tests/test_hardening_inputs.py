@@ -77,3 +77,65 @@ def test_a_float64_network_takes_numbers_beyond_float32(tmp_path, capsys):
     states[0, 0] = 1e300
     exp = xairl.explain(policy, states, background=np.zeros((3, 5)), method="exact")
     assert exp.states[0, 0] == 1e300 and np.isfinite(exp.values).all()
+
+
+# 6. Parquet states files ------------------------------------------------------------------------------------------
+def _parquet(path, columns: dict, names=None):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    names = names or list(columns)
+    arrays = [pa.array(columns[n]) if not isinstance(columns[n], pa.Array) else columns[n] for n in names]
+    pq.write_table(pa.Table.from_arrays(arrays, names=names), path)
+    return str(path)
+
+
+def _columns(n=4):
+    x = POLICY.background(n, seed=3).astype(np.float64)
+    return {f: x[:, j] for j, f in enumerate(FEATURES)}, x
+
+
+def test_a_parquet_states_file_is_explained(tmp_path, capsys):
+    """`xairl explain --states f.parquet` said "unknown file type '.parquet'" though --format parquet reads it;
+    other columns (an episode id) are ignored, the features read in the policy's order."""
+    cols, x = _columns()
+    path = _parquet(tmp_path / "s.parquet", {"episode": np.arange(4), **dict(reversed(list(cols.items())))})
+    from xairl.inputs import read_states
+
+    np.testing.assert_array_equal(read_states(path, FEATURES), x)
+    rc, out, err = run(capsys, "explain", "--states", path, "--background", path, "--method", "exact")
+    assert rc == 0 and out.count("state ") == 4, err
+
+
+@pytest.mark.parametrize("column, words", [
+    ("timestamp", ["column 'speed' holds timestamp[us] values, not numbers"]),
+    ("string", ["column 'speed' holds string values, not numbers"]),
+    ("duplicate", ["column(s) speed appear more than once"]),
+])
+def test_a_parquet_file_with_a_column_that_is_not_numbers_is_one_line(tmp_path, capsys, column, words):
+    import datetime
+
+    cols, _ = _columns()
+    names = list(FEATURES)
+    if column == "timestamp":
+        cols["speed"] = [datetime.datetime(2026, 1, 1, 0, 0, i) for i in range(4)]
+    elif column == "string":
+        cols["speed"] = ["fast", "slow", "fast", "slow"]
+    else:
+        names = names + ["speed"]
+    path = _parquet(tmp_path / "s.parquet", cols, names)
+    rc, _, err = run(capsys, "explain", "--states", path, "--method", "exact")
+    one_line_error(rc, err, path, *words)
+
+
+@pytest.mark.xfail(strict=True, reason="the streamed path reads Parquet in xairl/chunks.py, not in this change's "
+                   "files: its _parquet_file must call xairl.inputs.check_columns(pf.schema_arrow, feature_names)")
+def test_a_streamed_parquet_file_with_a_timestamp_column_is_one_line(tmp_path, capsys):
+    import datetime
+
+    cols, _ = _columns()
+    cols["speed"] = [datetime.datetime(2026, 1, 1, 0, 0, i) for i in range(4)]
+    path = _parquet(tmp_path / "s.parquet", cols)
+    rc, _, err = run(capsys, "explain", "--states", path, "--format", "parquet", "--out", str(tmp_path / "run"),
+                     "--method", "exact", "--no-robustness")
+    one_line_error(rc, err, "column 'speed' holds timestamp")

@@ -35,8 +35,8 @@ LIMIT_ENV = "XAIRL_MAX_STATES_BYTES"
 def read_states(path: str | Path, feature_names: Sequence[str], observation: Observation | None = None,
                 what: str = "states") -> np.ndarray:
     """Read states from .npy (any shape the observation takes), .npz (one array per key of a dict observation, or
-    ``arr_0, arr_1, ...`` for several inputs), .csv (header row naming the features, any order) or .json (list of
-    rows or of objects).
+    ``arr_0, arr_1, ...`` for several inputs), .csv (header row naming the features, any order), .json (list of
+    rows or of objects) or .parquet (one numeric column per feature, named as the features; other columns ignored).
 
     :param path: file to read.
     :param feature_names: the policy's features; CSV/JSON objects are reordered to match them.
@@ -58,13 +58,15 @@ def read_states(path: str | Path, feature_names: Sequence[str], observation: Obs
                 if any(d is None for d in data):
                     raise InputError(f"the policy takes {len(observation.parts)} inputs; save them with "
                                      "np.savez(path, x0, x1, ...).")
+        elif suffix == ".parquet":
+            data = _read_parquet(path, feature_names)
         elif suffix in (".csv", ".json"):
             if path.stat().st_size > MAX_TEXT_BYTES:
                 raise InputError(f"a {suffix} file of {path.stat().st_size / 1024 ** 2:.0f} MB is too large to parse "
                                  f"(limit {MAX_TEXT_BYTES // 1024 ** 2} MB); save the {what} as .npy instead.")
             data = (_read_csv if suffix == ".csv" else _read_json)(path, feature_names, what)
         else:
-            raise InputError(f"{path}: unknown file type '{suffix}'; use .csv, .npy, .npz or .json.")
+            raise InputError(f"{path}: unknown file type '{suffix}'; use .csv, .npy, .npz, .json or .parquet.")
     except InputError as exc:
         msg = str(exc)
         raise InputError(msg if msg.startswith(str(path)) else f"{path}: {msg}") from None
@@ -155,6 +157,42 @@ def _read_csv(path: Path, feature_names: Sequence[str], what: str) -> np.ndarray
                     f"line {i}, column '{feature_names[j]}': '{cell}' is not a number; fix or drop the row."
                 ) from None
     return out
+
+
+def check_columns(schema, feature_names: Sequence[str]) -> None:
+    """Refuse an Arrow schema (a Parquet file's) whose feature columns are missing, duplicated or not numbers,
+    naming the column: numpy would raise a DTypePromotionError on a timestamp, pyarrow a KeyError on a duplicate."""
+    import pyarrow.types as pat
+
+    names = list(schema.names)
+    twice = sorted({f for f in feature_names if names.count(f) > 1})
+    if twice:
+        raise InputError(f"column(s) {', '.join(twice[:5])} appear more than once; keep one of each.")
+    missing = [f for f in feature_names if f not in names]
+    if missing:
+        raise InputError(f"lacks column(s) {', '.join(missing[:5])}; one column per feature, named as the features.")
+    for f in feature_names:
+        kind = schema.field(f).type
+        if not (pat.is_integer(kind) or pat.is_floating(kind) or pat.is_boolean(kind) or pat.is_decimal(kind)):
+            raise InputError(f"column '{f}' holds {kind} values, not numbers; convert it to numbers (a time to "
+                             "seconds, a category to its code) or rename it.")
+
+
+def _read_parquet(path: Path, feature_names: Sequence[str]) -> np.ndarray:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    try:
+        pf = pq.ParquetFile(path)
+        check_columns(pf.schema_arrow, feature_names)
+        _check_size((pf.metadata.num_rows, len(feature_names)))
+        table = pf.read(columns=list(feature_names))
+    except pa.ArrowException as exc:
+        raise InputError(f"cannot read it as Parquet ({' '.join(str(exc).split())[:160]}).") from None
+    if not table.num_rows:
+        return np.empty((0, len(feature_names)))
+    return np.column_stack([table.column(f).to_numpy(zero_copy_only=False).astype(np.float64)
+                            for f in feature_names])
 
 
 def _read_json(path: Path, feature_names: Sequence[str], what: str):
