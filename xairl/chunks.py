@@ -31,6 +31,15 @@ def count_states(source, policy: Policy) -> int | None:
     return len(read_states(path, policy.feature_names, policy.observation))
 
 
+def count_rows(source, policy: Policy) -> int:
+    """Rows in a states source, a CSV file's counted by reading it through (block by block)."""
+    n = count_states(source, policy)
+    if n is None:
+        _, batches = _table_batches(Path(source), policy, CHUNK, 0)
+        n = sum(len(b) for b in batches)
+    return n
+
+
 def state_chunks(source, policy: Policy, chunk_size: int = CHUNK, start: int = 0) -> Iterator[tuple[int, np.ndarray]]:
     """(first row, checked float32 states) for each chunk of ``chunk_size`` rows from row ``start`` on.
 

@@ -12,6 +12,12 @@ run) and ``summary.json`` (mean |contribution| per feature over all states). Eac
 ``.part`` file and renamed when complete, so an interrupted run leaves only whole chunks, and ``resume`` explains
 exactly the chunks that are missing.
 
+A part is trusted by its contents, not its name: its metadata holds the run it belongs to (a hash of ``run.json``'s
+record), its first row, its number of rows, and a SHA-256 of its columns and metadata. ``resume`` reads every part
+first: a damaged one (a flipped bit, cut short, rows other than its name says) is explained again; a whole part of
+another run, or a file that is no part of this run (``part-...07``, a chunk past the end), is refused by name before
+anything is explained, so the dataset holds every state exactly once.
+
 Columns of a part: ``index`` (the state's row in the source), ``state`` (F float32), ``values`` (F x A float32,
 feature-major: ``values.reshape(F, A)``), ``base_values``, ``outputs`` and ``additivity_gap`` (A float64 each), and
 ``chosen`` and ``runner_up`` (action indices, -1 when nothing is chosen). The schema's metadata (key ``xairl``)
@@ -21,6 +27,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterator
@@ -28,13 +35,14 @@ from typing import Any, Iterator
 import numpy as np
 
 from .chunks import CHUNK, count_states, state_chunks
-from .errors import InputError
+from .errors import InputError, one_line
 from .explanation import Explanation
 from .files import write_text
 from .policy import Policy, model_hash
 
 SAMPLE = 1_000  # states kept (uniformly, by reservoir sampling) for the figures of a streamed run
 DATASET = "explanations.parquet"
+PART = re.compile(r"part-(\d{12})\.parquet")  # a part's name: its first row
 
 
 # ---- explaining ------------------------------------------------------------------------------------------------
@@ -79,11 +87,51 @@ def write_part(folder: Path, first: int, exp: Explanation, meta: dict) -> Path:
     }
     if exp.available is not None:  # the action mask: chosen and runner-up are taken among available actions
         columns["available"] = fixed(exp.available, a, pa.bool_())
-    table = pa.table(columns).replace_schema_metadata({"xairl": json.dumps(meta)})
+    meta = {**meta, "first": first, "rows": n}
+    table = pa.table(columns)
+    meta["sha256"] = _checksum(table, meta)
+    table = table.replace_schema_metadata({"xairl": json.dumps(meta)})
     path = folder / _part_name(first)
     with atomic_write(path, "wb") as fh:
         pq.write_table(table, fh, compression="zstd")
     return path
+
+
+def _checksum(table, meta: dict) -> str:
+    """SHA-256 of a part's columns (names, types, values) and of its metadata other than this checksum."""
+    import pyarrow as pa
+
+    digest = hashlib.sha256(json.dumps({k: v for k, v in meta.items() if k != "sha256"}, sort_keys=True).encode())
+    for name in table.column_names:
+        column = table.column(name).combine_chunks()
+        while pa.types.is_fixed_size_list(column.type):
+            column = column.flatten()
+        digest.update(f"\0{name}:{column.type}\0".encode())
+        digest.update(column.to_numpy(zero_copy_only=False).tobytes())
+    return digest.hexdigest()
+
+
+def check_part(path: Path, first: int, rows: int, run: str) -> tuple[str, str]:
+    """("ok", ""), ("bad", why) for a damaged part (explain its chunk again) or ("foreign", why) for a whole part of
+    another run: is ``path`` rows ``first..first + rows - 1`` of run ``run``, as written?"""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    try:
+        table = pq.read_table(path)
+        meta = json.loads(table.schema.metadata[b"xairl"])
+        whole = meta.pop("sha256") == _checksum(table, meta)
+    except (pa.ArrowException, OSError, KeyError, ValueError, TypeError, AttributeError, RecursionError,
+            MemoryError) as exc:
+        return "bad", f"unreadable: {one_line(exc, 80)}"
+    if not whole:
+        return "bad", "its checksum does not match its contents"
+    if meta.get("run") != run:
+        return "foreign", "a part written by another run (other states, policy, background, method or chunk size)"
+    index = table.column("index").to_numpy()
+    if meta.get("first") != first or not np.array_equal(index, np.arange(first, first + rows)):
+        return "bad", f"it holds {len(index)} row(s) from {meta.get('first')}, not rows {first}..{first + rows - 1}"
+    return "ok", ""
 
 
 def read_parquet(path: str | Path) -> Explanation:
@@ -210,7 +258,7 @@ def explain_to_parquet(policy: Policy, states, out: str | Path, background=None,
 @dataclass
 class Run:
     """A run's folder, once checked: its validated options, background, identity, the parts' metadata, and the
-    first rows of the chunks an interrupted run already wrote."""
+    first rows of the chunks an interrupted run already wrote whole (a damaged part's chunk is not among them)."""
 
     out: Path
     options: dict
@@ -226,18 +274,24 @@ class Run:
 
 def start_run(policy: Policy, states, out: str | Path, background, method: str, options: dict | None,
               chunk_size: int, resume: bool) -> Run:
-    """Checks the folder (a new run, or the same run with ``resume``) and records the run in ``run.json``; shared by
-    the local and the Ray engine."""
+    """Checks the folder (a new run, or the same run with ``resume``, every part it holds verified) and records the
+    run in ``run.json``; shared by the local and the Ray engine."""
+    from .chunks import count_rows
     from .plugins import get_attributor
 
     out = Path(out)
     options = get_attributor(method)(options).options.model_dump()
     bg = policy.background() if background is None else policy.check_states(background, "background")
     identity = run_identity(policy, states, bg, method, options, chunk_size)
-    done = _existing_run(out, identity, resume)
-    (out / DATASET).mkdir(parents=True, exist_ok=True)
-    write_text(out / "run.json", json.dumps(identity, indent=2))
-    return Run(out, options, bg, identity, part_meta(policy, method, options, identity), done)
+    meta = part_meta(policy, method, options, identity)
+    done = _existing_run(out, identity, resume, meta["run"], lambda: count_rows(states, policy))
+    try:
+        (out / DATASET).mkdir(parents=True, exist_ok=True)
+        write_text(out / "run.json", json.dumps(identity, indent=2))
+    except OSError as exc:
+        raise InputError(f"cannot write the run into {out} ({exc.strerror or one_line(exc)}); give a folder you can "
+                         "write to.") from None
+    return Run(out, options, bg, identity, meta, done)
 
 
 def finish_run(run: Run, summary: RunningSummary, states) -> RunningSummary:
@@ -249,27 +303,75 @@ def finish_run(run: Run, summary: RunningSummary, states) -> RunningSummary:
 
 
 def part_meta(policy: Policy, method: str, options: dict, identity: dict) -> dict:
-    """The metadata every part carries (key ``xairl`` of its Parquet schema)."""
+    """The metadata every part carries (key ``xairl`` of its Parquet schema; each part adds its first row, its
+    number of rows and its checksum)."""
     return {"feature_names": list(policy.feature_names), "action_names": list(policy.action_names), "method": method,
             "options": options, "output": policy.output, "policy": policy.name, "policy_hash": identity["policy_hash"],
             "observation": policy.observation.to_dict(),
-            "categories": {f: list(i.categories) for f, i in policy.features.items() if i.categories} or None}
+            "categories": {f: list(i.categories) for f, i in policy.features.items() if i.categories} or None,
+            "run": hashlib.sha256(json.dumps(identity, sort_keys=True).encode()).hexdigest()[:16]}
 
 
-def _existing_run(out: Path, identity: dict, resume: bool) -> set[int]:
-    """First rows of the chunks an earlier run completed (empty for a new folder); refuses another run's folder."""
-    parts = sorted((out / DATASET).glob("part-*.parquet")) if (out / DATASET).is_dir() else []
-    if not parts and not (out / "run.json").exists():
+def _existing_run(out: Path, identity: dict, resume: bool, run: str, total) -> set[int]:
+    """First rows of the chunks an earlier run completed and that are whole (empty for a new folder); refuses
+    another run's folder, and any file in the dataset that is not a part of this run, by name."""
+    import logging
+
+    folder = out / DATASET
+    try:
+        files = sorted(p for p in folder.iterdir() if not p.name.startswith((".", "_"))) if folder.is_dir() else []
+    except OSError as exc:
+        raise InputError(f"cannot read {folder} ({exc.strerror}); give a folder you can read and write.") from None
+    parts = [p for p in files if PART.fullmatch(p.name)]
+    if not files and not (out / "run.json").exists():
         return set()
-    if not resume:
+    if not resume and (parts or (out / "run.json").exists()):
         raise InputError(f"{out} already holds a run ({len(parts)} chunk(s) written); pass --resume to continue it, "
                          "or give another folder.")
-    try:
-        earlier = json.loads((out / "run.json").read_text())
-    except (OSError, ValueError):
-        earlier = None
-    if earlier != json.loads(json.dumps(identity)):
-        changed = sorted(k for k in identity if not earlier or earlier.get(k) != json.loads(json.dumps(identity))[k])
+    earlier = _record(out / "run.json")
+    if earlier is not None and earlier != json.loads(json.dumps(identity)):
+        changed = sorted(k for k in identity if earlier.get(k) != json.loads(json.dumps(identity))[k])
         raise InputError(f"{out} holds another run (it differs in {', '.join(changed) or 'run.json'}); resume needs "
                          "the same states, policy, background, method, options and chunk size.")
-    return {int(p.stem.split("-")[1]) for p in parts}
+    n, chunk = (total() if files else 0), identity["chunk_size"]
+    strays = [p for p in files if not PART.fullmatch(p.name) or int(p.name[5:17]) % chunk or int(p.name[5:17]) >= n]
+    if strays:
+        raise _not_ours(strays, f"no chunk of this run is named so: its chunks are part-<first row>.parquet, the "
+                        f"first rows multiples of {chunk} below {n}", folder)
+    done = set()
+    for path in parts:
+        first = int(path.name[5:17])
+        verdict, why = check_part(path, first, min(chunk, n - first), run)
+        if verdict == "foreign":
+            raise _not_ours([path], why, folder)
+        if verdict == "ok":
+            done.add(first)
+        else:  # written over when its chunk is explained again
+            logging.getLogger("xairl").warning(f"xairl: {path}: damaged ({why}); its rows are explained again.")
+    return done
+
+
+def _record(path: Path) -> dict | None:
+    """The run recorded in ``run.json`` (None without one); one line when it is not a record xairl wrote."""
+    if not path.exists():
+        return None
+    try:
+        record = json.loads(path.read_text())
+        what = "a JSON " + {str: "string", int: "number", float: "number", bool: "boolean"}.get(type(record), "list")
+        what = "JSON null" if record is None else what
+    except OSError as exc:
+        record, what = None, exc.strerror or one_line(exc, 80)
+    except RecursionError:
+        record, what = None, "JSON nested too deeply"
+    except ValueError:
+        record, what = None, "not JSON"
+    if not isinstance(record, dict):
+        raise InputError(f"{path}: not the record of a run ({what}); delete it and --resume again (each part is "
+                         "checked against this run), or give another folder.")
+    return record
+
+
+def _not_ours(paths: list[Path], why: str, folder: Path) -> InputError:
+    more = f" ({len(paths) - 1} more file(s) there are not parts of this run either)" if len(paths) > 1 else ""
+    return InputError(f"{paths[0]}: not a part of this run ({why}); delete it or move it out of {folder} and run "
+                      f"again{more}.")
