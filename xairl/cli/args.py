@@ -74,6 +74,22 @@ def out_dir(path) -> str | None:
     return None
 
 
+def make_dir(path: str, what: str = "--out"):
+    """Creates the folder ``path`` (mkdir -p) and checks a file can be written in it, before any work is done; one
+    line when the system refuses (``/proc/...``, a read-only disk, no permission)."""
+    import tempfile
+    from pathlib import Path
+
+    try:
+        Path(path).mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise InputError(f"{what} {_short(str(path))}: cannot write there ({exc.strerror or exc}); give a folder you "
+                         "can write to.") from None
+    return Path(path)
+
+
 def parse_options(pairs: Sequence[str]) -> dict:
     """``["n_steps=32", "method=riemann_left"]`` -> dict; values are read as JSON when they parse, else as text."""
     opts: dict = {}
