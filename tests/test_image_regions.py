@@ -10,7 +10,7 @@ import xairl
 from xairl.regions import in_regions
 from xairl.report import ReportContent, ReportRequest, write_report
 
-REGION = "the 8x8 patch at rows "
+REGION = "patch "
 
 
 @pytest.fixture(scope="module")
@@ -27,7 +27,7 @@ def test_an_image_is_narrated_in_verified_regions_within_two_seconds(cnn):
     policy, _, exp = cnn
     regions = in_regions(exp)
     assert len(regions.feature_names) == 3 * 8 * 8 and regions.feature_names[0] == \
-        "the 8x8 patch at rows 0 to 7, columns 0 to 7 of channel 0"
+        "patch A1 of channel 0"
     np.testing.assert_allclose(regions.values.sum(axis=1), exp.values.sum(axis=1), atol=1e-9)  # additivity kept
     xairl.narrate(exp, 0, policy=policy, robustness=False)  # warm: templates, the vocabulary's regexes
     for i in range(2):
@@ -45,8 +45,7 @@ def test_a_wrong_region_or_its_number_is_contradicted(cnn):
     policy, _, exp = cnn
     text = xairl.narrate(exp, 0, policy=policy, robustness=False).text
     start = text.index(REGION) + len(REGION)
-    row = int(text[start:text.index(" ", start)])
-    shifted = text[:start] + str(row + 1) + text[text.index(" ", start):]  # no patch starts at that row
+    shifted = text[:start] + "Z" + text[start + 1:]  # no patch is in column Z of an 8x8 grid
     check = xairl.verify(shifted, exp, 0, policy)
     assert check.status == "contradicted"
     assert any(c.rule == "region.unknown" and c.status == "contradicted" for c in check.claims)
@@ -85,7 +84,7 @@ def test_an_image_part_of_a_dict_observation_is_narrated_in_regions():
     states = {"image": rng.normal(size=(8, 1, 20, 20)), "vec": rng.normal(size=(8, 2))}
     exp = xairl.explain(policy, {k: v[:1] for k, v in states.items()}, background={k: v[1:] for k, v in states.items()})
     names = in_regions(exp).feature_names
-    assert names[0] == "the 2x2 patch at rows 0 to 1, columns 0 to 1 of image" and names[-2:] == ("vec[0]", "vec[1]")
+    assert names[0] == "patch A1 of image" and names[-2:] == ("vec[0]", "vec[1]")
     narrative = xairl.narrate(exp, 0, policy=policy, robustness=False)
     assert narrative.verified, narrative.text
 

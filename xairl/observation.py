@@ -17,6 +17,8 @@ import numpy as np
 from .errors import InputError
 
 KINDS = ("flat", "array", "dict", "tuple")
+#: what an image's channels are: 'channels' (colours, feature maps) or 'frames' (a frame stack)
+CHANNELS = ("channels", "frames")
 
 
 @dataclass(frozen=True)
@@ -27,11 +29,19 @@ class Part:
     :param shape: the shape of one state of this part, e.g. (4, 84, 84); ``()`` for a scalar.
     :param categories: for a discrete input given as integers: how many values it takes (it is explained as that
         many one-hot columns ``key=v``); ``None`` for numbers used as they are.
+    :param channels: what the first axis of an image (C, H, W) holds: 'channels' (colours, feature maps), or
+        'frames' for a frame stack (4 stacked Atari frames), whose regions are then said as 'patch F6 of frame 2'.
     """
 
     key: str
     shape: tuple[int, ...]
     categories: int | None = None
+    channels: str = "channels"
+
+    def __post_init__(self) -> None:
+        if self.channels not in CHANNELS:
+            raise InputError(f"channels='{self.channels}' of '{self.key}' is unknown; use one of "
+                             f"{', '.join(CHANNELS)}.")
 
     @property
     def size(self) -> int:
@@ -70,19 +80,21 @@ class Observation:
         return cls("flat", (Part("obs", (int(n_features),)),))
 
     @classmethod
-    def array(cls, shape: Sequence[int], key: str = "obs") -> "Observation":
-        """States of shape ``(n, *shape)``, e.g. frames (n, 4, 84, 84)."""
-        return cls("array", (Part(key, tuple(int(s) for s in shape)),))
+    def array(cls, shape: Sequence[int], key: str = "obs", channels: str = "channels") -> "Observation":
+        """States of shape ``(n, *shape)``, e.g. frames (n, 4, 84, 84); ``channels="frames"`` says that the first axis
+        of an image is a frame stack (its regions are said as 'patch F6 of frame 2', not 'of channel 2')."""
+        return cls("array", (Part(key, tuple(int(s) for s in shape), channels=channels),))
 
     @classmethod
-    def dict(cls, shapes: Mapping[str, Sequence[int] | int], categories: Mapping[str, int] | None = None
-             ) -> "Observation":
-        """A dict of arrays; ``categories`` names the keys holding integer categories (one-hot encoded)."""
-        categories = dict(categories or {})
+    def dict(cls, shapes: Mapping[str, Sequence[int] | int], categories: Mapping[str, int] | None = None,
+             channels: Mapping[str, str] | None = None) -> "Observation":
+        """A dict of arrays; ``categories`` names the keys holding integer categories (one-hot encoded), ``channels``
+        the image keys whose channels are 'frames' of a stack (:class:`Part`)."""
+        categories, channels = dict(categories or {}), dict(channels or {})
         parts = []
         for key, shape in shapes.items():
             shape = (shape,) if isinstance(shape, int) else tuple(int(s) for s in shape)
-            parts.append(Part(str(key), shape, categories.get(key)))
+            parts.append(Part(str(key), shape, categories.get(key), channels.get(key, "channels")))
         return cls("dict", tuple(parts))
 
     @classmethod
@@ -199,9 +211,18 @@ class Observation:
 
     def regions(self) -> dict[str, np.ndarray]:
         """Named patches of each channel of each image part (2-D or 3-D), for :meth:`Explanation.grouped`: what
-        narration speaks of instead of pixels (:func:`region_name`); empty when no image part has patches larger than
-        one pixel (a small image is narrated pixel by pixel)."""
-        out, single = {}, len(self.parts) == 1
+        narration speaks of instead of pixels (:func:`region_name`: 'patch F6 of frame 2'); empty when no image part
+        has patches larger than one pixel (a small image is narrated pixel by pixel)."""
+        return {name: idx for name, _, idx in self._patches()}
+
+    def region_extents(self) -> dict[str, str]:
+        """Each region's name -> the pixels it covers in words, for tables, hover texts and details ('the 12x12 patch
+        at rows 60 to 71, columns 60 to 71 of frame 2': :data:`REGION_EXTENT`, counting from 0)."""
+        return {name: extent for name, extent, _ in self._patches()}
+
+    def _patches(self):
+        """(name, extent, flat columns) of every region, in channel, row, column order."""
+        single = len(self.parts) == 1
         for p, cols in zip(self.parts, self.slices().values()):
             if p.categories or len(p.shape) not in (2, 3):
                 continue
@@ -210,19 +231,22 @@ class Observation:
             if size == 1:
                 continue
             idx = np.arange(cols.start, cols.stop).reshape(c, h, w)
+            layer = p.channels[:-1]  # 'channel' or 'frame'
             for ch, r, q in product(range(c), range(0, h, size), range(0, w, size)):
+                channel, key = (ch if c > 1 else None), (None if single else p.key)
                 rows, columns = (r, min(r + size, h) - 1), (q, min(q + size, w) - 1)
-                name = region_name(rows, columns, ch if c > 1 else None, None if single else p.key)
-                out[name] = idx[ch, r:r + size, q:q + size].ravel()
-        return out
+                yield (region_name(r // size, q // size, channel, key, layer),
+                       region_extent(rows, columns, channel, key, layer), idx[ch, r:r + size, q:q + size].ravel())
 
     def to_dict(self) -> dict:
         return {"kind": self.kind, "parts": [{"key": p.key, "shape": list(p.shape), "categories": p.categories}
+                                             | ({"channels": p.channels} if p.channels != "channels" else {})
                                              for p in self.parts]}
 
     @classmethod
     def from_dict(cls, d: Mapping) -> "Observation":
-        return cls(d["kind"], tuple(Part(p["key"], tuple(p["shape"]), p.get("categories")) for p in d["parts"]))
+        return cls(d["kind"], tuple(Part(p["key"], tuple(p["shape"]), p.get("categories"),
+                                         p.get("channels", "channels")) for p in d["parts"]))
 
 
 def patches(shape: Sequence[int], size: int | Sequence[int], prefix: str = "patch") -> dict[str, np.ndarray]:
@@ -239,14 +263,21 @@ def patches(shape: Sequence[int], size: int | Sequence[int], prefix: str = "patc
             for r in range(0, h, ph) for q in range(0, w, pw)}
 
 
-#: how a region is named: 'the 8x8 patch at rows 24 to 31, columns 32 to 39 of channel 2' (rows, columns and channels
-#: count from 0, as in the pixels' names 'obs[2,24,32]'; ' of KEY' ends the name in a dict of several inputs)
-REGION_FORMAT = "the {h}x{w} patch at rows {r0} to {r1}, columns {c0} to {c1}"
-#: any phrase shaped like a region's name, written as :data:`REGION_FORMAT` or close to it ('rows 3-8')
+#: how a region is named: a grid reference, 'patch F6' (column letters from the left, A first; row numbers from the
+#: top, 1 first, as on a map or a spreadsheet), then ' of frame 2' (a frame stack) or ' of channel 2' in an image of
+#: several channels (counting from 0, as in the pixels' names 'obs[2,60,60]'), then ' of KEY' in a dict of several
+#: inputs. The pixels a region covers are its extent (:data:`REGION_EXTENT`, :meth:`Observation.region_extents`).
+REGION_FORMAT = "patch {ref}"
+#: the pixels a region covers in words: 'the 12x12 patch at rows 60 to 71, columns 60 to 71' (rows and columns count
+#: from 0), then the channel or frame and the key as in its name; a text may name a region so too
+REGION_EXTENT = "the {h}x{w} patch at rows {r0} to {r1}, columns {c0} to {c1}"
+#: any phrase shaped like a region's name (:data:`REGION_FORMAT`, capital letters) or its extent
+#: (:data:`REGION_EXTENT`, or close to it: 'rows 3-8')
 _SPAN = r"\d+(?:\s*(?:to|-|–|through)\s*\d+)?"
-REGION_RE = re.compile(rf"\b(?:\d+\s*[x×]\s*\d+\s+)?(?:patch|region|block)\s+(?:at|spanning|covering|over)\s+rows?\s+"
-                       rf"{_SPAN}\s*,?\s*(?:and\s+)?columns?\s+{_SPAN}(?:\s+(?:of|in)\s+(?:channel|frame)\s+\d+)?",
-                       re.IGNORECASE)
+_LAYER = r"(?:\s+(?:of|in)\s+(?:the\s+)?(?:channel|frame)\s+\d+)?"
+REGION_RE = re.compile(rf"\b(?:(?i:(?:\d+\s*[x×]\s*\d+\s+)?(?:patch|region|block)\s+(?:at|spanning|covering|over)\s+"
+                       rf"rows?\s+{_SPAN}\s*,?\s*(?:and\s+)?columns?\s+{_SPAN}{_LAYER})"
+                       rf"|(?i:patch)\s+[A-Z]{{1,3}}[1-9]\d{{0,3}}\b(?i:{_LAYER}))")
 
 
 def region_size(h: int, w: int) -> int:
@@ -257,12 +288,30 @@ def region_size(h: int, w: int) -> int:
     return even[0] if even else target
 
 
-def region_name(rows: tuple[int, int], columns: tuple[int, int], channel: int | None = None,
-                key: str | None = None) -> str:
-    """A region's name in words (:data:`REGION_FORMAT`), from its first and last row and column (inclusive)."""
-    name = REGION_FORMAT.format(h=rows[1] - rows[0] + 1, w=columns[1] - columns[0] + 1, r0=rows[0], r1=rows[1],
+def grid_ref(row: int, column: int) -> str:
+    """A patch's grid reference from its row and column among the patches (from 0): (5, 5) -> 'F6', (0, 26) ->
+    'AA1'."""
+    letters, c = "", column + 1
+    while c:
+        c, rest = divmod(c - 1, 26)
+        letters = chr(ord("A") + rest) + letters
+    return f"{letters}{row + 1}"
+
+
+def region_name(row: int, column: int, channel: int | None = None, key: str | None = None,
+                layer: str = "channel") -> str:
+    """A region's name (:data:`REGION_FORMAT`) from its row and column among the patches (from 0): 'patch F6 of
+    frame 2'; ``layer`` is 'channel' or 'frame'."""
+    name = REGION_FORMAT.format(ref=grid_ref(row, column))
+    return name + (f" of {layer} {channel}" if channel is not None else "") + (f" of {key}" if key else "")
+
+
+def region_extent(rows: tuple[int, int], columns: tuple[int, int], channel: int | None = None,
+                  key: str | None = None, layer: str = "channel") -> str:
+    """The pixels a region covers in words (:data:`REGION_EXTENT`), from its first and last row and column."""
+    name = REGION_EXTENT.format(h=rows[1] - rows[0] + 1, w=columns[1] - columns[0] + 1, r0=rows[0], r1=rows[1],
                                 c0=columns[0], c1=columns[1])
-    return name + (f" of channel {channel}" if channel is not None else "") + (f" of {key}" if key else "")
+    return name + (f" of {layer} {channel}" if channel is not None else "") + (f" of {key}" if key else "")
 
 
 def names_preview(names: Sequence[str], what: str, shown: int = 3) -> str:

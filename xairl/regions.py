@@ -1,10 +1,13 @@
 """An image explanation in regions: what narration, its verifier and the report's cards speak of instead of pixels.
 
 An image of thousands of pixels is narrated patch by patch: each channel cut into square patches of about a tenth of
-the image's side (:meth:`xairl.Observation.regions`), each patch one feature named in words ('the 8x8 patch at rows 24
-to 31, columns 32 to 39 of channel 2'; rows, columns and channels count from 0, as in the pixels' names) whose
-contribution is the sum of its pixels' and whose value is their mean. Narration and :func:`xairl.verify` both read an
-image explanation through :func:`in_regions`, so a narrative's region names are the verifier's vocabulary.
+the image's side (:meth:`xairl.Observation.regions`), each patch one feature named by its grid reference ('patch F6 of
+channel 2', or 'of frame 2' in a frame stack, ``Observation.array(shape, channels="frames")``: column letters from the
+left, row numbers from the top; channels and frames count from 0, as in the pixels' names) whose contribution is the
+sum of its pixels' and whose value is their mean. The pixels each region covers ('the 8x8 patch at rows 40 to 47,
+columns 40 to 47 of channel 2') are in the regioned explanation's ``extras["regions"]``, for tables and hover texts.
+Narration and :func:`xairl.verify` both read an image explanation through :func:`in_regions`, so a narrative's region
+names are the verifier's vocabulary (which also takes a region's extent as its name).
 """
 from __future__ import annotations
 
@@ -17,11 +20,13 @@ from .observation import Observation
 
 
 def in_regions(exp: Explanation) -> Explanation:
-    """``exp`` with each image part's pixels grouped into named regions (other features as they are); ``exp`` itself
-    when it has no image part with patches larger than a pixel (flat, small or already grouped explanations)."""
+    """``exp`` with each image part's pixels grouped into named regions (other features as they are), each region's
+    extent in ``extras["regions"]`` (name -> 'the 8x8 patch at rows 40 to 47, columns 40 to 47 of channel 2'); ``exp``
+    itself when it has no image part with patches larger than a pixel (flat, small or already grouped explanations)."""
     if exp.observation is None:
         return exp
-    groups = Observation.from_dict(exp.observation).regions()
+    observation = Observation.from_dict(exp.observation)
+    groups = observation.regions()
     if not groups:
         return exp
     out = exp.grouped(groups)
@@ -33,4 +38,6 @@ def in_regions(exp: Explanation) -> Explanation:
         quartiles = np.stack([exp.background_quantiles[:, m[0]] if len(m) == 1 and out.feature_names[k] not in groups
                               else np.full(len(exp.background_quantiles), np.nan) for k, m in enumerate(members)],
                              axis=1)
-    return replace(out, states=states, background_quantiles=quartiles)
+    extents = observation.region_extents()
+    return replace(out, states=states, background_quantiles=quartiles,
+                   extras={**exp.extras, "regions": {f: extents[f] for f in out.feature_names if f in extents}})

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from ...explanation import Explanation
@@ -88,6 +89,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     for w, keys in shared.items():  # 'quality' of overall_quality and kitchen_quality: named, but not which
         if len(keys) > 1 and w not in phrases and w not in exact:
             phrases[w] = keys
+    for alias, f in _region_aliases(exp):  # 'the 12x12 patch at rows 60 to 71, ...' of 'patch F6 of frame 2'
+        exact.setdefault(_phrase(alias), set()).add(f)
     for phrase in [p for p in phrases if p.endswith("s") and p[:-1] in phrases]:  # 'condition' and 'conditions'
         phrases[phrase] = phrases[phrase[:-1]] = phrases[phrase] | phrases[phrase[:-1]]
     if exp.output != "actions":  # 'the probability of diabetes': the output's words are not a part of a feature's
@@ -113,8 +116,39 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     for p, kind, keys, label, form in entries:
         pattern, needle = _literal(p) if form == "literal" else _pattern(p, kind)
         compiled.append((pattern, kind, keys, label, "" if form == "literal" else form, needle))
-    return Vocabulary(compiled + _acronyms(exp.feature_names, exp.categories) + _shorthands(exp.feature_names), short,
-                      feature_words, frozenset(names))
+    return Vocabulary(compiled + _acronyms(exp.feature_names, exp.categories) + _shorthands(exp.feature_names) +
+                      _bare_regions(exp), short, feature_words, frozenset(names))
+
+
+def _regions(exp: Explanation) -> dict[str, str]:
+    """The explanation's image regions (name -> extent, as :func:`xairl.in_regions` keeps them); none for pixels."""
+    extents = (exp.extras or {}).get("regions")
+    return {f: str(extents[f]) for f in exp.feature_names if f in extents} if isinstance(extents, Mapping) else {}
+
+
+def _region_aliases(exp: Explanation) -> list[tuple[str, str]]:
+    """(alias, region) pairs: a region is also named by its extent ('the 12x12 patch at rows 60 to 71, columns 60 to
+    71 of frame 2'), and a frame as a channel or a channel as a frame ('patch F6 of channel 2')."""
+    other = {" of frame ": " of channel ", " of channel ": " of frame "}
+    out = []
+    for f, extent in _regions(exp).items():
+        for form in (f, extent):
+            swapped = next((form.replace(a, b) for a, b in other.items() if a in form), None)
+            out += [(form, f)] * (form != f) + ([(swapped, f)] if swapped else [])
+    return out
+
+
+def _bare_regions(exp: Explanation) -> list:
+    """A grid reference said without its channel or frame ('patch F6' in an image of several frames): an ambiguous
+    mention of that patch of every channel, unless a channel or frame follows (then it names one region, or none:
+    contradicted by :func:`.regions.unknown_regions`)."""
+    by_ref: dict[str, list[str]] = {}
+    for f in _regions(exp):
+        ref = f.split(" of ", 1)[0]
+        if ref != f:
+            by_ref.setdefault(ref, []).append(f)
+    return [(re.compile(rf"(?<![\w]){re.escape(ref)}(?![\w])(?!\s+(?:of|in)\s+(?:the\s+)?(?:channel|frame)\s+\d)",
+                        re.IGNORECASE), "feature", tuple(fs), "", "", _needle(ref)) for ref, fs in by_ref.items()]
 
 
 def _spellings(name_words: list[str]) -> list[str]:
