@@ -139,3 +139,44 @@ def test_a_streamed_parquet_file_with_a_timestamp_column_is_one_line(tmp_path, c
     rc, _, err = run(capsys, "explain", "--states", path, "--format", "parquet", "--out", str(tmp_path / "run"),
                      "--method", "exact", "--no-robustness")
     one_line_error(rc, err, "column 'speed' holds timestamp")
+
+
+# 4. a saved explanation's structured fields -----------------------------------------------------------------------
+def _saved(tmp_path, **fields):
+    exp = xairl.explain(POLICY, POLICY.background(2, seed=1), background=POLICY.background(20), method="exact")
+    data = {**json.loads(exp.to_json()), **fields}
+    path = tmp_path / "e.json"
+    path.write_text(json.dumps(data))
+    return str(path)
+
+
+@pytest.mark.parametrize("fields, words", [
+    ({"observation": {"kind": "flat", "parts": [{"key": "obs", "shape": 5, "categories": None}]}},
+     ["Explanation.observation", "parts.0.shape"]),
+    ({"observation": {"kind": "flat"}}, ["Explanation.observation", "parts: Field required"]),
+    ({"observation": {"a": 1}}, ["kind: Field required", "a: unknown field"]),
+    ({"observation": {"kind": "flat", "parts": [{"key": "obs", "shape": [7], "categories": None}]}},
+     ["describes 7 input columns but the values have 5 features"]),
+    ({"observation": {"kind": "array", "parts": [{"key": "obs", "shape": [0], "categories": None}]}},
+     ["greater than or equal to 1"]),
+    ({"background_quantiles": []}, ["background_quantiles has shape (0,), expected (3, 5)"]),
+    ({"background_quantiles": [[1]]}, ["background_quantiles has shape (1, 1), expected (3, 5)"]),
+    ({"output": "discrete"}, ["Explanation.output 'discrete' is not one of actions, continuous, value"]),
+])
+def test_a_saved_explanation_with_a_malformed_field_is_refused_when_read(tmp_path, capsys, fields, words):
+    """A malformed observation or quartiles was read without complaint, then narrate and verify raised a raw
+    TypeError, KeyError or IndexError (rc 1)."""
+    path = _saved(tmp_path, **fields)
+    rc, _, err = run(capsys, "verify", "The policy chose turn because of battery.", "--explanation", path)
+    one_line_error(rc, err, *words)
+    with pytest.raises(InputError, match=words[0].replace("(", r"\(").replace(")", r"\)")):
+        xairl.Explanation.from_json(open(path).read())
+
+
+def test_a_saved_explanation_keeps_its_observation_and_quartiles(tmp_path):
+    policy = xairl.Policy(torch.nn.Sequential(torch.nn.Flatten(), mlp([2 * 3 * 3, 4, 2])), observation=(2, 3, 3))
+    r = np.random.default_rng(0)
+    exp = xairl.explain(policy, r.normal(size=(2, 2, 3, 3)), background=r.normal(size=(6, 2, 3, 3)))
+    back = xairl.Explanation.from_json(exp.to_json())
+    assert back.observation == exp.observation and back.image_shape == (2, 3, 3)
+    np.testing.assert_array_equal(back.background_quantiles, exp.background_quantiles)

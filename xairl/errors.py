@@ -33,14 +33,16 @@ def one_line(exc: BaseException, limit: int = 300) -> str:
     return f"{type(exc).__name__}: {' '.join(str(exc).split())[:limit]}"
 
 
-def validation_message(exc, what: str) -> str:
+def validation_message(exc, what: str, unknown: str = "unknown option") -> str:
     """One line naming each bad field of a pydantic ``ValidationError``: ``invalid {what} (field: reason; ...).``
 
     Plugins use it to turn a settings model's error into an :class:`InputError` message.
+
+    :param unknown: what a field the model does not have is called ("unknown option", "unknown field").
     """
     parts = []
     for err in exc.errors():
         loc = ".".join(str(p)[:40] for p in err["loc"]) or "value"
-        msg = "unknown option" if err["type"] == "extra_forbidden" else err["msg"]
+        msg = unknown if err["type"] == "extra_forbidden" else err["msg"]
         parts.append(f"{loc}: {msg}")
     return " ".join(f"invalid {what} ({'; '.join(parts[:6])}{'; ...' if len(parts) > 6 else ''}).".split())

@@ -1,14 +1,13 @@
 """Explanation: the one result type of every attributor, shaped (states, features, actions)."""
 from __future__ import annotations
 
-import json
-from dataclasses import MISSING, dataclass, field, fields, replace
-from typing import Any, Mapping, Sequence, get_type_hints
+from dataclasses import dataclass, field, replace
+from typing import Any, Mapping, Sequence
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
+from pydantic import BaseModel, ConfigDict
 
-from .errors import InputError, validation_message
+from .errors import InputError
 
 
 @dataclass(frozen=True)
@@ -75,6 +74,14 @@ class Explanation:
             raise InputError(f"Explanation.states has shape {self.states.shape}, expected {(n, f)}.")
         if len(self.feature_names) != f or len(self.action_names) != a:
             raise InputError("Explanation names do not match the values' shape.")
+        if self.output not in ("actions", "continuous", "value"):
+            raise InputError(f"Explanation.output '{str(self.output)[:40]}' is not one of actions, continuous, value.")
+        from .explanation_io import check_observation, check_quartiles
+
+        if self.observation is not None:  # narration and images read it: checked here, not when it is used
+            object.__setattr__(self, "observation", check_observation(self.observation, f))
+        if self.background_quantiles is not None:  # (its NaN: a region's unknown quartiles, no level words)
+            check_quartiles(self.background_quantiles, f)
         for name in ("values", "base_values", "outputs", "states"):  # (a missing quartile: no level words)
             arr = getattr(self, name)
             if arr is not None and not np.isfinite(arr).all():
@@ -291,94 +298,15 @@ class Explanation:
     def to_json(self) -> str:
         """JSON text: each field of this class under its own name, arrays as nested lists (:func:`from_json` reads
         it back)."""
-        data = {f.name: _plain(getattr(self, f.name)) for f in fields(self)}
-        try:
-            return json.dumps(data, allow_nan=False)
-        except (TypeError, ValueError) as exc:  # options or extras a plugin filled with something JSON cannot hold
-            raise InputError(f"this explanation cannot be written as JSON ({exc}); keep its options and extras to "
-                             "numbers, text, lists and dicts.") from None
+        from .explanation_io import to_json
+        return to_json(self)
 
     @classmethod
     def from_json(cls, text: str | bytes) -> "Explanation":
         """The explanation :meth:`to_json` wrote; raises :class:`InputError` with a one-line reason on anything
         else (not JSON, NaN or infinity, nesting too deep, wrong fields, shapes that disagree)."""
-        def refuse(constant):
-            raise ValueError(f"{constant} is not a finite number")
-
-        def finite(literal):
-            value = float(literal)
-            return value if np.isfinite(value) else refuse(literal[:20])
-
-        try:
-            data = json.loads(text, parse_constant=refuse, parse_float=finite)
-        except RecursionError:
-            raise InputError("the explanation's JSON is nested too deeply; give the JSON that Explanation.to_json() "
-                             "writes.") from None
-        except (ValueError, TypeError) as exc:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
-            raise InputError(f"the explanation is not valid JSON ({' '.join(str(exc).split())[:120]}); give the "
-                             "JSON that Explanation.to_json() writes.") from None
-        try:
-            record = dict(_JSON_FORM.model_validate(data))
-        except ValidationError as exc:
-            raise InputError(f"the explanation's JSON does not match Explanation.to_json(): "
-                             f"{validation_message(exc, 'explanation')}") from None
-        except RecursionError:
-            raise InputError("the explanation's JSON is nested too deeply.") from None
-        try:
-            arrays = {k: _ARRAY_FIELDS[k][1](v) for k, v in record.items() if k in _ARRAY_FIELDS and v is not None}
-        except (ValueError, OverflowError):  # ragged lists, numbers beyond float64
-            raise InputError("the explanation's arrays have rows of different lengths or numbers beyond float64; "
-                             "give the JSON that Explanation.to_json() writes.") from None
-        return cls(**{**record, **arrays})
-
-
-def _plain(value):
-    """A field's value as JSON-ready Python: arrays as nested lists, mappings as dicts, tuples as lists."""
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, Mapping):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (tuple, list)):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
-
-
-def _floats(v) -> np.ndarray:
-    return np.asarray(v, dtype=np.float64)
-
-
-def _array_field(ndim: int, item=float):
-    """The JSON type of an array field (nested lists ``ndim`` deep) and how it becomes an array again."""
-    kind = item
-    for _ in range(ndim):
-        kind = list[kind]
-    return kind, (_floats if item is float else lambda v: np.asarray(v, dtype=bool))
-
-
-#: the array fields of :class:`Explanation` (all others are JSON as they are); the schema itself is the dataclass
-_ARRAY_FIELDS = {"values": _array_field(3), "base_values": _array_field(2), "outputs": _array_field(2),
-                 "states": _array_field(2), "background_quantiles": _array_field(2),
-                 "available": _array_field(2, bool)}
-
-
-def _json_form() -> type[BaseModel]:
-    """A validator of the JSON form, generated from the dataclass's own fields (names, types and defaults)."""
-    hints = get_type_hints(Explanation)
-    spec = {}
-    for f in fields(Explanation):
-        kind = hints[f.name]
-        if f.name in _ARRAY_FIELDS:
-            kind = _ARRAY_FIELDS[f.name][0] if f.name in ("values", "base_values", "outputs") else \
-                _ARRAY_FIELDS[f.name][0] | None
-        default = ... if f.default is MISSING and f.default_factory is MISSING else \
-            Field(default_factory=f.default_factory) if f.default_factory is not MISSING else f.default
-        spec[f.name] = (kind, default)
-    return create_model("ExplanationJSON", __config__=ConfigDict(extra="forbid"), **spec)
-
-
-_JSON_FORM = _json_form()
+        from .explanation_io import from_json
+        return from_json(cls, text)
 
 
 class StateRecord(BaseModel):

@@ -1,0 +1,149 @@
+"""The JSON form of an :class:`xairl.Explanation` (``to_json`` / ``from_json``) and the checks of its structured fields
+(the observation, the background quartiles) made when one is built or read: pydantic at the edge, one line on error."""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import MISSING, fields
+from typing import Annotated, Any, Literal, Mapping, get_type_hints
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
+
+from .errors import InputError, validation_message
+
+
+class _Part(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    key: str
+    shape: list[Annotated[int, Field(ge=1)]]
+    categories: Annotated[int, Field(ge=1)] | None = None
+
+
+class _Observation(BaseModel):
+    """``Observation.to_dict()``: what an explanation records of the policy's input."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    kind: Literal["flat", "array", "dict", "tuple"]
+    parts: list[_Part] = Field(min_length=1)
+
+
+def check_observation(observation: Any, n_features: int) -> dict:
+    """``observation`` as a plain ``Observation.to_dict()`` of ``n_features`` columns; a one-line
+    :class:`InputError` for anything else (not a mapping, parts missing, a shape that is a number, other columns)."""
+    try:
+        obs = _Observation.model_validate(observation)
+    except ValidationError as exc:
+        raise InputError(f"Explanation.observation is not what Observation.to_dict() writes: "
+                         f"{validation_message(exc, 'observation', 'unknown field')}") from None
+    if obs.kind in ("flat", "array") and len(obs.parts) != 1:
+        raise InputError(f"Explanation.observation of kind '{obs.kind}' has {len(obs.parts)} parts; it has one.")
+    columns = sum(p.categories or math.prod(p.shape) for p in obs.parts)
+    if columns != n_features:
+        raise InputError(f"Explanation.observation describes {columns} input columns but the values have "
+                         f"{n_features} features; give the observation of the explained policy (or None).")
+    return obs.model_dump()
+
+
+def check_quartiles(quartiles: Any, n_features: int) -> None:
+    """Background quartiles are a (3, n_features) array: the 25th, 50th and 75th percentiles of each feature."""
+    if not isinstance(quartiles, np.ndarray) or quartiles.shape != (3, n_features):
+        shape = getattr(quartiles, "shape", type(quartiles).__name__)
+        raise InputError(f"Explanation.background_quantiles has shape {shape}, expected (3, {n_features}): the 25th, "
+                         "50th and 75th percentiles of each feature over the background (or None).")
+
+
+def to_json(exp) -> str:
+    """JSON text: each field under its own name, arrays as nested lists (:func:`from_json` reads it back)."""
+    data = {f.name: _plain(getattr(exp, f.name)) for f in fields(exp)}
+    try:
+        return json.dumps(data, allow_nan=False)
+    except (TypeError, ValueError) as exc:  # options or extras a plugin filled with something JSON cannot hold
+        raise InputError(f"this explanation cannot be written as JSON ({exc}); keep its options and extras to "
+                         "numbers, text, lists and dicts.") from None
+
+
+def from_json(cls, text: str | bytes):
+    """The explanation :func:`to_json` wrote; :class:`InputError` with a one-line reason on anything else."""
+    def refuse(constant):
+        raise ValueError(f"{constant} is not a finite number")
+
+    def finite(literal):
+        value = float(literal)
+        return value if np.isfinite(value) else refuse(literal[:20])
+
+    try:
+        data = json.loads(text, parse_constant=refuse, parse_float=finite)
+    except RecursionError:
+        raise InputError("the explanation's JSON is nested too deeply; give the JSON that Explanation.to_json() "
+                         "writes.") from None
+    except (ValueError, TypeError) as exc:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
+        raise InputError(f"the explanation is not valid JSON ({' '.join(str(exc).split())[:120]}); give the "
+                         "JSON that Explanation.to_json() writes.") from None
+    try:
+        record = dict(_json_form().model_validate(data))
+    except ValidationError as exc:
+        raise InputError(f"the explanation's JSON does not match Explanation.to_json(): "
+                         f"{validation_message(exc, 'explanation', 'unknown field')}") from None
+    except RecursionError:
+        raise InputError("the explanation's JSON is nested too deeply.") from None
+    try:
+        arrays = {k: _ARRAY_FIELDS[k][1](v) for k, v in record.items() if k in _ARRAY_FIELDS and v is not None}
+    except (ValueError, OverflowError):  # ragged lists, numbers beyond float64
+        raise InputError("the explanation's arrays have rows of different lengths or numbers beyond float64; "
+                         "give the JSON that Explanation.to_json() writes.") from None
+    return cls(**{**record, **arrays})
+
+
+def _plain(value):
+    """A field's value as JSON-ready Python: arrays as nested lists, mappings as dicts, tuples as lists."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (tuple, list)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _floats(v) -> np.ndarray:
+    return np.asarray(v, dtype=np.float64)
+
+
+def _array_field(ndim: int, item=float):
+    """The JSON type of an array field (nested lists ``ndim`` deep) and how it becomes an array again."""
+    kind = item
+    for _ in range(ndim):
+        kind = list[kind]
+    return kind, (_floats if item is float else lambda v: np.asarray(v, dtype=bool))
+
+
+#: the array fields of :class:`Explanation` (all others are JSON as they are); the schema itself is the dataclass
+_ARRAY_FIELDS = {"values": _array_field(3), "base_values": _array_field(2), "outputs": _array_field(2),
+                 "states": _array_field(2), "background_quantiles": _array_field(2),
+                 "available": _array_field(2, bool)}
+_FORM: list[type[BaseModel]] = []
+
+
+def _json_form() -> type[BaseModel]:
+    """A validator of the JSON form, generated from the dataclass's own fields (names, types and defaults) once."""
+    if _FORM:
+        return _FORM[0]
+    from .explanation import Explanation
+
+    hints = get_type_hints(Explanation)
+    spec = {}
+    for f in fields(Explanation):
+        kind = hints[f.name]
+        if f.name in _ARRAY_FIELDS:
+            kind = _ARRAY_FIELDS[f.name][0] if f.name in ("values", "base_values", "outputs") else \
+                _ARRAY_FIELDS[f.name][0] | None
+        default = ... if f.default is MISSING and f.default_factory is MISSING else \
+            Field(default_factory=f.default_factory) if f.default_factory is not MISSING else f.default
+        spec[f.name] = (kind, default)
+    _FORM.append(create_model("ExplanationJSON", __config__=ConfigDict(extra="forbid"), **spec))
+    return _FORM[0]
