@@ -299,10 +299,13 @@ def _output_stems(output: str) -> frozenset[str]:
 #: 'against a typical 26 %', 'against the average of 5.6', 'against 26 %': 'against' as 'versus'
 _VERSUS = re.compile(r"\s+(?:(?:a|an|the|its|their)\s+)?(?:(?:typical|average|usual|baseline|base|expected|mean|norm\w*|"
                      r"overall|portfolio|population)\b|[+\-]?[$€£]?\d)", re.IGNORECASE)
-#: what may stand between two names of one subject list: commas, and/or, their values ('A (22) and B of 3')
-_JOIN = re.compile(r"^(?:\s|,|;|&|/|\band\b|\bor\b|\bplus\b|\bas well as\b|\b(?:together|along) with\b|\bboth\b|"
-                   r"\beither\b|\bits\b|\btheir\b|\bthe\b|\([^()]*\)|[+\-]?[$€£]?[\d.,]+\s*[a-zA-Z%]{0,4}|"
-                   r"\b(?:of|at)\b|:|=)*$", re.IGNORECASE)
+#: what may stand between two names of one subject list: commas, and/or, their values ('A (22) and B of 3'). Each
+#: text is read in one way only, so a text that fails fails in linear time (issue 51: '999...9 !' took 4x per 2 more
+#: digits): a number takes all its digits, commas (',' alone is one) and spaces, and its unit is never a whole word
+#: of the list ('3 and' is '3', 'and')
+_JOIN = re.compile(r"^(?:\s|[;&/:=]|\b(?:and|or|plus|as well as|(?:together|along) with|both|either|its|their|the|of|"
+                   r"at)\b|\([^()]*\)|[+\-]?[$€£]?[\d.,]+(?![\d.,])\s*(?!\s)[a-zA-Z%]{0,4}(?!(?:(?<=\band)|(?<=\bor)|"
+                   r"(?<=\bplus)|(?<=\bboth)|(?<=\bits)|(?<=\bthe)|(?<=\bof)|(?<=\bat))\b))*$", re.IGNORECASE)
 
 
 #: a clause that opens with a phrase of its own before its subject: 'Beyond A and B, ...', 'Alongside A, ...'
