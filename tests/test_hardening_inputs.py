@@ -180,3 +180,63 @@ def test_a_saved_explanation_keeps_its_observation_and_quartiles(tmp_path):
     back = xairl.Explanation.from_json(exp.to_json())
     assert back.observation == exp.observation and back.image_shape == (2, 3, 3)
     np.testing.assert_array_equal(back.background_quantiles, exp.background_quantiles)
+
+
+# 16. an episode out of a run ----------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def run_exp():
+    masked = xairl.Policy(POLICY.module, FEATURES, POLICY.action_names,
+                          action_mask=lambda x: np.c_[x[:, :1] > 0, np.ones((len(x), 2), bool)])
+    return xairl.explain(masked, POLICY.background(10, seed=5), background=POLICY.background(20),
+                         method="integrated_gradients", options={"n_steps": 8})
+
+
+def _same_states(part, whole, rows):
+    for field in ("values", "base_values", "outputs", "states", "available"):
+        np.testing.assert_array_equal(getattr(part, field), getattr(whole, field)[rows])
+    np.testing.assert_array_equal(part.extras["convergence_delta"], whole.extras["convergence_delta"][rows])
+    np.testing.assert_array_equal(part.chosen, whole.chosen[rows])
+    np.testing.assert_array_equal(part.background_quantiles, whole.background_quantiles)
+    assert (part.feature_names, part.action_names, part.method, part.options, part.output, part.observation) == \
+        (whole.feature_names, whole.action_names, whole.method, whole.options, whole.output, whole.observation)
+    assert len(part) == len(np.arange(len(whole))[rows])
+
+
+@pytest.mark.parametrize("key", [slice(None, 4), slice(3, 8), slice(None, None, 3), slice(-2, None),
+                                 [7, 2, 2, -1], np.array([0, 9]), "mask"])
+def test_an_explanation_is_sliced_state_by_state(run_exp, key):
+    """exp[:n] and exp[mask] raised TypeError ('Explanation' object is not subscriptable)."""
+    if isinstance(key, str):
+        key = run_exp.states[:, 0] > 0
+    part = run_exp[key]
+    assert isinstance(part, xairl.Explanation)
+    _same_states(part, run_exp, key)
+    assert part.additivity_gap.max() <= run_exp.additivity_gap.max()
+
+
+def test_an_int_gives_a_one_state_explanation_that_narrates(run_exp):
+    """An int is exp[i:i + 1] (not an array): narrate(exp[i], 0) says what narrate(exp, i) says."""
+    for i in (4, -1):
+        one = run_exp[i]
+        _same_states(one, run_exp, [i])
+    assert xairl.narrate(run_exp[4], 0, policy=POLICY, robustness=False).text == \
+        xairl.narrate(run_exp, 4, policy=POLICY, robustness=False).text
+    back = xairl.Explanation.from_json(run_exp.to_json())[2:5]  # extras read from JSON (lists) are cut too
+    assert np.shape(back.extras["convergence_delta"]) == (3, 3)
+
+
+@pytest.mark.parametrize("key, words", [
+    (10, "index 10 is out of range"),
+    (-11, "index -11 is out of range"),
+    (slice(5, 5), "holds no state"),
+    (np.zeros(10, bool), "holds no state"),
+    (np.ones(4, bool), "one bool per state: got shape (4,) for 10"),
+    ([0, 12], "position 12 is out of range"),
+    (1.5, "not float '1.5'"),
+    ("battery", "not str 'battery'"),
+    ((slice(None), 0), "output_slice"),
+])
+def test_a_selection_that_is_not_of_states_is_one_line(run_exp, key, words):
+    with pytest.raises(InputError) as err:
+        run_exp[key]
+    assert words in str(err.value) and "\n" not in str(err.value)

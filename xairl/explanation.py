@@ -118,6 +118,56 @@ class Explanation:
             raise InputError(f"index {index} is out of range: the explanation has {len(self.values)} state(s).")
         return int(index)
 
+    def __len__(self) -> int:
+        """The number of explained states."""
+        return len(self.values)
+
+    def __getitem__(self, key) -> "Explanation":
+        """The explanation of some of the states, e.g. an episode out of a run: ``exp[:200]``, ``exp[t0:t1]``,
+        ``exp[::10]``, ``exp[mask]`` (bools, one per state), ``exp[[3, 7]]`` (positions; negative count from the end).
+
+        Always an Explanation, never an array: an int gives the one-state Explanation ``exp[i:i + 1]`` (so that
+        plots, ``narrate(exp[i], 0)`` and ``verify`` take it as they take any). Every per-state array is cut alike:
+        values, base values, outputs, states, available actions, and each array in ``extras`` whose first axis is
+        the states (IG's convergence delta); per-run fields (names, method, options, background quartiles,
+        observation) are kept. The states are renumbered from 0 (:meth:`records`). Refused in one line: a
+        selection of no state, a mask of another length, positions out of range, or an index into features or
+        actions (``exp[:, j]``: use :meth:`grouped` or :meth:`output_slice`).
+        """
+        n = len(self.values)
+        if isinstance(key, tuple):
+            raise InputError("an Explanation is indexed by state only (exp[:n], exp[mask], exp[[i, j]]); for one "
+                             "output use exp.output_slice(j), for features exp.grouped(...).")
+        if isinstance(key, (int, np.integer)) and not isinstance(key, (bool, np.bool_)):
+            if not -n <= key < n:
+                raise InputError(f"index {key} is out of range: the explanation has {n} state(s).")
+            key = [int(key) % n]
+        if not isinstance(key, slice):
+            idx = np.asarray(key.detach().cpu() if hasattr(key, "detach") else key)
+            if idx.size == 0 and idx.ndim == 1:
+                idx = idx.astype(int)
+            if idx.dtype == bool and idx.shape != (n,):
+                raise InputError(f"a state mask has one bool per state: got shape {idx.shape} for {n} state(s).")
+            if idx.dtype != bool and (idx.ndim != 1 or idx.dtype.kind not in "iu"):
+                raise InputError(f"states are selected by a slice, a bool mask or whole-number positions, not "
+                                 f"{type(key).__name__} {str(key)[:40]!r}.")
+            if idx.dtype != bool and idx.size and not (-n <= idx.min() and idx.max() < n):
+                raise InputError(f"position {idx.max() if idx.max() >= n else idx.min()} is out of range: the "
+                                 f"explanation has {n} state(s).")
+            key = idx
+        rows = np.arange(n)[key]
+        if not rows.size:
+            raise InputError(f"the selection holds no state (of {n}); an Explanation explains at least one.")
+
+        def cut(arr):
+            return None if arr is None else np.asarray(arr)[rows].copy()
+
+        extras = {k: cut(v) if isinstance(v, np.ndarray) and v.ndim and len(v) == n else
+                  [v[i] for i in rows] if isinstance(v, (list, tuple)) and len(v) == n else v  # (read from JSON)
+                  for k, v in self.extras.items()}
+        return replace(self, values=cut(self.values), base_values=cut(self.base_values), outputs=cut(self.outputs),
+                       states=cut(self.states), available=cut(self.available), extras=extras)
+
     def _ranked(self) -> np.ndarray:
         """Actions per state, best available first (unavailable ones last)."""
         scores = self.outputs if self.available is None else np.where(self.available, self.outputs, -np.inf)
