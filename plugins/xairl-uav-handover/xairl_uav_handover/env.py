@@ -18,8 +18,10 @@ import numpy as np
 from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
+from xairl import InputError
+
 from .config import SimConfig
-from .features import ACTIONS, FEATURES
+from .features import ACTIONS, FEATURES, checked_actions
 from .simulator import Simulator
 
 #: per-flight quantities summed over each decision's simulator steps (StepInfo fields)
@@ -54,13 +56,15 @@ class HandoverVecEnv(gym.vector.VectorEnv):
     def reset(self, *, seed: int | None = None, options=None):
         """New flights; every random draw of the episode comes from ``seed``."""
         self.sim = Simulator(self.cfg, n_uavs=self.num_envs, seed=0 if seed is None else seed)
-        self.obs, self.candidates = self.sim.observe()
+        self._observe()
         return self.obs, {"candidates": self.candidates}
 
     def step(self, actions):
         """Hand over each flight to its candidate ``actions[k]`` (0 = stay) and fly ``decision_every`` steps."""
         sim, w = self.sim, self.cfg.reward
-        target = self.candidates[np.arange(sim.K), np.asarray(actions, dtype=np.int64)]
+        if np.shape(actions) != (sim.K,):
+            raise InputError(f"expected one action per flight, shape ({sim.K},), got shape {np.shape(actions)}.")
+        target = self.candidates[np.arange(sim.K), checked_actions(actions)]
         target = np.where(target < 0, sim.serving, target)
         sums = {key: np.zeros(sim.K) for key in METRICS + tuple(f"pingpong_{w:g}s" for w in PINGPONG_WINDOWS_S)}
         gain = np.zeros(sim.K)
@@ -76,9 +80,18 @@ class HandoverVecEnv(gym.vector.VectorEnv):
             n += 1
         reward = (-w.w_handover * sums["handover"] - w.w_lost * sums["lost_bits"] / 1e6
                   - w.w_pingpong * sums["pingpong_5s"] + gain / max(n, 1))
-        self.obs, self.candidates = sim.observe()
+        self._observe()
         ended = np.full(sim.K, sim.done)
         return self.obs, reward, np.zeros(sim.K, dtype=bool), ended, sums | {"candidates": self.candidates}
+
+    def _observe(self) -> None:
+        """The simulator's states and candidates; a non-finite state is refused before any policy acts on it."""
+        self.obs, self.candidates = self.sim.observe()
+        bad = ~np.isfinite(self.obs)
+        if bad.any():
+            k, j = (int(i[0]) for i in np.nonzero(bad))
+            raise InputError(f"the simulator gave flight {k} a state whose {FEATURES[j]} is {self.obs[k, j]:g}; "
+                             "check the simulator settings (a policy cannot act on it).")
 
 
 class UAVHandoverEnv(gym.Env):
@@ -97,5 +110,5 @@ class UAVHandoverEnv(gym.Env):
         return obs[0], {"candidates": info["candidates"][0]}
 
     def step(self, action):
-        obs, reward, terminated, truncated, info = self.vec.step(np.array([action]))
+        obs, reward, terminated, truncated, info = self.vec.step(np.reshape(np.asarray(action), -1))
         return obs[0], float(reward[0]), bool(terminated[0]), bool(truncated[0]), {k: v[0] for k, v in info.items()}

@@ -5,7 +5,7 @@ through it, and code that reads a state uses :data:`FEATURES` or the column slic
 """
 import numpy as np
 
-from xairl import Comparison, DomainFacts, FeatureInfo
+from xairl import Comparison, DomainFacts, FeatureInfo, InputError
 
 N_CANDIDATES = 4  # candidate 0 is the serving BS (stay); 1..3 the strongest other BSs
 FEATURES = ("x", "y", "z", "buffer_queue_size", "serving_bs",
@@ -53,6 +53,27 @@ def available_actions(states, observation) -> np.ndarray:
     mask = rsrq > np.float32(observation.detection_rsrq_db)
     mask[:, 0] = True
     return mask
+
+
+def checked_actions(actions, where=lambda k: f"flight {k}") -> np.ndarray:
+    """``actions`` as int64 indices, refused with an :class:`xairl.InputError` naming the first one (``where(k)``
+    says whose) that is not a whole number in 0..3: a policy's NaN must not be cast to some action."""
+    a = np.asarray(actions)
+    if a.dtype.kind in "iub":
+        ok = (a >= 0) & (a < len(ACTIONS))
+    else:
+        try:
+            f = a.astype(float)
+        except (TypeError, ValueError):
+            f = np.full(a.shape, np.nan)
+        ok = np.isfinite(f) & (f == np.round(f)) & (f >= 0) & (f < len(ACTIONS))
+    if not ok.all():
+        k = int(np.flatnonzero(~ok.ravel())[0])
+        v = a.ravel()[k]
+        v = f"{float(v):g}" if np.asarray(v).dtype.kind in "iufb" else repr(v)[:40]
+        raise InputError(f"the action for {where(k)} is {v}, not one of 0..{len(ACTIONS) - 1} (0 stays, k "
+                         f"hands over to candidate k); a policy whose output is NaN or out of range cannot act.")
+    return a.astype(np.int64)
 
 
 GROUPS = {"position": ("x", "y", "z"), "rsrp": ("rsrp_0", "rsrp_1", "rsrp_2", "rsrp_3"),

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from xairl import CheckpointError, Policy, atomic_write
+from xairl import CheckpointError, InputError, Policy, atomic_write
 
 from .config import SimConfig
 from .env import HandoverVecEnv
@@ -75,6 +75,10 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
         raise CheckpointError(f"{path}: not a readable safetensors checkpoint ({exc}); re-train or re-download it.")
     if not isinstance(meta, dict):
         raise CheckpointError(f"{path}: its metadata is not a JSON object; re-train or re-download it.")
+    for name, tensor in tensors.items():
+        if tensor.is_floating_point() and not torch.isfinite(tensor).all():
+            raise CheckpointError(f"{path}: tensor '{name}' holds NaN or inf (a corrupt file, or training that "
+                                  "diverged); re-train or re-download it.")
     hidden = _hidden_widths(path, meta, tensors)
     f = len(FEATURES)
     net = build_qnet(np.zeros(f), np.ones(f), hidden)
@@ -109,9 +113,30 @@ def _hidden_widths(path: Path, meta: dict, tensors: dict) -> tuple[int, ...]:
 
 def greedy(net: torch.nn.Module, obs: np.ndarray, config: SimConfig) -> np.ndarray:
     """The best available action per state: a handover only to a measured candidate (invalid-action masking)."""
+    x = torch.as_tensor(np.asarray(obs), dtype=torch.float32)
     with torch.no_grad():
-        q = net(torch.as_tensor(obs, dtype=torch.float32)).numpy()
+        q = net(x).numpy()
+    bad = ~np.isfinite(q).all(axis=1)
+    if bad.any():  # argmax would read a NaN row as action 0 ("stay") and the decision would look sane
+        _refuse_q(net, x.numpy(), int(np.flatnonzero(bad)[0]))
     return np.where(available_actions(obs, config.observation), q, -np.inf).argmax(axis=1)
+
+
+def _refuse_q(net: torch.nn.Module, x: np.ndarray, i: int) -> None:
+    """Say why the Q-values of state ``i`` of ``x`` (the network's float32 input) are NaN or inf."""
+    where = f"the DQN cannot act on state {i} of {len(x)}"
+    if not all(torch.isfinite(p).all() for p in net.parameters()):
+        raise CheckpointError(f"{where}: the Q-network's weights hold NaN or inf (a corrupt checkpoint, or training "
+                              "that diverged); re-train or re-download it.")
+    row = x[i].reshape(-1)
+    bad = np.flatnonzero(~np.isfinite(row))
+    if len(bad):
+        j = int(bad[0])
+        raise InputError(f"{where}: {FEATURES[j]} = {row[j]:g} is not a finite number (as float32, the network's "
+                         "input); fix that state.")
+    j = int(np.abs(row).argmax())
+    raise InputError(f"{where}: its Q-values overflow to NaN or inf (largest input {FEATURES[j]} = {row[j]:g}, far "
+                     "beyond any measurement); fix that state.")
 
 
 def random_available(rng: np.random.Generator, obs: np.ndarray, config: SimConfig) -> np.ndarray:

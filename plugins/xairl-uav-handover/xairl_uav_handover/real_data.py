@@ -24,7 +24,7 @@ from xairl import InputError
 
 from .buffer import buffer_step
 from .config import SimConfig
-from .features import FEATURES, N_CANDIDATES, state_rows
+from .features import FEATURES, N_CANDIDATES, checked_actions, state_rows
 from .features import RSRP as RSRP_COLUMNS
 from .simulator import hex_layout, n_sites
 from .uplink import capacity_bps, cell_deviation, interference_mw, rsrp_offset_db, sinr_db
@@ -48,6 +48,17 @@ class RealFlight:
     nb_pci: np.ndarray     # (n, slots) detected cells, NaN where empty
     nb_rsrp: np.ndarray
     nb_rsrq: np.ndarray
+
+    def __post_init__(self):
+        """A flight built in code is checked as a loaded one: every measurement finite (a neighbour slot may be
+        empty, NaN), so that no policy acts on an infinite state."""
+        for field in ("t", "xy", "pci", "rsrp", "rsrq", "snr", "nb_pci", "nb_rsrp", "nb_rsrq"):
+            v = np.asarray(getattr(self, field), dtype=float)
+            bad = np.isinf(v) if field.startswith("nb_") else ~np.isfinite(v)
+            if bad.any():
+                i = int(np.nonzero(bad)[0][0])
+                raise InputError(f"{self.name}: the flight's {field} is {v[np.nonzero(bad)][0]:g} at sample {i}, "
+                                 "not a finite number; measurements must be finite.")
 
     @property
     def observed_handovers(self) -> int:
@@ -88,7 +99,7 @@ def _read_export(path: Path):
     import pandas as pd
 
     try:
-        df = pd.read_csv(path, low_memory=False, dtype={"Time": str})
+        df = pd.read_csv(path, low_memory=False, dtype={"Time": str}, skip_blank_lines=False)  # index + 2: line
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise InputError(f"{path}: cannot read it as CSV ({str(exc).splitlines()[0]}).") from None
     missing = [c for c in REQUIRED if c not in df.columns]
@@ -103,7 +114,42 @@ def _read_export(path: Path):
                                                                           r"(\d+)$", c)))
     for c in ["Latitude", "Longitude", PCI, RSRP, RSRQ, "RS SNR", *_neighbour_columns(slots, df.columns)]:
         df[c] = pd.to_numeric(df[c], errors="coerce")
+    _check_measurements(df, path)
     return df, slots
+
+
+#: what a UE can report, with a margin (TS 36.133: RSRP -156..-31 dBm, RSRQ -34..2.5 dB, SINR -23..40 dB; 504 PCIs
+#: in LTE, 1008 in NR): a value outside is a broken file, and as float32 it would reach the DQN as inf
+PLAUSIBLE = {"RSRP": (-200.0, 0.0, "dBm"), "RSRQ": (-60.0, 20.0, "dB"), "RS SNR": (-50.0, 60.0, "dB"),
+             "Physical cell identity": (0.0, 1007.0, ""), "Latitude": (-90.0, 90.0, "deg"),
+             "Longitude": (-180.0, 180.0, "deg")}
+
+
+def _check_measurements(df, path: Path) -> None:
+    """Refuse a column in other units (its median outside what a UE reports), then the first row (by its line in
+    the file) with a non-finite or physically impossible measurement; an empty cell is a measurement not taken and
+    stays (NaN)."""
+    first = None
+    for col in df.columns:
+        kind = next((k for k in PLAUSIBLE if col == k or col.startswith(f"{k} (")), None)
+        if kind is None:
+            continue
+        lo, hi, unit = PLAUSIBLE[kind]
+        v = df[col].to_numpy(dtype=float)
+        med = np.median(v[np.isfinite(v)]) if np.isfinite(v).any() else lo
+        if not lo <= med <= hi:
+            raise InputError(f"{path}: column '{col}' has median {med:g}, outside {lo:g}..{hi:g}{' ' * bool(unit)}{unit}; wrong units?")
+        bad = ~np.isnan(v) & ~((v >= lo) & (v <= hi))  # inf and -inf fail the range too
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            line = int(df.index[k]) + 2  # the header is line 1; blank lines were kept, so the index counts lines
+            if first is None or line < first[0]:
+                first = (line, col, float(v[k]), lo, hi, unit)
+    if first is not None:
+        line, col, value, lo, hi, unit = first
+        what = (f"a non-finite number ({value:g})" if not np.isfinite(value) else
+                f"{value:g}, outside the {lo:g}..{hi:g}{' ' + unit if unit else ''} a UE reports")
+        raise InputError(f"{path}: line {line}: column '{col}' holds {what}; fix or delete that row.")
 
 
 def _neighbour_columns(slots: list[int], present) -> list[str]:
@@ -119,7 +165,7 @@ def _time_steps(df, slots: list[int], path: Path):
     g = df.groupby("_t", sort=True).first()
     fill = ["Latitude", "Longitude", "RS SNR", *_neighbour_columns(slots, g.columns)]
     g[fill] = g[fill].ffill(limit=2)
-    g = g[g[PCI].notna() & g[RSRP].notna() & g[RSRQ].notna() & g["Latitude"].notna()]
+    g = g[g[PCI].notna() & g[RSRP].notna() & g[RSRQ].notna() & g["Latitude"].notna() & g["Longitude"].notna()]
     if len(g) < 2:
         raise InputError(f"{path}: fewer than 2 time steps with a serving cell ('{PCI}').")
     for col, lo, hi, unit in ((RSRP, -160, -20, "dBm"), (RSRQ, -40, 0, "dB"), ("Latitude", -90, 90, "deg"),
@@ -157,6 +203,7 @@ class Walk:
     next_serving: np.ndarray   # (n,) the network's serving PCI at the next sample (its decision); last: itself
     queue_bits: np.ndarray     # (n,) the modelled uplink buffer
     lost_bits: float
+    name: str = ""             # the flight's
 
     @property
     def serving(self) -> np.ndarray:
@@ -236,7 +283,13 @@ def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
         queues.append(link.q)
         if i + 1 < len(f.t):
             link.advance(f.rsrp[i], serving, float(np.clip(f.t[i + 1] - f.t[i], 0, 5)), f.pci[i + 1] != serving)
-    return Walk(f.t, np.array(states), cands, np.append(f.pci[1:], f.pci[-1]), np.array(queues), link.lost)
+    states = np.array(states)
+    bad = ~np.isfinite(states)
+    if bad.any():  # finite measurements beyond float32 (the states' type)
+        i, j = (int(k[0]) for k in np.nonzero(bad))
+        raise InputError(f"{f.name}: the state at sample {i} has {FEATURES[j]} = {states[i, j]:g} (float32), not a "
+                         "finite number; fix that measurement.")
+    return Walk(f.t, states, cands, np.append(f.pci[1:], f.pci[-1]), np.array(queues), link.lost, f.name)
 
 
 def chm_handovers(f: RealFlight, config=None, sim_config: SimConfig | None = None) -> int:
@@ -296,7 +349,8 @@ def agreement(walks: list[Walk], make_decider) -> Agreement:
         standing = None  # (serving, proposed target) of the instant before
         for i in range(len(w.t) - 1):
             cand = w.candidates[i]
-            a = int(decide(w.states[i], cand, float(w.t[i])))
+            a = int(checked_actions([decide(w.states[i], cand, float(w.t[i]))],
+                                    lambda _: f"sample {i} (t = {w.t[i]:g} s) of {w.name or 'a walk'}")[0])
             target = cand[a] if a < len(cand) else cand[0]
             net_ho = w.next_serving[i] != cand[0]
             proposes = target != cand[0]

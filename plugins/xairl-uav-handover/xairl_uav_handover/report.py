@@ -97,6 +97,7 @@ class UAVReport(Report):
 
     def build(self, req: ReportRequest) -> ReportContent:
         real, real_setting = real_source(self.options.real)
+        loaded = _load_real(real) if real is not None else None  # a bad file is named before Table I's minutes
         ckpt = load_checkpoint()
         cfg = ckpt.sim_config
         content = ReportContent(
@@ -112,7 +113,7 @@ class UAVReport(Report):
             notes=["Simulated states: the DQN's own decision states on held-out flights (TR 36.777 UMa-AV, the "
                    "calibrated link and load of config.py). Contributions are to the chosen action's Q-value; the "
                    "background is 100 states after 10 s of flight under conventional handover."])
-        flights = self._add_real_flights(content, ckpt, req, real) if real is not None else []
+        flights = self._add_real_flights(content, ckpt, req, real, *loaded) if loaded else []
         self._add_timelines(content, ckpt, req, flights[:1])
         return content
 
@@ -142,13 +143,14 @@ class UAVReport(Report):
         return (f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s, value [bootstrap 95 % "
                 f"interval]. {verdict(res)} (The paper's medians per flight: {paper}.)", table_html(*html_table(res)))
 
-    def _add_real_flights(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest, real: Path) -> list:
-        """The calibration and agreement tables against the real flights in folder ``real``; returns the flights."""
+    def _add_real_flights(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest, real: Path,
+                          flights: list, bad: list[str]) -> list:
+        """The calibration and agreement tables against the ``flights`` loaded from folder ``real`` (``bad``: why
+        the others were skipped); returns the flights."""
         from tqdm import tqdm
 
-        from .real_data import chm_handovers, load_folder, walk
+        from .real_data import chm_handovers, walk
 
-        flights, bad = load_folder(real)
         cfg = ckpt.sim_config
         walks = [walk(f, cfg, seed=req.seed) for f in tqdm(flights, desc="real flights", disable=not req.progress)]
         chm_real = [chm_handovers(f, sim_config=cfg) for f in flights]
@@ -169,6 +171,18 @@ class UAVReport(Report):
         content.notes += [f"skipped file: {b}" for b in bad] + REAL_NOTES
         content.figures.append(_altitude_figure(req.out, str(real), cfg, flights, chm_real, req.seed))
         return flights
+
+
+def _load_real(real: Path) -> tuple[list, list[str]]:
+    """The flights of folder ``real`` and why the others were skipped, said on stderr too (the report's notes list
+    them all): a skipped file is never silent."""
+    from .real_data import load_folder
+
+    flights, bad = load_folder(real)
+    if bad:
+        print(f"xairl: report: skipped {len(bad)} of {len(bad) + len(flights)} flight file(s) (listed in the "
+              f"report's notes); first: {bad[0]}", file=sys.stderr)
+    return flights, bad
 
 
 def real_source(real: str | None) -> tuple[Path | None, str]:
