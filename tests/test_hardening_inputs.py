@@ -240,3 +240,48 @@ def test_a_selection_that_is_not_of_states_is_one_line(run_exp, key, words):
     with pytest.raises(InputError) as err:
         run_exp[key]
     assert words in str(err.value) and "\n" not in str(err.value)
+
+
+# 17. a parametrised action space ------------------------------------------------------------------------------------
+HYBRID = ["dash", "turn", "kick", "dash_power", "turn_angle", "kick_power"]
+KINDS = ["actions"] * 3 + ["continuous"] * 3
+
+
+@pytest.fixture(scope="module")
+def hybrid():
+    return mlp([4, 16, 6])
+
+
+def test_outputs_named_as_parameters_of_actions_are_refused(hybrid):
+    """Six outputs, three logits and their three parameters, were ranked together: 'chose kick_power'."""
+    with pytest.raises(InputError, match=r"output 'dash_power' reads as a parameter of action 'dash'.*"
+                                         r"xairl.Policy.heads\(module, output=\[...\]\).*output=\['actions'\] \* 6"):
+        xairl.Policy(hybrid, feature_names=list("abcd"), action_names=HYBRID)
+
+
+def test_outputs_declared_of_mixed_kinds_are_refused(hybrid):
+    with pytest.raises(InputError, match=r"mixed kinds \(actions: dash, turn, kick; continuous: dash_power, "
+                                         r"turn_angle, kick_power\).*Policy.heads"):
+        xairl.Policy(hybrid, feature_names=list("abcd"), action_names=HYBRID, output=KINDS)
+    with pytest.raises(InputError, match="output gives 5 kinds for 6 outputs"):
+        xairl.Policy(hybrid, feature_names=list("abcd"), action_names=HYBRID, output=KINDS[:5])
+    with pytest.raises(InputError, match=r"output \['actions', 'discrete'\] is unknown"):
+        xairl.Policy(hybrid, feature_names=list("abcd"), output=["actions", "discrete"])
+    same = xairl.Policy(hybrid, feature_names=list("abcd"), action_names=HYBRID, output=["actions"] * 6)
+    assert same.output == "actions"  # declared all discrete: the user's word is taken
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_heads_explain_the_actions_and_their_parameters_apart(hybrid, method):
+    heads = xairl.Policy.heads(hybrid, output=KINDS, action_names=HYBRID, feature_names=list("abcd"))
+    assert list(heads) == ["actions", "continuous"]
+    r = np.random.default_rng(0)
+    x, bg = r.normal(size=(3, 4)).astype(np.float32), r.normal(size=(10, 4)).astype(np.float32)
+    with torch.no_grad():
+        full = hybrid(torch.as_tensor(x)).numpy()
+    acts, params = (xairl.explain(heads[k], x, background=bg, method=method) for k in ("actions", "continuous"))
+    assert acts.action_names == ("dash", "turn", "kick") and acts.decides
+    assert params.action_names == ("dash_power", "turn_angle", "kick_power") and params.output == "continuous"
+    np.testing.assert_allclose(acts.outputs, full[:, :3], atol=1e-6)
+    np.testing.assert_allclose(params.outputs, full[:, 3:], atol=1e-6)
+    assert set(acts.chosen) <= {0, 1, 2}

@@ -10,6 +10,7 @@ import numpy as np
 import torch
 
 from .errors import InputError, XairlError
+from .heads import check_kinds, heads
 from .observation import Observation, names_preview
 
 
@@ -78,7 +79,10 @@ class Policy:
         a dict of shapes ``{"image": (3, 64, 64), "speed": (1,)}`` or a list of shapes (several inputs). Default:
         flat, one column per feature name.
     :param output: 'actions' (discrete action scores: Q-values or logits), 'continuous' (one column per action
-        dimension) or 'value' (one column: V(s), Q(s, a) or any regressor).
+        dimension) or 'value' (one column: V(s), Q(s, a) or any regressor); or one of them per output column. Outputs
+        of mixed kinds (a parametrised action space: action logits and their continuous parameters) are refused,
+        since a parameter's value would be ranked against the actions' scores: :meth:`heads` makes one policy per
+        kind. An undeclared output named as a parameter of another (``kick_power`` beside ``kick``) is refused too.
     :param features: optional :class:`FeatureInfo` per feature name, and per group name for a group narrated as
         one reason (``kind='group'``).
     :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}`` (plots show each as one bar).
@@ -106,15 +110,20 @@ class Policy:
     facts_hook: Callable[[np.ndarray, int, int], Any] | None = None
     action_mask: Callable[[np.ndarray], np.ndarray] | None = None
     observation: Any = None
-    output: Literal["actions", "continuous", "value"] = "actions"
+    output: Literal["actions", "continuous", "value"] | Sequence[str] = "actions"
 
     def __post_init__(self) -> None:
         if not isinstance(self.module, torch.nn.Module):
             raise InputError(f"module must be a torch.nn.Module, got {type(self.module).__name__}.")
-        if self.output not in OUTPUT_KINDS:
-            raise InputError(f"output '{self.output}' is unknown; use one of {', '.join(OUTPUT_KINDS)}.")
         def normalise(name: str, value) -> None:  # a frozen dataclass sets its own fields only here
             object.__setattr__(self, name, value)
+
+        kinds = None if isinstance(self.output, str) else tuple(str(k) for k in self.output or ())
+        if kinds is not None:  # one kind per output column: checked against the names below
+            normalise("output", kinds[0] if kinds else "")
+        if self.output not in OUTPUT_KINDS or (kinds and not set(kinds) <= set(OUTPUT_KINDS)):
+            raise InputError(f"output {self.output if kinds is None else list(kinds)!r} is unknown; use one of "
+                             f"{', '.join(OUTPUT_KINDS)}, or one of them per output column.")
 
         normalise("observation", _observation(self.observation, self.feature_names))
         normalise("name", str(self.name))
@@ -137,6 +146,7 @@ class Policy:
         if len(self.feature_names) != self.observation.n_features:
             raise InputError(f"{len(self.feature_names)} feature names for an observation of "
                              f"{self.observation.n_features} columns {self.observation.describe()}; name each column.")
+        check_kinds(self, kinds)
         if self.output == "value" and len(self.action_names) != 1:
             raise InputError("a 'value' policy has one output; give one name in action_names (e.g. ['value']).")
         names = set(self.feature_names)
@@ -158,6 +168,20 @@ class Policy:
         return (f"Policy({self.name!r}, {names_preview(self.feature_names, 'features')}; "
                 f"{names_preview(self.action_names, 'actions' if self.output == 'actions' else 'outputs')}; "
                 f"output {self.output}, observation {self.observation.describe()})")
+
+    @classmethod
+    def heads(cls, module: torch.nn.Module, output: Sequence[str], action_names: Sequence[str] | None = None,
+              **kwargs) -> dict[str, "Policy"]:
+        """One policy per kind of output, for a network whose outputs are of several kinds (a parametrised action
+        space, P-DQN style: the discrete actions' logits and their continuous parameters in one tensor).
+
+        :param output: the kind of each output column, e.g. ``['actions'] * 3 + ['continuous'] * 3``.
+        :param action_names: a name per output column (default ``action_0..``).
+        :param kwargs: the other :class:`Policy` arguments (feature names, observation, ...), shared by the heads.
+        :returns: ``{kind: Policy}`` in the order the kinds first appear, each on its own columns of the module's
+            output: ``heads['actions']`` chooses among the actions, ``heads['continuous']`` explains each parameter.
+        """
+        return heads(cls, module, output, action_names, **kwargs)
 
     @property
     def n_features(self) -> int:
@@ -275,10 +299,11 @@ class PolicyNetwork(torch.nn.Module):
             detail = " ".join(str(exc).split())[:300]
             own = _module_dtype(self.module)
             if own is not None and own != x.dtype:  # e.g. a float16 network: the dtype, not the shape, is wrong
+                own, given = (str(t).removeprefix("torch.") for t in (own, x.dtype))
                 raise InputError(f"policy '{self.policy_name}': its module {type(self.module).__name__} computes in "
-                                 f"{str(own).removeprefix('torch.')} and failed on {str(x.dtype).removeprefix('torch.')}"
-                                 f" states ({type(exc).__name__}: {detail[:160]}); xairl explains float32 and float64 "
-                                 "networks: convert it with module.float() or module.double().") from None
+                                 f"{own} and failed on {given} states ({type(exc).__name__}: {detail[:160]}); xairl "
+                                 "explains float32 and float64 networks: convert it with module.float() or "
+                                 "module.double().") from None
             shape = tuple(x.shape[:1]) + tuple(inp.shape[1:]) if isinstance(inp, torch.Tensor) else \
                 f"{self.observation.describe().replace('(n', f'({len(x)}')}"
             raise InputError(f"policy '{self.policy_name}': its module {type(self.module).__name__} raised "

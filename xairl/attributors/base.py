@@ -52,9 +52,10 @@ class Attributor:
         outputs = policy.scores(x)
         bad = ~np.isfinite(outputs).all(axis=1)
         if bad.any():
+            kind = np.dtype(policy.dtype)
             raise InputError(f"the policy's outputs are NaN or infinite for {int(bad.sum())} state(s), first state "
                              f"{int(np.argmax(bad))}: nothing can be explained; check the states' scale (a "
-                             f"{np.dtype(policy.dtype).name} network overflows beyond ~{np.finfo(policy.dtype).max:.0e}).")
+                             f"{kind.name} network overflows beyond ~{np.finfo(kind).max:.0e}).")
         module = policy.network
         was_training = policy.module.training  # the user's flag; the wrapper's own means nothing
         module.eval()
