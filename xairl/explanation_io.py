@@ -19,6 +19,7 @@ class _Part(BaseModel):
     key: str
     shape: list[Annotated[int, Field(ge=1)]]
     categories: Annotated[int, Field(ge=1)] | None = None
+    channels: Literal["channels", "frames"] = "channels"  # an image's channels, or the frames of a stack
 
 
 class _Observation(BaseModel):
@@ -83,7 +84,7 @@ def from_json(cls, text: str | bytes):
         raise InputError(f"the explanation is not valid JSON ({' '.join(str(exc).split())[:120]}); give the "
                          "JSON that Explanation.to_json() writes.") from None
     try:
-        record = dict(_json_form().model_validate(data))
+        record = dict(_json_form(cls).model_validate(data))
     except ValidationError as exc:
         raise InputError(f"the explanation's JSON does not match Explanation.to_json(): "
                          f"{validation_message(exc, 'explanation', 'unknown field')}") from None
@@ -129,12 +130,10 @@ _ARRAY_FIELDS = {"values": _array_field(3), "base_values": _array_field(2), "out
 _FORM: list[type[BaseModel]] = []
 
 
-def _json_form() -> type[BaseModel]:
+def _json_form(Explanation) -> type[BaseModel]:
     """A validator of the JSON form, generated from the dataclass's own fields (names, types and defaults) once."""
     if _FORM:
         return _FORM[0]
-    from .explanation import Explanation
-
     hints = get_type_hints(Explanation)
     spec = {}
     for f in fields(Explanation):
