@@ -16,6 +16,8 @@ class Explanation:
 
     For every state i and action a: ``base_values[i, a] + values[i, :, a].sum() ≈ outputs[i, a]``;
     ``additivity_gap[i, a]`` is the absolute difference.
+    ``exp[:n]``, ``exp[mask]``, ``exp[[i, j]]`` and ``exp[i]`` are the Explanation of those states (an episode out of
+    a run; an int gives a one-state Explanation), ``len(exp)`` their number.
 
     :param values: (n_states, n_features, n_actions) contributions.
     :param base_values: (n_states, n_actions) expected score over the background (or the baseline's score).
