@@ -25,7 +25,7 @@ from .sandbox import MAX_LOOP_DEPTH, loop_depth
 DECISION_VARS = {"index", "action", "runner_up", "score", "runner_up_score", "q_margin", "base_value", "method",
                  "additivity_gap", "top", "margin_top", "comparisons", "extras", "k", "output", "reasons",
                  "concession", "base_margin", "identifiers"}
-GLOBAL_VARS = {"n_states", "method", "ranking", "k"}
+GLOBAL_VARS = {"n_states", "method", "ranking", "view", "target", "k"}
 
 
 class TemplateError(XairlError):

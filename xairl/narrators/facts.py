@@ -28,8 +28,8 @@ class FeatureFact:
     :param rank: 1 for the largest |contribution| among the reasons (identifiers are context, not reasons).
     :param kind: the feature's ``FeatureInfo.kind``.
     :param fill: for a feature with a capacity, its value as a percentage of it; else None.
-    :param value_text: the value as a narrative writes it: '-85.3 dBm', '12.0 % full', a category's label, or empty
-        for a group.
+    :param value_text: the value as a narrative writes it: '-85.3 dBm', '12.0 % full', a category's label, 'mean
+        pixel value 33.1' for an image region (:func:`xairl.in_regions`), or empty for a group.
     """
 
     name: str
@@ -130,14 +130,23 @@ class GlobalFacts:
     """Over a set of states: the variables every global template sees (``context()``).
 
     :param n_states: how many states were explained; ``method`` the attributor.
-    :param ranking: features by mean |contribution| to the chosen action, each a dict with ``name``, ``label``,
-        ``unit``, ``rank``, ``mean_abs`` and ``high_values`` ('toward', 'against' or 'mixed': the direction in which
-        high values push, from the correlation of value and contribution).
+    :param ranking: features by mean |contribution| in ``view`` (the order of the beeswarm and importance plots of
+        that view), each a dict with ``name``, ``label``, ``unit``, ``rank``, ``mean_abs``, ``mean`` (the signed mean
+        contribution), ``direction`` (the sign of ``mean``: 'toward' raises the target, 'against' lowers it, 'mixed'
+        when the mean is under a fifth of ``mean_abs``: it pushed both ways), and ``high_values`` / ``low_values``
+        (the same, over the states where the feature's value is above / at most its median; 'mixed' also when its
+        values do not vary).
+    :param view: what the contributions add up to: 'margin' (the chosen action's score minus the runner-up's, the
+        default for discrete actions), 'score' (the chosen action's own score), or 'output' (a value or the first
+        dimension of a continuous action: nothing is chosen); ``target`` the same in words ('the margin over the
+        runner-up', "the chosen action's score", the output's name).
     """
 
     n_states: int
     method: str
     ranking: tuple[dict, ...]
+    view: str = "margin"
+    target: str = "the margin over the runner-up"
 
     def context(self) -> dict[str, Any]:
         """Variables a global template sees: every field and ``k``."""
@@ -205,11 +214,13 @@ def level(value: float, info: FeatureInfo, quartiles: tuple[float, float] | None
     return "typical", middle
 
 
-def _value_text(value: float, info: FeatureInfo, label: str | None) -> tuple[float | None, str]:
+def _value_text(value: float, info: FeatureInfo, label: str | None, region: bool = False) -> tuple[float | None, str]:
     if info.kind == "group":
         return None, ""
     if label is not None:
         return None, label
+    if region:  # an image region's value is the mean of its pixels: said so, not a bare number in brackets
+        return None, f"mean pixel value {fmt(value)}"
     if info.capacity is not None:
         fill = 100.0 * value / info.capacity
         return fill, f"{fmt(fill)} % full"
@@ -223,13 +234,14 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
     rank, _, share = unit_ranks(c, np.array([u.info.kind != "identifier" for u in us]))
     q = exp.background_quantiles
     labels = exp.value_labels
+    regions = (exp.extras or {}).get("regions") or {}  # an image's regions (xairl.in_regions)
     out = []
     for n, u in enumerate(us):
         j = u.columns[0]
         value = float(exp.states[i, j]) if len(u.columns) == 1 else float("nan")
         label = None if len(u.columns) > 1 or labels is None or labels[i, j] is None else str(labels[i, j])
         lvl, words = level(value, u.info, None if q is None or len(u.columns) > 1 else (float(q[0, j]), float(q[2, j])))
-        fill, text = _value_text(value, u.info, label)
+        fill, text = _value_text(value, u.info, label, u.name in regions)
         out.append(FeatureFact(u.name, u.info.description or u.name, value, u.info.unit, float(c[n]), float(share[n]),
                                "toward" if c[n] >= 0 else "against", lvl, words, int(rank[n]), u.info.kind, fill, text))
     return out
@@ -296,21 +308,34 @@ def _domain_facts(policy: Policy | None, state: np.ndarray, chosen: int, runner_
     return out
 
 
-def global_facts(exp: Explanation, policy: Policy | None = None, k: int = 5) -> GlobalFacts:
-    """Ranking by mean |contribution to the chosen action| and the direction of effect of high values."""
-    contrib = exp.for_chosen()
+def _direction(contrib: np.ndarray) -> str:
+    """'toward', 'against' or 'mixed' (empty, or a mean under a fifth of the mean size: both ways) of contributions."""
+    if not len(contrib):
+        return "mixed"
+    mean, size = float(contrib.mean()), float(np.abs(contrib).mean())
+    return "mixed" if abs(mean) < 0.2 * size or not size else "toward" if mean > 0 else "against"
+
+
+def global_facts(exp: Explanation, policy: Policy | None = None, k: int = 5, view: str = "margin") -> GlobalFacts:
+    """Features ranked by mean |contribution| in ``view`` ('margin' over the runner-up by default, as the plots rank
+    them; 'score': the chosen action's), each with the direction it pushed on average and for high and low values."""
+    contrib = exp.contributions(view)[0]
+    shown = view if exp.decides else "score" if exp.output == "actions" else "output"
+    output = exp.action_names[0] if exp.action_names[0].lower().startswith("the ") else f"the {exp.action_names[0]}"
+    target = {"margin": "the margin over the runner-up", "score": "the chosen action's score"}.get(shown, output)
     mean_abs = np.abs(contrib).mean(axis=0)
     ranking = []
     for rank, j in enumerate(np.argsort(-mean_abs, kind="stable")[:k], start=1):
         name = exp.feature_names[j]
         info = _info(policy, name)
-        effect = "mixed"
-        if exp.states is not None and len(contrib) > 2 and np.std(exp.states[:, j]) > 0 and np.std(contrib[:, j]) > 0:
-            rho = float(np.corrcoef(exp.states[:, j], contrib[:, j])[0, 1])
-            effect = "toward" if rho > 0.3 else "against" if rho < -0.3 else "mixed"
+        high = low = "mixed"
+        if exp.states is not None and np.ptp(exp.states[:, j]) > 0:
+            above = exp.states[:, j] > np.median(exp.states[:, j])
+            high, low = _direction(contrib[above, j]), _direction(contrib[~above, j])
         ranking.append({"name": name, "label": info.description or name, "unit": info.unit, "rank": rank,
-                        "mean_abs": float(mean_abs[j]), "high_values": effect})
-    return GlobalFacts(len(contrib), exp.method, tuple(ranking))
+                        "mean_abs": float(mean_abs[j]), "mean": float(contrib[:, j].mean()),
+                        "direction": _direction(contrib[:, j]), "high_values": high, "low_values": low})
+    return GlobalFacts(len(contrib), exp.method, tuple(ranking), shown, target)
 
 
 class _SampleExtras(dict):
@@ -325,7 +350,8 @@ def sample_context(kind: str) -> dict:
     (:func:`xairl.narrators.check_template`)."""
     if kind == "global":
         return GlobalFacts(10, "deep_shap", tuple({"name": f"f{i}", "label": f"feature {i}", "unit": "", "rank": i,
-                                                    "mean_abs": 1.0 / i, "high_values": "toward"}
+                                                    "mean_abs": 1.0 / i, "mean": 0.5 / i, "direction": "toward",
+                                                    "high_values": "toward", "low_values": "against"}
                                                    for i in range(1, 4))).context()
     feats = tuple(FeatureFact(f"f{i}", f"feature {i}", 1.0, "m", 0.5 / i, 30.0, "toward", "high", "high", i,
                               value_text="1.00 m") for i in range(1, 4))

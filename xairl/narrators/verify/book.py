@@ -117,8 +117,8 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
             e = feats[r["name"]]
             e.value = r["mean_abs"]
             e.ranks["chosen"] = r["rank"]
-            if r["high_values"] != "mixed":
-                e.contribs["chosen"] = 1.0 if r["high_values"] == "toward" else -1.0
+            if r["direction"] != "mixed":  # the direction it pushed on average, in the summary's view
+                e.contribs["chosen"] = 1.0 if r["direction"] == "toward" else -1.0
         return FactBook(feats, exp.output, None, None, {}, None, None, [float(g.n_states)], global_view=True,
                         n_states=g.n_states)
     d = decision_facts(exp, index, policy, k=len(exp.feature_names))
