@@ -1,11 +1,60 @@
 """What a notebook shows of an explanation: an HTML table of its first decisions and their largest contributions,
 in the margin view (the narratives' view), the view named. A Narrative shows its evidence card
-(:func:`xairl.evidence.card_html`)."""
+(:func:`xairl.evidence.card_html`). Also what figures and tables share with the narratives: a feature's value as the
+narratives write it (:func:`value_text`), and a progress bar that is quiet in a notebook (:func:`progress`).
+"""
 from __future__ import annotations
 
 import html
+import warnings
 
 import numpy as np
+
+#: what tqdm.auto warns, once per process, in a notebook without ipywidgets (shap and transformers import it)
+_NO_WIDGETS = "IProgress not found"
+
+
+def quiet_tqdm() -> None:
+    """Import ``tqdm.auto`` with its 'IProgress not found' warning silenced: it warns once, at its first import, in
+    a notebook without ipywidgets, and libraries (shap, transformers) import it. Call it before importing them; it
+    is idempotent and cheap (tqdm only)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=_NO_WIDGETS)
+        import tqdm.auto  # noqa: F401 (imported for its side effect: the module is cached, warned or not)
+
+
+def progress(iterable=None, **kwargs):
+    """A tqdm progress bar that is safe in a notebook: a widget bar where ipywidgets is installed, tqdm's text bar
+    elsewhere, and never the 'IProgress not found' warning. ``kwargs`` are tqdm's (``desc``, ``total``, ``unit``,
+    ``disable``)."""
+    quiet_tqdm()
+    from tqdm.auto import tqdm
+
+    return tqdm(iterable, **kwargs)
+
+
+def value_text(value: float, info=None, label: str | None = None) -> str:
+    """A feature's value as the narratives write it: a category's ``label``, the fill of a feature with a capacity
+    ('100 % full'), else the number in their format with the feature's unit ('-85.3 dBm'); ``info`` a
+    :class:`xairl.FeatureInfo` or None. The one formatter of values: figures and tables call it."""
+    if info is None:
+        from .prompts import fmt  # no policy: the narratives' number format, without torch
+
+        return label if label is not None else fmt(value)
+    from .narrators.facts import _value_text
+
+    return _value_text(float(value), info, label)[1]
+
+
+def state_value_text(exp, i: int, j: int, policy=None) -> str:
+    """State ``i``'s value of feature ``j`` of ``exp`` as :func:`value_text` writes it, with the unit, capacity
+    and categories ``policy`` declares for it (``Policy.features``); empty when ``exp`` keeps no states."""
+    if exp.states is None:
+        return ""
+    labels = exp.value_labels
+    label = None if labels is None or labels[i, j] is None else str(labels[i, j])
+    info = None if policy is None else policy.features.get(exp.feature_names[j])
+    return value_text(float(exp.states[i, j]), info, label)
 
 
 def explanation_html(exp, states: int = 5, top: int = 6) -> str:

@@ -4,7 +4,9 @@ in a notebook; :func:`save` writes it atomically). Nothing here imports shap.
 Every figure about a decision says what its contributions add up to (its ``view``): ``"margin"`` (default for
 discrete actions) is the chosen action's score minus the runner-up's, the view of the narratives and the evidence
 cards, why this action and not the next best; ``"score"`` is the chosen action's own score (Q-value or logit).
-Policies without a choice (values, continuous actions) show their first output.
+Policies without a choice (values, continuous actions) show their first output. Every figure names its view in
+an axis label or title (:func:`view_label`), and writes a feature's value as the narratives do, in its unit
+(``policy=``: '100 % full', '-85.3 dBm').
 
     >>> from xairl import plots
     >>> plots.beeswarm(exp)                      # every state, the strongest features
@@ -13,27 +15,67 @@ Policies without a choice (values, continuous actions) show their first output.
 """
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import Sequence, Union
 
 import numpy as np
 
+from .display import state_value_text
 from .explanation import Explanation
 from .files import save_figure
 from .regions import in_regions
 
 #: more features than this are plotted in groups (image patches, dict keys) or only the strongest are shown
 MAX_SHOWN = 40
+#: a plot's axes are never narrower than this (inches), however long the feature names beside them
+MIN_AXES_WIDTH = 4.5
+#: the actions' marks in a timeline: markers and a palette of their own, none of the features' line colours (tab10)
+ACTION_MARKERS = "osD^vP*Xph"
+ACTION_COLOURS = ("#000000", "#8c6d31", "#7b4173", "#637939", "#3182bd", "#e6550d", "#843c39", "#5254a3")
 #: an Explanation, or titled explanations side by side: ``[("simulated", e1), ("real", e2)]``
 Panels = Union[Explanation, Sequence[tuple[str, Explanation]]]
 
 
 def _figure(**kwargs):
     """A Figure of its own, outside pyplot: no backend is chosen or changed, nothing stays open; a notebook shows
-    the returned Figure, and :func:`save` renders it with Agg."""
+    the returned Figure, and :func:`save` renders it with Agg (the canvas attached here, to measure text)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    return Figure(**kwargs)
+    fig = Figure(**kwargs)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _layout(fig, axes, min_width: float = MIN_AXES_WIDTH) -> None:
+    """tight_layout, then a wider figure while the narrowest of ``axes`` is under ``min_width`` inches: long tick
+    labels (region names, 'name = value unit') take width from the figure, not from the plot."""
+    for _ in range(3):
+        fig.tight_layout()
+        narrowest = min(ax.get_position().width for ax in axes) * fig.get_figwidth()
+        if narrowest >= min_width - 0.05:
+            return
+        fig.set_figwidth(fig.get_figwidth() + (min_width - narrowest) * len(axes) + 0.1)
+    fig.tight_layout()
+
+
+def _keep_inside(fig, ax, texts, pad: float = 4.0) -> None:
+    """Widen ``ax``'s x-limits until every text of ``texts`` (value labels at the bars' ends) lies inside the axes,
+    ``pad`` pixels from its edges: off the tick labels beside it and within the figure."""
+    renderer = fig.canvas.get_renderer()
+    for _ in range(6):
+        fig.tight_layout()  # the new limits' tick labels (one may now sit at an edge) get their room
+        box = ax.get_window_extent(renderer)
+        extents = [t.get_window_extent(renderer) for t in texts]
+        left = max(box.x0 + pad - e.x0 for e in extents)  # pixels beyond the left edge (> 0: outside)
+        right = max(e.x1 - (box.x1 - pad) for e in extents)
+        if left <= 0 and right <= 0:
+            return
+        lo, hi = ax.get_xlim()
+        per_px = (hi - lo) / box.width
+        # the scale shrinks as the limits widen: a little more than the overshoot, then measure again
+        ax.set_xlim(lo - 1.3 * max(left, 0) * per_px, hi + 1.3 * max(right, 0) * per_px)
 
 
 def _cmap(name: str):
@@ -61,7 +103,7 @@ def view_label(exp: Explanation, view: str = "margin") -> str:
     """What the contributions of ``view`` add up to, in words for an axis or a title."""
     kind = _view(exp, view)
     if kind == "margin":
-        return "contribution to the margin (chosen - runner-up score)"
+        return "contribution to the margin over the runner-up"
     if kind == "score":
         return "contribution to the chosen action's score"
     return f"contribution to {exp.action_names[0]}"
@@ -107,6 +149,7 @@ def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | Non
             ax.scatter(c[keep, j], row + rng.uniform(-0.3, 0.3, len(keep)), s=4, c=colour, alpha=0.7, linewidths=0)
         ax.axvline(0, color="0.5", lw=0.8)
         ax.set_yticks(range(len(order)), [exp.feature_names[j] for j in order])
+        ax.tick_params(axis="y", labelleft=ax is axes[0, 0])  # one order: its names once, at the left
         ax.invert_yaxis()
         ax.set_xlabel(view_label(exp, view))
         ax.set_title(title)
@@ -116,7 +159,7 @@ def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | Non
         bar = fig.colorbar(ScalarMappable(cmap="coolwarm"), ax=axes[0, -1], ticks=[0, 1], fraction=0.03)
         bar.ax.set_yticklabels(["low", "high"])
         bar.set_label("feature value")
-    fig.tight_layout()
+    _layout(fig, list(axes[0]))
     return fig
 
 
@@ -136,19 +179,25 @@ def importance(explanations: Panels, view: str = "margin", max_display: int = 20
     ax.set_xlabel("mean |" + view_label(panels[0][1], view) + "|")
     if any(t for t, _ in panels):
         ax.legend()
-    fig.tight_layout()
+    _layout(fig, [ax])
     return fig
 
 
-def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int = 10, title: str = ""):
+def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int = 10, title: str = "", *,
+              policy=None):
     """From the expected value (over the background) to state ``index``'s: the ``shown`` largest contributions as
-    steps, the rest as one step. In the margin view the numbers are those of the narrative's evidence card."""
+    steps, the rest as one step. In the margin view the numbers are those of the narrative's evidence card.
+
+    :param policy: the :class:`xairl.Policy` explained: each feature's value is then written as its narratives
+        write it, in its unit or as its fill ('buffer = 100 % full'); without it, in their number format.
+    """
     i = exp.check_index(index)
     values, expected, value = exp.contributions(view)
     c, a, base, end = values[i], int(exp.focus[i]), float(expected[i]), float(value[i])
     order = np.argsort(-np.abs(c), kind="stable")
     top, rest = order[:shown], order[shown:]
-    labels = [exp.feature_names[j] + ("" if exp.states is None else f" = {exp.states[i, j]:.3g}") for j in top]
+    labels = [exp.feature_names[j] + ("" if exp.states is None else f" = {state_value_text(exp, i, j, policy)}")
+              for j in top]
     steps = list(c[top])
     if len(rest):
         labels.append(f"{len(rest)} other features")
@@ -158,8 +207,9 @@ def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int
     ax = fig.subplots()
     y = np.arange(len(steps))
     ax.barh(y, steps, left=start, color=["#d62728" if v >= 0 else "#1f77b4" for v in steps])
-    for yi, v, x0 in zip(y, steps, start):
-        ax.text(x0 + v, yi, f" {v:+.3g}", va="center", ha="left" if v >= 0 else "right", fontsize=8)
+    texts = [ax.annotate(f"{v:+.3g}", (x0 + v, yi), xytext=(3 if v >= 0 else -3, 0), textcoords="offset points",
+                         va="center", ha="left" if v >= 0 else "right", fontsize=8)
+             for yi, v, x0 in zip(y, steps, start)]  # outward from the bar's end, kept inside the axes below
     ax.set_yticks(y, labels)
     ax.invert_yaxis()
     ax.axvline(base, color="0.5", ls=":", lw=0.8)
@@ -167,13 +217,15 @@ def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int
             "score": f"{exp.action_names[a]}'s score (chosen)", "output": exp.action_names[a]}[_view(exp, view)]
     ax.set_xlabel(f"{what}: expected {base:.3g} -> this state {end:.3g}")
     ax.set_title(title or f"state {i}: {view_label(exp, view)}", fontsize=10)
-    fig.tight_layout()
+    _layout(fig, [ax])
+    _keep_inside(fig, ax, texts)
     return fig
 
 
-def image(exp: Explanation, index: int = 0):
-    """An image policy's frame (mean over channels) and, per output, its contributions summed over channels
-    (red raises the output, blue lowers it)."""
+def image(exp: Explanation, index: int = 0, view: str = "margin"):
+    """An image policy's frame (mean over channels) beside its contributions summed over channels (red raises, blue
+    lowers): in the ``"margin"`` view (discrete actions) one map of the margin of the chosen action over the
+    runner-up; in the ``"score"`` view (or when nothing is chosen) one map per output, of its own score."""
     from .errors import InputError
 
     shape = exp.image_shape
@@ -183,28 +235,39 @@ def image(exp: Explanation, index: int = 0):
     i = exp.check_index(index)
     frame = exp.states[i].reshape(shape)
     frame = frame.mean(axis=0) if len(shape) == 3 else frame
-    heat = [exp.image(a)[i] for a in range(exp.values.shape[2])]
-    heat = [h.sum(axis=0) if len(shape) == 3 else h for h in heat]
-    lim = max(float(np.abs(h).max()) for h in heat) or 1.0
+    kind = _view(exp, view)
+    if kind == "margin":
+        c, r = exp.action_names[exp.chosen[i]], exp.action_names[exp.runner_up[i]]
+        maps = [(f"{c} over {r}", contributions(exp, view)[i].reshape(shape))]
+        named = "contribution to the margin over the runner-up"
+    else:
+        chosen = exp.action_names[exp.chosen[i]] if exp.output == "actions" else None
+        maps = [(f"{name}{' (chosen)' if name == chosen else ''}", exp.image(a)[i])
+                for a, name in enumerate(exp.action_names)]
+        named = "contribution to each action's score" if exp.output == "actions" else "contribution to each output"
+    heat = [(t, h.sum(axis=0) if len(shape) == 3 else h) for t, h in maps]
+    lim = max(float(np.abs(h).max()) for _, h in heat) or 1.0
     n = len(heat) + 1
-    fig = _figure(figsize=(2.6 * n, 3))
+    fig = _figure(figsize=(max(2.6 * n, 5.2), 3.3))
     axes = fig.subplots(1, n)
     axes[0].imshow(frame, cmap="gray")
-    axes[0].set_title("state")
-    for ax, h, name in zip(axes[1:], heat, exp.action_names):
+    axes[0].set_title("state", fontsize=9)
+    for ax, (t, h) in zip(axes[1:], heat):
         ax.imshow(frame, cmap="gray", alpha=0.35)
         ax.imshow(h, cmap="bwr", vmin=-lim, vmax=lim, alpha=0.8)
-        chosen = exp.output == "actions" and name == exp.action_names[exp.chosen[i]]
-        ax.set_title(f"{name}{' (chosen)' if chosen else ''}", fontsize=9)
+        ax.set_title(t, fontsize=9)
     for ax in axes:
         ax.axis("off")
+    fig.suptitle(textwrap.fill(f"state {i}: {named} (red raises it, blue lowers it)", int(11 * fig.get_figwidth())),
+                 fontsize=10)
     fig.tight_layout()
     return fig
 
 
 def timeline(exp: Explanation, view: str = "margin", top: int = 5, title: str = ""):
-    """States in order (an episode, a flight): the ``top`` features' contributions over the steps, and above
-    them the decision at each step, so a reader sees when a feature started to decide."""
+    """States in order (an episode, a flight): the ``top`` features' contributions over the steps (lines), and above
+    them the decision at each step (a marker and colour per action, none of them the lines'), so a reader sees when
+    a feature started to decide."""
     exp = readable(exp)
     c = contributions(exp, view)
     order = importance_order(exp, view)[:top]
@@ -212,15 +275,20 @@ def timeline(exp: Explanation, view: str = "margin", top: int = 5, title: str = 
     fig = _figure(figsize=(9, 4.2))
     ax_act, ax = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [1, 4]})
     decided = exp.chosen if exp.output == "actions" else np.zeros(len(c), dtype=int)
-    ax_act.scatter(steps, decided, s=8, c=decided, cmap="tab10", vmin=0, vmax=9)
+    for a, name in enumerate(exp.action_names):
+        at = decided == a
+        if at.any():
+            ax_act.scatter(steps[at], decided[at], s=14, marker=ACTION_MARKERS[a % len(ACTION_MARKERS)],
+                           color=ACTION_COLOURS[a % len(ACTION_COLOURS)], linewidths=0, label=name)
     ax_act.set_yticks(range(len(exp.action_names)), exp.action_names, fontsize=7)
+    ax_act.set_ylim(-0.6, len(exp.action_names) - 0.4)
     ax_act.set_ylabel("chosen" if exp.output == "actions" else "", fontsize=8)
     for j in order:
         ax.plot(steps, c[:, j], lw=1.2, label=exp.feature_names[j])
     ax.axhline(0, color="0.5", lw=0.8)
     ax.set_xlabel("step (state index)")
-    ax.set_ylabel(view_label(exp, view), fontsize=8)
-    ax.legend(fontsize=7, ncol=min(len(order), 3), loc="upper left")
+    ax.set_ylabel(view_label(exp, view).replace(" over the", "\nover the"), fontsize=8)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), title="features", title_fontsize=7)
     ax_act.set_title(title or f"{len(c)} states in order", fontsize=10)
     fig.tight_layout()
     return fig

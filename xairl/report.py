@@ -111,18 +111,23 @@ def table_html(header: list[str], rows: list[list]) -> str:
 
 def importance_table(exps: list[tuple[str, Explanation]], top: int | None = None, what: str = "features"
                      ) -> tuple[str, str]:
-    """Each feature's rank by mean |contribution to the chosen action| per dataset (the ``top`` first only, when
-    given), and the Spearman rank correlation of every dataset's global importance with the first's."""
-    imp = [np.abs(e.for_chosen()).mean(axis=0) for _, e in exps]
+    """Each feature's rank by mean |contribution| in the margin view (:func:`xairl.plots.view_label`: to the margin
+    over the runner-up for discrete actions, as the narratives and figures rank them) per dataset (the ``top`` first
+    only, when given), and the Spearman rank correlation of every dataset's global importance with the first's."""
+    from .plots import view_label
+
+    imp = [np.abs(e.contributions("margin")[0]).mean(axis=0) for _, e in exps]
     ranks = [np.argsort(np.argsort(-v)) + 1 for v in imp]
     names = exps[0][1].feature_names
     rows = [[f, *[int(r[j]) for r in ranks], *[float(v[j]) for v in imp]] for j, f in
             sorted(enumerate(names), key=lambda t: ranks[0][t[0]])][:top]
     rhos = [float(_spearman(imp[0], v)) for v in imp[1:]]
+    named = view_label(exps[0][1])
     title = ("Global importance by dataset" if len(rows) == len(names) else
-             f"The {len(rows)} most important of {len(names)} {what} ({exps[0][0]})") + "".join(
+             f"The {len(rows)} most important of {len(names)} {what} ({exps[0][0]})")
+    title += f", by mean |{named}|" + "".join(
         f"; Spearman rank correlation {label} vs {exps[0][0]}: {rho:.2f}" for (label, _), rho in zip(exps[1:], rhos))
-    header = ["feature", *[f"rank ({label})" for label, _ in exps], *[f"mean |contribution| ({label})" for label, _ in exps]]
+    header = ["feature", *[f"rank ({label})" for label, _ in exps], *[f"mean |{named}| ({label})" for label, _ in exps]]
     return title, table_html(header, rows)
 
 
@@ -132,27 +137,30 @@ def _spearman(a: np.ndarray, b: np.ndarray) -> float:
     return spearmanr(a, b).statistic
 
 
-def _figures(exps: list[tuple[str, Explanation]], pick: int, groups: dict, out: Path) -> list[tuple[str, Path]]:
-    """The report's figures, each captioned with what its contributions add up to. Images are plotted in the regions
-    their narratives name and dicts by key (thousands of pixels are no beeswarm); the image plot shows the pixels."""
+def _figures(exps: list[tuple[str, Explanation]], pick: int, groups: dict, out: Path, policy: Policy | None = None
+             ) -> list[tuple[str, Path]]:
+    """The report's figures, all in the margin view (the narratives' and the cards'; the first output when nothing
+    is chosen), each captioned with what its contributions add up to. Images are plotted in the regions their
+    narratives name and dicts by key (thousands of pixels are no beeswarm); the image plot shows the pixels. The
+    waterfall writes values in their units (``policy``'s features)."""
     from . import plots
 
     (ref_label, ref), decides = exps[0], exps[0][1].output == "actions"
     shown = [(label, plots.readable(e)) for label, e in exps]
-    target = "the chosen action's score" if decides else f"output {ref.action_names[0]}"
+    target = plots.view_label(ref)
     what = f"{ref_label} state {pick}" + (f": {ref.action_names[ref.chosen[pick]]}" if decides else "")
-    figures = [(f"SHAP values of {target}, {' vs '.join(l for l, _ in exps)} (same feature order, by {ref_label} "
-                "importance)", plots.save(plots.beeswarm(shown, view="score"), out / "beeswarm.png")),
-               (f"Global importance: mean |contribution| to {target}",
-                plots.save(plots.importance(shown, view="score"), out / "importance.png")),
-               (f"One {'decision' if decides else 'state'} ({what}){': contributions to the margin over the runner-up, as in its card' if decides else ''}",
-                plots.save(plots.waterfall(shown[0][1], pick), out / "waterfall.png"))]
+    figures = [(f"SHAP values, {target}: {' vs '.join(l for l, _ in exps)} (same feature order, by {ref_label} "
+                "importance)", plots.save(plots.beeswarm(shown), out / "beeswarm.png")),
+               (f"Global importance: mean |{target}|", plots.save(plots.importance(shown), out / "importance.png")),
+               (f"One {'decision' if decides else 'state'} ({what}): {target}{', as in its card' if decides else ''}",
+                plots.save(plots.waterfall(shown[0][1], pick, policy=policy), out / "waterfall.png"))]
     if ref.image_shape is not None:
-        figures.append((f"Contributions over the frame, per output ({ref_label} state {pick}; red raises the output, "
-                        "blue lowers it; summed over channels)", plots.save(plots.image(ref, pick), out / "image.png")))
+        figures.append((f"Contributions over the frame ({ref_label} state {pick}; {target}; red raises it, blue "
+                        "lowers it; summed over channels)", plots.save(plots.image(ref, pick), out / "image.png")))
     if groups:
-        figures.append((f"Global importance by group ({'; '.join(g + ' = ' + ', '.join(m) for g, m in groups.items())})",
-                        plots.save(plots.importance([(l, e.grouped(groups)) for l, e in exps], view="score"),
+        figures.append((f"Global importance by group, mean |{target}| "
+                        f"({'; '.join(g + ' = ' + ', '.join(m) for g, m in groups.items())})",
+                        plots.save(plots.importance([(l, e.grouped(groups)) for l, e in exps]),
                                    out / "importance_groups.png")))
     return figures
 
@@ -175,9 +183,8 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
 
     :param explained: explanations already computed, by dataset label (the others are explained here).
     """
-    from tqdm import tqdm
-
     from .attributors import explain
+    from .display import progress
 
     t0 = time.time()
     out = Path(req.out)
@@ -185,7 +192,7 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     (out / "report.html").unlink(missing_ok=True)  # a failed re-run must not leave the last run's report beside it
     exps: list[tuple[str, Explanation]] = []
     explained = explained or {}
-    for label, states in tqdm(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress):
+    for label, states in progress(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress):
         exps.append((label, explained.get(label) or explain(content.policy, states, background=content.background,
                                                             method=req.method, options=req.options)))
     if req.records:
@@ -196,7 +203,7 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
         write_text(out / "explanations.schema.json", json.dumps(StateRecord.model_json_schema(), indent=2))
     ref = exps[0][1]
     pick = _interesting(ref)
-    figures = _figures(exps, pick, dict(content.policy.groups), out) + list(content.figures)
+    figures = _figures(exps, pick, dict(content.policy.groups), out, content.policy) + list(content.figures)
     # an image's importance by region (the top ones), not by pixel; its narratives' cards list regions too
     regioned = [(label, in_regions(e)) for label, e in exps]
     image = regioned[0][1] is not ref
@@ -216,15 +223,14 @@ def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, sh
     """(narrative, evidence) for narrated decisions of the reference dataset (``pick`` first), its global summary
     and, with groups, the summary with each group as one reason; the evidence is of ``shown`` (``ref`` in regions,
     for an image: what the narratives speak of)."""
-    from tqdm import tqdm
-
+    from .display import progress
     from .narrators import narrate
 
     idx = [pick] + [i for i in range(len(ref.values)) if i != pick][: max(req.n_narrated - 1, 0)]
     out = [narrate(ref, i, narrator=req.narrator, template=req.template or content.template, policy=content.policy,
                    background=content.background, options=req.narrator_options, prompt_dirs=req.prompt_dirs,
                    robustness=req.robustness)
-           for i in tqdm(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)]
+           for i in progress(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)]
     out.append(narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs))
     pairs = [(n, n.evidence if n.evidence is not None else evidence(shown, n)) for n in out]  # of its regions
     if content.policy.groups:
