@@ -19,8 +19,8 @@ from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.evaluate import run_flights
 from xairl_uav_handover.features import FEATURES
 from xairl_uav_handover.policy import (DQNController, build_qnet, greedy, load_checkpoint, save_checkpoint)
-from xairl_uav_handover.real_data import PCI, RSRP, RealFlight, Walk, agreement, load_flight, load_folder, walk
-from xairl_uav_handover.report import real_source
+from xairl_uav_handover.real_data import PCI, RSRP, RealFlight, Walk, agreement, load_flight, walk
+from xairl_uav_handover.report import _load_real, real_source
 
 UKM = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "ukm-uav-lte" / "raw"
 needs_data = pytest.mark.skipif(not UKM.is_dir(), reason="../shared/data/ukm-uav-lte is not here")
@@ -105,15 +105,18 @@ def test_report_refuses_a_folder_of_hostile_flights_in_one_line(tmp_path, capsys
 
 
 @needs_data
-def test_report_names_the_skipped_hostile_flight(tmp_path):
-    """A folder with a good flight and a hostile one: the hostile one is skipped by name, never walked."""
+def test_report_names_the_skipped_hostile_flight(tmp_path, capsys):
+    """A folder with a good flight and a hostile one: the hostile one is skipped by name (on stderr too), never
+    walked."""
     real = tmp_path / "real"
     real.mkdir()
     (real / "25m.csv").write_text("\n".join((UKM / "25m.csv").read_text().splitlines()[:800]) + "\n")
     path, line = hostile_export(real, RSRP, "inf")
-    flights, bad = load_folder(real)
+    flights, bad = _load_real(real)
     assert [f.name for f in flights] == ["25m.csv"]
     assert len(bad) == 1 and str(path) in bad[0] and f"line {line}" in bad[0]
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("xairl: report: skipped 1 of 2 flight file(s)") and bad[0] in err[0]
 
 
 def small_flight(**changes) -> dict:

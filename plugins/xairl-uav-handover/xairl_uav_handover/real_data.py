@@ -349,8 +349,10 @@ def agreement(walks: list[Walk], make_decider) -> Agreement:
         standing = None  # (serving, proposed target) of the instant before
         for i in range(len(w.t) - 1):
             cand = w.candidates[i]
-            a = int(checked_actions([decide(w.states[i], cand, float(w.t[i]))],
-                                    lambda _: f"sample {i} (t = {w.t[i]:g} s) of {w.name or 'a walk'}")[0])
+            a = decide(w.states[i], cand, float(w.t[i]))
+            if type(a) is not int or not 0 <= a < N_CANDIDATES:  # a NaN must not be cast to some action
+                a = int(checked_actions([a], lambda _, i=i, w=w: f"sample {i} (t = {w.t[i]:g} s) of "
+                                                                  f"{w.name or 'a walk'}")[0])
             target = cand[a] if a < len(cand) else cand[0]
             net_ho = w.next_serving[i] != cand[0]
             proposes = target != cand[0]
