@@ -17,7 +17,8 @@ def _cnn(channels: str = "channels"):
     torch.manual_seed(0)
     net = torch.nn.Sequential(torch.nn.Conv2d(3, 4, 8, 4), torch.nn.ReLU(), torch.nn.Conv2d(4, 8, 4, 2),
                               torch.nn.ReLU(), torch.nn.Flatten(), torch.nn.Linear(8 * 6 * 6, 4))
-    policy = xairl.Policy(net, observation=Observation.array((3, 64, 64), channels=channels), name="cnn")
+    shape = (3, 64, 64) if channels == "channels" else Observation.array((3, 64, 64), channels=channels)
+    policy = xairl.Policy(net, observation=shape, name="cnn")
     frames = np.random.default_rng(0).integers(0, 256, (10, 3, 64, 64)).astype(np.float32)
     return policy, xairl.explain(policy, frames[:2], background=frames[2:])
 
@@ -28,34 +29,41 @@ def stack():
 
 
 @pytest.fixture(scope="module")
+def rgb():
+    return _cnn()
+
+
+@pytest.fixture(scope="module")
 def toy():
     p = toy_policy()
     return p, xairl.explain(p, p.background(25, seed=3), background=p.background(100))
 
 
 # ---- item 13: image policies in words ---------------------------------------------------------------------------
-def test_region_sentences_are_short_and_their_numbers_labelled(stack):
-    policy, exp = stack
+def test_region_sentences_are_short_and_their_numbers_labelled(rgb):
+    policy, exp = rgb
     for i in range(2):
         n = xairl.narrate(exp, i, policy=policy, robustness=False)
         assert n.verified, n.text
         assert "rows" not in n.text and "columns" not in n.text  # the extent is for tables, not for sentences
-        assert re.search(r"\bpatch [A-H][1-8] of frame [0-2] \(mean pixel value \d", n.text), n.text
+        assert re.search(r"\bpatch [A-H][1-8] of channel [0-2] \(mean pixel value \d", n.text), n.text
         assert max(len(s) for s, _ in n.sentences) < 240, n.sentences  # 299 with 'the 8x8 patch at rows ...'
-        assert max(len(f) for f in in_regions(exp).feature_names) <= len("patch H8 of frame 2")
+        assert max(len(f) for f in in_regions(exp).feature_names) <= len("patch H8 of channel 2")
         assert not re.search(r"\(\d[\d.]*\)", n.text), n.text  # no bare number in brackets after a region
 
 
-def test_a_frame_stack_is_said_in_frames_and_keeps_it_through_json(stack):
+def test_a_frame_stack_is_said_in_frames_and_keeps_it_through_json(stack, rgb):
     policy, exp = stack
+    assert in_regions(rgb[1]).feature_names[0] == "patch A1 of channel 0"  # channels stay channels by default
     names = in_regions(exp).feature_names
     assert names[0] == "patch A1 of frame 0" and names[-1] == "patch H8 of frame 2"
     again = xairl.Explanation.from_json(exp.to_json())
     assert in_regions(again).feature_names == names
     assert in_regions(again).extras["regions"]["patch H8 of frame 2"] == \
         "the 8x8 patch at rows 56 to 63, columns 56 to 63 of frame 2"
-    _, plain = _cnn()
-    assert in_regions(plain).feature_names[0] == "patch A1 of channel 0"  # channels stay channels by default
+    for i in range(2):
+        n = xairl.narrate(exp, i, policy=policy, robustness=False)
+        assert n.verified and " of frame " in n.text and "channel" not in n.text, n.text
     with pytest.raises(xairl.InputError, match="frames"):
         Observation.array((4, 84, 84), channels="frame")
 
