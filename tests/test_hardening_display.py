@@ -265,6 +265,22 @@ def test_timeline_gives_actions_their_own_colours_and_markers(toy):
     assert len(colours) == len(set(exp.chosen.tolist())) == len(set(marks)), "each action its own colour and marker"
 
 
+def test_a_decision_with_one_action_available_is_no_margin_of_an_action_over_itself(toy, tmp_path):
+    """A mask leaving one action: its waterfall is the score's (as its card), and the report picks a real choice."""
+    from xairl.report import _interesting
+
+    _, exp = toy
+    available = np.ones(exp.outputs.shape, dtype=bool)
+    available[:3, 1:] = False  # states 0-2: only the first action
+    exp = replace(exp, available=available)
+    assert (exp.runner_up[:3] == exp.chosen[:3]).all()
+    fig = plots.waterfall(exp, 0)
+    assert "chosen action's score" in fig.axes[0].get_title() and "only action" in fig.axes[0].get_title()
+    assert " over " not in fig.axes[0].get_xlabel()
+    assert any(abs(float(t.get_text())) > 0 for t in fig.axes[0].texts)
+    assert _interesting(exp) >= 3
+
+
 def _long_regions(n_features=30) -> xairl.Explanation:
     rng = np.random.default_rng(0)
     names = [f"the 12x12 patch at rows {12 * (k % 7)} to {12 * (k % 7) + 11}, columns {12 * (k // 7)} to "

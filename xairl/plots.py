@@ -186,12 +186,15 @@ def importance(explanations: Panels, view: str = "margin", max_display: int = 20
 def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int = 10, title: str = "", *,
               policy=None):
     """From the expected value (over the background) to state ``index``'s: the ``shown`` largest contributions as
-    steps, the rest as one step. In the margin view the numbers are those of the narrative's evidence card.
+    steps, the rest as one step. In the margin view the numbers are those of the narrative's evidence card (and, as
+    there, a decision with one action available, hence no runner-up, is shown in the score view, the title says so).
 
     :param policy: the :class:`xairl.Policy` explained: each feature's value is then written as its narratives
         write it, in its unit or as its fill ('buffer = 100 % full'); without it, in their number format.
     """
     i = exp.check_index(index)
+    alone = _view(exp, view) == "margin" and exp.runner_up[i] == exp.chosen[i]
+    view = "score" if alone else view  # one action was available: no margin, its score (as its card shows)
     values, expected, value = exp.contributions(view)
     c, a, base, end = values[i], int(exp.focus[i]), float(expected[i]), float(value[i])
     order = np.argsort(-np.abs(c), kind="stable")
@@ -216,7 +219,8 @@ def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int
     what = {"margin": f"margin of {exp.action_names[a]} over {exp.action_names[int(exp.runner_up[i])]}",
             "score": f"{exp.action_names[a]}'s score (chosen)", "output": exp.action_names[a]}[_view(exp, view)]
     ax.set_xlabel(f"{what}: expected {base:.3g} -> this state {end:.3g}")
-    ax.set_title(title or f"state {i}: {view_label(exp, view)}", fontsize=10)
+    ax.set_title(title or f"state {i}: {view_label(exp, view)}" + (" (the only action available)" if alone else ""),
+                 fontsize=10)
     _layout(fig, [ax])
     _keep_inside(fig, ax, texts)
     return fig

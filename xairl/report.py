@@ -166,15 +166,19 @@ def _figures(exps: list[tuple[str, Explanation]], pick: int, groups: dict, out: 
 
 
 def _interesting(exp: Explanation) -> int:
-    """A decision worth a waterfall: the first whose action is not the most common one, else the closest call."""
-    common = np.bincount(exp.chosen).argmax()
-    rare = np.flatnonzero(exp.chosen != common)
+    """A decision worth a waterfall: the first whose action is not the most common one, else the closest call; among
+    the decisions that had a choice (a runner-up other than the action: a mask may leave one action), when any did."""
+    idx = np.arange(len(exp.values))
+    chose = idx[exp.runner_up != exp.chosen] if exp.output == "actions" else idx
+    chose = chose if len(chose) else idx
+    common = np.bincount(exp.chosen[chose]).argmax()
+    rare = chose[exp.chosen[chose] != common]
     if len(rare):
         return int(rare[0])
     if exp.output != "actions":
         return 0
-    gap = exp.outputs[np.arange(len(exp.values)), exp.chosen] - exp.outputs[np.arange(len(exp.values)), exp.runner_up]
-    return int(np.argmin(gap))
+    gap = exp.outputs[chose, exp.chosen[chose]] - exp.outputs[chose, exp.runner_up[chose]]
+    return int(chose[np.argmin(gap)])
 
 
 def write_report(req: ReportRequest, content: ReportContent, explained: dict[str, Explanation] | None = None
