@@ -61,7 +61,7 @@ OUTPUT_BEFORE = re.compile(r"\b(?:estimated\s+|predicted\s+)?q[\s-]?values?\s+(?
                            r"(?:about|around|roughly|only|just)?\s*$",  # 'a predicted probability of 66%'
                            re.IGNORECASE)
 #: 'a 43% predicted probability of default', 'an estimated $316,107 price' (not 'a 12% risk increase')
-_OUTPUT_AFTER = re.compile(r"\s*(?:predicted|estimated|modell?ed)?\s*(?:probability|chance|likelihood|prediction|"
+_OUTPUT_AFTER = re.compile(r"\s*(?:(?:predicted|estimated|modell?ed)\s*)?(?:probability|chance|likelihood|prediction|"
                            r"estimate)\b(?!\s+(?:increase|rise|drop|decrease|reduction|change|shift|gain|loss)\b)"
                            r"|\s*(?:predicted|forecast)\s*(?:[.;,)]|$)",  # ('$1,850 baseline, $2,739 predicted.')
                            re.IGNORECASE)
@@ -78,9 +78,10 @@ _ARGUED = re.compile(r"\b(argu\w*|favou?r\w*|support\w*|help\w*|affect\w*|impact
 
 #: what a push comes from, right after its number: '19 points of that come from the contract', 'about 14 from the
 #: 12% price increase' (a value of the name may stand before it)
-_FROM_NAME = re.compile(r"\s*(?:percentage points?|points?|pts|pp)?\s*(?:of (?:that|it|this)\s+)?(?:comes?\s+|came\s+)?"
+_FROM_NAME = re.compile(r"\s*(?:(?:percentage points?|points?|pts|pp)\s*)?(?:of (?:that|it|this)\s+)?"
+                        r"(?:comes?\s+|came\s+)?"
                         r"(?:from|due to|thanks to|because of)\s+(?:the\s+|its\s+|their\s+|his\s+|her\s+|a\s+|an\s+)?"
-                        r"(?:[\d.,]+\s*%?\s+)?(?=\0)", re.IGNORECASE)
+                        r"(?:[\d.,]+(?:\s*%)?\s+)?(?=\0)", re.IGNORECASE)
 
 
 def bind_number(n, masked: str, mentions, names, paired, scored, book: FactBook, ctx, unit_of) -> Claim:

@@ -34,7 +34,7 @@ _AFTER_THAN = re.compile(r"\s*(?:the|its|their|his|her|a|an|being|[\w-]+'s)\s+(?
                          r"base|baseline|prediction|forecast|output|score)\b)[a-z'-]+\s+){0,4}", re.IGNORECASE)
 #: a ratio after the name compared with: '... than the pacing plan (-1.4) by a factor of ~2.6'
 #: or 'outweighed the gusts by roughly 1.5 to 1', 'outweighs fever roughly two to one (1.46 vs 0.77)'
-_FACTOR_AFTER = re.compile(r"(?:\s*\([^()]*\))?\s*(?:did\s+|does\s+)?,?\s*(?:by\s+a\s+factor\s+of\s+"
+_FACTOR_AFTER = re.compile(r"(?:\s*\([^()]*\))?\s*(?:(?:did|does)\s+)?(?:,\s*)?(?:by\s+a\s+factor\s+of\s+"
                            r"(?:about\s+|roughly\s+|around\s+|nearly\s+|almost\s+|~\s*)?(\d+(?:\.\d+)?)\b|"
                            rf"(?:by\s+)?{RATIO_HEDGE}"
                            r"(\d+(?:\.\d+)?|one|two|three|four|five|ten)\s*(?:to|:)\s*(1|one|[2-9]|two|three|four)"

@@ -228,7 +228,8 @@ _AMOUNT_VERB = re.compile(r"^(?:add(?:s|ed|ing)?|contribut\w*|giv\w*|brings?|bro
 _LOSS_OBJECT = re.compile(r"\s+(?:(?:a|an|the|its|another|further|small\w*|slight\w*|modest|large\w*|big\w*|"
                           r"sizeable|hefty|noticeable|minor|mild)\s+){0,3}(?:penalty|penalties|reduction|discount|"
                           r"deduction|drag|decrease|drop|loss|cut|downgrade|drawback|malus|haircut)\b", re.IGNORECASE)
-_SIGNED_OBJECT = re.compile(r"\s+(?:about|around|roughly|only|just|nearly|almost|some)?\s*(?P<sign>[+\-])\s?[$€£]?\d")
+_SIGNED_OBJECT = re.compile(r"\s+(?:(?:about|around|roughly|only|just|nearly|almost|some)\s*)?(?P<sign>[+\-])\s?"
+                            r"[$€£]?\d")
 
 
 def as_said_after(masked: str, m: re.Match, polarity: int) -> int:
@@ -340,7 +341,7 @@ _ELLIPTIC = re.compile(r"^\W*(?:while|although|though|whereas|if|when)\b(?![^,;]
 #: pushed toward', 'A slightly lowers')
 _RIGHT_BEFORE = re.compile(r"\s*(?:\([^()]*\)\s*)?(?:[A-Za-z]+\s+){0,2}")
 #: a list after its header's colon: 'Raising risk: A, B', 'push it up: A (+1.8), B'
-_HEADER = re.compile(r"(?:\W*[\w']+){0,3}\W*:")
+_HEADER = re.compile(r"(?:\W*\w[\w']*(?![\w'])){0,3}\W*:")  # (each word whole: no backtracking)
 
 
 def _unless_other_clause(claims: list[Claim], subjects: list[Mention], m: re.Match, masked: str,

@@ -32,7 +32,7 @@ class Mention:
 
 
 #: a label given to its feature after it: "the mother's job, which is categorized as 'other'"
-_ASSIGNED = re.compile(r"[\s,]*(?:which|that)?\s*(?:is|was|being)?\s*(?:categori[sz]ed|classified|listed|coded|"
+_ASSIGNED = re.compile(r"[\s,]*(?:(?:which|that)\s*)?(?:(?:is|was|being)\s*)?(?:categori[sz]ed|classified|listed|coded|"
                        r"recorded|labell?ed|given)\s+as\s+(?:an?\s+)?[\"'“‘]?", re.IGNORECASE)
 
 

@@ -52,9 +52,30 @@ def read(sentence: str, spans: list[tuple[int, int, str]]):
                 continue
             taken |= set(range(span.start, span.end))
             retokenizer.merge(span, attrs={"ENT_ID": key, "ENT_TYPE": "NAME", "ENT_IOB": 3})
+        for a, b in _symbol_runs(doc, taken):
+            retokenizer.merge(doc[a:b])
     for _, component in nlp.pipeline:
         doc = component(doc)
     return doc
+
+
+#: this many tokens in a row without a letter or digit ('//////', '( ( ( (') are parsed as one: they say nothing,
+#: and a sentence of hundreds of them took the tagger and parser 0.1 s (issue 51's fuzz)
+SYMBOL_RUN = 8
+
+
+def _symbol_runs(doc, taken: set[int]) -> list[tuple[int, int]]:
+    """Runs of at least :data:`SYMBOL_RUN` tokens of symbols only (no name among them), as [start, end) indices."""
+    runs, start = [], None
+    for i in range(len(doc) + 1):
+        symbol = i < len(doc) and i not in taken and not any(c.isalnum() for c in doc[i].text)
+        if symbol and start is None:
+            start = i
+        elif not symbol and start is not None:
+            if i - start >= SYMBOL_RUN:
+                runs.append((start, i))
+            start = None
+    return runs
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ _PART_OF = re.compile(r"\d[\d.,]*\s*(?:points?|pts|%)?\s+of\s+(?:roughly\s+|abou
 
 
 #: a total's word right after it: '6.3 points in total', '$806 in total reductions'
-_TOTAL_AFTER = re.compile(r"\s*(?:points?|pts)?\s*(?:in total|in all|altogether|combined|overall)\b", re.IGNORECASE)
+_TOTAL_AFTER = re.compile(r"\s*(?:(?:points?|pts)\s*)?(?:in total|in all|altogether|combined|overall)\b", re.IGNORECASE)
 
 
 def sum_reading(n: Number, masked: str, names, book: FactBook) -> Claim | None:
