@@ -20,7 +20,7 @@ from xairl_uav_handover.evaluate import run_flights
 from xairl_uav_handover.features import FEATURES
 from xairl_uav_handover.policy import (DQNController, build_qnet, greedy, load_checkpoint, save_checkpoint)
 from xairl_uav_handover.real_data import PCI, RSRP, RealFlight, Walk, agreement, load_flight, walk
-from xairl_uav_handover.report import _load_real, real_source
+from xairl_uav_handover.report import real_source
 
 UKM = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "ukm-uav-lte" / "raw"
 needs_data = pytest.mark.skipif(not UKM.is_dir(), reason="../shared/data/ukm-uav-lte is not here")
@@ -112,6 +112,8 @@ def test_report_names_the_skipped_hostile_flight(tmp_path, capsys):
     real.mkdir()
     (real / "25m.csv").write_text("\n".join((UKM / "25m.csv").read_text().splitlines()[:800]) + "\n")
     path, line = hostile_export(real, RSRP, "inf")
+    from xairl_uav_handover.report import _load_real  # the report reads the flights before anything else
+
     flights, bad = _load_real(real)
     assert [f.name for f in flights] == ["25m.csv"]
     assert len(bad) == 1 and str(path) in bad[0] and f"line {line}" in bad[0]
@@ -175,12 +177,14 @@ def test_evaluation_with_a_nan_network_raises(ckpt):
         run_flights(DQNController(nan_net(ckpt)), cfg, 2, seed=0)
 
 
-def test_checkpoint_with_nan_weights_is_refused(ckpt, tmp_path):
+def test_checkpoint_with_nan_weights_is_refused(ckpt, tmp_path, capsys):
     path = tmp_path / "nan.safetensors"
     save_checkpoint(nan_net(ckpt), path, ckpt.meta)
     with pytest.raises(CheckpointError, match=r"nan.safetensors: .*NaN or inf") as info:
         load_checkpoint(path)
     assert "\n" not in str(info.value)
+    msg = one_line_error(capsys, ["uav", "evaluate", "--checkpoint", str(path), "--flights", "1", "--duration", "1"])
+    assert str(path) in msg and "NaN or inf" in msg
 
 
 @pytest.mark.parametrize("action", [np.nan, np.inf, -1, 4, 1.5])
