@@ -149,17 +149,17 @@ def _figures(exps: list[tuple[str, Explanation]], pick: int, groups: dict, out: 
     shown = [(label, plots.readable(e)) for label, e in exps]
     target = plots.view_label(ref)
     what = f"{ref_label} state {pick}" + (f": {ref.action_names[ref.chosen[pick]]}" if decides else "")
-    figures = [(f"SHAP values, {target}: {' vs '.join(l for l, _ in exps)} (same feature order, by {ref_label} "
-                "importance)", plots.save(plots.beeswarm(shown), out / "beeswarm.png")),
+    figures = [((f"SHAP values, {target}: {' vs '.join(l for l, _ in exps)} (same feature order, by {ref_label} "
+                 "importance)"), plots.save(plots.beeswarm(shown), out / "beeswarm.png")),
                (f"Global importance: mean |{target}|", plots.save(plots.importance(shown), out / "importance.png")),
                (f"One {'decision' if decides else 'state'} ({what}): {target}{', as in its card' if decides else ''}",
                 plots.save(plots.waterfall(shown[0][1], pick, policy=policy), out / "waterfall.png"))]
     if ref.image_shape is not None:
-        figures.append((f"Contributions over the frame ({ref_label} state {pick}; {target}; red raises it, blue "
-                        "lowers it; summed over channels)", plots.save(plots.image(ref, pick), out / "image.png")))
+        figures.append(((f"Contributions over the frame ({ref_label} state {pick}; {target}; red raises it, blue "
+                         "lowers it; summed over channels)"), plots.save(plots.image(ref, pick), out / "image.png")))
     if groups:
-        figures.append((f"Global importance by group, mean |{target}| "
-                        f"({'; '.join(g + ' = ' + ', '.join(m) for g, m in groups.items())})",
+        figures.append(((f"Global importance by group, mean |{target}| "
+                         f"({'; '.join(g + ' = ' + ', '.join(m) for g, m in groups.items())})"),
                         plots.save(plots.importance([(l, e.grouped(groups)) for l, e in exps]),
                                    out / "importance_groups.png")))
     return figures
