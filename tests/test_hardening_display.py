@@ -355,6 +355,21 @@ def test_the_reports_figures_and_table_are_in_the_margin_view_and_say_so(toy, tm
     assert table.index(exp.feature_names[ranked[0]]) < table.index(exp.feature_names[ranked[1]])
 
 
+def test_the_reports_region_table_gives_each_grid_name_its_pixels(image_exp):
+    """Short region names in words, the rows and columns they cover in the table (issue 51, item 13)."""
+    from xairl.regions import in_regions
+    from xairl.report import REGIONS_ARE, TOP_REGIONS, importance_table
+
+    regions = in_regions(image_exp)
+    title, table = importance_table([("frames", regions)], TOP_REGIONS, REGIONS_ARE)
+    assert "<th>pixels</th>" in table and f"The {TOP_REGIONS} most important of" in title
+    extents = regions.extras["regions"]
+    top = np.abs(regions.margin()).mean(axis=0).argmax()
+    name = regions.feature_names[top]
+    assert f"<td>{name}</td><td>{extents[name]}</td><td>1</td>" in table
+    assert "rows" in extents[name] and "rows" not in name  # the name short, the extent in the table
+
+
 # --- item 18: no 'IProgress not found' in a notebook --------------------------------------------------------------
 
 NOTEBOOK = ("import sys, types\n"

@@ -26,7 +26,8 @@ from .regions import in_regions
 
 #: an image's report lists this many regions by importance (its cards list every region, sorted)
 TOP_REGIONS = 20
-REGIONS_ARE = "regions (patches of one channel; rows, columns and channels count from 0)"
+REGIONS_ARE = ("regions (patches of one channel or frame on a grid: letters count columns, numbers rows, from the "
+               "top left; the pixels each covers beside it, counted from 0)")
 
 
 @dataclass
@@ -119,15 +120,18 @@ def importance_table(exps: list[tuple[str, Explanation]], top: int | None = None
     imp = [np.abs(e.contributions("margin")[0]).mean(axis=0) for _, e in exps]
     ranks = [np.argsort(np.argsort(-v)) + 1 for v in imp]
     names = exps[0][1].feature_names
-    rows = [[f, *[int(r[j]) for r in ranks], *[float(v[j]) for v in imp]] for j, f in
-            sorted(enumerate(names), key=lambda t: ranks[0][t[0]])][:top]
+    extents = (exps[0][1].extras or {}).get("regions")  # an image's regions: the pixels each grid name covers
+    extents = extents if isinstance(extents, dict) and any(f in extents for f in names) else None
+    rows = [[f, *([str(extents.get(f, ""))] if extents else []), *[int(r[j]) for r in ranks],
+             *[float(v[j]) for v in imp]] for j, f in sorted(enumerate(names), key=lambda t: ranks[0][t[0]])][:top]
     rhos = [float(_spearman(imp[0], v)) for v in imp[1:]]
     named = view_label(exps[0][1])
     title = ("Global importance by dataset" if len(rows) == len(names) else
              f"The {len(rows)} most important of {len(names)} {what} ({exps[0][0]})")
     title += f", by mean |{named}|" + "".join(
         f"; Spearman rank correlation {label} vs {exps[0][0]}: {rho:.2f}" for (label, _), rho in zip(exps[1:], rhos))
-    header = ["feature", *[f"rank ({label})" for label, _ in exps], *[f"mean |{named}| ({label})" for label, _ in exps]]
+    header = ["feature", *(["pixels"] if extents else []), *[f"rank ({label})" for label, _ in exps],
+              *[f"mean |{named}| ({label})" for label, _ in exps]]
     return title, table_html(header, rows)
 
 
