@@ -398,6 +398,7 @@ def test_progress_bars_are_quiet_in_a_notebook_and_still_count():
     assert "IProgress" not in run.stderr and "explaining" in run.stderr and run.stdout.strip() == "4"
 
 
+@pytest.mark.slow
 def test_a_report_in_a_notebook_leaves_tqdm_auto_quiet_for_the_libraries_after_it(tmp_path):
     """The report's bars are the notebook-safe ones: tqdm.auto is then imported quietly, and shap or transformers
     importing it later in the same kernel print nothing."""
@@ -412,6 +413,7 @@ def test_a_report_in_a_notebook_leaves_tqdm_auto_quiet_for_the_libraries_after_i
     assert "IProgress" not in run.stderr and "explaining (deep_shap)" in run.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="kernel_shap.py (not this change's file) must call "
                    "xairl.display.quiet_tqdm() before `import shap`; then remove this mark")
 def test_kernel_shap_shows_no_iprogress_warning_in_a_notebook():
