@@ -14,9 +14,9 @@ from .checks import Claim
 from .numbers import matches
 from .vocabulary import split_words
 
-_SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:q(?:[\s-]*value)?\s*(?:=|:|of)?|scored|scores|score of|"
+_SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:(?:q(?:[\s-]*value)?(?:\s*(?:=|:|of))?|scored|scores|score of|"
                         r"with a score of|came second at|"
-                        r"second at|score|at|of|was|=)?\s*\(?(?:q\s*=\s*)?$", re.IGNORECASE)
+                        r"second at|score|at|of|was|=)\s*)?\(?(?:q\s*=\s*)?$", re.IGNORECASE)
 
 
 _ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|lands?|landed|ends? up|ended up|settles?|"
@@ -28,7 +28,7 @@ _ENDS_AT = re.compile(r"\b(?:down|up|falls?|fell|drops?|dropped|rises?|rose|land
 _FROM = re.compile(r"\bfrom\s+(?:(?:an?|the|its)\s+)?(?:(?:average|base(?:line)?|base rate|starting point|typical)"
                    r"(?:\s+(?:rate|value|estimate|prediction|q(?:[\s-]?value)?))?\s+(?:of\s+)?)?[$€£]?\s*$",
                    re.IGNORECASE)
-_FROM_TO = re.compile(r"\bfrom\s+[^;]{1,40}?\s+(?:down\s+|up\s+)?to\s+(?:about|around|roughly)?\s*[$€£]?$",
+_FROM_TO = re.compile(r"\bfrom\s+[^;]{1,40}?\s+(?:down\s+|up\s+)?to\s+(?:(?:about|around|roughly)\s*)?[$€£]?$",
                       re.IGNORECASE)
 #: '..., giving 39.5%': where the output ends (an unsigned number; '..., giving +14.7' is a push)
 _GIVING = re.compile(r"(?:,\s*|\bwhich\s+)(?:giving|gives|for a final|to give|yielding|yields)\s+(?:about\s+|"

@@ -24,7 +24,7 @@ MARGIN_AFTER = re.compile(r"^\s*(?:points?\s+)?(?:above|ahead|higher|more than)\
                           r"^(?:-?\s*points?)?\s+(?:lead|margin|gap|edge|advantage)\b|"
                           r"^\s+points?\s+of\s+(?:lead|margin|gap)\b", re.IGNORECASE)
 _RUNNER_BEFORE = re.compile(r"(?<!bit )(?<!little )(?<!just )(?<!well )(?<!slightly )(?<!touch )(?<!hair )"
-                            r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?[$€£]?\s*$",
+                            r"\b(vs\.?|versus|against|compared with|over)\s*(?:a\s+|an\s+)?(?:[$€£]\s*)?$",
                             re.IGNORECASE)
 SCORE_BEFORE = re.compile(r"\b(scor\w+|q[- ]?values?|q\s*\([^)]*\)|q)\s*(?:of|=|:|at|was|is)?\s*$", re.IGNORECASE)
 _BASE_AFTER = re.compile(r"^\s*(?!vs\b|versus\b|against\b|compared\b)(?:\w+\s+)?(baseline|base value|base rate|base|"
@@ -50,7 +50,7 @@ NET_BEFORE = re.compile(r"\b(?:net (?:effect|uplift|change|shift|push|contributi
                         r"(?:uplift|premium|change|shift) (?:over|above|from|relative to) (?:the )?(?:base(?:line)?|"
                         r"base value|base rate|average))\b(?:\s+(?:of|over|from|across)\s+[^.;:()\d]{1,30}?)?\s*"
                         r"(?:[:=]|\bis\b|\bwas\b|\bof\b)?\s*(?:about|around|roughly)?\s*[$€£]?$", re.IGNORECASE)
-_COMPARE_AFTER = re.compile(rf"^\s*(?:dB|dBm)?\s*(?:{quantities.COMPARISON_WORDS}|more|less)\b",
+_COMPARE_AFTER = re.compile(rf"^\s*(?:(?:dB|dBm)\s*)?(?:{quantities.COMPARISON_WORDS}|more|less)\b",
                             re.IGNORECASE)
 
 
