@@ -64,7 +64,7 @@ def _keep_inside(fig, ax, texts, pad: float = 4.0) -> None:
     """Widen ``ax``'s x-limits until every text of ``texts`` (value labels at the bars' ends) lies inside the axes,
     ``pad`` pixels from its edges: off the tick labels beside it and within the figure."""
     renderer = fig.canvas.get_renderer()
-    for _ in range(6):
+    for _ in range(6 if texts else 0):
         fig.tight_layout()  # the new limits' tick labels (one may now sit at an edge) get their room
         box = ax.get_window_extent(renderer)
         extents = [t.get_window_extent(renderer) for t in texts]
@@ -76,6 +76,8 @@ def _keep_inside(fig, ax, texts, pad: float = 4.0) -> None:
         per_px = (hi - lo) / box.width
         # the scale shrinks as the limits widen: a little more than the overshoot, then measure again
         ax.set_xlim(lo - 1.3 * max(left, 0) * per_px, hi + 1.3 * max(right, 0) * per_px)
+    else:
+        fig.tight_layout()
 
 
 def _cmap(name: str):
