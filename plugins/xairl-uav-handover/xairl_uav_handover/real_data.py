@@ -135,10 +135,11 @@ def _check_measurements(df, path: Path) -> None:
         if kind is None:
             continue
         lo, hi, unit = PLAUSIBLE[kind]
+        unit = f" {unit}" if unit else ""
         v = df[col].to_numpy(dtype=float)
         med = np.median(v[np.isfinite(v)]) if np.isfinite(v).any() else lo
         if not lo <= med <= hi:
-            raise InputError(f"{path}: column '{col}' has median {med:g}, outside {lo:g}..{hi:g}{' ' * bool(unit)}{unit}; wrong units?")
+            raise InputError(f"{path}: column '{col}' has median {med:g}, outside {lo:g}..{hi:g}{unit}; wrong units?")
         bad = ~np.isnan(v) & ~((v >= lo) & (v <= hi))  # inf and -inf fail the range too
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
@@ -148,7 +149,7 @@ def _check_measurements(df, path: Path) -> None:
     if first is not None:
         line, col, value, lo, hi, unit = first
         what = (f"a non-finite number ({value:g})" if not np.isfinite(value) else
-                f"{value:g}, outside the {lo:g}..{hi:g}{' ' + unit if unit else ''} a UE reports")
+                f"{value:g}, outside the {lo:g}..{hi:g}{unit} a UE reports")
         raise InputError(f"{path}: line {line}: column '{col}' holds {what}; fix or delete that row.")
 
 
