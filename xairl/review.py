@@ -8,8 +8,8 @@ the same browser and against hostile clients: a Host allow-list (``127.0.0.1:POR
 against DNS rebinding, the Origin of a POST checked when sent (else 403), a token made at start-up in every form,
 a body limit (413, decided before reading), a socket timeout per read or write, a total deadline per connection
 (a client trickling one byte at a time is hung up on when it passes), a cap on open connections (503 beyond it),
-and 400 for malformed forms, all without tracebacks. Not defended: anyone with a shell on this machine (they can read the store
-anyway); there is no TLS and no authentication beyond the token.
+and 400 for malformed forms, all without tracebacks. Not defended: anyone with a shell on this machine (they can
+read the store anyway); there is no TLS and no authentication beyond the token.
 """
 from __future__ import annotations
 
