@@ -46,6 +46,29 @@ def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ra
     assert np.array_equal(again.values, local.values)
 
 
+def test_ray_resume_explains_a_damaged_part_again_and_refuses_a_stray_by_name(tmp_path, local_ray):
+    """Issue 51, item 2, on the Ray engine: the parts carry the same checksums, and resume checks them alike."""
+    import pyarrow.parquet as pq
+
+    from xairl.errors import InputError
+    from xairl.scale import explain_on_ray
+
+    states, bg = POLICY.background(3_000, seed=6), POLICY.background(20)
+    explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=1000, workers=2)
+    parts = tmp_path / "ray" / "explanations.parquet"
+    flipped = parts / "part-000000001000.parquet"
+    whole = flipped.read_bytes()
+    flipped.write_bytes(whole[:len(whole) // 2] + bytes([whole[len(whole) // 2] ^ 4]) + whole[len(whole) // 2 + 1:])
+    (parts / "part-000000000007.parquet").write_bytes((parts / "part-000000000000.parquet").read_bytes())
+    with pytest.raises(InputError, match="part-000000000007.parquet: not a part of this run"):
+        explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=1000, workers=2, resume=True)
+    (parts / "part-000000000007.parquet").unlink()
+    summary = explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=1000, workers=2, resume=True)
+    assert summary.n == 3_000 and flipped.read_bytes() == whole  # explained again, to the same bits
+    index = pq.read_table(parts, columns=["index"]).column("index").to_numpy()
+    assert len(index) == 3_000 and np.array_equal(np.sort(index), np.arange(3_000))  # every state exactly once
+
+
 def test_ray_reads_parquet_by_row_group_and_csv_once_rewritten(tmp_path, local_ray):
     import pyarrow as pa
     import pyarrow.parquet as pq

@@ -334,7 +334,8 @@ def _existing_run(out: Path, identity: dict, resume: bool, run: str, total) -> s
         raise InputError(f"{out} holds another run (it differs in {', '.join(changed) or 'run.json'}); resume needs "
                          "the same states, policy, background, method, options and chunk size.")
     n, chunk = (total() if files else 0), identity["chunk_size"]
-    strays = [p for p in files if not PART.fullmatch(p.name) or int(p.name[5:17]) % chunk or int(p.name[5:17]) >= n]
+    strays = [p for p in files if not PART.fullmatch(p.name) or int(p.name[5:17]) % chunk or int(p.name[5:17]) >= n
+              or not p.is_file()]
     if strays:
         raise _not_ours(strays, f"no chunk of this run is named so: its chunks are part-<first row>.parquet, the "
                         f"first rows multiples of {chunk} below {n}", folder)
