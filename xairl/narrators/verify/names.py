@@ -14,7 +14,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from .vocabulary import Vocabulary, split_words
+from ...observation import REGION_RE
+from .vocabulary import Vocabulary, region_key, split_words
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,11 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
             if not any(taken[m.start():m.end()]):
                 found.append(Mention(m.start(), m.end(), kind, keys, label, form))
                 taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
+    for m in REGION_RE.finditer(text) if vocab.regions else ():  # a region by its extent, or its grid ref alone
+        keys = vocab.regions.get(region_key(m.group(0)))
+        if keys and not any(taken[m.start():m.end()]):
+            found.append(Mention(m.start(), m.end(), "feature", keys))
+            taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
     features = [m for m in found if m.kind == "feature"]
     for f, labels in vocab.short_labels.items():  # 'Y', 'Ex', 'other': only right next to their feature
         near = [m for m in features if f in m.keys]

@@ -6,7 +6,7 @@ from __future__ import annotations
 import functools
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ...explanation import Explanation
 from ...observation import REGION_RE
@@ -55,6 +55,8 @@ class Vocabulary:
     #: with all the words of one such set ('the mother having a job'), may be a vague mention of a feature, not a
     #: thing the model lacks
     name_words: frozenset = frozenset()
+    #: an image's regions by their other names (:func:`region_key` of the phrase -> the regions it may mean)
+    regions: dict[str, tuple[str, ...]] = field(default_factory=dict)
 
 
 def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
@@ -89,8 +91,6 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     for w, keys in shared.items():  # 'quality' of overall_quality and kitchen_quality: named, but not which
         if len(keys) > 1 and w not in phrases and w not in exact:
             phrases[w] = keys
-    for alias, f in _region_aliases(exp):  # 'the 12x12 patch at rows 60 to 71, ...' of 'patch F6 of frame 2'
-        exact.setdefault(_phrase(alias), set()).add(f)
     for phrase in [p for p in phrases if p.endswith("s") and p[:-1] in phrases]:  # 'condition' and 'conditions'
         phrases[phrase] = phrases[phrase[:-1]] = phrases[phrase] | phrases[phrase[:-1]]
     if exp.output != "actions":  # 'the probability of diabetes': the output's words are not a part of a feature's
@@ -116,8 +116,8 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     for p, kind, keys, label, form in entries:
         pattern, needle = _literal(p) if form == "literal" else _pattern(p, kind)
         compiled.append((pattern, kind, keys, label, "" if form == "literal" else form, needle))
-    return Vocabulary(compiled + _acronyms(exp.feature_names, exp.categories) + _shorthands(exp.feature_names) +
-                      _bare_regions(exp), short, feature_words, frozenset(names))
+    return Vocabulary(compiled + _acronyms(exp.feature_names, exp.categories) + _shorthands(exp.feature_names), short,
+                      feature_words, frozenset(names), _region_aliases(exp))
 
 
 def _regions(exp: Explanation) -> dict[str, str]:
@@ -126,29 +126,34 @@ def _regions(exp: Explanation) -> dict[str, str]:
     return {f: str(extents[f]) for f in exp.feature_names if f in extents} if isinstance(extents, Mapping) else {}
 
 
-def _region_aliases(exp: Explanation) -> list[tuple[str, str]]:
-    """(alias, region) pairs: a region is also named by its extent ('the 12x12 patch at rows 60 to 71, columns 60 to
-    71 of frame 2'), and a frame as a channel or a channel as a frame ('patch F6 of channel 2')."""
+def region_key(phrase: str) -> str:
+    """A region phrase (:data:`xairl.observation.REGION_RE`) in one spelling, to look it up: 'The 8×8 patch at rows
+    16-23 and columns 40 to 47 in channel 1' -> '8x8 patch at rows 16 to 23 columns 40 to 47 of channel 1'."""
+    key = re.sub(r"\s*(?:\bto\b|-|–|\bthrough\b)\s*", " to ", phrase.lower().replace("×", "x").replace(",", " "))
+    key = re.sub(r"\b(?:spanning|covering|over)\b", "at", re.sub(r"\bin\b", "of", key))
+    key = re.sub(r"\brow\b", "rows", re.sub(r"\bcolumn\b", "columns", key))
+    return " ".join(w for w in key.split() if w not in ("the", "and"))
+
+
+def _region_aliases(exp: Explanation) -> dict[str, tuple[str, ...]]:
+    """Other names of each region (:func:`region_key` -> regions): its extent ('the 12x12 patch at rows 60 to 71,
+    columns 60 to 71 of frame 2'), a frame said as a channel or a channel as a frame ('patch F6 of channel 2'), and its
+    grid reference alone ('patch F6' in an image of several frames: an ambiguous mention of that patch of each
+    frame). Looked up per region phrase of a text (:func:`.names.find_mentions`): one regex for all of them, not one
+    per alias (hundreds of patterns, compiled again on every call once they overflow ``re``'s cache)."""
     other = {" of frame ": " of channel ", " of channel ": " of frame "}
-    out = []
+    out: dict[str, set[str]] = {}
     for f, extent in _regions(exp).items():
         for form in (f, extent):
-            swapped = next((form.replace(a, b) for a, b in other.items() if a in form), None)
-            out += [(form, f)] * (form != f) + ([(swapped, f)] if swapped else [])
-    return out
-
-
-def _bare_regions(exp: Explanation) -> list:
-    """A grid reference said without its channel or frame ('patch F6' in an image of several frames): an ambiguous
-    mention of that patch of every channel, unless a channel or frame follows (then it names one region, or none:
-    contradicted by :func:`.regions.unknown_regions`)."""
-    by_ref: dict[str, list[str]] = {}
-    for f in _regions(exp):
+            swapped = next((form.replace(a, b) for a, b in other.items() if a in form), form)
+            for alias in {form, swapped}:
+                out.setdefault(region_key(alias), set()).add(f)
+                if (m := REGION_RE.search(alias)) and m.group(0) != alias.removeprefix("the "):  # ' of KEY' left out
+                    out.setdefault(region_key(m.group(0)), set()).add(f)
         ref = f.split(" of ", 1)[0]
         if ref != f:
-            by_ref.setdefault(ref, []).append(f)
-    return [(re.compile(rf"(?<![\w]){re.escape(ref)}(?![\w])(?!\s+(?:of|in)\s+(?:the\s+)?(?:channel|frame)\s+\d)",
-                        re.IGNORECASE), "feature", tuple(fs), "", "", _needle(ref)) for ref, fs in by_ref.items()]
+            out.setdefault(region_key(ref), set()).add(f)
+    return {k: tuple(sorted(v)) for k, v in out.items()}
 
 
 def _spellings(name_words: list[str]) -> list[str]:
