@@ -12,6 +12,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from benchmarks.fuzz_resume import BG, CHUNK, N, POLICY, STATES, make_runs, mutate, one_case, part
+from xairl import plugins
 from xairl.cli import explain as explain_cli
 from xairl.cli import main
 from xairl.errors import InputError
@@ -109,6 +110,14 @@ def test_a_truncated_part_is_explained_again_on_resume(tmp_path, capsys):
 @pytest.mark.parametrize("fmt", [[], ["--format", "parquet"]])
 def test_an_out_folder_that_cannot_be_made_is_one_line(tmp_path, capsys, fmt):
     assert main(["explain", "--n", "3", "--out", "/proc/forbidden", *fmt]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "/proc/forbidden: cannot write there" in err
+
+
+def test_a_report_out_folder_that_cannot_be_made_is_one_line(capsys, monkeypatch):
+    pytest.importorskip("xairl_uav_handover", reason="the UAV plugin (make setup installs it) has a report")
+    monkeypatch.setenv(plugins.LOAD_ENV, "uav-handover")
+    assert main(["report", "--plugin", "uav-handover", "--n", "5", "--out", "/proc/forbidden"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "/proc/forbidden: cannot write there" in err
 

@@ -13,7 +13,7 @@ from typing import Sequence
 
 from .. import plugins
 from ..errors import InputError, XairlError
-from .args import MARKS, Parser, count, narration_arguments, new_file, out_dir, parse_options
+from .args import MARKS, Parser, count, make_dir, narration_arguments, new_file, out_dir, parse_options
 from .explain import explain_parser
 
 
@@ -65,7 +65,7 @@ def cmd_report(args) -> int:
                         narrator=args.narrator, narrator_options=parse_options(args.narrator_option),
                         template=args.template, prompt_dirs=args.prompts, seed=args.seed, n_states=args.n,
                         robustness=not args.no_robustness)
-    req.out.mkdir(parents=True, exist_ok=True)
+    make_dir(req.out)  # one line, before any work, where the folder cannot be made (--out /proc/x)
     path = write_report(req, report.build(req))
     print(f"report: {path.resolve()}")
     return 0
