@@ -16,7 +16,7 @@ from xairl import plugins
 from xairl.cli import explain as explain_cli
 from xairl.cli import main
 from xairl.errors import InputError
-from xairl.stream import DATASET, explain_to_parquet
+from xairl.stream import DATASET, explain_to_parquet, read_parquet
 
 CASES = 210  # with a fixed seed: the resume fuzz of the issue's "done when" (benchmarks/fuzz_resume.py runs more)
 
@@ -59,6 +59,16 @@ def test_a_stray_or_foreign_part_is_refused_by_name_before_anything_is_explained
         _resume(out)
     assert "\n" not in str(caught.value)
     assert before == {p.name: p.stat().st_mtime_ns for p in (out / DATASET).iterdir()}  # nothing written
+
+
+def test_read_parquet_refuses_a_folder_that_holds_a_row_twice(runs, tmp_path):
+    root, reference, _ = runs
+    shutil.copytree(root / "run" / DATASET, tmp_path / DATASET)
+    shutil.copy(tmp_path / DATASET / part(20), tmp_path / DATASET / "part-000000000007.parquet")
+    with pytest.raises(InputError, match="row 20 is in two parts"):
+        read_parquet(tmp_path / DATASET)
+    (tmp_path / DATASET / "part-000000000007.parquet").unlink()
+    assert np.array_equal(read_parquet(tmp_path / DATASET).values, reference.values)
 
 
 def test_the_issues_cli_resumes_a_bit_flip_whole_and_refuses_part_07(tmp_path, capsys, caplog):

@@ -150,6 +150,10 @@ def read_parquet(path: str | Path) -> Explanation:
     except (pa.ArrowException, OSError, KeyError, ValueError) as exc:
         raise InputError(f"{path}: not an xairl Parquet dataset ({' '.join(str(exc).split())[:120]}).") from None
     table = table.sort_by("index")
+    twice = np.flatnonzero(np.diff(table.column("index").to_numpy()) == 0)
+    if len(twice):  # pandas and pyarrow would read the folder with the row twice
+        raise InputError(f"{path}: row {table.column('index')[int(twice[0])]} is in two parts: a copy or another run's "
+                         "part is there (xairl explain --resume names it).")
     f, a = len(meta["feature_names"]), len(meta["action_names"])
 
     def rows(name: str, width: int) -> np.ndarray:
