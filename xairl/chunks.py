@@ -33,6 +33,8 @@ def count_states(source, policy: Policy) -> int | None:
 
 def count_rows(source, policy: Policy) -> int:
     """Rows in a states source, a CSV file's counted by reading it through (block by block)."""
+    if isinstance(source, (str, Path)) and not Path(source).is_file():
+        raise InputError(f"{source}: no such file; give a .npy, .parquet, .csv, .npz or .json file of states.")
     n = count_states(source, policy)
     if n is None:
         _, batches = _table_batches(Path(source), policy, CHUNK, 0)
