@@ -52,9 +52,25 @@ def test_api_options(options, method):
     if method == "integrated_gradients" and isinstance(options.get("n_steps"), int):
         options["n_steps"] = min(abs(options["n_steps"]), 64) + 2
     try:
-        xairl.explain(POLICY, BG[:2], background=BG[:5], method=method, options=options)
-    except XairlError:
-        pass
+        exp = xairl.explain(POLICY, BG[:2], background=BG[:5], method=method, options=options)
+    except XairlError as exc:
+        assert "\n" not in str(exc)
+        return
+    _well_formed(exp, method, options)
+
+
+def _well_formed(exp, method, options):
+    """An explanation that was accepted: its shapes, finite numbers, the policy's own outputs (whatever the options),
+    its contributions adding up to them (IG: up to the convergence delta it reports), the options it ran with."""
+    assert exp.values.shape == (2, 5, 3) and exp.base_values.shape == exp.outputs.shape == (2, 3)
+    assert all(np.isfinite(a).all() for a in (exp.values, exp.base_values, exp.outputs))
+    assert exp.method == method and exp.feature_names == tuple(FEATURES) and len(exp.action_names) == 3
+    np.testing.assert_allclose(exp.outputs, REFERENCE.outputs, rtol=1e-5, atol=1e-5)
+    if method == "integrated_gradients":
+        np.testing.assert_allclose(np.abs(exp.extras["convergence_delta"]), exp.additivity_gap, atol=1e-4)
+    else:
+        assert exp.additivity_gap.max() <= 1e-4
+    assert set(options) <= set(exp.options)
 
 
 cell = st.one_of(st.floats(width=32).map(repr), st.text(string.printable, max_size=6), st.just(""), st.just("nan"))
@@ -134,7 +150,8 @@ def test_cli_values_of_any_flag(flag, value):
     _cli_ok(argv)
 
 
-EXPLANATION = xairl.explain(POLICY, BG[:2], background=BG, method="exact").to_json()
+REFERENCE = xairl.explain(POLICY, BG[:2], background=BG, method="exact")
+EXPLANATION = REFERENCE.to_json()
 json_values = st.recursive(st.one_of(st.none(), st.booleans(), st.integers(-10 ** 30, 10 ** 30), floats,
                                      st.text(max_size=4)),
                            lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=6), inner,

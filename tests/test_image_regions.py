@@ -1,7 +1,5 @@
 """An image policy is narrated, verified and reported in regions (patches of one channel named in words), not in
 pixels; its repr and its explanation's stay short. A small CNN on 3x64x64 frames, built here (no training)."""
-import time
-
 import numpy as np
 import pytest
 import torch
@@ -9,6 +7,9 @@ import torch
 import xairl
 from xairl.regions import in_regions
 from xairl.report import ReportContent, ReportRequest, write_report
+from tests.work_budget import calls
+
+NARRATE_CALLS = 1_000_000  # function calls to narrate one state of the CNN below, verification included
 
 REGION = "patch "
 
@@ -23,7 +24,9 @@ def cnn():
     return policy, frames, xairl.explain(policy, frames[:2], background=frames[2:])
 
 
-def test_an_image_is_narrated_in_verified_regions_within_two_seconds(cnn):
+def test_an_image_is_narrated_in_verified_regions_with_little_work(cnn):
+    """Work counted in function calls (cProfile's count), not seconds (a 2 s limit failed under load): ~270,000 for
+    192 regions; in pixels (12,288 features) many times more. The time: benchmarks/bench_test_timings.py."""
     policy, _, exp = cnn
     regions = in_regions(exp)
     assert len(regions.feature_names) == 3 * 8 * 8 and regions.feature_names[0] == \
@@ -31,9 +34,8 @@ def test_an_image_is_narrated_in_verified_regions_within_two_seconds(cnn):
     np.testing.assert_allclose(regions.values.sum(axis=1), exp.values.sum(axis=1), atol=1e-9)  # additivity kept
     xairl.narrate(exp, 0, policy=policy, robustness=False)  # warm: templates, the vocabulary's regexes
     for i in range(2):
-        start = time.perf_counter()
-        narrative = xairl.narrate(exp, i, policy=policy, robustness=False)
-        assert time.perf_counter() - start < 2.0
+        narrative, work = calls(xairl.narrate, exp, i, policy=policy, robustness=False)
+        assert work < NARRATE_CALLS
         assert narrative.verified, [c for c in narrative.claims if c.status != "verified"]
         assert REGION in narrative.text and "obs[" not in narrative.text
         assert xairl.verify(narrative.text, exp, i, policy).ok  # the pixel explanation is read in regions too

@@ -12,6 +12,7 @@ from xairl.narrators import check_template
 from xairl.narrators.facts import sample_context
 from xairl.prompts import TemplateError
 from xairl.toy import toy_policy
+from tests.work_budget import calls
 
 GOOD = 'name: explain_action\nkind: decision\nsentences:\n  - ["Custom: the policy chose {{ action }}."]\n'
 
@@ -81,19 +82,20 @@ def test_prompts_cli(capsys, tmp_path):
 
 HOSTILE_DIR = Path(__file__).parent / "hostile_templates"
 HOSTILE = sorted(HOSTILE_DIR.glob("*.yaml"))
+#: function calls (as cProfile counts them) to refuse one attack, whole narration included: the most, macro_fanout's,
+#: are ~560,000; a loop or fan-out the sandbox did not stop makes many millions
+HOSTILE_CALLS = 2_000_000
 
 
 @pytest.mark.parametrize("path", HOSTILE, ids=lambda p: p.stem)
 def test_hostile_templates_are_refused_quickly(path):
-    """Attribute escapes, mutation, runaway loops, bombs, recursion, imports: a clear error, in well under a second."""
-    import time
-
+    """Attribute escapes, mutation, runaway loops, bombs, recursion, imports: a clear error, after little work
+    (counted in calls, not seconds: the times are in benchmarks/bench_test_timings.py)."""
     p = toy_policy()
     e = xairl.explain(p, p.background(1))
-    t0 = time.perf_counter()
     with pytest.raises((TemplateError, UnknownNameError)) as info:
-        xairl.narrate(e, 0, template=str(path))
-    assert time.perf_counter() - t0 < 2.0
+        calls(xairl.narrate, e, 0, template=str(path))
+    assert info.value.calls < HOSTILE_CALLS
     assert str(path) in str(info.value) and "\n" not in str(info.value)
 
 
@@ -104,18 +106,16 @@ def test_hostile_corpus_size():
 @pytest.mark.parametrize("path", HOSTILE, ids=lambda p: p.stem)
 def test_hostile_templates_stay_small(path):
     """Bounds hold for the whole rendering: each attack is refused before it allocates or loops much."""
-    import time
     import tracemalloc
 
     tracemalloc.start()
-    t0 = time.perf_counter()
     try:
         with pytest.raises((TemplateError, UnknownNameError)) as info:
-            prompts.load(path).render_variants(sample_context("decision"))
+            calls(lambda: prompts.load(path).render_variants(sample_context("decision")))
         peak = tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
-    assert time.perf_counter() - t0 < 2.0
+    assert info.value.calls < HOSTILE_CALLS
     assert peak < 50 * 2**20, f"peak {peak / 2**20:.0f} MB"
     assert str(path) in str(info.value) and "\n" not in str(info.value)
 

@@ -1,7 +1,6 @@
 """The verifier on prose it did not write: each pipeline step on its own, the held-out corpus, bad input."""
 import json
 import pathlib
-import time
 from dataclasses import replace
 
 import numpy as np
@@ -15,6 +14,7 @@ from xairl.narrators.verify.numbers import find_numbers, matches, normalise
 from xairl.narrators.verify.book import clean_surface
 from benchmarks.bench_verifier import explanation_from_tuples, load_corpus, run, shapstories_case
 from tests import narrative_domains as domains
+from tests.work_budget import calls
 
 
 @pytest.mark.parametrize("text,value,unit,hedge", [
@@ -334,10 +334,11 @@ def test_shares_ratios_and_counts_of_factors(text, status):
 @pytest.mark.parametrize("text", ["", " ", "x" * 1_000_000, "Die Geruchsnote erhöht die Vorhersage deutlich.",
                                   "odor adds 1.5e-1", "odor adds\u00a00.15 \u2212 wait", "\x00\x01"])
 def test_bad_input_gives_a_status_not_an_exception(text):
-    t = time.perf_counter()
-    res = xairl.verify(text, _exp(), 0)
+    """... after little work: counted in function calls, not seconds (~230,000 for the million characters, cut at
+    200,000; the time is in benchmarks/bench_test_timings.py)."""
+    res, work = calls(xairl.verify, text, _exp(), 0)
     assert res.status in ("verified", "contradicted", "unchecked")
-    assert time.perf_counter() - t < 10
+    assert work < 1_000_000
 
 
 @pytest.fixture(scope="module")
