@@ -1,5 +1,7 @@
 """``xairl explain``: a policy's decisions on states from a file or its sampler, printed as a table or JSON lines,
-narrated, written as a report (``--out``), or streamed chunk by chunk into Parquet (``--format parquet``)."""
+narrated, written as a report (``--out``), or streamed chunk by chunk into Parquet (``--format parquet``, and
+``--out`` alone above STREAM_ABOVE states: what an operator explaining a large log needs, memory bounded, a progress
+bar, resumable)."""
 from __future__ import annotations
 
 import argparse
