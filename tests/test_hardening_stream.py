@@ -33,6 +33,7 @@ def _resume(out):
     return explain_to_parquet(POLICY, STATES, out, background=BG, chunk_size=CHUNK, progress=False, resume=True)
 
 
+@pytest.mark.slow
 def test_resume_fuzz_ends_in_every_state_exactly_once_or_a_refusal_naming_the_part(runs, monkeypatch):
     """Bit flips, truncation, short parts, deletions, swapped names, stray and foreign parts, one to three at a time
     (and run.json made no record in one case in ten): each resume ends with every state exactly once and the values

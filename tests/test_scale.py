@@ -46,6 +46,7 @@ def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ra
     assert np.array_equal(again.values, local.values)
 
 
+@pytest.mark.slow
 def test_ray_resume_explains_a_damaged_part_again_and_refuses_a_stray_by_name(tmp_path, local_ray):
     """Issue 51, item 2, on the Ray engine: the parts carry the same checksums, and resume checks them alike."""
     import pyarrow.parquet as pq
