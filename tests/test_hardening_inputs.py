@@ -128,8 +128,6 @@ def test_a_parquet_file_with_a_column_that_is_not_numbers_is_one_line(tmp_path, 
     one_line_error(rc, err, path, *words)
 
 
-@pytest.mark.xfail(strict=True, reason="the streamed path reads Parquet in xairl/chunks.py, not in this change's "
-                   "files: its _parquet_file must call xairl.inputs.check_columns(pf.schema_arrow, feature_names)")
 def test_a_streamed_parquet_file_with_a_timestamp_column_is_one_line(tmp_path, capsys):
     import datetime
 

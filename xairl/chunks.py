@@ -11,7 +11,7 @@ import numpy as np
 
 from .errors import InputError
 from .files import atomic_write
-from .inputs import npy_header, read_states
+from .inputs import check_columns, npy_header, read_states
 from .policy import Policy
 
 CHUNK = 50_000  # states per chunk: a few MB of results, and bounded memory whatever the attributor
@@ -114,10 +114,10 @@ def _parquet_file(path: Path, policy: Policy):
         pf = pq.ParquetFile(path)
     except (pa.ArrowException, OSError) as exc:
         raise _unreadable(path, exc) from None
-    missing = [f for f in policy.feature_names if f not in pf.schema_arrow.names]
-    if missing:
-        raise InputError(f"{path}: lacks column(s) {', '.join(missing[:5])}; one column per feature, named as the "
-                         "features.")
+    try:
+        check_columns(pf.schema_arrow, policy.feature_names)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
     return pf
 
 
