@@ -414,8 +414,6 @@ def test_a_report_in_a_notebook_leaves_tqdm_auto_quiet_for_the_libraries_after_i
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="kernel_shap.py (not this change's file) must call "
-                   "xairl.display.quiet_tqdm() before `import shap`; then remove this mark")
 def test_kernel_shap_shows_no_iprogress_warning_in_a_notebook():
     run = _in_a_notebook("import xairl\n"
                          "p = xairl.get_policy('toy')\n"

@@ -120,7 +120,7 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
     :param address: a running Ray cluster; None starts Ray on this machine with ``workers`` CPUs.
     """
     ray = _ray()
-    from tqdm import tqdm
+    from .display import progress as bar
 
     source = str(Path(states).resolve()) if isinstance(states, (str, Path)) else policy.check_states(states)
     run = start_run(policy, states, out, background, method, options, chunk_size, resume)
@@ -154,7 +154,7 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
         if staged:
             Path(source).unlink(missing_ok=True)
     summary = RunningSummary()
-    for first in tqdm(range(0, total, chunk_size), desc="summing", unit="chunk", disable=not progress):
+    for first in bar(range(0, total, chunk_size), desc="summing", unit="chunk", disable=not progress):
         summary.add(first, read_parquet(run.parts / _part_name(first)))
     return finish_run(run, summary, states)
 

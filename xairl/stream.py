@@ -241,13 +241,13 @@ def explain_to_parquet(policy: Policy, states, out: str | Path, background=None,
     (``progress=None``: only when stderr is one). ``resume=True`` continues an interrupted run of the same
     states, policy, background, method, options and chunk size; without it, a folder that already holds a run is
     refused (nothing is overwritten)."""
-    from tqdm import tqdm
+    from .display import progress
 
     from .attributors import explain
 
     run = start_run(policy, states, out, background, method, options, chunk_size, resume)
     summary = RunningSummary()
-    bar = tqdm(total=count_states(states, policy), unit="states", desc=f"explaining ({method})",
+    bar = progress(total=count_states(states, policy), unit="states", desc=f"explaining ({method})",
                disable=False if progress else None if progress is None else True, smoothing=0.1)
     with bar:
         for first, x in state_chunks(states, policy, chunk_size):

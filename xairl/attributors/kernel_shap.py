@@ -7,6 +7,7 @@ import numpy as np
 import torch
 from pydantic import Field
 
+from ..display import quiet_tqdm
 from .base import Attributor, Options
 
 
@@ -25,6 +26,7 @@ class KernelShap(Attributor):
     Options = KernelShapOptions
 
     def _attribute(self, policy, x, bg):
+        quiet_tqdm()  # shap imports tqdm.auto, which warns 'IProgress not found' in a notebook without ipywidgets
         import shap
 
         dev = policy.device

@@ -49,6 +49,7 @@ from typing import Literal
 
 from pydantic import Field
 
+from ..display import quiet_tqdm
 from ..errors import InputError, XairlError
 from ..options import Options
 from ..paths import model_cache_dir
@@ -74,6 +75,7 @@ class LocalLMOptions(Options):
 def _transformers():
     """The transformers module, imported only here (``import xairl`` and the template narrator never import it);
     InputError with the one-line install hint when it, or a package it needs, is missing."""
+    quiet_tqdm()  # transformers imports tqdm.auto, which warns 'IProgress not found' in a notebook without widgets
     try:
         import transformers
     except ImportError as exc:

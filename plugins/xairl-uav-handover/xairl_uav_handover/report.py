@@ -147,12 +147,12 @@ class UAVReport(Report):
                           flights: list, bad: list[str]) -> list:
         """The calibration and agreement tables against the ``flights`` loaded from folder ``real`` (``bad``: why
         the others were skipped); returns the flights."""
-        from tqdm import tqdm
+        from xairl.display import progress
 
         from .real_data import chm_handovers, walk
 
         cfg = ckpt.sim_config
-        walks = [walk(f, cfg, seed=req.seed) for f in tqdm(flights, desc="real flights", disable=not req.progress)]
+        walks = [walk(f, cfg, seed=req.seed) for f in progress(flights, desc="real flights", disable=not req.progress)]
         chm_real = [chm_handovers(f, sim_config=cfg) for f in flights]
         states = np.concatenate([w.states for w in walks])
         pick = np.random.default_rng(req.seed).choice(len(states), size=min(req.n_states, len(states)), replace=False)

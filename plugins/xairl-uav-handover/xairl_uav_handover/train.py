@@ -147,7 +147,7 @@ def train(tc: TrainConfig, sim_cfg: SimConfig | None = None, progress: bool = Tr
 def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
     from stable_baselines3.common.buffers import ReplayBuffer
     from stable_baselines3.common.utils import set_random_seed
-    from tqdm import tqdm
+    from xairl.display import progress
 
     sim_cfg = sim_cfg or SimConfig()
     set_random_seed(tc.seed)  # python, numpy (the replay buffer samples with it) and torch
@@ -174,7 +174,7 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
     for _ in range(tc.pretrain_updates if demos is not None else 0):
         update()
     history = []
-    bar = tqdm(total=total, desc="training DQN", unit="dec", disable=not progress)
+    bar = progress(total=total, desc="training DQN", unit="dec", disable=not progress)
     for ep in range(tc.episodes):
         for g in opt.param_groups:
             g["lr"] = learning_rate(tc, ep)
