@@ -12,6 +12,7 @@ Each figure is the best of three runs.
 """
 from __future__ import annotations
 
+import contextlib
 import pathlib
 import sys
 import time
@@ -32,10 +33,8 @@ def best(fn, runs: int = 3) -> float:
     times = []
     for _ in range(runs):
         t = time.perf_counter()
-        try:
+        with contextlib.suppress(Exception):  # the hostile templates are refused: that is the run
             fn()
-        except Exception:  # noqa: BLE001 - the hostile templates are refused: that is the run
-            pass
         times.append(time.perf_counter() - t)
     return min(times)
 
@@ -45,8 +44,8 @@ def templates() -> list[tuple[str, float, float]]:
     e = xairl.explain(p, p.background(1))
     out = []
     for path in HOSTILE:
-        narrate = best(lambda: xairl.narrate(e, 0, template=str(path)))
-        render = best(lambda: prompts.load(path).render_variants(sample_context("decision")))
+        narrate = best(lambda path=path: xairl.narrate(e, 0, template=str(path)))
+        render = best(lambda path=path: prompts.load(path).render_variants(sample_context("decision")))
         out.append((path.stem, narrate, render))
     return out
 
@@ -61,7 +60,7 @@ def image() -> list[float]:
     frames = np.random.default_rng(0).integers(0, 256, (10, 3, 64, 64)).astype(np.float32)
     exp = xairl.explain(policy, frames[:2], background=frames[2:])
     xairl.narrate(exp, 0, policy=policy, robustness=False)  # warm
-    return [best(lambda: xairl.narrate(exp, i, policy=policy, robustness=False)) for i in range(2)]
+    return [best(lambda i=i: xairl.narrate(exp, i, policy=policy, robustness=False)) for i in range(2)]
 
 
 def _exp():
@@ -79,7 +78,7 @@ def verify_times() -> tuple[float, float, float]:
     verify("odor adds 0.15.", exp, 0)  # warm: the parser
     million = best(lambda: verify("x" * 1_000_000, exp, 0))
     sentence = "odor raised it by 0.15 and cap_diameter lowered it by 0.05, "
-    short, long = (best(lambda: verify(sentence * repeat + ".", exp, 0)) for repeat in (100, 400))
+    short, long = (best(lambda repeat=repeat: verify(sentence * repeat + ".", exp, 0)) for repeat in (100, 400))
     return million, short, long
 
 

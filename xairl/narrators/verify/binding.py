@@ -15,7 +15,7 @@ from .numbers import matches
 from .vocabulary import split_words
 
 _SCORE_GAP = re.compile(r"^\W{0,3}(?:\(|=|:|\s)*(?:(?:q(?:[\s-]*value)?(?:\s*(?:=|:|of))?|scored|scores|score of|"
-                        r"with a score of|came second at|"
+                        r"with a score of|came second (?:at|with)|"
                         r"second at|score|at|of|was|=)\s*)?\(?(?:q\s*=\s*)?$", re.IGNORECASE)
 
 
