@@ -118,3 +118,22 @@ def test_a_list_with_numbers_between_its_names_is_still_one_subject(text, status
     exp = _explanation(["speed", "battery", "load"], [0.4, -0.2, 0.05])
     result = verify(text, exp, 0)
     assert [c.status for c in result.claims if c.kind == "direction"] == statuses, result.claims
+
+
+def test_sentence_ends_are_found_in_linear_work(monkeypatch):
+    """2,000 tabs and 2,000 '! ': each '!' was a candidate end whose test for a list item's number ('1.') read the
+    whole text before it again (quadratic); the cheap tests come first now, and the number is read in place."""
+    verifier = importlib.import_module("xairl.narrators.verify")  # (the package: its name is also the function's)
+    read = []
+
+    class Counted:
+        def fullmatch(self, text, start, end):
+            read.append(end - start)
+            return verifier._ITEM_NUMBER_PATTERN.fullmatch(text, start, end)
+
+    monkeypatch.setattr(verifier, "_ITEM_NUMBER_PATTERN", verifier._ITEM_NUMBER, raising=False)
+    monkeypatch.setattr(verifier, "_ITEM_NUMBER", Counted())
+    text = "\t" * 2000 + " x" + " !" * 2000 + " " + "Speed raised it. 1. Load lowered it. e.g. " * 3
+    spans = verifier.sentences(text)
+    assert sum(read) <= 4 * len(text), f"{sum(read)} characters read for a text of {len(text)}"
+    assert [text[a:b].strip() for a, b in spans][-3:] == ["e.g. Speed raised it.", "1. Load lowered it.", "e.g."]
