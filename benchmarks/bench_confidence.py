@@ -62,7 +62,7 @@ def main() -> None:
     for name in args.policy or ["toy", "uav-dqn"]:
         try:
             policy = xairl.get_policy(name)  # through the plugin registry: the core imports no plugin
-        except xairl.UnknownNameError:
+        except xairl.plugin.UnknownNameError:
             print(f"{name}: not installed, skipped")
             continue
         run(name, policy, policy.background(args.n, seed=11), policy.background(100, seed=7), args.robustness)

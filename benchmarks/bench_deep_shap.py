@@ -24,7 +24,7 @@ def mlp_policy(sizes):
     for i, (a, b) in enumerate(zip(sizes[:-1], sizes[1:])):
         layers += [torch.nn.Linear(a, b)] + ([torch.nn.ReLU()] if i < len(sizes) - 2 else [])
     f, a = sizes[0], sizes[-1]
-    return xairl.TorchPolicy(torch.nn.Sequential(*layers).eval(), [f"f{i}" for i in range(f)],
+    return xairl.Policy(torch.nn.Sequential(*layers).eval(), [f"f{i}" for i in range(f)],
                              [f"a{i}" for i in range(a)],
                              background_sampler=lambda n, s: np.random.default_rng(s).normal(size=(n, f)))
 

@@ -16,7 +16,7 @@ def main():
         torch.manual_seed(f)
         net = torch.nn.Sequential(torch.nn.Linear(f, 32), torch.nn.ReLU(), torch.nn.Linear(32, 32), torch.nn.ReLU(),
                                   torch.nn.Linear(32, 4)).eval()
-        p = xairl.TorchPolicy(net, [f"f{i}" for i in range(f)], list("abcd"))
+        p = xairl.Policy(net, [f"f{i}" for i in range(f)], list("abcd"))
         r = np.random.default_rng(f)
         x, bg = r.normal(size=(4, f)), r.normal(size=(50, f))
         t0 = time.perf_counter()

@@ -1,4 +1,4 @@
-"""A plain torch Q-network (CleanRL style), trained briefly on CartPole, explained through xairl.TorchPolicy.
+"""A plain torch Q-network (CleanRL style), trained briefly on CartPole, explained through xairl.Policy.
 
 Run: python examples/cleanrl_style.py [--steps 2000]
 """
@@ -36,7 +36,7 @@ for step in range(args.steps):  # one-step Q-learning, no replay: short and good
     seen.append(obs)
     obs = env.reset()[0] if term or trunc else nxt
 
-policy = xairl.TorchPolicy(q, ["cart_position", "cart_velocity", "pole_angle", "pole_velocity"], ["left", "right"])
+policy = xairl.Policy(q, ["cart_position", "cart_velocity", "pole_angle", "pole_velocity"], ["left", "right"])
 exp = xairl.explain(policy, np.array(seen[-3:]), background=np.array(seen[:200]), method="exact")
 print(xairl.narrate(exp, 0, policy=policy, template="why_not").text)
 print("global:", xairl.narrate(exp, None, policy=policy).text)

@@ -33,7 +33,7 @@ def make_policy(model_name):
     torch.manual_seed(3)
     net = MODELS[model_name]().eval()
     n_out = net(torch.zeros(1, 5)).shape[1]
-    return xairl.TorchPolicy(net, [f"f{i}" for i in range(5)], [f"a{i}" for i in range(n_out)])
+    return xairl.Policy(net, [f"f{i}" for i in range(5)], [f"a{i}" for i in range(n_out)])
 
 
 @pytest.fixture(scope="module")
@@ -88,7 +88,7 @@ def test_hooks_and_mode_restored_after_error(method, data):
     x, bg = data
     net = Exploding(fuse=2)  # call 1 is the policy's own scoring; call 2 is inside the attributor
     net.train()
-    policy = xairl.TorchPolicy(net, [f"f{i}" for i in range(5)], ["a", "b", "c"])
+    policy = xairl.Policy(net, [f"f{i}" for i in range(5)], ["a", "b", "c"])
     # the user's exception comes out as one xairl line naming the module and the input's shape
     with pytest.raises(xairl.InputError, match=r"module Exploding raised RuntimeError \(injected failure\) on input \("):
         xairl.explain(policy, x, background=bg, method=method, options=SMALL.get(method, {}))

@@ -9,7 +9,7 @@ import torch
 import xairl
 from xairl.errors import InputError
 from xairl.evidence import card_html, evidence
-from xairl.narrators.facts import decision_facts, level
+from xairl.facts import decision_facts, value_level
 
 
 def _policy(**features):
@@ -22,7 +22,7 @@ def _policy(**features):
             "load": xairl.FeatureInfo("bit", "the queue", "lightly loaded", "heavily loaded", capacity=100.0),
             "cell": xairl.FeatureInfo("", "the cell id", kind="identifier"),
             "position": xairl.FeatureInfo("", "the position", kind="group")} | features
-    return xairl.TorchPolicy(net, ["speed", "load", "x", "y", "cell"], ["go", "wait"], features=info,
+    return xairl.Policy(net, ["speed", "load", "x", "y", "cell"], ["go", "wait"], features=info,
                              groups={"position": ("x", "y")})
 
 
@@ -53,11 +53,11 @@ def test_reasons_favour_the_decision_and_the_concession_opposes_it(case):
 def test_level_words_come_from_capacity_and_thresholds_not_degenerate_quartiles(case):
     p, exp = case
     load = p.features["load"]
-    assert level(50.0, load, None) == ("typical", "moderate")
-    assert level(80.0, load, None)[1] == "heavily loaded" and level(10.0, load, None)[1] == "lightly loaded"
-    assert level(80.0, load, (0.0, 100.0))[1] == "heavily loaded"  # the range wins over quartiles
-    assert level(8.6, xairl.FeatureInfo(), (0.0, 0.0)) == ("unknown", "")  # degenerate background: no word
-    assert level(8.6, xairl.FeatureInfo(), (0.0, 5.0))[0] == "high"
+    assert value_level(50.0, load, None) == ("typical", "moderate")
+    assert value_level(80.0, load, None)[1] == "heavily loaded" and value_level(10.0, load, None)[1] == "lightly loaded"
+    assert value_level(80.0, load, (0.0, 100.0))[1] == "heavily loaded"  # the range wins over quartiles
+    assert value_level(8.6, xairl.FeatureInfo(), (0.0, 0.0)) == ("unknown", "")  # degenerate background: no word
+    assert value_level(8.6, xairl.FeatureInfo(), (0.0, 5.0))[0] == "high"
     f = {x.name: x for x in decision_facts(exp, 0, p).top}
     assert f["load"].fill == pytest.approx(0.5) and f["load"].value_text == "0.50 % full"
     assert f["speed"].level_text == "moderate"
@@ -100,12 +100,12 @@ def test_history_reaches_a_hook_that_takes_it(case):
     def hook(state, chosen, runner_up, history=None):
         seen.append(None if history is None else history.shape)
         steps = 0 if history is None else len(history)
-        return xairl.DomainFacts(comparisons=(xairl.Comparison(f"it has gone for {steps} steps", steps, "steps"),))
+        return xairl.facts.DomainFacts(comparisons=(xairl.facts.Comparison(f"it has gone for {steps} steps", steps, "steps"),))
 
     hooked = replace(p, facts_hook=hook)  # a Policy is frozen: a changed one is a new one
     n = xairl.narrate(exp, 0, policy=hooked, robustness=False, history=np.zeros((4, 5)))
     assert seen[0] == (4, 5) and "gone for 4 steps" in n.text and n.verified
-    plain = replace(p, facts_hook=lambda state, chosen, runner_up: xairl.DomainFacts())  # called without history
+    plain = replace(p, facts_hook=lambda state, chosen, runner_up: xairl.facts.DomainFacts())  # called without history
     assert xairl.narrate(exp, 0, policy=plain, robustness=False, history=np.zeros((4, 5))).verified
 
 

@@ -235,7 +235,7 @@ def test_waterfall_writes_values_as_the_narratives_do_in_the_features_unit(toy):
     labels = [t.label1.get_text() for t in fig.axes[0].yaxis.get_major_ticks()]
     j = {f: k for k, f in enumerate(exp.feature_names)}
     speed, battery = exp.states[i, j["speed"]], exp.states[i, j["battery"]]
-    from xairl.prompts import fmt
+    from xairl.facts import format_number as fmt
 
     assert f"speed = {fmt(speed)} m/s" in labels
     assert f"battery = {fmt(100 * battery / 4.0)} % full" in labels

@@ -51,13 +51,13 @@ def test_unknown_method_and_option(policy):
 def test_policy_checks_names_and_module():
     net = torch.nn.Linear(2, 2)
     with pytest.raises(InputError, match="duplicates"):
-        xairl.TorchPolicy(net, ["a", "a"], ["x", "y"])
+        xairl.Policy(net, ["a", "a"], ["x", "y"])
     with pytest.raises(InputError, match="torch.nn.Module"):
-        xairl.TorchPolicy(lambda x: x, ["a", "b"], ["x", "y"])
+        xairl.Policy(lambda x: x, ["a", "b"], ["x", "y"])
     with pytest.raises(InputError, match="returned shape"):
-        xairl.TorchPolicy(net, ["a", "b"], ["x", "y", "z"]).scores(np.zeros((1, 2)))
+        xairl.Policy(net, ["a", "b"], ["x", "y", "z"]).scores(np.zeros((1, 2)))
     with pytest.raises(InputError, match="no background sampler; give background states: --background FILE"):
-        xairl.explain(xairl.TorchPolicy(net, ["a", "b"], ["x", "y"]), np.zeros((1, 2)))
+        xairl.explain(xairl.Policy(net, ["a", "b"], ["x", "y"]), np.zeros((1, 2)))
 
 
 def write(tmp_path, name, text):

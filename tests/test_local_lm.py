@@ -5,11 +5,11 @@ import sys
 import pytest
 
 import xairl
+from xairl import prompts
 from xairl.errors import InputError
+from xairl.facts import decision_facts
 from xairl.narrators import local_lm
 from xairl.narrators.base import first_phrasings
-from xairl.narrators.facts import decision_facts
-from xairl import prompts
 from xairl.toy import toy_policy
 
 

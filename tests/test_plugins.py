@@ -11,7 +11,7 @@ from xairl.errors import PluginError, UnknownNameError
 
 
 class DuplicateAttributor:
-    @xairl.hookimpl
+    @xairl.plugin.hookimpl
     def register_attributors(self, register):
         register("deep_shap", "xairl.attributors.exact:Exact")
 
@@ -35,11 +35,11 @@ def test_entry_point_plugin_is_discovered(tmp_path, monkeypatch):
     (tmp_path / "fake_xairl_plugin.py").write_text(textwrap.dedent('''
         import xairl
 
-        @xairl.hookimpl
+        @xairl.plugin.hookimpl
         def register_policies(register):
             register("fake-policy", "xairl.toy:toy_policy", "borrowed toy")
 
-        @xairl.hookimpl
+        @xairl.plugin.hookimpl
         def register_commands(register):
             def configure(parser):
                 parser.add_argument("--word", default="hi")
@@ -76,7 +76,7 @@ def _install(tmp_path, monkeypatch, name: str, code: str) -> None:
 GOOD = """
     import xairl
 
-    @xairl.hookimpl
+    @xairl.plugin.hookimpl
     def register_policies(register):
         register("good-policy", "xairl.toy:toy_policy", "borrowed toy")
 """
@@ -84,9 +84,9 @@ GOOD = """
 
 @pytest.mark.parametrize("broken, error", [
     ("raise RuntimeError('boom at import')", "fails to load (RuntimeError: boom at import)"),
-    ("import xairl\n@xairl.hookimpl\ndef register_policies(register):\n    register('half', 'x:y')\n"
+    ("import xairl\n@xairl.plugin.hookimpl\ndef register_policies(register):\n    register('half', 'x:y')\n"
      "    raise KeyError('oops')\n", "failed in register_policies (KeyError"),
-    ("import xairl\n@xairl.hookimpl\ndef register_everything(register):\n    pass\n", "implements an unknown hook"),
+    ("import xairl\n@xairl.plugin.hookimpl\ndef register_everything(register):\n    pass\n", "implements an unknown hook"),
 ])
 def test_a_broken_plugin_is_reported_and_breaks_nothing_else(tmp_path, monkeypatch, capsys, broken, error):
     from xairl.cli import main
@@ -132,23 +132,23 @@ REPORT = """
     from pydantic import Field
     import xairl
 
-    class TinyOptions(xairl.Options):
+    class TinyOptions(xairl.plugin.Options):
         rows: int = Field(1, ge=1, description="rows of the plugin's own table")
 
-    class TinyReport(xairl.Report):
+    class TinyReport(xairl.plugin.Report):
         name = "tiny"
         Options = TinyOptions
 
         def build(self, request):
             policy = xairl.get_policy("toy")
-            table = xairl.table_html(["k", "square"], [[k, k * k] for k in range(self.options.rows)])
-            return xairl.ReportContent(title="tiny report", policy=policy, background=policy.background(20),
+            table = xairl.plugin.table_html(["k", "square"], [[k, k * k] for k in range(self.options.rows)])
+            return xairl.plugin.ReportContent(title="tiny report", policy=policy, background=policy.background(20),
                                        datasets=[("sampled", policy.background(request.n_states, seed=1)),
                                                  ("again", policy.background(request.n_states, seed=1))],
                                        tables=[("squares", table)],
                                        commentary=lambda exps: [f"read {', '.join(exps)}"])
 
-    @xairl.hookimpl
+    @xairl.plugin.hookimpl
     def register_reports(register):
         register("tiny", "tiny_plugin:TinyReport", "a report with one option")
 """
@@ -180,10 +180,10 @@ def test_facts_hook_must_return_domain_facts():
 
     policy = toy_policy()
     exp = xairl.explain(policy, policy.background(1, seed=2), background=policy.background(20), method="exact")
-    policy = replace(policy, facts_hook=lambda state, chosen, runner_up: xairl.DomainFacts(
-        {"note": 7}, (xairl.Comparison("the gap was 1.5 m", 1.5, "m"),)))
+    policy = replace(policy, facts_hook=lambda state, chosen, runner_up: xairl.facts.DomainFacts(
+        {"note": 7}, (xairl.facts.Comparison("the gap was 1.5 m", 1.5, "m"),)))
     assert xairl.verify("The gap was 1.5 m.", exp, 0, policy).ok
     assert not xairl.verify("The gap was 2.5 m.", exp, 0, policy).ok
     policy = replace(policy, facts_hook=lambda state, chosen, runner_up: {"extras": {}, "comparisons": []})
-    with pytest.raises(PluginError, match="facts_hook returned dict; it must return xairl.DomainFacts"):
+    with pytest.raises(PluginError, match="facts_hook returned dict; it must return xairl.facts.DomainFacts"):
         xairl.narrate(exp, 0, policy=policy)

@@ -5,14 +5,14 @@ import jinja2
 import pytest
 
 import xairl
+from tests.work_budget import calls
 from xairl import prompts
 from xairl.cli import main
 from xairl.errors import UnknownNameError
+from xairl.facts import sample_context
 from xairl.narrators import check_template
-from xairl.narrators.facts import sample_context
 from xairl.prompts import TemplateError
 from xairl.toy import toy_policy
-from tests.work_budget import calls
 
 GOOD = 'name: explain_action\nkind: decision\nsentences:\n  - ["Custom: the policy chose {{ action }}."]\n'
 

@@ -13,7 +13,7 @@ from .conftest import ReusedActivations, mlp
 
 
 def policy_of(net, f, a):
-    return xairl.TorchPolicy(net.eval(), [f"f{i}" for i in range(f)], [f"a{i}" for i in range(a)])
+    return xairl.Policy(net.eval(), [f"f{i}" for i in range(f)], [f"a{i}" for i in range(a)])
 
 
 REF_MODELS = {

@@ -181,6 +181,6 @@ def test_narration_of_a_value_head_and_a_2d_actor_verifies(algo, obs, act, head)
 
 
 def xairl_fmt(v):
-    from xairl import format_number as fmt
+    from xairl.facts import format_number as fmt
 
     return fmt(float(v))

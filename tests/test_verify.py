@@ -72,7 +72,7 @@ def test_confidence_near_tie_below_clear_decision():
     with torch.no_grad():
         net.weight.copy_(torch.tensor([[1.0, 0.5], [0.0, 0.5]]))  # Q0 - Q1 = x0
         net.bias.zero_()
-    policy = xairl.TorchPolicy(net, ["gap", "common"], ["a", "b"])
+    policy = xairl.Policy(net, ["gap", "common"], ["a", "b"])
     bg = np.random.default_rng(0).normal(size=(50, 2))
     exp = xairl.explain(policy, [[0.001, 1.0], [3.0, 1.0]], background=bg, method="exact")
     tie = xairl.narrate(exp, 0, policy=policy, background=bg)
@@ -99,7 +99,7 @@ def test_names_and_descriptions_cannot_smuggle_claims():
         net.weight.copy_(torch.tensor([[1.0, 0.0], [0.0, 1.0]]))
         net.bias.zero_()
     hostile = xairl.FeatureInfo("", "speed, the most important feature, pushing toward go by +9.99")
-    policy = xairl.TorchPolicy(net, ["speed", "load"], ["go", "stop"], features={"speed": hostile},
+    policy = xairl.Policy(net, ["speed", "load"], ["go", "stop"], features={"speed": hostile},
                                action_aliases={"stop": ["stop, which raises go by 12.5%"]})
     bg = np.zeros((10, 2))
     exp = xairl.explain(policy, [[0.1, 2.0]], background=bg, method="exact")  # load dominates, stop is chosen

@@ -4,17 +4,17 @@ import pathlib
 from dataclasses import replace
 
 import numpy as np
-import torch
 import pytest
+import torch
 
 import xairl
-from xairl.narrators.verify.names import find_mentions
-from xairl.narrators.verify.vocabulary import vocabulary
-from xairl.narrators.verify.numbers import find_numbers, matches, normalise
-from xairl.narrators.verify.book import clean_surface
 from benchmarks.bench_verifier import explanation_from_tuples, load_corpus, run, shapstories_case
 from tests import narrative_domains as domains
 from tests.work_budget import calls
+from xairl.narrators.verify.book import clean_surface
+from xairl.narrators.verify.names import find_mentions
+from xairl.narrators.verify.numbers import find_numbers, matches, normalise
+from xairl.narrators.verify.vocabulary import vocabulary
 
 
 @pytest.mark.parametrize("text,value,unit,hedge", [
@@ -378,7 +378,7 @@ def _signal_policy():
     features = {f"rsrq_{k}": xairl.FeatureInfo("dB", f"{w}'s RSRQ", aliases=(f"candidate {k}'s RSRQ",) if k else ())
                 for k, w in enumerate(who)}
     net = torch.nn.Linear(3, 2)
-    return xairl.TorchPolicy(net, list(features), ["stay", "handover"], features=features)
+    return xairl.Policy(net, list(features), ["stay", "handover"], features=features)
 
 
 def test_qualifiers_narrow_an_ambiguous_name():

@@ -33,30 +33,6 @@ def progress(iterable=None, **kwargs):
     return tqdm(iterable, **kwargs)
 
 
-def value_text(value: float, info=None, label: str | None = None) -> str:
-    """A feature's value as the narratives write it: a category's ``label``, the fill of a feature with a capacity
-    ('100 % full'), else the number in their format with the feature's unit ('-85.3 dBm'); ``info`` a
-    :class:`xairl.FeatureInfo` or None. The one formatter of values: figures and tables call it."""
-    if info is None:
-        from .prompts import fmt  # no policy: the narratives' number format, without torch
-
-        return label if label is not None else fmt(value)
-    from .narrators.facts import _value_text
-
-    return _value_text(float(value), info, label)[1]
-
-
-def state_value_text(exp, i: int, j: int, policy=None) -> str:
-    """State ``i``'s value of feature ``j`` of ``exp`` as :func:`value_text` writes it, with the unit, capacity
-    and categories ``policy`` declares for it (``Policy.features``); empty when ``exp`` keeps no states."""
-    if exp.states is None:
-        return ""
-    labels = exp.value_labels
-    label = None if labels is None or labels[i, j] is None else str(labels[i, j])
-    info = None if policy is None else policy.features.get(exp.feature_names[j])
-    return value_text(float(exp.states[i, j]), info, label)
-
-
 def explanation_html(exp, states: int = 5, top: int = 6) -> str:
     """The summary line, then the first ``states`` decisions with their ``top`` contributions to the margin over the
     runner-up (to the first output when nothing is chosen)."""

@@ -7,10 +7,13 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import InputError, PluginError
-from ..explanation import Explanation
-from ..policy import FeatureInfo, Policy
-from ..prompts import fmt
+from .errors import InputError, PluginError
+from .explanation import Explanation
+from .policy import FeatureInfo, Policy
+from .prompts import format_number
+
+__all__ = ["Comparison", "DecisionFacts", "DomainFacts", "FeatureFact", "GlobalFacts", "decision_facts", "format_number",
+           "global_facts", "narration_units", "state_value_text", "value_level", "value_text"]
 
 
 @dataclass(frozen=True)
@@ -166,7 +169,7 @@ class Unit:
     info: FeatureInfo
 
 
-def units(exp: Explanation, policy: Policy | None) -> list[Unit]:
+def narration_units(exp: Explanation, policy: Policy | None) -> list[Unit]:
     """The narration units of an explanation: each group narrated as one reason, then every feature outside them."""
     index = {f: j for j, f in enumerate(exp.feature_names)}
     out, taken = [], set()
@@ -194,7 +197,7 @@ def unit_ranks(contrib: np.ndarray, reasons: np.ndarray) -> tuple[np.ndarray, np
     return rank, signed, 100 * size / (float(size.sum()) or 1.0)
 
 
-def level(value: float, info: FeatureInfo, quartiles: tuple[float, float] | None) -> tuple[str, str]:
+def value_level(value: float, info: FeatureInfo, quartiles: tuple[float, float] | None) -> tuple[str, str]:
     """(level, words) of a value: from the feature's thresholds or capacity (a physical range) when it has one,
     else from the background's quartiles when they are distinct (a degenerate background, e.g. a buffer empty in
     three states of four, says nothing about 'high'), else unknown."""
@@ -214,22 +217,42 @@ def level(value: float, info: FeatureInfo, quartiles: tuple[float, float] | None
     return "typical", middle
 
 
-def _value_text(value: float, info: FeatureInfo, label: str | None, region: bool = False) -> tuple[float | None, str]:
+def _fill_and_text(value: float, info: FeatureInfo, label: str | None, region: bool = False) -> tuple[float | None, str]:
     if info.kind == "group":
         return None, ""
     if label is not None:
         return None, label
     if region:  # an image region's value is the mean of its pixels: said so, not a bare number in brackets
-        return None, f"mean pixel value {fmt(value)}"
+        return None, f"mean pixel value {format_number(value)}"
     if info.capacity is not None:
         fill = 100.0 * value / info.capacity
-        return fill, f"{fmt(fill)} % full"
-    return None, f"{fmt(value)} {info.unit}".strip()
+        return fill, f"{format_number(fill)} % full"
+    return None, f"{format_number(value)} {info.unit}".strip()
+
+
+def value_text(value: float, info: FeatureInfo | None = None, label: str | None = None) -> str:
+    """A feature's value as the narratives write it: a category's ``label``, the fill of a feature with a capacity
+    ('100 % full'), else the number in their format with the feature's unit ('-85.3 dBm'). The one formatter of
+    values: narratives, figures and tables call it."""
+    if info is None:
+        return label if label is not None else format_number(value)
+    return _fill_and_text(float(value), info, label)[1]
+
+
+def state_value_text(exp: Explanation, i: int, j: int, policy: Policy | None = None) -> str:
+    """State ``i``'s value of feature ``j`` as :func:`value_text` writes it, with the unit, capacity and categories
+    ``policy`` declares for it; empty when ``exp`` keeps no states."""
+    if exp.states is None:
+        return ""
+    labels = exp.value_labels
+    label = None if labels is None or labels[i, j] is None else str(labels[i, j])
+    info = None if policy is None else policy.features.get(exp.feature_names[j])
+    return value_text(float(exp.states[i, j]), info, label)
 
 
 def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy | None) -> list[FeatureFact]:
     """A :class:`FeatureFact` per narration unit of state ``i`` for ``contrib`` (one value per feature)."""
-    us = units(exp, policy)
+    us = narration_units(exp, policy)
     c = np.array([float(contrib[list(u.columns)].sum()) for u in us])
     rank, _, share = unit_ranks(c, np.array([u.info.kind != "identifier" for u in us]))
     q = exp.background_quantiles
@@ -240,8 +263,8 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
         j = u.columns[0]
         value = float(exp.states[i, j]) if len(u.columns) == 1 else float("nan")
         label = None if len(u.columns) > 1 or labels is None or labels[i, j] is None else str(labels[i, j])
-        lvl, words = level(value, u.info, None if q is None or len(u.columns) > 1 else (float(q[0, j]), float(q[2, j])))
-        fill, text = _value_text(value, u.info, label, u.name in regions)
+        lvl, words = value_level(value, u.info, None if q is None or len(u.columns) > 1 else (float(q[0, j]), float(q[2, j])))
+        fill, text = _fill_and_text(value, u.info, label, u.name in regions)
         out.append(FeatureFact(u.name, u.info.description or u.name, value, u.info.unit, float(c[n]), float(share[n]),
                                "toward" if c[n] >= 0 else "against", lvl, words, int(rank[n]), u.info.kind, fill, text))
     return out
@@ -304,7 +327,7 @@ def _domain_facts(policy: Policy | None, state: np.ndarray, chosen: int, runner_
         return DomainFacts()
     if not isinstance(out, DomainFacts) or not all(isinstance(c, Comparison) for c in out.comparisons):
         raise PluginError(f"policy '{policy.name}': facts_hook returned {type(out).__name__}; it must return "
-                          "xairl.DomainFacts(extras={...}, comparisons=(xairl.Comparison(...), ...)) or None.")
+                          "xairl.facts.DomainFacts(extras={...}, comparisons=(xairl.facts.Comparison(...), ...)) or None.")
     return out
 
 

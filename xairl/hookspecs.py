@@ -1,6 +1,6 @@
 """The hooks a plugin implements. Each receives a ``register`` callback (simonw/llm style).
 
-A plugin is a module (or object) with functions marked ``@xairl.hookimpl`` and is found through the
+A plugin is a module (or object) with functions marked ``@xairl.plugin.hookimpl`` and is found through the
 ``xairl`` entry-point group. Built-ins register through these same hooks. Targets may be given as
 ``"package.module:attribute"`` strings so that nothing heavy is imported until a name is looked up.
 """
@@ -23,7 +23,7 @@ def register_policies(register):
 def register_attributors(register):
     """Register attribution methods.
 
-    :param register: ``register(name, cls, description="")``; ``cls`` is an :class:`xairl.Attributor` subclass
+    :param register: ``register(name, cls, description="")``; ``cls`` is an :class:`xairl.plugin.Attributor` subclass
         or a ``"module:attr"`` string naming one.
     """
 
@@ -33,7 +33,7 @@ def register_narrators(register):
     """Register narrators that turn an Explanation into words.
 
     :param register: ``register(name, cls, description="")``; ``cls`` (or the ``"module:attr"`` naming it) is an
-        :class:`xairl.Narrator` subclass with an ``Options`` model and a ``_compose`` method.
+        :class:`xairl.plugin.Narrator` subclass with an ``Options`` model and a ``_compose`` method.
     """
 
 
@@ -60,6 +60,6 @@ def register_reports(register):
     """Register reports for ``xairl report --plugin NAME --out DIR``.
 
     :param register: ``register(name, cls, description="")``; ``cls`` (or the ``"module:attr"`` naming it) is an
-        :class:`xairl.Report` subclass: its ``Options`` model declares the report's own settings
-        (``-o key=value``) and ``build(request)`` returns an :class:`xairl.ReportContent`.
+        :class:`xairl.plugin.Report` subclass: its ``Options`` model declares the report's own settings
+        (``-o key=value``) and ``build(request)`` returns an :class:`xairl.plugin.ReportContent`.
     """

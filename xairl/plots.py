@@ -21,8 +21,8 @@ from typing import Sequence, Union
 
 import numpy as np
 
-from .display import state_value_text
 from .explanation import Explanation
+from .facts import state_value_text
 from .files import save_figure
 from .regions import in_regions
 

@@ -89,7 +89,7 @@ class Policy:
     :param background_sampler: optional ``f(n, seed) -> states`` of typical states (any form ``observation`` takes).
     :param name: how the policy is called in reports.
     :param action_aliases: other names of each action in text, e.g. ``{"stay": ["keep the serving BS"]}``.
-    :param facts_hook: optional ``f(state, chosen, runner_up, history=None) -> xairl.DomainFacts`` adding domain
+    :param facts_hook: optional ``f(state, chosen, runner_up, history=None) -> xairl.facts.DomainFacts`` adding domain
         facts that templates may cite and the verifier accepts (``chosen`` and ``runner_up`` are action indices;
         ``history``, when the caller knows it, the states before this one in the same episode, oldest first, as an
         array (h, n_features): for facts such as "the neighbour has been stronger for 4 steps"). A hook without a

@@ -49,7 +49,7 @@ class TemplateSpec(BaseModel):
         return [[s] if isinstance(s, str) else s for s in v] if isinstance(v, list) else v
 
 
-def fmt(x: float, signed: bool = False) -> str:
+def format_number(x: float, signed: bool = False) -> str:
     """How every number in a narrative is written (the ``num`` and ``signed`` filters, and the facts' own texts):
     0 decimals from 100, 1 from 10, else 2 (3 significant digits below 0.01)."""
     x = float(x)
@@ -71,8 +71,8 @@ def fmt(x: float, signed: bool = False) -> str:
 
 def environment() -> ImmutableSandboxedEnvironment:
     """A fresh bounded sandbox (:mod:`xairl.sandbox`) with the template filters: ``num`` and ``signed`` write numbers
-    as :func:`fmt` does, ``cap`` capitalises the first letter."""
-    return sandbox.environment({"num": fmt, "signed": lambda x: fmt(x, True),
+    as :func:`format_number` does, ``cap`` capitalises the first letter."""
+    return sandbox.environment({"num": format_number, "signed": lambda x: format_number(x, True),
                                 "cap": lambda t: str(t)[:1].upper() + str(t)[1:]})
 
 

@@ -95,7 +95,7 @@ def corpus(explanation, policy, templates=("explain_action", "why_not"), indices
     ``why_not`` template is skipped there.
     """
     from . import prompts
-    from .narrators.facts import decision_facts
+    from .facts import decision_facts
 
     cases: list[Case] = []
     for name in templates:

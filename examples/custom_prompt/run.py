@@ -8,7 +8,7 @@ import xairl
 
 here = Path(__file__).parent / "prompts"
 for path in sorted(here.glob("*.yaml")):
-    problems = xairl.check_template(path)
+    problems = xairl.plugin.check_template(path)
     print(path.name, "ok" if not problems else problems)
 policy = xairl.get_policy("toy")
 exp = xairl.explain(policy, policy.background(2, seed=4))

@@ -9,7 +9,7 @@ from .base import Attributor, Options
 def explain(policy: Policy, states, background=None, method: str = "deep_shap", options=None) -> Explanation:
     """Explain a policy's decisions on ``states``.
 
-    :param policy: an :class:`xairl.Policy` (see :func:`xairl.TorchPolicy`).
+    :param policy: an :class:`xairl.Policy` (see :func:`xairl.Policy`).
     :param states: array-like (n, n_features) or one state (n_features,).
     :param background: typical states the contributions are measured against; default: the policy's sampler.
     :param method: a registered attributor name (``xairl attributors`` lists them).

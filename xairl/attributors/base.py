@@ -14,7 +14,6 @@ from ..explanation import Explanation
 from ..options import Options, parse_options
 from ..policy import Policy
 
-
 #: the most features exact Shapley values enumerate (2^16 coalitions); here so that refusals can name it
 EXACT_MAX_FEATURES = 16
 
@@ -46,7 +45,7 @@ class Attributor:
         """
         if not isinstance(policy, Policy):
             raise InputError(f"expected an xairl.Policy, got {type(policy).__name__}; wrap a network with "
-                             "xairl.TorchPolicy(module, feature_names, action_names).")
+                             "xairl.Policy(module, feature_names, action_names).")
         x = policy.check_states(states)
         bg = policy.background() if background is None else policy.check_states(background, "background")
         outputs = policy.scores(x)

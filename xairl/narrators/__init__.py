@@ -22,7 +22,7 @@ def narrate(explanation: Explanation, index: int | None = 0, *, narrator: str = 
     :param store: a :class:`xairl.feedback.FeedbackStore` that records the shown narrative, with its evidence
         (the state, the margin's contributions, the sentences' statuses) for the review page.
 
-    The other parameters are those of :meth:`xairl.Narrator.narrate`.
+    The other parameters are those of :meth:`xairl.plugin.Narrator.narrate`.
     """
     from ..plugins import registry
 
@@ -38,7 +38,7 @@ def check_template(path: str | Path) -> list[str]:
     """Problems of a template file, one line each (:func:`xairl.prompts.check`), including a trial rendering with
     sample facts; what ``xairl prompts check`` prints."""
     from .. import prompts
-    from .facts import sample_context
+    from ..facts import sample_context
 
     return prompts.check(path, sample_context)
 

@@ -15,11 +15,11 @@ import numpy as np
 from ..errors import InputError
 from ..evidence import CARD_STYLE, card_html, evidence
 from ..explanation import Explanation
+from ..facts import DomainFacts, decision_facts, global_facts
 from ..options import Options, parse_options
 from ..policy import Policy
-from .confidence import confidence
-from .facts import DomainFacts, decision_facts, global_facts
 from ..regions import in_regions
+from .confidence import confidence
 from .verify import Claim, verify
 
 
@@ -63,7 +63,7 @@ def first_phrasings(variants: list[list[str]]) -> str:
 class Narrator:
     """Turns an Explanation into words that are checked against its numbers.
 
-    Subclasses set ``name``, optionally an ``Options`` model (pydantic, derived from :class:`xairl.Options`), and
+    Subclasses set ``name``, optionally an ``Options`` model (pydantic, derived from :class:`xairl.plugin.Options`), and
     implement :meth:`_compose`. :meth:`narrate` is the public method and is not overridden.
 
     :param options: a dict or an instance of the subclass's ``Options`` model; unknown keys are an error.

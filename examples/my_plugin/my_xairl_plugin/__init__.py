@@ -9,30 +9,30 @@ from pathlib import Path
 import xairl
 
 
-@xairl.hookimpl
+@xairl.plugin.hookimpl
 def register_policies(register):
     register("thermostat", "my_xairl_plugin.thermostat:thermostat_policy",
              "heat or idle, from temperature and occupancy")
 
 
-@xairl.hookimpl
+@xairl.plugin.hookimpl
 def register_attributors(register):
     register("occlusion", "my_xairl_plugin.occlusion:Occlusion",
              "occlusion: score drop when one feature is replaced by background values (not additive)")
 
 
-@xairl.hookimpl
+@xairl.plugin.hookimpl
 def register_narrators(register):
     register("shortest", "my_xairl_plugin.shortest:ShortestNarrator",
              "the shortest phrasing of each sentence, at most max_sentences sentences")
 
 
-@xairl.hookimpl
+@xairl.plugin.hookimpl
 def register_prompt_dirs(register):
     register(Path(__file__).parent / "prompts")
 
 
-@xairl.hookimpl
+@xairl.plugin.hookimpl
 def register_commands(register):
     def configure(parser):
         parser.add_argument("--temperature", type=float, default=17.0)

@@ -12,11 +12,11 @@ from pydantic import Field
 import xairl
 
 
-class OcclusionOptions(xairl.Options):
+class OcclusionOptions(xairl.plugin.Options):
     max_rows: int = Field(65_536, ge=1, description="rows per forward batch")
 
 
-class Occlusion(xairl.Attributor):
+class Occlusion(xairl.plugin.Attributor):
     """Score drop when one feature at a time takes the background's values."""
 
     name = "occlusion"

@@ -8,11 +8,11 @@ from pydantic import Field
 import xairl
 
 
-class ShortestOptions(xairl.Options):
+class ShortestOptions(xairl.plugin.Options):
     max_sentences: int = Field(2, ge=1, description="sentences kept, in template order")
 
 
-class ShortestNarrator(xairl.Narrator):
+class ShortestNarrator(xairl.plugin.Narrator):
     """Terse narratives for a dashboard."""
 
     name = "shortest"

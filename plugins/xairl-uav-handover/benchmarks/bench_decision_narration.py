@@ -24,10 +24,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-import xairl
 from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.policy import background_states, greedy, load_checkpoint, uav_policy
+
+import xairl
 
 REAL = Path(__file__).resolve().parents[4] / "shared" / "data" / "ukm-uav-lte" / "raw"
 DIRECTION = re.compile(r"\b(push\w*|favou?r\w*|toward|against|raised?|lowered?)\b", re.IGNORECASE)
@@ -91,7 +91,7 @@ def measure(policy, exp, histories, template: str) -> dict:
                 continue
             label = info.description or f
             value = float(exp.states[i, idx[f]])
-            truth = xairl.value_level(value, info, None)[0]
+            truth = xairl.facts.value_level(value, info, None)[0]
             for word, lvl in ((info.low, "low"), (info.high, "high")):
                 if re.search(re.escape(label) + r"\s*\([^)]*\b" + re.escape(word), n.text) and truth != lvl:
                     out["level_contradicts_range"] += 1

@@ -10,17 +10,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-
-from xairl import CheckpointError, InputError
-from xairl.cli import main
 from xairl_uav_handover import ukm
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.evaluate import run_flights
 from xairl_uav_handover.features import FEATURES
-from xairl_uav_handover.policy import (DQNController, build_qnet, greedy, load_checkpoint, save_checkpoint)
+from xairl_uav_handover.policy import DQNController, build_qnet, greedy, load_checkpoint, save_checkpoint
 from xairl_uav_handover.real_data import PCI, RSRP, RealFlight, Walk, agreement, load_flight, walk
 from xairl_uav_handover.report import real_source
+
+from xairl import InputError
+from xairl.cli import main
+from xairl.plugin import CheckpointError
 
 UKM = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "ukm-uav-lte" / "raw"
 needs_data = pytest.mark.skipif(not UKM.is_dir(), reason="../shared/data/ukm-uav-lte is not here")

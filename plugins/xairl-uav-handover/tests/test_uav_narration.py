@@ -3,15 +3,14 @@ import collections
 import re
 
 import numpy as np
-
 import pytest
+from xairl_uav_handover.features import LABEL_WORDS, handover_facts
+from xairl_uav_handover.policy import uav_policy
 
 import xairl
 from xairl import prompts
-from xairl import decision_facts
+from xairl.facts import decision_facts
 from xairl.testing import corpus
-from xairl_uav_handover.features import LABEL_WORDS, handover_facts
-from xairl_uav_handover.policy import uav_policy
 
 
 @pytest.fixture(scope="module")
@@ -32,11 +31,11 @@ def test_handover_template_comes_from_the_plugin(uav):
 def test_handover_facts():
     state = [0, 0, 100, 0, 7, -70, -66, -80, -90, -12, -8, -20, -25]
     f = handover_facts(state, 1, 0)
-    assert isinstance(f, xairl.DomainFacts)
+    assert isinstance(f, xairl.facts.DomainFacts)
     assert f.extras == {"decision": "hand over", "serving_bs": 7, "target_candidate": 1, "compared_candidate": 1,
                         "runner_up_candidate": 0, "buffer_fill": 0.0, "buffer_trend": "", "a3_decisions": 1,
                         "chm": "start its time-to-trigger"}
-    assert f.comparisons == (xairl.Comparison("the strongest neighbour's RSRP was 4.0 dB above the serving BS's "
+    assert f.comparisons == (xairl.facts.Comparison("the strongest neighbour's RSRP was 4.0 dB above the serving BS's "
                                               "RSRP", 4.0, "dB"),)
     assert handover_facts(state, 0, 2).comparisons[0].text.startswith("the second strongest neighbour's RSRP "
                                                                       "was 10.0 dB below")
@@ -53,7 +52,7 @@ def test_handover_facts_with_history():
     f = handover_facts(now, 0, 1, history=np.array([weak, now, emptier]))
     assert f.extras["a3_decisions"] == 3 and f.extras["chm"] == "hand over to candidate 1"
     assert f.extras["buffer_fill"] == 25.0 and f.extras["buffer_trend"] == "rising"
-    assert f.comparisons[1] == xairl.Comparison("the strongest neighbour has been more than 2 dB above the serving BS "
+    assert f.comparisons[1] == xairl.facts.Comparison("the strongest neighbour has been more than 2 dB above the serving BS "
                                                 "for 3 consecutive decisions", 3, "consecutive")
     assert handover_facts(now, 0, 1, history=np.array([now, weak])).extras["chm"] == "start its time-to-trigger"
     assert handover_facts(weak, 0, 1).extras["chm"] == "stay"

@@ -4,16 +4,16 @@ import json
 import numpy as np
 import pytest
 import torch
+from xairl_uav_handover.baselines import CHM, SAMRO
+from xairl_uav_handover.evaluate import rankings
+from xairl_uav_handover.features import FEATURES
+from xairl_uav_handover.policy import DQNController, build_qnet, load_checkpoint, save_checkpoint, uav_policy
+from xairl_uav_handover.table import ROWS, flights, with_intervals
 
 import xairl
 from xairl import plugins
 from xairl.cli import main
-from xairl import CheckpointError
-from xairl_uav_handover.baselines import CHM, SAMRO
-from xairl_uav_handover.evaluate import rankings
-from xairl_uav_handover.table import ROWS, flights, with_intervals
-from xairl_uav_handover.features import FEATURES
-from xairl_uav_handover.policy import DQNController, build_qnet, load_checkpoint, save_checkpoint, uav_policy
+from xairl.plugin import CheckpointError
 
 
 def test_registered_through_entry_point():
@@ -86,9 +86,8 @@ def test_corrupt_and_mismatched_checkpoints(tmp_path):
 def test_checkpoint_metadata_is_checked_against_its_tensors_before_anything_is_built(tmp_path, monkeypatch):
     """(issue 27) a 200-byte file whose metadata says hidden=[100000]*3 used to allocate 40 GB before the shape
     check: the widths are now read from the tensors and the network is never built."""
-    from safetensors.torch import save_file
-
     import xairl_uav_handover.policy as module
+    from safetensors.torch import save_file
 
     built = []
     monkeypatch.setattr(module, "build_qnet", lambda *a, **k: built.append(a) or pytest.fail("network built"))

@@ -35,7 +35,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def _sim_config(base, duration=None):
     from pydantic import ValidationError
-    from xairl import InputError, validation_message
+
+    from xairl import InputError
+    from xairl.plugin import validation_message
 
     from .config import SimConfig
 
@@ -57,7 +59,9 @@ def run_train(args) -> int:
     import re
 
     from pydantic import ValidationError
-    from xairl import InputError, validation_message
+
+    from xairl import InputError
+    from xairl.plugin import validation_message
 
     from .train import TrainConfig, train_checkpoint
 

@@ -5,7 +5,8 @@ through it, and code that reads a state uses :data:`FEATURES` or the column slic
 """
 import numpy as np
 
-from xairl import Comparison, DomainFacts, FeatureInfo, InputError
+from xairl import FeatureInfo, InputError
+from xairl.facts import Comparison, DomainFacts
 
 N_CANDIDATES = 4  # candidate 0 is the serving BS (stay); 1..3 the strongest other BSs
 FEATURES = ("x", "y", "z", "buffer_queue_size", "serving_bs",

@@ -9,7 +9,7 @@
 The timeline shows the serving and strongest-neighbour RSRP, the buffer's fill, the handovers, and the three
 reasons with the largest mean |contribution to the margin| over time. The summary states the flight's counts and the
 reason that most often came first, and is checked by :func:`xairl.verify` against the flight's explanation and
-its counts (:class:`xairl.DomainFacts`).
+its counts (:class:`xairl.facts.DomainFacts`).
 """
 from __future__ import annotations
 
@@ -19,9 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from xairl import Comparison, DomainFacts, Explanation, Policy, decision_facts, save_figure, verify
-from xairl import format_number as fmt
-from xairl import narration_units as units
+from xairl import Explanation, Policy, verify
+from xairl.facts import Comparison, DomainFacts, decision_facts
+from xairl.facts import format_number as fmt
+from xairl.facts import narration_units as units
+from xairl.plugin import save_figure
 
 from .features import BUFFER, RSRP
 from .policy import Checkpoint, greedy

@@ -5,7 +5,7 @@ Registered by the entry point ``uav-handover`` in group ``xairl``. Targets are `
 """
 from pathlib import Path
 
-from xairl import hookimpl
+from xairl.plugin import hookimpl
 
 
 @hookimpl

@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from xairl import CheckpointError, InputError, Policy, atomic_write
+from xairl import InputError, Policy
+from xairl.plugin import CheckpointError, atomic_write
 
 from .config import SimConfig
 from .env import HandoverVecEnv

@@ -13,13 +13,21 @@ from pathlib import Path
 import numpy as np
 from pydantic import Field
 
-from xairl import Explanation, InputError, Options, Report, ReportContent, ReportRequest, save_figure, table_html
+from xairl import Explanation, InputError
+from xairl.plugin import Options, Report, ReportContent, ReportRequest, save_figure, table_html
 
 from .baselines import CHM, SAMRO, CHMOnSamples, SAMROOnSamples
 from .evaluate import PAPER, chm_rate_by_altitude
 from .features import FEATURES, GROUPS
-from .policy import (Checkpoint, DQNController, background_states, dqn_decision_states, greedy, load_checkpoint,
-                     uav_policy)
+from .policy import (
+    Checkpoint,
+    DQNController,
+    background_states,
+    dqn_decision_states,
+    greedy,
+    load_checkpoint,
+    uav_policy,
+)
 
 BANDS = ((20.0, 60.0), (60.0, 100.0), (100.0, 160.0))
 
@@ -147,7 +155,7 @@ class UAVReport(Report):
                           flights: list, bad: list[str]) -> list:
         """The calibration and agreement tables against the ``flights`` loaded from folder ``real`` (``bad``: why
         the others were skipped); returns the flights."""
-        from xairl.display import progress
+        from xairl.plugin import progress
 
         from .real_data import chm_handovers, walk
 

@@ -20,7 +20,7 @@ import numpy as np
 import torch
 from pydantic import Field, model_validator
 
-from xairl import Options
+from xairl.plugin import Options
 
 from .baselines import RSRQRule
 from .config import SimConfig
@@ -147,7 +147,8 @@ def train(tc: TrainConfig, sim_cfg: SimConfig | None = None, progress: bool = Tr
 def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
     from stable_baselines3.common.buffers import ReplayBuffer
     from stable_baselines3.common.utils import set_random_seed
-    from xairl.display import progress
+
+    from xairl.plugin import progress
 
     sim_cfg = sim_cfg or SimConfig()
     set_random_seed(tc.seed)  # python, numpy (the replay buffer samples with it) and torch

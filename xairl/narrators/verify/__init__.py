@@ -38,7 +38,7 @@ from ...explanation import Explanation
 from ...policy import Policy
 from ...regions import in_regions
 from . import binding, checks, clauses, directions, parse, quantities, regions, reread, sums
-from .book import add_facts, FactBook, clean_surface, fact_book
+from .book import FactBook, add_facts, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, named_features
 from .numbers import NUMBER_RE, find_numbers, matches, normalise, unit_in_name
@@ -182,7 +182,7 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
     """Check every claim of ``text`` against the explanation of state ``index`` (``None``: the global view).
 
     :param policy: optional, for feature descriptions, aliases and units, action aliases and domain facts.
-    :param facts: optional :class:`xairl.DomainFacts` beyond the explanation (e.g. a flight's handover counts): its
+    :param facts: optional :class:`xairl.facts.DomainFacts` beyond the explanation (e.g. a flight's handover counts): its
         numbers may be cited, each comparison's value followed by its unit. With ``index=None`` the summary is
         taken to be made from them: a number that is none of the facts is contradicted, not unchecked.
     :returns: a :class:`Verification`; never raises on odd text (empty, very long, another language).

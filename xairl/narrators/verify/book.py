@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...explanation import Explanation
+from ...facts import DomainFacts, decision_facts, global_facts, narration_units, unit_ranks
 from ...policy import Policy
-from ..facts import DomainFacts, decision_facts, global_facts, unit_ranks, units
 
 _CLAIMY = re.compile(r"[+\-\u2212]\d|\d\.\d|%|\b(toward|towards|against|raises|lowers|increases|decreases|pushes|"
                      r"favours|favors|opposes|mattered most)\b|\b(most important|main|largest|biggest|strongest|top|"
@@ -109,7 +109,7 @@ def legend(description: str) -> dict[int, str]:
 
 
 def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None) -> FactBook:
-    us = units(exp, policy)
+    us = narration_units(exp, policy)
     feats = {f: FeatureFacts() for f in exp.feature_names} | {u.name: FeatureFacts() for u in us}
     if index is None:
         g = global_facts(exp, policy, k=len(exp.feature_names))

@@ -1,0 +1,48 @@
+"""What a plugin author builds on: the hook marker, the base classes, report and option types, file helpers, the
+errors a plugin raises, and the test corpus for a plugin's own templates.
+
+``import xairl.plugin`` is light: each name is imported on first use, so a plugin module that only needs
+``hookimpl`` at import time does not load torch (``xairl --help`` stays fast).
+
+>>> from xairl.plugin import hookimpl, Attributor, Report, Options
+"""
+
+from __future__ import annotations
+
+from xairl import lazy_attributes
+
+#: public name -> the module that defines it
+_LAZY = {
+    # hooks (xairl.hookspecs holds the specifications and their documentation)
+    "hookimpl": "xairl.hookspecs",
+    "hookspec": "xairl.hookspecs",
+    # base classes of what a plugin registers
+    "Attributor": "xairl.attributors",
+    "Narrator": "xairl.narrators",
+    "Report": "xairl.report",
+    "ReportRequest": "xairl.report",
+    "ReportContent": "xairl.report",
+    "table_html": "xairl.report",
+    "StateRecord": "xairl.explanation",
+    # options: a plugin's own settings, validated like the built-ins'
+    "Options": "xairl.options",
+    "parse_options": "xairl.options",
+    # files written whole or not at all (a crash never leaves a partial file under its final name)
+    "atomic_write": "xairl.files",
+    "save_figure": "xairl.files",
+    # a progress bar that is quiet in a notebook without ipywidgets
+    "progress": "xairl.display",
+    # registries and checks
+    "get_attributor": "xairl.plugins",
+    "check_template": "xairl.narrators",
+    "corpus": "xairl.testing",
+    # errors a plugin raises (xairl.XairlError and xairl.InputError are the user-facing ones)
+    "UnknownNameError": "xairl.errors",
+    "PluginError": "xairl.errors",
+    "UnsupportedModelError": "xairl.errors",
+    "CheckpointError": "xairl.errors",
+    "validation_message": "xairl.errors",
+}
+
+__all__ = sorted(_LAZY)
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY)
