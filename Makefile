@@ -12,7 +12,7 @@ PLUGINS := $(wildcard plugins/*/pyproject.toml)
 # (pipefail keeps pip's own failure; grep's "nothing left to print" is not one)
 QUIET := 2>&1 | { grep -v "^WARNING: Location" || true; }
 
-.PHONY: setup setup-demo demo test bench docs clean
+.PHONY: setup setup-demo demo test lint format bench docs clean
 
 # make demo installs what the demo needs (the core and the reference plugin); make test adds the extras, the local
 # language model's weights and Chromium for the browser tests
@@ -52,8 +52,17 @@ demo: setup-demo
 
 # two workers, one torch thread each: the suite's files shared over two cores (one thread per worker, as two
 # workers with torch's default threads each slow each other down)
-test: setup
+test: setup lint
 	OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 $(PY) -m pytest -n 2 --dist loadfile
+
+# ruff (pinned in the test extra): the lint rules and the format, as configured in pyproject.toml
+lint: setup
+	$(PY) -m ruff check .
+	$(PY) -m ruff format --check .
+
+format: setup
+	$(PY) -m ruff check --fix .
+	$(PY) -m ruff format .
 
 docs: setup
 	$(PY) -m mkdocs build --strict --site-dir site

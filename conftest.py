@@ -1,4 +1,5 @@
 """Fixtures for every test folder (core and plugins)."""
+
 import os
 
 import pytest

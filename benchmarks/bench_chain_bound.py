@@ -7,6 +7,7 @@ x cores: what the path would reach if every other step were free and the cores s
 
 Run: .venv/bin/python benchmarks/bench_chain_bound.py [--states 50000] [--cores 2]
 """
+
 import argparse
 import time
 
@@ -35,19 +36,23 @@ def main():
     x, bg = rng.normal(size=(n, 8)).astype(np.float32), rng.normal(size=(b, 8)).astype(np.float32)
     layers = chain(_only_child(policy, x[:1]))
     a, width = policy.n_actions, max(getattr(layer, "out_features", 0) for layer in layers)
-    per = max(1, 2 ** 20 // (a * width) // b)  # the attributor's batch (deep_shap._attribute_chain)
+    per = max(1, 2**20 // (a * width) // b)  # the attributor's batch (deep_shap._attribute_chain)
     xt, bt = torch.as_tensor(x), torch.as_tensor(bg)
     total = timed(lambda: xairl.explain(policy, x, background=bg))
-    mult = timed(lambda: [chain_multipliers(layers, xt[s:s + per], bt) for s in range(0, n, per)])
+    mult = timed(lambda: [chain_multipliers(layers, xt[s : s + per], bt) for s in range(0, n, per)])
     rows, w2, w1 = torch.randn(per * b * a, 64), torch.randn(64, 64), torch.randn(64, 8)
     gemm = timed(lambda: [(rows @ w2) @ w1 for _ in range(0, n, per)])
     flops = 2 * n * b * a * (64 * 64 + 64 * 8)
-    print(f"one thread, {n} states: explain {total:.2f} s ({n / total:,.0f} states/s); multipliers {mult:.2f} s; the "
-          f"two matrix products alone {gemm:.2f} s ({flops / gemm / 1e9:.0f} GFLOP/s, {gemm / mult:.0%} of the "
-          f"multipliers' time)")
+    print(
+        f"one thread, {n} states: explain {total:.2f} s ({n / total:,.0f} states/s); multipliers {mult:.2f} s; the "
+        f"two matrix products alone {gemm:.2f} s ({flops / gemm / 1e9:.0f} GFLOP/s, {gemm / mult:.0%} of the "
+        f"multipliers' time)"
+    )
     ceiling = n / gemm * args.cores
-    print(f"ceiling on {args.cores} cores, every other step free: {ceiling:,.0f} states/s = {ceiling / 50_000:.2f} x "
-          "the 50,000 states/s target")
+    print(
+        f"ceiling on {args.cores} cores, every other step free: {ceiling:,.0f} states/s = {ceiling / 50_000:.2f} x "
+        "the 50,000 states/s target"
+    )
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@
 Run: .venv/bin/python benchmarks/bench_cnn.py [--sizes 5x10,100x100] [--repeats 3] [--skip-table]
 (100 x 100 takes ~2.5 min: ~1 min xairl, ~1.5 min shap)
 """
+
 import argparse
 import os
 import sys
@@ -35,8 +36,10 @@ def speed(sizes, repeats):
     import shap
     from captum.attr import DeepLiftShap
 
-    print("| network | states x background | xairl deep_shap | shap | captum | vs shap | vs captum | max diff to shap | "
-          "gradient floor | most any exact method gains over shap |")
+    print(
+        "| network | states x background | xairl deep_shap | shap | captum | vs shap | vs captum | max diff to shap | "
+        "gradient floor | most any exact method gains over shap |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|")
     for n, b in sizes:
         policy, x, bg, (xt, bt) = build("nature_cnn", n_states=n, n_background=b)
@@ -51,9 +54,13 @@ def speed(sizes, repeats):
             dl = DeepLiftShap(net)
             t_cap, _ = timed(lambda: [dl.attribute(xt, baselines=bt, target=a) for a in range(policy.n_actions)], 1)
         diff = np.abs(e.values - np.asarray(sv).reshape(n, -1, policy.n_actions)).max()
-        print(f"| NatureCNN 4x84x84, 6 actions | {n} x {b} | {t_ours:.2f} s | {t_shap:.2f} s | {t_cap:.2f} s | "
-              f"**{t_shap / t_ours:.1f}x** | {t_cap / t_ours:.1f}x | {diff:.1e} | {floor:.2f} s | {t_shap / floor:.1f}x |"
-              .replace("nan s", "not run (memory)").replace("nanx", "-"), flush=True)
+        print(
+            f"| NatureCNN 4x84x84, 6 actions | {n} x {b} | {t_ours:.2f} s | {t_shap:.2f} s | {t_cap:.2f} s | "
+            f"**{t_shap / t_ours:.1f}x** | {t_cap / t_ours:.1f}x | {diff:.1e} | {floor:.2f} s | {t_shap / floor:.1f}x |".replace(
+                "nan s", "not run (memory)"
+            ).replace("nanx", "-"),
+            flush=True,
+        )
 
 
 def gradient_floor(policy, x, bg) -> float:
@@ -89,8 +96,10 @@ def table():
             c = f"{np.abs(e.values - captum_values(policy, x, bg)).max():.1e}"
         except RuntimeError as exc:  # captum refuses an input the network does not use
             c = f"captum refuses ({str(exc).split('.')[0]})"
-        print(f"| {name} | {policy.n_features} | {policy.n_actions} | {e.additivity_gap.max():.1e} | {s:.1e} | {c} |",
-              flush=True)
+        print(
+            f"| {name} | {policy.n_features} | {policy.n_actions} | {e.additivity_gap.max():.1e} | {s:.1e} | {c} |",
+            flush=True,
+        )
 
 
 def main():

@@ -9,6 +9,7 @@ confidence of the nearest-tie quarter of decisions against the clearest quarter,
 
     .venv/bin/python benchmarks/bench_confidence.py [--n 200] [--robustness] [--policy NAME ...]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -25,7 +26,7 @@ VAGUE = " The situation looked delicate. Operators should keep an eye on this ki
 
 def _wrong_number(text: str) -> str:
     m = re.search(r"by ([+-]?)(\d+\.\d+)", text)
-    return text[:m.start(2)] + f"{float(m.group(2)) * 3 + 1:.2f}" + text[m.end(2):] if m else text + " It scored 999."
+    return text[: m.start(2)] + f"{float(m.group(2)) * 3 + 1:.2f}" + text[m.end(2) :] if m else text + " It scored 999."
 
 
 def auc(hi: list[float], lo: list[float]) -> float:
@@ -46,9 +47,11 @@ def run(label: str, policy, states, bg, robustness: bool) -> None:
     margins, true = np.array(margins), np.array(true)
     q1, q3 = np.quantile(margins, [0.25, 0.75])
     rho = spearmanr(margins, true).statistic
-    print(f"{label:<8}{len(states):>5}{np.mean(true):>10.3f}{np.mean(wrong):>13.3f}{np.mean(vague):>13.3f}"
-          f"{auc(true, wrong):>11.2f}{auc(true, vague):>11.2f}{true[margins <= q1].mean():>12.3f}"
-          f"{true[margins >= q3].mean():>10.3f}{rho:>8.2f}")
+    print(
+        f"{label:<8}{len(states):>5}{np.mean(true):>10.3f}{np.mean(wrong):>13.3f}{np.mean(vague):>13.3f}"
+        f"{auc(true, wrong):>11.2f}{auc(true, vague):>11.2f}{true[margins <= q1].mean():>12.3f}"
+        f"{true[margins >= q3].mean():>10.3f}{rho:>8.2f}"
+    )
 
 
 def main() -> None:
@@ -57,8 +60,10 @@ def main() -> None:
     ap.add_argument("--robustness", action="store_true", help="include agreement and stability (slower)")
     ap.add_argument("--policy", action="append", help="a registered policy (repeatable; default: toy, uav-dqn)")
     args = ap.parse_args()
-    print(f"{'policy':<8}{'n':>5}{'true text':>10}{'contradicted':>13}{'low coverage':>13}{'AUC t>c':>11}"
-          f"{'AUC t>low':>11}{'near ties':>12}{'clearest':>10}{'rho':>8}")
+    print(
+        f"{'policy':<8}{'n':>5}{'true text':>10}{'contradicted':>13}{'low coverage':>13}{'AUC t>c':>11}"
+        f"{'AUC t>low':>11}{'near ties':>12}{'clearest':>10}{'rho':>8}"
+    )
     for name in args.policy or ["toy", "uav-dqn"]:
         try:
             policy = xairl.get_policy(name)  # through the plugin registry: the core imports no plugin

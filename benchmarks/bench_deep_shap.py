@@ -6,6 +6,7 @@ Goal (issue 6): >= 50x shap.DeepExplainer on the reference DQN.
 Run: .venv/bin/python benchmarks/bench_deep_shap.py [--sizes 1000,10000] [--device cpu|cuda] [--repeats 3]
      [--policy uav-dqn]
 """
+
 import argparse
 import os
 import platform
@@ -24,9 +25,12 @@ def mlp_policy(sizes):
     for i, (a, b) in enumerate(zip(sizes[:-1], sizes[1:])):
         layers += [torch.nn.Linear(a, b)] + ([torch.nn.ReLU()] if i < len(sizes) - 2 else [])
     f, a = sizes[0], sizes[-1]
-    return xairl.Policy(torch.nn.Sequential(*layers).eval(), [f"f{i}" for i in range(f)],
-                             [f"a{i}" for i in range(a)],
-                             background_sampler=lambda n, s: np.random.default_rng(s).normal(size=(n, f)))
+    return xairl.Policy(
+        torch.nn.Sequential(*layers).eval(),
+        [f"f{i}" for i in range(f)],
+        [f"a{i}" for i in range(a)],
+        background_sampler=lambda n, s: np.random.default_rng(s).normal(size=(n, f)),
+    )
 
 
 def models(device, policy_name=None):
@@ -67,10 +71,14 @@ def main():
 
     dev = torch.device(args.device)
     gpu = torch.cuda.get_device_name(0) if dev.type == "cuda" else "none"
-    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, GPU {gpu}; torch {torch.__version__}, "
-          f"shap {shap.__version__}, captum {captum.__version__}; device {dev}")
-    print(f"{'model':<20}{'states':>7}{'xairl s':>9}{'shap s':>9}{'captum s':>10}{'x shap':>9}{'x captum':>10}"
-          f"{'max|diff| shap':>16}{'captum':>10}")
+    print(
+        f"machine: {platform.machine()}, {os.cpu_count()} cores, GPU {gpu}; torch {torch.__version__}, "
+        f"shap {shap.__version__}, captum {captum.__version__}; device {dev}"
+    )
+    print(
+        f"{'model':<20}{'states':>7}{'xairl s':>9}{'shap s':>9}{'captum s':>10}{'x shap':>9}{'x captum':>10}"
+        f"{'max|diff| shap':>16}{'captum':>10}"
+    )
     wanted = {m for m in args.models.split(",") if m}
     for name, policy in models(dev, args.policy).items():
         if wanted and name not in wanted:
@@ -78,19 +86,29 @@ def main():
         bg = torch.as_tensor(policy.background(100, seed=1), device=dev)
         for n in (int(s) for s in args.sizes.split(",")):
             x = torch.as_tensor(policy.background(n, seed=2), device=dev)
-            t_ours, ours = timed(lambda: xairl.explain(policy, x, background=bg, method="deep_shap").values,
-                                 args.repeats)
+            t_ours, ours = timed(
+                lambda: xairl.explain(policy, x, background=bg, method="deep_shap").values, args.repeats
+            )
             if n > args.peer_max:
                 print(f"{name:<20}{n:>7}{t_ours:>9.2f}{'-':>9}{'-':>10}   (peers not timed above --peer-max)")
                 continue
             net = policy.module
-            t_shap, sv = timed(lambda: np.asarray(shap.DeepExplainer(net, bg).shap_values(x, check_additivity=False)),
-                               args.peer_repeats)
+            t_shap, sv = timed(
+                lambda: np.asarray(shap.DeepExplainer(net, bg).shap_values(x, check_additivity=False)),
+                args.peer_repeats,
+            )
             dls = DeepLiftShap(net)
-            t_cap, cv = timed(lambda: np.stack([dls.attribute(x, baselines=bg, target=k).detach().cpu().numpy()
-                                                for k in range(policy.n_actions)], axis=-1), args.peer_repeats)
-            print(f"{name:<20}{n:>7}{t_ours:>9.2f}{t_shap:>9.2f}{t_cap:>10.2f}{t_shap / t_ours:>8.1f}x"
-                  f"{t_cap / t_ours:>9.1f}x{np.abs(ours - sv).max():>16.1e}{np.abs(ours - cv).max():>10.1e}")
+            t_cap, cv = timed(
+                lambda: np.stack(
+                    [dls.attribute(x, baselines=bg, target=k).detach().cpu().numpy() for k in range(policy.n_actions)],
+                    axis=-1,
+                ),
+                args.peer_repeats,
+            )
+            print(
+                f"{name:<20}{n:>7}{t_ours:>9.2f}{t_shap:>9.2f}{t_cap:>10.2f}{t_shap / t_ours:>8.1f}x"
+                f"{t_cap / t_ours:>9.1f}x{np.abs(ours - sv).max():>16.1e}{np.abs(ours - cv).max():>10.1e}"
+            )
 
 
 if __name__ == "__main__":

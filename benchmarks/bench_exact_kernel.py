@@ -2,6 +2,7 @@
 
 Run: .venv/bin/python benchmarks/bench_exact_kernel.py
 """
+
 import time
 
 import numpy as np
@@ -14,8 +15,9 @@ def main():
     print(f"{'F':>3}{'exact s/state':>15}{'kernel s/state':>16}{'max|exact-kernel|':>19}")
     for f in (4, 8, 12, 16):
         torch.manual_seed(f)
-        net = torch.nn.Sequential(torch.nn.Linear(f, 32), torch.nn.ReLU(), torch.nn.Linear(32, 32), torch.nn.ReLU(),
-                                  torch.nn.Linear(32, 4)).eval()
+        net = torch.nn.Sequential(
+            torch.nn.Linear(f, 32), torch.nn.ReLU(), torch.nn.Linear(32, 32), torch.nn.ReLU(), torch.nn.Linear(32, 4)
+        ).eval()
         p = xairl.Policy(net, [f"f{i}" for i in range(f)], list("abcd"))
         r = np.random.default_rng(f)
         x, bg = r.normal(size=(4, f)), r.normal(size=(50, f))

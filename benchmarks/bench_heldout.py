@@ -16,6 +16,7 @@ are read here:
     .venv/bin/python benchmarks/bench_heldout.py --show tuning   # also every disagreement of the tuning files
     .venv/bin/python benchmarks/bench_heldout.py --tuning-only --show tuning   # while tuning: no held-out figure
 """
+
 from __future__ import annotations
 
 import argparse
@@ -41,8 +42,9 @@ def case_explanation(case: dict) -> xairl.Explanation:
     """A one-output Explanation from a case: [name, value, contribution] per feature (a string value is a category),
     the base value and the output's words."""
     names, values, contributions = zip(*[(str(f[0]), f[1], float(f[2])) for f in case["features"]])
-    return one_output(list(names), list(values), list(contributions), float(case["base_value"]),
-                      case.get("output") or "prediction")
+    return one_output(
+        list(names), list(values), list(contributions), float(case["base_value"]), case.get("output") or "prediction"
+    )
 
 
 def load(path: pathlib.Path) -> list[dict]:
@@ -50,13 +52,33 @@ def load(path: pathlib.Path) -> list[dict]:
     for case in yaml.safe_load(path.read_text())["cases"]:
         exp = case_explanation(case)
         for entry in case["narratives"]:
-            (label, text), = entry.items()
-            items.append({"file": _name(path), "case": case["id"], "domain": case["domain"], "error": label,
-                          "accurate": label == "ok", "text": text, "explanation": exp, "wrong_facts": False})
+            ((label, text),) = entry.items()
+            items.append(
+                {
+                    "file": _name(path),
+                    "case": case["id"],
+                    "domain": case["domain"],
+                    "error": label,
+                    "accurate": label == "ok",
+                    "text": text,
+                    "explanation": exp,
+                    "wrong_facts": False,
+                }
+            )
             if label == "ok":
                 for kind, e in manipulated(exp):
-                    items.append({"file": _name(path), "case": case["id"], "domain": case["domain"], "error": kind,
-                                  "accurate": False, "text": text, "explanation": e, "wrong_facts": True})
+                    items.append(
+                        {
+                            "file": _name(path),
+                            "case": case["id"],
+                            "domain": case["domain"],
+                            "error": kind,
+                            "accurate": False,
+                            "text": text,
+                            "explanation": e,
+                            "wrong_facts": True,
+                        }
+                    )
     return items
 
 
@@ -81,11 +103,15 @@ def report(items: list[dict], show: str | None) -> None:
         acc = sum(it["result"].accurate for it in good)
         ok = sum(it["result"].ok for it in good)
         caught = sum(not it["result"].accurate for it in bad)
-        print(f"\n## {name}: {len({it['case'] for it in part})} cases, domains: "
-              f"{', '.join(sorted({it['domain'] for it in part}))}")
-        print(f"accurate narratives called accurate: {acc}/{len(good)} = {100 * acc / len(good):.1f} %  "
-              f"(ok: {ok}/{len(good)} = {100 * ok / len(good):.1f} %, mean coverage "
-              f"{np.mean([it['result'].coverage for it in good]):.2f})")
+        print(
+            f"\n## {name}: {len({it['case'] for it in part})} cases, domains: "
+            f"{', '.join(sorted({it['domain'] for it in part}))}"
+        )
+        print(
+            f"accurate narratives called accurate: {acc}/{len(good)} = {100 * acc / len(good):.1f} %  "
+            f"(ok: {ok}/{len(good)} = {100 * ok / len(good):.1f} %, mean coverage "
+            f"{np.mean([it['result'].coverage for it in good]):.2f})"
+        )
         print(f"labelled errors contradicted: {caught}/{len(bad)} = {100 * caught / max(1, len(bad)):.1f} %")
         kinds = collections.defaultdict(lambda: [0, 0])
         for it in bad + moved:
@@ -93,15 +119,25 @@ def report(items: list[dict], show: str | None) -> None:
             kinds[it["error"]][1] += 1
         print("| error | contradicted | n |\n|---|---|---|")
         for k, (c, n) in sorted(kinds.items()):
-            print(f"| {k}{' (explanation changed)' if k in ('inverted signs', 'top two swapped') else ''} | {c} | {n} |")
+            print(
+                f"| {k}{' (explanation changed)' if k in ('inverted signs', 'top two swapped') else ''} | {c} | {n} |"
+            )
         if show and name.startswith(show):
             for it in good + bad:
                 if it["result"].accurate != it["accurate"]:
-                    probs = "; ".join(f"{c.kind} '{c.text}': {c.detail}" for c in it["result"].claims
-                                      if c.status == "contradicted") or "nothing contradicted"
+                    probs = (
+                        "; ".join(
+                            f"{c.kind} '{c.text}': {c.detail}"
+                            for c in it["result"].claims
+                            if c.status == "contradicted"
+                        )
+                        or "nothing contradicted"
+                    )
                     print(f"- [{it['case']} {it['error']}] {it['text']!r}\n    -> {probs}")
     per_sentence = [it["seconds"] / it["n_sentences"] for it in items]
-    print(f"\nspeed: median {1000 * statistics.median(per_sentence):.2f} ms per sentence over {len(items)} verifications")
+    print(
+        f"\nspeed: median {1000 * statistics.median(per_sentence):.2f} ms per sentence over {len(items)} verifications"
+    )
 
 
 def long_text(items: list[dict], words: int = 1000) -> None:
@@ -114,23 +150,30 @@ def long_text(items: list[dict], words: int = 1000) -> None:
     while len(text.split()) < words:
         text += "\n\n" + texts[k % len(texts)]
         k += 1
-    text = text[:[m.end() for m in re.finditer(r"\S+", text)][words - 1]].strip()
+    text = text[: [m.end() for m in re.finditer(r"\S+", text)][words - 1]].strip()
     for shape, written in (("as written", text), ("flattened", " ".join(text.split()))):
         runs = []
         for _ in range(5):
             t = time.perf_counter()
             xairl.verify(written, items[0]["explanation"], 0)
             runs.append(time.perf_counter() - t)
-        print(f"a {words}-word narrative ({case}, {shape}): median {1000 * statistics.median(runs):.0f} ms "
-              "over 5 runs")
+        print(f"a {words}-word narrative ({case}, {shape}): median {1000 * statistics.median(runs):.0f} ms over 5 runs")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--show", choices=("tuning",), help="list every disagreement of the tuning files (the held-out "
-                    "files' texts are not shown: their counts are the figure)")
-    ap.add_argument("--tuning-only", action="store_true", help="measure the tuning files only (while tuning, so that "
-                    "no held-out figure is seen before the rules are frozen)")
+    ap.add_argument(
+        "--show",
+        choices=("tuning",),
+        help="list every disagreement of the tuning files (the held-out "
+        "files' texts are not shown: their counts are the figure)",
+    )
+    ap.add_argument(
+        "--tuning-only",
+        action="store_true",
+        help="measure the tuning files only (while tuning, so that "
+        "no held-out figure is seen before the rules are frozen)",
+    )
     args = ap.parse_args()
     files = ([] if args.tuning_only else sorted(HELDOUT.glob("*.yaml"))) + sorted(HELDOUT.glob("tuning/*.yaml"))
     items = [it for path in files for it in load(path)]

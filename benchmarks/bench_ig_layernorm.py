@@ -11,6 +11,7 @@ agrees, over the same states and background (exact on 12 features: 4,096 coaliti
 
 Run: .venv/bin/python benchmarks/bench_ig_layernorm.py [--states 50] [--seeds 3]
 """
+
 import argparse
 
 import numpy as np
@@ -27,13 +28,21 @@ def network(kind: str, seed: int) -> torch.nn.Module:
     torch.manual_seed(seed)
     norm = {"relu": [], "layernorm": [torch.nn.LayerNorm(64)], "layernorm+gelu": [torch.nn.LayerNorm(64)]}[kind]
     act = torch.nn.GELU if kind.endswith("gelu") else torch.nn.ReLU
-    return torch.nn.Sequential(torch.nn.Linear(F, 64), *norm, act(), torch.nn.Linear(64, 64), *[
-        torch.nn.LayerNorm(64)] * bool(norm), act(), torch.nn.Linear(64, A)).eval()
+    return torch.nn.Sequential(
+        torch.nn.Linear(F, 64),
+        *norm,
+        act(),
+        torch.nn.Linear(64, 64),
+        *[torch.nn.LayerNorm(64)] * bool(norm),
+        act(),
+        torch.nn.Linear(64, A),
+    ).eval()
 
 
 def compare(kind: str, seed: int, n: int) -> dict:
-    policy = xairl.Policy(network(kind, seed), feature_names=[f"f{i}" for i in range(F)],
-                          action_names=[f"a{i}" for i in range(A)])
+    policy = xairl.Policy(
+        network(kind, seed), feature_names=[f"f{i}" for i in range(F)], action_names=[f"a{i}" for i in range(A)]
+    )
     rng = np.random.default_rng(seed)
     bg, x = rng.normal(size=(40, F)).astype("float32"), rng.normal(size=(n, F)).astype("float32")
     truth = xairl.explain(policy, x, background=bg, method="exact").margin()
@@ -43,9 +52,11 @@ def compare(kind: str, seed: int, n: int) -> dict:
             continue  # deep_shap refuses LayerNorm (UnsupportedModelError) rather than give wrong numbers
         got = xairl.explain(policy, x, background=bg, method=method, options=OPTIONS.get(method)).margin()
         scale = np.abs(truth).max(axis=1)
-        out[method] = (float(np.abs(got - truth).max() / np.abs(truth).max()),
-                       float(np.mean(np.abs(got - truth).max(axis=1) / scale)),
-                       float(np.mean(np.abs(got).argmax(1) == np.abs(truth).argmax(1))))
+        out[method] = (
+            float(np.abs(got - truth).max() / np.abs(truth).max()),
+            float(np.mean(np.abs(got - truth).max(axis=1) / scale)),
+            float(np.mean(np.abs(got).argmax(1) == np.abs(truth).argmax(1))),
+        )
     return out
 
 
@@ -54,8 +65,10 @@ def main():
     ap.add_argument("--states", type=int, default=50)
     ap.add_argument("--seeds", type=int, default=3)
     args = ap.parse_args()
-    print(f"12-64-64-4 MLPs, {args.states} states x 40 background, {args.seeds} seeds; contributions to the margin "
-          "(chosen - runner-up); error relative to max |exact|; kernel_shap with 1,000 samples")
+    print(
+        f"12-64-64-4 MLPs, {args.states} states x 40 background, {args.seeds} seeds; contributions to the margin "
+        "(chosen - runner-up); error relative to max |exact|; kernel_shap with 1,000 samples"
+    )
     print(f"{'network':<16} {'method':<22} {'max rel. error':>15} {'mean per state':>15} {'same top feature':>17}")
     for kind in ("relu", "layernorm", "layernorm+gelu"):
         runs = [compare(kind, s, args.states) for s in range(args.seeds)]

@@ -5,6 +5,7 @@ Networks: SB3's NatureCNN layout on Atari frames (4, 84, 84) and on RGB frames (
 background frames. Target (issue 29): at most 2 s per frame on 2 cores.
 Run: .venv/bin/python benchmarks/bench_image_narration.py [--frames 5]
 """
+
 import argparse
 import time
 
@@ -16,8 +17,15 @@ import xairl
 
 def nature_cnn(shape, actions=6):
     torch.manual_seed(0)
-    conv = torch.nn.Sequential(torch.nn.Conv2d(shape[0], 32, 8, 4), torch.nn.ReLU(), torch.nn.Conv2d(32, 64, 4, 2),
-                               torch.nn.ReLU(), torch.nn.Conv2d(64, 64, 3, 1), torch.nn.ReLU(), torch.nn.Flatten())
+    conv = torch.nn.Sequential(
+        torch.nn.Conv2d(shape[0], 32, 8, 4),
+        torch.nn.ReLU(),
+        torch.nn.Conv2d(32, 64, 4, 2),
+        torch.nn.ReLU(),
+        torch.nn.Conv2d(64, 64, 3, 1),
+        torch.nn.ReLU(),
+        torch.nn.Flatten(),
+    )
     flat = conv(torch.zeros(1, *shape)).shape[1]
     return torch.nn.Sequential(conv, torch.nn.Linear(flat, 512), torch.nn.ReLU(), torch.nn.Linear(512, actions)).eval()
 
@@ -30,7 +38,7 @@ def main():
     for shape in ((4, 84, 84), (3, 64, 64)):
         policy = xairl.Policy(nature_cnn(shape), observation=shape, name="cnn")
         frames = np.random.default_rng(0).random((args.frames + 50, *shape), dtype=np.float32)
-        bg, x = frames[args.frames:], frames[:args.frames]
+        bg, x = frames[args.frames :], frames[: args.frames]
         exp = xairl.explain(policy, x, background=bg)
         xairl.narrate(exp, 0, policy=policy, robustness=False)  # warm: the template, the vocabulary, spaCy
         with_r, without, ok = [], [], 0
@@ -42,8 +50,10 @@ def main():
             ok += xairl.narrate(exp, i, policy=policy, robustness=False).verified and n.verified
             without.append(time.perf_counter() - t)
         regions = len(xairl.in_regions(exp).feature_names)
-        print(f"{'x'.join(map(str, shape)):<12} {regions:>8} {np.median(with_r):>21.2f} {np.median(without):>18.2f} "
-              f"{ok:>6}/{args.frames}")
+        print(
+            f"{'x'.join(map(str, shape)):<12} {regions:>8} {np.median(with_r):>21.2f} {np.median(without):>18.2f} "
+            f"{ok:>6}/{args.frames}"
+        )
 
 
 if __name__ == "__main__":

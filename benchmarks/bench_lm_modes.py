@@ -24,6 +24,7 @@ Run (about 10 minutes on 2 busy cores; nothing is downloaded):
 ``--threads 1`` is several times faster for rewrite (greedy generation); the figures in the module doc of
 xairl/narrators/local_lm.py give both.
 """
+
 import argparse
 import os
 import platform
@@ -42,11 +43,13 @@ import numpy as np  # noqa: E402
 
 import xairl  # noqa: E402
 
-COLD = ("import time; t0 = time.perf_counter(); import xairl; from xairl.narrators import local_lm; "
-        "t1 = time.perf_counter(); local_lm.load_model(); t2 = time.perf_counter(); "
-        "p = xairl.get_policy({policy!r}); e = xairl.explain(p, p.background(1, seed=5), background=p.background(50)); "
-        "t3 = time.perf_counter(); n = xairl.narrate(e, 0, narrator='local_lm', policy=p, template={template!r}, "
-        "options={options!r}); t4 = time.perf_counter(); print(t1 - t0, t2 - t1, t4 - t3, t4 - t0 - (t3 - t2))")
+COLD = (
+    "import time; t0 = time.perf_counter(); import xairl; from xairl.narrators import local_lm; "
+    "t1 = time.perf_counter(); local_lm.load_model(); t2 = time.perf_counter(); "
+    "p = xairl.get_policy({policy!r}); e = xairl.explain(p, p.background(1, seed=5), background=p.background(50)); "
+    "t3 = time.perf_counter(); n = xairl.narrate(e, 0, narrator='local_lm', policy=p, template={template!r}, "
+    "options={options!r}); t4 = time.perf_counter(); print(t1 - t0, t2 - t1, t4 - t3, t4 - t0 - (t3 - t2))"
+)
 SENTENCE = re.compile(r"(?<=[.!?])\s+(?=[A-Z0-9])")
 
 
@@ -74,9 +77,11 @@ def run_policy(name: str, template: str, n_states: int, n_rewrite: int, threads:
     extra = {"threads": threads} if threads else {}
     rows, pairs = [], []
     template_texts = []
-    for label, narrator, options, count in (("template", "template", None, n_states),
-                                            ("local_lm choose", "local_lm", {"mode": "choose", **extra}, n_states),
-                                            ("local_lm rewrite", "local_lm", {"mode": "rewrite", **extra}, n_rewrite)):
+    for label, narrator, options, count in (
+        ("template", "template", None, n_states),
+        ("local_lm choose", "local_lm", {"mode": "choose", **extra}, n_states),
+        ("local_lm rewrite", "local_lm", {"mode": "rewrite", **extra}, n_rewrite),
+    ):
         if not count:
             continue
         times, first, shown_diff, own_diff, edit, own_edit, sent, words = [], [], [], [], [], [], [], []
@@ -99,8 +104,22 @@ def run_policy(name: str, template: str, n_states: int, n_rewrite: int, threads:
             if options and options["mode"] == "rewrite":
                 pairs.append((name, i, base, own, n.source == narrator))
         t = np.array(times)
-        rows.append((name, label, count, np.mean(first), np.mean(shown_diff), np.mean(own_diff), np.mean(edit),
-                     np.mean(own_edit), np.mean(words), np.mean(sent), np.median(t), np.percentile(t, 90)))
+        rows.append(
+            (
+                name,
+                label,
+                count,
+                np.mean(first),
+                np.mean(shown_diff),
+                np.mean(own_diff),
+                np.mean(edit),
+                np.mean(own_edit),
+                np.mean(words),
+                np.mean(sent),
+                np.median(t),
+                np.percentile(t, 90),
+            )
+        )
     return rows, pairs
 
 
@@ -124,8 +143,10 @@ def main():
 
 def run(args, cache: str, n_rewrite: int) -> None:
     policies = [tuple(p.split(":")) for p in args.policies.split(",")]
-    print(f"machine: {platform.machine()}, {os.cpu_count()} cores (load {os.getloadavg()[0]:.1f}); "
-          f"{args.states} states per policy, rewrite on the first {n_rewrite}; model cache {cache}")
+    print(
+        f"machine: {platform.machine()}, {os.cpu_count()} cores (load {os.getloadavg()[0]:.1f}); "
+        f"{args.states} states per policy, rewrite on the first {n_rewrite}; model cache {cache}"
+    )
 
     from xairl.narrators import local_lm
 
@@ -133,13 +154,16 @@ def run(args, cache: str, n_rewrite: int) -> None:
     t0 = time.perf_counter()
     local_lm.load_model()  # the first use ever converts the packaged GGUF to a cached safetensors copy
     first_use = time.perf_counter() - t0
-    code = COLD.format(policy=policies[0][0], template=policies[0][1],
-                       options={"threads": args.threads} if args.threads else {})
+    code = COLD.format(
+        policy=policies[0][0], template=policies[0][1], options={"threads": args.threads} if args.threads else {}
+    )
     cold = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     imp, load, one, total = map(float, cold[-4:])
     print(f"first use in this process ({'cached copy' if had_copy else 'GGUF conversion + load'}): {first_use:.1f} s")
-    print(f"cold start, new process: import xairl {imp:.1f} s + model load (imports transformers) {load:.1f} s + "
-          f"first narrative {one:.1f} s = {total:.1f} s to the first local_lm narrative")
+    print(
+        f"cold start, new process: import xairl {imp:.1f} s + model load (imports transformers) {load:.1f} s + "
+        f"first narrative {one:.1f} s = {total:.1f} s to the first local_lm narrative"
+    )
 
     rows, pairs = [], []
     for name, template in policies:
@@ -147,24 +171,44 @@ def run(args, cache: str, n_rewrite: int) -> None:
         rows += r
         pairs += p
 
-    head = ("policy", "narrator", "n", "verified 1st", "shown!=tpl", "own!=tpl", "edit shown", "edit own",
-            "tpl words", "sent.changed", "warm median", "p90")
+    head = (
+        "policy",
+        "narrator",
+        "n",
+        "verified 1st",
+        "shown!=tpl",
+        "own!=tpl",
+        "edit shown",
+        "edit own",
+        "tpl words",
+        "sent.changed",
+        "warm median",
+        "p90",
+    )
     print()
-    print(f"{head[0]:<8} {head[1]:<17} {head[2]:>3} {head[3]:>12} {head[4]:>10} {head[5]:>8} {head[6]:>10} "
-          f"{head[7]:>8} {head[8]:>9} {head[9]:>12} {head[10]:>11} {head[11]:>7}")
+    print(
+        f"{head[0]:<8} {head[1]:<17} {head[2]:>3} {head[3]:>12} {head[4]:>10} {head[5]:>8} {head[6]:>10} "
+        f"{head[7]:>8} {head[8]:>9} {head[9]:>12} {head[10]:>11} {head[11]:>7}"
+    )
     for name, label, n, first, sd, od, ed, oed, words, sent, med, p90 in rows:
-        print(f"{name:<8} {label:<17} {n:>3} {100 * first:>11.0f}% {100 * sd:>9.0f}% {100 * od:>7.0f}% {ed:>10.1f} "
-              f"{oed:>8.1f} {words:>9.0f} {100 * sent:>11.0f}% {med:>10.2f}s {p90:>6.2f}s")
-    print("(verified 1st: the narrator's own text verified; shown/own != tpl: the shown text / the model's own text"
-          " differs from the template's; edit: mean word-level edit distance to the template's text)")
+        print(
+            f"{name:<8} {label:<17} {n:>3} {100 * first:>11.0f}% {100 * sd:>9.0f}% {100 * od:>7.0f}% {ed:>10.1f} "
+            f"{oed:>8.1f} {words:>9.0f} {100 * sent:>11.0f}% {med:>10.2f}s {p90:>6.2f}s"
+        )
+    print(
+        "(verified 1st: the narrator's own text verified; shown/own != tpl: the shown text / the model's own text"
+        " differs from the template's; edit: mean word-level edit distance to the template's text)"
+    )
 
     # two example pairs: a verified rewrite if there is one, and a rejected one; else the first two
     good = [p for p in pairs if p[4]]
     bad = [p for p in pairs if not p[4]]
     examples = (good[:1] + bad[:1]) if good and bad else pairs[:2]
     for name, i, base, own, ok in examples:
-        print(f"\n--- {name}, state {i}: rewrite {'verified, shown' if ok else 'rejected, template shown instead'} "
-              f"({word_edits(base, own)} word edits)")
+        print(
+            f"\n--- {name}, state {i}: rewrite {'verified, shown' if ok else 'rejected, template shown instead'} "
+            f"({word_edits(base, own)} word edits)"
+        )
         print(textwrap.fill("template: " + base, 116, subsequent_indent="          "))
         print(textwrap.fill("rewrite:  " + own, 116, subsequent_indent="          "))
 

@@ -4,6 +4,7 @@ The policy is a registered one (default: the reference plugin's uav-dqn when ins
 Each measurement runs in a fresh process; 'baseline' is the same process doing everything except the attribution.
 Run: .venv/bin/python benchmarks/bench_memory.py [--states 100000] [--policy NAME]
 """
+
 import argparse
 import subprocess
 import sys
@@ -20,8 +21,12 @@ print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, time.perf_count
 
 
 def peak(states: int, run: bool, policy: str):
-    out = subprocess.run([sys.executable, "-c", CODE.format(rep=states // 1000, run=run, policy=policy)],
-                         capture_output=True, text=True, check=True).stdout.split()
+    out = subprocess.run(
+        [sys.executable, "-c", CODE.format(rep=states // 1000, run=run, policy=policy)],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.split()
     return float(out[0]), float(out[1])
 
 
@@ -36,6 +41,8 @@ if __name__ == "__main__":
     n = args.states
     base, _ = peak(n, False, name)
     mem, secs = peak(n, True, name)
-    print(f"deep_shap on {name}, {n} states x 100 background, all actions: peak RSS {mem:.0f} MB (process without the "
-          f"attribution: {base:.0f} MB; attribution adds {mem - base:.0f} MB) in {secs:.1f} s; goal 2048 MB: "
-          f"{mem / 2048:.2f} of it")
+    print(
+        f"deep_shap on {name}, {n} states x 100 background, all actions: peak RSS {mem:.0f} MB (process without the "
+        f"attribution: {base:.0f} MB; attribution adds {mem - base:.0f} MB) in {secs:.1f} s; goal 2048 MB: "
+        f"{mem / 2048:.2f} of it"
+    )

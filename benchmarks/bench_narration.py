@@ -6,6 +6,7 @@ Run: .venv/bin/python benchmarks/bench_narration.py [--policy toy] [--template e
      [--rewrite-states 50] [--verifier-only] [--label-words W,W]
 The reference plugin's figures: --policy uav-dqn --template handover --label-words BS,candidate
 """
+
 import argparse
 import os
 import platform
@@ -18,9 +19,11 @@ import numpy as np
 import xairl
 from xairl.testing import corpus
 
-COLD = ("import time; t = time.perf_counter(); import xairl; p = xairl.get_policy({policy!r}); "
-        "e = xairl.explain(p, p.background(1, seed=5), background=p.background(50)); "
-        "n = xairl.narrate(e, 0, narrator='local_lm', policy=p); print(time.perf_counter() - t, n.verified)")
+COLD = (
+    "import time; t = time.perf_counter(); import xairl; p = xairl.get_policy({policy!r}); "
+    "e = xairl.explain(p, p.background(1, seed=5), background=p.background(50)); "
+    "n = xairl.narrate(e, 0, narrator='local_lm', policy=p); print(time.perf_counter() - t, n.verified)"
+)
 
 
 def run_mode(exp, policy, mode, n_states, template):
@@ -56,16 +59,21 @@ def main():
     policy = xairl.get_policy(args.policy)
     exp = xairl.explain(policy, policy.background(args.states, seed=21), background=policy.background(100))
     xairl.narrate(exp, 0, narrator="local_lm", policy=policy)  # converts the model once (not timed as cold start)
-    cold = subprocess.run([sys.executable, "-c", COLD.format(policy=args.policy)], capture_output=True, text=True,
-                          check=True).stdout.split()
-    print(f"cold start (new process: imports, model load from the cached copy, one narrative): {float(cold[0]):.2f} s"
-          f" (goal 5 s: {float(cold[0]) / 5:.2f} of it)")
+    cold = subprocess.run(
+        [sys.executable, "-c", COLD.format(policy=args.policy)], capture_output=True, text=True, check=True
+    ).stdout.split()
+    print(
+        f"cold start (new process: imports, model load from the cached copy, one narrative): {float(cold[0]):.2f} s"
+        f" (goal 5 s: {float(cold[0]) / 5:.2f} of it)"
+    )
     for mode, n in (("choose", args.states), ("rewrite", args.rewrite_states)):
         t, ok, fb, cov = run_mode(exp, policy, mode, n, args.template)
-        print(f"local_lm mode={mode:<8} states {n:>4}: verified on first try {100 * ok / n:5.1f} %, fallback "
-              f"{100 * fb / n:5.1f} %, coverage of the model's text mean {cov.mean() if len(cov) else 0:.2f} "
-              f"(full in {100 * np.mean(cov == 1) if len(cov) else 0:.0f} %), warm latency median {np.median(t):.2f} s, "
-              f"p90 {np.percentile(t, 90):.2f} s (goal 1.5 s: {np.median(t) / 1.5:.2f} of it)")
+        print(
+            f"local_lm mode={mode:<8} states {n:>4}: verified on first try {100 * ok / n:5.1f} %, fallback "
+            f"{100 * fb / n:5.1f} %, coverage of the model's text mean {cov.mean() if len(cov) else 0:.2f} "
+            f"(full in {100 * np.mean(cov == 1) if len(cov) else 0:.0f} %), warm latency median {np.median(t):.2f} s, "
+            f"p90 {np.percentile(t, 90):.2f} s (goal 1.5 s: {np.median(t) / 1.5:.2f} of it)"
+        )
     verifier_corpus(args.policy, args.template, label_words, min(args.states, 150))
 
 
@@ -85,8 +93,11 @@ def verifier_corpus(name: str, template: str, label_words: tuple[str, ...], n_st
                 right, rejected = right + 1, rejected + (not ok)
             else:
                 wrong, caught = wrong + 1, caught + (not ok)
-    print(f"verifier: {caught}/{wrong} mutations caught ({100 * caught / wrong:.2f} %), {rejected}/{right} correct "
-          f"paraphrases rejected; {1000 * (time.perf_counter() - t0) / (wrong + right):.1f} ms/text")
+    print(
+        f"verifier: {caught}/{wrong} mutations caught ({100 * caught / wrong:.2f} %), {rejected}/{right} correct "
+        f"paraphrases rejected; {1000 * (time.perf_counter() - t0) / (wrong + right):.1f} ms/text"
+    )
+
 
 if __name__ == "__main__":
     main()

@@ -11,6 +11,7 @@ Run: .venv/bin/python benchmarks/bench_ray.py [--states 200000] [--kernel-states
      [--narrations 16]                                      (0 skips a part)
 (the issue's figures: --states 1000000 --kernel-states 10000; about 40 minutes on 2 cores)
 """
+
 import argparse
 import tempfile
 import time
@@ -18,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 from fleet_mlp import make_policy
+
 import xairl
 from xairl.scale import explain_on_ray, narrate_on_ray
 from xairl.stream import explain_to_parquet, read_parquet
@@ -43,15 +45,27 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         np.save(tmp / "s.npy", rng.normal(size=(args.states, 8)).astype(np.float32))
-        local = timed(explain_to_parquet, policy, tmp / "s.npy", tmp / "local", background=bg,
-                      chunk_size=args.chunk_size, progress=False)
-        ray = timed(explain_on_ray, policy, tmp / "s.npy", tmp / "ray", background=bg, chunk_size=args.chunk_size,
-                    workers=2)
-        same = np.array_equal(read_parquet(tmp / "local" / "explanations.parquet").values,
-                              read_parquet(tmp / "ray" / "explanations.parquet").values)
-        print(f"deep_shap, {args.states} states: local {local:.1f} s ({args.states / local:,.0f} states/s), Ray with 2 "
-              f"workers {ray:.1f} s ({args.states / ray:,.0f} states/s); Ray / local = {ray / local:.2f} (target <= "
-              f"1.5); values identical: {same}")
+        local = timed(
+            explain_to_parquet,
+            policy,
+            tmp / "s.npy",
+            tmp / "local",
+            background=bg,
+            chunk_size=args.chunk_size,
+            progress=False,
+        )
+        ray = timed(
+            explain_on_ray, policy, tmp / "s.npy", tmp / "ray", background=bg, chunk_size=args.chunk_size, workers=2
+        )
+        same = np.array_equal(
+            read_parquet(tmp / "local" / "explanations.parquet").values,
+            read_parquet(tmp / "ray" / "explanations.parquet").values,
+        )
+        print(
+            f"deep_shap, {args.states} states: local {local:.1f} s ({args.states / local:,.0f} states/s), Ray with 2 "
+            f"workers {ray:.1f} s ({args.states / ray:,.0f} states/s); Ray / local = {ray / local:.2f} (target <= "
+            f"1.5); values identical: {same}"
+        )
         for method, m in (("kernel_shap", args.kernel_states), ("exact", args.exact_states)):
             if m:
                 per_worker(policy, bg, tmp, method, m, rng)
@@ -63,12 +77,33 @@ def per_worker(policy, bg, tmp: Path, method: str, m: int, rng) -> None:
     """A per-state method on m states: Ray with 1 and 2 workers, and the local engine."""
     np.save(tmp / f"{method}.npy", rng.normal(size=(m, 8)).astype(np.float32))
     chunk = max(1, m // 8)  # enough chunks to keep 2 workers busy
-    one, two = (timed(explain_on_ray, policy, tmp / f"{method}.npy", tmp / f"{method}{w}", background=bg,
-                      method=method, chunk_size=chunk, workers=w) for w in (1, 2))
-    here = timed(explain_to_parquet, policy, tmp / f"{method}.npy", tmp / f"{method}0", background=bg, method=method,
-                 chunk_size=chunk, progress=False)
-    print(f"{method}, {m} states: Ray 1 worker {one:.1f} s, 2 workers {two:.1f} s: speed-up per added worker "
-          f"{one / two:.2f}x (ideal 2.00 on 2 cores); local engine {here:.1f} s")
+    one, two = (
+        timed(
+            explain_on_ray,
+            policy,
+            tmp / f"{method}.npy",
+            tmp / f"{method}{w}",
+            background=bg,
+            method=method,
+            chunk_size=chunk,
+            workers=w,
+        )
+        for w in (1, 2)
+    )
+    here = timed(
+        explain_to_parquet,
+        policy,
+        tmp / f"{method}.npy",
+        tmp / f"{method}0",
+        background=bg,
+        method=method,
+        chunk_size=chunk,
+        progress=False,
+    )
+    print(
+        f"{method}, {m} states: Ray 1 worker {one:.1f} s, 2 workers {two:.1f} s: speed-up per added worker "
+        f"{one / two:.2f}x (ideal 2.00 on 2 cores); local engine {here:.1f} s"
+    )
 
 
 def narrations(k: int) -> None:
@@ -89,9 +124,11 @@ def narrations(k: int) -> None:
         there = narrate_on_ray(exp, workers=w, **kw)
         times[w] = time.perf_counter() - t
         assert [n.text for n in there] == texts, "Ray's narratives differ from this process's"
-    print(f"local_lm narration, {k} states: this process {local:.1f} s (model loaded in it), Ray 1 worker "
-          f"{times[1]:.1f} s, 2 workers {times[2]:.1f} s: speed-up per added worker {times[1] / times[2]:.2f}x; the "
-          "same texts")
+    print(
+        f"local_lm narration, {k} states: this process {local:.1f} s (model loaded in it), Ray 1 worker "
+        f"{times[1]:.1f} s, 2 workers {times[2]:.1f} s: speed-up per added worker {times[1] / times[2]:.2f}x; the "
+        "same texts"
+    )
 
 
 if __name__ == "__main__":

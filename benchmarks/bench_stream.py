@@ -6,6 +6,7 @@ cores, peak RSS <= 1 GB, Parquet <= 1/3 of JSON lines, peak RSS at 10x the state
 Run: .venv/bin/python benchmarks/bench_stream.py [--states 1000000] [--scale 10] [--chunk-size 50000]
 (--scale 10 also runs 10x the states, for the flat-memory check; it takes ten times as long.)
 """
+
 import argparse
 import os
 import resource
@@ -48,16 +49,31 @@ def main():
         for n in sorted({args.states, args.states * args.scale}):
             states = np.lib.format.open_memmap(tmp / f"s{n}.npy", mode="w+", dtype=np.float32, shape=(n, 8))
             for a in range(0, n, 1_000_000):  # written in pieces: the benchmark itself stays small too
-                states[a:a + 1_000_000] = rng.normal(size=(min(1_000_000, n - a), 8))
+                states[a : a + 1_000_000] = rng.normal(size=(min(1_000_000, n - a), 8))
             states.flush()
             del states
             out = tmp / f"out{n}"
-            secs, rss = run([xairl, "explain", *common, "--states", str(tmp / f"s{n}.npy"), "--out", str(out),
-                             "--format", "parquet", "--chunk-size", str(args.chunk_size)])
+            secs, rss = run(
+                [
+                    xairl,
+                    "explain",
+                    *common,
+                    "--states",
+                    str(tmp / f"s{n}.npy"),
+                    "--out",
+                    str(out),
+                    "--format",
+                    "parquet",
+                    "--chunk-size",
+                    str(args.chunk_size),
+                ]
+            )
             peaks[n] = rss
             disk = sum(p.stat().st_size for p in (out / "explanations.parquet").glob("part-*.parquet"))
-            print(f"{n} states: {secs:.1f} s, {n / secs:,.0f} states/s (target 50,000: {n / secs / 50_000:.2f}x), "
-                  f"peak RSS {rss:.0f} MB (target 1024: {rss / 1024:.2f}x), Parquet {disk / n:.1f} bytes/state")
+            print(
+                f"{n} states: {secs:.1f} s, {n / secs:,.0f} states/s (target 50,000: {n / secs / 50_000:.2f}x), "
+                f"peak RSS {rss:.0f} MB (target 1024: {rss / 1024:.2f}x), Parquet {disk / n:.1f} bytes/state"
+            )
             (tmp / f"s{n}.npy").unlink()
         small = min(peaks)
         if len(peaks) > 1:
@@ -65,13 +81,31 @@ def main():
             print(f"peak RSS at {big} states / at {small}: {peaks[big] / peaks[small]:.3f} (target <= 1.10)")
         sample = 10_000  # JSON lines of the same explanations, on fewer states (bytes per state do not depend on n)
         np.save(tmp / "few.npy", rng.normal(size=(sample, 8)).astype(np.float32))
-        jsonl = subprocess.run([xairl, "explain", *common, "--states", str(tmp / "few.npy"), "--format", "jsonl"],
-                               capture_output=True, check=True).stdout
-        subprocess.run([xairl, "explain", *common, "--states", str(tmp / "few.npy"), "--out", str(tmp / "few"),
-                        "--format", "parquet"], capture_output=True, check=True)
+        jsonl = subprocess.run(
+            [xairl, "explain", *common, "--states", str(tmp / "few.npy"), "--format", "jsonl"],
+            capture_output=True,
+            check=True,
+        ).stdout
+        subprocess.run(
+            [
+                xairl,
+                "explain",
+                *common,
+                "--states",
+                str(tmp / "few.npy"),
+                "--out",
+                str(tmp / "few"),
+                "--format",
+                "parquet",
+            ],
+            capture_output=True,
+            check=True,
+        )
         pq = sum(p.stat().st_size for p in (tmp / "few" / "explanations.parquet").glob("part-*.parquet")) / sample
-        print(f"bytes per state, {sample} states: JSON lines {len(jsonl) / sample:.0f}, Parquet {pq:.0f}: "
-              f"Parquet / JSON lines = {pq / (len(jsonl) / sample):.3f} (target <= 0.333)")
+        print(
+            f"bytes per state, {sample} states: JSON lines {len(jsonl) / sample:.0f}, Parquet {pq:.0f}: "
+            f"Parquet / JSON lines = {pq / (len(jsonl) / sample):.3f} (target <= 0.333)"
+        )
     print(f"(this process's own peak: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB)")
 
 

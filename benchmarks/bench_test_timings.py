@@ -10,6 +10,7 @@ and the seconds are measured here, where a loaded machine gives a slow figure, n
 - verify() on 4x the text: the ratio of the times (old limit 8x + 0.5 s, ``tests/test_verify_robust.py``).
 Each figure is the best of three runs.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -54,8 +55,14 @@ def image() -> list[float]:
     import torch
 
     torch.manual_seed(0)
-    net = torch.nn.Sequential(torch.nn.Conv2d(3, 4, 8, 4), torch.nn.ReLU(), torch.nn.Conv2d(4, 8, 4, 2),
-                              torch.nn.ReLU(), torch.nn.Flatten(), torch.nn.Linear(8 * 6 * 6, 4))
+    net = torch.nn.Sequential(
+        torch.nn.Conv2d(3, 4, 8, 4),
+        torch.nn.ReLU(),
+        torch.nn.Conv2d(4, 8, 4, 2),
+        torch.nn.ReLU(),
+        torch.nn.Flatten(),
+        torch.nn.Linear(8 * 6 * 6, 4),
+    )
     policy = xairl.Policy(net, observation=(3, 64, 64), name="cnn")
     frames = np.random.default_rng(0).integers(0, 256, (10, 3, 64, 64)).astype(np.float32)
     exp = xairl.explain(policy, frames[:2], background=frames[2:])
@@ -65,10 +72,16 @@ def image() -> list[float]:
 
 def _exp():
     c = np.array([0.11, 0.15, -0.05])
-    return xairl.Explanation(values=c.reshape(1, -1, 1), base_values=np.array([[0.3]]),
-                             outputs=np.array([[0.3 + c.sum()]]), states=np.array([[1, 0, 7.5]]),
-                             feature_names=("gill_size", "odor", "cap_diameter"), action_names=("poisonous",),
-                             method="given", output="value")
+    return xairl.Explanation(
+        values=c.reshape(1, -1, 1),
+        base_values=np.array([[0.3]]),
+        outputs=np.array([[0.3 + c.sum()]]),
+        states=np.array([[1, 0, 7.5]]),
+        feature_names=("gill_size", "odor", "cap_diameter"),
+        action_names=("poisonous",),
+        method="given",
+        output="value",
+    )
 
 
 def verify_times() -> tuple[float, float, float]:
@@ -87,16 +100,20 @@ def main() -> int:
     rows = templates()
     name, narrate, _ = max(rows, key=lambda r: r[1])
     render_name, _, render = max(rows, key=lambda r: r[2])
-    print(f"hostile templates ({len(rows)}): slowest refusal {narrate:.3f} s through narrate ({name}), "
-          f"{render:.3f} s rendering alone ({render_name}); old limit 2 s")
+    print(
+        f"hostile templates ({len(rows)}): slowest refusal {narrate:.3f} s through narrate ({name}), "
+        f"{render:.3f} s rendering alone ({render_name}); old limit 2 s"
+    )
     over += [f"template {name}"] if max(narrate, render) >= 2.0 else []
     per_state = image()
     print(f"CNN 3x64x64 narrated in regions: {', '.join(f'{t:.3f}' for t in per_state)} s per state; old limit 2 s")
     over += ["image narration"] if max(per_state) >= 2.0 else []
     million, short, long = verify_times()
     print(f"verify, 1,000,000 characters: {million:.2f} s; old limit 10 s")
-    print(f"verify, 100 and 400 clauses: {short:.3f} s and {long:.3f} s, ratio {long / short:.2f} (4x the text; "
-          f"quadratic would be 16); old limit 8x + 0.5 s")
+    print(
+        f"verify, 100 and 400 clauses: {short:.3f} s and {long:.3f} s, ratio {long / short:.2f} (4x the text; "
+        f"quadratic would be 16); old limit 8x + 0.5 s"
+    )
     over += ["verify of a million characters"] if million >= 10 else []
     over += ["verify's ratio"] if long >= 8 * short + 0.5 else []
     if over:

@@ -37,6 +37,7 @@ narratives, ``description``, and plain restatements, ``bad_description``) are ac
 its explanation with every sign inverted and with the two largest contributions swapped (a description that names
 no rank and whose top two share a sign stays true under the swap: that group's misses are not all errors).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -65,8 +66,9 @@ SPLITS = ("dev", *(f"dev{k}" for k in range(2, 22)), "test", "test2")
 def load_corpus() -> list[dict]:
     """Every narrative with its case's Explanation, domain, split, label and error kind. ``dev2`` to ``dev5`` hold
     narratives written later, on the dev cases only, in other voices (tuning material like ``dev``)."""
-    cases = {c["id"]: c for path in (DATA / "cases.json", DATA / "dev2" / "cases.json")
-             for c in json.loads(path.read_text())}
+    cases = {
+        c["id"]: c for path in (DATA / "cases.json", DATA / "dev2" / "cases.json") for c in json.loads(path.read_text())
+    }
     out = []
     for domain in domains.DOMAINS:
         for later in (None, *(s for s in SPLITS if s not in ("dev", "test"))):
@@ -77,9 +79,18 @@ def load_corpus() -> list[dict]:
                 assert not later or case["split"] == split, f"{path}: {case_id} is not a {split} case"
                 exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
                 for item in items:
-                    (label, text), = item.items()
-                    out.append({"case": case_id, "domain": domain, "split": later or case["split"],
-                                "error": label, "accurate": label == "ok", "text": text, "explanation": exp})
+                    ((label, text),) = item.items()
+                    out.append(
+                        {
+                            "case": case_id,
+                            "domain": domain,
+                            "split": later or case["split"],
+                            "error": label,
+                            "accurate": label == "ok",
+                            "text": text,
+                            "explanation": exp,
+                        }
+                    )
     return out
 
 
@@ -117,8 +128,10 @@ def report(items: list[dict], show: str | None) -> None:
         part = [it for it in items if it["split"] == split]
         agree = sum(it["ok"] == it["accurate"] for it in part)
         on_accurate = sum(it["result"].accurate == it["accurate"] for it in part)
-        print(f"\n## {split} split: agreement {agree}/{len(part)} = {100 * agree / len(part):.1f} % (on `accurate`, "
-              f"nothing contradicted: {on_accurate}/{len(part)} = {100 * on_accurate / len(part):.1f} %)")
+        print(
+            f"\n## {split} split: agreement {agree}/{len(part)} = {100 * agree / len(part):.1f} % (on `accurate`, "
+            f"nothing contradicted: {on_accurate}/{len(part)} = {100 * on_accurate / len(part):.1f} %)"
+        )
         print("| domain | agree | n | % |\n|---|---|---|---|")
         for k, a, n in table(part, lambda it: it["domain"]):
             print(f"| {k} | {a} | {n} | {100 * a / n:.0f} |")
@@ -145,16 +158,25 @@ def explanation_from_tuples(text: str, output: str = "prediction") -> xairl.Expl
     return one_output([t[0].strip() for t in tuples], values, [float(t[2]) for t in tuples], output=output)
 
 
-def one_output(names: list[str], values: list, contributions: list[float], base: float = 0.0,
-               output: str = "prediction") -> xairl.Explanation:
+def one_output(
+    names: list[str], values: list, contributions: list[float], base: float = 0.0, output: str = "prediction"
+) -> xairl.Explanation:
     """A one-output Explanation of one state: each feature's value (a str is a category's label) and contribution;
     the prediction is the baseline plus their sum."""
     cats = {n: (v,) for n, v in zip(names, values) if isinstance(v, str)}
     states = np.array([[0.0 if isinstance(v, str) else float(v) for v in values]])
     contrib = np.array(contributions, dtype=float)
-    return xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.array([[base]]),
-                             outputs=np.array([[base + contrib.sum()]]), states=states, feature_names=tuple(names),
-                             action_names=(output,), method="given", output="value", categories=cats or None)
+    return xairl.Explanation(
+        values=contrib.reshape(1, -1, 1),
+        base_values=np.array([[base]]),
+        outputs=np.array([[base + contrib.sum()]]),
+        states=states,
+        feature_names=tuple(names),
+        action_names=(output,),
+        method="given",
+        output="value",
+        categories=cats or None,
+    )
 
 
 def explingo_items(path: str) -> list[dict]:
@@ -164,16 +186,32 @@ def explingo_items(path: str) -> list[dict]:
         exp = explanation_from_tuples(row["explanation"])
         domain = row["context"].split(" predicts ")[-1][:28]
         if "narrative" in row:  # accuracy_tests.json: a labelled narrative
-            out.append({"case": row["explanation"][:40], "domain": domain, "split": "explingo",
-                        "error": row["accuracy_rationalization"], "accurate": row["accuracy_score"] > 0,
-                        "text": row["narrative"], "explanation": exp})
+            out.append(
+                {
+                    "case": row["explanation"][:40],
+                    "domain": domain,
+                    "split": "explingo",
+                    "error": row["accuracy_rationalization"],
+                    "accurate": row["accuracy_score"] > 0,
+                    "text": row["narrative"],
+                    "explanation": exp,
+                }
+            )
         for key in ("description", "bad_description"):  # dataset/*.json: accurate texts, and wrong for the same
             if row.get(key):  # explanation manipulated
-                kind = key.replace('_', ' ')
+                kind = key.replace("_", " ")
                 for error, e in ((f"gold {kind}", exp), *manipulated(exp)):
-                    out.append({"case": row["explanation"][:40], "domain": domain, "split": "explingo",
-                                "error": error if e is exp else f"{error}, {kind}", "accurate": e is exp,
-                                "text": row[key], "explanation": e})
+                    out.append(
+                        {
+                            "case": row["explanation"][:40],
+                            "domain": domain,
+                            "split": "explingo",
+                            "error": error if e is exp else f"{error}, {kind}",
+                            "accurate": e is exp,
+                            "text": row[key],
+                            "explanation": e,
+                        }
+                    )
     return out
 
 
@@ -194,18 +232,29 @@ def shapstories_case(dataset: str, index: int) -> tuple[int, xairl.Explanation, 
     names = tuple(feats)
     cats = {f: tuple(d[1]) for f, d in feats.items() if isinstance(d[1], list)}
     value = {f: (cats[f].index(v) if f in cats else v) for f, (v, _) in given.items()}
-    states = np.array([[value.get(f, min(2, len(cats[f]) - 1) if f in cats else feats[f][2]) for f in names]],
-                      float)  # else the median (a category: its third code)
+    states = np.array(
+        [[value.get(f, min(2, len(cats[f]) - 1) if f in cats else feats[f][2]) for f in names]], float
+    )  # else the median (a category: its third code)
     contrib = np.array([given[f][1] if f in given else 0.001 for f in names])
     quartiles = np.array([[np.nan if f in cats else feats[f][k] for f in names] for k in (1, 2, 3)], float)
-    exp = xairl.Explanation(values=contrib.reshape(1, -1, 1), base_values=np.array([[prediction - contrib.sum()]]),
-                            outputs=np.array([[prediction]]), states=states, feature_names=names,
-                            action_names=(domain["output"],), method="given", output="value",
-                            background_quantiles=quartiles, categories=cats or None)
-    info = {f: xairl.FeatureInfo(d[4] if len(d) > 4 else "", d[0], categories=cats.get(f, ()))
-            for f, d in feats.items()}
-    policy = xairl.Policy(torch.nn.Linear(len(names), 1), list(names), [domain["output"]], features=info,
-                          output="value", name=dataset)
+    exp = xairl.Explanation(
+        values=contrib.reshape(1, -1, 1),
+        base_values=np.array([[prediction - contrib.sum()]]),
+        outputs=np.array([[prediction]]),
+        states=states,
+        feature_names=names,
+        action_names=(domain["output"],),
+        method="given",
+        output="value",
+        background_quantiles=quartiles,
+        categories=cats or None,
+    )
+    info = {
+        f: xairl.FeatureInfo(d[4] if len(d) > 4 else "", d[0], categories=cats.get(f, ())) for f, d in feats.items()
+    }
+    policy = xairl.Policy(
+        torch.nn.Linear(len(names), 1), list(names), [domain["output"]], features=info, output="value", name=dataset
+    )
     return batch, exp, policy
 
 
@@ -225,8 +274,18 @@ def shapstories_items(path: str) -> list[dict]:
         split = "held out" if dataset in about.get("held_out", ()) else f"batch {batch}"
         label = about.get("contradicting", {}).get(case, "ok")
         for error, e in ((label, exp), *manipulated(exp)):
-            out.append({"case": case, "domain": dataset, "split": f"shapstories {split}", "error": error,
-                        "accurate": error == "ok", "text": row["round0_narrative"], "explanation": e, "policy": policy})
+            out.append(
+                {
+                    "case": case,
+                    "domain": dataset,
+                    "split": f"shapstories {split}",
+                    "error": error,
+                    "accurate": error == "ok",
+                    "text": row["round0_narrative"],
+                    "explanation": e,
+                    "policy": policy,
+                }
+            )
     return out
 
 
@@ -239,8 +298,10 @@ def manipulated(exp: xairl.Explanation) -> list[tuple[str, xairl.Explanation]]:
     swapped = values.copy()
     swapped[0, order[:2], 0] = values[0, order[1::-1], 0]
     base = exp.base_values
-    return [("inverted signs", replace(exp, values=-values, outputs=base - values.sum(axis=1))),
-            ("top two swapped", replace(exp, values=swapped, outputs=base + swapped.sum(axis=1)))]
+    return [
+        ("inverted signs", replace(exp, values=-values, outputs=base - values.sum(axis=1))),
+        ("top two swapped", replace(exp, values=swapped, outputs=base + swapped.sum(axis=1))),
+    ]
 
 
 def main() -> None:
@@ -251,15 +312,20 @@ def main() -> None:
     args = ap.parse_args()
     if args.explingo or args.shapstories:
         items = run(explingo_items(args.explingo) if args.explingo else shapstories_items(args.shapstories), {})
-        name = f"Explingo {pathlib.Path(args.explingo).stem}" if args.explingo else \
-            f"SHAPnarrative-agents {pathlib.Path(args.shapstories).stem}"
+        name = (
+            f"Explingo {pathlib.Path(args.explingo).stem}"
+            if args.explingo
+            else f"SHAPnarrative-agents {pathlib.Path(args.shapstories).stem}"
+        )
         agree = sum(it["ok"] == it["accurate"] for it in items)
         print(f"## {name} (outside): agreement {agree}/{len(items)} = {100 * agree / len(items):.1f} %")
         print("| group | agree | n |\n|---|---|---|")
+
         def group(it):
             if args.shapstories:
                 return f"{it['split']}, {it['domain']}, {it['error']}"
             return ("accurate: " if it["accurate"] else "inaccurate: ") + it["error"]
+
         for k, a, n in table(items, group):
             print(f"| {k} | {a} | {n} |")
         if args.shapstories:

@@ -13,6 +13,7 @@ A case over half the limit is run twice more and its best time kept: the machine
 collection) is not the verifier's work; its first time is printed too. The unit tests bound the same work without a
 clock (``tests/test_hardening_verify.py`` counts a pattern's backtracking steps).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -32,10 +33,16 @@ from xairl.narrators.verify import verify  # noqa: E402
 def _explanation(names, actions=("out",), seed=0):
     rng = np.random.default_rng(seed)
     v = rng.normal(size=(1, len(names), len(actions)))
-    return xairl.Explanation(values=v, base_values=np.zeros((1, len(actions))), outputs=v.sum(axis=1),
-                             states=rng.normal(size=(1, len(names))), feature_names=tuple(names),
-                             action_names=tuple(actions), method="given",
-                             output="value" if len(actions) == 1 else "actions")
+    return xairl.Explanation(
+        values=v,
+        base_values=np.zeros((1, len(actions))),
+        outputs=v.sum(axis=1),
+        states=rng.normal(size=(1, len(names))),
+        feature_names=tuple(names),
+        action_names=tuple(actions),
+        method="given",
+        output="value" if len(actions) == 1 else "actions",
+    )
 
 
 EXPLANATIONS = [
@@ -44,11 +51,56 @@ EXPLANATIONS = [
     _explanation(["sensors[0]", "rsrp_1", "obs[1,32,35]", "battery_level"], seed=2),
     _explanation([f"f_{i}" for i in range(60)], seed=3),
 ]
-WORDS = ["and", "or", "as well as", "together with", "both", "the", "its", "of", "at", "plus", "raised", "lowered",
-         "raised it", "pushed toward", "lowered the score", "by", "about", "not", "without", "would be higher",
-         "Raising it:", "more than", "twice", "because", "toward", "the most", "average", "is categorized as",
-         "predicted probability", "points", "in total", "vs", "from", "to", "%", "!", "?", "(", ")", ":", ";", "-",
-         "+", "$", "\0", "'s", "\u2212", "\u00a0"]
+WORDS = [
+    "and",
+    "or",
+    "as well as",
+    "together with",
+    "both",
+    "the",
+    "its",
+    "of",
+    "at",
+    "plus",
+    "raised",
+    "lowered",
+    "raised it",
+    "pushed toward",
+    "lowered the score",
+    "by",
+    "about",
+    "not",
+    "without",
+    "would be higher",
+    "Raising it:",
+    "more than",
+    "twice",
+    "because",
+    "toward",
+    "the most",
+    "average",
+    "is categorized as",
+    "predicted probability",
+    "points",
+    "in total",
+    "vs",
+    "from",
+    "to",
+    "%",
+    "!",
+    "?",
+    "(",
+    ")",
+    ":",
+    ";",
+    "-",
+    "+",
+    "$",
+    "\0",
+    "'s",
+    "\u2212",
+    "\u00a0",
+]
 SEPARATORS = [" ", ",", ".", "!", "-", "(", ")", "'", ":", "%", "/", "\t", ", ", " ,", "( ", " !", "\0"]
 
 
@@ -57,8 +109,11 @@ def _digits(rng: random.Random) -> str:
     run = "".join(rng.choice("0123456789") for _ in range(n)) if rng.random() < 0.5 else "9" * n
     if rng.random() < 0.3:  # commas and points inside the run
         run = "".join(c + (rng.choice(",.") if rng.random() < 0.3 else "") for c in run)
-    return rng.choice(["", "", "+", "-", "$", "-$"]) + run + rng.choice(["", "", " ", "%", " km", "kmh", " and",
-                                                                         " pts", "e5"])
+    return (
+        rng.choice(["", "", "+", "-", "$", "-$"])
+        + run
+        + rng.choice(["", "", " ", "%", " km", "kmh", " and", " pts", "e5"])
+    )
 
 
 def _run(rng: random.Random) -> str:
@@ -104,7 +159,7 @@ def main(argv=None) -> int:
         exp = EXPLANATIONS[rng.randrange(len(EXPLANATIONS))]
         text = case(rng, list(exp.feature_names))
         took = []
-        for attempt in range(3):
+        for _attempt in range(3):
             t = time.perf_counter()
             result = verify(text, exp, 0)
             took.append((time.perf_counter() - t) * 1000)
@@ -119,8 +174,10 @@ def main(argv=None) -> int:
     ms, text, names = worst
     shown = text if len(text) <= 160 else f"{text[:100]!r}...{text[-40:]!r} ({len(text)} chars)"
     print(f"{len(times)} cases in {total:.1f} s (seed {args.seed}); statuses {statuses}")
-    print(f"per case: median {statistics.median(times):.2f} ms, p99 {np.percentile(times, 99):.1f} ms, "
-          f"max {max(times):.1f} ms (first runs: max {max(firsts):.1f} ms); limit {args.limit_ms:.0f} ms")
+    print(
+        f"per case: median {statistics.median(times):.2f} ms, p99 {np.percentile(times, 99):.1f} ms, "
+        f"max {max(times):.1f} ms (first runs: max {max(firsts):.1f} ms); limit {args.limit_ms:.0f} ms"
+    )
     print(f"worst case: {ms:.1f} ms over [{names}]: {shown if len(text) > 160 else repr(shown)}")
     over = sum(t >= args.limit_ms for t in times)
     if over:

@@ -5,6 +5,7 @@ Per state, for the chosen action: Spearman correlation of the two feature rankin
 overlap of the top 3, and max |difference|.
 Run: .venv/bin/python benchmarks/faithfulness.py [--states 100] [--policy NAME]
 """
+
 import argparse
 
 import numpy as np
@@ -33,14 +34,15 @@ def main():
     rho = [spearman(np.abs(d[i]), np.abs(e[i])) for i in range(n)]
     rho_signed = [spearman(d[i], e[i]) for i in range(n)]
     top1 = np.mean([np.argmax(np.abs(d[i])) == np.argmax(np.abs(e[i])) for i in range(n)])
-    top3 = np.mean([len(set(np.argsort(-np.abs(d[i]))[:3]) & set(np.argsort(-np.abs(e[i]))[:3])) / 3
-                    for i in range(n)])
+    top3 = np.mean([len(set(np.argsort(-np.abs(d[i]))[:3]) & set(np.argsort(-np.abs(e[i]))[:3])) / 3 for i in range(n)])
     glob = spearman(np.abs(d).mean(0), np.abs(e).mean(0))
-    print(f"{name}, {n} states, 50 background, chosen action: Spearman of |contribution| rankings median "
-          f"{np.median(rho):.3f} (mean {np.mean(rho):.3f}, min {np.min(rho):.3f}); signed values median "
-          f"{np.median(rho_signed):.3f}; same top feature {100 * top1:.0f} %; top-3 overlap {100 * top3:.0f} %; "
-          f"global importance ranking Spearman {glob:.3f}; max |deep_shap - exact| {np.abs(d - e).max():.3f} "
-          f"(mean |exact| {np.abs(e).mean():.3f})")
+    print(
+        f"{name}, {n} states, 50 background, chosen action: Spearman of |contribution| rankings median "
+        f"{np.median(rho):.3f} (mean {np.mean(rho):.3f}, min {np.min(rho):.3f}); signed values median "
+        f"{np.median(rho_signed):.3f}; same top feature {100 * top1:.0f} %; top-3 overlap {100 * top3:.0f} %; "
+        f"global importance ranking Spearman {glob:.3f}; max |deep_shap - exact| {np.abs(d - e).max():.3f} "
+        f"(mean |exact| {np.abs(e).mean():.3f})"
+    )
 
 
 if __name__ == "__main__":

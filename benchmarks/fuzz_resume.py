@@ -8,6 +8,7 @@ end whole. Damage alone must never be refused. Prints the tally per kind of dama
 Run: .venv/bin/python benchmarks/fuzz_resume.py [--cases 1000] [--seed 51] [--engine ray]
 (``tests/test_hardening_stream.py`` runs 210 cases of it with the local engine.)
 """
+
 from __future__ import annotations
 
 import argparse
@@ -61,7 +62,7 @@ def mutate(kind: str, parts: Path, other: Path, rng: random.Random) -> str | Non
         data[rng.randrange(len(data))] ^= 1 << rng.randrange(8)
         victim.write_bytes(bytes(data))
     elif kind == "truncate":
-        victim.write_bytes(victim.read_bytes()[:rng.randrange(victim.stat().st_size)])
+        victim.write_bytes(victim.read_bytes()[: rng.randrange(victim.stat().st_size)])
     elif kind == "short":  # fewer rows, the metadata kept (unless an earlier damage left it unreadable)
         try:
             table = pq.read_table(victim)
@@ -75,8 +76,15 @@ def mutate(kind: str, parts: Path, other: Path, rng: random.Random) -> str | Non
         a.rename(parts / "swap.tmp"), b.rename(a), (parts / "swap.tmp").rename(b)
     elif kind == "stray":  # a copy under a name that is no chunk's: misaligned, past the end, or no part's name
         misaligned = rng.randrange(1, N)
-        name = rng.choice([part(misaligned + (misaligned % CHUNK == 0)), part(N + CHUNK * rng.randrange(3)),
-                           "part-7.parquet", "extra.parquet", "notes.txt"])
+        name = rng.choice(
+            [
+                part(misaligned + (misaligned % CHUNK == 0)),
+                part(N + CHUNK * rng.randrange(3)),
+                "part-7.parquet",
+                "extra.parquet",
+                "notes.txt",
+            ]
+        )
         shutil.copy(victim, parts / name)
         return name
     elif kind == "foreign":  # another run's part, whole, under one of this run's names
@@ -116,8 +124,9 @@ def one_case(case: int, root: Path, reference, run: str, rng: random.Random, eng
             summary = engine(POLICY, STATES, out, background=BG, chunk_size=CHUNK, progress=False, resume=True)
         except InputError as exc:
             message = str(exc)
-            assert "\n" not in message and ("not a part of this run (" in message or
-                                             "run.json: not the record of a run (" in message), message
+            assert "\n" not in message and (
+                "not a part of this run (" in message or "run.json: not the record of a run (" in message
+            ), message
             refused = next(p for p in [out / "run.json", *(out / DATASET).iterdir()] if f"{p}: not " in message)
             assert not_a_part_of_the_run(refused, run), message
             refusals.append(refused.name)
@@ -147,11 +156,17 @@ def main() -> None:
 
         from xairl.scale import explain_on_ray
 
-        ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level="ERROR",
-                 _node_ip_address="127.0.0.1")
+        ray.init(
+            num_cpus=2,
+            include_dashboard=False,
+            log_to_driver=False,
+            logging_level="ERROR",
+            _node_ip_address="127.0.0.1",
+        )
 
         def engine(*a, **k):
             return explain_on_ray(*a, workers=2, **{key: v for key, v in k.items() if key != "progress"})
+
     import logging
 
     logging.getLogger("xairl").setLevel(logging.ERROR)  # the notes on damaged parts: one per case
@@ -174,8 +189,10 @@ def main() -> None:
     seconds = time.perf_counter() - t0
     print(f"{args.cases} cases ({args.engine} engine, seed {args.seed}) in {seconds:.1f} s")
     for kind in ("all", *KINDS, "run.json"):
-        print(f"  {kind:<9} whole at once {tally[kind, 'whole at once']:>5}   refused by name, then whole "
-              f"{tally[kind, 'refused by name, then whole']:>5}")
+        print(
+            f"  {kind:<9} whole at once {tally[kind, 'whole at once']:>5}   refused by name, then whole "
+            f"{tally[kind, 'refused by name, then whole']:>5}"
+        )
     print(f"  violations: {len(failures)}", *failures[:10], sep="\n    ")
     sys.exit(1 if failures else 0)
 

@@ -9,6 +9,7 @@ written or any verifier change was made. Run once; the corpus refers to the stor
     .venv/bin/python benchmarks/make_narrative_cases.py
     .venv/bin/python benchmarks/make_narrative_cases.py --dev2   # dev2/cases.json: two UAV 'stay' dev cases
 """
+
 from __future__ import annotations
 
 import json
@@ -44,9 +45,16 @@ def _explanations(domain: str) -> xairl.Explanation:
 
 
 def _one(exp: xairl.Explanation, i: int) -> dict:
-    one = xairl.Explanation(**{**exp.__dict__, "values": exp.values[i:i + 1], "base_values": exp.base_values[i:i + 1],
-                               "outputs": exp.outputs[i:i + 1], "states": exp.states[i:i + 1],
-                               "available": None if exp.available is None else exp.available[i:i + 1]})
+    one = xairl.Explanation(
+        **{
+            **exp.__dict__,
+            "values": exp.values[i : i + 1],
+            "base_values": exp.base_values[i : i + 1],
+            "outputs": exp.outputs[i : i + 1],
+            "states": exp.states[i : i + 1],
+            "available": None if exp.available is None else exp.available[i : i + 1],
+        }
+    )
     return json.loads(one.to_json())
 
 
@@ -72,8 +80,14 @@ def main() -> None:
     for domain in domains.DOMAINS:
         exp = _explanations(domain)
         for i in range(len(exp.values)):
-            cases.append({"id": f"{domain}-{i}", "domain": domain, "split": "dev" if i < 4 else "test",
-                          "explanation": _one(exp, i)})
+            cases.append(
+                {
+                    "id": f"{domain}-{i}",
+                    "domain": domain,
+                    "split": "dev" if i < 4 else "test",
+                    "explanation": _one(exp, i),
+                }
+            )
     OUT.write_text(json.dumps(cases, indent=1) + "\n")
     print(f"wrote {len(cases)} cases to {OUT}")
 

@@ -2,6 +2,7 @@
 
 Run: .venv/bin/python benchmarks/stress_feedback.py [--procs 8] [--writes 1000]
 """
+
 import argparse
 import multiprocessing as mp
 import os
@@ -58,8 +59,12 @@ if __name__ == "__main__":
     with tempfile.TemporaryDirectory() as d:
         n, secs = run(a.procs, a.writes, Path(d) / "fb.sqlite")
         want = a.procs * a.writes
-        print(f"{a.procs} processes x {a.writes} writes: {n}/{want} distinct records stored, {want - n} lost, "
-              f"{secs:.1f} s ({want / secs:.0f} writes/s)")
+        print(
+            f"{a.procs} processes x {a.writes} writes: {n}/{want} distinct records stored, {want - n} lost, "
+            f"{secs:.1f} s ({want / secs:.0f} writes/s)"
+        )
         rows, integrity = killed_writer(Path(d) / "killed.sqlite")
-        print(f"writer killed with SIGKILL after 3 s: store readable, {rows} complete records, integrity_check: "
-              f"{integrity}")
+        print(
+            f"writer killed with SIGKILL after 3 s: store readable, {rows} complete records, integrity_check: "
+            f"{integrity}"
+        )

@@ -1,5 +1,6 @@
 """A griffe extension for the API reference: Sphinx cross-reference roles in the docstrings (``:class:`xairl.Policy```,
 ``:meth:`grouped```) are shown as inline code, since MkDocs does not read Sphinx roles."""
+
 from __future__ import annotations
 
 import re

@@ -5,6 +5,7 @@ Run: python examples/atari_cnn.py [--out atari-report]
 CLI: xairl explain --policy examples/atari_cnn.py:make_policy --policy-arg seed=0 --states s.npy --background bg.npy \
        --out DIR        (s.npy, bg.npy: uint8 or float frames of shape (n, 4, 84, 84); this script writes both)
 """
+
 import argparse
 from pathlib import Path
 
@@ -26,8 +27,12 @@ def make_policy(seed: int = 0, checkpoint: str | None = None) -> xairl.Policy:
     if checkpoint:
         net.load_state_dict(torch.load(checkpoint, weights_only=True))
     # frames arrive as 0..255; the network sees them / 255 as SB3 does (a linear step, explained through)
-    return xairl.Policy(torch.nn.Sequential(Scale(1 / 255), net).eval(), observation=(4, 84, 84),
-                        action_names=ACTIONS, name="atari-nature-cnn")
+    return xairl.Policy(
+        torch.nn.Sequential(Scale(1 / 255), net).eval(),
+        observation=(4, 84, 84),
+        action_names=ACTIONS,
+        name="atari-nature-cnn",
+    )
 
 
 class Scale(torch.nn.Module):
@@ -48,7 +53,7 @@ def frames(n: int, seed: int) -> np.ndarray:
     for i in range(n):
         r, c = rng.integers(10, 70, 2)
         for t in range(4):
-            out[i, t, r + t:r + t + 8, c:c + 8] = 255
+            out[i, t, r + t : r + t + 8, c : c + 8] = 255
     return out
 
 

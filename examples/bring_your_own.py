@@ -5,6 +5,7 @@ Run: python examples/bring_your_own.py --out byo   (writes byo/my_q.pt, byo/stat
 then: xairl explain --policy examples/bring_your_own.py:make_policy --policy-arg checkpoint=byo/my_q.pt \
         --states byo/states.npy --background byo/background.npy --out byo/report
 """
+
 import argparse
 from pathlib import Path
 
@@ -22,8 +23,9 @@ class QNetwork(nn.Module):
 
     def __init__(self, n_obs: int = 4, n_actions: int = 2):
         super().__init__()
-        self.network = nn.Sequential(nn.Linear(n_obs, 120), nn.ReLU(), nn.Linear(120, 84), nn.ReLU(),
-                                     nn.Linear(84, n_actions))
+        self.network = nn.Sequential(
+            nn.Linear(n_obs, 120), nn.ReLU(), nn.Linear(120, 84), nn.ReLU(), nn.Linear(84, n_actions)
+        )
 
     def forward(self, x):
         return self.network(x)
@@ -49,5 +51,7 @@ if __name__ == "__main__":
     scale = np.array([2.4, 1.0, 0.2, 1.0], dtype=np.float32)
     np.save(out / "states.npy", (rng.uniform(-1, 1, (args.states, 4)) * scale).astype(np.float32))
     np.save(out / "background.npy", (rng.uniform(-1, 1, (args.background, 4)) * scale).astype(np.float32))
-    print(f"xairl explain --policy {__file__}:make_policy --policy-arg checkpoint={out / 'my_q.pt'} "
-          f"--states {out / 'states.npy'} --background {out / 'background.npy'} --out {out / 'report'}")
+    print(
+        f"xairl explain --policy {__file__}:make_policy --policy-arg checkpoint={out / 'my_q.pt'} "
+        f"--states {out / 'states.npy'} --background {out / 'background.npy'} --out {out / 'report'}"
+    )

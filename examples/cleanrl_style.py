@@ -2,6 +2,7 @@
 
 Run: python examples/cleanrl_style.py [--steps 2000]
 """
+
 import argparse
 import random
 
@@ -17,8 +18,9 @@ args = ap.parse_args()
 torch.manual_seed(0)
 random.seed(0)
 env = gym.make("CartPole-v1")
-q = torch.nn.Sequential(torch.nn.Linear(4, 64), torch.nn.ReLU(), torch.nn.Linear(64, 64), torch.nn.ReLU(),
-                        torch.nn.Linear(64, 2))
+q = torch.nn.Sequential(
+    torch.nn.Linear(4, 64), torch.nn.ReLU(), torch.nn.Linear(64, 64), torch.nn.ReLU(), torch.nn.Linear(64, 2)
+)
 opt = torch.optim.Adam(q.parameters(), lr=1e-3)
 obs, _ = env.reset(seed=0)
 seen = []

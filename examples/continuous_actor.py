@@ -3,6 +3,7 @@ each action dimension on its own, the critic's Q(s, actor(s)) as a value, both n
 
 Run: python examples/continuous_actor.py [--timesteps 600]
 """
+
 import argparse
 
 import gymnasium as gym
@@ -19,7 +20,7 @@ states = [env.reset(seed=s)[0] for s in range(60)]
 names = ["cos_theta", "sin_theta", "angular_velocity"]
 
 # --- xairl: the actor's torque (in N m, as the environment takes it) and the critic's value of it ---
-actor = xairl.from_sb3(model, feature_names=names, action_names=["torque"])       # output: continuous
+actor = xairl.from_sb3(model, feature_names=names, action_names=["torque"])  # output: continuous
 critic = xairl.from_sb3(model, head="q", feature_names=names, action_names=["Q"])  # output: value
 for policy in (actor, critic):
     exp = xairl.explain(policy, states[:2], background=states[2:], method="deep_shap")

@@ -2,6 +2,7 @@
 
 Run: python examples/sb3_cartpole.py [--timesteps 3000]
 """
+
 import argparse
 
 import gymnasium as gym
@@ -17,8 +18,11 @@ model = DQN("MlpPolicy", env, learning_starts=200, seed=0, verbose=0).learn(args
 states = [env.reset(seed=s)[0] for s in range(60)]
 
 # --- xairl: the whole explanation in a few lines ---
-policy = xairl.from_sb3(model, feature_names=["cart_position", "cart_velocity", "pole_angle", "pole_velocity"],
-                        action_names=["push_left", "push_right"])
+policy = xairl.from_sb3(
+    model,
+    feature_names=["cart_position", "cart_velocity", "pole_angle", "pole_velocity"],
+    action_names=["push_left", "push_right"],
+)
 exp = xairl.explain(policy, states[:5], background=states[5:], method="deep_shap")
 for i in range(len(exp.values)):
     print(xairl.narrate(exp, i, policy=policy).text)

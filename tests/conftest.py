@@ -1,4 +1,5 @@
 """Helpers shared by the core tests. The core is tested alone: no installed plugin is loaded."""
+
 import numpy as np
 import pytest
 import torch

@@ -2,6 +2,7 @@
 with random data in place of MNIST / California housing (nothing is downloaded), plus SB3's NatureCNN and a
 dict-input model. Each entry builds (policy, states, background, reference inputs) for the conformance table in
 ``tests/test_deep_models.py`` and ``benchmarks/conformance_deep.py``."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -30,11 +31,19 @@ class MnistCNN(nn.Module):
 
     def __init__(self):
         super().__init__()
-        self.conv_layers = nn.Sequential(nn.Conv2d(1, 10, 5), nn.MaxPool2d(2), nn.Tanh(), nn.Conv2d(10, 20, 5),
-                                         nn.ConvTranspose2d(20, 20, 1), nn.AdaptiveAvgPool2d((4, 4)), nn.Softplus(),
-                                         nn.Flatten())
-        self.fc_layers = nn.Sequential(nn.Linear(320, 50), nn.BatchNorm1d(50), nn.ReLU(), nn.Linear(50, 10), nn.ELU(),
-                                       nn.Softmax(dim=1))
+        self.conv_layers = nn.Sequential(
+            nn.Conv2d(1, 10, 5),
+            nn.MaxPool2d(2),
+            nn.Tanh(),
+            nn.Conv2d(10, 20, 5),
+            nn.ConvTranspose2d(20, 20, 1),
+            nn.AdaptiveAvgPool2d((4, 4)),
+            nn.Softplus(),
+            nn.Flatten(),
+        )
+        self.fc_layers = nn.Sequential(
+            nn.Linear(320, 50), nn.BatchNorm1d(50), nn.ReLU(), nn.Linear(50, 10), nn.ELU(), nn.Softmax(dim=1)
+        )
 
     def forward(self, x):
         return self.fc_layers(self.conv_layers(x).view(-1, 320))
@@ -43,8 +52,9 @@ class MnistCNN(nn.Module):
 class _Nested1(nn.Module):
     def __init__(self, f):
         super().__init__()
-        self.net = nn.Sequential(nn.Sequential(nn.Identity(), nn.Conv1d(1, 1, 1), nn.ConvTranspose1d(1, 1, 1)),
-                                 nn.AdaptiveAvgPool1d(f // 2))
+        self.net = nn.Sequential(
+            nn.Sequential(nn.Identity(), nn.Conv1d(1, 1, 1), nn.ConvTranspose1d(1, 1, 1)), nn.AdaptiveAvgPool1d(f // 2)
+        )
 
     def forward(self, x):
         return self.net(x.unsqueeze(1)).squeeze(1)
@@ -90,7 +100,9 @@ class MultiInputNet(nn.Module):
         super().__init__()
         self.disconnected = disconnected
         self.linear = nn.Linear(f // 2 if disconnected else f, 2)
-        self.output = nn.Sequential(nn.MaxPool1d(2), {"relu": nn.ReLU(), "selu": nn.SELU(), "gelu": nn.GELU()}[activation])
+        self.output = nn.Sequential(
+            nn.MaxPool1d(2), {"relu": nn.ReLU(), "selu": nn.SELU(), "gelu": nn.GELU()}[activation]
+        )
 
     def forward(self, x1, x2):
         x = self.linear(x1 if self.disconnected else torch.cat((x1, x2), dim=-1)).unsqueeze(1)
@@ -146,8 +158,10 @@ def build(name: str, n_states: int = 2, n_background: int = 10, seed: int = 0):
         return policy, x, bg, (torch.as_tensor(x), torch.as_tensor(bg))
     if name.startswith("multi_input"):
         _, disconnected, act = name.split(":")
-        net = _train(MultiInputNet(disconnected=disconnected == "disconnected", activation=act),
-                     lambda: ((torch.randn(64, 4), torch.randn(64, 4)), torch.randn(64, 1)))
+        net = _train(
+            MultiInputNet(disconnected=disconnected == "disconnected", activation=act),
+            lambda: ((torch.randn(64, 4), torch.randn(64, 4)), torch.randn(64, 1)),
+        )
         x = [rand(n_states, 4), rand(n_states, 4)]
         bg = [rand(n_background, 4), rand(n_background, 4)]
         policy = xairl.Policy(net, observation=[(4,), (4,)], output="value")
@@ -167,8 +181,14 @@ def build(name: str, n_states: int = 2, n_background: int = 10, seed: int = 0):
     raise KeyError(name)
 
 
-NAMES = ["mnist_cnn", "nested", "single_output", *(f"multi_input:{d}:{a}" for d in ("connected", "disconnected")
-                                                  for a in ("relu", "selu", "gelu")), "nature_cnn", "dict"]
+NAMES = [
+    "mnist_cnn",
+    "nested",
+    "single_output",
+    *(f"multi_input:{d}:{a}" for d in ("connected", "disconnected") for a in ("relu", "selu", "gelu")),
+    "nature_cnn",
+    "dict",
+]
 
 
 def shap_values(policy, inputs) -> np.ndarray:
@@ -176,8 +196,11 @@ def shap_values(policy, inputs) -> np.ndarray:
     import shap
 
     x, bg = inputs
-    net = _TupleToDict(policy.module, [p.key for p in policy.observation.parts]) \
-        if policy.observation.kind == "dict" else policy.module
+    net = (
+        _TupleToDict(policy.module, [p.key for p in policy.observation.parts])
+        if policy.observation.kind == "dict"
+        else policy.module
+    )
     ex = shap.DeepExplainer(net, bg)
     sv = ex.shap_values(x, check_additivity=False)
     parts = sv if isinstance(x, list) else [sv]
@@ -199,8 +222,10 @@ def captum_values(policy, x, bg) -> np.ndarray:
     from captum.attr import DeepLiftShap
 
     obs = policy.observation
-    xs, bs = obs.unflatten(torch.as_tensor(policy.check_states(x))), obs.unflatten(
-        torch.as_tensor(policy.check_states(bg, "background")))
+    xs, bs = (
+        obs.unflatten(torch.as_tensor(policy.check_states(x))),
+        obs.unflatten(torch.as_tensor(policy.check_states(bg, "background"))),
+    )
     net = policy.module
     if obs.kind == "dict":
         net, xs, bs = _TupleToDict(net, list(xs)), tuple(xs.values()), tuple(bs.values())

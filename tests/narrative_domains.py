@@ -7,6 +7,7 @@ payments raise the default risk), so their SHAP values read like a real model's.
 Policy whose metadata (names, descriptions, units, categories, aliases, domain facts) a verifier may use; the
 corpus stores the explanations themselves, so re-fitting a model never changes a label.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -44,12 +45,27 @@ def sample(domain: str, n: int, seed: int) -> np.ndarray:
     """``n`` synthetic rows of a tabular domain, in raw units (categorical features as integer codes)."""
     r = np.random.default_rng(seed)
     if domain == "housing":
-        cols = [r.normal(1500, 450, n).clip(500, 4000), r.integers(3, 11, n), r.integers(1920, 2011, n),
-                r.lognormal(9.1, 0.35, n), r.integers(0, 4, n), r.integers(0, 5, n), r.integers(0, 2, n),
-                r.integers(0, 4, n)]
+        cols = [
+            r.normal(1500, 450, n).clip(500, 4000),
+            r.integers(3, 11, n),
+            r.integers(1920, 2011, n),
+            r.lognormal(9.1, 0.35, n),
+            r.integers(0, 4, n),
+            r.integers(0, 5, n),
+            r.integers(0, 2, n),
+            r.integers(0, 4, n),
+        ]
     else:
-        cols = [r.integers(21, 76, n), r.lognormal(10.8, 0.45, n), r.uniform(0.05, 0.75, n), r.poisson(0.8, n),
-                r.integers(0, 31, n), r.integers(0, 4, n), r.integers(0, 3, n), r.integers(0, 4, n)]
+        cols = [
+            r.integers(21, 76, n),
+            r.lognormal(10.8, 0.45, n),
+            r.uniform(0.05, 0.75, n),
+            r.poisson(0.8, n),
+            r.integers(0, 31, n),
+            r.integers(0, 4, n),
+            r.integers(0, 3, n),
+            r.integers(0, 4, n),
+        ]
     return np.column_stack(cols).astype(np.float32)
 
 
@@ -58,13 +74,31 @@ def _truth(domain: str, x: np.ndarray) -> np.ndarray:
     if domain == "housing":
         nb = np.array([0.0, -18e3, 35e3, -12e3, 20e3])[x[:, 5].astype(int)]
         kq = np.array([-15e3, 0.0, 12e3, 30e3])[x[:, 7].astype(int)]
-        return (40e3 + 62 * x[:, 0] + 9e3 * x[:, 1] + 420 * (x[:, 2] - 1970) + 1.4 * x[:, 3] + 7e3 * x[:, 4]
-                + nb + 9e3 * x[:, 6] + kq)
+        return (
+            40e3
+            + 62 * x[:, 0]
+            + 9e3 * x[:, 1]
+            + 420 * (x[:, 2] - 1970)
+            + 1.4 * x[:, 3]
+            + 7e3 * x[:, 4]
+            + nb
+            + 9e3 * x[:, 6]
+            + kq
+        )
     emp = np.array([0.0, 0.4, 1.3, -0.2])[x[:, 5].astype(int)]
     hous = np.array([-0.3, 0.25, 0.1])[x[:, 6].astype(int)]
     purp = np.array([0.0, 0.2, 0.6, -0.1])[x[:, 7].astype(int)]
-    return (-1.2 - 0.02 * (x[:, 0] - 40) - 0.9 * (np.log(x[:, 1]) - 10.8) + 3.0 * (x[:, 2] - 0.35)
-            + 0.55 * x[:, 3] - 0.04 * x[:, 4] + emp + hous + purp)
+    return (
+        -1.2
+        - 0.02 * (x[:, 0] - 40)
+        - 0.9 * (np.log(x[:, 1]) - 10.8)
+        + 3.0 * (x[:, 2] - 0.35)
+        + 0.55 * x[:, 3]
+        - 0.04 * x[:, 4]
+        + emp
+        + hous
+        + purp
+    )
 
 
 class _Tabular(torch.nn.Module):
@@ -81,15 +115,16 @@ class _Tabular(torch.nn.Module):
         self.register_buffer("std", torch.ones(len(self.num)))
         self.register_buffer("out_scale", torch.ones(()))
         self.register_buffer("out_shift", torch.zeros(()))
-        self.net = torch.nn.Sequential(torch.nn.Linear(len(self.num) + sum(self.sizes), 32), torch.nn.ReLU(),
-                                       torch.nn.Linear(32, 1))
+        self.net = torch.nn.Sequential(
+            torch.nn.Linear(len(self.num) + sum(self.sizes), 32), torch.nn.ReLU(), torch.nn.Linear(32, 1)
+        )
         self.sigmoid = domain == "credit"
 
     def raw(self, x: torch.Tensor) -> torch.Tensor:
         """The standardised output (before scaling and the sigmoid)."""
         parts = [(x[:, self.num] - self.mean) / self.std]
         for j, k in zip(self.cat, self.sizes):
-            parts.append((x[:, j:j + 1] == torch.arange(k, dtype=x.dtype)).to(x.dtype))
+            parts.append((x[:, j : j + 1] == torch.arange(k, dtype=x.dtype)).to(x.dtype))
         return self.net(torch.cat(parts, dim=1))
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
@@ -132,6 +167,12 @@ def policy(domain: str, module: torch.nn.Module | None = None) -> xairl.Policy:
         return toy_policy()
     spec = SPECS[domain]
     features = {f: xairl.FeatureInfo(unit, desc, categories=cats) for f, (desc, unit, cats) in spec.items()}
-    return xairl.Policy(module if module is not None else _Tabular(domain), list(spec), [OUTPUT_NAME[domain]],
-                        features=features, output="value", name=domain,
-                        background_sampler=lambda n, seed: sample(domain, n, seed))
+    return xairl.Policy(
+        module if module is not None else _Tabular(domain),
+        list(spec),
+        [OUTPUT_NAME[domain]],
+        features=features,
+        output="value",
+        name=domain,
+        background_sampler=lambda n, seed: sample(domain, n, seed),
+    )

@@ -6,21 +6,25 @@ does so in ``re`` too; a run stops with :class:`TooManySteps` once it has spent 
 deterministic: the same pattern and text always take the same number, on any machine and under any load. Character
 classes are read approximately (Unicode categories by ``str`` methods), which changes no count that matters here.
 """
+
 from __future__ import annotations
 
 import re
 import sys
 
 try:
-    from re import _constants as C, _parser as P  # Python 3.11+
+    from re import _constants as C  # Python 3.11+
+    from re import _parser as P
 except ImportError:  # Python 3.10
     import sre_constants as C  # type: ignore[no-redef]
     import sre_parse as P  # type: ignore[no-redef]
 
 _CATEGORIES = {
-    C.CATEGORY_DIGIT: str.isdecimal, C.CATEGORY_SPACE: str.isspace,
+    C.CATEGORY_DIGIT: str.isdecimal,
+    C.CATEGORY_SPACE: str.isspace,
     C.CATEGORY_WORD: lambda ch: ch.isalnum() or ch == "_",
-    C.CATEGORY_NOT_DIGIT: lambda ch: not ch.isdecimal(), C.CATEGORY_NOT_SPACE: lambda ch: not ch.isspace(),
+    C.CATEGORY_NOT_DIGIT: lambda ch: not ch.isdecimal(),
+    C.CATEGORY_NOT_SPACE: lambda ch: not ch.isspace(),
     C.CATEGORY_NOT_WORD: lambda ch: not (ch.isalnum() or ch == "_"),
 }
 _ATOMIC = getattr(C, "ATOMIC_GROUP", None)
@@ -90,11 +94,15 @@ class StepCounter:
 
         def word(i):
             return 0 <= i < len(text) and (text[i].isalnum() or text[i] == "_")
+
         if code in (C.AT_BEGINNING, C.AT_BEGINNING_STRING):
             return pos == 0 or (code == C.AT_BEGINNING and flags & re.MULTILINE and text[pos - 1] == "\n")
         if code == C.AT_END:
-            return pos == len(text) or (pos == len(text) - 1 and text[pos] == "\n") or bool(
-                flags & re.MULTILINE and pos < len(text) and text[pos] == "\n")
+            return (
+                pos == len(text)
+                or (pos == len(text) - 1 and text[pos] == "\n")
+                or bool(flags & re.MULTILINE and pos < len(text) and text[pos] == "\n")
+            )
         if code == C.AT_END_STRING:
             return pos == len(text)
         if code == C.AT_BOUNDARY:
@@ -111,6 +119,7 @@ class StepCounter:
 
         def nxt(p, c):
             return self._seq(items, i + 1, p, c, flags, k)
+
         if op in (C.LITERAL, C.NOT_LITERAL, C.ANY, C.IN):
             return pos < len(self.text) and self._char(op, av, self.text[pos], flags) and nxt(pos + 1, caps)
         if op == C.AT:
@@ -123,6 +132,7 @@ class StepCounter:
 
             def close(p, c):
                 return nxt(p, {**c, group: (pos, p)} if group else c)
+
             return self._seq(list(sub), 0, pos, caps, inner, close)
         if op in (C.MAX_REPEAT, C.MIN_REPEAT, _POSSESSIVE):
             return self._repeat(op, av, pos, caps, flags, nxt)
@@ -141,7 +151,7 @@ class StepCounter:
         if op == C.GROUPREF:
             if av not in caps:
                 return False
-            said = self.text[caps[av][0]:caps[av][1]]
+            said = self.text[caps[av][0] : caps[av][1]]
             return self.text.startswith(said, pos) and nxt(pos + len(said), caps)
         raise NotImplementedError(op)
 
@@ -159,10 +169,12 @@ class StepCounter:
             self._tick()
             if op == C.MIN_REPEAT and count >= lo and nxt(p, c):
                 return True
-            if count < hi and self._seq(sub, 0, p, c, flags,
-                                        lambda q, d: (q != p or count < lo) and more(count + 1, q, d)):
+            if count < hi and self._seq(
+                sub, 0, p, c, flags, lambda q, d: (q != p or count < lo) and more(count + 1, q, d)
+            ):
                 return True
             return op != C.MIN_REPEAT and count >= lo and nxt(p, c)
+
         if op == _POSSESSIVE:
             ends = []
             self._repeat(C.MAX_REPEAT, av, pos, caps, flags, lambda p, c: ends.append((p, c)) or True)

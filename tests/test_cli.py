@@ -20,8 +20,10 @@ def run(capsys, *argv):
 
 
 def test_help_does_not_import_heavy_libraries():
-    code = ("import sys\nfrom xairl.cli import main\ntry:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
-            "print([m for m in ('torch', 'shap', 'transformers', 'captum') if m in sys.modules])")
+    code = (
+        "import sys\nfrom xairl.cli import main\ntry:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+        "print([m for m in ('torch', 'shap', 'transformers', 'captum') if m in sys.modules])"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert "explain" in out and out.strip().endswith("[]")
 
@@ -43,8 +45,9 @@ def test_explain_csv_jsonl_matches_api(tmp_path, capsys):
     csv.write_text(",".join(FEATURES) + "\n" + "\n".join(",".join(map(repr, r.tolist())) for r in states) + "\n")
     bg = tmp_path / "bg.npy"
     np.save(bg, policy.background(20))
-    rc, out, err = run(capsys, "explain", "--states", str(csv), "--background", str(bg), "--method", "exact",
-                       "--format", "jsonl")
+    rc, out, err = run(
+        capsys, "explain", "--states", str(csv), "--background", str(bg), "--method", "exact", "--format", "jsonl"
+    )
     assert rc == 0, err
     recs = [json.loads(line) for line in out.splitlines()]
     ref = xairl.explain(policy, states, background=np.load(bg), method="exact")
@@ -76,8 +79,20 @@ def test_narration_marks_each_sentence(tmp_path, capsys):
 
 
 def test_explain_table_and_options(capsys):
-    rc, out, err = run(capsys, "explain", "--n", "2", "--method", "integrated_gradients", "-o", "n_steps=16",
-                       "-o", "method=riemann_left", "--top", "2")
+    rc, out, err = run(
+        capsys,
+        "explain",
+        "--n",
+        "2",
+        "--method",
+        "integrated_gradients",
+        "-o",
+        "n_steps=16",
+        "-o",
+        "method=riemann_left",
+        "--top",
+        "2",
+    )
     assert rc == 0, err
     assert out.count(": chose ") == 2 and "integrated_gradients" in out
     assert out.startswith("contributions to the margin") and out.count("expected margin") == 2
@@ -97,25 +112,31 @@ def test_version_and_examples(capsys):
         assert "examples:" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("argv, match", [
-    (["explain", "--method", "shapley"], "unknown attributor 'shapley'"),
-    (["explain", "--policy", "nope"], "unknown policy 'nope'"),
-    (["explain", "-o", "foo=1"], "foo: unknown option"),
-    (["explain", "-o", "novalue"], "is not key=value"),
-    (["explain", "--method", "exact", "-o", "max_rows=-3"], "max_rows"),
-    (["explain", "--states", "/nonexistent.csv"], "no such file"),
-])
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (["explain", "--method", "shapley"], "unknown attributor 'shapley'"),
+        (["explain", "--policy", "nope"], "unknown policy 'nope'"),
+        (["explain", "-o", "foo=1"], "foo: unknown option"),
+        (["explain", "-o", "novalue"], "is not key=value"),
+        (["explain", "--method", "exact", "-o", "max_rows=-3"], "max_rows"),
+        (["explain", "--states", "/nonexistent.csv"], "no such file"),
+    ],
+)
 def test_user_errors_are_one_line_exit_2(capsys, argv, match):
     rc, out, err = run(capsys, *argv)
     assert rc == 2
     assert match in err and err.count("\n") == 1 and "Traceback" not in err
 
 
-@pytest.mark.parametrize("content, match", [
-    ("battery,distance\n1,2\n", "lack column"),
-    (",".join(FEATURES) + "\n1,2,nan,4,5\n", "NaN/inf"),
-    (",".join(FEATURES) + "\n1,2,three,4,5\n", "'three' is not a number"),
-])
+@pytest.mark.parametrize(
+    "content, match",
+    [
+        ("battery,distance\n1,2\n", "lack column"),
+        (",".join(FEATURES) + "\n1,2,nan,4,5\n", "NaN/inf"),
+        (",".join(FEATURES) + "\n1,2,three,4,5\n", "'three' is not a number"),
+    ],
+)
 def test_bad_state_files(tmp_path, capsys, content, match):
     p = tmp_path / "s.csv"
     p.write_text(content)
@@ -133,20 +154,33 @@ def test_background_of_wrong_width(tmp_path, capsys):
 def test_installed_script_smoke():
     exe = shutil.which("xairl", path=str(Path(sys.executable).parent)) or shutil.which("xairl")
     assert exe, "the console script `xairl` is not installed"
-    res = subprocess.run([exe, "explain", "--n", "1", "--format", "jsonl"], capture_output=True, text=True,
-                         env={**os.environ, "XAIRL_DEBUG": ""}, timeout=120)
+    res = subprocess.run(
+        [exe, "explain", "--n", "1", "--format", "jsonl"],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "XAIRL_DEBUG": ""},
+        timeout=120,
+    )
     assert res.returncode == 0, res.stderr
     assert json.loads(res.stdout)["method"] == "deep_shap"
 
 
 def test_verify_trace_names_the_reading_of_each_claim(tmp_path, capsys):
-    exp = xairl.Explanation(values=np.array([[[0.3], [-0.2]]]), base_values=np.zeros((1, 1)),
-                            outputs=np.array([[0.1]]), states=np.array([[1.0, 2.0]]), feature_names=("speed", "load"),
-                            action_names=("risk",), method="given", output="value")
+    exp = xairl.Explanation(
+        values=np.array([[[0.3], [-0.2]]]),
+        base_values=np.zeros((1, 1)),
+        outputs=np.array([[0.1]]),
+        states=np.array([[1.0, 2.0]]),
+        feature_names=("speed", "load"),
+        action_names=("risk",),
+        method="given",
+        output="value",
+    )
     path = tmp_path / "exp.json"
     path.write_text(exp.to_json())
-    rc, out, _ = run(capsys, "verify", "Speed raised the risk by 0.3 over the last 30 days.", "--explanation",
-                     str(path), "--trace")
+    rc, out, _ = run(
+        capsys, "verify", "Speed raised the risk by 0.3 over the last 30 days.", "--explanation", str(path), "--trace"
+    )
     assert rc == 0 and "accurate: yes; ok: yes" in out
     assert "number.name-before" in out and "parse.counts-other" in out and "it counts 'days'" in out
     rc, out, _ = run(capsys, "verify", "The load lowered it by 0.5.", "--explanation", str(path))

@@ -1,4 +1,5 @@
 """One table over every registered attributor (captum's idea): shape, determinism, additivity, clean-up."""
+
 import numpy as np
 import pytest
 import torch
@@ -12,9 +13,20 @@ from .conftest import ReusedActivations, mlp
 MODELS = {
     "relu_mlp": lambda: mlp([5, 16, 16, 3]),
     "mixed_acts": lambda: torch.nn.Sequential(
-        torch.nn.Linear(5, 8), torch.nn.LeakyReLU(0.1), torch.nn.Linear(8, 8), torch.nn.ELU(),
-        torch.nn.Linear(8, 8), torch.nn.SiLU(), torch.nn.Linear(8, 8), torch.nn.Sigmoid(),
-        torch.nn.Linear(8, 8), torch.nn.Softplus(), torch.nn.Linear(8, 8), torch.nn.GELU(), torch.nn.Linear(8, 4)),
+        torch.nn.Linear(5, 8),
+        torch.nn.LeakyReLU(0.1),
+        torch.nn.Linear(8, 8),
+        torch.nn.ELU(),
+        torch.nn.Linear(8, 8),
+        torch.nn.SiLU(),
+        torch.nn.Linear(8, 8),
+        torch.nn.Sigmoid(),
+        torch.nn.Linear(8, 8),
+        torch.nn.Softplus(),
+        torch.nn.Linear(8, 8),
+        torch.nn.GELU(),
+        torch.nn.Linear(8, 4),
+    ),
     "reused_relu": lambda: ReusedActivations(f=5),
 }
 # IG is not a Shapley method: its gap is its convergence delta, bounded here for 64 Gauss-Legendre steps
@@ -90,7 +102,9 @@ def test_hooks_and_mode_restored_after_error(method, data):
     net.train()
     policy = xairl.Policy(net, [f"f{i}" for i in range(5)], ["a", "b", "c"])
     # the user's exception comes out as one xairl line naming the module and the input's shape
-    with pytest.raises(xairl.InputError, match=r"module Exploding raised RuntimeError \(injected failure\) on input \("):
+    with pytest.raises(
+        xairl.InputError, match=r"module Exploding raised RuntimeError \(injected failure\) on input \("
+    ):
         xairl.explain(policy, x, background=bg, method=method, options=SMALL.get(method, {}))
     assert net.calls >= 2
     assert hook_count(net) == 0

@@ -1,5 +1,6 @@
 """Decision narration: reasons for the margin first with the strongest opposing one as a concession, feature kinds
 (identifier, group, capacity, thresholds), level words, coverage in the confidence, evidence."""
+
 from dataclasses import replace
 
 import numpy as np
@@ -18,12 +19,15 @@ def _policy(**features):
     with torch.no_grad():
         net.weight.copy_(torch.tensor([[2.0, -3.0, 0.5, 0.5, 1.0], [0.0, 0.0, 0.0, 0.0, 1.0]]))
         net.bias.zero_()
-    info = {"speed": xairl.FeatureInfo("m/s", "the speed", thresholds=(1.0, 5.0)),
-            "load": xairl.FeatureInfo("bit", "the queue", "lightly loaded", "heavily loaded", capacity=100.0),
-            "cell": xairl.FeatureInfo("", "the cell id", kind="identifier"),
-            "position": xairl.FeatureInfo("", "the position", kind="group")} | features
-    return xairl.Policy(net, ["speed", "load", "x", "y", "cell"], ["go", "wait"], features=info,
-                             groups={"position": ("x", "y")})
+    info = {
+        "speed": xairl.FeatureInfo("m/s", "the speed", thresholds=(1.0, 5.0)),
+        "load": xairl.FeatureInfo("bit", "the queue", "lightly loaded", "heavily loaded", capacity=100.0),
+        "cell": xairl.FeatureInfo("", "the cell id", kind="identifier"),
+        "position": xairl.FeatureInfo("", "the position", kind="group"),
+    } | features
+    return xairl.Policy(
+        net, ["speed", "load", "x", "y", "cell"], ["go", "wait"], features=info, groups={"position": ("x", "y")}
+    )
 
 
 @pytest.fixture(scope="module")
@@ -100,7 +104,9 @@ def test_history_reaches_a_hook_that_takes_it(case):
     def hook(state, chosen, runner_up, history=None):
         seen.append(None if history is None else history.shape)
         steps = 0 if history is None else len(history)
-        return xairl.facts.DomainFacts(comparisons=(xairl.facts.Comparison(f"it has gone for {steps} steps", steps, "steps"),))
+        return xairl.facts.DomainFacts(
+            comparisons=(xairl.facts.Comparison(f"it has gone for {steps} steps", steps, "steps"),)
+        )
 
     hooked = replace(p, facts_hook=hook)  # a Policy is frozen: a changed one is a new one
     n = xairl.narrate(exp, 0, policy=hooked, robustness=False, history=np.zeros((4, 5)))

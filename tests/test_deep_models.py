@@ -1,5 +1,6 @@
 """Conformance of deep_shap on the networks of shap's own DeepExplainer tests, SB3's NatureCNN and dict / multi-input
 networks: values against shap.DeepExplainer and captum's DeepLiftShap, additivity, hooks removed after a failure."""
+
 import numpy as np
 import pytest
 import torch

@@ -1,6 +1,7 @@
 """Seeded runs give bit-identical explanations and narratives across processes (with different hash seeds), for
 every attribution method and the template narrator. The local language model's runs repeat in one process
 (tests/test_local_lm.py): its load is what costs time, so it is loaded once."""
+
 import os
 import subprocess
 import sys
@@ -22,6 +23,14 @@ print(h.hexdigest())
 
 
 def test_two_processes_same_bits():
-    runs = [subprocess.run([sys.executable, "-c", CODE], capture_output=True, text=True, check=True,
-                           env={**os.environ, "PYTHONHASHSEED": seed}).stdout.strip() for seed in ("1", "2")]
+    runs = [
+        subprocess.run(
+            [sys.executable, "-c", CODE],
+            capture_output=True,
+            text=True,
+            check=True,
+            env={**os.environ, "PYTHONHASHSEED": seed},
+        ).stdout.strip()
+        for seed in ("1", "2")
+    ]
     assert len(runs[0]) == 64 and runs[0] == runs[1]

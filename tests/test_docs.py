@@ -1,5 +1,6 @@
 """The documentation: the MkDocs site (with the API reference from the docstrings) builds without a warning, the
 README stays short, and every relative link in the Markdown files points to a file that exists."""
+
 import os
 import re
 import subprocess
@@ -43,8 +44,14 @@ def test_relative_links_point_to_files(path):
 def test_site_builds_without_warnings(tmp_path):
     # no skip when MkDocs is missing: the docs extra (pip install -e '.[docs]') is part of the test set-up
     env = {**os.environ, "NO_COLOR": "1"}
-    proc = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
-                          cwd=ROOT, capture_output=True, text=True, timeout=120, env=env)
+    proc = subprocess.run(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+    )
     output = proc.stdout + proc.stderr
     assert proc.returncode == 0, output[-4000:]
     assert "WARNING" not in output, output[-4000:]

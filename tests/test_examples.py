@@ -1,17 +1,23 @@
 """Every example runs with a tiny budget (CleanRL-style subprocess smoke tests)."""
+
 import os
 import subprocess
 import sys
 from pathlib import Path
-
 
 ROOT = Path(__file__).resolve().parents[1]
 EX = ROOT / "examples"
 
 
 def run(args, env=None, timeout=300):
-    res = subprocess.run([sys.executable, *args], capture_output=True, text=True, timeout=timeout, cwd=ROOT,
-                         env={**os.environ, **(env or {})})
+    res = subprocess.run(
+        [sys.executable, *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        cwd=ROOT,
+        env={**os.environ, **(env or {})},
+    )
     assert res.returncode == 0, res.stderr[-2000:]
     return res.stdout
 
@@ -30,10 +36,26 @@ def test_atari_cnn_and_its_cli_with_nothing_installed(tmp_path):
     out = run([str(EX / "atari_cnn.py"), "--out", str(tmp_path / "ex")])
     assert "strongest patches: ['patch[" in out and (tmp_path / "ex" / "image.png").stat().st_size > 5000
     xairl = str(Path(sys.executable).with_name("xairl"))
-    res = subprocess.run([xairl, "explain", "--policy", f"{EX / 'atari_cnn.py'}:make_policy", "--policy-arg", "seed=1",
-                          "--states", str(tmp_path / "ex" / "states.npy"), "--background",
-                          str(tmp_path / "ex" / "background.npy"), "--out", str(tmp_path / "rep")],
-                         capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    res = subprocess.run(
+        [
+            xairl,
+            "explain",
+            "--policy",
+            f"{EX / 'atari_cnn.py'}:make_policy",
+            "--policy-arg",
+            "seed=1",
+            "--states",
+            str(tmp_path / "ex" / "states.npy"),
+            "--background",
+            str(tmp_path / "ex" / "background.npy"),
+            "--out",
+            str(tmp_path / "rep"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+    )
     assert res.returncode == 0, res.stderr[-2000:]
     for name in ("explanations.jsonl", "report.html", "beeswarm.png", "image.png"):
         assert (tmp_path / "rep" / name).stat().st_size > 0, name
@@ -56,20 +78,71 @@ def test_custom_prompt():
 def test_my_plugin_installs_and_registers(tmp_path):
     """pip installs the example plugin into its own folder; the entry point makes xairl find it."""
     target = tmp_path / "site"
-    subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation", "--target",
-                    str(target), str(EX / "my_plugin")], check=True, capture_output=True, timeout=300)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "install",
+            "-q",
+            "--no-deps",
+            "--no-build-isolation",
+            "--target",
+            str(target),
+            str(EX / "my_plugin"),
+        ],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
     env = {"PYTHONPATH": str(target), "XAIRL_LOAD_PLUGINS": "my-plugin"}
     out = run(["-m", "xairl.cli", "plugins"], env)
-    assert ("my-plugin\n  attributor: occlusion\n  command: thermostat\n  narrator: shortest\n  policy: thermostat\n"
-            "  prompt directory: ") in out
+    assert (
+        "my-plugin\n  attributor: occlusion\n  command: thermostat\n  narrator: shortest\n  policy: thermostat\n"
+        "  prompt directory: "
+    ) in out
     out = run(["-m", "xairl.cli", "thermostat", "--temperature", "15"], env)
     assert out.startswith("The thermostat chose heat: the room temperature (15 degC, cold) pushed toward it by +")
-    out = run(["-m", "xairl.cli", "explain", "--policy", "thermostat", "--n", "2", "--narrate", "--no-record",
-               "--template", "thermostat"], env)
+    out = run(
+        [
+            "-m",
+            "xairl.cli",
+            "explain",
+            "--policy",
+            "thermostat",
+            "--n",
+            "2",
+            "--narrate",
+            "--no-record",
+            "--template",
+            "thermostat",
+        ],
+        env,
+    )
     assert out.count("[verified") == 2
     # the plugin's attributor and narrator, with options validated against their own models
-    out = run(["-m", "xairl.cli", "explain", "--policy", "thermostat", "--method", "occlusion", "-o", "max_rows=64",
-               "--n", "2", "--narrate", "--narrator", "shortest", "-n", "max_sentences=1", "--no-record"], env)
+    out = run(
+        [
+            "-m",
+            "xairl.cli",
+            "explain",
+            "--policy",
+            "thermostat",
+            "--method",
+            "occlusion",
+            "-o",
+            "max_rows=64",
+            "--n",
+            "2",
+            "--narrate",
+            "--narrator",
+            "shortest",
+            "-n",
+            "max_sentences=1",
+            "--no-record",
+        ],
+        env,
+    )
     assert out.count("[verified") == 2 and out.count("; shortest]") == 2
     for line in out.splitlines()[1::2]:  # one sentence per narrative
         assert line.strip().count(". ") == 0 and line.strip().endswith(".")

@@ -90,9 +90,15 @@ def test_patches_group_an_image_and_keep_additivity():
     assert sorted(np.concatenate(list(groups.values()))) == list(range(4 * 84 * 84))
     rng = np.random.default_rng(0)
     f = 4 * 84 * 84
-    e = xairl.Explanation(values=rng.normal(size=(2, f, 3)), base_values=np.zeros((2, 3)), outputs=np.zeros((2, 3)),
-                          states=rng.normal(size=(2, f)), feature_names=tuple(f"p{i}" for i in range(f)),
-                          action_names=("a", "b", "c"), method="test")
+    e = xairl.Explanation(
+        values=rng.normal(size=(2, f, 3)),
+        base_values=np.zeros((2, 3)),
+        outputs=np.zeros((2, 3)),
+        states=rng.normal(size=(2, f)),
+        feature_names=tuple(f"p{i}" for i in range(f)),
+        action_names=("a", "b", "c"),
+        method="test",
+    )
     g = e.grouped(groups)
     assert g.feature_names[0] == "patch[0,0]" and g.values.shape == (2, 196, 3)
     np.testing.assert_allclose(g.values.sum(axis=1), e.values.sum(axis=1))

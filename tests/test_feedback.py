@@ -1,4 +1,5 @@
 """The SQLite feedback store: record, review, export, concurrent writers, interrupted writes, CLI review."""
+
 import io
 import json
 import multiprocessing as mp

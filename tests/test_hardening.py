@@ -2,6 +2,7 @@
 CLI), never a traceback, a wrong result marked verified, or a partial file. The review page's items are in
 tests/test_review_page.py, the templates' in tests/test_prompts.py, the layers' in tests/test_layers.py and the fuzz
 runs in tests/test_fuzz.py."""
+
 import io
 import json
 import os
@@ -59,17 +60,34 @@ def test_an_explanation_of_non_finite_numbers_cannot_be_built_or_read():
             xairl.Explanation.from_json(text.replace("[[[", f"[[[{token}, ", 1))
 
 
-@pytest.mark.parametrize("text, words", [
-    ("", "not valid JSON"), ("{", "not valid JSON"), ("[]", "does not match"), ("null", "does not match"),
-    ('{"values": 1}', "does not match"), ("[" * 5000 + "]" * 5000, "nested too deeply"),
-    (b"\xff\xfe\x00", "not valid JSON"), ('{"values": [[[1]]], "base_values": [[0]], "outputs": [[1]], '
-                                         '"states": null, "feature_names": ["a"], "action_names": ["x", "y"], '
-                                         '"method": "m"}', "names do not match"),
-    ('{"values": [[[1], [2, 3]]], "base_values": [[0]], "outputs": [[1]], "states": null, "feature_names": ["a", "b"],'
-     ' "action_names": ["x"], "method": "m"}', "rows of different lengths"),
-    ('{"values": [[[1e308]], [[1e308]]], "base_values": [[0], [0]], "outputs": [[1' + "0" * 400 + '], [1]], '
-     '"states": null, "feature_names": ["a"], "action_names": ["x"], "method": "m"}', "does not match"),
-])
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        ("", "not valid JSON"),
+        ("{", "not valid JSON"),
+        ("[]", "does not match"),
+        ("null", "does not match"),
+        ('{"values": 1}', "does not match"),
+        ("[" * 5000 + "]" * 5000, "nested too deeply"),
+        (b"\xff\xfe\x00", "not valid JSON"),
+        (
+            '{"values": [[[1]]], "base_values": [[0]], "outputs": [[1]], '
+            '"states": null, "feature_names": ["a"], "action_names": ["x", "y"], '
+            '"method": "m"}',
+            "names do not match",
+        ),
+        (
+            '{"values": [[[1], [2, 3]]], "base_values": [[0]], "outputs": [[1]], "states": null, "feature_names": ["a", "b"],'
+            ' "action_names": ["x"], "method": "m"}',
+            "rows of different lengths",
+        ),
+        (
+            '{"values": [[[1e308]], [[1e308]]], "base_values": [[0], [0]], "outputs": [[1' + "0" * 400 + "], [1]], "
+            '"states": null, "feature_names": ["a"], "action_names": ["x"], "method": "m"}',
+            "does not match",
+        ),
+    ],
+)
 def test_from_json_refuses_bad_input_in_one_line(text, words):
     """It used to raise raw pydantic, JSONDecodeError or IndexError text."""
     with pytest.raises(InputError, match=words) as info:
@@ -78,8 +96,13 @@ def test_from_json_refuses_bad_input_in_one_line(text, words):
 
 
 def test_json_round_trip_keeps_every_field():
-    policy = xairl.Policy(POLICY.module, FEATURES, POLICY.action_names, action_mask=lambda x: np.ones(
-        (len(x), 3), bool), features={"wind": xairl.FeatureInfo(categories=("calm", "storm"))})
+    policy = xairl.Policy(
+        POLICY.module,
+        FEATURES,
+        POLICY.action_names,
+        action_mask=lambda x: np.ones((len(x), 3), bool),
+        features={"wind": xairl.FeatureInfo(categories=("calm", "storm"))},
+    )
     exp = xairl.explain(policy, POLICY.background(3, seed=1), background=POLICY.background(20), method="exact")
     back = xairl.Explanation.from_json(exp.to_json())
     for f in ("values", "base_values", "outputs", "states", "background_quantiles", "available"):
@@ -90,12 +113,15 @@ def test_json_round_trip_keeps_every_field():
 
 
 # 4. inputs that should be refused ---------------------------------------------------------------------------------
-@pytest.mark.parametrize("states, words", [
-    (np.ones((2, 5)) * (1 + 2j), "complex numbers"),
-    (np.array([np.datetime64("2026-01-01")] * 5)[None], "dates"),
-    (np.array([np.timedelta64(3, "s")] * 5)[None], "time spans"),
-    ([[10 ** 400, 1, 1, 1, 1]], "must be numeric"),
-])
+@pytest.mark.parametrize(
+    "states, words",
+    [
+        (np.ones((2, 5)) * (1 + 2j), "complex numbers"),
+        (np.array([np.datetime64("2026-01-01")] * 5)[None], "dates"),
+        (np.array([np.timedelta64(3, "s")] * 5)[None], "time spans"),
+        ([[10**400, 1, 1, 1, 1]], "must be numeric"),
+    ],
+)
 def test_states_that_numpy_would_misread_are_refused(states, words):
     """Complex arrays lost their imaginary part with a warning; dates and time spans were taken as counts."""
     with pytest.raises(InputError, match=words):
@@ -112,11 +138,11 @@ def test_a_small_file_that_would_expand_enormously_is_refused_before_loading(tmp
     """A 3.9 MB .npz expanding to 4 GB and a .npy header claiming 10^11 rows ended in MemoryError."""
     bomb = tmp_path / "bomb.npz"
     with zipfile.ZipFile(bomb, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("arr_0.npy", _npy_header((10 ** 11, 5)) + b"\0" * 1000)
+        z.writestr("arr_0.npy", _npy_header((10**11, 5)) + b"\0" * 1000)
     rc, _, err = run(capsys, "explain", "--states", str(bomb))
     one_line_error(rc, err, "would take 3.73e+03 GiB", "XAIRL_MAX_STATES_BYTES")
     claim = tmp_path / "claim.npy"
-    claim.write_bytes(_npy_header((10 ** 11, 5)) + b"\0" * 100)
+    claim.write_bytes(_npy_header((10**11, 5)) + b"\0" * 100)
     rc, _, err = run(capsys, "explain", "--states", str(claim))
     one_line_error(rc, err, "claim.npy")
     truncated = tmp_path / "truncated.npy"
@@ -136,18 +162,21 @@ def test_the_size_limit_can_be_raised(tmp_path, monkeypatch):
 
 
 # 5. one-line errors, exit 2 ---------------------------------------------------------------------------------------
-@pytest.mark.parametrize("argv, words", [
-    (["explain", "--n", "-1"], "--n: -1 must be between 1"),
-    (["explain", "--seed", "-1"], "--seed: -1 must be between 0"),
-    (["explain", "--background-size", "-5"], "--background-size: -5"),
-    (["explain", "--method", "kernel_shap", "-o", "nsamples=-5"], "nsamples"),
-    (["explain", "--method", "kernel_shap", "-o", "seed=-3"], "seed"),
-    (["explain", "--top", "-1"], "--top: -1 must be at least 1"),
-    (["explain", "--n", "two"], "'two' is not a whole number"),
-    (["review", "--serve", "--port", "99999"], "--port: 99999 must be between 0 and 65535"),
-    (["report", "--plugin", "uav-handover", "--n", "0"], "--n: 0"),
-    (["explain", "--nonsense"], "unrecognized arguments: --nonsense"),
-])
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["explain", "--n", "-1"], "--n: -1 must be between 1"),
+        (["explain", "--seed", "-1"], "--seed: -1 must be between 0"),
+        (["explain", "--background-size", "-5"], "--background-size: -5"),
+        (["explain", "--method", "kernel_shap", "-o", "nsamples=-5"], "nsamples"),
+        (["explain", "--method", "kernel_shap", "-o", "seed=-3"], "seed"),
+        (["explain", "--top", "-1"], "--top: -1 must be at least 1"),
+        (["explain", "--n", "two"], "'two' is not a whole number"),
+        (["review", "--serve", "--port", "99999"], "--port: 99999 must be between 0 and 65535"),
+        (["report", "--plugin", "uav-handover", "--n", "0"], "--n: 0"),
+        (["explain", "--nonsense"], "unrecognized arguments: --nonsense"),
+    ],
+)
 def test_bad_numbers_and_flags_are_one_line_errors(capsys, argv, words):
     rc, _, err = run(capsys, *argv)
     one_line_error(rc, err, words)
@@ -179,11 +208,13 @@ def test_a_model_folder_holding_a_pickle_is_refused_without_loading_it(tmp_path,
     """transformers would unpickle pytorch_model.bin; only safetensors (or GGUF) weights are read."""
     folder = tmp_path / "lm"
     folder.mkdir()
-    (folder / "config.json").write_text(json.dumps({"model_type": "gpt2", "n_layer": 1, "n_head": 1, "n_embd": 8,
-                                                    "vocab_size": 10}))
+    (folder / "config.json").write_text(
+        json.dumps({"model_type": "gpt2", "n_layer": 1, "n_head": 1, "n_embd": 8, "vocab_size": 10})
+    )
     marker = tmp_path / "ran"
     (folder / "pytorch_model.bin").write_bytes(
-        b"cos\nsystem\n(S'touch " + str(marker).encode() + b"'\ntR.")  # a pickle that runs a command
+        b"cos\nsystem\n(S'touch " + str(marker).encode() + b"'\ntR."
+    )  # a pickle that runs a command
     from xairl.narrators.local_lm import load_model
 
     with pytest.raises(InputError, match="cannot load the model .*safetensors"):
@@ -296,8 +327,9 @@ def test_the_confidence_doc_states_the_weights_the_code_uses():
 def test_a_policy_is_built_normalised_and_frozen():
     import dataclasses
 
-    policy = xairl.Policy(POLICY.module, list(FEATURES), ["forward", "turn", "recharge"],
-                          groups={"motion": ["speed", "wind"]})
+    policy = xairl.Policy(
+        POLICY.module, list(FEATURES), ["forward", "turn", "recharge"], groups={"motion": ["speed", "wind"]}
+    )
     assert policy.feature_names == FEATURES and isinstance(policy.action_names, tuple)
     assert policy.groups == {"motion": ("speed", "wind")}
     with pytest.raises(dataclasses.FrozenInstanceError):

@@ -2,6 +2,7 @@
 figures keep their labels apart and inside, write values in the feature's unit and give actions their own marks
 (14), the region beeswarm is readable (13), every figure names its view (15), and notebooks get no 'IProgress not
 found' (18)."""
+
 import itertools
 import socket
 import subprocess
@@ -85,7 +86,7 @@ def test_clients_that_trickle_are_hung_up_on_at_the_deadline_and_a_normal_client
             if k in cut:
                 continue
             try:
-                s.send(stream[sent:sent + 1])
+                s.send(stream[sent : sent + 1])
             except OSError:
                 cut[k] = time.monotonic() - opened
                 continue
@@ -178,8 +179,12 @@ def _overlap(a, b, slack=0.5) -> bool:
 
 
 def _inside(box, outer, slack=1.0) -> bool:
-    return box.x0 >= outer.x0 - slack and box.x1 <= outer.x1 + slack and box.y0 >= outer.y0 - slack and \
-        box.y1 <= outer.y1 + slack
+    return (
+        box.x0 >= outer.x0 - slack
+        and box.x1 <= outer.x1 + slack
+        and box.y0 >= outer.y0 - slack
+        and box.y1 <= outer.y1 + slack
+    )
 
 
 def _all_texts(fig):
@@ -193,8 +198,14 @@ def _all_texts(fig):
 def toy():
     """The toy policy, with a unit and a capacity declared for two of its features, and its explanation."""
     p = toy_policy()
-    p = replace(p, features={**p.features, "speed": FeatureInfo("m/s", "speed"),
-                             "battery": FeatureInfo("kWh", "battery charge", capacity=4.0)})
+    p = replace(
+        p,
+        features={
+            **p.features,
+            "speed": FeatureInfo("m/s", "speed"),
+            "battery": FeatureInfo("kWh", "battery charge", capacity=4.0),
+        },
+    )
     return p, xairl.explain(p, p.background(16, seed=1), background=p.background(40, seed=2))
 
 
@@ -205,10 +216,15 @@ def _lopsided(n_features=10) -> xairl.Explanation:
     v[:, 0, 0], v[:, 0, 1] = -60.0, 0.0  # action 0 chosen by its other features, pulled far down by feature 0
     v[:, 1:, 0] += 9.0
     base = np.array([[150.0, 140.0, 0.0]] * 4)
-    return xairl.Explanation(values=v, base_values=base, outputs=base + v.sum(axis=1),
-                             states=rng.normal(size=(4, n_features)) * 1e6,
-                             feature_names=[f"rsrq_{k}" for k in range(n_features)], action_names=["a", "b", "c"],
-                             method="test")
+    return xairl.Explanation(
+        values=v,
+        base_values=base,
+        outputs=base + v.sum(axis=1),
+        states=rng.normal(size=(4, n_features)) * 1e6,
+        feature_names=[f"rsrq_{k}" for k in range(n_features)],
+        action_names=["a", "b", "c"],
+        method="test",
+    )
 
 
 @pytest.mark.parametrize("view", ["margin", "score"])
@@ -242,8 +258,11 @@ def test_waterfall_writes_values_as_the_narratives_do_in_the_features_unit(toy):
     no_units = [t.label1.get_text() for t in plots.waterfall(_lopsided(), 0).axes[0].yaxis.get_major_ticks()]
     assert not [t for t in no_units if "e+" in t], no_units  # 1e6 is written out, as a narrative writes it
     narrative = xairl.narrate(exp, i, policy=policy, robustness=False)
-    fact = next(f for f in narrative.facts.features if f.name == "battery") if hasattr(narrative, "facts") and \
-        hasattr(narrative.facts, "features") else None
+    fact = (
+        next(f for f in narrative.facts.features if f.name == "battery")
+        if hasattr(narrative, "facts") and hasattr(narrative.facts, "features")
+        else None
+    )
     if fact is not None:  # the same text as the narrative's own fact
         assert f"battery = {fact.value_text}" in labels
 
@@ -284,12 +303,21 @@ def test_a_decision_with_one_action_available_is_no_margin_of_an_action_over_its
 
 def _long_regions(n_features=30) -> xairl.Explanation:
     rng = np.random.default_rng(0)
-    names = [f"the 12x12 patch at rows {12 * (k % 7)} to {12 * (k % 7) + 11}, columns {12 * (k // 7)} to "
-             f"{12 * (k // 7) + 11} of channel {k % 4}" for k in range(n_features)]
+    names = [
+        f"the 12x12 patch at rows {12 * (k % 7)} to {12 * (k % 7) + 11}, columns {12 * (k // 7)} to "
+        f"{12 * (k // 7) + 11} of channel {k % 4}"
+        for k in range(n_features)
+    ]
     v = rng.normal(size=(40, n_features, 3)) * np.linspace(1, 0.01, n_features)[None, :, None]
-    return xairl.Explanation(values=v, base_values=np.zeros((40, 3)), outputs=v.sum(axis=1),
-                             states=rng.normal(size=(40, n_features)), feature_names=names,
-                             action_names=["a", "b", "c"], method="test")
+    return xairl.Explanation(
+        values=v,
+        base_values=np.zeros((40, 3)),
+        outputs=v.sum(axis=1),
+        states=rng.normal(size=(40, n_features)),
+        feature_names=names,
+        action_names=["a", "b", "c"],
+        method="test",
+    )
 
 
 @pytest.fixture(scope="module")
@@ -297,10 +325,12 @@ def image_exp():
     import torch
 
     torch.manual_seed(0)
-    net = torch.nn.Sequential(torch.nn.Conv2d(4, 4, 8, 4), torch.nn.ReLU(), torch.nn.Flatten(),
-                              torch.nn.Linear(4 * 15 * 15, 6))
-    policy = xairl.Policy(net.eval(), observation=(4, 64, 64),
-                          action_names=["noop", "fire", "up", "right", "left", "down"])
+    net = torch.nn.Sequential(
+        torch.nn.Conv2d(4, 4, 8, 4), torch.nn.ReLU(), torch.nn.Flatten(), torch.nn.Linear(4 * 15 * 15, 6)
+    )
+    policy = xairl.Policy(
+        net.eval(), observation=(4, 64, 64), action_names=["noop", "fire", "up", "right", "left", "down"]
+    )
     frames = np.random.default_rng(0).uniform(0, 1, (8, 4, 64, 64)).astype(np.float32)
     return xairl.explain(policy, frames[:3], background=frames[3:])
 
@@ -314,8 +344,10 @@ def test_region_beeswarm_is_no_thin_strip_and_its_labels_neither_overlap_nor_lea
         for ax in plotted:
             assert ax.get_window_extent(r).width / fig.dpi >= 4.0, "the plot is a thin strip"
             drawn = _tick_labels(ax)
-            for ticks in ([t for t in drawn if t in ax.get_xticklabels()],
-                          [t for t in drawn if t in ax.get_yticklabels()]):
+            for ticks in (
+                [t for t in drawn if t in ax.get_xticklabels()],
+                [t for t in drawn if t in ax.get_yticklabels()],
+            ):
                 boxes = _boxes(ticks, r)
                 for (ta, a), (tb, b) in itertools.pairwise(boxes):
                     assert not _overlap(a, b), f"tick labels {ta!r} and {tb!r} overlap"
@@ -372,15 +404,18 @@ def test_the_reports_region_table_gives_each_grid_name_its_pixels(image_exp):
 
 # --- item 18: no 'IProgress not found' in a notebook --------------------------------------------------------------
 
-NOTEBOOK = ("import sys, types\n"
-            "sys.modules['ipykernel.zmqshell'] = types.ModuleType('ipykernel.zmqshell')  # what tqdm reads as Jupyter\n"
-            "import IPython\n")
+NOTEBOOK = (
+    "import sys, types\n"
+    "sys.modules['ipykernel.zmqshell'] = types.ModuleType('ipykernel.zmqshell')  # what tqdm reads as Jupyter\n"
+    "import IPython\n"
+)
 
 
 def _in_a_notebook(code: str) -> subprocess.CompletedProcess:
     """``code`` run where tqdm believes it is in a Jupyter kernel without ipywidgets (as a bare Jupyter install)."""
-    return subprocess.run([sys.executable, "-c", NOTEBOOK + code], capture_output=True, text=True, timeout=120,
-                          check=False)
+    return subprocess.run(
+        [sys.executable, "-c", NOTEBOOK + code], capture_output=True, text=True, timeout=120, check=False
+    )
 
 
 def test_the_notebook_check_is_real():
@@ -390,10 +425,12 @@ def test_the_notebook_check_is_real():
 
 
 def test_progress_bars_are_quiet_in_a_notebook_and_still_count():
-    run = _in_a_notebook("from xairl.display import progress\n"
-                         "assert sum(progress(range(3), desc='explaining')) == 3\n"
-                         "import tqdm.auto  # as shap and transformers do, later\n"
-                         "print(len(list(progress(range(4), disable=True))))\n")
+    run = _in_a_notebook(
+        "from xairl.display import progress\n"
+        "assert sum(progress(range(3), desc='explaining')) == 3\n"
+        "import tqdm.auto  # as shap and transformers do, later\n"
+        "print(len(list(progress(range(4), disable=True))))\n"
+    )
     assert run.returncode == 0, run.stderr
     assert "IProgress" not in run.stderr and "explaining" in run.stderr and run.stdout.strip() == "4"
 
@@ -408,16 +445,19 @@ def test_a_report_in_a_notebook_leaves_tqdm_auto_quiet_for_the_libraries_after_i
         "p = toy_policy()\n"
         f"write_report(ReportRequest(out={str(tmp_path)!r}, narrate=False), ReportContent('toy', p, p.background(30),"
         " [('sampled', p.background(8, seed=1))]))\n"
-        "import tqdm.auto\n")
+        "import tqdm.auto\n"
+    )
     assert run.returncode == 0, run.stderr
     assert "IProgress" not in run.stderr and "explaining (deep_shap)" in run.stderr
 
 
 @pytest.mark.slow
 def test_kernel_shap_shows_no_iprogress_warning_in_a_notebook():
-    run = _in_a_notebook("import xairl\n"
-                         "p = xairl.get_policy('toy')\n"
-                         "xairl.explain(p, p.background(2, seed=1), background=p.background(10, seed=2),"
-                         " method='kernel_shap', options={'nsamples': 30})\n")
+    run = _in_a_notebook(
+        "import xairl\n"
+        "p = xairl.get_policy('toy')\n"
+        "xairl.explain(p, p.background(2, seed=1), background=p.background(10, seed=2),"
+        " method='kernel_shap', options={'nsamples': 30})\n"
+    )
     assert run.returncode == 0, run.stderr
     assert "IProgress" not in run.stderr

@@ -1,6 +1,7 @@
 """Issue 51, hardening round 3 (items 4, 6, 9, 10, 16, 17): what a user brings (a saved explanation, a Parquet file,
 a float64 network, huge numbers, an episode to slice out, a parametrised action space) is explained correctly or
 refused in one line that says what to do, never a raw exception or a silent wrong answer."""
+
 import json
 
 import numpy as np
@@ -62,8 +63,11 @@ def test_a_finite_number_beyond_float32_is_named_an_overflow():
     """1e300 is finite; it was reported as a 'NaN/inf value', which the user's file does not hold."""
     states = POLICY.background(2).astype(np.float64)
     states[1, 2] = 1e300
-    with pytest.raises(InputError, match=r"1 value\(s\) beyond the float32 range .* row 1, column 2 \(1e\+300\); "
-                                         r"scale those inputs down, or give a float64 network") as err:
+    with pytest.raises(
+        InputError,
+        match=r"1 value\(s\) beyond the float32 range .* row 1, column 2 \(1e\+300\); "
+        r"scale those inputs down, or give a float64 network",
+    ) as err:
         xairl.explain(POLICY, states, background=POLICY.background(4))
     assert "NaN" not in str(err.value)
     states[1, 2] = np.nan
@@ -107,11 +111,14 @@ def test_a_parquet_states_file_is_explained(tmp_path, capsys):
     assert rc == 0 and out.count("state ") == 4, err
 
 
-@pytest.mark.parametrize("column, words", [
-    ("timestamp", ["column 'speed' holds timestamp[us] values, not numbers"]),
-    ("string", ["column 'speed' holds string values, not numbers"]),
-    ("duplicate", ["column(s) speed appear more than once"]),
-])
+@pytest.mark.parametrize(
+    "column, words",
+    [
+        ("timestamp", ["column 'speed' holds timestamp[us] values, not numbers"]),
+        ("string", ["column 'speed' holds string values, not numbers"]),
+        ("duplicate", ["column(s) speed appear more than once"]),
+    ],
+)
 def test_a_parquet_file_with_a_column_that_is_not_numbers_is_one_line(tmp_path, capsys, column, words):
     import datetime
 
@@ -134,8 +141,19 @@ def test_a_streamed_parquet_file_with_a_timestamp_column_is_one_line(tmp_path, c
     cols, _ = _columns()
     cols["speed"] = [datetime.datetime(2026, 1, 1, 0, 0, i) for i in range(4)]
     path = _parquet(tmp_path / "s.parquet", cols)
-    rc, _, err = run(capsys, "explain", "--states", path, "--format", "parquet", "--out", str(tmp_path / "run"),
-                     "--method", "exact", "--no-robustness")
+    rc, _, err = run(
+        capsys,
+        "explain",
+        "--states",
+        path,
+        "--format",
+        "parquet",
+        "--out",
+        str(tmp_path / "run"),
+        "--method",
+        "exact",
+        "--no-robustness",
+    )
     one_line_error(rc, err, "column 'speed' holds timestamp")
 
 
@@ -148,19 +166,28 @@ def _saved(tmp_path, **fields):
     return str(path)
 
 
-@pytest.mark.parametrize("fields, words", [
-    ({"observation": {"kind": "flat", "parts": [{"key": "obs", "shape": 5, "categories": None}]}},
-     ["Explanation.observation", "parts.0.shape"]),
-    ({"observation": {"kind": "flat"}}, ["Explanation.observation", "parts: Field required"]),
-    ({"observation": {"a": 1}}, ["kind: Field required", "a: unknown field"]),
-    ({"observation": {"kind": "flat", "parts": [{"key": "obs", "shape": [7], "categories": None}]}},
-     ["describes 7 input columns but the values have 5 features"]),
-    ({"observation": {"kind": "array", "parts": [{"key": "obs", "shape": [0], "categories": None}]}},
-     ["greater than or equal to 1"]),
-    ({"background_quantiles": []}, ["background_quantiles has shape (0,), expected (3, 5)"]),
-    ({"background_quantiles": [[1]]}, ["background_quantiles has shape (1, 1), expected (3, 5)"]),
-    ({"output": "discrete"}, ["Explanation.output 'discrete' is not one of actions, continuous, value"]),
-])
+@pytest.mark.parametrize(
+    "fields, words",
+    [
+        (
+            {"observation": {"kind": "flat", "parts": [{"key": "obs", "shape": 5, "categories": None}]}},
+            ["Explanation.observation", "parts.0.shape"],
+        ),
+        ({"observation": {"kind": "flat"}}, ["Explanation.observation", "parts: Field required"]),
+        ({"observation": {"a": 1}}, ["kind: Field required", "a: unknown field"]),
+        (
+            {"observation": {"kind": "flat", "parts": [{"key": "obs", "shape": [7], "categories": None}]}},
+            ["describes 7 input columns but the values have 5 features"],
+        ),
+        (
+            {"observation": {"kind": "array", "parts": [{"key": "obs", "shape": [0], "categories": None}]}},
+            ["greater than or equal to 1"],
+        ),
+        ({"background_quantiles": []}, ["background_quantiles has shape (0,), expected (3, 5)"]),
+        ({"background_quantiles": [[1]]}, ["background_quantiles has shape (1, 1), expected (3, 5)"]),
+        ({"output": "discrete"}, ["Explanation.output 'discrete' is not one of actions, continuous, value"]),
+    ],
+)
 def test_a_saved_explanation_with_a_malformed_field_is_refused_when_read(tmp_path, capsys, fields, words):
     """A malformed observation or quartiles was read without complaint, then narrate and verify raised a raw
     TypeError, KeyError or IndexError (rc 1)."""
@@ -183,10 +210,19 @@ def test_a_saved_explanation_keeps_its_observation_and_quartiles(tmp_path):
 # 16. an episode out of a run ----------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def run_exp():
-    masked = xairl.Policy(POLICY.module, FEATURES, POLICY.action_names,
-                          action_mask=lambda x: np.c_[x[:, :1] > 0, np.ones((len(x), 2), bool)])
-    return xairl.explain(masked, POLICY.background(10, seed=5), background=POLICY.background(20),
-                         method="integrated_gradients", options={"n_steps": 8})
+    masked = xairl.Policy(
+        POLICY.module,
+        FEATURES,
+        POLICY.action_names,
+        action_mask=lambda x: np.c_[x[:, :1] > 0, np.ones((len(x), 2), bool)],
+    )
+    return xairl.explain(
+        masked,
+        POLICY.background(10, seed=5),
+        background=POLICY.background(20),
+        method="integrated_gradients",
+        options={"n_steps": 8},
+    )
 
 
 def _same_states(part, whole, rows):
@@ -195,13 +231,20 @@ def _same_states(part, whole, rows):
     np.testing.assert_array_equal(part.extras["convergence_delta"], whole.extras["convergence_delta"][rows])
     np.testing.assert_array_equal(part.chosen, whole.chosen[rows])
     np.testing.assert_array_equal(part.background_quantiles, whole.background_quantiles)
-    assert (part.feature_names, part.action_names, part.method, part.options, part.output, part.observation) == \
-        (whole.feature_names, whole.action_names, whole.method, whole.options, whole.output, whole.observation)
+    assert (part.feature_names, part.action_names, part.method, part.options, part.output, part.observation) == (
+        whole.feature_names,
+        whole.action_names,
+        whole.method,
+        whole.options,
+        whole.output,
+        whole.observation,
+    )
     assert len(part) == len(np.arange(len(whole))[rows])
 
 
-@pytest.mark.parametrize("key", [slice(None, 4), slice(3, 8), slice(None, None, 3), slice(-2, None),
-                                 [7, 2, 2, -1], np.array([0, 9]), "mask"])
+@pytest.mark.parametrize(
+    "key", [slice(None, 4), slice(3, 8), slice(None, None, 3), slice(-2, None), [7, 2, 2, -1], np.array([0, 9]), "mask"]
+)
 def test_an_explanation_is_sliced_state_by_state(run_exp, key):
     """exp[:n] and exp[mask] raised TypeError ('Explanation' object is not subscriptable)."""
     if isinstance(key, str):
@@ -217,23 +260,28 @@ def test_an_int_gives_a_one_state_explanation_that_narrates(run_exp):
     for i in (4, -1):
         one = run_exp[i]
         _same_states(one, run_exp, [i])
-    assert xairl.narrate(run_exp[4], 0, policy=POLICY, robustness=False).text == \
-        xairl.narrate(run_exp, 4, policy=POLICY, robustness=False).text
+    assert (
+        xairl.narrate(run_exp[4], 0, policy=POLICY, robustness=False).text
+        == xairl.narrate(run_exp, 4, policy=POLICY, robustness=False).text
+    )
     back = xairl.Explanation.from_json(run_exp.to_json())[2:5]  # extras read from JSON (lists) are cut too
     assert np.shape(back.extras["convergence_delta"]) == (3, 3)
 
 
-@pytest.mark.parametrize("key, words", [
-    (10, "index 10 is out of range"),
-    (-11, "index -11 is out of range"),
-    (slice(5, 5), "holds no state"),
-    (np.zeros(10, bool), "holds no state"),
-    (np.ones(4, bool), "one bool per state: got shape (4,) for 10"),
-    ([0, 12], "position 12 is out of range"),
-    (1.5, "not float '1.5'"),
-    ("battery", "not str 'battery'"),
-    ((slice(None), 0), "output_slice"),
-])
+@pytest.mark.parametrize(
+    "key, words",
+    [
+        (10, "index 10 is out of range"),
+        (-11, "index -11 is out of range"),
+        (slice(5, 5), "holds no state"),
+        (np.zeros(10, bool), "holds no state"),
+        (np.ones(4, bool), "one bool per state: got shape (4,) for 10"),
+        ([0, 12], "position 12 is out of range"),
+        (1.5, "not float '1.5'"),
+        ("battery", "not str 'battery'"),
+        ((slice(None), 0), "output_slice"),
+    ],
+)
 def test_a_selection_that_is_not_of_states_is_one_line(run_exp, key, words):
     with pytest.raises(InputError) as err:
         run_exp[key]
@@ -252,14 +300,20 @@ def hybrid():
 
 def test_outputs_named_as_parameters_of_actions_are_refused(hybrid):
     """Six outputs, three logits and their three parameters, were ranked together: 'chose kick_power'."""
-    with pytest.raises(InputError, match=r"output 'dash_power' reads as a parameter of action 'dash'.*"
-                                         r"xairl.Policy.heads\(module, output=\[...\]\).*output=\['actions'\] \* 6"):
+    with pytest.raises(
+        InputError,
+        match=r"output 'dash_power' reads as a parameter of action 'dash'.*"
+        r"xairl.Policy.heads\(module, output=\[...\]\).*output=\['actions'\] \* 6",
+    ):
         xairl.Policy(hybrid, feature_names=list("abcd"), action_names=HYBRID)
 
 
 def test_outputs_declared_of_mixed_kinds_are_refused(hybrid):
-    with pytest.raises(InputError, match=r"mixed kinds \(actions: dash, turn, kick; continuous: dash_power, "
-                                         r"turn_angle, kick_power\).*Policy.heads"):
+    with pytest.raises(
+        InputError,
+        match=r"mixed kinds \(actions: dash, turn, kick; continuous: dash_power, "
+        r"turn_angle, kick_power\).*Policy.heads",
+    ):
         xairl.Policy(hybrid, feature_names=list("abcd"), action_names=HYBRID, output=KINDS)
     with pytest.raises(InputError, match="output gives 5 kinds for 6 outputs"):
         xairl.Policy(hybrid, feature_names=list("abcd"), action_names=HYBRID, output=KINDS[:5])

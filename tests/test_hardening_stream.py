@@ -2,6 +2,7 @@
 fuzz of damaged, stray, foreign and reordered parts ends in every state exactly once, or in one line naming the file
 to delete); a folder that cannot be written or a run.json that is no record is one line; ``--out`` on many states
 streams."""
+
 import json
 import os
 import random
@@ -11,7 +12,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from benchmarks.fuzz_resume import BG, CHUNK, N, POLICY, STATES, make_runs, mutate, one_case, part
+from benchmarks.fuzz_resume import BG, CHUNK, POLICY, STATES, N, make_runs, mutate, one_case, part
 from xairl import plugins
 from xairl.cli import explain as explain_cli
 from xairl.cli import main
@@ -45,8 +46,9 @@ def test_resume_fuzz_ends_in_every_state_exactly_once_or_a_refusal_naming_the_pa
     ends = [one_case(case, root, reference, run, rng) for case in range(CASES)]
     refused = [e for e in ends if e["refusals"]]
     assert len(ends) == CASES and len(refused) > CASES // 4, len(refused)
-    assert all(set(e["refusals"]) <= set(e["named"]) | {"run.json", *(part(f) for f in range(0, N, CHUNK))}
-               for e in refused)
+    assert all(
+        set(e["refusals"]) <= set(e["named"]) | {"run.json", *(part(f) for f in range(0, N, CHUNK))} for e in refused
+    )
 
 
 @pytest.mark.parametrize("kind", ["stray", "foreign"])
@@ -73,8 +75,19 @@ def test_read_parquet_refuses_a_folder_that_holds_a_row_twice(runs, tmp_path):
 
 
 def test_the_issues_cli_resumes_a_bit_flip_whole_and_refuses_part_07(tmp_path, capsys, caplog):
-    argv = ["explain", "--n", "3000", "--out", str(tmp_path / "r"), "--format", "parquet", "--chunk-size", "500",
-            "--background-size", "20"]
+    argv = [
+        "explain",
+        "--n",
+        "3000",
+        "--out",
+        str(tmp_path / "r"),
+        "--format",
+        "parquet",
+        "--chunk-size",
+        "500",
+        "--background-size",
+        "20",
+    ]
     assert main(argv) == 0
     parts = tmp_path / "r" / DATASET
     flipped = parts / part(1000)
@@ -95,8 +108,19 @@ def test_the_issues_cli_resumes_a_bit_flip_whole_and_refuses_part_07(tmp_path, c
 
 @pytest.mark.parametrize("record", ["[1, 2]", "42", '"a run"', "null", "[" * 100_000 + "]" * 100_000, "{", ""])
 def test_a_run_json_that_is_no_record_is_refused_in_one_line(tmp_path, capsys, record):
-    argv = ["explain", "--n", "30", "--out", str(tmp_path / "r"), "--format", "parquet", "--chunk-size", "10",
-            "--background-size", "10"]
+    argv = [
+        "explain",
+        "--n",
+        "30",
+        "--out",
+        str(tmp_path / "r"),
+        "--format",
+        "parquet",
+        "--chunk-size",
+        "10",
+        "--background-size",
+        "10",
+    ]
     assert main(argv) == 0
     (tmp_path / "r" / "run.json").write_text(record)
     capsys.readouterr()
@@ -109,8 +133,19 @@ def test_a_run_json_that_is_no_record_is_refused_in_one_line(tmp_path, capsys, r
 
 
 def test_a_truncated_part_is_explained_again_on_resume(tmp_path, capsys):
-    argv = ["explain", "--n", "30", "--out", str(tmp_path / "r"), "--format", "parquet", "--chunk-size", "10",
-            "--background-size", "10"]
+    argv = [
+        "explain",
+        "--n",
+        "30",
+        "--out",
+        str(tmp_path / "r"),
+        "--format",
+        "parquet",
+        "--chunk-size",
+        "10",
+        "--background-size",
+        "10",
+    ]
     assert main(argv) == 0
     cut = tmp_path / "r" / DATASET / part(10)
     cut.write_bytes(cut.read_bytes()[:100])
@@ -139,8 +174,12 @@ def test_out_on_many_states_streams_into_parquet_and_says_so(tmp_path, capsys, m
     out, err = capsys.readouterr()
     assert "1001 states: streaming them into" in err and "--format jsonl" in err and "(1001 states)" in out
     assert (tmp_path / "big" / DATASET).is_dir() and not (tmp_path / "big" / "explanations.jsonl").exists()
-    assert main(["explain", "--n", "1001", "--out", str(tmp_path / "kept"), "--format", "jsonl",
-                 "--background-size", "10"]) == 0  # asked for: one JSON lines file
+    assert (
+        main(
+            ["explain", "--n", "1001", "--out", str(tmp_path / "kept"), "--format", "jsonl", "--background-size", "10"]
+        )
+        == 0
+    )  # asked for: one JSON lines file
     assert len((tmp_path / "kept" / "explanations.jsonl").read_text().splitlines()) == 1001
     assert main(["explain", "--n", "1000", "--out", str(tmp_path / "small"), "--background-size", "10"]) == 0
     assert (tmp_path / "small" / "explanations.jsonl").exists() and not (tmp_path / "small" / DATASET).exists()

@@ -5,6 +5,7 @@ digits in `directions._JOIN`; other patterns were cubic in a run of spaces.
 Work is counted, not timed: :mod:`tests.regex_steps` replays Python's backtracking over a pattern and counts its
 steps, the same on any machine and under any load. The times are in ``benchmarks/bench_verify_fuzz.py``.
 """
+
 import importlib
 import pkgutil
 import re
@@ -13,8 +14,8 @@ import numpy as np
 import pytest
 
 import xairl
-from xairl.narrators.verify import binding, comparisons, decision, directions, names, sums, verify
 from tests.regex_steps import StepCounter, TooManySteps, steps
+from xairl.narrators.verify import binding, comparisons, decision, directions, names, sums, verify
 
 BUDGET = 100_000  # steps: the linear patterns take a few thousand on these texts, the old _JOIN billions
 
@@ -23,8 +24,9 @@ def _steps(pattern: re.Pattern, text: str) -> int:
     try:
         return steps(pattern, text, "match", BUDGET)
     except TooManySteps:
-        pytest.fail(f"{pattern.pattern[:60]!r}... backtracks past {BUDGET} steps on {text[:40]!r}... "
-                    f"({len(text)} characters)")
+        pytest.fail(
+            f"{pattern.pattern[:60]!r}... backtracks past {BUDGET} steps on {text[:40]!r}... ({len(text)} characters)"
+        )
 
 
 #: each pattern that backtracked more than linearly, with the text family that showed it (the run doubles)
@@ -93,9 +95,16 @@ def test_no_pattern_backtracks_past_the_budget_on_a_hostile_run(name, pattern):
 
 def _explanation(names_, values):
     v = np.asarray(values, dtype=float).reshape(1, -1, 1)
-    return xairl.Explanation(values=v, base_values=np.zeros((1, 1)), outputs=v.sum(axis=1),
-                             states=np.ones((1, len(names_))), feature_names=tuple(names_), action_names=("out",),
-                             method="given", output="value")
+    return xairl.Explanation(
+        values=v,
+        base_values=np.zeros((1, 1)),
+        outputs=v.sum(axis=1),
+        states=np.ones((1, len(names_))),
+        feature_names=tuple(names_),
+        action_names=("out",),
+        method="given",
+        output="value",
+    )
 
 
 @pytest.mark.parametrize("digits", [12, 30, 400, 5000])
@@ -109,11 +118,14 @@ def test_the_issues_sentence_is_read(digits):
     assert "battery" in directions_said[0].detail and "speed" not in directions_said[0].detail
 
 
-@pytest.mark.parametrize("text, statuses", [
-    ("speed 22 and battery raised it.", ["verified", "contradicted"]),  # a list, with a value between the names
-    ("speed (0.4), 3 km and battery lowered it.", ["contradicted", "verified"]),
-    ("speed 999999999999999999999999 and load raised it.", ["verified", "verified"]),
-])
+@pytest.mark.parametrize(
+    "text, statuses",
+    [
+        ("speed 22 and battery raised it.", ["verified", "contradicted"]),  # a list, with a value between the names
+        ("speed (0.4), 3 km and battery lowered it.", ["contradicted", "verified"]),
+        ("speed 999999999999999999999999 and load raised it.", ["verified", "verified"]),
+    ],
+)
 def test_a_list_with_numbers_between_its_names_is_still_one_subject(text, statuses):
     exp = _explanation(["speed", "battery", "load"], [0.4, -0.2, 0.05])
     result = verify(text, exp, 0)

@@ -1,6 +1,7 @@
 """Issue 51, items 13 and 15 (the words): image regions said by a short grid reference, a frame stack's channels said
 as frames, the number in brackets labelled, explain_score's runner-up and margin said plainly; the global summary
 ranks in the margin view the plots use by default, says so, and says each feature's direction truly."""
+
 import re
 
 import numpy as np
@@ -15,8 +16,14 @@ from xairl.toy import toy_policy
 
 def _cnn(channels: str = "channels"):
     torch.manual_seed(0)
-    net = torch.nn.Sequential(torch.nn.Conv2d(3, 4, 8, 4), torch.nn.ReLU(), torch.nn.Conv2d(4, 8, 4, 2),
-                              torch.nn.ReLU(), torch.nn.Flatten(), torch.nn.Linear(8 * 6 * 6, 4))
+    net = torch.nn.Sequential(
+        torch.nn.Conv2d(3, 4, 8, 4),
+        torch.nn.ReLU(),
+        torch.nn.Conv2d(4, 8, 4, 2),
+        torch.nn.ReLU(),
+        torch.nn.Flatten(),
+        torch.nn.Linear(8 * 6 * 6, 4),
+    )
     shape = (3, 64, 64) if channels == "channels" else Observation.array((3, 64, 64), channels=channels)
     policy = xairl.Policy(net, observation=shape, name="cnn")
     frames = np.random.default_rng(0).integers(0, 256, (10, 3, 64, 64)).astype(np.float32)
@@ -59,8 +66,10 @@ def test_a_frame_stack_is_said_in_frames_and_keeps_it_through_json(stack, rgb):
     assert names[0] == "patch A1 of frame 0" and names[-1] == "patch H8 of frame 2"
     again = xairl.Explanation.from_json(exp.to_json())
     assert in_regions(again).feature_names == names
-    assert in_regions(again).extras["regions"]["patch H8 of frame 2"] == \
-        "the 8x8 patch at rows 56 to 63, columns 56 to 63 of frame 2"
+    assert (
+        in_regions(again).extras["regions"]["patch H8 of frame 2"]
+        == "the 8x8 patch at rows 56 to 63, columns 56 to 63 of frame 2"
+    )
     for i in range(2):
         n = xairl.narrate(exp, i, policy=policy, robustness=False)
         assert n.verified and " of frame " in n.text and "channel" not in n.text, n.text
@@ -85,8 +94,11 @@ def test_a_region_is_verified_by_its_name_or_extent_and_a_wrong_one_contradicted
     assert status(extent)[0] == "verified"  # 'the 8x8 patch at rows 16 to 23, ...' names the same region
     assert status(name.replace(" of frame ", " of channel "))[0] == "verified"
     assert status(other)[0] == "contradicted"  # an existing region, but not the one with this push
-    for wrong in ("patch Z9 of frame 1", name.rsplit(" ", 1)[0] + " 7",  # no column Z, no frame 7
-                  extent.replace("rows 16", "rows 17")):
+    for wrong in (
+        "patch Z9 of frame 1",
+        name.rsplit(" ", 1)[0] + " 7",  # no column Z, no frame 7
+        extent.replace("rows 16", "rows 17"),
+    ):
         verdict, rules = status(wrong)
         assert verdict == "contradicted" and "region.unknown" in rules, wrong
 

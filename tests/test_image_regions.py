@@ -1,13 +1,14 @@
 """An image policy is narrated, verified and reported in regions (patches of one channel named in words), not in
 pixels; its repr and its explanation's stay short. A small CNN on 3x64x64 frames, built here (no training)."""
+
 import numpy as np
 import pytest
 import torch
 
 import xairl
+from tests.work_budget import calls
 from xairl.regions import in_regions
 from xairl.report import ReportContent, ReportRequest, write_report
-from tests.work_budget import calls
 
 NARRATE_CALLS = 1_000_000  # function calls to narrate one state of the CNN below, verification included
 
@@ -17,8 +18,14 @@ REGION = "patch "
 @pytest.fixture(scope="module")
 def cnn():
     torch.manual_seed(0)
-    net = torch.nn.Sequential(torch.nn.Conv2d(3, 4, 8, 4), torch.nn.ReLU(), torch.nn.Conv2d(4, 8, 4, 2),
-                              torch.nn.ReLU(), torch.nn.Flatten(), torch.nn.Linear(8 * 6 * 6, 4))
+    net = torch.nn.Sequential(
+        torch.nn.Conv2d(3, 4, 8, 4),
+        torch.nn.ReLU(),
+        torch.nn.Conv2d(4, 8, 4, 2),
+        torch.nn.ReLU(),
+        torch.nn.Flatten(),
+        torch.nn.Linear(8 * 6 * 6, 4),
+    )
     policy = xairl.Policy(net, observation=(3, 64, 64), name="cnn")
     frames = np.random.default_rng(0).integers(0, 256, (10, 3, 64, 64)).astype(np.float32)
     return policy, frames, xairl.explain(policy, frames[:2], background=frames[2:])
@@ -29,8 +36,7 @@ def test_an_image_is_narrated_in_verified_regions_with_little_work(cnn):
     192 regions; in pixels (12,288 features) many times more. The time: benchmarks/bench_test_timings.py."""
     policy, _, exp = cnn
     regions = in_regions(exp)
-    assert len(regions.feature_names) == 3 * 8 * 8 and regions.feature_names[0] == \
-        "patch A1 of channel 0"
+    assert len(regions.feature_names) == 3 * 8 * 8 and regions.feature_names[0] == "patch A1 of channel 0"
     np.testing.assert_allclose(regions.values.sum(axis=1), exp.values.sum(axis=1), atol=1e-9)  # additivity kept
     xairl.narrate(exp, 0, policy=policy, robustness=False)  # warm: templates, the vocabulary's regexes
     for i in range(2):
@@ -47,13 +53,13 @@ def test_a_wrong_region_or_its_number_is_contradicted(cnn):
     policy, _, exp = cnn
     text = xairl.narrate(exp, 0, policy=policy, robustness=False).text
     start = text.index(REGION) + len(REGION)
-    shifted = text[:start] + "Z" + text[start + 1:]  # no patch is in column Z of an 8x8 grid
+    shifted = text[:start] + "Z" + text[start + 1 :]  # no patch is in column Z of an 8x8 grid
     check = xairl.verify(shifted, exp, 0, policy)
     assert check.status == "contradicted"
     assert any(c.rule == "region.unknown" and c.status == "contradicted" for c in check.claims)
     channel = text.index(" of channel ", start) + len(" of channel ")  # another region: its numbers are not these
     other = str((int(text[channel]) + 1) % 3)
-    assert xairl.verify(text[:channel] + other + text[channel + 1:], exp, 0, policy).status == "contradicted"
+    assert xairl.verify(text[:channel] + other + text[channel + 1 :], exp, 0, policy).status == "contradicted"
 
 
 def test_flat_small_and_grouped_explanations_are_narrated_as_before(cnn):
@@ -103,8 +109,7 @@ def test_reprs_are_short(cnn):
 def test_the_report_lists_the_top_regions_not_every_pixel(cnn, tmp_path):
     policy, frames, _ = cnn
     content = ReportContent("cnn", policy, frames[6:], [("sim", frames[:3])])
-    path = write_report(ReportRequest(tmp_path, n_narrated=2, robustness=False, progress=False, records=False),
-                        content)
+    path = write_report(ReportRequest(tmp_path, n_narrated=2, robustness=False, progress=False, records=False), content)
     page = path.read_text()
     assert "The 20 most important of 192 regions" in page and REGION in page
     assert "obs[" not in page and "NOT verified" not in page

@@ -1,4 +1,5 @@
 """Bad input gives one clear InputError through the API."""
+
 import numpy as np
 import pytest
 import torch
@@ -14,16 +15,19 @@ def policy():
     return toy_policy()
 
 
-@pytest.mark.parametrize("states, match", [
-    (np.zeros((2, 4)), "has 4 features but the policy expects 5"),
-    (np.zeros((0, 5)), "empty"),
-    (np.array([[np.nan, 0, 0, 0, 0]]), "NaN/inf value.*row 0, column 0"),
-    (np.array([[0, 0, np.inf, 0, 0]]), "NaN/inf"),
-    (np.full((1, 5), 1e300), "beyond the float32 range"),
-    (np.zeros((2, 5, 1)), "2-D array"),
-    ([["a", 1, 2, 3, 4]], "numeric"),
-    ([[1, 2], [1, 2, 3]], "numeric"),
-])
+@pytest.mark.parametrize(
+    "states, match",
+    [
+        (np.zeros((2, 4)), "has 4 features but the policy expects 5"),
+        (np.zeros((0, 5)), "empty"),
+        (np.array([[np.nan, 0, 0, 0, 0]]), "NaN/inf value.*row 0, column 0"),
+        (np.array([[0, 0, np.inf, 0, 0]]), "NaN/inf"),
+        (np.full((1, 5), 1e300), "beyond the float32 range"),
+        (np.zeros((2, 5, 1)), "2-D array"),
+        ([["a", 1, 2, 3, 4]], "numeric"),
+        ([[1, 2], [1, 2, 3]], "numeric"),
+    ],
+)
 def test_bad_states(policy, states, match):
     with pytest.raises(InputError, match=match):
         xairl.explain(policy, states, background=np.zeros((3, 5)))
@@ -72,16 +76,19 @@ def test_csv_reorders_columns_by_header(tmp_path):
     np.testing.assert_array_equal(read_states(p, FEATURES), [[1, 2, 3, 4, 5]])
 
 
-@pytest.mark.parametrize("name, text, match", [
-    ("a.csv", "battery,distance,speed,obstacle\n1,2,3,4\n", "states lack column.*wind"),
-    ("b.csv", ",".join(FEATURES) + "\n1,2,x,4,5\n", "line 2, column 'speed': 'x' is not a number"),
-    ("c.csv", "", "empty"),
-    ("d.csv", ",".join(FEATURES) + "\n", "empty"),
-    ("e.json", "{not json", "cannot read"),
-    ("f.json", '[{"battery": 1}]', "lack key"),
-    ("g.txt", "1,2", "unknown file type"),
-    ("h.npy", "not an array", "cannot read"),
-])
+@pytest.mark.parametrize(
+    "name, text, match",
+    [
+        ("a.csv", "battery,distance,speed,obstacle\n1,2,3,4\n", "states lack column.*wind"),
+        ("b.csv", ",".join(FEATURES) + "\n1,2,x,4,5\n", "line 2, column 'speed': 'x' is not a number"),
+        ("c.csv", "", "empty"),
+        ("d.csv", ",".join(FEATURES) + "\n", "empty"),
+        ("e.json", "{not json", "cannot read"),
+        ("f.json", '[{"battery": 1}]', "lack key"),
+        ("g.txt", "1,2", "unknown file type"),
+        ("h.npy", "not an array", "cannot read"),
+    ],
+)
 def test_bad_files_name_the_file(tmp_path, name, text, match):
     p = write(tmp_path, name, text)
     with pytest.raises(InputError, match=match) as info:

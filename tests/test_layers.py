@@ -3,6 +3,7 @@
 and its benchmarks import no plugin (they reach plugins through the registry, ``xairl.get_policy``), and the
 reference plugin's code and benchmarks use only the public namespaces (``xairl``, ``xairl.plugin``, ``xairl.facts``,
 ``xairl.plots``, ``xairl.errors``), never xairl's private modules."""
+
 import ast
 from pathlib import Path
 
@@ -22,15 +23,20 @@ def _imports(path: Path) -> set[str]:
     return out
 
 
-@pytest.mark.parametrize("path", sorted([*(ROOT / "xairl").rglob("*.py"), *(ROOT / "benchmarks").glob("*.py")]),
-                         ids=lambda p: str(p.relative_to(ROOT)))
+@pytest.mark.parametrize(
+    "path",
+    sorted([*(ROOT / "xairl").rglob("*.py"), *(ROOT / "benchmarks").glob("*.py")]),
+    ids=lambda p: str(p.relative_to(ROOT)),
+)
 def test_the_core_imports_no_plugin(path):
     assert not {m for m in _imports(path) if m.split(".")[0] == "xairl_uav_handover"}
 
 
-@pytest.mark.parametrize("path", sorted([*(PLUGIN / "xairl_uav_handover").rglob("*.py"),
-                                         *(PLUGIN / "benchmarks").glob("*.py")]),
-                         ids=lambda p: str(p.relative_to(ROOT)))
+@pytest.mark.parametrize(
+    "path",
+    sorted([*(PLUGIN / "xairl_uav_handover").rglob("*.py"), *(PLUGIN / "benchmarks").glob("*.py")]),
+    ids=lambda p: str(p.relative_to(ROOT)),
+)
 def test_the_plugin_uses_public_names_only(path):
     public = {"xairl.plugin", "xairl.facts", "xairl.plots", "xairl.errors"}
     assert not {m for m in _imports(path) if m.startswith("xairl.") and m not in public}
@@ -48,6 +54,10 @@ def test_no_module_of_the_core_is_in_an_import_cycle():
     import grimp
 
     graph = grimp.build_graph("xairl", cache_dir=None)
-    cycles = [(a, b) for a in sorted(graph.modules) for b in sorted(graph.find_modules_directly_imported_by(a))
-              if graph.chain_exists(importer=b, imported=a)]
+    cycles = [
+        (a, b)
+        for a in sorted(graph.modules)
+        for b in sorted(graph.find_modules_directly_imported_by(a))
+        if graph.chain_exists(importer=b, imported=a)
+    ]
     assert not cycles, [graph.find_shortest_chain(importer=b, imported=a) for a, b in cycles[:3]]

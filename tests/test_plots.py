@@ -1,5 +1,6 @@
 """The public plotting module: each function returns a matplotlib Figure labelled with its view, and a decision's
 waterfall shows the numbers of the narrative's evidence card."""
+
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
@@ -17,8 +18,11 @@ def exp():
 
 
 def _texts(fig) -> str:
-    return " ".join(t.get_text() for ax in fig.axes for t in [ax.xaxis.label, ax.yaxis.label, ax.title]
-                    + ax.get_yticklabels() + ax.texts)
+    return " ".join(
+        t.get_text()
+        for ax in fig.axes
+        for t in [ax.xaxis.label, ax.yaxis.label, ax.title] + ax.get_yticklabels() + ax.texts
+    )
 
 
 def test_each_figure_names_its_view(exp):

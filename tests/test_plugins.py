@@ -20,8 +20,9 @@ def test_duplicate_name_is_an_error_naming_both_plugins():
     pm = plugins.get_plugin_manager()
     pm.register(DuplicateAttributor(), name="dup-plugin")
     plugins.reset(pm)
-    with pytest.raises(PluginError, match="'deep_shap' is registered by both '(xairl|dup-plugin)' and "
-                                          "'(xairl|dup-plugin)'"):
+    with pytest.raises(
+        PluginError, match="'deep_shap' is registered by both '(xairl|dup-plugin)' and '(xairl|dup-plugin)'"
+    ):
         plugins.registry("attributor")
 
 
@@ -32,7 +33,8 @@ def test_unknown_names_list_the_known_ones():
 
 def test_entry_point_plugin_is_discovered(tmp_path, monkeypatch):
     """A real distribution on sys.path with an entry point in group 'xairl' (no mock of importlib.metadata)."""
-    (tmp_path / "fake_xairl_plugin.py").write_text(textwrap.dedent('''
+    (tmp_path / "fake_xairl_plugin.py").write_text(
+        textwrap.dedent("""
         import xairl
 
         @xairl.plugin.hookimpl
@@ -45,7 +47,8 @@ def test_entry_point_plugin_is_discovered(tmp_path, monkeypatch):
                 parser.add_argument("--word", default="hi")
                 parser.set_defaults(run=lambda args: print("fake says", args.word) or 0)
             register("fake", configure, "a command from a plugin")
-    '''))
+    """)
+    )
     dist = tmp_path / "fake_xairl_plugin-0.1.dist-info"
     dist.mkdir()
     (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: fake-xairl-plugin\nVersion: 0.1\n")
@@ -57,6 +60,7 @@ def test_entry_point_plugin_is_discovered(tmp_path, monkeypatch):
     assert plugins.registry("policy").entry("fake-policy").plugin == "fake"
     assert plugins.get_policy("fake-policy").n_features == 5
     from xairl.cli import main
+
     assert main(["fake", "--word", "yo"]) == 0
     assert plugins.summary()["fake"] == {"policy": ["fake-policy"], "command": ["fake"]}
 
@@ -82,12 +86,21 @@ GOOD = """
 """
 
 
-@pytest.mark.parametrize("broken, error", [
-    ("raise RuntimeError('boom at import')", "fails to load (RuntimeError: boom at import)"),
-    ("import xairl\n@xairl.plugin.hookimpl\ndef register_policies(register):\n    register('half', 'x:y')\n"
-     "    raise KeyError('oops')\n", "failed in register_policies (KeyError"),
-    ("import xairl\n@xairl.plugin.hookimpl\ndef register_everything(register):\n    pass\n", "implements an unknown hook"),
-])
+@pytest.mark.parametrize(
+    "broken, error",
+    [
+        ("raise RuntimeError('boom at import')", "fails to load (RuntimeError: boom at import)"),
+        (
+            "import xairl\n@xairl.plugin.hookimpl\ndef register_policies(register):\n    register('half', 'x:y')\n"
+            "    raise KeyError('oops')\n",
+            "failed in register_policies (KeyError",
+        ),
+        (
+            "import xairl\n@xairl.plugin.hookimpl\ndef register_everything(register):\n    pass\n",
+            "implements an unknown hook",
+        ),
+    ],
+)
 def test_a_broken_plugin_is_reported_and_breaks_nothing_else(tmp_path, monkeypatch, capsys, broken, error):
     from xairl.cli import main
 
@@ -121,8 +134,10 @@ def test_plugins_are_selected_by_environment(tmp_path, monkeypatch):
 
 def test_import_is_lazy():
     """`import xairl` loads no plugin and no heavy library; the first lookup does."""
-    code = ("import sys, xairl; heavy = [m for m in ('torch', 'shap', 'transformers', 'captum', 'xairl.builtins') "
-            "if m in sys.modules]; print(heavy)")
+    code = (
+        "import sys, xairl; heavy = [m for m in ('torch', 'shap', 'transformers', 'captum', 'xairl.builtins') "
+        "if m in sys.modules]; print(heavy)"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"
 
@@ -180,8 +195,12 @@ def test_facts_hook_must_return_domain_facts():
 
     policy = toy_policy()
     exp = xairl.explain(policy, policy.background(1, seed=2), background=policy.background(20), method="exact")
-    policy = replace(policy, facts_hook=lambda state, chosen, runner_up: xairl.facts.DomainFacts(
-        {"note": 7}, (xairl.facts.Comparison("the gap was 1.5 m", 1.5, "m"),)))
+    policy = replace(
+        policy,
+        facts_hook=lambda state, chosen, runner_up: xairl.facts.DomainFacts(
+            {"note": 7}, (xairl.facts.Comparison("the gap was 1.5 m", 1.5, "m"),)
+        ),
+    )
     assert xairl.verify("The gap was 1.5 m.", exp, 0, policy).ok
     assert not xairl.verify("The gap was 2.5 m.", exp, 0, policy).ok
     policy = replace(policy, facts_hook=lambda state, chosen, runner_up: {"extras": {}, "comparisons": []})

@@ -1,4 +1,5 @@
 """Templates: lookup order, sandbox, `xairl prompts` and check with line numbers."""
+
 from pathlib import Path
 
 import jinja2
@@ -42,15 +43,21 @@ def test_unknown_template():
         prompts.load("nope")
 
 
-@pytest.mark.parametrize("body, expected", [
-    ('name: t\nsentences:\n  - ["{{ action }"]\n', ":3: syntax error"),
-    ('name: t\nsentences:\n  - ["ok {{ actoin }}"]\n', ":3: unknown variable 'actoin'"),
-    ('name: t\nsentences:\n  - |\n    line one\n    {{ "".__class__ }}\n', ":5: sandbox violation: access to '__class__'"),
-    ('name: t\nsentences:\n  - ["{{ top.__globals__ }}"]\n', "sandbox violation"),
-    ('name: t\nsentences: [\n', "YAML error"),
-    ('name: t\nsentence: ["x"]\n', "sentence: unknown option"),
-    ('name: t\nkind: global\nsentences:\n  - ["{{ action }}"]\n', "unknown variable 'action'"),
-])
+@pytest.mark.parametrize(
+    "body, expected",
+    [
+        ('name: t\nsentences:\n  - ["{{ action }"]\n', ":3: syntax error"),
+        ('name: t\nsentences:\n  - ["ok {{ actoin }}"]\n', ":3: unknown variable 'actoin'"),
+        (
+            'name: t\nsentences:\n  - |\n    line one\n    {{ "".__class__ }}\n',
+            ":5: sandbox violation: access to '__class__'",
+        ),
+        ('name: t\nsentences:\n  - ["{{ top.__globals__ }}"]\n', "sandbox violation"),
+        ("name: t\nsentences: [\n", "YAML error"),
+        ('name: t\nsentence: ["x"]\n', "sentence: unknown option"),
+        ('name: t\nkind: global\nsentences:\n  - ["{{ action }}"]\n', "unknown variable 'action'"),
+    ],
+)
 def test_check_reports_problems_with_lines(tmp_path, body, expected):
     path = tmp_path / "t.yaml"
     path.write_text(body)
@@ -137,15 +144,18 @@ def test_refusals_name_the_bound(tmp_path):
         prompts.load(path).render_variants(sample_context("decision"))
 
 
-@pytest.mark.parametrize("text", [
-    "{{ ('x' * 1000 * 100)|length }}",  # a string at the size bound
-    "{% for a in 'x' * 100 %}{% for b in 'x' * 99 %}{% endfor %}{% endfor %}done",  # 100 + 9,900 steps
-    "{{ '%5.2f' % 3.14159 }} {{ '{:>6}'.format('a') }} {{ 'a'|center(9) }} {{ 'b'.ljust(4) }}|",
-    "{{ [1, 2] + [3] }} {{ 'a' ~ 1 ~ [2] }} {{ ['a', 'b']|join(', ') }} {{ 'aa'|replace('a', 'bb') }}",
-    "{{ 'a b'|indent(2, first=True) }} {{ 'ab cd'|wordwrap(2, break_on_hyphens=False) }} "
-    "{{ 'abcdef'|truncate(5, leeway=0) }} {{ [1, 2, 3]|batch(2, 0)|list }} {{ [[1], [2]]|sum(start=[]) }}",
-    "{% macro m(x) %}<{{ x }}>{% endmacro %}{% for t in ('a', 'b') %}{{ m(t) }}{% else %}none{% endfor %}",
-])
+@pytest.mark.parametrize(
+    "text",
+    [
+        "{{ ('x' * 1000 * 100)|length }}",  # a string at the size bound
+        "{% for a in 'x' * 100 %}{% for b in 'x' * 99 %}{% endfor %}{% endfor %}done",  # 100 + 9,900 steps
+        "{{ '%5.2f' % 3.14159 }} {{ '{:>6}'.format('a') }} {{ 'a'|center(9) }} {{ 'b'.ljust(4) }}|",
+        "{{ [1, 2] + [3] }} {{ 'a' ~ 1 ~ [2] }} {{ ['a', 'b']|join(', ') }} {{ 'aa'|replace('a', 'bb') }}",
+        "{{ 'a b'|indent(2, first=True) }} {{ 'ab cd'|wordwrap(2, break_on_hyphens=False) }} "
+        "{{ 'abcdef'|truncate(5, leeway=0) }} {{ [1, 2, 3]|batch(2, 0)|list }} {{ [[1], [2]]|sum(start=[]) }}",
+        "{% macro m(x) %}<{{ x }}>{% endmacro %}{% for t in ('a', 'b') %}{{ m(t) }}{% else %}none{% endfor %}",
+    ],
+)
 def test_legitimate_templates_within_bounds_render(tmp_path, text):
     path = tmp_path / "t.yaml"
     path.write_text(f'name: t\nsentences:\n  - ["{text}"]\n')

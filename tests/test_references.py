@@ -1,4 +1,5 @@
 """Our values against independent references: shap.DeepExplainer, captum DeepLiftShap, brute-force Shapley."""
+
 import itertools
 from math import factorial
 
@@ -49,8 +50,9 @@ def test_deep_shap_reused_module_is_exact():
     """A ReLU module called twice: our per-call hooks keep additivity (shap/captum state per module breaks here)."""
     net = ReusedActivations(f=6)
     r = np.random.default_rng(2)
-    e = xairl.explain(policy_of(net, 6, 3), r.normal(size=(8, 6)), background=r.normal(size=(16, 6)),
-                      method="deep_shap")
+    e = xairl.explain(
+        policy_of(net, 6, 3), r.normal(size=(8, 6)), background=r.normal(size=(16, 6)), method="deep_shap"
+    )
     assert e.additivity_gap.max() < 1e-5
 
 
@@ -72,8 +74,12 @@ def test_deep_shap_refuses_functional_nonlinearity():
     torch.manual_seed(0)
     r = np.random.default_rng(0)
     with pytest.raises(UnsupportedModelError, match="do not add up"):
-        xairl.explain(policy_of(Functional(), 4, 2), r.normal(size=(5, 4)) * 3, background=r.normal(size=(9, 4)),
-                      method="deep_shap")
+        xairl.explain(
+            policy_of(Functional(), 4, 2),
+            r.normal(size=(5, 4)) * 3,
+            background=r.normal(size=(9, 4)),
+            method="deep_shap",
+        )
 
 
 def brute_force_shapley(fn, x, bg):
@@ -120,8 +126,12 @@ def test_kernel_shap_approaches_exact_as_budget_grows():
     r = np.random.default_rng(4)
     x, bg = r.normal(size=(4, 10)), r.normal(size=(10, 10))
     truth = xairl.explain(policy, x, background=bg, method="exact").values
-    errors = [np.abs(xairl.explain(policy, x, background=bg, method="kernel_shap",
-                                   options={"nsamples": n}).values - truth).max() for n in (60, 600, 1100)]
+    errors = [
+        np.abs(
+            xairl.explain(policy, x, background=bg, method="kernel_shap", options={"nsamples": n}).values - truth
+        ).max()
+        for n in (60, 600, 1100)
+    ]
     assert errors[0] > errors[1] > errors[2]
     assert errors[0] < 0.04
     assert errors[1] < 5e-3
@@ -134,8 +144,12 @@ class PlainForward(torch.nn.Module):
     def __init__(self, act):
         super().__init__()
         torch.manual_seed(8)
-        self.fc1, self.bn, self.fc2, self.fc3 = (torch.nn.Linear(7, 24), torch.nn.BatchNorm1d(24),
-                                                 torch.nn.Linear(24, 12), torch.nn.Linear(12, 3))
+        self.fc1, self.bn, self.fc2, self.fc3 = (
+            torch.nn.Linear(7, 24),
+            torch.nn.BatchNorm1d(24),
+            torch.nn.Linear(24, 12),
+            torch.nn.Linear(12, 3),
+        )
         self.a1, self.a2, self.drop = act(), act(), torch.nn.Dropout(0.2)
         with torch.no_grad():
             self.bn.running_mean.uniform_(-0.5, 0.5)
@@ -145,8 +159,16 @@ class PlainForward(torch.nn.Module):
         return self.fc3(self.drop(self.a2(self.fc2(self.a1(self.bn(self.fc1(x)))))))
 
 
-SHAP_ACTS = [torch.nn.ReLU, torch.nn.LeakyReLU, torch.nn.ELU, torch.nn.Sigmoid, torch.nn.Tanh, torch.nn.Softplus,
-             torch.nn.SELU, torch.nn.GELU]
+SHAP_ACTS = [
+    torch.nn.ReLU,
+    torch.nn.LeakyReLU,
+    torch.nn.ELU,
+    torch.nn.Sigmoid,
+    torch.nn.Tanh,
+    torch.nn.Softplus,
+    torch.nn.SELU,
+    torch.nn.GELU,
+]
 CAPTUM_ACTS = {torch.nn.ReLU, torch.nn.ELU, torch.nn.Sigmoid, torch.nn.Tanh, torch.nn.Softplus}
 
 

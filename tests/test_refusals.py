@@ -1,5 +1,6 @@
 """No silent wrong answer: each network that used to be explained wrongly, or to crash with a raw error, is now
 refused with one line that says why and names only methods that accept it."""
+
 import numpy as np
 import pytest
 import torch
@@ -29,8 +30,11 @@ class FunctionalTanhActor(nn.Module):
 def test_functional_nonlinearity_is_refused_by_deep_shap():
     policy = xairl.Policy(FunctionalTanhActor(), ["cos", "sin", "vel"], ["torque"], output="continuous")
     x, bg = data(3)
-    with pytest.raises(UnsupportedModelError, match=r"functional nonlinearity \(torch.tanh.*use method="
-                                                    r"'integrated_gradients' or 'kernel_shap' or 'exact'"):
+    with pytest.raises(
+        UnsupportedModelError,
+        match=r"functional nonlinearity \(torch.tanh.*use method="
+        r"'integrated_gradients' or 'kernel_shap' or 'exact'",
+    ):
         xairl.explain(policy, x, background=bg, method="deep_shap")
     # the same actor with the tanh as a module is explained exactly
     fixed = nn.Sequential(FunctionalTanhActor().net, nn.Tanh())
@@ -86,14 +90,20 @@ def test_a_module_taking_two_inputs_given_one_says_so():
             return self.lin(torch.cat([a, b], dim=1))
 
     flat = xairl.Policy(TwoInputs(), [f"o{i}" for i in range(6)], ["a", "b"])
-    with pytest.raises(InputError, match=r"module TwoInputs raised TypeError \(.*missing 1 required positional "
-                                         r"argument.*\) on input \(2, 6\)"):
+    with pytest.raises(
+        InputError,
+        match=r"module TwoInputs raised TypeError \(.*missing 1 required positional "
+        r"argument.*\) on input \(2, 6\)",
+    ):
         flat.scores(np.zeros((2, 6)))
     two = xairl.Policy(TwoInputs(), observation=[(4,), (2,)], action_names=["a", "b"])
     assert two.feature_names[:2] == ("input0[0]", "input0[1]") and two.feature_names[4:] == ("input1[0]", "input1[1]")
     rng = np.random.default_rng(0)
-    e = xairl.explain(two, [rng.normal(size=(2, 4)), rng.normal(size=(2, 2))],
-                      background=[rng.normal(size=(9, 4)), rng.normal(size=(9, 2))])
+    e = xairl.explain(
+        two,
+        [rng.normal(size=(2, 4)), rng.normal(size=(2, 2))],
+        background=[rng.normal(size=(9, 4)), rng.normal(size=(9, 2))],
+    )
     assert e.values.shape == (2, 6, 2) and e.additivity_gap.max() < 1e-6
 
 

@@ -1,5 +1,6 @@
 """The review page in a real browser (Debian's headless Chromium through its chromedriver): load it, see the
 evidence beside each narrative, review items, and find the verdicts in the SQLite store."""
+
 import re
 import shutil
 import socket
@@ -61,8 +62,12 @@ def _http(port, method, path, headers, body=b"", timeout=5):
 
 def _post(port, form, origin=None, host=None):
     body = form.encode()
-    headers = {"Host": host or f"127.0.0.1:{port}", "Content-Type": "application/x-www-form-urlencoded",
-               "Content-Length": str(len(body)), **({"Origin": origin} if origin else {})}
+    headers = {
+        "Host": host or f"127.0.0.1:{port}",
+        "Content-Type": "application/x-www-form-urlencoded",
+        "Content-Length": str(len(body)),
+        **({"Origin": origin} if origin else {}),
+    }
     return _http(port, "POST", "/review", headers, body)
 
 
@@ -123,8 +128,9 @@ def test_a_stalled_request_is_dropped_and_others_are_served(store, serve):
     port = serve(timeout=1)
     stalled = [socket.create_connection(("127.0.0.1", port), timeout=10) for _ in range(5)]
     for s in stalled:  # claims 100 bytes, sends 10
-        s.sendall(f"POST /review HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 100\r\n\r\n".encode()
-                  + b"token=abcd")
+        s.sendall(
+            f"POST /review HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 100\r\n\r\n".encode() + b"token=abcd"
+        )
     assert _http(port, "GET", "/", {"Host": f"127.0.0.1:{port}"})[0] == 200
     start = time.monotonic()
     for s in stalled:
@@ -165,7 +171,9 @@ def test_hostile_requests_print_no_traceback(store, capfd, serve):
     assert "Traceback" not in err and err == ""
 
 
-@pytest.mark.skipif(not BROWSER, reason="Debian's chromium and chromium-driver are not installed (make test installs them)")
+@pytest.mark.skipif(
+    not BROWSER, reason="Debian's chromium and chromium-driver are not installed (make test installs them)"
+)
 def test_review_in_headless_chromium(store, tmp_path):
     from selenium import webdriver
     from selenium.common.exceptions import StaleElementReferenceException
@@ -182,9 +190,18 @@ def test_review_in_headless_chromium(store, tmp_path):
 
     opts = webdriver.ChromeOptions()
     opts.binary_location = shutil.which("chromium")
-    for flag in ("--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
-                 "--disable-component-update", "--disable-sync", "--disable-dev-shm-usage",
-                 f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1200,1600"):
+    for flag in (
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--disable-dev-shm-usage",
+        f"--user-data-dir={tmp_path / 'profile'}",
+        "--window-size=1200,1600",
+    ):
         opts.add_argument(flag)
     server, url = serve_in_thread(store)
     driver = webdriver.Chrome(options=opts, service=Service(shutil.which("chromedriver")))

@@ -1,5 +1,6 @@
 """xairl.from_sb3 on real Stable-Baselines3 models of every algorithm and policy kind (built untrained with small
 buffers, a few gradient steps where cheap; no mocks). Each Policy's outputs are compared here with SB3's own."""
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -10,8 +11,13 @@ import xairl
 from xairl.errors import InputError
 
 IMAGE = spaces.Box(0, 255, (4, 84, 84), np.uint8)  # Atari frames after SB3's VecFrameStack + transpose
-DICT = spaces.Dict({"image": spaces.Box(0, 255, (3, 36, 36), np.uint8), "vec": spaces.Box(-1, 1, (5,), np.float32),
-                    "mode": spaces.Discrete(3)})
+DICT = spaces.Dict(
+    {
+        "image": spaces.Box(0, 255, (3, 36, 36), np.uint8),
+        "vec": spaces.Box(-1, 1, (5,), np.float32),
+        "mode": spaces.Discrete(3),
+    }
+)
 
 
 class SpaceEnv(gym.Env):
@@ -25,15 +31,19 @@ class SpaceEnv(gym.Env):
         return self.observation_space.sample(), {}
 
     def step(self, action):
-        return self.observation_space.sample(), float(self.np_random.normal()), False, \
-            bool(self.np_random.random() < 0.1), {}
+        return (
+            self.observation_space.sample(),
+            float(self.np_random.normal()),
+            False,
+            bool(self.np_random.random() < 0.1),
+            {},
+        )
 
 
 def states(space, n, seed=1):
     space.seed(seed)
     raw = [space.sample() for _ in range(n)]
-    return {k: np.stack([r[k] for r in raw]) for k in space.spaces} if isinstance(space, spaces.Dict) \
-        else np.stack(raw)
+    return {k: np.stack([r[k] for r in raw]) for k in space.spaces} if isinstance(space, spaces.Dict) else np.stack(raw)
 
 
 def sb3_outputs(model, head, obs):
@@ -74,19 +84,36 @@ CASES = [  # algorithm, policy, observation, action space, head, reference, outp
     ("PPO", "MlpPolicy", "CartPole-v1", None, "policy", "log-probs", "actions", 32),
     ("PPO", "MlpPolicy", "CartPole-v1", None, "value", "value", "value", 0),
     ("PPO", "MlpPolicy", "Pendulum-v1", None, "policy", "predict", "continuous", 32),
-    ("A2C", "MlpPolicy", spaces.Box(-1, 1, (6,), np.float32), spaces.Box(-2, 3, (2,), np.float32), "policy",
-     "predict", "continuous", 16),
+    (
+        "A2C",
+        "MlpPolicy",
+        spaces.Box(-1, 1, (6,), np.float32),
+        spaces.Box(-2, 3, (2,), np.float32),
+        "policy",
+        "predict",
+        "continuous",
+        16,
+    ),
     ("A2C", "MultiInputPolicy", DICT, spaces.Discrete(3), "value", "value", "value", 0),
     ("SAC", "MlpPolicy", "Pendulum-v1", None, "policy", "predict", "continuous", 32),
     ("SAC", "MlpPolicy", "Pendulum-v1", None, "q", "q", "value", 0),
-    ("TD3", "MlpPolicy", spaces.Box(-1, 1, (6,), np.float32), spaces.Box(-2, 3, (2,), np.float32), "policy",
-     "predict", "continuous", 32),
+    (
+        "TD3",
+        "MlpPolicy",
+        spaces.Box(-1, 1, (6,), np.float32),
+        spaces.Box(-2, 3, (2,), np.float32),
+        "policy",
+        "predict",
+        "continuous",
+        32,
+    ),
     ("DDPG", "MlpPolicy", "Pendulum-v1", None, "q", "q", "value", 0),
 ]
 
 
-@pytest.mark.parametrize("algo, kind, obs, act, head, ref, output, steps", CASES,
-                         ids=[f"{c[0]}-{c[1]}-{c[4]}" for c in CASES])
+@pytest.mark.parametrize(
+    "algo, kind, obs, act, head, ref, output, steps", CASES, ids=[f"{c[0]}-{c[1]}-{c[4]}" for c in CASES]
+)
 def test_from_sb3_equals_sb3(algo, kind, obs, act, head, ref, output, steps):
     model = build(algo, kind, obs, act)
     if steps:
@@ -100,8 +127,11 @@ def test_from_sb3_equals_sb3(algo, kind, obs, act, head, ref, output, steps):
     np.testing.assert_allclose(ours, sb3_outputs(model, ref, x).reshape(ours.shape), rtol=0, atol=1e-6)
     if output == "actions":
         np.testing.assert_array_equal(policy.act(x), model.predict(x, deterministic=True)[0])
-    e = xairl.explain(policy, {k: v[:2] for k, v in x.items()} if isinstance(x, dict) else x[:2],
-                      background={k: v[2:] for k, v in x.items()} if isinstance(x, dict) else x[2:])
+    e = xairl.explain(
+        policy,
+        {k: v[:2] for k, v in x.items()} if isinstance(x, dict) else x[:2],
+        background={k: v[2:] for k, v in x.items()} if isinstance(x, dict) else x[2:],
+    )
     assert e.output == output and e.values.shape == (2, policy.n_features, policy.n_actions)
     assert e.additivity_gap.max() <= 1e-5 * max(1.0, np.abs(e.outputs).max())
 
@@ -155,10 +185,13 @@ def test_value_head_needs_an_actor_critic():
         xairl.from_sb3(build("SAC", "MlpPolicy", "Pendulum-v1", None), head="value")
 
 
-@pytest.mark.parametrize("algo, obs, act, head", [
-    ("PPO", "CartPole-v1", None, "value"),
-    ("TD3", spaces.Box(-1, 1, (6,), np.float32), spaces.Box(-2, 3, (2,), np.float32), "policy"),
-])
+@pytest.mark.parametrize(
+    "algo, obs, act, head",
+    [
+        ("PPO", "CartPole-v1", None, "value"),
+        ("TD3", spaces.Box(-1, 1, (6,), np.float32), spaces.Box(-2, 3, (2,), np.float32), "policy"),
+    ],
+)
 def test_narration_of_a_value_head_and_a_2d_actor_verifies(algo, obs, act, head):
     model = build(algo, "MlpPolicy", obs, act)
     policy = xairl.from_sb3(model, head=head)

@@ -1,5 +1,6 @@
 """The Ray engine (issue 28) on a local Ray started by the test (2 workers, loopback only): the same Parquet parts,
 bit for bit, as the local engine, resume included; and the local engine never imports Ray."""
+
 import subprocess
 import sys
 
@@ -17,8 +18,9 @@ POLICY = toy_policy()
 @pytest.fixture(scope="module")
 def local_ray():
     """One local Ray for the module (2 CPUs, loopback only): the engine uses a running Ray and leaves it running."""
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level="ERROR",
-             _node_ip_address="127.0.0.1")
+    ray.init(
+        num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level="ERROR", _node_ip_address="127.0.0.1"
+    )
     yield
     ray.shutdown()
 
@@ -38,8 +40,22 @@ def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ra
     lost = sorted((tmp_path / "ray" / "explanations.parquet").glob("part-*.parquet"))[2:4]
     for part in lost:  # as if the run had been killed before these chunks were written
         part.unlink()
-    argv = ["explain", "--states", str(states), "--out", str(tmp_path / "ray"), "--format", "parquet", "--engine",
-            "ray", "--workers", "2", "--chunk-size", "1000", "--resume"]
+    argv = [
+        "explain",
+        "--states",
+        str(states),
+        "--out",
+        str(tmp_path / "ray"),
+        "--format",
+        "parquet",
+        "--engine",
+        "ray",
+        "--workers",
+        "2",
+        "--chunk-size",
+        "1000",
+        "--resume",
+    ]
     assert main(argv + ["--background-size", "31"]) == 2  # another background than the run's: refused
     assert main(argv + ["--background-size", "30"]) == 0  # the same run (the sampler's 30 states): resumed
     again = read_parquet(tmp_path / "ray" / "explanations.parquet")
@@ -59,7 +75,7 @@ def test_ray_resume_explains_a_damaged_part_again_and_refuses_a_stray_by_name(tm
     parts = tmp_path / "ray" / "explanations.parquet"
     flipped = parts / "part-000000001000.parquet"
     whole = flipped.read_bytes()
-    flipped.write_bytes(whole[:len(whole) // 2] + bytes([whole[len(whole) // 2] ^ 4]) + whole[len(whole) // 2 + 1:])
+    flipped.write_bytes(whole[: len(whole) // 2] + bytes([whole[len(whole) // 2] ^ 4]) + whole[len(whole) // 2 + 1 :])
     (parts / "part-000000000007.parquet").write_bytes((parts / "part-000000000000.parquet").read_bytes())
     with pytest.raises(InputError, match="part-000000000007.parquet: not a part of this run"):
         explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=1000, workers=2, resume=True)
@@ -78,17 +94,22 @@ def test_ray_reads_parquet_by_row_group_and_csv_once_rewritten(tmp_path, local_r
     from xairl.toy import FEATURES
 
     states, bg = POLICY.background(2_500, seed=5), POLICY.background(20)
-    pq.write_table(pa.table({f: states[:, j] for j, f in enumerate(FEATURES)}), tmp_path / "s.parquet",
-                   row_group_size=300)  # row groups that do not fall on the chunks' bounds
-    (tmp_path / "s.csv").write_text(",".join(FEATURES) + "\n" + "\n".join(",".join(repr(float(v)) for v in row)
-                                                                          for row in states))
+    pq.write_table(
+        pa.table({f: states[:, j] for j, f in enumerate(FEATURES)}), tmp_path / "s.parquet", row_group_size=300
+    )  # row groups that do not fall on the chunks' bounds
+    (tmp_path / "s.csv").write_text(
+        ",".join(FEATURES) + "\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in states)
+    )
     local = explain_to_parquet(POLICY, states, tmp_path / "local", background=bg, chunk_size=1000, progress=False)
     for name in ("s.parquet", "s.csv"):
-        summary = explain_on_ray(POLICY, tmp_path / name, tmp_path / name.replace(".", "_"), background=bg,
-                                 chunk_size=1000, workers=2)
+        summary = explain_on_ray(
+            POLICY, tmp_path / name, tmp_path / name.replace(".", "_"), background=bg, chunk_size=1000, workers=2
+        )
         assert summary.n == local.n == 2_500
-        assert np.array_equal(read_parquet(tmp_path / name.replace(".", "_") / "explanations.parquet").values,
-                              read_parquet(tmp_path / "local" / "explanations.parquet").values), name
+        assert np.array_equal(
+            read_parquet(tmp_path / name.replace(".", "_") / "explanations.parquet").values,
+            read_parquet(tmp_path / "local" / "explanations.parquet").values,
+        ), name
         assert not (tmp_path / name.replace(".", "_") / STAGED).exists()  # the CSV's rewrite is removed
 
 
@@ -102,14 +123,18 @@ def test_ray_reports_a_users_error_in_one_line_and_keeps_what_was_written(tmp_pa
 
     states = POLICY.background(2_500, seed=6).astype(float)
     states[1_700, 2] = np.nan  # found by the worker that reads rows 1000..1999, not by the driver
-    pq.write_table(pa.table({f: states[:, j] for j, f in enumerate(FEATURES)}), tmp_path / "s.parquet",
-                   row_group_size=500)
+    pq.write_table(
+        pa.table({f: states[:, j] for j, f in enumerate(FEATURES)}), tmp_path / "s.parquet", row_group_size=500
+    )
     with pytest.raises(InputError, match=r"rows 1000\.\.1999 contain 1 NaN/inf value") as err:
-        explain_on_ray(POLICY, tmp_path / "s.parquet", tmp_path / "o", background=POLICY.background(20),
-                       chunk_size=1000, workers=2)
+        explain_on_ray(
+            POLICY, tmp_path / "s.parquet", tmp_path / "o", background=POLICY.background(20), chunk_size=1000, workers=2
+        )
     assert "\n" not in str(err.value) and "Ray" not in str(err.value)
-    assert sorted(p.name for p in (tmp_path / "o" / "explanations.parquet").glob("*.parquet")) == \
-        ["part-000000000000.parquet", "part-000000002000.parquet"]  # the good chunks stay, for --resume
+    assert sorted(p.name for p in (tmp_path / "o" / "explanations.parquet").glob("*.parquet")) == [
+        "part-000000000000.parquet",
+        "part-000000002000.parquet",
+    ]  # the good chunks stay, for --resume
     (tmp_path / "s.csv").write_text(",".join(FEATURES) + "\n")  # a header and no state
     with pytest.raises(InputError, match="holds no state"):
         explain_on_ray(POLICY, tmp_path / "s.csv", tmp_path / "o2", background=POLICY.background(20))
@@ -135,8 +160,12 @@ def test_narrations_on_ray_are_the_narrations_here_in_order(local_ray):
 
 
 def test_the_local_engine_imports_no_ray(tmp_path):
-    code = ("import sys, numpy as np; from xairl.toy import toy_policy; from xairl.stream import explain_to_parquet; "
-            f"p = toy_policy(); explain_to_parquet(p, p.background(100), {str(tmp_path / 'o')!r}, progress=False); "
-            "print('ray' in sys.modules)")
-    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip() \
+    code = (
+        "import sys, numpy as np; from xairl.toy import toy_policy; from xairl.stream import explain_to_parquet; "
+        f"p = toy_policy(); explain_to_parquet(p, p.background(100), {str(tmp_path / 'o')!r}, progress=False); "
+        "print('ray' in sys.modules)"
+    )
+    assert (
+        subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
         == "False"
+    )

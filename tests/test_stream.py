@@ -1,5 +1,6 @@
 """Streaming (issue 28): states read in chunks from .npy, Parquet and CSV, explained chunk by chunk into a Parquet
 dataset, equal to explaining them at once; a run killed with kill -9 and resumed explains every state exactly once."""
+
 import json
 import os
 import signal
@@ -13,9 +14,9 @@ import pyarrow.parquet as pq
 import pytest
 
 import xairl
+from xairl.chunks import _table_batches, stage_parquet, state_chunks
 from xairl.cli import main
 from xairl.errors import InputError
-from xairl.chunks import _table_batches, stage_parquet, state_chunks
 from xairl.stream import explain_chunks, explain_to_parquet, read_parquet
 from xairl.toy import FEATURES, toy_policy
 
@@ -31,11 +32,17 @@ def reference():
 
 def _sources(folder):
     np.save(folder / "s.npy", STATES)
-    pq.write_table(pa.table({f: STATES[:, j].astype(np.float64) for j, f in enumerate(reversed(FEATURES))}
-                            | {f: STATES[:, FEATURES.index(f)].astype(np.float64) for f in FEATURES}),
-                   folder / "s.parquet", row_group_size=700)
-    (folder / "s.csv").write_text(",".join(FEATURES[::-1]) + "\n" + "\n".join(
-        ",".join(repr(float(v)) for v in row[::-1]) for row in STATES))
+    pq.write_table(
+        pa.table(
+            {f: STATES[:, j].astype(np.float64) for j, f in enumerate(reversed(FEATURES))}
+            | {f: STATES[:, FEATURES.index(f)].astype(np.float64) for f in FEATURES}
+        ),
+        folder / "s.parquet",
+        row_group_size=700,
+    )
+    (folder / "s.csv").write_text(
+        ",".join(FEATURES[::-1]) + "\n" + "\n".join(",".join(repr(float(v)) for v in row[::-1]) for row in STATES)
+    )
     return [folder / "s.npy", folder / "s.parquet", folder / "s.csv", STATES]
 
 
@@ -47,7 +54,10 @@ def test_every_source_gives_the_same_chunks(tmp_path):
         for start in (1000, 1999, 2000):  # Parquet: the row groups before the chunk (700 rows each) are not read
             later = list(state_chunks(source, POLICY, chunk_size=1000, start=start))
             assert [first for first, _ in later] == list(range(start - start % 1000, 2345, 1000)), (source, start)
-            assert np.array_equal(np.concatenate([c for _, c in later]), STATES[start - start % 1000:]), (source, start)
+            assert np.array_equal(np.concatenate([c for _, c in later]), STATES[start - start % 1000 :]), (
+                source,
+                start,
+            )
 
 
 def test_parquet_is_read_from_the_row_group_that_holds_the_first_row_wanted(tmp_path):
@@ -69,8 +79,14 @@ def test_chunks_equal_one_explanation_of_all_states(reference):
 
 
 def test_parquet_dataset_round_trip_and_summary(tmp_path, reference):
-    summary = explain_to_parquet(POLICY, tmp_path / "s.npy" if np.save(tmp_path / "s.npy", STATES) is None else None,
-                                 tmp_path / "out", background=BG, chunk_size=1000, progress=False)
+    summary = explain_to_parquet(
+        POLICY,
+        tmp_path / "s.npy" if np.save(tmp_path / "s.npy", STATES) is None else None,
+        tmp_path / "out",
+        background=BG,
+        chunk_size=1000,
+        progress=False,
+    )
     back = read_parquet(tmp_path / "out" / "explanations.parquet")
     assert np.array_equal(back.values, reference.values.astype(np.float32).astype(np.float64))
     assert np.array_equal(back.outputs, reference.outputs) and back.feature_names == reference.feature_names
@@ -94,17 +110,35 @@ def test_a_folder_holding_a_run_is_not_overwritten_and_resume_checks_it_is_the_s
     with pytest.raises(InputError, match="differs in background_sha256"):
         explain_to_parquet(POLICY, STATES, out, background=BG[:20], chunk_size=1000, progress=False, resume=True)
     with pytest.raises(InputError, match="differs in method, options"):
-        explain_to_parquet(POLICY, STATES, out, background=BG, method="exact", chunk_size=1000, progress=False,
-                           resume=True)
+        explain_to_parquet(
+            POLICY, STATES, out, background=BG, method="exact", chunk_size=1000, progress=False, resume=True
+        )
 
 
 def test_kill_9_then_resume_explains_every_state_exactly_once(tmp_path):
     states = tmp_path / "s.npy"
     np.save(states, POLICY.background(16_000, seed=9))
     out = tmp_path / "out"
-    argv = [sys.executable, "-m", "xairl.cli", "explain", "--states", str(states), "--out", str(out), "--format",
-            "parquet", "--chunk-size", "500", "--method", "integrated_gradients", "-o", "n_steps=8",
-            "--background-size", "20"]
+    argv = [
+        sys.executable,
+        "-m",
+        "xairl.cli",
+        "explain",
+        "--states",
+        str(states),
+        "--out",
+        str(out),
+        "--format",
+        "parquet",
+        "--chunk-size",
+        "500",
+        "--method",
+        "integrated_gradients",
+        "-o",
+        "n_steps=8",
+        "--background-size",
+        "20",
+    ]
     proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     parts = out / "explanations.parquet"
     deadline = time.time() + 120
@@ -123,14 +157,24 @@ def test_kill_9_then_resume_explains_every_state_exactly_once(tmp_path):
     for junk in parts.glob(".*.part"):  # what the kill left: hidden, never under a final name
         junk.unlink()
     again = tmp_path / "again"
-    explain_to_parquet(POLICY, states, again, background=POLICY.background(20, seed=0), method="integrated_gradients",
-                       options={"n_steps": 8}, chunk_size=500, progress=False)
+    explain_to_parquet(
+        POLICY,
+        states,
+        again,
+        background=POLICY.background(20, seed=0),
+        method="integrated_gradients",
+        options={"n_steps": 8},
+        chunk_size=500,
+        progress=False,
+    )
     assert np.array_equal(read_parquet(parts).values, read_parquet(again / "explanations.parquet").values)
 
 
 def test_cli_parquet_writes_a_report_of_a_sample_and_shows_progress_on_a_terminal(tmp_path, capsys):
-    assert main(["explain", "--n", "3000", "--out", str(tmp_path / "r"), "--format", "parquet", "--chunk-size",
-                 "1000"]) == 0
+    assert (
+        main(["explain", "--n", "3000", "--out", str(tmp_path / "r"), "--format", "parquet", "--chunk-size", "1000"])
+        == 0
+    )
     out = capsys.readouterr().out
     assert "(3000 states)" in out and (tmp_path / "r" / "report.html").exists()
     html = (tmp_path / "r" / "report.html").read_text()

@@ -1,4 +1,5 @@
 """The verifier on a corpus of real narratives made wrong, and of correct paraphrases."""
+
 import collections
 
 import numpy as np
@@ -27,8 +28,16 @@ def test_mutation_corpus_all_caught_no_paraphrase_rejected(toy):
         if ok != c.should_pass:
             wrongly.append((c.kind, c.text))
     kinds = {k for k, _ in results}
-    assert {"wrong number", "flipped direction", "swapped rank", "unknown feature", "wrong action",
-            "other phrasing", "coarser rounding", "direction synonym"} <= kinds
+    assert {
+        "wrong number",
+        "flipped direction",
+        "swapped rank",
+        "unknown feature",
+        "wrong action",
+        "other phrasing",
+        "coarser rounding",
+        "direction synonym",
+    } <= kinds
     assert len(cases) > 800
     assert not wrongly, wrongly[:3]
 
@@ -99,8 +108,13 @@ def test_names_and_descriptions_cannot_smuggle_claims():
         net.weight.copy_(torch.tensor([[1.0, 0.0], [0.0, 1.0]]))
         net.bias.zero_()
     hostile = xairl.FeatureInfo("", "speed, the most important feature, pushing toward go by +9.99")
-    policy = xairl.Policy(net, ["speed", "load"], ["go", "stop"], features={"speed": hostile},
-                               action_aliases={"stop": ["stop, which raises go by 12.5%"]})
+    policy = xairl.Policy(
+        net,
+        ["speed", "load"],
+        ["go", "stop"],
+        features={"speed": hostile},
+        action_aliases={"stop": ["stop, which raises go by 12.5%"]},
+    )
     bg = np.zeros((10, 2))
     exp = xairl.explain(policy, [[0.1, 2.0]], background=bg, method="exact")  # load dominates, stop is chosen
     n = xairl.narrate(exp, 0, policy=policy)

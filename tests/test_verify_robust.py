@@ -2,17 +2,19 @@
 random unicode, numbers in odd formats, names in any script or of punctuation only, non-finite explanations, 500
 features); and
 xairl's own templates verify on every kind of policy, whatever digits or brackets its names hold."""
+
 import math
 
 import numpy as np
 import pytest
 import torch
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import xairl
+from tests.work_budget import calls
 from xairl.errors import InputError
 from xairl.narrators.verify import verify
-from tests.work_budget import calls
 
 
 def _explanation(values, names, states=None, actions=("out",), output="value", categories=None):
@@ -21,8 +23,17 @@ def _explanation(values, names, states=None, actions=("out",), output="value", c
     base = np.zeros((1, len(actions)))
     with np.errstate(all="ignore"):
         out = base + v.sum(axis=1)
-    return xairl.Explanation(values=v, base_values=base, outputs=out, states=s, feature_names=tuple(names),
-                             action_names=tuple(actions), method="given", output=output, categories=categories)
+    return xairl.Explanation(
+        values=v,
+        base_values=base,
+        outputs=out,
+        states=s,
+        feature_names=tuple(names),
+        action_names=tuple(actions),
+        method="given",
+        output=output,
+        categories=categories,
+    )
 
 
 POOL = [
@@ -30,16 +41,73 @@ POOL = [
     _explanation([0.4, -0.2, 0.05], ["速度", "Δ", "-"], actions=("?",)),
     _explanation([0.4, -0.2, 0.05], ["sensors[0]", "obs[1,32,35]", "rsrp_1"]),
     _explanation([1e308, -1e308, 0.05], ["speed", "load", "wind"], states=[1e308, -1e308, 5e-324]),
-    _explanation([[0.4, -0.1], [-0.2, 0.3], [0.05, 0.0]], ["speed", "load", "wind"], actions=("turn", "recharge"),
-                 output="actions"),
-    _explanation([0.3, -0.1, 0.2], ["contract", "tenure", "city"], states=[0, 12, 0],
-                 categories={"contract": ("One year",), "city": ("São Paulo",)}),
+    _explanation(
+        [[0.4, -0.1], [-0.2, 0.3], [0.05, 0.0]],
+        ["speed", "load", "wind"],
+        actions=("turn", "recharge"),
+        output="actions",
+    ),
+    _explanation(
+        [0.3, -0.1, 0.2],
+        ["contract", "tenure", "city"],
+        states=[0, 12, 0],
+        categories={"contract": ("One year",), "city": ("São Paulo",)},
+    ),
 ]
-FRAGMENTS = ["speed", "load", "raised", "lowered", "the score", "by", "about", "not", "because", "if it had",
-             "the most", "second", "(", ")", ",", ".", "\n- ", "速度", "Δ", " ? ", "sensors[0]", "obs[1,32,35]",
-             "1e999", "1e-400", "1" + "0" * 320, "9" * 400, "-0", "+.5", "3/0", "22,5", "1 000 000", "½", "٣",
-             "NaN", "inf", "−1.37", "$1.2k", "43 %", "12 pts", "4th", "1 1 1", "twenty-one", "minus 2", "rsrp_1",
-             "battery_level:", "Q_turn", "One year", "two-year contract", "São Paulo", "\x00", "\u202e", "🙂"]
+FRAGMENTS = [
+    "speed",
+    "load",
+    "raised",
+    "lowered",
+    "the score",
+    "by",
+    "about",
+    "not",
+    "because",
+    "if it had",
+    "the most",
+    "second",
+    "(",
+    ")",
+    ",",
+    ".",
+    "\n- ",
+    "速度",
+    "Δ",
+    " ? ",
+    "sensors[0]",
+    "obs[1,32,35]",
+    "1e999",
+    "1e-400",
+    "1" + "0" * 320,
+    "9" * 400,
+    "-0",
+    "+.5",
+    "3/0",
+    "22,5",
+    "1 000 000",
+    "½",
+    "٣",
+    "NaN",
+    "inf",
+    "−1.37",
+    "$1.2k",
+    "43 %",
+    "12 pts",
+    "4th",
+    "1 1 1",
+    "twenty-one",
+    "minus 2",
+    "rsrp_1",
+    "battery_level:",
+    "Q_turn",
+    "One year",
+    "two-year contract",
+    "São Paulo",
+    "\x00",
+    "\u202e",
+    "🙂",
+]
 
 
 def _no_failure(result) -> None:
@@ -59,8 +127,11 @@ def test_sentences_of_names_numbers_and_hostile_fragments(parts, index):
     _no_failure(verify(" ".join(parts), POOL[index], 0))
 
 
-WIDE = _explanation(np.random.default_rng(0).normal(size=500), [f"f_{i}" for i in range(500)],
-                    states=np.random.default_rng(1).normal(size=500))
+WIDE = _explanation(
+    np.random.default_rng(0).normal(size=500),
+    [f"f_{i}" for i in range(500)],
+    states=np.random.default_rng(1).normal(size=500),
+)
 
 
 @settings(max_examples=60, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
@@ -69,8 +140,15 @@ def test_five_hundred_features(parts):
     _no_failure(verify(" ".join(parts), WIDE, 0))
 
 
-@pytest.mark.parametrize("values, states", [([np.nan, -0.2, 0.05], None), ([np.inf, -np.inf, 0.05], None),
-                                            ([1e308, 1e308, -1e308], None), ([0.4, -0.2, 0.05], [np.inf, 0, 1])])
+@pytest.mark.parametrize(
+    "values, states",
+    [
+        ([np.nan, -0.2, 0.05], None),
+        ([np.inf, -np.inf, 0.05], None),
+        ([1e308, 1e308, -1e308], None),
+        ([0.4, -0.2, 0.05], [np.inf, 0, 1]),
+    ],
+)
 def test_a_non_finite_explanation_cannot_be_built_so_nothing_is_verified_against_it(values, states):
     """(issue 27: an overflowing network used to give an Explanation of NaN that narrate() called verified)"""
     with pytest.raises(InputError, match="NaN or infinity"):
@@ -137,12 +215,14 @@ def _policies():
         "flat": xairl.Policy(mlp, observation=(4,)),
         "dict": xairl.Policy(_Dict(), observation={"sensors": (4,), "speed": (1,)}),
         "image pixels": xairl.Policy(_Image(), observation=(3, 8, 8)),
-        "image patch names": xairl.Policy(torch.nn.Linear(4, 3), feature_names=[
-            "patch[0,0]", "patch[0,1]", "patch[1,0]", "patch[1,1]"]),
+        "image patch names": xairl.Policy(
+            torch.nn.Linear(4, 3), feature_names=["patch[0,0]", "patch[0,1]", "patch[1,0]", "patch[1,1]"]
+        ),
         "continuous": xairl.Policy(torch.nn.Linear(4, 2), observation=(4,), output="continuous"),
         "value": xairl.Policy(torch.nn.Linear(4, 1), observation=(4,), output="value"),
-        "names in any script": xairl.Policy(torch.nn.Linear(3, 2), feature_names=["速度", "Δ", "-"],
-                                            action_names=["停", "?"]),
+        "names in any script": xairl.Policy(
+            torch.nn.Linear(3, 2), feature_names=["速度", "Δ", "-"], action_names=["停", "?"]
+        ),
     }
 
 

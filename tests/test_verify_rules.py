@@ -1,6 +1,7 @@
 """One test per example of every rule in :mod:`xairl.narrators.verify.rules`: a 'fires' sentence's verification
 holds a claim made by that rule, a 'silent' one's holds none. The table and the code name the same rules, and the
 docs list them all."""
+
 import pathlib
 import re
 
@@ -10,11 +11,16 @@ import xairl
 from xairl.narrators.verify import binding, rules
 
 VERIFY = pathlib.Path(xairl.__file__).parent / "narrators" / "verify"
-_RULE_ID = re.compile(r"[\"']((?:names|action|category|number|parse|direction|rank|identifier|region)\.[a-z-]+)"
-                      r"[\"']")
-EXAMPLES = [pytest.param(r.id, fires, name, text, id=f"{r.id}-{'fires' if fires else 'silent'}-{i}")
-            for r in rules.RULES for fires, examples in ((True, r.fires), (False, r.silent))
-            for i, (name, text) in enumerate(examples)]
+_RULE_ID = re.compile(
+    r"[\"']((?:names|action|category|number|parse|direction|rank|identifier|region)\.[a-z-]+)"
+    r"[\"']"
+)
+EXAMPLES = [
+    pytest.param(r.id, fires, name, text, id=f"{r.id}-{'fires' if fires else 'silent'}-{i}")
+    for r in rules.RULES
+    for fires, examples in ((True, r.fires), (False, r.silent))
+    for i, (name, text) in enumerate(examples)
+]
 
 
 @pytest.mark.parametrize("rule,fires,name,text", EXAMPLES)

@@ -7,6 +7,7 @@ still shows as many more of them. Work done inside one C call (a regular express
 built by ``*``) is not counted here: ``tests/regex_steps.py`` counts a pattern's steps, and the sandbox sizes what
 a template builds before it is built. The times themselves are in ``benchmarks/bench_test_timings.py``.
 """
+
 from __future__ import annotations
 
 import cProfile

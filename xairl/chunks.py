@@ -2,10 +2,11 @@
 (through pyarrow), arrays and .npz/.json files whole, then sliced. Chunks start at multiples of the chunk size, so a
 chunk is the same rows whoever reads it: the streaming engine, a resumed run or a Ray worker that reads only its own.
 """
+
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 
@@ -60,12 +61,17 @@ def state_chunks(source, policy: Policy, chunk_size: int = CHUNK, start: int = 0
         first, batches = _table_batches(path, policy, chunk_size, start - start % chunk_size)
         yield from _rechunk(batches, policy, chunk_size, start, str(path), first)
         return
-    rows = _NpyRows(path) if suffix == ".npy" else read_states(path, policy.feature_names, policy.observation) \
-        if path is not None else policy.check_states(source)
+    rows = (
+        _NpyRows(path)
+        if suffix == ".npy"
+        else read_states(path, policy.feature_names, policy.observation)
+        if path is not None
+        else policy.check_states(source)
+    )
     n = len(rows)
     for a in range(start - start % chunk_size, n, chunk_size):
         what = f"{path or 'states'}: rows {a}..{min(a + chunk_size, n) - 1}"
-        yield a, policy.check_states(np.asarray(rows[a:a + chunk_size]), what)
+        yield a, policy.check_states(np.asarray(rows[a : a + chunk_size]), what)
 
 
 class _NpyRows:
@@ -81,8 +87,9 @@ class _NpyRows:
         except (ValueError, OSError, EOFError) as exc:
             raise InputError(f"{path}: cannot read it as .npy ({' '.join(str(exc).split())[:120]}).") from None
         if self.dtype.hasobject or not self.shape:
-            raise InputError(f"{path}: holds {'Python objects' if self.dtype.hasobject else 'a single number'}, not "
-                             "rows of states.")
+            raise InputError(
+                f"{path}: holds {'Python objects' if self.dtype.hasobject else 'a single number'}, not rows of states."
+            )
         self.path, self.fortran = path, fortran
         self.row = int(np.prod(self.shape[1:], dtype=np.int64))
         if path.stat().st_size - self.offset < len(self) * self.row * self.dtype.itemsize:
@@ -97,8 +104,7 @@ class _NpyRows:
             return np.array(np.load(self.path, mmap_mode="r", allow_pickle=False)[a:b])
         with self.path.open("rb") as fh:
             fh.seek(self.offset + a * self.row * self.dtype.itemsize)
-            return np.fromfile(fh, self.dtype, count=max(b - a, 0) * self.row).reshape(max(b - a, 0),
-                                                                                       *self.shape[1:])
+            return np.fromfile(fh, self.dtype, count=max(b - a, 0) * self.row).reshape(max(b - a, 0), *self.shape[1:])
 
 
 def _unreadable(path: Path, exc: Exception) -> InputError:
@@ -137,24 +143,37 @@ def _table_batches(path: Path, policy: Policy, chunk_size: int, start: int) -> t
         from pyarrow import csv
 
         try:
-            first, batches = 0, iter(csv.open_csv(path, convert_options=csv.ConvertOptions(
-                include_columns=names, column_types={f: pa.float64() for f in names})))
+            first, batches = (
+                0,
+                iter(
+                    csv.open_csv(
+                        path,
+                        convert_options=csv.ConvertOptions(
+                            include_columns=names, column_types={f: pa.float64() for f in names}
+                        ),
+                    )
+                ),
+            )
         except (pa.ArrowException, OSError) as exc:
             raise _unreadable(path, exc) from None
 
     def arrays() -> Iterator[np.ndarray]:
         try:
             for batch in batches:
-                yield np.column_stack([batch.column(f).to_numpy(zero_copy_only=False) for f in names]) \
-                    if batch.num_rows else np.empty((0, len(names)))
+                yield (
+                    np.column_stack([batch.column(f).to_numpy(zero_copy_only=False) for f in names])
+                    if batch.num_rows
+                    else np.empty((0, len(names)))
+                )
         except (pa.ArrowException, OSError) as exc:
             raise _unreadable(path, exc) from None
 
     return first, arrays()
 
 
-def _rechunk(batches: Iterator[np.ndarray], policy: Policy, chunk_size: int, start: int, what: str,
-             first: int = 0) -> Iterator[tuple[int, np.ndarray]]:
+def _rechunk(
+    batches: Iterator[np.ndarray], policy: Policy, chunk_size: int, start: int, what: str, first: int = 0
+) -> Iterator[tuple[int, np.ndarray]]:
     """Batches of any size, the first starting at row ``first`` -> chunks of ``chunk_size`` rows (the last may be
     shorter) starting at multiples of ``chunk_size``, from the chunk that holds row ``start`` on."""
     target, buffered, held = start - start % chunk_size, [], 0

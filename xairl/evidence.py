@@ -5,6 +5,7 @@ every feature's value and contributions to the margin over the runner-up and to 
 verification status, the confidence components) as plain JSON-ready data; the feedback store keeps it with the
 narrative, and :func:`card_html` draws the same card in the HTML report and on the review page.
 """
+
 from __future__ import annotations
 
 import html
@@ -22,9 +23,12 @@ STATUS_MARK = {"verified": "&#10003;", "contradicted": "&#10007;", "unchecked": 
 def evidence(exp: Explanation, narrative) -> dict[str, Any]:
     """What a card shows for ``narrative`` of ``exp`` (its state ``narrative.index``; a global summary has no
     state and only its sentences and confidence)."""
-    out: dict[str, Any] = {"sentences": [list(s) for s in narrative.sentences],
-                           "components": {k: v for k, v in narrative.components.items() if v is not None},
-                           "confidence": narrative.confidence, "verified": narrative.verified}
+    out: dict[str, Any] = {
+        "sentences": [list(s) for s in narrative.sentences],
+        "components": {k: v for k, v in narrative.components.items() if v is not None},
+        "confidence": narrative.confidence,
+        "verified": narrative.verified,
+    }
     i = narrative.index
     if i is None or exp.states is None or exp.values.ndim != 3:
         return out
@@ -36,12 +40,26 @@ def evidence(exp: Explanation, narrative) -> dict[str, Any]:
     rows = []
     for j in np.argsort(-np.abs(view), kind="stable"):
         label = None if labels is None or labels[i, j] is None else str(labels[i, j])
-        rows.append({"name": exp.feature_names[j], "value": label if label is not None else float(exp.states[i, j]),
-                     "contribution": float(view[j]), "to_chosen": float(exp.values[i, j, c])})
-    out.update({"action": exp.action_names[c], "runner_up": exp.action_names[r] if deciding else None,
-                "target": f"margin of {exp.action_names[c]} over {exp.action_names[r]}" if deciding
-                else f"{exp.action_names[c]}'s score",
-                "base": base, "output": base + float(view.sum()), "features": rows})
+        rows.append(
+            {
+                "name": exp.feature_names[j],
+                "value": label if label is not None else float(exp.states[i, j]),
+                "contribution": float(view[j]),
+                "to_chosen": float(exp.values[i, j, c]),
+            }
+        )
+    out.update(
+        {
+            "action": exp.action_names[c],
+            "runner_up": exp.action_names[r] if deciding else None,
+            "target": f"margin of {exp.action_names[c]} over {exp.action_names[r]}"
+            if deciding
+            else f"{exp.action_names[c]}'s score",
+            "base": base,
+            "output": base + float(view.sum()),
+            "features": rows,
+        }
+    )
     return out
 
 
@@ -53,8 +71,9 @@ def waterfall_html(ev: dict) -> str:
     """The margin (or score) built from its base, one bar per large contribution: an HTML/CSS waterfall."""
     rows = ev["features"][:SHOWN]
     rest = sum(f["contribution"] for f in ev["features"][SHOWN:])
-    steps = [(f["name"], f["contribution"]) for f in rows] + ([(f"{len(ev['features']) - SHOWN} others", rest)]
-                                                               if len(ev["features"]) > SHOWN else [])
+    steps = [(f["name"], f["contribution"]) for f in rows] + (
+        [(f"{len(ev['features']) - SHOWN} others", rest)] if len(ev["features"]) > SHOWN else []
+    )
     level, points = ev["base"], [ev["base"]]
     for _, v in steps:
         level += v
@@ -66,40 +85,53 @@ def waterfall_html(ev: dict) -> str:
         a, b = sorted((level, level + v))
         left, width = 100 * (a - lo) / span, max(100 * (b - a) / span, 0.3)
         cls = "up" if v >= 0 else "down"
-        bars.append(f"<div class=wf-row><span class=wf-name>{html.escape(name)}</span><span class=wf-track>"
-                    f"<span class='wf-bar {cls}' style='left:{left:.2f}%;width:{width:.2f}%'></span></span>"
-                    f"<span class=wf-val>{v:+.3g}</span></div>")
+        bars.append(
+            f"<div class=wf-row><span class=wf-name>{html.escape(name)}</span><span class=wf-track>"
+            f"<span class='wf-bar {cls}' style='left:{left:.2f}%;width:{width:.2f}%'></span></span>"
+            f"<span class=wf-val>{v:+.3g}</span></div>"
+        )
         level += v
-    return (f"<div class=waterfall><div class=wf-head>{html.escape(ev['target'])}: base {ev['base']:.3g} &rarr; "
-            f"{ev['output']:.3g}</div>{''.join(bars)}</div>")
+    return (
+        f"<div class=waterfall><div class=wf-head>{html.escape(ev['target'])}: base {ev['base']:.3g} &rarr; "
+        f"{ev['output']:.3g}</div>{''.join(bars)}</div>"
+    )
 
 
 def card_html(narrative_text: str, ev: dict, meta: str = "", controls: str = "") -> str:
     """A decision card: the narrative with each sentence marked, the state, the waterfall, the confidence."""
     sentences = ev.get("sentences") or [[narrative_text, "verified" if ev.get("verified") else "unchecked"]]
-    text = " ".join(f"<span class='s {st}' title='{st}'>{html.escape(s)} <sup>{STATUS_MARK.get(st, '?')}</sup></span>"
-                    for s, st in sentences)
+    text = " ".join(
+        f"<span class='s {st}' title='{st}'>{html.escape(s)} <sup>{STATUS_MARK.get(st, '?')}</sup></span>"
+        for s, st in sentences
+    )
     comps = "".join(f"<tr><td>{html.escape(k)}</td><td>{v:.2f}</td></tr>" for k, v in ev.get("components", {}).items())
     parts = [f"<p class=narrative>{text}</p>"]
     if meta:
         parts.append(f"<p class=meta>{meta}</p>")
     side = [f"<table class=comp><tr><th>confidence</th><th>{ev.get('confidence', 0):.2f}</th></tr>{comps}</table>"]
     if "features" in ev:
-        state = "".join(f"<tr><td>{html.escape(f['name'])}</td><td>{_num(f['value'])}</td><td>{f['contribution']:+.3g}"
-                        f"</td></tr>" for f in ev["features"])
-        side.insert(0, f"<table class=state><tr><th>feature</th><th>value</th><th>to the {'margin' if ev.get('runner_up') else 'score'}"
-                       f"</th></tr>{state}</table>")
+        state = "".join(
+            f"<tr><td>{html.escape(f['name'])}</td><td>{_num(f['value'])}</td><td>{f['contribution']:+.3g}</td></tr>"
+            for f in ev["features"]
+        )
+        side.insert(
+            0,
+            f"<table class=state><tr><th>feature</th><th>value</th><th>to the {'margin' if ev.get('runner_up') else 'score'}"
+            f"</th></tr>{state}</table>",
+        )
         parts.append(waterfall_html(ev))
     parts.append(f"<div class=side>{''.join(side)}</div>")
     return f"<div class=card>{''.join(parts)}{controls}</div>"
 
 
-CARD_STYLE = (".card{border:1px solid #ccd;border-radius:6px;padding:.6em 1em;margin:1em 0}.narrative{font-size:105%}"
-              ".s.verified sup{color:#070}.s.contradicted{background:#fdd}.s.contradicted sup{color:#b00}"
-              ".s.unchecked{background:#ffe9b3}.s.unchecked sup{color:#a60}.side{display:flex;gap:2em;flex-wrap:wrap;"
-              "align-items:flex-start}.side table{font-size:85%}.waterfall{margin:.5em 0;font-size:85%;max-width:760px}"
-              ".wf-row{display:flex;align-items:center;height:1.4em}.wf-name{width:14em;overflow:hidden;"
-              "white-space:nowrap}.wf-track{position:relative;flex:1;height:1em;background:#f4f4f4}.wf-bar{position:"
-              "absolute;top:0;height:100%}.wf-bar.up{background:#d62728}.wf-bar.down{background:#1f77b4}"
-              ".wf-val{width:5em;text-align:right}.wf-head{font-weight:bold;margin-bottom:.2em}"
-              ".meta{color:#555;font-size:90%}")
+CARD_STYLE = (
+    ".card{border:1px solid #ccd;border-radius:6px;padding:.6em 1em;margin:1em 0}.narrative{font-size:105%}"
+    ".s.verified sup{color:#070}.s.contradicted{background:#fdd}.s.contradicted sup{color:#b00}"
+    ".s.unchecked{background:#ffe9b3}.s.unchecked sup{color:#a60}.side{display:flex;gap:2em;flex-wrap:wrap;"
+    "align-items:flex-start}.side table{font-size:85%}.waterfall{margin:.5em 0;font-size:85%;max-width:760px}"
+    ".wf-row{display:flex;align-items:center;height:1.4em}.wf-name{width:14em;overflow:hidden;"
+    "white-space:nowrap}.wf-track{position:relative;flex:1;height:1em;background:#f4f4f4}.wf-bar{position:"
+    "absolute;top:0;height:100%}.wf-bar.up{background:#d62728}.wf-bar.down{background:#1f77b4}"
+    ".wf-val{width:5em;text-align:right}.wf-head{font-weight:bold;margin-bottom:.2em}"
+    ".meta{color:#555;font-size:90%}"
+)

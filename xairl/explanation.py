@@ -1,8 +1,10 @@
 """Explanation: the one result type of every attributor, shaped (states, features, actions)."""
+
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict
@@ -61,8 +63,7 @@ class Explanation:
             if not isinstance(getattr(self, name), np.ndarray):
                 raise InputError(f"Explanation.{name} must be a numpy array, not {type(getattr(self, name)).__name__}.")
         if self.values.ndim != 3:
-            raise InputError(f"Explanation.values has shape {self.values.shape}; expected (states, features, "
-                             "actions).")
+            raise InputError(f"Explanation.values has shape {self.values.shape}; expected (states, features, actions).")
         n, f, a = self.values.shape
         for name, arr, shape in (
             ("base_values", self.base_values, (n, a)),
@@ -87,9 +88,11 @@ class Explanation:
         for name in ("values", "base_values", "outputs", "states"):  # (a missing quartile: no level words)
             arr = getattr(self, name)
             if arr is not None and not np.isfinite(arr).all():
-                raise InputError(f"Explanation.{name} holds NaN or infinity ({int((~np.isfinite(arr)).sum())} "
-                                 "value(s)): the network's outputs or contributions overflowed; nothing here can be "
-                                 "trusted. Check the states' scale (a float32 network overflows beyond ~1e38).")
+                raise InputError(
+                    f"Explanation.{name} holds NaN or infinity ({int((~np.isfinite(arr)).sum())} "
+                    "value(s)): the network's outputs or contributions overflowed; nothing here can be "
+                    "trusted. Check the states' scale (a float32 network overflows beyond ~1e38)."
+                )
         for arr in (self.values, self.base_values, self.outputs, self.available):
             if arr is not None:
                 arr.setflags(write=False)
@@ -97,14 +100,19 @@ class Explanation:
     def __repr__(self) -> str:  # counts and the first few names, never every feature (the arrays are the fields)
         from .observation import names_preview
 
-        feats, acts = (names_preview(self.feature_names, "features"),
-                       names_preview(self.action_names, "actions" if self.output == "actions" else "outputs"))
-        return (f"Explanation({self.method!r}, {len(self.values)} states; {feats}; {acts}; output {self.output}, "
-                f"largest additivity gap {self.additivity_gap.max(initial=0.0):.2g})")
+        feats, acts = (
+            names_preview(self.feature_names, "features"),
+            names_preview(self.action_names, "actions" if self.output == "actions" else "outputs"),
+        )
+        return (
+            f"Explanation({self.method!r}, {len(self.values)} states; {feats}; {acts}; output {self.output}, "
+            f"largest additivity gap {self.additivity_gap.max(initial=0.0):.2g})"
+        )
 
     def _repr_html_(self) -> str:
         """Jupyter's view (:func:`xairl.display.explanation_html`): the first decisions and what decided them."""
         from .display import explanation_html
+
         return explanation_html(self)
 
     @property
@@ -124,7 +132,7 @@ class Explanation:
         """The number of explained states."""
         return len(self.values)
 
-    def __getitem__(self, key) -> "Explanation":
+    def __getitem__(self, key) -> Explanation:
         """The explanation of some of the states, e.g. an episode out of a run: ``exp[:200]``, ``exp[t0:t1]``,
         ``exp[::10]``, ``exp[mask]`` (bools, one per state), ``exp[[3, 7]]`` (positions; negative count from the end).
 
@@ -138,8 +146,10 @@ class Explanation:
         """
         n = len(self.values)
         if isinstance(key, tuple):
-            raise InputError("an Explanation is indexed by state only (exp[:n], exp[mask], exp[[i, j]]); for one "
-                             "output use exp.output_slice(j), for features exp.grouped(...).")
+            raise InputError(
+                "an Explanation is indexed by state only (exp[:n], exp[mask], exp[[i, j]]); for one "
+                "output use exp.output_slice(j), for features exp.grouped(...)."
+            )
         if isinstance(key, (int, np.integer)) and not isinstance(key, (bool, np.bool_)):
             if not -n <= key < n:
                 raise InputError(f"index {key} is out of range: the explanation has {n} state(s).")
@@ -151,11 +161,15 @@ class Explanation:
             if idx.dtype == bool and idx.shape != (n,):
                 raise InputError(f"a state mask has one bool per state: got shape {idx.shape} for {n} state(s).")
             if idx.dtype != bool and (idx.ndim != 1 or idx.dtype.kind not in "iu"):
-                raise InputError(f"states are selected by a slice, a bool mask or whole-number positions, not "
-                                 f"{type(key).__name__} {str(key)[:40]!r}.")
+                raise InputError(
+                    f"states are selected by a slice, a bool mask or whole-number positions, not "
+                    f"{type(key).__name__} {str(key)[:40]!r}."
+                )
             if idx.dtype != bool and idx.size and not (-n <= idx.min() and idx.max() < n):
-                raise InputError(f"position {idx.max() if idx.max() >= n else idx.min()} is out of range: the "
-                                 f"explanation has {n} state(s).")
+                raise InputError(
+                    f"position {idx.max() if idx.max() >= n else idx.min()} is out of range: the "
+                    f"explanation has {n} state(s)."
+                )
             key = idx
         rows = np.arange(n)[key]
         if not rows.size:
@@ -164,11 +178,23 @@ class Explanation:
         def cut(arr):
             return None if arr is None else np.asarray(arr)[rows].copy()
 
-        extras = {k: cut(v) if isinstance(v, np.ndarray) and v.ndim and len(v) == n else
-                  [v[i] for i in rows] if isinstance(v, (list, tuple)) and len(v) == n else v  # (read from JSON)
-                  for k, v in self.extras.items()}
-        return replace(self, values=cut(self.values), base_values=cut(self.base_values), outputs=cut(self.outputs),
-                       states=cut(self.states), available=cut(self.available), extras=extras)
+        extras = {
+            k: cut(v)
+            if isinstance(v, np.ndarray) and v.ndim and len(v) == n
+            else [v[i] for i in rows]
+            if isinstance(v, (list, tuple)) and len(v) == n
+            else v  # (read from JSON)
+            for k, v in self.extras.items()
+        }
+        return replace(
+            self,
+            values=cut(self.values),
+            base_values=cut(self.base_values),
+            outputs=cut(self.outputs),
+            states=cut(self.states),
+            available=cut(self.available),
+            extras=extras,
+        )
 
     def _ranked(self) -> np.ndarray:
         """Actions per state, best available first (unavailable ones last)."""
@@ -248,7 +274,7 @@ class Explanation:
             return self.margin(), expected - self.base_values[idx, r], value - self.outputs[idx, r]
         return self.values[idx, :, c], expected, value
 
-    def grouped(self, groups: Mapping[str, Sequence[str] | np.ndarray]) -> "Explanation":
+    def grouped(self, groups: Mapping[str, Sequence[str] | np.ndarray]) -> Explanation:
         """Sum the contributions of each group into one feature named after it; other features stay as they are.
 
         :param groups: group name -> member feature names, or member column indices (e.g. from
@@ -267,13 +293,17 @@ class Explanation:
             else:
                 unknown = [m for m in members.tolist() if m not in index]
                 if unknown:
-                    raise InputError(f"group '{g}' names unknown feature '{unknown[0]}'; known: "
-                                     f"{', '.join(self.feature_names[:20])}{' ...' if len(index) > 20 else ''}.")
+                    raise InputError(
+                        f"group '{g}' names unknown feature '{unknown[0]}'; known: "
+                        f"{', '.join(self.feature_names[:20])}{' ...' if len(index) > 20 else ''}."
+                    )
                 idx = np.array([index[m] for m in members.tolist()], dtype=int)
             clash = idx[owner[idx] >= 0]
             if clash.size:
-                raise InputError(f"feature '{self.feature_names[clash[0]]}' is in groups '{names[owner[clash[0]]]}' "
-                                 f"and '{g}'; groups must not overlap.")
+                raise InputError(
+                    f"feature '{self.feature_names[clash[0]]}' is in groups '{names[owner[clash[0]]]}' "
+                    f"and '{g}'; groups must not overlap."
+                )
             owner[idx] = k
         # one column per group (at its first member's place) and per ungrouped feature, in feature order
         order, out_names, seen = [], [], set()
@@ -290,17 +320,28 @@ class Explanation:
         grouped = owner >= 0
         np.add.at(sums.transpose(1, 0, 2), owner[grouped], self.values[:, grouped, :].transpose(1, 0, 2))
         cols = [self.values[:, i, :] if kind == "f" else sums[:, i, :] for kind, i in order]
-        return replace(self, values=np.stack(cols, axis=1), feature_names=tuple(out_names), states=None,
-                       background_quantiles=None, observation=None)
+        return replace(
+            self,
+            values=np.stack(cols, axis=1),
+            feature_names=tuple(out_names),
+            states=None,
+            background_quantiles=None,
+            observation=None,
+        )
 
-    def output_slice(self, j: int) -> "Explanation":
+    def output_slice(self, j: int) -> Explanation:
         """The explanation of output ``j`` alone (one dimension of a continuous action, narrated on its own)."""
         if not 0 <= j < self.values.shape[2]:
             raise InputError(f"output {j} is out of range: the explanation has {self.values.shape[2]} output(s).")
         cut = slice(j, j + 1)
-        return replace(self, values=self.values[:, :, cut], base_values=self.base_values[:, cut],
-                       outputs=self.outputs[:, cut], action_names=(self.action_names[j],),
-                       available=None if self.available is None else self.available[:, cut])
+        return replace(
+            self,
+            values=self.values[:, :, cut],
+            base_values=self.base_values[:, cut],
+            outputs=self.outputs[:, cut],
+            action_names=(self.action_names[j],),
+            available=None if self.available is None else self.available[:, cut],
+        )
 
     def groups_by_part(self) -> dict[str, np.ndarray]:
         """Column indices of each input part (the keys of a dict observation, the inputs of a multi-input module),
@@ -324,7 +365,7 @@ class Explanation:
             a = np.full(n, self.action_names.index(action) if isinstance(action, str) else int(action))
         return self.values[np.arange(n), :, a].reshape(n, *shape)
 
-    def records(self, dataset: str | None = None) -> list["StateRecord"]:
+    def records(self, dataset: str | None = None) -> list[StateRecord]:
         """One :class:`StateRecord` per explained state (the JSON-lines form); ``dataset`` labels where the states
         came from (e.g. 'simulated', 'real')."""
         gap, chosen, runner = self.additivity_gap, self.chosen, self.runner_up
@@ -332,32 +373,36 @@ class Explanation:
         decides = self.output == "actions"  # continuous dimensions and values have nothing chosen
         out = []
         for i in range(len(self.values)):
-            out.append(StateRecord(
-                index=i,
-                dataset=dataset,
-                method=self.method,
-                state=None if self.states is None else dict(zip(self.feature_names, self.states[i].tolist())),
-                output=self.output,
-                chosen=acts[chosen[i]] if decides else None,
-                runner_up=acts[runner[i]] if decides else None,
-                scores=dict(zip(acts, self.outputs[i].tolist())),
-                base_values=dict(zip(acts, self.base_values[i].tolist())),
-                values={f: dict(zip(acts, self.values[i, j].tolist())) for j, f in enumerate(self.feature_names)},
-                additivity_gap=dict(zip(acts, gap[i].tolist())),
-            ))
+            out.append(
+                StateRecord(
+                    index=i,
+                    dataset=dataset,
+                    method=self.method,
+                    state=None if self.states is None else dict(zip(self.feature_names, self.states[i].tolist())),
+                    output=self.output,
+                    chosen=acts[chosen[i]] if decides else None,
+                    runner_up=acts[runner[i]] if decides else None,
+                    scores=dict(zip(acts, self.outputs[i].tolist())),
+                    base_values=dict(zip(acts, self.base_values[i].tolist())),
+                    values={f: dict(zip(acts, self.values[i, j].tolist())) for j, f in enumerate(self.feature_names)},
+                    additivity_gap=dict(zip(acts, gap[i].tolist())),
+                )
+            )
         return out
 
     def to_json(self) -> str:
         """JSON text: each field of this class under its own name, arrays as nested lists (:func:`from_json` reads
         it back)."""
         from .explanation_io import to_json
+
         return to_json(self)
 
     @classmethod
-    def from_json(cls, text: str | bytes) -> "Explanation":
+    def from_json(cls, text: str | bytes) -> Explanation:
         """The explanation :meth:`to_json` wrote; raises :class:`InputError` with a one-line reason on anything
         else (not JSON, NaN or infinity, nesting too deep, wrong fields, shapes that disagree)."""
         from .explanation_io import from_json
+
         return from_json(cls, text)
 
 

@@ -1,11 +1,13 @@
 """The JSON form of an :class:`xairl.Explanation` (``to_json`` / ``from_json``) and the checks of its structured fields
 (the observation, the background quartiles) made when one is built or read: pydantic at the edge, one line on error."""
+
 from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import MISSING, fields
-from typing import Annotated, Any, Literal, Mapping, get_type_hints
+from typing import Annotated, Any, Literal, get_type_hints
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
@@ -37,14 +39,18 @@ def check_observation(observation: Any, n_features: int) -> dict:
     try:
         obs = _Observation.model_validate(observation)
     except ValidationError as exc:
-        raise InputError(f"Explanation.observation is not what Observation.to_dict() writes: "
-                         f"{validation_message(exc, 'observation', 'unknown field')}") from None
+        raise InputError(
+            f"Explanation.observation is not what Observation.to_dict() writes: "
+            f"{validation_message(exc, 'observation', 'unknown field')}"
+        ) from None
     if obs.kind in ("flat", "array") and len(obs.parts) != 1:
         raise InputError(f"Explanation.observation of kind '{obs.kind}' has {len(obs.parts)} parts; it has one.")
     columns = sum(p.categories or math.prod(p.shape) for p in obs.parts)
     if columns != n_features:
-        raise InputError(f"Explanation.observation describes {columns} input columns but the values have "
-                         f"{n_features} features; give the observation of the explained policy (or None).")
+        raise InputError(
+            f"Explanation.observation describes {columns} input columns but the values have "
+            f"{n_features} features; give the observation of the explained policy (or None)."
+        )
     return obs.model_dump()
 
 
@@ -52,8 +58,10 @@ def check_quartiles(quartiles: Any, n_features: int) -> None:
     """Background quartiles are a (3, n_features) array: the 25th, 50th and 75th percentiles of each feature."""
     if not isinstance(quartiles, np.ndarray) or quartiles.shape != (3, n_features):
         shape = getattr(quartiles, "shape", type(quartiles).__name__)
-        raise InputError(f"Explanation.background_quantiles has shape {shape}, expected (3, {n_features}): the 25th, "
-                         "50th and 75th percentiles of each feature over the background (or None).")
+        raise InputError(
+            f"Explanation.background_quantiles has shape {shape}, expected (3, {n_features}): the 25th, "
+            "50th and 75th percentiles of each feature over the background (or None)."
+        )
 
 
 def to_json(exp) -> str:
@@ -62,12 +70,15 @@ def to_json(exp) -> str:
     try:
         return json.dumps(data, allow_nan=False)
     except (TypeError, ValueError) as exc:  # options or extras a plugin filled with something JSON cannot hold
-        raise InputError(f"this explanation cannot be written as JSON ({exc}); keep its options and extras to "
-                         "numbers, text, lists and dicts.") from None
+        raise InputError(
+            f"this explanation cannot be written as JSON ({exc}); keep its options and extras to "
+            "numbers, text, lists and dicts."
+        ) from None
 
 
 def from_json(cls, text: str | bytes):
     """The explanation :func:`to_json` wrote; :class:`InputError` with a one-line reason on anything else."""
+
     def refuse(constant):
         raise ValueError(f"{constant} is not a finite number")
 
@@ -78,23 +89,30 @@ def from_json(cls, text: str | bytes):
     try:
         data = json.loads(text, parse_constant=refuse, parse_float=finite)
     except RecursionError:
-        raise InputError("the explanation's JSON is nested too deeply; give the JSON that Explanation.to_json() "
-                         "writes.") from None
+        raise InputError(
+            "the explanation's JSON is nested too deeply; give the JSON that Explanation.to_json() writes."
+        ) from None
     except (ValueError, TypeError) as exc:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
-        raise InputError(f"the explanation is not valid JSON ({' '.join(str(exc).split())[:120]}); give the "
-                         "JSON that Explanation.to_json() writes.") from None
+        raise InputError(
+            f"the explanation is not valid JSON ({' '.join(str(exc).split())[:120]}); give the "
+            "JSON that Explanation.to_json() writes."
+        ) from None
     try:
         record = dict(_json_form(cls).model_validate(data))
     except ValidationError as exc:
-        raise InputError(f"the explanation's JSON does not match Explanation.to_json(): "
-                         f"{validation_message(exc, 'explanation', 'unknown field')}") from None
+        raise InputError(
+            f"the explanation's JSON does not match Explanation.to_json(): "
+            f"{validation_message(exc, 'explanation', 'unknown field')}"
+        ) from None
     except RecursionError:
         raise InputError("the explanation's JSON is nested too deeply.") from None
     try:
         arrays = {k: _ARRAY_FIELDS[k][1](v) for k, v in record.items() if k in _ARRAY_FIELDS and v is not None}
     except (ValueError, OverflowError):  # ragged lists, numbers beyond float64
-        raise InputError("the explanation's arrays have rows of different lengths or numbers beyond float64; "
-                         "give the JSON that Explanation.to_json() writes.") from None
+        raise InputError(
+            "the explanation's arrays have rows of different lengths or numbers beyond float64; "
+            "give the JSON that Explanation.to_json() writes."
+        ) from None
     return cls(**{**record, **arrays})
 
 
@@ -124,9 +142,14 @@ def _array_field(ndim: int, item=float):
 
 
 #: the array fields of :class:`Explanation` (all others are JSON as they are); the schema itself is the dataclass
-_ARRAY_FIELDS = {"values": _array_field(3), "base_values": _array_field(2), "outputs": _array_field(2),
-                 "states": _array_field(2), "background_quantiles": _array_field(2),
-                 "available": _array_field(2, bool)}
+_ARRAY_FIELDS = {
+    "values": _array_field(3),
+    "base_values": _array_field(2),
+    "outputs": _array_field(2),
+    "states": _array_field(2),
+    "background_quantiles": _array_field(2),
+    "available": _array_field(2, bool),
+}
 _FORM: list[type[BaseModel]] = []
 
 
@@ -139,10 +162,18 @@ def _json_form(Explanation) -> type[BaseModel]:
     for f in fields(Explanation):
         kind = hints[f.name]
         if f.name in _ARRAY_FIELDS:
-            kind = _ARRAY_FIELDS[f.name][0] if f.name in ("values", "base_values", "outputs") else \
-                _ARRAY_FIELDS[f.name][0] | None
-        default = ... if f.default is MISSING and f.default_factory is MISSING else \
-            Field(default_factory=f.default_factory) if f.default_factory is not MISSING else f.default
+            kind = (
+                _ARRAY_FIELDS[f.name][0]
+                if f.name in ("values", "base_values", "outputs")
+                else _ARRAY_FIELDS[f.name][0] | None
+            )
+        default = (
+            ...
+            if f.default is MISSING and f.default_factory is MISSING
+            else Field(default_factory=f.default_factory)
+            if f.default_factory is not MISSING
+            else f.default
+        )
         spec[f.name] = (kind, default)
     _FORM.append(create_model("ExplanationJSON", __config__=ConfigDict(extra="forbid"), **spec))
     return _FORM[0]

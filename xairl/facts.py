@@ -1,9 +1,11 @@
 """Facts computed by code from an Explanation: the only source of numbers, names and directions in a narrative."""
+
 from __future__ import annotations
 
 import inspect
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -12,8 +14,20 @@ from .explanation import Explanation
 from .policy import FeatureInfo, Policy
 from .prompts import format_number
 
-__all__ = ["Comparison", "DecisionFacts", "DomainFacts", "FeatureFact", "GlobalFacts", "decision_facts", "format_number",
-           "global_facts", "narration_units", "state_value_text", "value_level", "value_text"]
+__all__ = [
+    "Comparison",
+    "DecisionFacts",
+    "DomainFacts",
+    "FeatureFact",
+    "GlobalFacts",
+    "decision_facts",
+    "format_number",
+    "global_facts",
+    "narration_units",
+    "state_value_text",
+    "value_level",
+    "value_text",
+]
 
 
 @dataclass(frozen=True)
@@ -217,7 +231,9 @@ def value_level(value: float, info: FeatureInfo, quartiles: tuple[float, float] 
     return "typical", middle
 
 
-def _fill_and_text(value: float, info: FeatureInfo, label: str | None, region: bool = False) -> tuple[float | None, str]:
+def _fill_and_text(
+    value: float, info: FeatureInfo, label: str | None, region: bool = False
+) -> tuple[float | None, str]:
     if info.kind == "group":
         return None, ""
     if label is not None:
@@ -263,10 +279,27 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
         j = u.columns[0]
         value = float(exp.states[i, j]) if len(u.columns) == 1 else float("nan")
         label = None if len(u.columns) > 1 or labels is None or labels[i, j] is None else str(labels[i, j])
-        lvl, words = value_level(value, u.info, None if q is None or len(u.columns) > 1 else (float(q[0, j]), float(q[2, j])))
+        lvl, words = value_level(
+            value, u.info, None if q is None or len(u.columns) > 1 else (float(q[0, j]), float(q[2, j]))
+        )
         fill, text = _fill_and_text(value, u.info, label, u.name in regions)
-        out.append(FeatureFact(u.name, u.info.description or u.name, value, u.info.unit, float(c[n]), float(share[n]),
-                               "toward" if c[n] >= 0 else "against", lvl, words, int(rank[n]), u.info.kind, fill, text))
+        out.append(
+            FeatureFact(
+                u.name,
+                u.info.description or u.name,
+                value,
+                u.info.unit,
+                float(c[n]),
+                float(share[n]),
+                "toward" if c[n] >= 0 else "against",
+                lvl,
+                words,
+                int(rank[n]),
+                u.info.kind,
+                fill,
+                text,
+            )
+        )
     return out
 
 
@@ -274,8 +307,9 @@ def _top(facts: list[FeatureFact], k: int) -> tuple[FeatureFact, ...]:
     return tuple(sorted((f for f in facts if f.rank), key=lambda f: f.rank)[:k])
 
 
-def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = None, k: int = 3,
-                   history: np.ndarray | None = None) -> DecisionFacts:
+def decision_facts(
+    exp: Explanation, index: int = 0, policy: Policy | None = None, k: int = 3, history: np.ndarray | None = None
+) -> DecisionFacts:
     """Facts about state ``index``: the action, runner-up, Q-gap, top-``k`` reasons for the chosen action's score,
     for the margin against the runner-up, the reasons that favour the decision and its strongest concession, the
     identifiers as context, and the policy plugin's own facts (given ``history``, the episode's earlier states)."""
@@ -283,8 +317,10 @@ def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = Non
     if exp.states is None:
         raise InputError("this explanation has no states (it was grouped); narrate the ungrouped explanation.")
     if exp.output != "actions" and exp.values.shape[2] != 1:
-        raise InputError(f"this explanation has {exp.values.shape[2]} {exp.output} outputs; narrate one at a time "
-                         "(Explanation.output_slice(j)).")
+        raise InputError(
+            f"this explanation has {exp.values.shape[2]} {exp.output} outputs; narrate one at a time "
+            "(Explanation.output_slice(j))."
+        )
     c, r = int(exp.chosen[index]), int(exp.runner_up[index])
     domain = _domain_facts(policy, np.asarray(exp.states[index]), c, r, history)
     chosen = _feature_facts(exp, index, exp.for_chosen()[index], policy)
@@ -292,12 +328,20 @@ def decision_facts(exp: Explanation, index: int = 0, policy: Policy | None = Non
     margin = _feature_facts(exp, index, exp.margin()[index], policy) if deciding else []
     ranked = _top(margin, len(margin))
     return DecisionFacts(
-        index=index, action=exp.action_names[c], runner_up=exp.action_names[r],
-        score=float(exp.outputs[index, c]), runner_up_score=float(exp.outputs[index, r]),
-        q_margin=float(exp.outputs[index, c] - exp.outputs[index, r]), base_value=float(exp.base_values[index, c]),
-        method=exp.method, additivity_gap=float(exp.additivity_gap[index, c]),
-        top=_top(chosen, k), margin_top=_top(margin, k),
-        comparisons=tuple(domain.comparisons), extras=dict(domain.extras), output=exp.output,
+        index=index,
+        action=exp.action_names[c],
+        runner_up=exp.action_names[r],
+        score=float(exp.outputs[index, c]),
+        runner_up_score=float(exp.outputs[index, r]),
+        q_margin=float(exp.outputs[index, c] - exp.outputs[index, r]),
+        base_value=float(exp.base_values[index, c]),
+        method=exp.method,
+        additivity_gap=float(exp.additivity_gap[index, c]),
+        top=_top(chosen, k),
+        margin_top=_top(margin, k),
+        comparisons=tuple(domain.comparisons),
+        extras=dict(domain.extras),
+        output=exp.output,
         reasons=tuple(f for f in ranked if f.contribution > 0)[:k],
         concession=next((f for f in ranked if f.contribution < 0), None),
         base_margin=float(exp.base_values[index, c] - exp.base_values[index, r]) if deciding else 0.0,
@@ -313,8 +357,9 @@ def _takes_history(hook) -> bool:
     return "history" in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
 
 
-def _domain_facts(policy: Policy | None, state: np.ndarray, chosen: int, runner_up: int,
-                  history: np.ndarray | None = None) -> DomainFacts:
+def _domain_facts(
+    policy: Policy | None, state: np.ndarray, chosen: int, runner_up: int, history: np.ndarray | None = None
+) -> DomainFacts:
     """The policy plugin's ``facts_hook`` output, checked for its type; ``history`` goes to hooks that take it. An
     image narrated in regions (:mod:`xairl.regions`) has no pixel state to give the hook: it is not called there."""
     if policy is None or policy.facts_hook is None or len(state) != policy.n_features:
@@ -326,8 +371,10 @@ def _domain_facts(policy: Policy | None, state: np.ndarray, chosen: int, runner_
     if out is None:
         return DomainFacts()
     if not isinstance(out, DomainFacts) or not all(isinstance(c, Comparison) for c in out.comparisons):
-        raise PluginError(f"policy '{policy.name}': facts_hook returned {type(out).__name__}; it must return "
-                          "xairl.facts.DomainFacts(extras={...}, comparisons=(xairl.facts.Comparison(...), ...)) or None.")
+        raise PluginError(
+            f"policy '{policy.name}': facts_hook returned {type(out).__name__}; it must return "
+            "xairl.facts.DomainFacts(extras={...}, comparisons=(xairl.facts.Comparison(...), ...)) or None."
+        )
     return out
 
 
@@ -355,9 +402,19 @@ def global_facts(exp: Explanation, policy: Policy | None = None, k: int = 5, vie
         if exp.states is not None and np.ptp(exp.states[:, j]) > 0:
             above = exp.states[:, j] > np.median(exp.states[:, j])
             high, low = _direction(contrib[above, j]), _direction(contrib[~above, j])
-        ranking.append({"name": name, "label": info.description or name, "unit": info.unit, "rank": rank,
-                        "mean_abs": float(mean_abs[j]), "mean": float(contrib[:, j].mean()),
-                        "direction": _direction(contrib[:, j]), "high_values": high, "low_values": low})
+        ranking.append(
+            {
+                "name": name,
+                "label": info.description or name,
+                "unit": info.unit,
+                "rank": rank,
+                "mean_abs": float(mean_abs[j]),
+                "mean": float(contrib[:, j].mean()),
+                "direction": _direction(contrib[:, j]),
+                "high_values": high,
+                "low_values": low,
+            }
+        )
     return GlobalFacts(len(contrib), exp.method, tuple(ranking), shown, target)
 
 
@@ -372,15 +429,48 @@ def sample_context(kind: str) -> dict:
     """Plausible facts of a template ``kind`` ('decision' or 'global'), for trial renderings
     (:func:`xairl.narrators.check_template`)."""
     if kind == "global":
-        return GlobalFacts(10, "deep_shap", tuple({"name": f"f{i}", "label": f"feature {i}", "unit": "", "rank": i,
-                                                    "mean_abs": 1.0 / i, "mean": 0.5 / i, "direction": "toward",
-                                                    "high_values": "toward", "low_values": "against"}
-                                                   for i in range(1, 4))).context()
-    feats = tuple(FeatureFact(f"f{i}", f"feature {i}", 1.0, "m", 0.5 / i, 30.0, "toward", "high", "high", i,
-                              value_text="1.00 m") for i in range(1, 4))
+        return GlobalFacts(
+            10,
+            "deep_shap",
+            tuple(
+                {
+                    "name": f"f{i}",
+                    "label": f"feature {i}",
+                    "unit": "",
+                    "rank": i,
+                    "mean_abs": 1.0 / i,
+                    "mean": 0.5 / i,
+                    "direction": "toward",
+                    "high_values": "toward",
+                    "low_values": "against",
+                }
+                for i in range(1, 4)
+            ),
+        ).context()
+    feats = tuple(
+        FeatureFact(f"f{i}", f"feature {i}", 1.0, "m", 0.5 / i, 30.0, "toward", "high", "high", i, value_text="1.00 m")
+        for i in range(1, 4)
+    )
     against = FeatureFact("f4", "feature 4", 2.0, "m", -0.1, 10.0, "against", "low", "low", 4, value_text="2.00 m")
-    ident = FeatureFact("f5", "feature 5", 15.0, "", 0.0, 0.0, "toward", "unknown", "", 0, "identifier",
-                        value_text="15")
-    return DecisionFacts(0, "a", "b", 1.0, 0.5, 0.5, 0.2, "deep_shap", 0.0, feats, feats,
-                         (Comparison("x is 1 dB above y", 1.0, "dB"),), {}, reasons=feats, concession=against,
-                         base_margin=0.1, identifiers=(ident,)).context() | {"extras": _SampleExtras()}
+    ident = FeatureFact(
+        "f5", "feature 5", 15.0, "", 0.0, 0.0, "toward", "unknown", "", 0, "identifier", value_text="15"
+    )
+    return DecisionFacts(
+        0,
+        "a",
+        "b",
+        1.0,
+        0.5,
+        0.5,
+        0.2,
+        "deep_shap",
+        0.0,
+        feats,
+        feats,
+        (Comparison("x is 1 dB above y", 1.0, "dB"),),
+        {},
+        reasons=feats,
+        concession=against,
+        base_margin=0.1,
+        identifiers=(ident,),
+    ).context() | {"extras": _SampleExtras()}

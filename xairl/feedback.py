@@ -3,15 +3,17 @@
 Each write is one short ``BEGIN IMMEDIATE`` transaction on its own connection, in WAL mode with a generous busy
 timeout, so many processes can record at once without losing rows, and an interrupted write rolls back cleanly.
 """
+
 from __future__ import annotations
 
 import json
 import sqlite3
 import time
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator, TextIO
+from typing import TextIO
 
 from .errors import InputError
 from .paths import user_dir
@@ -58,8 +60,9 @@ class FeedbackStore:
         if path is None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         elif not self.path.parent.is_dir():
-            raise InputError(f"{self.path}: the folder {self.path.parent} does not exist; create it or pass another "
-                             "path.")
+            raise InputError(
+                f"{self.path}: the folder {self.path.parent} does not exist; create it or pass another path."
+            )
         if self.path.is_dir():
             raise InputError(f"{self.path} is a folder; pass a file path for the feedback store.")
         try:
@@ -68,7 +71,9 @@ class FeedbackStore:
                 if "evidence" not in {row[1] for row in db.execute("PRAGMA table_info(narratives)")}:
                     db.execute("ALTER TABLE narratives ADD COLUMN evidence TEXT")  # a store from before 0.3
         except sqlite3.DatabaseError as exc:
-            raise InputError(f"{self.path}: not a usable feedback store ({exc}); move it away or pass another path.")
+            raise InputError(
+                f"{self.path}: not a usable feedback store ({exc}); move it away or pass another path."
+            ) from None
 
     @contextmanager
     def _tx(self) -> Iterator[sqlite3.Connection]:
@@ -94,26 +99,55 @@ class FeedbackStore:
         ev = getattr(narrative, "evidence", None)
         if ev is None and explanation is not None:
             ev = evidence(explanation, narrative)
-        row = (time.time(), getattr(policy, "name", None), model_hash(policy.module) if policy is not None else None,
-               narrative.template, narrative.source, narrative.extras.get("method"), narrative.index, narrative.text,
-               json.dumps([c.__dict__ for c in narrative.claims]), int(narrative.verified), narrative.confidence,
-               json.dumps(ev) if ev is not None else None)
+        row = (
+            time.time(),
+            getattr(policy, "name", None),
+            model_hash(policy.module) if policy is not None else None,
+            narrative.template,
+            narrative.source,
+            narrative.extras.get("method"),
+            narrative.index,
+            narrative.text,
+            json.dumps([c.__dict__ for c in narrative.claims]),
+            int(narrative.verified),
+            narrative.confidence,
+            json.dumps(ev) if ev is not None else None,
+        )
         with self._tx() as db:
-            cur = db.execute("INSERT INTO narratives (created, policy, model_hash, template, source, method, "
-                             "state_index, text, claims, verified, confidence, evidence) "
-                             "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)", row)
+            cur = db.execute(
+                "INSERT INTO narratives (created, policy, model_hash, template, source, method, "
+                "state_index, text, claims, verified, confidence, evidence) "
+                "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)",
+                row,
+            )
             return int(cur.lastrowid)
 
     def records(self, status: str | None = None) -> list[Record]:
         db = sqlite3.connect(self.path, timeout=60)
         try:
-            q = "SELECT id, policy, template, source, text, claims, verified, confidence, status, correction, " \
+            q = (
+                "SELECT id, policy, template, source, text, claims, verified, confidence, status, correction, "
                 "evidence FROM narratives" + (" WHERE status = ?" if status else "") + " ORDER BY id"
+            )
             rows = db.execute(q, (status,) if status else ()).fetchall()
         finally:
             db.close()
-        return [Record(r[0], r[1], r[2], r[3], r[4], json.loads(r[5]), bool(r[6]), r[7], r[8], r[9],
-                       json.loads(r[10]) if r[10] else None) for r in rows]
+        return [
+            Record(
+                r[0],
+                r[1],
+                r[2],
+                r[3],
+                r[4],
+                json.loads(r[5]),
+                bool(r[6]),
+                r[7],
+                r[8],
+                r[9],
+                json.loads(r[10]) if r[10] else None,
+            )
+            for r in rows
+        ]
 
     def review(self, record_id: int, status: str, correction: str | None = None) -> None:
         """Mark a narrative accepted, rejected or corrected (with the operator's text)."""
@@ -122,8 +156,10 @@ class FeedbackStore:
         if (status == "corrected") != bool(correction and correction.strip()):
             raise InputError("a correction needs its text, and only 'corrected' takes one.")
         with self._tx() as db:
-            cur = db.execute("UPDATE narratives SET status = ?, correction = ?, reviewed = ? WHERE id = ?",
-                             (status, correction, time.time(), record_id))
+            cur = db.execute(
+                "UPDATE narratives SET status = ?, correction = ?, reviewed = ? WHERE id = ?",
+                (status, correction, time.time(), record_id),
+            )
             if cur.rowcount == 0:
                 raise InputError(f"no narrative with id {record_id} in {self.path}.")
 
@@ -131,13 +167,26 @@ class FeedbackStore:
         """Write corrected narratives as JSON lines (original, correction, template); returns how many."""
         n = 0
         for r in self.records("corrected"):
-            out.write(json.dumps({"id": r.id, "template": r.template, "policy": r.policy, "original": r.text,
-                                  "correction": r.correction}) + "\n")
+            out.write(
+                json.dumps(
+                    {
+                        "id": r.id,
+                        "template": r.template,
+                        "policy": r.policy,
+                        "original": r.text,
+                        "correction": r.correction,
+                    }
+                )
+                + "\n"
+            )
             n += 1
         return n
 
     def examples(self, limit: int = 3) -> list[str]:
         """The latest corrections and accepted texts, as examples for the local LM narrator."""
-        recs = [r.correction if r.status == "corrected" else r.text
-                for r in self.records() if r.status in ("corrected", "accepted")]
+        recs = [
+            r.correction if r.status == "corrected" else r.text
+            for r in self.records()
+            if r.status in ("corrected", "accepted")
+        ]
         return recs[-limit:]

@@ -5,13 +5,15 @@ Everything xairl writes for a user (explanations, reports, figures, exports, che
 disk, and only then renamed over the target, which is atomic on POSIX and Windows file systems. A reader sees the
 old file or the complete new one, never a mix; an interrupted write leaves at most a ``.part`` file.
 """
+
 from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import IO, Iterator
+from typing import IO
 
 
 @contextmanager

@@ -4,6 +4,7 @@ A plugin is a module (or object) with functions marked ``@xairl.plugin.hookimpl`
 ``xairl`` entry-point group. Built-ins register through these same hooks. Targets may be given as
 ``"package.module:attribute"`` strings so that nothing heavy is imported until a name is looked up.
 """
+
 import pluggy
 
 hookspec = pluggy.HookspecMarker("xairl")

@@ -1,12 +1,13 @@
 """Turning user data (arrays, .csv/.npy/.npz/.json/.parquet files) into checked state matrices."""
+
 from __future__ import annotations
 
 import csv
 import json
 import os
 import zipfile
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -26,14 +27,15 @@ def as_states(data, n_features: int, what: str = "states") -> np.ndarray:
 
 #: the most memory a states file may take once read (as float64), unless $XAIRL_MAX_STATES_BYTES says otherwise:
 #: checked from the file's header before anything is loaded, so a small file that expands enormously is refused
-MAX_STATES_BYTES = 2 * 1024 ** 3
+MAX_STATES_BYTES = 2 * 1024**3
 #: CSV and JSON files are parsed into Python objects first (~10x their size): larger ones should be .npy
-MAX_TEXT_BYTES = 256 * 1024 ** 2
+MAX_TEXT_BYTES = 256 * 1024**2
 LIMIT_ENV = "XAIRL_MAX_STATES_BYTES"
 
 
-def read_states(path: str | Path, feature_names: Sequence[str], observation: Observation | None = None,
-                what: str = "states") -> np.ndarray:
+def read_states(
+    path: str | Path, feature_names: Sequence[str], observation: Observation | None = None, what: str = "states"
+) -> np.ndarray:
     """Read states from .npy (any shape the observation takes), .npz (one array per key of a dict observation, or
     ``arr_0, arr_1, ...`` for several inputs), .csv (header row naming the features, any order), .json (list of
     rows or of objects) or .parquet (one numeric column per feature, named as the features; other columns ignored).
@@ -56,14 +58,17 @@ def read_states(path: str | Path, feature_names: Sequence[str], observation: Obs
             if observation.kind == "tuple":
                 data = [data.get(f"arr_{i}") for i in range(len(observation.parts))]
                 if any(d is None for d in data):
-                    raise InputError(f"the policy takes {len(observation.parts)} inputs; save them with "
-                                     "np.savez(path, x0, x1, ...).")
+                    raise InputError(
+                        f"the policy takes {len(observation.parts)} inputs; save them with np.savez(path, x0, x1, ...)."
+                    )
         elif suffix == ".parquet":
             data = _read_parquet(path, feature_names)
         elif suffix in (".csv", ".json"):
             if path.stat().st_size > MAX_TEXT_BYTES:
-                raise InputError(f"a {suffix} file of {path.stat().st_size / 1024 ** 2:.0f} MB is too large to parse "
-                                 f"(limit {MAX_TEXT_BYTES // 1024 ** 2} MB); save the {what} as .npy instead.")
+                raise InputError(
+                    f"a {suffix} file of {path.stat().st_size / 1024**2:.0f} MB is too large to parse "
+                    f"(limit {MAX_TEXT_BYTES // 1024**2} MB); save the {what} as .npy instead."
+                )
             data = (_read_csv if suffix == ".csv" else _read_json)(path, feature_names, what)
         else:
             raise InputError(f"{path}: unknown file type '{suffix}'; use .csv, .npy, .npz, .json or .parquet.")
@@ -90,16 +95,17 @@ def _check_size(shape: tuple[int, ...], name: str = "") -> None:
     need = 8 * int(np.prod(shape, dtype=object))  # as float64, which every state becomes
     if need > _limit():
         where = f" '{name}'" if name else ""
-        raise InputError(f"the array{where} has shape {shape} and would take {need / 1024 ** 3:.3g} GiB in memory, "
-                         f"more than the {_limit() / 1024 ** 3:.3g} GiB limit; stream it (--format parquet --out DIR), or "
-                         f"raise the limit with ${LIMIT_ENV}=BYTES.")
+        raise InputError(
+            f"the array{where} has shape {shape} and would take {need / 1024**3:.3g} GiB in memory, "
+            f"more than the {_limit() / 1024**3:.3g} GiB limit; stream it (--format parquet --out DIR), or "
+            f"raise the limit with ${LIMIT_ENV}=BYTES."
+        )
 
 
 def npy_header(fh) -> tuple[tuple[int, ...], bool, np.dtype]:
     """(shape, Fortran order, dtype) from the header of a .npy file open at its start; the file is left at the data."""
     version = np.lib.format.read_magic(fh)
-    return (np.lib.format.read_array_header_1_0(fh) if version == (1, 0) else
-            np.lib.format.read_array_header_2_0(fh))
+    return np.lib.format.read_array_header_1_0(fh) if version == (1, 0) else np.lib.format.read_array_header_2_0(fh)
 
 
 def _header(fh, name: str = "") -> tuple[tuple[int, ...], np.dtype]:
@@ -115,8 +121,10 @@ def _load_npy(path: Path) -> np.ndarray:
         start = fh.tell()
     promised = int(np.prod(shape, dtype=object)) * dtype.itemsize
     if not dtype.hasobject and path.stat().st_size - start < promised:
-        raise InputError(f"its header promises an array of shape {shape} ({promised} bytes) but the file holds "
-                         f"{path.stat().st_size - start}; it is truncated: save it again.")
+        raise InputError(
+            f"its header promises an array of shape {shape} ({promised} bytes) but the file holds "
+            f"{path.stat().st_size - start}; it is truncated: save it again."
+        )
     return np.load(path, allow_pickle=False)
 
 
@@ -174,8 +182,10 @@ def check_columns(schema, feature_names: Sequence[str]) -> None:
     for f in feature_names:
         kind = schema.field(f).type
         if not (pat.is_integer(kind) or pat.is_floating(kind) or pat.is_boolean(kind) or pat.is_decimal(kind)):
-            raise InputError(f"column '{f}' holds {kind} values, not numbers; convert it to numbers (a time to "
-                             "seconds, a category to its code) or rename it.")
+            raise InputError(
+                f"column '{f}' holds {kind} values, not numbers; convert it to numbers (a time to "
+                "seconds, a category to its code) or rename it."
+            )
 
 
 def _read_parquet(path: Path, feature_names: Sequence[str]) -> np.ndarray:
@@ -191,8 +201,7 @@ def _read_parquet(path: Path, feature_names: Sequence[str]) -> np.ndarray:
         raise InputError(f"cannot read it as Parquet ({' '.join(str(exc).split())[:160]}).") from None
     if not table.num_rows:
         return np.empty((0, len(feature_names)))
-    return np.column_stack([table.column(f).to_numpy(zero_copy_only=False).astype(np.float64)
-                            for f in feature_names])
+    return np.column_stack([table.column(f).to_numpy(zero_copy_only=False).astype(np.float64) for f in feature_names])
 
 
 def _read_json(path: Path, feature_names: Sequence[str], what: str):

@@ -5,12 +5,14 @@ Data flows one way: user states -> :meth:`Observation.flatten` -> (n, F) float32
 policy's network through :meth:`Observation.unflatten` (a view and a split, both linear, so every attribution
 method sees through them).
 """
+
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from itertools import product
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -40,8 +42,9 @@ class Part:
 
     def __post_init__(self) -> None:
         if self.channels not in CHANNELS:
-            raise InputError(f"channels='{self.channels}' of '{self.key}' is unknown; use one of "
-                             f"{', '.join(CHANNELS)}.")
+            raise InputError(
+                f"channels='{self.channels}' of '{self.key}' is unknown; use one of {', '.join(CHANNELS)}."
+            )
 
     @property
     def size(self) -> int:
@@ -76,18 +79,22 @@ class Observation:
 
     # ---- constructors -------------------------------------------------------------------------------------
     @classmethod
-    def flat(cls, n_features: int) -> "Observation":
+    def flat(cls, n_features: int) -> Observation:
         return cls("flat", (Part("obs", (int(n_features),)),))
 
     @classmethod
-    def array(cls, shape: Sequence[int], key: str = "obs", channels: str = "channels") -> "Observation":
+    def array(cls, shape: Sequence[int], key: str = "obs", channels: str = "channels") -> Observation:
         """States of shape ``(n, *shape)``, e.g. frames (n, 4, 84, 84); ``channels="frames"`` says that the first axis
         of an image is a frame stack (its regions are said as 'patch F6 of frame 2', not 'of channel 2')."""
         return cls("array", (Part(key, tuple(int(s) for s in shape), channels=channels),))
 
     @classmethod
-    def dict(cls, shapes: Mapping[str, Sequence[int] | int], categories: Mapping[str, int] | None = None,
-             channels: Mapping[str, str] | None = None) -> "Observation":
+    def dict(
+        cls,
+        shapes: Mapping[str, Sequence[int] | int],
+        categories: Mapping[str, int] | None = None,
+        channels: Mapping[str, str] | None = None,
+    ) -> Observation:
         """A dict of arrays; ``categories`` names the keys holding integer categories (one-hot encoded), ``channels``
         the image keys whose channels are 'frames' of a stack (:class:`Part`)."""
         categories, channels = dict(categories or {}), dict(channels or {})
@@ -98,7 +105,7 @@ class Observation:
         return cls("dict", tuple(parts))
 
     @classmethod
-    def several(cls, shapes: Sequence[Sequence[int]]) -> "Observation":
+    def several(cls, shapes: Sequence[Sequence[int]]) -> Observation:
         """Several inputs, passed to the module as positional tensors ``module(x0, x1, ...)``."""
         return cls("tuple", tuple(Part(f"input{i}", tuple(int(s) for s in sh)) for i, sh in enumerate(shapes)))
 
@@ -144,10 +151,15 @@ class Observation:
             if self.kind != "dict":
                 raise InputError(f"{what}: got a dict but this policy takes {self.describe()}; pass an array.")
             return _finite(np.concatenate(self._columns(states, what), axis=1), what, dtype)
-        if isinstance(states, (tuple, list)) and self.kind == "tuple" and len(states) == len(self.parts) and \
-                all(hasattr(s, "shape") for s in states):
-            return _finite(np.concatenate(self._columns(dict(zip([p.key for p in self.parts], states)), what),
-                                          axis=1), what, dtype)
+        if (
+            isinstance(states, (tuple, list))
+            and self.kind == "tuple"
+            and len(states) == len(self.parts)
+            and all(hasattr(s, "shape") for s in states)
+        ):
+            return _finite(
+                np.concatenate(self._columns(dict(zip([p.key for p in self.parts], states)), what), axis=1), what, dtype
+            )
         arr = _numeric(states, what)
         f = self.n_features
         if self.kind == "array":
@@ -159,13 +171,15 @@ class Observation:
         if arr.ndim == 1 and arr.size == f:
             arr = arr[None, :]
         if arr.ndim != 2:
-            shape = "a 2-D array (n, %d)" % f if self.kind == "flat" else f"{self.describe()} or a flat (n, {f}) array"
+            shape = f"a 2-D array (n, {f})" if self.kind == "flat" else f"{self.describe()} or a flat (n, {f}) array"
             raise InputError(f"{what} must be {shape}; got shape {arr.shape}.")
         if arr.shape[0] == 0:
             raise InputError(f"{what} is empty: give at least one state.")
         if arr.shape[1] != f:
-            raise InputError(f"{what} has {arr.shape[1]} features but the policy expects {f}"
-                             f"{' as ' + self.describe() if self.kind != 'flat' else ''}; check the column order/count.")
+            raise InputError(
+                f"{what} has {arr.shape[1]} features but the policy expects {f}"
+                f"{' as ' + self.describe() if self.kind != 'flat' else ''}; check the column order/count."
+            )
         return _finite(arr, what, dtype)
 
     def _columns(self, states: Mapping, what: str) -> list[np.ndarray]:
@@ -184,8 +198,9 @@ class Observation:
                 if a.shape == p.shape:
                     a = a[None]
                 if a.shape[1:] != p.shape:
-                    raise InputError(f"{what}['{p.key}'] has shape {a.shape}; expected (n, "
-                                     f"{', '.join(map(str, p.shape))}).")
+                    raise InputError(
+                        f"{what}['{p.key}'] has shape {a.shape}; expected (n, {', '.join(map(str, p.shape))})."
+                    )
                 a = a.reshape(len(a), -1)
             if n is not None and len(a) != n:
                 raise InputError(f"{what}: the parts have different numbers of states ({n} and {len(a)}).")
@@ -197,8 +212,10 @@ class Observation:
         """A torch (n, F) tensor -> what the module takes: one tensor, a dict of tensors, or a tuple of them."""
         if self.kind == "flat":
             return x
-        out = {p.key: x[:, s].reshape(len(x), *(p.shape if not p.categories else (p.categories,)))
-               for p, s in zip(self.parts, self.slices().values())}
+        out = {
+            p.key: x[:, s].reshape(len(x), *(p.shape if not p.categories else (p.categories,)))
+            for p, s in zip(self.parts, self.slices().values())
+        }
         if self.kind == "array":
             return out[self.parts[0].key]
         return out if self.kind == "dict" else tuple(out.values())
@@ -235,18 +252,31 @@ class Observation:
             for ch, r, q in product(range(c), range(0, h, size), range(0, w, size)):
                 channel, key = (ch if c > 1 else None), (None if single else p.key)
                 rows, columns = (r, min(r + size, h) - 1), (q, min(q + size, w) - 1)
-                yield (region_name(r // size, q // size, channel, key, layer),
-                       region_extent(rows, columns, channel, key, layer), idx[ch, r:r + size, q:q + size].ravel())
+                yield (
+                    region_name(r // size, q // size, channel, key, layer),
+                    region_extent(rows, columns, channel, key, layer),
+                    idx[ch, r : r + size, q : q + size].ravel(),
+                )
 
     def to_dict(self) -> dict:
-        return {"kind": self.kind, "parts": [{"key": p.key, "shape": list(p.shape), "categories": p.categories}
-                                             | ({"channels": p.channels} if p.channels != "channels" else {})
-                                             for p in self.parts]}
+        return {
+            "kind": self.kind,
+            "parts": [
+                {"key": p.key, "shape": list(p.shape), "categories": p.categories}
+                | ({"channels": p.channels} if p.channels != "channels" else {})
+                for p in self.parts
+            ],
+        }
 
     @classmethod
-    def from_dict(cls, d: Mapping) -> "Observation":
-        return cls(d["kind"], tuple(Part(p["key"], tuple(p["shape"]), p.get("categories"),
-                                         p.get("channels", "channels")) for p in d["parts"]))
+    def from_dict(cls, d: Mapping) -> Observation:
+        return cls(
+            d["kind"],
+            tuple(
+                Part(p["key"], tuple(p["shape"]), p.get("categories"), p.get("channels", "channels"))
+                for p in d["parts"]
+            ),
+        )
 
 
 def patches(shape: Sequence[int], size: int | Sequence[int], prefix: str = "patch") -> dict[str, np.ndarray]:
@@ -259,8 +289,11 @@ def patches(shape: Sequence[int], size: int | Sequence[int], prefix: str = "patc
     c, h, w = (1, *shape) if len(shape) == 2 else shape
     ph, pw = (size, size) if isinstance(size, int) else tuple(size)
     idx = np.arange(c * h * w).reshape(c, h, w)
-    return {f"{prefix}[{r // ph},{q // pw}]": idx[:, r:r + ph, q:q + pw].ravel()
-            for r in range(0, h, ph) for q in range(0, w, pw)}
+    return {
+        f"{prefix}[{r // ph},{q // pw}]": idx[:, r : r + ph, q : q + pw].ravel()
+        for r in range(0, h, ph)
+        for q in range(0, w, pw)
+    }
 
 
 #: how a region is named: a grid reference, 'patch F6' (column letters from the left, A first; row numbers from the
@@ -275,9 +308,11 @@ REGION_EXTENT = "the {h}x{w} patch at rows {r0} to {r1}, columns {c0} to {c1}"
 #: (:data:`REGION_EXTENT`, or close to it: 'rows 3-8')
 _SPAN = r"\d+(?:\s*(?:to|-|–|through)\s*\d+)?"
 _LAYER = r"(?:\s+(?:of|in)\s+(?:the\s+)?(?:channel|frame)\s+\d+)?"
-REGION_RE = re.compile(rf"\b(?:(?i:(?:\d+\s*[x×]\s*\d+\s+)?(?:patch|region|block)\s+(?:at|spanning|covering|over)\s+"
-                       rf"rows?\s+{_SPAN}\s*,?\s*(?:and\s+)?columns?\s+{_SPAN}{_LAYER})"
-                       rf"|(?i:patch)\s+[A-Z]{{1,3}}[1-9]\d{{0,3}}\b(?i:{_LAYER}))")
+REGION_RE = re.compile(
+    rf"\b(?:(?i:(?:\d+\s*[x×]\s*\d+\s+)?(?:patch|region|block)\s+(?:at|spanning|covering|over)\s+"
+    rf"rows?\s+{_SPAN}\s*,?\s*(?:and\s+)?columns?\s+{_SPAN}{_LAYER})"
+    rf"|(?i:patch)\s+[A-Z]{{1,3}}[1-9]\d{{0,3}}\b(?i:{_LAYER}))"
+)
 
 
 def region_size(h: int, w: int) -> int:
@@ -298,19 +333,26 @@ def grid_ref(row: int, column: int) -> str:
     return f"{letters}{row + 1}"
 
 
-def region_name(row: int, column: int, channel: int | None = None, key: str | None = None,
-                layer: str = "channel") -> str:
+def region_name(
+    row: int, column: int, channel: int | None = None, key: str | None = None, layer: str = "channel"
+) -> str:
     """A region's name (:data:`REGION_FORMAT`) from its row and column among the patches (from 0): 'patch F6 of
     frame 2'; ``layer`` is 'channel' or 'frame'."""
     name = REGION_FORMAT.format(ref=grid_ref(row, column))
     return name + (f" of {layer} {channel}" if channel is not None else "") + (f" of {key}" if key else "")
 
 
-def region_extent(rows: tuple[int, int], columns: tuple[int, int], channel: int | None = None,
-                  key: str | None = None, layer: str = "channel") -> str:
+def region_extent(
+    rows: tuple[int, int],
+    columns: tuple[int, int],
+    channel: int | None = None,
+    key: str | None = None,
+    layer: str = "channel",
+) -> str:
     """The pixels a region covers in words (:data:`REGION_EXTENT`), from its first and last row and column."""
-    name = REGION_EXTENT.format(h=rows[1] - rows[0] + 1, w=columns[1] - columns[0] + 1, r0=rows[0], r1=rows[1],
-                                c0=columns[0], c1=columns[1])
+    name = REGION_EXTENT.format(
+        h=rows[1] - rows[0] + 1, w=columns[1] - columns[0] + 1, r0=rows[0], r1=rows[1], c0=columns[0], c1=columns[1]
+    )
     return name + (f" of {layer} {channel}" if channel is not None else "") + (f" of {key}" if key else "")
 
 
@@ -328,8 +370,10 @@ def _numeric(data, what: str) -> np.ndarray:
     try:
         arr = np.asarray(data)
         if arr.dtype.kind in _REFUSED_KINDS:  # numpy would drop the imaginary part or count nanoseconds
-            raise InputError(f"{what} hold {_REFUSED_KINDS[arr.dtype.kind]} ({arr.dtype}); give real numbers "
-                             "(float or int), converting the column yourself if that is meant.")
+            raise InputError(
+                f"{what} hold {_REFUSED_KINDS[arr.dtype.kind]} ({arr.dtype}); give real numbers "
+                "(float or int), converting the column yourself if that is meant."
+            )
         return arr.astype(np.float64)
     except (TypeError, ValueError, OverflowError) as exc:
         if isinstance(exc, InputError):

@@ -4,6 +4,7 @@ Every configurable piece declares a pydantic model derived from :class:`Options`
 validates user input with :func:`parse_options`, so a typo in ``-o key=value`` is one line naming the key and the
 keys that exist.
 """
+
 from __future__ import annotations
 
 from typing import TypeVar
@@ -21,7 +22,7 @@ class Options(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
 
-def parse_options(model: type[T], options: "dict | T | None", what: str) -> T:
+def parse_options(model: type[T], options: dict | T | None, what: str) -> T:
     """``options`` validated against ``model``; raises :class:`InputError` naming the bad keys and the known ones.
 
     :param what: how the message names the owner, e.g. ``"deep_shap options"``.

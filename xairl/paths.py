@@ -1,4 +1,5 @@
 """Where xairl keeps user files: ``$XAIRL_USER_PATH`` (default ``~/.xairl``)."""
+
 from __future__ import annotations
 
 import os

@@ -13,11 +13,12 @@ an axis label or title (:func:`view_label`), and writes a feature's value as the
     >>> plots.waterfall(exp, index=3)            # one decision, from the expected margin to this one
     >>> plots.save(plots.image(exp, 0), "frame.png")
 """
+
 from __future__ import annotations
 
 import textwrap
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence, Union
 
 import numpy as np
 
@@ -34,7 +35,7 @@ MIN_AXES_WIDTH = 4.5
 ACTION_MARKERS = "osD^vP*Xph"
 ACTION_COLOURS = ("#000000", "#8c6d31", "#7b4173", "#637939", "#3182bd", "#e6550d", "#843c39", "#5254a3")
 #: an Explanation, or titled explanations side by side: ``[("simulated", e1), ("real", e2)]``
-Panels = Union[Explanation, Sequence[tuple[str, Explanation]]]
+Panels = Explanation | Sequence[tuple[str, Explanation]]
 
 
 def _figure(**kwargs):
@@ -131,8 +132,7 @@ def importance_order(exp: Explanation, view: str = "margin") -> np.ndarray:
     return np.argsort(-np.abs(contributions(exp, view)).mean(axis=0), kind="stable")
 
 
-def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | None = None,
-             max_display: int = 20):
+def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | None = None, max_display: int = 20):
     """One dot per state and feature at its contribution, coloured by the feature's value (low blue, high red);
     several titled explanations side by side share one feature order (the first's importance unless ``order``).
     Images and dict observations are shown by patch and by key."""
@@ -174,8 +174,12 @@ def importance(explanations: Panels, view: str = "margin", max_display: int = 20
     ax = fig.subplots()
     h = 0.8 / len(panels)
     for k, (title, exp) in enumerate(panels):
-        ax.barh(np.arange(len(names)) + k * h, np.abs(contributions(exp, view)).mean(axis=0)[order], height=h,
-                label=title or None)
+        ax.barh(
+            np.arange(len(names)) + k * h,
+            np.abs(contributions(exp, view)).mean(axis=0)[order],
+            height=h,
+            label=title or None,
+        )
     ax.set_yticks(np.arange(len(names)) + 0.4 - h / 2, names)
     ax.invert_yaxis()
     ax.set_xlabel("mean |" + view_label(panels[0][1], view) + "|")
@@ -185,8 +189,7 @@ def importance(explanations: Panels, view: str = "margin", max_display: int = 20
     return fig
 
 
-def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int = 10, title: str = "", *,
-              policy=None):
+def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int = 10, title: str = "", *, policy=None):
     """From the expected value (over the background) to state ``index``'s: the ``shown`` largest contributions as
     steps, the rest as one step. In the margin view the numbers are those of the narrative's evidence card (and, as
     there, a decision with one action available, hence no runner-up, is shown in the score view, the title says so).
@@ -201,8 +204,9 @@ def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int
     c, a, base, end = values[i], int(exp.focus[i]), float(expected[i]), float(value[i])
     order = np.argsort(-np.abs(c), kind="stable")
     top, rest = order[:shown], order[shown:]
-    labels = [exp.feature_names[j] + ("" if exp.states is None else f" = {state_value_text(exp, i, j, policy)}")
-              for j in top]
+    labels = [
+        exp.feature_names[j] + ("" if exp.states is None else f" = {state_value_text(exp, i, j, policy)}") for j in top
+    ]
     steps = list(c[top])
     if len(rest):
         labels.append(f"{len(rest)} other features")
@@ -212,17 +216,30 @@ def waterfall(exp: Explanation, index: int = 0, view: str = "margin", shown: int
     ax = fig.subplots()
     y = np.arange(len(steps))
     ax.barh(y, steps, left=start, color=["#d62728" if v >= 0 else "#1f77b4" for v in steps])
-    texts = [ax.annotate(f"{v:+.3g}", (x0 + v, yi), xytext=(3 if v >= 0 else -3, 0), textcoords="offset points",
-                         va="center", ha="left" if v >= 0 else "right", fontsize=8)
-             for yi, v, x0 in zip(y, steps, start)]  # outward from the bar's end, kept inside the axes below
+    texts = [
+        ax.annotate(
+            f"{v:+.3g}",
+            (x0 + v, yi),
+            xytext=(3 if v >= 0 else -3, 0),
+            textcoords="offset points",
+            va="center",
+            ha="left" if v >= 0 else "right",
+            fontsize=8,
+        )
+        for yi, v, x0 in zip(y, steps, start)
+    ]  # outward from the bar's end, kept inside the axes below
     ax.set_yticks(y, labels)
     ax.invert_yaxis()
     ax.axvline(base, color="0.5", ls=":", lw=0.8)
-    what = {"margin": f"margin of {exp.action_names[a]} over {exp.action_names[int(exp.runner_up[i])]}",
-            "score": f"{exp.action_names[a]}'s score (chosen)", "output": exp.action_names[a]}[_view(exp, view)]
+    what = {
+        "margin": f"margin of {exp.action_names[a]} over {exp.action_names[int(exp.runner_up[i])]}",
+        "score": f"{exp.action_names[a]}'s score (chosen)",
+        "output": exp.action_names[a],
+    }[_view(exp, view)]
     ax.set_xlabel(f"{what}: expected {base:.3g} -> this state {end:.3g}")
-    ax.set_title(title or f"state {i}: {view_label(exp, view)}" + (" (the only action available)" if alone else ""),
-                 fontsize=10)
+    ax.set_title(
+        title or f"state {i}: {view_label(exp, view)}" + (" (the only action available)" if alone else ""), fontsize=10
+    )
     _layout(fig, [ax])
     _keep_inside(fig, ax, texts)
     return fig
@@ -236,8 +253,10 @@ def image(exp: Explanation, index: int = 0, view: str = "margin"):
 
     shape = exp.image_shape
     if shape is None:
-        raise InputError("plots.image needs an image observation (Observation with an image shape); use "
-                         "plots.waterfall or plots.beeswarm for flat features.")
+        raise InputError(
+            "plots.image needs an image observation (Observation with an image shape); use "
+            "plots.waterfall or plots.beeswarm for flat features."
+        )
     i = exp.check_index(index)
     frame = exp.states[i].reshape(shape)
     frame = frame.mean(axis=0) if len(shape) == 3 else frame
@@ -248,8 +267,10 @@ def image(exp: Explanation, index: int = 0, view: str = "margin"):
         named = "contribution to the margin over the runner-up"
     else:
         chosen = exp.action_names[exp.chosen[i]] if exp.output == "actions" else None
-        maps = [(f"{name}{' (chosen)' if name == chosen else ''}", exp.image(a)[i])
-                for a, name in enumerate(exp.action_names)]
+        maps = [
+            (f"{name}{' (chosen)' if name == chosen else ''}", exp.image(a)[i])
+            for a, name in enumerate(exp.action_names)
+        ]
         named = "contribution to each action's score" if exp.output == "actions" else "contribution to each output"
     heat = [(t, h.sum(axis=0) if len(shape) == 3 else h) for t, h in maps]
     lim = max(float(np.abs(h).max()) for _, h in heat) or 1.0
@@ -264,8 +285,9 @@ def image(exp: Explanation, index: int = 0, view: str = "margin"):
         ax.set_title(t, fontsize=9)
     for ax in axes:
         ax.axis("off")
-    fig.suptitle(textwrap.fill(f"state {i}: {named} (red raises it, blue lowers it)", int(11 * fig.get_figwidth())),
-                 fontsize=10)
+    fig.suptitle(
+        textwrap.fill(f"state {i}: {named} (red raises it, blue lowers it)", int(11 * fig.get_figwidth())), fontsize=10
+    )
     fig.tight_layout()
     return fig
 
@@ -284,8 +306,15 @@ def timeline(exp: Explanation, view: str = "margin", top: int = 5, title: str = 
     for a, name in enumerate(exp.action_names):
         at = decided == a
         if at.any():
-            ax_act.scatter(steps[at], decided[at], s=14, marker=ACTION_MARKERS[a % len(ACTION_MARKERS)],
-                           color=ACTION_COLOURS[a % len(ACTION_COLOURS)], linewidths=0, label=name)
+            ax_act.scatter(
+                steps[at],
+                decided[at],
+                s=14,
+                marker=ACTION_MARKERS[a % len(ACTION_MARKERS)],
+                color=ACTION_COLOURS[a % len(ACTION_COLOURS)],
+                linewidths=0,
+                label=name,
+            )
     ax_act.set_yticks(range(len(exp.action_names)), exp.action_names, fontsize=7)
     ax_act.set_ylim(-0.6, len(exp.action_names) - 0.4)
     ax_act.set_ylabel("chosen" if exp.output == "actions" else "", fontsize=8)

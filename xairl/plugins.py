@@ -1,11 +1,13 @@
 """Plugin discovery and the registries built from the hooks. Nothing loads until the first lookup."""
+
 from __future__ import annotations
 
 import importlib
 import importlib.metadata
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import pluggy
 
@@ -18,7 +20,7 @@ BUILTIN_NAME = "xairl"
 LOAD_ENV = "XAIRL_LOAD_PLUGINS"
 
 _pm: pluggy.PluginManager | None = None
-_registries: dict[str, "Registry"] = {}
+_registries: dict[str, Registry] = {}
 _failures: dict[str, str] = {}
 
 
@@ -64,7 +66,9 @@ def get_plugin_manager() -> pluggy.PluginManager:
         pm.add_hookspecs(hookspecs)
         _load_entry_points(pm)
         for modname in DEFAULT_PLUGINS:
-            pm.register(importlib.import_module(modname), name=BUILTIN_NAME if modname == DEFAULT_PLUGINS[0] else modname)
+            pm.register(
+                importlib.import_module(modname), name=BUILTIN_NAME if modname == DEFAULT_PLUGINS[0] else modname
+            )
         _pm = pm
     return _pm
 
@@ -107,8 +111,10 @@ class Entry:
         try:
             return resolve(self.target)
         except (ImportError, AttributeError) as exc:
-            raise PluginError(f"plugin '{self.plugin}' registered '{self.name}' as {self.target!r}, which fails to "
-                              f"import ({exc}); reinstall the plugin.") from exc
+            raise PluginError(
+                f"plugin '{self.plugin}' registered '{self.name}' as {self.target!r}, which fails to "
+                f"import ({exc}); reinstall the plugin."
+            ) from exc
 
 
 class Registry:
@@ -136,8 +142,10 @@ class Registry:
         for entry in new:
             if entry.name in self.entries:
                 first = self.entries[entry.name].plugin
-                raise PluginError(f"{self.kind} '{entry.name}' is registered by both '{first}' and '{plugin}'; "
-                                  "uninstall one of them or rename it in the plugin.")
+                raise PluginError(
+                    f"{self.kind} '{entry.name}' is registered by both '{first}' and '{plugin}'; "
+                    "uninstall one of them or rename it in the plugin."
+                )
             self.entries[entry.name] = entry
 
     def names(self) -> list[str]:
@@ -147,8 +155,9 @@ class Registry:
         if name not in self.entries:
             known = ", ".join(self.names()) or "none"
             broken = f"; left out: {', '.join(sorted(_failures))} (see `xairl plugins`)" if _failures else ""
-            raise UnknownNameError(f"unknown {self.kind} '{name}'; known: {known} (see `xairl {self.list_command}`)"
-                                   f"{broken}.")
+            raise UnknownNameError(
+                f"unknown {self.kind} '{name}'; known: {known} (see `xairl {self.list_command}`){broken}."
+            )
         return self.entries[name]
 
     def load(self, name: str) -> Any:
@@ -236,18 +245,23 @@ def load_policy(spec: str, kwargs: dict | None = None, observation=None):
         except XairlError:
             raise
         except Exception as exc:
-            raise InputError(f"{spec}({', '.join(f'{k}={v!r}' for k, v in kwargs.items())}) raised "
-                             f"{one_line(exc, 200)}.") from None
+            raise InputError(
+                f"{spec}({', '.join(f'{k}={v!r}' for k, v in kwargs.items())}) raised {one_line(exc, 200)}."
+            ) from None
     elif kwargs:
         raise InputError(f"{spec} is not callable; --policy-arg needs a function that builds the policy.")
     if isinstance(obj, torch.nn.Module):
         if observation is None:
-            raise InputError(f"{spec} is a bare torch module: give --states so that its input shape is known, or "
-                             "return an xairl.Policy.")
+            raise InputError(
+                f"{spec} is a bare torch module: give --states so that its input shape is known, or "
+                "return an xairl.Policy."
+            )
         obj = Policy(obj.eval(), observation=tuple(observation), name=attr)
     if not isinstance(obj, Policy):
-        raise InputError(f"{spec} gave a {type(obj).__name__}; it must be an xairl.Policy, a torch module, or a "
-                         "function returning one.")
+        raise InputError(
+            f"{spec} gave a {type(obj).__name__}; it must be an xairl.Policy, a torch module, or a "
+            "function returning one."
+        )
     return obj
 
 

@@ -1,10 +1,12 @@
 """Policy: a trained torch network mapping a batch of states to its outputs (action scores, continuous actions or a
 value), with names, metadata and the structure of its input."""
+
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Literal, Mapping, Sequence
+from typing import Any, Literal
 
 import numpy as np
 import torch
@@ -52,8 +54,9 @@ class FeatureInfo:
         if self.capacity is not None and not (np.isfinite(self.capacity) and self.capacity > 0):
             raise InputError(f"FeatureInfo capacity must be a positive number, got {self.capacity}.")
         if self.thresholds is not None and not (len(self.thresholds) == 2 and self.thresholds[0] <= self.thresholds[1]):
-            raise InputError(f"FeatureInfo thresholds must be (low below, high above) with low <= high, got "
-                             f"{self.thresholds}.")
+            raise InputError(
+                f"FeatureInfo thresholds must be (low below, high above) with low <= high, got {self.thresholds}."
+            )
 
 
 FEATURE_KINDS = ("numeric", "categorical", "identifier", "group")
@@ -115,6 +118,7 @@ class Policy:
     def __post_init__(self) -> None:
         if not isinstance(self.module, torch.nn.Module):
             raise InputError(f"module must be a torch.nn.Module, got {type(self.module).__name__}.")
+
         def normalise(name: str, value) -> None:  # a frozen dataclass sets its own fields only here
             object.__setattr__(self, name, value)
 
@@ -122,8 +126,10 @@ class Policy:
         if kinds is not None:  # one kind per output column: checked against the names below
             normalise("output", kinds[0] if kinds else "")
         if self.output not in OUTPUT_KINDS or (kinds and not set(kinds) <= set(OUTPUT_KINDS)):
-            raise InputError(f"output {self.output if kinds is None else list(kinds)!r} is unknown; use one of "
-                             f"{', '.join(OUTPUT_KINDS)}, or one of them per output column.")
+            raise InputError(
+                f"output {self.output if kinds is None else list(kinds)!r} is unknown; use one of "
+                f"{', '.join(OUTPUT_KINDS)}, or one of them per output column."
+            )
 
         normalise("observation", _observation(self.observation, self.feature_names))
         normalise("name", str(self.name))
@@ -144,8 +150,10 @@ class Policy:
                 dup = sorted({n for n in names if names.count(n) > 1})
                 raise InputError(f"{what} has duplicates ({', '.join(dup)}); names must be unique.")
         if len(self.feature_names) != self.observation.n_features:
-            raise InputError(f"{len(self.feature_names)} feature names for an observation of "
-                             f"{self.observation.n_features} columns {self.observation.describe()}; name each column.")
+            raise InputError(
+                f"{len(self.feature_names)} feature names for an observation of "
+                f"{self.observation.n_features} columns {self.observation.describe()}; name each column."
+            )
         check_kinds(self, kinds)
         if self.output == "value" and len(self.action_names) != 1:
             raise InputError("a 'value' policy has one output; give one name in action_names (e.g. ['value']).")
@@ -153,8 +161,10 @@ class Policy:
         described = {f for f, i in self.features.items() if i.kind != "group"}
         unknown = sorted(described - names) + sorted({str(f) for g in self.groups.values() for f in g} - names)
         if unknown:
-            raise InputError(f"metadata names unknown feature(s) {', '.join(unknown[:5])}; use names from "
-                             "feature_names (column indices, as xairl.patches gives, go to Explanation.grouped).")
+            raise InputError(
+                f"metadata names unknown feature(s) {', '.join(unknown[:5])}; use names from "
+                "feature_names (column indices, as xairl.patches gives, go to Explanation.grouped)."
+            )
         for g, info in self.features.items():
             if info.kind == "group" and g not in self.groups:
                 raise InputError(f"features['{g}'] has kind 'group' but '{g}' is not in groups; add it to groups.")
@@ -165,13 +175,16 @@ class Policy:
     def __repr__(self) -> str:
         """Counts and the first few names, never thousands: ``Policy('cnn', 12288 features: obs[0,0,0], ... ;
         4 actions: ...; output actions, observation (n, 3, 64, 64))``."""
-        return (f"Policy({self.name!r}, {names_preview(self.feature_names, 'features')}; "
-                f"{names_preview(self.action_names, 'actions' if self.output == 'actions' else 'outputs')}; "
-                f"output {self.output}, observation {self.observation.describe()})")
+        return (
+            f"Policy({self.name!r}, {names_preview(self.feature_names, 'features')}; "
+            f"{names_preview(self.action_names, 'actions' if self.output == 'actions' else 'outputs')}; "
+            f"output {self.output}, observation {self.observation.describe()})"
+        )
 
     @classmethod
-    def heads(cls, module: torch.nn.Module, output: Sequence[str], action_names: Sequence[str] | None = None,
-              **kwargs) -> dict[str, "Policy"]:
+    def heads(
+        cls, module: torch.nn.Module, output: Sequence[str], action_names: Sequence[str] | None = None, **kwargs
+    ) -> dict[str, Policy]:
         """One policy per kind of output, for a network whose outputs are of several kinds (a parametrised action
         space, P-DQN style: the discrete actions' logits and their continuous parameters in one tensor).
 
@@ -244,22 +257,27 @@ class Policy:
             raise InputError(f"policy '{self.name}': an action_mask needs discrete actions (output='actions').")
         mask = np.asarray(self.action_mask(x), dtype=bool)
         if mask.shape != (len(x), self.n_actions) or not mask.any(axis=1).all():
-            raise InputError(f"policy '{self.name}': action_mask must return a bool array {(len(x), self.n_actions)} "
-                             "with at least one available action per state.")
+            raise InputError(
+                f"policy '{self.name}': action_mask must return a bool array {(len(x), self.n_actions)} "
+                "with at least one available action per state."
+            )
         return mask
 
     def act(self, states) -> np.ndarray:
         """Index of the highest-scoring available action per state (discrete actions only)."""
         if self.output != "actions":
-            raise InputError(f"policy '{self.name}' outputs {self.output}, not discrete actions: nothing is chosen; "
-                             "use scores().")
+            raise InputError(
+                f"policy '{self.name}' outputs {self.output}, not discrete actions: nothing is chosen; use scores()."
+            )
         return np.where(self.available(states), self.scores(states), -np.inf).argmax(axis=1)
 
     def background(self, n: int = 100, seed: int = 0) -> np.ndarray:
         """`n` typical states from the policy's sampler; raises when it has none."""
         if self.background_sampler is None:
-            raise InputError(f"policy '{self.name}' has no background sampler; give background states: --background FILE "
-                             "on the command line, background=array in Python.")
+            raise InputError(
+                f"policy '{self.name}' has no background sampler; give background states: --background FILE "
+                "on the command line, background=array in Python."
+            )
         return self.check_states(self.background_sampler(n, seed), "background")
 
 
@@ -300,24 +318,35 @@ class PolicyNetwork(torch.nn.Module):
             own = _module_dtype(self.module)
             if own is not None and own != x.dtype:  # e.g. a float16 network: the dtype, not the shape, is wrong
                 own, given = (str(t).removeprefix("torch.") for t in (own, x.dtype))
-                raise InputError(f"policy '{self.policy_name}': its module {type(self.module).__name__} computes in "
-                                 f"{own} and failed on {given} states ({type(exc).__name__}: {detail[:160]}); xairl "
-                                 "explains float32 and float64 networks: convert it with module.float() or "
-                                 "module.double().") from None
-            shape = tuple(x.shape[:1]) + tuple(inp.shape[1:]) if isinstance(inp, torch.Tensor) else \
-                f"{self.observation.describe().replace('(n', f'({len(x)}')}"
-            raise InputError(f"policy '{self.policy_name}': its module {type(self.module).__name__} raised "
-                             f"{type(exc).__name__} ({detail}) on input {shape}; check that it takes "
-                             f"{self.observation.describe()}.") from None
+                raise InputError(
+                    f"policy '{self.policy_name}': its module {type(self.module).__name__} computes in "
+                    f"{own} and failed on {given} states ({type(exc).__name__}: {detail[:160]}); xairl "
+                    "explains float32 and float64 networks: convert it with module.float() or "
+                    "module.double()."
+                ) from None
+            shape = (
+                tuple(x.shape[:1]) + tuple(inp.shape[1:])
+                if isinstance(inp, torch.Tensor)
+                else f"{self.observation.describe().replace('(n', f'({len(x)}')}"
+            )
+            raise InputError(
+                f"policy '{self.policy_name}': its module {type(self.module).__name__} raised "
+                f"{type(exc).__name__} ({detail}) on input {shape}; check that it takes "
+                f"{self.observation.describe()}."
+            ) from None
         if not isinstance(out, torch.Tensor):
-            raise InputError(f"policy '{self.policy_name}': its module {type(self.module).__name__} returned a "
-                             f"{type(out).__name__}, not a tensor; wrap it so that it returns one (batch, n_outputs) "
-                             "tensor (e.g. the logits or Q-values only).")
+            raise InputError(
+                f"policy '{self.policy_name}': its module {type(self.module).__name__} returned a "
+                f"{type(out).__name__}, not a tensor; wrap it so that it returns one (batch, n_outputs) "
+                "tensor (e.g. the logits or Q-values only)."
+            )
         if out.dim() == 1 and len(out) == len(x):
             out = out[:, None]
         if out.dim() != 2 or len(out) != len(x):
-            raise InputError(f"policy '{self.policy_name}': the module returned shape {tuple(out.shape)} for "
-                             f"{len(x)} states; it must return (batch, n_outputs).")
+            raise InputError(
+                f"policy '{self.policy_name}': the module returned shape {tuple(out.shape)} for "
+                f"{len(x)} states; it must return (batch, n_outputs)."
+            )
         return out
 
 
@@ -347,4 +376,3 @@ def _observation(obs, feature_names) -> Observation:
         shape = (obs,) if isinstance(obs, int) else tuple(obs)
         return Observation.flat(shape[0]) if len(shape) == 1 else Observation.array(shape)
     raise InputError(f"observation must be a shape, a dict of shapes or a list of shapes; got {type(obs).__name__}.")
-

@@ -6,11 +6,13 @@ template narrator uses the first variant; the language-model narrator chooses am
 Lookup of ``NAME``: explicit folders (``--prompts DIR``) > ``$XAIRL_USER_PATH/prompts`` > plugin folders
 (``register_prompt_dirs``) > the built-ins shipped in the wheel.
 """
+
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterable, Literal
+from typing import Literal
 
 import yaml
 from jinja2 import TemplateSyntaxError, UndefinedError, meta, nodes
@@ -22,9 +24,27 @@ from .errors import UnknownNameError, XairlError, validation_message
 from .paths import user_dir
 from .sandbox import MAX_LOOP_DEPTH, loop_depth
 
-DECISION_VARS = {"index", "action", "runner_up", "score", "runner_up_score", "q_margin", "base_value", "method",
-                 "additivity_gap", "top", "margin_top", "comparisons", "extras", "k", "output", "reasons",
-                 "concession", "base_margin", "identifiers"}
+DECISION_VARS = {
+    "index",
+    "action",
+    "runner_up",
+    "score",
+    "runner_up_score",
+    "q_margin",
+    "base_value",
+    "method",
+    "additivity_gap",
+    "top",
+    "margin_top",
+    "comparisons",
+    "extras",
+    "k",
+    "output",
+    "reasons",
+    "concession",
+    "base_margin",
+    "identifiers",
+}
 GLOBAL_VARS = {"n_states", "method", "ranking", "view", "target", "k"}
 
 
@@ -72,8 +92,13 @@ def format_number(x: float, signed: bool = False) -> str:
 def environment() -> ImmutableSandboxedEnvironment:
     """A fresh bounded sandbox (:mod:`xairl.sandbox`) with the template filters: ``num`` and ``signed`` write numbers
     as :func:`format_number` does, ``cap`` capitalises the first letter."""
-    return sandbox.environment({"num": format_number, "signed": lambda x: format_number(x, True),
-                                "cap": lambda t: str(t)[:1].upper() + str(t)[1:]})
+    return sandbox.environment(
+        {
+            "num": format_number,
+            "signed": lambda x: format_number(x, True),
+            "cap": lambda t: str(t)[:1].upper() + str(t)[1:],
+        }
+    )
 
 
 @dataclass
@@ -90,8 +115,10 @@ class Template:
         """Every variant of every sentence, rendered in one sandbox (one budget); raises :class:`TemplateError`
         with file and line."""
         env = environment()
-        return [[self._render(env, text, f"{self.path}:{self.lines[s][v]}", context) for v, text in enumerate(variants)]
-                for s, variants in enumerate(self.spec.sentences)]
+        return [
+            [self._render(env, text, f"{self.path}:{self.lines[s][v]}", context) for v, text in enumerate(variants)]
+            for s, variants in enumerate(self.spec.sentences)
+        ]
 
     @staticmethod
     def _render(env: ImmutableSandboxedEnvironment, text: str, where: str, context: dict) -> str:
@@ -102,8 +129,10 @@ class Template:
         except UndefinedError as exc:
             raise TemplateError(f"{where}: {exc}; see `xairl prompts check` for the variables.") from None
         except RecursionError:  # parsing deep nesting, or a macro calling itself
-            raise TemplateError(f"{where}: refused by the sandbox (nesting or recursion deeper than Python's stack "
-                                "allows; templates may not recurse).") from None
+            raise TemplateError(
+                f"{where}: refused by the sandbox (nesting or recursion deeper than Python's stack "
+                "allows; templates may not recurse)."
+            ) from None
         except TemplateSyntaxError as exc:
             raise TemplateError(f"{where}: syntax error: {exc.message}.") from None
         except Exception as exc:  # a filter or test raising on odd data
@@ -137,8 +166,9 @@ def load(name_or_path: str | Path, extra: Iterable[str | Path] = ()) -> Template
         return parse(p)
     found = available(extra)
     if str(name_or_path) not in found:
-        raise UnknownNameError(f"unknown template '{name_or_path}'; known: {', '.join(sorted(found))} "
-                               "(see `xairl prompts list`).")
+        raise UnknownNameError(
+            f"unknown template '{name_or_path}'; known: {', '.join(sorted(found))} (see `xairl prompts list`)."
+        )
     return parse(found[str(name_or_path)])
 
 
@@ -150,8 +180,9 @@ def _variant_lines(text: str) -> list[list[int]]:
             lines = []
             for item in value.value:
                 items = item.value if isinstance(item, yaml.SequenceNode) else [item]
-                lines.append([n.start_mark.line + 1 + (1 if getattr(n, "style", None) in ("|", ">") else 0)
-                              for n in items])
+                lines.append(
+                    [n.start_mark.line + 1 + (1 if getattr(n, "style", None) in ("|", ">") else 0) for n in items]
+                )
             return lines
     return []
 
@@ -163,8 +194,10 @@ def _read(path: Path) -> str:
     except OSError as exc:
         raise TemplateError(f"{path}: cannot read it ({exc}).") from None
     except UnicodeDecodeError as exc:
-        raise TemplateError(f"{path}: not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset {exc.start}); a "
-                            "template is a YAML text file.") from None
+        raise TemplateError(
+            f"{path}: not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset {exc.start}); a "
+            "template is a YAML text file."
+        ) from None
 
 
 def _parse_text(path: Path, text: str) -> Template:
@@ -217,16 +250,23 @@ def check(path: str | Path, sample: Callable[[str], dict] | None = None) -> list
                 raise TemplateError(f"{path}:{base}: refused by the sandbox ({exc}).") from None
             if loop_depth(ast) > MAX_LOOP_DEPTH:
                 problems.append(f"{path}:{base}: sandbox violation: loops nested more than {MAX_LOOP_DEPTH} deep")
-            assigned = {n.name for a in ast.find_all(nodes.Assign) for n in [a.target, *a.target.find_all(nodes.Name)]
-                        if isinstance(n, nodes.Name)}
+            assigned = {
+                n.name
+                for a in ast.find_all(nodes.Assign)
+                for n in [a.target, *a.target.find_all(nodes.Name)]
+                if isinstance(n, nodes.Name)
+            }
             for name in sorted(meta.find_undeclared_variables(ast) - allowed - assigned):
-                problems.append(f"{path}:{base}: unknown variable '{name}'; a {tpl.spec.kind} template has: "
-                                f"{', '.join(sorted(allowed))}")
+                problems.append(
+                    f"{path}:{base}: unknown variable '{name}'; a {tpl.spec.kind} template has: "
+                    f"{', '.join(sorted(allowed))}"
+                )
             for node in ast.find_all((nodes.Getattr, nodes.Getitem)):
                 attr = node.attr if isinstance(node, nodes.Getattr) else getattr(node.arg, "value", None)
                 if isinstance(attr, str) and attr.startswith("_"):
-                    problems.append(f"{path}:{base + node.lineno - 1}: sandbox violation: access to '{attr}' is "
-                                    "refused")
+                    problems.append(
+                        f"{path}:{base + node.lineno - 1}: sandbox violation: access to '{attr}' is refused"
+                    )
     if not problems and sample is not None:
         try:
             tpl.render_variants(sample(tpl.spec.kind))

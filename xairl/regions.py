@@ -9,6 +9,7 @@ columns 40 to 47 of channel 2') are in the regioned explanation's ``extras["regi
 Narration and :func:`xairl.verify` both read an image explanation through :func:`in_regions`, so a narrative's region
 names are the verifier's vocabulary (which also takes a region's extent as its name).
 """
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -35,9 +36,19 @@ def in_regions(exp: Explanation) -> Explanation:
     states = None if exp.states is None else np.stack([exp.states[:, m].mean(axis=1) for m in members], axis=1)
     quartiles = None
     if exp.background_quantiles is not None:  # a region's quartiles are unknown (NaN: no level words)
-        quartiles = np.stack([exp.background_quantiles[:, m[0]] if len(m) == 1 and out.feature_names[k] not in groups
-                              else np.full(len(exp.background_quantiles), np.nan) for k, m in enumerate(members)],
-                             axis=1)
+        quartiles = np.stack(
+            [
+                exp.background_quantiles[:, m[0]]
+                if len(m) == 1 and out.feature_names[k] not in groups
+                else np.full(len(exp.background_quantiles), np.nan)
+                for k, m in enumerate(members)
+            ],
+            axis=1,
+        )
     extents = observation.region_extents()
-    return replace(out, states=states, background_quantiles=quartiles,
-                   extras={**exp.extras, "regions": {f: extents[f] for f in out.feature_names if f in extents}})
+    return replace(
+        out,
+        states=states,
+        background_quantiles=quartiles,
+        extras={**exp.extras, "regions": {f: extents[f] for f in out.feature_names if f in extents}},
+    )

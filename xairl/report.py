@@ -4,15 +4,17 @@ A plugin's :class:`Report` (hook ``register_reports``) declares its own options 
 datasets to explain, a background, and its own tables and figures (:class:`ReportContent`); this module does the
 rest the same way for every plugin (:func:`write_report`).
 """
+
 from __future__ import annotations
 
 import base64
 import html
 import json
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
@@ -23,11 +25,12 @@ from .options import Options, parse_options
 from .policy import Policy
 from .regions import in_regions
 
-
 #: an image's report lists this many regions by importance (its cards list every region, sorted)
 TOP_REGIONS = 20
-REGIONS_ARE = ("regions (patches of one channel or frame on a grid: letters count columns, numbers rows, from the "
-               "top left; the pixels each covers beside it, counted from 0)")
+REGIONS_ARE = (
+    "regions (patches of one channel or frame on a grid: letters count columns, numbers rows, from the "
+    "top left; the pixels each covers beside it, counted from 0)"
+)
 
 
 @dataclass
@@ -73,8 +76,8 @@ class ReportContent:
     title: str
     policy: Policy
     background: np.ndarray
-    datasets: list[tuple[str, np.ndarray]]   # (label, states); the first is the reference for feature order
-    tables: list[tuple[str, str]] = field(default_factory=list)   # (title, html table)
+    datasets: list[tuple[str, np.ndarray]]  # (label, states); the first is the reference for feature order
+    tables: list[tuple[str, str]] = field(default_factory=list)  # (title, html table)
     figures: list[tuple[str, Path]] = field(default_factory=list)  # (caption, png)
     notes: list[str] = field(default_factory=list)
     settings: dict = field(default_factory=dict)
@@ -102,6 +105,7 @@ class Report:
 
 def table_html(header: list[str], rows: list[list]) -> str:
     """An HTML table; floats with two decimals, everything else escaped."""
+
     def cell(v):
         return f"{v:.2f}" if isinstance(v, float) else html.escape(str(v))
 
@@ -110,8 +114,9 @@ def table_html(header: list[str], rows: list[list]) -> str:
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def importance_table(exps: list[tuple[str, Explanation]], top: int | None = None, what: str = "features"
-                     ) -> tuple[str, str]:
+def importance_table(
+    exps: list[tuple[str, Explanation]], top: int | None = None, what: str = "features"
+) -> tuple[str, str]:
     """Each feature's rank by mean |contribution| in the margin view (:func:`xairl.plots.view_label`: to the margin
     over the runner-up for discrete actions, as the narratives and figures rank them) per dataset (the ``top`` first
     only, when given), and the Spearman rank correlation of every dataset's global importance with the first's."""
@@ -122,16 +127,26 @@ def importance_table(exps: list[tuple[str, Explanation]], top: int | None = None
     names = exps[0][1].feature_names
     extents = (exps[0][1].extras or {}).get("regions")  # an image's regions: the pixels each grid name covers
     extents = extents if isinstance(extents, dict) and any(f in extents for f in names) else None
-    rows = [[f, *([str(extents.get(f, ""))] if extents else []), *[int(r[j]) for r in ranks],
-             *[float(v[j]) for v in imp]] for j, f in sorted(enumerate(names), key=lambda t: ranks[0][t[0]])][:top]
+    rows = [
+        [f, *([str(extents.get(f, ""))] if extents else []), *[int(r[j]) for r in ranks], *[float(v[j]) for v in imp]]
+        for j, f in sorted(enumerate(names), key=lambda t: ranks[0][t[0]])
+    ][:top]
     rhos = [float(_spearman(imp[0], v)) for v in imp[1:]]
     named = view_label(exps[0][1])
-    title = ("Global importance by dataset" if len(rows) == len(names) else
-             f"The {len(rows)} most important of {len(names)} {what} ({exps[0][0]})")
+    title = (
+        "Global importance by dataset"
+        if len(rows) == len(names)
+        else f"The {len(rows)} most important of {len(names)} {what} ({exps[0][0]})"
+    )
     title += f", by mean |{named}|" + "".join(
-        f"; Spearman rank correlation {label} vs {exps[0][0]}: {rho:.2f}" for (label, _), rho in zip(exps[1:], rhos))
-    header = ["feature", *(["pixels"] if extents else []), *[f"rank ({label})" for label, _ in exps],
-              *[f"mean |{named}| ({label})" for label, _ in exps]]
+        f"; Spearman rank correlation {label} vs {exps[0][0]}: {rho:.2f}" for (label, _), rho in zip(exps[1:], rhos)
+    )
+    header = [
+        "feature",
+        *(["pixels"] if extents else []),
+        *[f"rank ({label})" for label, _ in exps],
+        *[f"mean |{named}| ({label})" for label, _ in exps],
+    ]
     return title, table_html(header, rows)
 
 
@@ -141,8 +156,9 @@ def _spearman(a: np.ndarray, b: np.ndarray) -> float:
     return spearmanr(a, b).statistic
 
 
-def _figures(exps: list[tuple[str, Explanation]], pick: int, groups: dict, out: Path, policy: Policy | None = None
-             ) -> list[tuple[str, Path]]:
+def _figures(
+    exps: list[tuple[str, Explanation]], pick: int, groups: dict, out: Path, policy: Policy | None = None
+) -> list[tuple[str, Path]]:
     """The report's figures, all in the margin view (the narratives' and the cards'; the first output when nothing
     is chosen), each captioned with what its contributions add up to. Images are plotted in the regions their
     narratives name and dicts by key (thousands of pixels are no beeswarm); the image plot shows the pixels. The
@@ -153,19 +169,42 @@ def _figures(exps: list[tuple[str, Explanation]], pick: int, groups: dict, out: 
     shown = [(label, plots.readable(e)) for label, e in exps]
     target = plots.view_label(ref)
     what = f"{ref_label} state {pick}" + (f": {ref.action_names[ref.chosen[pick]]}" if decides else "")
-    figures = [((f"SHAP values, {target}: {' vs '.join(l for l, _ in exps)} (same feature order, by {ref_label} "
-                 "importance)"), plots.save(plots.beeswarm(shown), out / "beeswarm.png")),
-               (f"Global importance: mean |{target}|", plots.save(plots.importance(shown), out / "importance.png")),
-               (f"One {'decision' if decides else 'state'} ({what}): {target}{', as in its card' if decides else ''}",
-                plots.save(plots.waterfall(shown[0][1], pick, policy=policy), out / "waterfall.png"))]
+    figures = [
+        (
+            (
+                f"SHAP values, {target}: {' vs '.join(label for label, _ in exps)} (same feature order, by {ref_label} "
+                "importance)"
+            ),
+            plots.save(plots.beeswarm(shown), out / "beeswarm.png"),
+        ),
+        (f"Global importance: mean |{target}|", plots.save(plots.importance(shown), out / "importance.png")),
+        (
+            f"One {'decision' if decides else 'state'} ({what}): {target}{', as in its card' if decides else ''}",
+            plots.save(plots.waterfall(shown[0][1], pick, policy=policy), out / "waterfall.png"),
+        ),
+    ]
     if ref.image_shape is not None:
-        figures.append(((f"Contributions over the frame ({ref_label} state {pick}; {target}; red raises it, blue "
-                         "lowers it; summed over channels)"), plots.save(plots.image(ref, pick), out / "image.png")))
+        figures.append(
+            (
+                (
+                    f"Contributions over the frame ({ref_label} state {pick}; {target}; red raises it, blue "
+                    "lowers it; summed over channels)"
+                ),
+                plots.save(plots.image(ref, pick), out / "image.png"),
+            )
+        )
     if groups:
-        figures.append(((f"Global importance by group, mean |{target}| "
-                         f"({'; '.join(g + ' = ' + ', '.join(m) for g, m in groups.items())})"),
-                        plots.save(plots.importance([(l, e.grouped(groups)) for l, e in exps]),
-                                   out / "importance_groups.png")))
+        figures.append(
+            (
+                (
+                    f"Global importance by group, mean |{target}| "
+                    f"({'; '.join(g + ' = ' + ', '.join(m) for g, m in groups.items())})"
+                ),
+                plots.save(
+                    plots.importance([(label, e.grouped(groups)) for label, e in exps]), out / "importance_groups.png"
+                ),
+            )
+        )
     return figures
 
 
@@ -185,8 +224,7 @@ def _interesting(exp: Explanation) -> int:
     return int(chose[np.argmin(gap)])
 
 
-def write_report(req: ReportRequest, content: ReportContent, explained: dict[str, Explanation] | None = None
-                 ) -> Path:
+def write_report(req: ReportRequest, content: ReportContent, explained: dict[str, Explanation] | None = None) -> Path:
     """Write explanations.jsonl (+ its JSON schema), PNG figures and report.html into ``req.out``.
 
     :param explained: explanations already computed, by dataset label (the others are explained here).
@@ -201,8 +239,15 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     exps: list[tuple[str, Explanation]] = []
     explained = explained or {}
     for label, states in progress(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress):
-        exps.append((label, explained.get(label) or explain(content.policy, states, background=content.background,
-                                                            method=req.method, options=req.options)))
+        exps.append(
+            (
+                label,
+                explained.get(label)
+                or explain(
+                    content.policy, states, background=content.background, method=req.method, options=req.options
+                ),
+            )
+        )
     if req.records:
         with atomic_write(out / "explanations.jsonl") as fh:
             for label, exp in exps:
@@ -215,13 +260,22 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     # an image's importance by region (the top ones), not by pixel; its narratives' cards list regions too
     regioned = [(label, in_regions(e)) for label, e in exps]
     image = regioned[0][1] is not ref
-    tables = list(content.tables) + ([importance_table(regioned, TOP_REGIONS, REGIONS_ARE) if image else
-                                      importance_table(exps)] if len(exps) > 1 or image else [])
+    tables = list(content.tables) + (
+        [importance_table(regioned, TOP_REGIONS, REGIONS_ARE) if image else importance_table(exps)]
+        if len(exps) > 1 or image
+        else []
+    )
     notes = (content.commentary({label: e for label, e in exps}) if content.commentary else []) + content.notes
     narratives = _narratives(req, content, ref, regioned[0][1], pick) if req.narrate else []
-    settings = {"method": req.method, "options": req.options, "narrator": req.narrator, "seed": req.seed,
-                "background states": len(content.background), "seconds to explain, plot and narrate": round(time.time() - t0, 1),
-                **content.settings}
+    settings = {
+        "method": req.method,
+        "options": req.options,
+        "narrator": req.narrator,
+        "seed": req.seed,
+        "background states": len(content.background),
+        "seconds to explain, plot and narrate": round(time.time() - t0, 1),
+        **content.settings,
+    }
     path = out / "report.html"
     write_text(path, _html(content.title, tables, notes, exps, figures, narratives, settings))
     return path
@@ -235,10 +289,20 @@ def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, sh
     from .narrators import narrate
 
     idx = [pick] + [i for i in range(len(ref.values)) if i != pick][: max(req.n_narrated - 1, 0)]
-    out = [narrate(ref, i, narrator=req.narrator, template=req.template or content.template, policy=content.policy,
-                   background=content.background, options=req.narrator_options, prompt_dirs=req.prompt_dirs,
-                   robustness=req.robustness)
-           for i in progress(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)]
+    out = [
+        narrate(
+            ref,
+            i,
+            narrator=req.narrator,
+            template=req.template or content.template,
+            policy=content.policy,
+            background=content.background,
+            options=req.narrator_options,
+            prompt_dirs=req.prompt_dirs,
+            robustness=req.robustness,
+        )
+        for i in progress(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)
+    ]
     out.append(narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs))
     pairs = [(n, n.evidence if n.evidence is not None else evidence(shown, n)) for n in out]  # of its regions
     if content.policy.groups:
@@ -254,30 +318,49 @@ def _img(path: Path) -> str:
 
 def _html(title, tables, notes, exps, figures, narratives, settings) -> str:
     parts = [f"<h1>{html.escape(title)}</h1>"]
-    parts.append("<h2>Settings</h2>" + table_html(["setting", "value"], [[k, json.dumps(v) if isinstance(v, (dict, list))
-                                                                         else v] for k, v in settings.items()]))
+    parts.append(
+        "<h2>Settings</h2>"
+        + table_html(
+            ["setting", "value"],
+            [[k, json.dumps(v) if isinstance(v, (dict, list)) else v] for k, v in settings.items()],
+        )
+    )
     for heading, table in tables:
         parts.append(f"<h2>{html.escape(heading)}</h2>{table}")
-    parts.append("<h2>Explanations</h2><p>" + ", ".join(f"{html.escape(l)}: {len(e.values)} states, largest "
-                                                       f"additivity gap {e.additivity_gap.max():.1e}" for l, e in exps)
-                 + "</p>")
+    parts.append(
+        "<h2>Explanations</h2><p>"
+        + ", ".join(
+            f"{html.escape(label)}: {len(e.values)} states, largest additivity gap {e.additivity_gap.max():.1e}"
+            for label, e in exps
+        )
+        + "</p>"
+    )
     for caption, png in figures:
-        parts.append(f"<figure><img src='{_img(png)}' alt='{html.escape(caption)}'><figcaption>"
-                     f"{html.escape(caption)}</figcaption></figure>")
+        parts.append(
+            f"<figure><img src='{_img(png)}' alt='{html.escape(caption)}'><figcaption>"
+            f"{html.escape(caption)}</figcaption></figure>"
+        )
     if narratives:
-        parts.append("<h2>Narrated decisions</h2><p class=meta>Each sentence is marked &#10003; verified, &#10007; "
-                     "contradicted or ? unchecked (no claim the verifier could check); the waterfall builds the margin "
-                     "of the chosen action over the runner-up (the score, when nothing is chosen) from its background "
-                     "average, feature by feature.</p>")
+        parts.append(
+            "<h2>Narrated decisions</h2><p class=meta>Each sentence is marked &#10003; verified, &#10007; "
+            "contradicted or ? unchecked (no claim the verifier could check); the waterfall builds the margin "
+            "of the chosen action over the runner-up (the score, when nothing is chosen) from its background "
+            "average, feature by feature.</p>"
+        )
         for n, ev in narratives:
             where = "all states" if n.index is None else f"state {n.index}"
-            meta = (f"{where} &middot; template {html.escape(n.template)} &middot; {html.escape(n.source)}"
-                    + ("" if n.verified else " &middot; <span class=bad>NOT verified</span>"))
+            meta = f"{where} &middot; template {html.escape(n.template)} &middot; {html.escape(n.source)}" + (
+                "" if n.verified else " &middot; <span class=bad>NOT verified</span>"
+            )
             parts.append(card_html(n.text, ev, meta))
     if notes:
         parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in notes) + "</ul>")
-    style = ("body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}table{border-collapse:collapse;"
-             "margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}"
-             "img{max-width:100%}.ok{color:#070;font-weight:bold}.bad{color:#b00;font-weight:bold}" + CARD_STYLE)
-    return (f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
-            f"<style>{style}</style></head><body>{''.join(parts)}</body></html>")
+    style = (
+        "body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}table{border-collapse:collapse;"
+        "margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}"
+        "img{max-width:100%}.ok{color:#070;font-weight:bold}.bad{color:#b00;font-weight:bold}" + CARD_STYLE
+    )
+    return (
+        f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
+        f"<style>{style}</style></head><body>{''.join(parts)}</body></html>"
+    )

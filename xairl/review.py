@@ -11,6 +11,7 @@ a body limit (413, decided before reading), a socket timeout per read or write, 
 and 400 for malformed forms, all without tracebacks. Not defended: anyone with a shell on this machine (they can
 read the store anyway); there is no TLS and no authentication beyond the token.
 """
+
 from __future__ import annotations
 
 import html
@@ -34,8 +35,10 @@ TIMEOUT = 10.0  # seconds a client may stall before its connection is dropped
 DEADLINE = 20.0  # seconds a connection may last in all (one request: HTTP/1.0), however it trickles
 MAX_CONNECTIONS = 16  # open at once (a browser opens about 6); beyond it a connection is answered 503 and closed
 _BUSY_TEXT = b"too many connections; retry shortly\n"
-_BUSY = (b"HTTP/1.0 503 Service Unavailable\r\nContent-Type: text/plain; charset=utf-8\r\nRetry-After: 5\r\n"
-         b"Content-Length: %d\r\nConnection: close\r\n\r\n%s" % (len(_BUSY_TEXT), _BUSY_TEXT))
+_BUSY = (
+    b"HTTP/1.0 503 Service Unavailable\r\nContent-Type: text/plain; charset=utf-8\r\nRetry-After: 5\r\n"
+    b"Content-Length: %d\r\nConnection: close\r\n\r\n%s" % (len(_BUSY_TEXT), _BUSY_TEXT)
+)
 _NUMBER = re.compile(r"[0-9]{1,18}")  # fits SQLite's 64-bit integer and stays under int()'s digit limit
 
 
@@ -128,30 +131,40 @@ class _Server(ThreadingHTTPServer):
 
 
 def _item(r: Record, token: str) -> str:
-    meta = (f"#{r.id} &middot; {html.escape(r.policy or '?')} &middot; template {html.escape(r.template or '?')} "
-            f"&middot; {html.escape(r.source or '?')} &middot; <b class=status>{html.escape(r.status)}</b>"
-            + (f" &middot; correction: <i>{html.escape(r.correction)}</i>" if r.correction else ""))
-    form = (f"<form method=post action='/review' class=verdict><input type=hidden name=id value='{r.id}'>"
-            f"<input type=hidden name=token value='{token}'>"
-            f"<button name=status value=accepted class=accept>Accept</button> "
-            f"<button name=status value=rejected class=reject>Reject</button> "
-            f"<textarea name=correction rows=2 cols=70 placeholder='corrected text'></textarea> "
-            f"<button name=status value=corrected class=correct>Correct</button></form>")
+    meta = (
+        f"#{r.id} &middot; {html.escape(r.policy or '?')} &middot; template {html.escape(r.template or '?')} "
+        f"&middot; {html.escape(r.source or '?')} &middot; <b class=status>{html.escape(r.status)}</b>"
+        + (f" &middot; correction: <i>{html.escape(r.correction)}</i>" if r.correction else "")
+    )
+    form = (
+        f"<form method=post action='/review' class=verdict><input type=hidden name=id value='{r.id}'>"
+        f"<input type=hidden name=token value='{token}'>"
+        f"<button name=status value=accepted class=accept>Accept</button> "
+        f"<button name=status value=rejected class=reject>Reject</button> "
+        f"<textarea name=correction rows=2 cols=70 placeholder='corrected text'></textarea> "
+        f"<button name=status value=corrected class=correct>Correct</button></form>"
+    )
     ev = r.evidence or {"sentences": [], "components": {}, "confidence": r.confidence, "verified": r.verified}
     return f"<section class=item id='item-{r.id}'>{card_html(r.text, ev, meta, form)}</section>"
 
 
 def page(store: FeedbackStore, token: str, show_all: bool = False, message: str = "") -> str:
     records = store.records() if show_all else store.records("pending")
-    head = (f"<h1>Narratives to review</h1><p class=meta>{len(records)} {'recorded' if show_all else 'pending'} in "
-            f"{html.escape(str(store.path))} &middot; <a href='/?all=1'>all</a> &middot; <a href='/'>pending</a></p>")
+    head = (
+        f"<h1>Narratives to review</h1><p class=meta>{len(records)} {'recorded' if show_all else 'pending'} in "
+        f"{html.escape(str(store.path))} &middot; <a href='/?all=1'>all</a> &middot; <a href='/'>pending</a></p>"
+    )
     note = f"<p class=message>{html.escape(message)}</p>" if message else ""
     body = "".join(_item(r, token) for r in records) or "<p class=empty>Nothing to review.</p>"
-    style = CARD_STYLE + ("body{font-family:sans-serif;max-width:1100px;margin:1.5em auto;color:#222}"
-                          ".message{background:#e6f4e6;padding:.4em}.verdict{margin-top:.6em}"
-                          "td,th{border:1px solid #ddd;padding:1px 6px}table{border-collapse:collapse}")
-    return (f"<!doctype html><html><head><meta charset='utf-8'><title>xairl review</title><style>{style}</style>"
-            f"</head><body>{head}{note}{body}</body></html>")
+    style = CARD_STYLE + (
+        "body{font-family:sans-serif;max-width:1100px;margin:1.5em auto;color:#222}"
+        ".message{background:#e6f4e6;padding:.4em}.verdict{margin-top:.6em}"
+        "td,th{border:1px solid #ddd;padding:1px 6px}table{border-collapse:collapse}"
+    )
+    return (
+        f"<!doctype html><html><head><meta charset='utf-8'><title>xairl review</title><style>{style}</style>"
+        f"</head><body>{head}{note}{body}</body></html>"
+    )
 
 
 class _Handler(BaseHTTPRequestHandler):
@@ -180,8 +193,10 @@ class _Handler(BaseHTTPRequestHandler):
         sent = self.headers.get_all("Host") or []
         if len(sent) == 1 and sent[0].strip().lower() in self.server.hosts:
             return False
-        self._send(HTTPStatus.MISDIRECTED_REQUEST, "misdirected request: this page answers only to "
-                   f"http://{HOST}:{self.server.server_address[1]}/")
+        self._send(
+            HTTPStatus.MISDIRECTED_REQUEST,
+            f"misdirected request: this page answers only to http://{HOST}:{self.server.server_address[1]}/",
+        )
         return True
 
     def do_GET(self):  # noqa: N802 (http.server's naming)
@@ -191,8 +206,7 @@ class _Handler(BaseHTTPRequestHandler):
         if url.path != "/":
             return self._send(HTTPStatus.NOT_FOUND, "not found")
         q = parse_qs(url.query)
-        self._send(HTTPStatus.OK, page(self.server.store, self.server.token, bool(q.get("all")),
-                                       q.get("msg", [""])[0]))
+        self._send(HTTPStatus.OK, page(self.server.store, self.server.token, bool(q.get("all")), q.get("msg", [""])[0]))
 
     def _form(self) -> dict | None:
         """The posted form, once the Origin, the length and the token are checked; None after an error answer."""
@@ -238,8 +252,13 @@ class _Handler(BaseHTTPRequestHandler):
         pass
 
 
-def make_server(store: FeedbackStore, port: int = 0, timeout: float = TIMEOUT, deadline: float = DEADLINE,
-                max_connections: int = MAX_CONNECTIONS) -> ThreadingHTTPServer:
+def make_server(
+    store: FeedbackStore,
+    port: int = 0,
+    timeout: float = TIMEOUT,
+    deadline: float = DEADLINE,
+    max_connections: int = MAX_CONNECTIONS,
+) -> ThreadingHTTPServer:
     """A review server for ``store`` on 127.0.0.1 (``port`` 0: any free port; ``server.server_address`` says).
 
     :param timeout: seconds a client may stall in one read or write before its connection is dropped.
@@ -247,8 +266,10 @@ def make_server(store: FeedbackStore, port: int = 0, timeout: float = TIMEOUT, d
     :param max_connections: connections served at once; one more is answered 503 and closed.
     """
     if not (deadline > 0 and timeout > 0 and max_connections >= 1):
-        raise InputError(f"the review server needs a positive timeout and deadline and at least one connection, got "
-                         f"timeout={timeout}, deadline={deadline}, max_connections={max_connections}.")
+        raise InputError(
+            f"the review server needs a positive timeout and deadline and at least one connection, got "
+            f"timeout={timeout}, deadline={deadline}, max_connections={max_connections}."
+        )
     handler = type("Handler", (_Handler,), {"timeout": timeout})  # a socket timeout per server
     server = _Server((HOST, port), handler, deadline, max_connections)
     server.store, server.token = store, secrets.token_urlsafe(16)
@@ -269,8 +290,9 @@ def serve(store: FeedbackStore, port: int = 8765) -> None:
         server.server_close()
 
 
-def serve_in_thread(store: FeedbackStore, timeout: float = TIMEOUT, deadline: float = DEADLINE,
-                    max_connections: int = MAX_CONNECTIONS) -> tuple[ThreadingHTTPServer, str]:
+def serve_in_thread(
+    store: FeedbackStore, timeout: float = TIMEOUT, deadline: float = DEADLINE, max_connections: int = MAX_CONNECTIONS
+) -> tuple[ThreadingHTTPServer, str]:
     """A server on a free port in a daemon thread, and its address (for tests and notebooks); the parameters are
     :func:`make_server`'s."""
     server = make_server(store, 0, timeout, deadline, max_connections)

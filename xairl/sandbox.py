@@ -6,12 +6,12 @@ Every value a template builds is sized, before it is built where the size can be
 per rendering. Each bound is refused with jinja2's ``SecurityError`` naming it; :mod:`xairl.prompts` turns that into
 a one-line ``TemplateError`` with the file and line. ``tests/hostile_templates/`` holds the attacks.
 """
+
 from __future__ import annotations
 
 import functools
 import re
-from collections.abc import Iterator
-from typing import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 
 from jinja2 import StrictUndefined, nodes
 from jinja2.runtime import LoopContext, Macro
@@ -55,7 +55,7 @@ def _int(x) -> int:
 
 def _spec_widths(spec: str) -> int:
     """Upper bound on the padding a format spec adds: the sum of its numbers (width, precision)."""
-    return sum(int(d) if len(d) <= 12 else 10 ** 12 for d in re.findall(r"\d+", spec))
+    return sum(int(d) if len(d) <= 12 else 10**12 for d in re.findall(r"\d+", spec))
 
 
 _PRINTF_SPEC = re.compile(r"%(?:\([^)]*\))?([-#0 +*\d.]*)")
@@ -221,8 +221,11 @@ class _Sandbox(ImmutableSandboxedEnvironment):
             if is_map and (kwargs or len(args) != 1):
                 raise TypeError("format_map() takes exactly one argument")
             args, kwargs = ((), args[0]) if is_map else (args, kwargs)
-            formatter = (_BoundedEscapeFormatter(self, escape=owner.escape) if isinstance(owner, Markup)
-                         else _BoundedFormatter(self))
+            formatter = (
+                _BoundedEscapeFormatter(self, escape=owner.escape)
+                if isinstance(owner, Markup)
+                else _BoundedFormatter(self)
+            )
             return type(owner)(formatter.vformat(owner, args, kwargs))
 
         return bounded_format
@@ -254,12 +257,14 @@ _FILTER_SIZES = {
     "format": lambda value, *args, **kwargs: _printf_size(str(value), kwargs or args),
     "replace": lambda s, old, new, count=None: _replace_size(s, old, new, -1 if count is None else count),
     "join": lambda value, d="", attribute=None: _size(value) * (1 + len(str(d))),
-    "batch": lambda value, linecount, fill_with=None: _size(value) + (
-        0 if fill_with is None else _int(linecount) * (1 + _size(fill_with))),
+    "batch": lambda value, linecount, fill_with=None: (
+        _size(value) + (0 if fill_with is None else _int(linecount) * (1 + _size(fill_with)))
+    ),
     "slice": lambda value, slices, fill_with=None: _size(value) + _int(slices) * (1 + _size(fill_with)),
     # adding n lists one by one copies the running total n times
-    "sum": lambda iterable, attribute=None, start=0: 0 if isinstance(start, (int, float)) else
-    _size(iterable) * len(iterable) + _size(start),
+    "sum": lambda iterable, attribute=None, start=0: (
+        0 if isinstance(start, (int, float)) else _size(iterable) * len(iterable) + _size(start)
+    ),
     "tojson": lambda value, indent=None: (_size(value) + 1) * (10 + _pad(indent)),
 }
 
@@ -354,16 +359,25 @@ def environment(filters: Mapping[str, Callable] | None = None) -> ImmutableSandb
     """A fresh sandbox per rendering (the range(), step and work budgets are per rendering), with ``filters`` added
     to Jinja's built-in ones; every filter is bounded."""
     budget = _Budget()
-    env = _Sandbox(budget, undefined=StrictUndefined, autoescape=False, trim_blocks=True, lstrip_blocks=True,
-                   finalize=budget.checked)  # every {{ }} output, in macros and set blocks too, is paid for
-    env.globals = {"range": _budgeted_range(), "dict": dict, "namespace": env.globals["namespace"],
-                   RESERVED + "iter": budget.iterate, RESERVED + "concat": budget.concat,
-                   RESERVED + "checked": budget.checked}
+    env = _Sandbox(
+        budget,
+        undefined=StrictUndefined,
+        autoescape=False,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        finalize=budget.checked,
+    )  # every {{ }} output, in macros and set blocks too, is paid for
+    env.globals = {
+        "range": _budgeted_range(),
+        "dict": dict,
+        "namespace": env.globals["namespace"],
+        RESERVED + "iter": budget.iterate,
+        RESERVED + "concat": budget.concat,
+        RESERVED + "checked": budget.checked,
+    }
     env.filters.update(filters or {})
     env.filters = {name: _guard_filter(name, f, budget) for name, f in env.filters.items()}
     return env
-
-
 
 
 def render(env: ImmutableSandboxedEnvironment, text: str, context: Mapping) -> str:

@@ -6,6 +6,7 @@ observation preprocessing done in differentiable form (images / 255; a Discrete 
 the Policy's outputs are compared with SB3's own (``predict(deterministic=True)``, ``q_net``, ``predict_values``,
 the critic's ``q1_forward``) on sample states, and a mismatch is refused.
 """
+
 from __future__ import annotations
 
 from typing import Literal
@@ -94,8 +95,15 @@ class _QOfActor(torch.nn.Module):
         return self.critic.q_networks[0](torch.cat([self.critic.features_extractor(prep), action], dim=1))
 
 
-def from_sb3(model, head: Literal["policy", "value", "q"] = "policy", feature_names=None, action_names=None,
-             branch: int | None = None, check: bool = True, **kwargs) -> Policy:
+def from_sb3(
+    model,
+    head: Literal["policy", "value", "q"] = "policy",
+    feature_names=None,
+    action_names=None,
+    branch: int | None = None,
+    check: bool = True,
+    **kwargs,
+) -> Policy:
     """A Stable-Baselines3 model as a :class:`Policy`.
 
     :param model: any SB3 model (DQN, PPO, A2C, SAC, TD3, DDPG; MlpPolicy, CnnPolicy, MultiInputPolicy), or an
@@ -114,20 +122,31 @@ def from_sb3(model, head: Literal["policy", "value", "q"] = "policy", feature_na
         raise InputError(f"head '{head}' is unknown; use one of {', '.join(HEADS)}.")
     policy = model.policy
     if hasattr(policy, "lstm_actor"):
-        raise InputError(f"{type(model).__name__} is recurrent: its action depends on the LSTM's hidden state, which "
-                         "is not part of the observation, so an explanation of the observation alone would be of a "
-                         "different policy; explain a feed-forward policy (PPO, A2C, DQN, SAC, ...) instead.")
+        raise InputError(
+            f"{type(model).__name__} is recurrent: its action depends on the LSTM's hidden state, which "
+            "is not part of the observation, so an explanation of the observation alone would be of a "
+            "different policy; explain a feed-forward policy (PPO, A2C, DQN, SAC, ...) instead."
+        )
     if hasattr(policy, "quantile_net"):
-        raise InputError(f"{type(model).__name__} outputs quantiles per action; xairl explains one score per "
-                         "action: use DQN, or explain a module that averages the quantiles with xairl.Policy.")
+        raise InputError(
+            f"{type(model).__name__} outputs quantiles per action; xairl explains one score per "
+            "action: use DQN, or explain a module that averages the quantiles with xairl.Policy."
+        )
     obs_space, act_space = model.observation_space, model.action_space
     observation = _observation(obs_space)
     prep = _Preprocess(obs_space, getattr(policy, "normalize_images", True))
     output, names, network = _head(model, policy, head, act_space, prep, branch, spaces)
     if feature_names is None:
         feature_names = observation.feature_names()
-    result = Policy(network.eval(), feature_names, action_names or names, observation=observation, output=output,
-                    name=kwargs.pop("name", f"{type(model).__name__.lower()}-{head}"), **kwargs)
+    result = Policy(
+        network.eval(),
+        feature_names,
+        action_names or names,
+        observation=observation,
+        output=output,
+        name=kwargs.pop("name", f"{type(model).__name__.lower()}-{head}"),
+        **kwargs,
+    )
     if check:
         _check(model, result, head, branch, spaces)
     return result
@@ -143,8 +162,10 @@ def _observation(space) -> Observation:
             return Part(key, (), int(s.n))
         if isinstance(s, (spaces.Box, spaces.MultiBinary)):
             return Part(key, tuple(int(d) for d in s.shape))
-        raise InputError(f"observation '{key}' is {type(s).__name__}; xairl explains Box, Discrete and MultiBinary "
-                         "observations (and Dicts of them).")
+        raise InputError(
+            f"observation '{key}' is {type(s).__name__}; xairl explains Box, Discrete and MultiBinary "
+            "observations (and Dicts of them)."
+        )
 
     if isinstance(space, spaces.Dict):
         return Observation("dict", tuple(part(k, s) for k, s in space.spaces.items()))
@@ -160,22 +181,33 @@ def _head(model, policy, head, act_space, prep, branch, spaces):
     continuous = isinstance(act_space, spaces.Box)
     if head == "value":
         if not hasattr(policy, "value_net"):
-            raise InputError(f"{algo} has no state-value head; head='value' is for actor-critics (PPO, A2C); "
-                             f"{'use head=' + repr('q') if hasattr(policy, 'critic') else 'use head=' + repr('policy')}.")
+            raise InputError(
+                f"{algo} has no state-value head; head='value' is for actor-critics (PPO, A2C); "
+                f"{'use head=' + repr('q') if hasattr(policy, 'critic') else 'use head=' + repr('policy')}."
+            )
         extractor = getattr(policy, "vf_features_extractor", None) or policy.features_extractor
-        return "value", ["value"], _SB3Network(prep, extractor, _ActorCritic(policy.mlp_extractor, policy.value_net,
-                                                                              critic=True))
+        return (
+            "value",
+            ["value"],
+            _SB3Network(prep, extractor, _ActorCritic(policy.mlp_extractor, policy.value_net, critic=True)),
+        )
     if head == "q":
         if not (hasattr(policy, "critic") and hasattr(policy, "actor")):
             raise InputError(f"{algo} has no action-value critic; head='q' is for SAC, TD3 and DDPG.")
         return "value", ["q"], _QOfActor(prep, _actor_net(policy, act_space, env_units=False), policy.critic)
     if hasattr(policy, "q_net"):  # DQN
         n = int(act_space.n)
-        return "actions", [f"action_{i}" for i in range(n)], _SB3Network(prep, policy.q_net.features_extractor,
-                                                                          policy.q_net.q_net)
+        return (
+            "actions",
+            [f"action_{i}" for i in range(n)],
+            _SB3Network(prep, policy.q_net.features_extractor, policy.q_net.q_net),
+        )
     if hasattr(policy, "actor") and continuous:  # SAC, TD3, DDPG
-        return "continuous", [f"action_{i}" for i in range(act_space.shape[0])], \
-            _actor_net(policy, act_space, env_units=True, prep=prep)
+        return (
+            "continuous",
+            [f"action_{i}" for i in range(act_space.shape[0])],
+            _actor_net(policy, act_space, env_units=True, prep=prep),
+        )
     if hasattr(policy, "action_net"):  # PPO, A2C
         extractor = getattr(policy, "pi_features_extractor", None) or policy.features_extractor
         out = policy.action_net
@@ -185,26 +217,34 @@ def _head(model, policy, head, act_space, prep, branch, spaces):
         elif isinstance(act_space, spaces.MultiDiscrete):
             nvec = [int(v) for v in act_space.nvec]
             if branch is None or not 0 <= branch < len(nvec):
-                raise InputError(f"{algo} has a MultiDiscrete action space with {len(nvec)} sub-actions, each its own "
-                                 f"decision; pick one with branch=0..{len(nvec) - 1}.")
+                raise InputError(
+                    f"{algo} has a MultiDiscrete action space with {len(nvec)} sub-actions, each its own "
+                    f"decision; pick one with branch=0..{len(nvec) - 1}."
+                )
             start = sum(nvec[:branch])
             out = torch.nn.Sequential(out, _Columns(start, start + nvec[branch]))
             names, kind = [f"action_{branch}={i}" for i in range(nvec[branch])], "actions"
         elif continuous:
             if getattr(policy, "squash_output", False):
-                raise InputError(f"{algo} with squashed (gSDE) actions is not supported; train without "
-                                 "squash_output.")
+                raise InputError(f"{algo} with squashed (gSDE) actions is not supported; train without squash_output.")
             # SB3 clips the mean to the bounds: an affine map to [-1, 1], Hardtanh, and back keeps it a module
             low, high = act_space.low, act_space.high
-            out = torch.nn.Sequential(out, _Scale(low, high, inverse=True), torch.nn.Hardtanh(), _Scale(low, high)) \
-                if np.all(np.isfinite(low)) and np.all(np.isfinite(high)) else out
+            out = (
+                torch.nn.Sequential(out, _Scale(low, high, inverse=True), torch.nn.Hardtanh(), _Scale(low, high))
+                if np.all(np.isfinite(low)) and np.all(np.isfinite(high))
+                else out
+            )
             names, kind = [f"action_{i}" for i in range(act_space.shape[0])], "continuous"
         else:
-            raise InputError(f"{algo}'s action space {act_space} is not supported; xairl explains Discrete, "
-                             "MultiDiscrete (one branch at a time) and Box actions.")
+            raise InputError(
+                f"{algo}'s action space {act_space} is not supported; xairl explains Discrete, "
+                "MultiDiscrete (one branch at a time) and Box actions."
+            )
         return kind, names, _SB3Network(prep, extractor, _ActorCritic(policy.mlp_extractor, out, critic=False))
-    raise InputError(f"unsupported SB3 policy {type(policy).__name__}: expected DQN (q_net), an actor-critic "
-                     "(action_net) or SAC/TD3/DDPG (actor).")
+    raise InputError(
+        f"unsupported SB3 policy {type(policy).__name__}: expected DQN (q_net), an actor-critic "
+        "(action_net) or SAC/TD3/DDPG (actor)."
+    )
 
 
 class _Columns(torch.nn.Module):
@@ -215,7 +255,7 @@ class _Columns(torch.nn.Module):
         self.start, self.stop = start, stop
 
     def forward(self, x):
-        return x[:, self.start:self.stop]
+        return x[:, self.start : self.stop]
 
 
 def _actor_net(policy, act_space, env_units: bool, prep=None) -> torch.nn.Module:
@@ -229,8 +269,11 @@ def _actor_net(policy, act_space, env_units: bool, prep=None) -> torch.nn.Module
     if env_units:
         layers.append(_Scale(act_space.low, act_space.high))
     head = torch.nn.Sequential(*layers)
-    return _SB3Network(prep, actor.features_extractor, head) if prep is not None else \
-        torch.nn.Sequential(actor.features_extractor, head)
+    return (
+        _SB3Network(prep, actor.features_extractor, head)
+        if prep is not None
+        else torch.nn.Sequential(actor.features_extractor, head)
+    )
 
 
 def _check(model, result: Policy, head, branch, spaces) -> None:
@@ -266,11 +309,15 @@ def _check(model, result: Policy, head, branch, spaces) -> None:
     err = float(np.abs(ours - theirs).max())
     scale = max(1.0, float(np.abs(theirs).max()))
     if not err <= 1e-5 * scale:
-        raise InputError(f"from_sb3: the explained network's outputs differ from {type(model).__name__}'s own by "
-                         f"{err:.3g} on sample states; this model's policy is built in a way xairl does not read "
-                         "(custom policy class?): wrap its forward pass yourself with xairl.Policy.")
+        raise InputError(
+            f"from_sb3: the explained network's outputs differ from {type(model).__name__}'s own by "
+            f"{err:.3g} on sample states; this model's policy is built in a way xairl does not read "
+            "(custom policy class?): wrap its forward pass yourself with xairl.Policy."
+        )
     if result.output == "actions" and branch is None:
         acts = np.asarray(model.predict(batch, deterministic=True)[0]).reshape(-1)
         if not np.array_equal(decided, acts):
-            raise InputError(f"from_sb3: the highest score is not the action {type(model).__name__}.predict takes; "
-                             "refusing to explain a different decision.")
+            raise InputError(
+                f"from_sb3: the highest score is not the action {type(model).__name__}.predict takes; "
+                "refusing to explain a different decision."
+            )

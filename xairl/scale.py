@@ -16,6 +16,7 @@ the driver from the written parts, in order.
 ``ray.init()`` starts Ray on this machine with ``workers`` CPUs (loopback only); ``address`` joins a running cluster
 (``ray://host:10001`` or ``auto``).
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -44,8 +45,15 @@ def _start(ray, address: str | None, workers: int) -> bool:
     True when started here (and so to be shut down here)."""
     if ray.is_initialized():
         return False
-    ray.init(address=address, num_cpus=None if address else workers, include_dashboard=False, log_to_driver=False,
-             logging_level="ERROR", configure_logging=False, **({} if address else {"_node_ip_address": "127.0.0.1"}))
+    ray.init(
+        address=address,
+        num_cpus=None if address else workers,
+        include_dashboard=False,
+        log_to_driver=False,
+        logging_level="ERROR",
+        configure_logging=False,
+        **({} if address else {"_node_ip_address": "127.0.0.1"}),
+    )
     return True
 
 
@@ -54,8 +62,10 @@ def _usable(ray, workers: int) -> int:
     would wait for ever); as many as its CPUs allow otherwise."""
     cpus = int(ray.cluster_resources().get("CPU", 0))
     if workers < 1 or cpus < 1:
-        raise InputError(f"the Ray engine needs at least one worker and one CPU: asked for {workers} worker(s), the "
-                         f"cluster has {cpus} CPU(s).")
+        raise InputError(
+            f"the Ray engine needs at least one worker and one CPU: asked for {workers} worker(s), the "
+            f"cluster has {cpus} CPU(s)."
+        )
     return min(workers, cpus)
 
 
@@ -78,11 +88,20 @@ def _unwrapped(ray):
 class _ChunkWorker:
     """A Ray actor: explains the chunks whose first rows it is given, each into its own part."""
 
-    def __init__(self, policy: Policy, states, background: np.ndarray, method: str, options: dict, chunk_size: int,
-                 parts: str, meta: dict, threads: int):
-        import torch
-
+    def __init__(
+        self,
+        policy: Policy,
+        states,
+        background: np.ndarray,
+        method: str,
+        options: dict,
+        chunk_size: int,
+        parts: str,
+        meta: dict,
+        threads: int,
+    ):
         import ray
+        import torch
 
         torch.set_num_threads(threads)  # one worker per core: no oversubscription
         if isinstance(states, ray.ObjectRef):  # an array in the object store, shared by the workers of a node
@@ -110,9 +129,19 @@ class _ChunkWorker:
         return {"first": batch["first"], "error": np.array(errors, dtype=object)}
 
 
-def explain_on_ray(policy: Policy, states, out: str | Path, background=None, method: str = "deep_shap",
-                   options: dict | None = None, chunk_size: int = CHUNK, resume: bool = False, workers: int = 2,
-                   address: str | None = None, progress: bool | None = None) -> RunningSummary:
+def explain_on_ray(
+    policy: Policy,
+    states,
+    out: str | Path,
+    background=None,
+    method: str = "deep_shap",
+    options: dict | None = None,
+    chunk_size: int = CHUNK,
+    resume: bool = False,
+    workers: int = 2,
+    address: str | None = None,
+    progress: bool | None = None,
+) -> RunningSummary:
     """:func:`xairl.explain_to_parquet` on Ray: the same folder, the same parts (bit for bit), ``workers`` actors.
 
     :param states: a .npy or .parquet file (each worker reads its chunks: on a cluster, a path every node can read),
@@ -138,13 +167,27 @@ def explain_on_ray(policy: Policy, states, out: str | Path, background=None, met
         if todo:
             with _unwrapped(ray):
                 ray.data.DataContext.get_current().enable_progress_bars = False
-                done = ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo)).map_batches(
-                    _ChunkWorker, batch_size=1, num_cpus=1,
-                    compute=ray.data.ActorPoolStrategy(size=_usable(ray, workers)),
-                    fn_constructor_kwargs={"policy": policy, "states": ref, "background": run.background,
-                                           "method": method, "options": run.options, "chunk_size": chunk_size,
-                                           "parts": str(run.parts), "meta": run.meta, "threads": 1},
-                ).materialize()
+                done = (
+                    ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo))
+                    .map_batches(
+                        _ChunkWorker,
+                        batch_size=1,
+                        num_cpus=1,
+                        compute=ray.data.ActorPoolStrategy(size=_usable(ray, workers)),
+                        fn_constructor_kwargs={
+                            "policy": policy,
+                            "states": ref,
+                            "background": run.background,
+                            "method": method,
+                            "options": run.options,
+                            "chunk_size": chunk_size,
+                            "parts": str(run.parts),
+                            "meta": run.meta,
+                            "threads": 1,
+                        },
+                    )
+                    .materialize()
+                )
                 failed = [row["error"] for row in done.select_columns(["error"]).take_all() if row["error"]]
             if failed:  # the chunks written so far stay: fix the states and --resume
                 raise InputError(failed[0])
@@ -175,8 +218,15 @@ class _NarrationWorker:
         return narrate(self.exp, index, narrator=self.narrator, **self.kwargs)
 
 
-def narrate_on_ray(explanation, indices=None, narrator: str = "local_lm", workers: int = 2,
-                   address: str | None = None, threads: int = 1, **kwargs) -> list:
+def narrate_on_ray(
+    explanation,
+    indices=None,
+    narrator: str = "local_lm",
+    workers: int = 2,
+    address: str | None = None,
+    threads: int = 1,
+    **kwargs,
+) -> list:
     """:func:`xairl.narrate` for many states of ``explanation`` on ``workers`` Ray actors (each loads the narrator
     once): the narratives of ``indices`` (default: every state), in their order. ``kwargs`` are
     :func:`xairl.narrate`'s (``policy``, ``background``, ``options``, ``template``, ...); ``store`` is not taken

@@ -23,14 +23,16 @@ feature-major: ``values.reshape(F, A)``), ``base_values``, ``outputs`` and ``add
 ``chosen`` and ``runner_up`` (action indices, -1 when nothing is chosen). The schema's metadata (key ``xairl``)
 holds the names, the method, its options and the policy's hash.
 """
+
 from __future__ import annotations
 
 import hashlib
 import json
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import numpy as np
 
@@ -46,8 +48,15 @@ PART = re.compile(r"part-(\d{12})\.parquet")  # a part's name: its first row
 
 
 # ---- explaining ------------------------------------------------------------------------------------------------
-def explain_chunks(policy: Policy, states, background=None, method: str = "deep_shap", options: dict | None = None,
-                   chunk_size: int = CHUNK, start: int = 0) -> Iterator[tuple[int, Explanation]]:
+def explain_chunks(
+    policy: Policy,
+    states,
+    background=None,
+    method: str = "deep_shap",
+    options: dict | None = None,
+    chunk_size: int = CHUNK,
+    start: int = 0,
+) -> Iterator[tuple[int, Explanation]]:
     """(first row, Explanation) for each chunk of ``states`` (an array or a file, see :func:`state_chunks`), in
     order; memory stays that of one chunk whatever the number of states."""
     from .attributors import explain
@@ -121,8 +130,16 @@ def check_part(path: Path, first: int, rows: int, run: str) -> tuple[str, str]:
         table = pq.read_table(path)
         meta = json.loads(table.schema.metadata[b"xairl"])
         whole = meta.pop("sha256") == _checksum(table, meta)
-    except (pa.ArrowException, OSError, KeyError, ValueError, TypeError, AttributeError, RecursionError,
-            MemoryError) as exc:
+    except (
+        pa.ArrowException,
+        OSError,
+        KeyError,
+        ValueError,
+        TypeError,
+        AttributeError,
+        RecursionError,
+        MemoryError,
+    ) as exc:
         return "bad", f"unreadable: {one_line(exc, 80)}"
     if not whole:
         return "bad", "its checksum does not match its contents"
@@ -152,19 +169,30 @@ def read_parquet(path: str | Path) -> Explanation:
     table = table.sort_by("index")
     twice = np.flatnonzero(np.diff(table.column("index").to_numpy()) == 0)
     if len(twice):  # pandas and pyarrow would read the folder with the row twice
-        raise InputError(f"{path}: row {table.column('index')[int(twice[0])]} is in two parts: a copy or another run's "
-                         "part is there (xairl explain --resume names it).")
+        raise InputError(
+            f"{path}: row {table.column('index')[int(twice[0])]} is in two parts: a copy or another run's "
+            "part is there (xairl explain --resume names it)."
+        )
     f, a = len(meta["feature_names"]), len(meta["action_names"])
 
     def rows(name: str, width: int) -> np.ndarray:
         return table.column(name).combine_chunks().flatten().to_numpy().reshape(-1, width).astype(np.float64)
 
     available = rows("available", a).astype(bool) if "available" in table.column_names else None
-    return Explanation(values=rows("values", f * a).reshape(-1, f, a), base_values=rows("base_values", a),
-                       outputs=rows("outputs", a), states=rows("state", f), feature_names=tuple(meta["feature_names"]),
-                       action_names=tuple(meta["action_names"]), method=meta["method"], options=meta["options"],
-                       output=meta["output"], observation=meta.get("observation"), available=available,
-                       categories=meta.get("categories"))
+    return Explanation(
+        values=rows("values", f * a).reshape(-1, f, a),
+        base_values=rows("base_values", a),
+        outputs=rows("outputs", a),
+        states=rows("state", f),
+        feature_names=tuple(meta["feature_names"]),
+        action_names=tuple(meta["action_names"]),
+        method=meta["method"],
+        options=meta["options"],
+        output=meta["output"],
+        observation=meta.get("observation"),
+        available=available,
+        categories=meta.get("categories"),
+    )
 
 
 @dataclass
@@ -202,53 +230,88 @@ class RunningSummary:
             return None
         parts = [e for _, e in sorted(self.sample, key=lambda p: p[0])]
         first = parts[0]
-        return Explanation(**{**first.__dict__, **{k: np.concatenate([getattr(p, k) for p in parts])
-                                                   for k in ("values", "base_values", "outputs", "states")},
-                              "available": None if first.available is None else
-                              np.concatenate([p.available for p in parts])})
+        return Explanation(
+            **{
+                **first.__dict__,
+                **{
+                    k: np.concatenate([getattr(p, k) for p in parts])
+                    for k in ("values", "base_values", "outputs", "states")
+                },
+                "available": None if first.available is None else np.concatenate([p.available for p in parts]),
+            }
+        )
 
     def to_dict(self, feature_names) -> dict:
         mean = {"chosen_score": self.abs_chosen / max(self.n, 1), "margin": self.abs_margin / max(self.n, 1)}
-        return {"states": self.n, "sampled_for_figures": len(self.sample),
-                "mean_abs_contribution": {k: dict(zip(feature_names, v.tolist())) for k, v in mean.items()}}
+        return {
+            "states": self.n,
+            "sampled_for_figures": len(self.sample),
+            "mean_abs_contribution": {k: dict(zip(feature_names, v.tolist())) for k, v in mean.items()},
+        }
 
 
 def _rows(exp: Explanation, i: int) -> Explanation:
     """State ``i`` alone, copied: a view would keep its whole chunk in memory as long as the sample holds it."""
     s = slice(i, i + 1)
-    return Explanation(**{**exp.__dict__, "values": exp.values[s].copy(), "base_values": exp.base_values[s].copy(),
-                          "outputs": exp.outputs[s].copy(), "states": exp.states[s].copy(),
-                          "available": None if exp.available is None else exp.available[s].copy()})
+    return Explanation(
+        **{
+            **exp.__dict__,
+            "values": exp.values[s].copy(),
+            "base_values": exp.base_values[s].copy(),
+            "outputs": exp.outputs[s].copy(),
+            "states": exp.states[s].copy(),
+            "available": None if exp.available is None else exp.available[s].copy(),
+        }
+    )
 
 
-def run_identity(policy: Policy, source, background: np.ndarray, method: str, options: dict, chunk_size: int
-                 ) -> dict[str, Any]:
+def run_identity(
+    policy: Policy, source, background: np.ndarray, method: str, options: dict, chunk_size: int
+) -> dict[str, Any]:
     """What makes two runs the same run (``resume`` continues only that)."""
     if isinstance(source, (str, Path)):
         stat = Path(source).stat()
         where = {"source": str(Path(source).resolve()), "source_bytes": stat.st_size, "source_mtime": stat.st_mtime}
     else:
         where = {"source": "array", "source_sha256": hashlib.sha256(np.ascontiguousarray(source).tobytes()).hexdigest()}
-    return {**where, "chunk_size": chunk_size, "method": method, "options": options, "policy": policy.name,
-            "policy_hash": model_hash(policy.module),
-            "background_sha256": hashlib.sha256(np.ascontiguousarray(background).tobytes()).hexdigest()}
+    return {
+        **where,
+        "chunk_size": chunk_size,
+        "method": method,
+        "options": options,
+        "policy": policy.name,
+        "policy_hash": model_hash(policy.module),
+        "background_sha256": hashlib.sha256(np.ascontiguousarray(background).tobytes()).hexdigest(),
+    }
 
 
-def explain_to_parquet(policy: Policy, states, out: str | Path, background=None, method: str = "deep_shap",
-                       options: dict | None = None, chunk_size: int = CHUNK, resume: bool = False,
-                       progress: bool | None = None) -> RunningSummary:
+def explain_to_parquet(
+    policy: Policy,
+    states,
+    out: str | Path,
+    background=None,
+    method: str = "deep_shap",
+    options: dict | None = None,
+    chunk_size: int = CHUNK,
+    resume: bool = False,
+    progress: bool | None = None,
+) -> RunningSummary:
     """Explain ``states`` chunk by chunk into ``out`` (layout in the module doc), with a progress bar on a terminal
     (``progress=None``: only when stderr is one). ``resume=True`` continues an interrupted run of the same
     states, policy, background, method, options and chunk size; without it, a folder that already holds a run is
     refused (nothing is overwritten)."""
-    from .display import progress
-
     from .attributors import explain
+    from .display import progress
 
     run = start_run(policy, states, out, background, method, options, chunk_size, resume)
     summary = RunningSummary()
-    bar = progress(total=count_states(states, policy), unit="states", desc=f"explaining ({method})",
-               disable=False if progress else None if progress is None else True, smoothing=0.1)
+    bar = progress(
+        total=count_states(states, policy),
+        unit="states",
+        desc=f"explaining ({method})",
+        disable=False if progress else None if progress is None else True,
+        smoothing=0.1,
+    )
     with bar:
         for first, x in state_chunks(states, policy, chunk_size):
             if first not in run.done:  # (a whole chunk from an interrupted run is not explained again)
@@ -276,8 +339,16 @@ class Run:
         return self.out / DATASET
 
 
-def start_run(policy: Policy, states, out: str | Path, background, method: str, options: dict | None,
-              chunk_size: int, resume: bool) -> Run:
+def start_run(
+    policy: Policy,
+    states,
+    out: str | Path,
+    background,
+    method: str,
+    options: dict | None,
+    chunk_size: int,
+    resume: bool,
+) -> Run:
     """Checks the folder (a new run, or the same run with ``resume``, every part it holds verified) and records the
     run in ``run.json``; shared by the local and the Ray engine."""
     from .chunks import count_rows
@@ -293,8 +364,9 @@ def start_run(policy: Policy, states, out: str | Path, background, method: str, 
         (out / DATASET).mkdir(parents=True, exist_ok=True)
         write_text(out / "run.json", json.dumps(identity, indent=2))
     except OSError as exc:
-        raise InputError(f"cannot write the run into {out} ({exc.strerror or one_line(exc)}); give a folder you can "
-                         "write to.") from None
+        raise InputError(
+            f"cannot write the run into {out} ({exc.strerror or one_line(exc)}); give a folder you can write to."
+        ) from None
     return Run(out, options, bg, identity, meta, done)
 
 
@@ -309,11 +381,18 @@ def finish_run(run: Run, summary: RunningSummary, states) -> RunningSummary:
 def part_meta(policy: Policy, method: str, options: dict, identity: dict) -> dict:
     """The metadata every part carries (key ``xairl`` of its Parquet schema; each part adds its first row, its
     number of rows and its checksum)."""
-    return {"feature_names": list(policy.feature_names), "action_names": list(policy.action_names), "method": method,
-            "options": options, "output": policy.output, "policy": policy.name, "policy_hash": identity["policy_hash"],
-            "observation": policy.observation.to_dict(),
-            "categories": {f: list(i.categories) for f, i in policy.features.items() if i.categories} or None,
-            "run": hashlib.sha256(json.dumps(identity, sort_keys=True).encode()).hexdigest()[:16]}
+    return {
+        "feature_names": list(policy.feature_names),
+        "action_names": list(policy.action_names),
+        "method": method,
+        "options": options,
+        "output": policy.output,
+        "policy": policy.name,
+        "policy_hash": identity["policy_hash"],
+        "observation": policy.observation.to_dict(),
+        "categories": {f: list(i.categories) for f, i in policy.features.items() if i.categories} or None,
+        "run": hashlib.sha256(json.dumps(identity, sort_keys=True).encode()).hexdigest()[:16],
+    }
 
 
 def _existing_run(out: Path, identity: dict, resume: bool, run: str, total) -> set[int]:
@@ -330,19 +409,30 @@ def _existing_run(out: Path, identity: dict, resume: bool, run: str, total) -> s
     if not files and not (out / "run.json").exists():
         return set()
     if not resume and (parts or (out / "run.json").exists()):
-        raise InputError(f"{out} already holds a run ({len(parts)} chunk(s) written); pass --resume to continue it, "
-                         "or give another folder.")
+        raise InputError(
+            f"{out} already holds a run ({len(parts)} chunk(s) written); pass --resume to continue it, "
+            "or give another folder."
+        )
     earlier = _record(out / "run.json")
     if earlier is not None and earlier != json.loads(json.dumps(identity)):
         changed = sorted(k for k in identity if earlier.get(k) != json.loads(json.dumps(identity))[k])
-        raise InputError(f"{out} holds another run (it differs in {', '.join(changed) or 'run.json'}); resume needs "
-                         "the same states, policy, background, method, options and chunk size.")
+        raise InputError(
+            f"{out} holds another run (it differs in {', '.join(changed) or 'run.json'}); resume needs "
+            "the same states, policy, background, method, options and chunk size."
+        )
     n, chunk = (total() if files else 0), identity["chunk_size"]
-    strays = [p for p in files if not PART.fullmatch(p.name) or int(p.name[5:17]) % chunk or int(p.name[5:17]) >= n
-              or not p.is_file()]
+    strays = [
+        p
+        for p in files
+        if not PART.fullmatch(p.name) or int(p.name[5:17]) % chunk or int(p.name[5:17]) >= n or not p.is_file()
+    ]
     if strays:
-        raise _not_ours(strays, f"no chunk of this run is named so: its chunks are part-<first row>.parquet, the "
-                        f"first rows multiples of {chunk} below {n}", folder)
+        raise _not_ours(
+            strays,
+            f"no chunk of this run is named so: its chunks are part-<first row>.parquet, the "
+            f"first rows multiples of {chunk} below {n}",
+            folder,
+        )
     done = set()
     for path in parts:
         first = int(path.name[5:17])
@@ -371,12 +461,15 @@ def _record(path: Path) -> dict | None:
     except ValueError:
         record, what = None, "not JSON"
     if not isinstance(record, dict):
-        raise InputError(f"{path}: not the record of a run ({what}); delete it and --resume again (each part is "
-                         "checked against this run), or give another folder.")
+        raise InputError(
+            f"{path}: not the record of a run ({what}); delete it and --resume again (each part is "
+            "checked against this run), or give another folder."
+        )
     return record
 
 
 def _not_ours(paths: list[Path], why: str, folder: Path) -> InputError:
     more = f" ({len(paths) - 1} more file(s) there are not parts of this run either)" if len(paths) > 1 else ""
-    return InputError(f"{paths[0]}: not a part of this run ({why}); delete it or move it out of {folder} and run "
-                      f"again{more}.")
+    return InputError(
+        f"{paths[0]}: not a part of this run ({why}); delete it or move it out of {folder} and run again{more}."
+    )

@@ -1,4 +1,5 @@
 """A tiny, deterministic example policy, so the CLI and the tests have something to explain without any plugin."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -13,8 +14,9 @@ ACTIONS = ("forward", "turn", "recharge")
 def toy_network(seed: int = 0) -> torch.nn.Module:
     """A 5-16-16-3 ReLU MLP with weights drawn from a seeded generator (no global RNG touched)."""
     gen = torch.Generator().manual_seed(seed)
-    net = torch.nn.Sequential(torch.nn.Linear(5, 16), torch.nn.ReLU(), torch.nn.Linear(16, 16), torch.nn.ReLU(),
-                              torch.nn.Linear(16, 3))
+    net = torch.nn.Sequential(
+        torch.nn.Linear(5, 16), torch.nn.ReLU(), torch.nn.Linear(16, 16), torch.nn.ReLU(), torch.nn.Linear(16, 3)
+    )
     with torch.no_grad():
         for p in net.parameters():
             p.copy_(torch.randn(p.shape, generator=gen) * 0.5)
@@ -30,8 +32,10 @@ def toy_policy() -> Policy:
         toy_network(),
         FEATURES,
         ACTIONS,
-        features={"battery": FeatureInfo("", "battery charge (standardised)", "nearly empty", "full"),
-                  "distance": FeatureInfo("", "distance to the goal (standardised)", "close", "far")},
+        features={
+            "battery": FeatureInfo("", "battery charge (standardised)", "nearly empty", "full"),
+            "distance": FeatureInfo("", "distance to the goal (standardised)", "close", "far"),
+        },
         background_sampler=toy_background,
         name="toy",
     )

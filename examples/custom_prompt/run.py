@@ -2,6 +2,7 @@
 
 Run: python examples/custom_prompt/run.py
 """
+
 from pathlib import Path
 
 import xairl

@@ -1,4 +1,5 @@
 """Attribution methods behind one interface; :func:`explain` is the entry point."""
+
 from __future__ import annotations
 
 from ..explanation import Explanation

@@ -2,6 +2,7 @@
 
 Subclasses implement :meth:`Attributor._attribute` only (the public/private split of SB3's predict/_predict).
 """
+
 from __future__ import annotations
 
 from typing import Any, ClassVar
@@ -44,17 +45,21 @@ class Attributor:
         even when attribution fails.
         """
         if not isinstance(policy, Policy):
-            raise InputError(f"expected an xairl.Policy, got {type(policy).__name__}; wrap a network with "
-                             "xairl.Policy(module, feature_names, action_names).")
+            raise InputError(
+                f"expected an xairl.Policy, got {type(policy).__name__}; wrap a network with "
+                "xairl.Policy(module, feature_names, action_names)."
+            )
         x = policy.check_states(states)
         bg = policy.background() if background is None else policy.check_states(background, "background")
         outputs = policy.scores(x)
         bad = ~np.isfinite(outputs).all(axis=1)
         if bad.any():
             kind = np.dtype(policy.dtype)
-            raise InputError(f"the policy's outputs are NaN or infinite for {int(bad.sum())} state(s), first state "
-                             f"{int(np.argmax(bad))}: nothing can be explained; check the states' scale (a "
-                             f"{kind.name} network overflows beyond ~{np.finfo(kind).max:.0e}).")
+            raise InputError(
+                f"the policy's outputs are NaN or infinite for {int(bad.sum())} state(s), first state "
+                f"{int(np.argmax(bad))}: nothing can be explained; check the states' scale (a "
+                f"{kind.name} network overflows beyond ~{np.finfo(kind).max:.0e})."
+            )
         module = policy.network
         was_training = policy.module.training  # the user's flag; the wrapper's own means nothing
         module.eval()
@@ -99,7 +104,8 @@ class Attributor:
         if not gap <= self.tolerance * scale:  # NaN is refused too
             raise UnsupportedModelError(
                 f"{self.name} contributions do not add up to the output (gap {gap:.3g}, {what} {scale:.3g}, "
-                f"tolerance {self.tolerance:g} of it): {self.gap_reason}; otherwise {alternatives(policy, self.name)}")
+                f"tolerance {self.tolerance:g} of it): {self.gap_reason}; otherwise {alternatives(policy, self.name)}"
+            )
 
     def _attribute(self, policy: Policy, x: np.ndarray, bg: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
         """The subclass's method: contributions of ``x`` (n, f) against ``bg`` (m, f), module already in eval mode.
@@ -117,7 +123,7 @@ class Attributor:
     def _forward(policy: Policy, rows: torch.Tensor, chunk: int) -> torch.Tensor:
         """Scores of many rows in chunks, without gradients (float64 on the CPU)."""
         with torch.no_grad():
-            parts = [policy.network(rows[i:i + chunk]).double().cpu() for i in range(0, len(rows), chunk)]
+            parts = [policy.network(rows[i : i + chunk]).double().cpu() for i in range(0, len(rows), chunk)]
         return torch.cat(parts)
 
 

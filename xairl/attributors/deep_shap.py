@@ -15,6 +15,7 @@ networks whose calls depend on their input. A pure Sequential MLP on flat states
 (:func:`chain_multipliers`). What is left is the work no exact method skips, a backward pass per output and pair:
 ``benchmarks/bench_cnn.py`` times that floor.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -28,14 +29,56 @@ from .base import Attributor, Options, alternatives
 
 nn = torch.nn
 #: layers whose gradient already is the DeepLIFT multiplier (linear in eval mode)
-LINEAR = (nn.Linear, nn.Identity, nn.Flatten, nn.Unflatten, nn.Dropout, nn.Dropout1d, nn.Dropout2d, nn.Dropout3d,
-          nn.AlphaDropout, nn.BatchNorm1d, nn.BatchNorm2d, nn.BatchNorm3d, nn.Conv1d, nn.Conv2d, nn.Conv3d,
-          nn.ConvTranspose1d, nn.ConvTranspose2d, nn.ConvTranspose3d, nn.AvgPool1d, nn.AvgPool2d, nn.AvgPool3d,
-          nn.AdaptiveAvgPool1d, nn.AdaptiveAvgPool2d, nn.AdaptiveAvgPool3d, nn.ZeroPad1d, nn.ZeroPad2d,
-          nn.ZeroPad3d, nn.ConstantPad1d, nn.ConstantPad2d, nn.ConstantPad3d)
+LINEAR = (
+    nn.Linear,
+    nn.Identity,
+    nn.Flatten,
+    nn.Unflatten,
+    nn.Dropout,
+    nn.Dropout1d,
+    nn.Dropout2d,
+    nn.Dropout3d,
+    nn.AlphaDropout,
+    nn.BatchNorm1d,
+    nn.BatchNorm2d,
+    nn.BatchNorm3d,
+    nn.Conv1d,
+    nn.Conv2d,
+    nn.Conv3d,
+    nn.ConvTranspose1d,
+    nn.ConvTranspose2d,
+    nn.ConvTranspose3d,
+    nn.AvgPool1d,
+    nn.AvgPool2d,
+    nn.AvgPool3d,
+    nn.AdaptiveAvgPool1d,
+    nn.AdaptiveAvgPool2d,
+    nn.AdaptiveAvgPool3d,
+    nn.ZeroPad1d,
+    nn.ZeroPad2d,
+    nn.ZeroPad3d,
+    nn.ConstantPad1d,
+    nn.ConstantPad2d,
+    nn.ConstantPad3d,
+)
 #: elementwise nonlinearities handled with the rescale rule
-NONLINEAR = (nn.ReLU, nn.LeakyReLU, nn.ELU, nn.SiLU, nn.GELU, nn.Tanh, nn.Sigmoid, nn.Softplus, nn.ReLU6,
-             nn.Hardtanh, nn.SELU, nn.CELU, nn.Mish, nn.Softsign, nn.Tanhshrink)
+NONLINEAR = (
+    nn.ReLU,
+    nn.LeakyReLU,
+    nn.ELU,
+    nn.SiLU,
+    nn.GELU,
+    nn.Tanh,
+    nn.Sigmoid,
+    nn.Softplus,
+    nn.ReLU6,
+    nn.Hardtanh,
+    nn.SELU,
+    nn.CELU,
+    nn.Mish,
+    nn.Softsign,
+    nn.Tanhshrink,
+)
 #: the rescale rule per element, as shap applies it; additive only as the network's final layer (checked)
 SOFTMAX = (nn.Softmax, nn.LogSoftmax)
 MAXPOOL = (nn.MaxPool1d, nn.MaxPool2d, nn.MaxPool3d)
@@ -124,9 +167,15 @@ class _Rule(torch.autograd.Function):
         xi, xo, ri, ro = ctx.saved_tensors
         if not ctx.joint:
             return ctx.rule(ctx.layer, xi, xo, ri, ro, g, g), None, None, None, None, None
-        gx, gr = g[:len(xi)], g[len(xi):]
-        return (torch.cat([ctx.rule(ctx.layer, xi, xo, ri, ro, gx, gr), ctx.rule(ctx.layer, ri, ro, xi, xo, gr, gx)]),
-                None, None, None, None, None)
+        gx, gr = g[: len(xi)], g[len(xi) :]
+        return (
+            torch.cat([ctx.rule(ctx.layer, xi, xo, ri, ro, gx, gr), ctx.rule(ctx.layer, ri, ro, xi, xo, gr, gx)]),
+            None,
+            None,
+            None,
+            None,
+            None,
+        )
 
 
 @contextlib.contextmanager
@@ -142,9 +191,11 @@ def _hooked(rules, make_hook):
 
 def _recorder(calls: list):
     """A forward hook that records (layer, input, output) of each call, in call order."""
+
     def hook(module, inputs, output):
         if isinstance(output, torch.Tensor) and inputs and isinstance(inputs[0], torch.Tensor):
             calls.append((module, inputs[0].detach(), output.detach()))
+
     return hook
 
 
@@ -157,6 +208,7 @@ def _hook(rule, calls=None, m: int = 0):
     """The forward hook of one nonlinear layer. With ``calls`` (the reference side's (input, output) of each call,
     recorded on the background in call order; consumed) and ``m`` (how many states the batch pairs with the
     background), the split layout; else the joint one."""
+
     def hook(module, inputs, output):
         if not isinstance(output, torch.Tensor) or not inputs or not isinstance(inputs[0], torch.Tensor):
             return None
@@ -167,6 +219,7 @@ def _hook(rule, calls=None, m: int = 0):
         _, ri, ro = calls.pop(0)
         ri, ro = (t.unsqueeze(0).expand(m, *t.shape).reshape(m * t.shape[0], *t.shape[1:]) for t in (ri, ro))
         return _Rule.apply(inputs[0], output, ri, ro, module, rule)
+
     return hook
 
 
@@ -183,8 +236,9 @@ def check_supported(module: torch.nn.Module, suggest: str = "") -> list[tuple[to
             rules.append((sub, _rescale))
         elif isinstance(sub, MAXPOOL):
             if sub.return_indices:
-                raise UnsupportedModelError(f"deep_shap does not support '{name}' (MaxPool with return_indices); "
-                                            f"{suggest}")
+                raise UnsupportedModelError(
+                    f"deep_shap does not support '{name}' (MaxPool with return_indices); {suggest}"
+                )
             rules.append((sub, _maxpool))
         elif isinstance(sub, LINEAR + CONTAINERS) or getattr(sub, "xairl_linear", False):
             continue  # a module may declare itself linear (an affine map, a reshape): its gradient is its multiplier
@@ -202,8 +256,12 @@ def _only_child(policy, x: np.ndarray) -> torch.nn.Module:
     if isinstance(module, torch.nn.Sequential):
         return module
     children = list(module.children())
-    if len(children) != 1 or not isinstance(children[0], torch.nn.Sequential) or \
-            any(True for _ in module.parameters(recurse=False)) or any(True for _ in module.buffers(recurse=False)):
+    if (
+        len(children) != 1
+        or not isinstance(children[0], torch.nn.Sequential)
+        or any(True for _ in module.parameters(recurse=False))
+        or any(True for _ in module.buffers(recurse=False))
+    ):
         return module
     t = torch.as_tensor(x[:256], device=policy.device)
     with torch.no_grad():
@@ -222,8 +280,9 @@ def chain(module: torch.nn.Module) -> list[torch.nn.Module] | None:
             if inner is None:
                 return None
             out += inner
-        elif isinstance(layer, (torch.nn.Linear, torch.nn.BatchNorm1d, torch.nn.Identity, torch.nn.Dropout,
-                                torch.nn.AlphaDropout)) or isinstance(layer, NONLINEAR):
+        elif isinstance(
+            layer, (torch.nn.Linear, torch.nn.BatchNorm1d, torch.nn.Identity, torch.nn.Dropout, torch.nn.AlphaDropout)
+        ) or isinstance(layer, NONLINEAR):
             out.append(layer)
         else:
             return None
@@ -254,8 +313,9 @@ def chain_multipliers(layers, xs: torch.Tensor, bg: torch.Tensor) -> tuple[torch
                 steps.append(("matmul", layer.weight))
                 hx, hr = layer(hx), layer(hr)
             elif isinstance(layer, torch.nn.BatchNorm1d):  # eval mode: an affine map per feature
-                steps.append(("scale", (layer.weight if layer.affine else 1.0)
-                              / torch.sqrt(layer.running_var + layer.eps)))
+                steps.append(
+                    ("scale", (layer.weight if layer.affine else 1.0) / torch.sqrt(layer.running_var + layer.eps))
+                )
                 hx, hr = layer(hx), layer(hr)
         mult = torch.eye(hx.shape[1], dtype=hx.dtype, device=hx.device)[None]  # (1, actions, width)
         for kind, t in reversed(steps):
@@ -269,9 +329,11 @@ class DeepShap(Attributor):
     name = "deep_shap"
     Options = DeepShapOptions
     tolerance = 1e-5  # float32 rounding stays near 1e-6 of the output scale on the networks we test
-    gap_reason = ("the network computes something deep_shap cannot see: a functional nonlinearity (torch.tanh, "
-                  "F.relu, ...), a product of two activations, or a softmax before the last layer; make such "
-                  "operations nn modules")
+    gap_reason = (
+        "the network computes something deep_shap cannot see: a functional nonlinearity (torch.tanh, "
+        "F.relu, ...), a product of two activations, or a softmax before the last layer; make such "
+        "operations nn modules"
+    )
 
     def _attribute(self, policy, x, bg):
         layers = chain(_only_child(policy, x)) if policy.observation.kind == "flat" else None
@@ -293,14 +355,14 @@ class DeepShap(Attributor):
         the rows are ``[state sides; reference sides]``."""
         n, f = xt.shape
         b = len(bt)
-        per = max(1, min(self.options.max_pairs, max(1, 2 ** 22 // f)) // b)  # bounds the batch
+        per = max(1, min(self.options.max_pairs, max(1, 2**22 // f)) // b)  # bounds the batch
         values = np.empty((n, f, a))
         calls: list = []
         if split:
             with _hooked(rules, lambda rule: _recorder(calls)), torch.no_grad():
                 base = module(bt).double().mean(dim=0).cpu().numpy()
         for s in range(0, n, per):
-            xs = xt[s:s + per]
+            xs = xt[s : s + per]
             m = len(xs)
             xp = xs[:, None, :].expand(m, b, f).reshape(m * b, f)
             rp = bt[None, :, :].expand(m, b, f).reshape(m * b, f)
@@ -311,12 +373,12 @@ class DeepShap(Attributor):
             if queue:
                 raise _Mismatch()
             if not split:
-                base = out[m * b:].detach().double().mean(dim=0).cpu().numpy()
+                base = out[m * b :].detach().double().mean(dim=0).cpu().numpy()
             delta = (xp - rp).reshape(m, b, f)
             for j in range(a):
                 grad = torch.autograd.grad(out[:, j].sum(), rows, retain_graph=j + 1 < a)[0]
                 contrib = (grad[: m * b].reshape(m, b, f) * delta).mean(dim=1).double()
-                values[s:s + m, :, j] = contrib.cpu().numpy()
+                values[s : s + m, :, j] = contrib.cpu().numpy()
         return values, base, {}
 
     def _attribute_chain(self, policy, layers, x, bg):
@@ -327,17 +389,17 @@ class DeepShap(Attributor):
         widest = max([f] + [getattr(layer, "out_features", 0) for layer in layers])
         # ~4 MB of multipliers per batch: they stay in the CPU's cache (3x faster than 64 MB batches on 2 cores,
         # with half the peak memory; benchmarks/bench_stream.py)
-        per = max(1, min(self.options.max_pairs, 2 ** 20 // (a * widest)) // b)
+        per = max(1, min(self.options.max_pairs, 2**20 // (a * widest)) // b)
         values = np.empty((n, f, a))
         outputs = np.empty((n, a))
         base = None
         for s in range(0, n, per):
-            xs = xt[s:s + per]
+            xs = xt[s : s + per]
             m = len(xs)
             mult, ox, orr = chain_multipliers(layers, xs, bt)
             delta = (xs[:, None, :] - bt[None, :, :]).reshape(m * b, 1, f)
             contrib = (mult * delta).reshape(m, b, a, f).mean(dim=1).double()
-            values[s:s + m] = contrib.transpose(1, 2).cpu().numpy()
-            outputs[s:s + m] = ox.double().cpu().numpy()
+            values[s : s + m] = contrib.transpose(1, 2).cpu().numpy()
+            outputs[s : s + m] = ox.double().cpu().numpy()
             base = orr.double().mean(dim=0).cpu().numpy()
         return values, base, {}

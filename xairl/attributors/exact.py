@@ -3,6 +3,7 @@
 v(S) = mean over background r of f(x_S, r_rest). phi_i = sum over S without i of |S|!(F-|S|-1)!/F! (v(S+i) - v(S)).
 All 2^F coalitions are evaluated in batched forwards, so this serves as ground truth up to 16 features.
 """
+
 from __future__ import annotations
 
 from math import factorial
@@ -22,7 +23,7 @@ class ExactOptions(Options):
 
 def coalition_weights(f: int) -> tuple[np.ndarray, np.ndarray]:
     """Masks (2^f, f) as booleans, bit j = feature j, and the Shapley weight of each coalition size 0..f-1."""
-    ids = np.arange(2 ** f)
+    ids = np.arange(2**f)
     masks = ((ids[:, None] >> np.arange(f)) & 1).astype(bool)
     weights = np.array([factorial(s) * factorial(f - s - 1) / factorial(f) for s in range(f)])
     return masks, weights
@@ -37,8 +38,10 @@ class Exact(Attributor):
     def _attribute(self, policy, x, bg):
         n, f = x.shape
         if f > MAX_FEATURES:
-            raise InputError(f"exact enumerates 2^{f} coalitions; {f} features is more than {MAX_FEATURES}: "
-                             "use method='deep_shap' or 'kernel_shap'.")
+            raise InputError(
+                f"exact enumerates 2^{f} coalitions; {f} features is more than {MAX_FEATURES}: "
+                "use method='deep_shap' or 'kernel_shap'."
+            )
         masks, weights = coalition_weights(f)
         dev = policy.device
         mt = torch.as_tensor(masks, device=dev)[:, None, :]

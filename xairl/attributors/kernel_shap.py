@@ -1,4 +1,5 @@
 """KernelSHAP through shap.KernelExplainer: model-agnostic, sampled coalitions, seeded."""
+
 from __future__ import annotations
 
 from typing import Annotated, Literal
@@ -13,10 +14,12 @@ from .base import Attributor, Options
 
 class KernelShapOptions(Options):
     nsamples: Annotated[int, Field(ge=1, le=10_000_000)] | Literal["auto"] = Field(
-        "auto", description="coalitions evaluated per state; 'auto' = 2F + 2048")
-    l1_reg: bool | float | Literal["auto", "aic", "bic"] | Annotated[str, Field(pattern=r"^num_features\(\d+\)$")] = \
+        "auto", description="coalitions evaluated per state; 'auto' = 2F + 2048"
+    )
+    l1_reg: bool | float | Literal["auto", "aic", "bic"] | Annotated[str, Field(pattern=r"^num_features\(\d+\)$")] = (
         Field(False, description="shap's feature selection; False keeps every feature")
-    seed: int = Field(0, ge=0, le=2 ** 32 - 1, description="seed of the coalition sampler")
+    )
+    seed: int = Field(0, ge=0, le=2**32 - 1, description="seed of the coalition sampler")
 
 
 class KernelShap(Attributor):

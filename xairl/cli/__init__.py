@@ -3,13 +3,14 @@
 Only argparse and the plugin registry are imported here; torch and shap load inside the commands that need them.
 ``args`` holds the argument types shared by the commands, ``explain`` the biggest command with its four outputs.
 """
+
 from __future__ import annotations
 
 import argparse
 import json
 import os
 import sys
-from typing import Sequence
+from collections.abc import Sequence
 
 from .. import plugins
 from ..errors import InputError, XairlError
@@ -46,8 +47,9 @@ def cmd_attributors(args) -> int:
     for row in rows:
         print(f"{row['name']}  ({row['plugin']}): {row['description']}")
         for key, spec in row["options"].get("properties", {}).items():
-            kind = spec.get("type") or "|".join(str(a.get("type", a.get("const", a.get("enum", "?"))))
-                                                for a in spec.get("anyOf", []))
+            kind = spec.get("type") or "|".join(
+                str(a.get("type", a.get("const", a.get("enum", "?")))) for a in spec.get("anyOf", [])
+            )
             if "enum" in spec:
                 kind = "|".join(spec["enum"])
             print(f"    -o {key}=  {kind}, default {spec.get('default')!r}: {spec.get('description', '')}")
@@ -61,10 +63,19 @@ def cmd_report(args) -> int:
 
     report = plugins.registry("report").load(args.plugin)(parse_options(args.option))
     method_options = plugins.get_attributor(args.method)(parse_options(args.method_option)).options.model_dump()
-    req = ReportRequest(out=Path(args.out), method=args.method, options=method_options, narrate=args.narrate,
-                        narrator=args.narrator, narrator_options=parse_options(args.narrator_option),
-                        template=args.template, prompt_dirs=args.prompts, seed=args.seed, n_states=args.n,
-                        robustness=not args.no_robustness)
+    req = ReportRequest(
+        out=Path(args.out),
+        method=args.method,
+        options=method_options,
+        narrate=args.narrate,
+        narrator=args.narrator,
+        narrator_options=parse_options(args.narrator_option),
+        template=args.template,
+        prompt_dirs=args.prompts,
+        seed=args.seed,
+        n_states=args.n,
+        robustness=not args.no_robustness,
+    )
     make_dir(req.out)  # one line, before any work, where the folder cannot be made (--out /proc/x)
     path = write_report(req, report.build(req))
     print(f"report: {path.resolve()}")
@@ -80,7 +91,9 @@ def cmd_prompts(args) -> int:
             print(f"{name:<18} {tpl.spec.kind:<9} {path}\n    {tpl.spec.description}")
         return 0
     if not args.target:
-        raise InputError(f"`xairl prompts {args.action}` needs a template {'name' if args.action == 'show' else 'path'}.")
+        raise InputError(
+            f"`xairl prompts {args.action}` needs a template {'name' if args.action == 'show' else 'path'}."
+        )
     if args.action == "show":
         tpl = prompts.load(args.target, args.prompts)
         print(f"# {tpl.path}")
@@ -106,8 +119,10 @@ def cmd_verify(args) -> int:
         with open(args.explanation, "rb") as fh:
             raw = fh.read()
     except OSError as exc:
-        raise InputError(f"cannot read --explanation {args.explanation}: {exc.strerror}; give the JSON that "
-                         f"Explanation.to_json() writes.") from None
+        raise InputError(
+            f"cannot read --explanation {args.explanation}: {exc.strerror}; give the JSON that "
+            f"Explanation.to_json() writes."
+        ) from None
     try:
         exp = Explanation.from_json(raw)
     except InputError as exc:
@@ -126,8 +141,10 @@ def cmd_verify(args) -> int:
 
         fired = sorted({c.rule for c in result.claims if c.rule in BY_ID})
         print("rules:" if fired else "rules: none fired", *(f"  {r}: {BY_ID[r].reads}" for r in fired), sep="\n")
-    print(f"accurate: {'yes' if result.accurate else 'no'}; ok: {'yes' if result.ok else 'no'} "
-          f"(coverage {result.coverage:.0%}){'; ' + result.note if result.note else ''}")
+    print(
+        f"accurate: {'yes' if result.accurate else 'no'}; ok: {'yes' if result.ok else 'no'} "
+        f"(coverage {result.coverage:.0%}){'; ' + result.note if result.note else ''}"
+    )
     return 0 if result.accurate else 1
 
 
@@ -151,8 +168,10 @@ def cmd_review(args) -> int:
     print(f"{len(pending)} narrative(s) to review in {store.path}")
     for r in pending:
         bad = [c for c in r.claims if c["status"] != "verified"]
-        print(f"\n#{r.id} [{r.template}, {r.source}, confidence {r.confidence:.2f}, "
-              f"{'verified' if r.verified else f'{len(bad)} unverified claim(s)'}]")
+        print(
+            f"\n#{r.id} [{r.template}, {r.source}, confidence {r.confidence:.2f}, "
+            f"{'verified' if r.verified else f'{len(bad)} unverified claim(s)'}]"
+        )
         marked = (r.evidence or {}).get("sentences") or []
         print("\n".join(f"    {MARKS.get(st, st):<13} {t}" for t, st in marked) or f"    {r.text}")
         while True:
@@ -242,8 +261,12 @@ def version_line() -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = Parser(prog="xairl", description="Explain what a reinforcement-learning policy decided and why.",
-                    epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = Parser(
+        prog="xairl",
+        description="Explain what a reinforcement-learning policy decided and why.",
+        epilog=EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     parser.add_argument("--version", action="version", version=version_line())
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     p = sub.add_parser("plugins", help="list installed plugins and what each registers")
@@ -258,21 +281,28 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("target", nargs="?", help="template name (show) or .yaml path (check)")
     p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder")
     p.set_defaults(run=cmd_prompts)
-    p = _command(sub, "verify", help="check a text's claims against an explanation (exit 1 when one is "
-                       "contradicted)")
+    p = _command(sub, "verify", help="check a text's claims against an explanation (exit 1 when one is contradicted)")
     p.add_argument("text", help="the text to check, or - to read it from standard input")
-    p.add_argument("--explanation", required=True, metavar="FILE", help="the explanation, as Explanation.to_json() "
-                   "writes it")
+    p.add_argument(
+        "--explanation", required=True, metavar="FILE", help="the explanation, as Explanation.to_json() writes it"
+    )
     p.add_argument("--index", type=count(0), default=0, help="which state of the explanation the text is about")
     p.add_argument("--trace", action="store_true", help="every claim: status, kind, words, rule, reason")
     p.set_defaults(run=cmd_verify)
-    p = _command(sub, "review", help="accept, reject or correct recorded narratives in the terminal, or in a local "
-                       "web page with the evidence (--serve)")
+    p = _command(
+        sub,
+        "review",
+        help="accept, reject or correct recorded narratives in the terminal, or in a local "
+        "web page with the evidence (--serve)",
+    )
     p.add_argument("--db", type=new_file, default=None, help="feedback store (default: in the user dir)")
     p.add_argument("--serve", action="store_true", help="serve the review page on http://127.0.0.1:PORT/")
-    p.add_argument("--port", type=count(0, 65535), default=8765, help="port of the review page (default 8765; 0: "
-                   "any free port)")
-    p.add_argument("--export", type=new_file, metavar="FILE", help="write the corrections as JSON lines instead of reviewing")
+    p.add_argument(
+        "--port", type=count(0, 65535), default=8765, help="port of the review page (default 8765; 0: any free port)"
+    )
+    p.add_argument(
+        "--export", type=new_file, metavar="FILE", help="write the corrections as JSON lines instead of reviewing"
+    )
     p.set_defaults(run=cmd_review)
     commands = plugins.registry("command")
     for name in commands.names():
@@ -283,14 +313,26 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _report_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument("--plugin", required=True, help="the report's name (see `xairl plugins`), e.g. uav-handover")
-    p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",
-                   help="an option of the plugin's report, validated against its schema (e.g. -o real=PATH)")
+    p.add_argument(
+        "-o",
+        "--option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="an option of the plugin's report, validated against its schema (e.g. -o real=PATH)",
+    )
     p.add_argument("--out", type=out_dir, default="xairl-report", help="report folder (default xairl-report)")
     p.add_argument("--n", type=count(1, 1_000_000), default=500, help="states explained per dataset")
-    p.add_argument("--seed", type=count(0, 2 ** 32 - 1), default=0, help="seed of everything the report samples")
+    p.add_argument("--seed", type=count(0, 2**32 - 1), default=0, help="seed of everything the report samples")
     p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
-    p.add_argument("-m", "--method-option", action="append", default=[], metavar="KEY=VALUE",
-                   help="an option of the attribution method; repeatable")
+    p.add_argument(
+        "-m",
+        "--method-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="an option of the attribution method; repeatable",
+    )
     narration_arguments(p)
     p.set_defaults(run=cmd_report)
 
@@ -312,6 +354,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as exc:  # a bug of ours or a plugin's: one line, the traceback only on request
         if os.environ.get("XAIRL_DEBUG"):
             raise
-        print(f"xairl: internal error: {type(exc).__name__}: {exc} (set XAIRL_DEBUG=1 for the traceback; please "
-              "report it)", file=sys.stderr)
+        print(
+            f"xairl: internal error: {type(exc).__name__}: {exc} (set XAIRL_DEBUG=1 for the traceback; please "
+            "report it)",
+            file=sys.stderr,
+        )
         return 1

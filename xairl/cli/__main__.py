@@ -1,4 +1,5 @@
 """``python -m xairl.cli``: the ``xairl`` command."""
+
 import sys
 
 from . import main

@@ -1,10 +1,11 @@
 """The command line's argument types and shared arguments: numbers in a range, paths checked before anything runs,
 ``key=value`` options, and argparse errors as one line (exit status 2 through :func:`xairl.cli.main`)."""
+
 from __future__ import annotations
 
 import argparse
 import json
-from typing import Sequence
+from collections.abc import Sequence
 
 from ..errors import InputError
 
@@ -18,6 +19,7 @@ class Parser(argparse.ArgumentParser):
 
 def count(low: int, high: int | None = None):
     """An argparse type: an integer in ``low..high``."""
+
     def parse(text: str) -> int:
         try:
             value = int(text)
@@ -38,6 +40,7 @@ def _short(text: str, limit: int = 80) -> str:
 
 def _path(check):
     """An argparse type from ``check(path) -> problem or None``; a path the system refuses is a problem too."""
+
     def parse(text: str) -> str:
         from pathlib import Path
 
@@ -85,8 +88,9 @@ def make_dir(path: str, what: str = "--out"):
         with tempfile.TemporaryFile(dir=path):
             pass
     except OSError as exc:
-        raise InputError(f"{what} {_short(str(path))}: cannot write there ({exc.strerror or exc}); give a folder you "
-                         "can write to.") from None
+        raise InputError(
+            f"{what} {_short(str(path))}: cannot write there ({exc.strerror or exc}); give a folder you can write to."
+        ) from None
     return Path(path)
 
 
@@ -108,11 +112,23 @@ def narration_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--narrate", action="store_true", help="explain decisions in words, checked against the numbers")
     p.add_argument("--narrator", default="template", help="template (default), local_lm, or a plugin's narrator")
     p.add_argument("--template", default=None, help="template name or .yaml path (default explain_action)")
-    p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder, searched first")
-    p.add_argument("-n", "--narrator-option", action="append", default=[], metavar="KEY=VALUE",
-                   help="a narrator option, e.g. -n mode=rewrite or -n model=PATH")
-    p.add_argument("--no-robustness", action="store_true", help="confidence without the agreement and stability "
-                   "components (saves three extra explanations per narrated state)")
+    p.add_argument(
+        "--prompts", action="append", default=[], metavar="DIR", help="extra template folder, searched first"
+    )
+    p.add_argument(
+        "-n",
+        "--narrator-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="a narrator option, e.g. -n mode=rewrite or -n model=PATH",
+    )
+    p.add_argument(
+        "--no-robustness",
+        action="store_true",
+        help="confidence without the agreement and stability "
+        "components (saves three extra explanations per narrated state)",
+    )
 
 
 #: how each sentence's status is shown: an unchecked sentence is said to be unchecked, never passed as verified

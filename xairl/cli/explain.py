@@ -2,6 +2,7 @@
 narrated, written as a report (``--out``), or streamed chunk by chunk into Parquet (``--format parquet``, and
 ``--out`` alone above STREAM_ABOVE states: what an operator explaining a large log needs, memory bounded, a progress
 bar, resumable)."""
+
 from __future__ import annotations
 
 import argparse
@@ -10,7 +11,6 @@ import json
 from .. import plugins
 from ..errors import InputError
 from .args import MARKS, count, make_dir, narration_arguments, new_file, out_dir, parse_options
-
 
 #: above this many states, ``--out DIR`` without a --format streams them into DIR/explanations.parquet (200,000 toy
 #: states as one JSON-lines file: 207 MB built in memory, 1.18 GB peak RSS, written at the end with no progress bar;
@@ -38,8 +38,11 @@ def cmd_explain(args) -> int:
         states = read_states(args.states, policy.feature_names, policy.observation)
     elif not args.states:
         states = policy.background(args.n, seed=args.seed + 1)
-    bg = read_states(args.background, policy.feature_names, policy.observation, "background") if args.background else \
-        policy.background(args.background_size, seed=args.seed)
+    bg = (
+        read_states(args.background, policy.feature_names, policy.observation, "background")
+        if args.background
+        else policy.background(args.background_size, seed=args.seed)
+    )
     if args.format == "parquet":
         return _stream(args, policy, args.states or states, bg, options.model_dump())
     exp = explain(policy, states, background=bg, method=args.method, options=options.model_dump())
@@ -77,9 +80,12 @@ def _choose_format(args, policy):
     if n > STREAM_ABOVE or args.resume or args.engine == "ray":
         args.format = "parquet"
     if n > STREAM_ABOVE:
-        print(f"xairl: {n} states: streaming them into {Path(args.out) / 'explanations.parquet'} chunk by chunk, as "
-              f"--format parquet does (resumable with --resume); --format jsonl writes one explanations.jsonl "
-              f"instead, in memory.", file=sys.stderr)
+        print(
+            f"xairl: {n} states: streaming them into {Path(args.out) / 'explanations.parquet'} chunk by chunk, as "
+            f"--format parquet does (resumable with --resume); --format jsonl writes one explanations.jsonl "
+            f"instead, in memory.",
+            file=sys.stderr,
+        )
     return states
 
 
@@ -90,14 +96,20 @@ def _print_table(exp, top: int, view: str) -> int:
 
     decides = exp.output == "actions"
     if exp.decides:
-        print("contributions to the margin: score(chosen) - score(runner-up)" if view == "margin" else
-              "contributions to the chosen action's score")
+        print(
+            "contributions to the margin: score(chosen) - score(runner-up)"
+            if view == "margin"
+            else "contributions to the chosen action's score"
+        )
     values, expected, value = exp.contributions(view)
     for i, rec in enumerate(exp.records()):
         scores = ", ".join(f"{a}={v:.3f}" for a, v in rec.scores.items())
-        print(f"state {i}: chose {rec.chosen} (runner-up {rec.runner_up}); scores {scores}" if decides else
-              f"state {i}: {exp.output} {scores}")
-        for a in ([int(exp.chosen[i])] if decides else range(exp.values.shape[2])):
+        print(
+            f"state {i}: chose {rec.chosen} (runner-up {rec.runner_up}); scores {scores}"
+            if decides
+            else f"state {i}: {exp.output} {scores}"
+        )
+        for a in [int(exp.chosen[i])] if decides else range(exp.values.shape[2]):
             contrib = values[i] if decides else exp.values[i, :, a]
             if not decides:
                 print(f"  {exp.action_names[a]}:")
@@ -106,7 +118,9 @@ def _print_table(exp, top: int, view: str) -> int:
             if exp.decides and view == "margin":
                 print(f"    expected margin {expected[i]:.4f} -> margin {value[i]:.4f} ({exp.method})")
             else:
-                print(f"    base {exp.base_values[i, a]:.4f}, additivity gap {exp.additivity_gap[i, a]:.2e} ({exp.method})")
+                print(
+                    f"    base {exp.base_values[i, a]:.4f}, additivity gap {exp.additivity_gap[i, a]:.2e} ({exp.method})"
+                )
     return 0
 
 
@@ -131,12 +145,23 @@ def _write_report(args, exp, policy, bg) -> int:
 
     from ..report import ReportContent, ReportRequest, write_report
 
-    req = ReportRequest(out=Path(args.out), method=args.method, options=dict(exp.options), narrate=args.narrate,
-                        narrator=args.narrator, narrator_options=parse_options(args.narrator_option),
-                        template=args.template, prompt_dirs=args.prompts, seed=args.seed, n_states=len(exp.values),
-                        robustness=not args.no_robustness, progress=False)
-    content = ReportContent(title=f"xairl: {policy.name}", policy=policy, background=bg,
-                            datasets=[("states", exp.states)])
+    req = ReportRequest(
+        out=Path(args.out),
+        method=args.method,
+        options=dict(exp.options),
+        narrate=args.narrate,
+        narrator=args.narrator,
+        narrator_options=parse_options(args.narrator_option),
+        template=args.template,
+        prompt_dirs=args.prompts,
+        seed=args.seed,
+        n_states=len(exp.values),
+        robustness=not args.no_robustness,
+        progress=False,
+    )
+    content = ReportContent(
+        title=f"xairl: {policy.name}", policy=policy, background=bg, datasets=[("states", exp.states)]
+    )
     path = write_report(req, content, explained={"states": exp})
     print(f"report: {path.resolve()}")
     return 0
@@ -156,27 +181,63 @@ def _stream(args, policy, states, bg, options: dict) -> int:
     if args.engine == "ray":
         from ..scale import explain_on_ray
 
-        summary = explain_on_ray(policy, states, out, background=bg, method=args.method, options=options,
-                                 chunk_size=args.chunk_size, resume=args.resume, workers=args.workers,
-                                 address=args.ray_address)
+        summary = explain_on_ray(
+            policy,
+            states,
+            out,
+            background=bg,
+            method=args.method,
+            options=options,
+            chunk_size=args.chunk_size,
+            resume=args.resume,
+            workers=args.workers,
+            address=args.ray_address,
+        )
     else:
-        summary = explain_to_parquet(policy, states, out, background=bg, method=args.method, options=options,
-                                     chunk_size=args.chunk_size, resume=args.resume)
+        summary = explain_to_parquet(
+            policy,
+            states,
+            out,
+            background=bg,
+            method=args.method,
+            options=options,
+            chunk_size=args.chunk_size,
+            resume=args.resume,
+        )
     seconds = time.time() - t0
     means = summary.to_dict(policy.feature_names)["mean_abs_contribution"]
     order = sorted(policy.feature_names, key=lambda f: -means["margin"][f])
-    table = table_html(["feature", "mean |contribution| to the margin", "to the chosen score"],
-                       [[f, f"{means['margin'][f]:.4g}", f"{means['chosen_score'][f]:.4g}"] for f in order])
-    req = ReportRequest(out=out, method=args.method, options=options, narrate=args.narrate, narrator=args.narrator,
-                        narrator_options=parse_options(args.narrator_option), template=args.template,
-                        prompt_dirs=args.prompts, seed=args.seed, n_states=summary.n,
-                        robustness=not args.no_robustness, progress=False, records=False)
-    content = ReportContent(title=f"xairl: {policy.name}", policy=policy, background=bg,
-                            datasets=[("states", summary.sample_explanation().states)],
-                            tables=[(f"Mean |contribution| over all {summary.n} states", table)],
-                            notes=[f"{summary.n} states explained in {seconds:.1f} s ({summary.n / max(seconds, 1e-9):.0f}"
-                                   f" states/s) into {out / 'explanations.parquet'}; the figures show a uniform "
-                                   f"sample of {len(summary.sample)} of them."])
+    table = table_html(
+        ["feature", "mean |contribution| to the margin", "to the chosen score"],
+        [[f, f"{means['margin'][f]:.4g}", f"{means['chosen_score'][f]:.4g}"] for f in order],
+    )
+    req = ReportRequest(
+        out=out,
+        method=args.method,
+        options=options,
+        narrate=args.narrate,
+        narrator=args.narrator,
+        narrator_options=parse_options(args.narrator_option),
+        template=args.template,
+        prompt_dirs=args.prompts,
+        seed=args.seed,
+        n_states=summary.n,
+        robustness=not args.no_robustness,
+        progress=False,
+        records=False,
+    )
+    content = ReportContent(
+        title=f"xairl: {policy.name}",
+        policy=policy,
+        background=bg,
+        datasets=[("states", summary.sample_explanation().states)],
+        tables=[(f"Mean |contribution| over all {summary.n} states", table)],
+        notes=[
+            f"{summary.n} states explained in {seconds:.1f} s ({summary.n / max(seconds, 1e-9):.0f}"
+            f" states/s) into {out / 'explanations.parquet'}; the figures show a uniform "
+            f"sample of {len(summary.sample)} of them."
+        ],
+    )
     path = write_report(req, content, explained={"states": summary.sample_explanation()})
     print(f"explanations: {(out / 'explanations.parquet').resolve()} ({summary.n} states)\nreport: {path.resolve()}")
     return 0
@@ -191,13 +252,33 @@ def _print_narratives(args, exp, policy, bg) -> int:
     if args.examples_from_feedback and store is not None:
         options.setdefault("examples", store.examples())
     for i in range(len(exp.values)):
-        n = narrate(exp, i, narrator=args.narrator, template=args.template, policy=policy, background=bg,
-                    robustness=not args.no_robustness,
-                    options=options, prompt_dirs=args.prompts, store=store)
+        n = narrate(
+            exp,
+            i,
+            narrator=args.narrator,
+            template=args.template,
+            policy=policy,
+            background=bg,
+            robustness=not args.no_robustness,
+            options=options,
+            prompt_dirs=args.prompts,
+            store=store,
+        )
         if args.format == "jsonl":
-            print(json.dumps({"index": i, "text": n.text, "verified": n.verified, "confidence": n.confidence,
-                              "components": n.components, "source": n.source, "template": n.template,
-                              "sentences": [{"text": t, "status": st} for t, st in n.sentences]}))
+            print(
+                json.dumps(
+                    {
+                        "index": i,
+                        "text": n.text,
+                        "verified": n.verified,
+                        "confidence": n.confidence,
+                        "components": n.components,
+                        "source": n.source,
+                        "template": n.template,
+                        "sentences": [{"text": t, "status": st} for t, st in n.sentences],
+                    }
+                )
+            )
             continue
         mark = "verified" if n.verified else "NOT VERIFIED"
         parts = ", ".join(f"{k} {v:.2f}" for k, v in n.components.items() if v is not None)
@@ -207,48 +288,101 @@ def _print_narratives(args, exp, policy, bg) -> int:
 
 
 def explain_parser(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--policy", default="toy", help="registered policy name (see `xairl plugins`), or with nothing "
-                   "installed package.module:attr or path/file.py:attr (a Policy, a torch module, or a function "
-                   "returning one, called with the --policy-arg values); default: toy. A module:attr or file.py:attr "
-                   "imports and runs that code, as any Python entry point does: give only code you trust")
-    p.add_argument("--policy-arg", action="append", default=[], metavar="KEY=VALUE",
-                   help="argument of a module:attr policy function, e.g. --policy-arg checkpoint=my_q.pt")
-    p.add_argument("--out", type=out_dir, default=None, metavar="DIR",
-                   help="write explanations.jsonl, figures and report.html into DIR instead of printing; more than "
-                   f"{STREAM_ABOVE:,} states (or --resume, or --engine ray) are streamed into "
-                   "DIR/explanations.parquet instead, as with --format parquet, and the report shows a sample of them "
-                   "(--format jsonl keeps one JSON-lines file, built in memory)")
-    p.add_argument("--states", help="states to explain: .csv with a header naming the features, .npy "
-                   "(n, *obs_shape), .npz (dict observations) or .json; "
-                   "default: --n states from the policy's sampler")
+    p.add_argument(
+        "--policy",
+        default="toy",
+        help="registered policy name (see `xairl plugins`), or with nothing "
+        "installed package.module:attr or path/file.py:attr (a Policy, a torch module, or a function "
+        "returning one, called with the --policy-arg values); default: toy. A module:attr or file.py:attr "
+        "imports and runs that code, as any Python entry point does: give only code you trust",
+    )
+    p.add_argument(
+        "--policy-arg",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="argument of a module:attr policy function, e.g. --policy-arg checkpoint=my_q.pt",
+    )
+    p.add_argument(
+        "--out",
+        type=out_dir,
+        default=None,
+        metavar="DIR",
+        help="write explanations.jsonl, figures and report.html into DIR instead of printing; more than "
+        f"{STREAM_ABOVE:,} states (or --resume, or --engine ray) are streamed into "
+        "DIR/explanations.parquet instead, as with --format parquet, and the report shows a sample of them "
+        "(--format jsonl keeps one JSON-lines file, built in memory)",
+    )
+    p.add_argument(
+        "--states",
+        help="states to explain: .csv with a header naming the features, .npy "
+        "(n, *obs_shape), .npz (dict observations) or .json; "
+        "default: --n states from the policy's sampler",
+    )
     p.add_argument("--background", help="background states file (default: the policy's sampler)")
-    p.add_argument("--background-size", type=count(1, 1_000_000), default=100, help="background states drawn from the sampler")
+    p.add_argument(
+        "--background-size", type=count(1, 1_000_000), default=100, help="background states drawn from the sampler"
+    )
     p.add_argument("--n", type=count(1, 10_000_000), default=5, help="states to sample when --states is not given")
-    p.add_argument("--seed", type=count(0, 2 ** 32 - 1), default=0, help="seed of the sampled states and background")
+    p.add_argument("--seed", type=count(0, 2**32 - 1), default=0, help="seed of the sampled states and background")
     p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
-    p.add_argument("-o", "--option", action="append", default=[], metavar="KEY=VALUE",
-                   help="an option of the method, validated against its schema; repeatable")
-    p.add_argument("--format", choices=("table", "jsonl", "parquet"), default=None,
-                   help="table or jsonl on the terminal; parquet: streamed chunk by chunk into --out DIR (any number "
-                   f"of states, resumable with --resume). Default: table, or parquet with --out above {STREAM_ABOVE:,} "
-                   "states")
-    p.add_argument("--chunk-size", type=count(1, 10_000_000), default=50_000, help="states per chunk with --format "
-                   "parquet (memory grows with it)")
-    p.add_argument("--resume", action="store_true", help="with --format parquet (or --out alone): continue an "
-                   "interrupted run in --out")
-    p.add_argument("--engine", choices=("local", "ray"), default="local", help="with --format parquet: this process "
-                   "(local) or Ray workers (pip install 'xairl[scale]')")
+    p.add_argument(
+        "-o",
+        "--option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="an option of the method, validated against its schema; repeatable",
+    )
+    p.add_argument(
+        "--format",
+        choices=("table", "jsonl", "parquet"),
+        default=None,
+        help="table or jsonl on the terminal; parquet: streamed chunk by chunk into --out DIR (any number "
+        f"of states, resumable with --resume). Default: table, or parquet with --out above {STREAM_ABOVE:,} "
+        "states",
+    )
+    p.add_argument(
+        "--chunk-size",
+        type=count(1, 10_000_000),
+        default=50_000,
+        help="states per chunk with --format parquet (memory grows with it)",
+    )
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="with --format parquet (or --out alone): continue an interrupted run in --out",
+    )
+    p.add_argument(
+        "--engine",
+        choices=("local", "ray"),
+        default="local",
+        help="with --format parquet: this process (local) or Ray workers (pip install 'xairl[scale]')",
+    )
     p.add_argument("--workers", type=count(1, 100_000), default=2, help="Ray workers (one CPU each; default 2)")
-    p.add_argument("--ray-address", default=None, metavar="ADDRESS", help="a running Ray cluster (e.g. auto or "
-                   "ray://host:10001); default: Ray started on this machine")
+    p.add_argument(
+        "--ray-address",
+        default=None,
+        metavar="ADDRESS",
+        help="a running Ray cluster (e.g. auto or ray://host:10001); default: Ray started on this machine",
+    )
     p.add_argument("--top", type=count(1), default=5, help="features shown per state in the table")
-    p.add_argument("--view", choices=("margin", "score"), default="margin",
-                   help="what the terminal table's contributions add up to for a decision: the margin over the "
-                   "runner-up (default; the narratives' view) or the chosen action's score (reports and narratives "
-                   "show the margin beside the score)")
+    p.add_argument(
+        "--view",
+        choices=("margin", "score"),
+        default="margin",
+        help="what the terminal table's contributions add up to for a decision: the margin over the "
+        "runner-up (default; the narratives' view) or the chosen action's score (reports and narratives "
+        "show the margin beside the score)",
+    )
     narration_arguments(p)
-    p.add_argument("--feedback-db", type=new_file, default=None, help="SQLite store of shown narratives (default: in the user dir)")
+    p.add_argument(
+        "--feedback-db", type=new_file, default=None, help="SQLite store of shown narratives (default: in the user dir)"
+    )
     p.add_argument("--no-record", action="store_true", help="do not record the narratives for review")
-    p.add_argument("--examples-from-feedback", action="store_true",
-                   help="give the local LM the operators' latest accepted or corrected narratives as examples")
+    p.add_argument(
+        "--examples-from-feedback",
+        action="store_true",
+        help="give the local LM the operators' latest accepted or corrected narratives as examples",
+    )
     p.set_defaults(run=cmd_explain)

@@ -1,8 +1,9 @@
 """Narration: facts by code, words by a template or a local language model, every claim verified."""
+
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Iterable
 
 from ..explanation import Explanation
 from ..policy import Policy
@@ -11,10 +12,21 @@ from .confidence import confidence
 from .verify import Verification, verify
 
 
-def narrate(explanation: Explanation, index: int | None = 0, *, narrator: str = "template",
-            template: str | None = None, policy: Policy | None = None, background=None, options: dict | None = None,
-            prompt_dirs: Iterable[str] = (), k: int = 3, store=None, robustness: bool = True,
-            history=None) -> Narrative:
+def narrate(
+    explanation: Explanation,
+    index: int | None = 0,
+    *,
+    narrator: str = "template",
+    template: str | None = None,
+    policy: Policy | None = None,
+    background=None,
+    options: dict | None = None,
+    prompt_dirs: Iterable[str] = (),
+    k: int = 3,
+    store=None,
+    robustness: bool = True,
+    history=None,
+) -> Narrative:
     """Words for decision ``index`` (``None``: a global summary over all states), checked against the numbers.
 
     :param narrator: a registered narrator ('template', 'local_lm', or a plugin's).
@@ -27,8 +39,17 @@ def narrate(explanation: Explanation, index: int | None = 0, *, narrator: str = 
     from ..plugins import registry
 
     writer: Narrator = registry("narrator").load(narrator)(options)
-    narrative = writer.narrate(explanation, index, template=template, policy=policy, background=background,
-                               prompt_dirs=prompt_dirs, k=k, robustness=robustness, history=history)
+    narrative = writer.narrate(
+        explanation,
+        index,
+        template=template,
+        policy=policy,
+        background=background,
+        prompt_dirs=prompt_dirs,
+        k=k,
+        robustness=robustness,
+        history=history,
+    )
     if store is not None:
         store.record(narrative, policy=policy)  # with its evidence: the numbers of what it says
     return narrative

@@ -4,11 +4,13 @@
 sandbox, the subclass's :meth:`Narrator._compose` for the words, the verifier, the template fallback when the
 words fail verification, and the confidence score (xairl.narrators.confidence).
 """
+
 from __future__ import annotations
 
 import html
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar, Iterable
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -51,8 +53,11 @@ class Narrative:
     def _repr_html_(self) -> str:
         """Jupyter's view: the evidence card of the HTML report (each sentence marked, the state, the waterfall)."""
         meta = html.escape(f"{self.source}, template {self.template}, state {self.index}")
-        return f"<style>{CARD_STYLE}</style>" + card_html(self.text, self.evidence or {
-            "sentences": [list(s) for s in self.sentences], "confidence": self.confidence}, meta)
+        return f"<style>{CARD_STYLE}</style>" + card_html(
+            self.text,
+            self.evidence or {"sentences": [list(s) for s in self.sentences], "confidence": self.confidence},
+            meta,
+        )
 
 
 def first_phrasings(variants: list[list[str]]) -> str:
@@ -75,9 +80,18 @@ class Narrator:
     def __init__(self, options: dict | Options | None = None):
         self.options = parse_options(self.Options, options, f"{self.name} narrator options")
 
-    def narrate(self, explanation: Explanation, index: int | None = 0, template: str | None = None,
-                policy: Policy | None = None, background=None, prompt_dirs: Iterable[str] = (), k: int = 3,
-                robustness: bool = True, history=None) -> Narrative:
+    def narrate(
+        self,
+        explanation: Explanation,
+        index: int | None = 0,
+        template: str | None = None,
+        policy: Policy | None = None,
+        background=None,
+        prompt_dirs: Iterable[str] = (),
+        k: int = 3,
+        robustness: bool = True,
+        history=None,
+    ) -> Narrative:
         """Words for decision ``index`` (``None``: a global summary over all states), verified, with confidence.
 
         :param template: template name or .yaml path; default 'explain_action' (or 'global_summary').
@@ -91,20 +105,32 @@ class Narrator:
         from .. import prompts
 
         index = None if index is None else explanation.check_index(index)
-        default = "global_summary" if index is None else \
-            "explain_action" if explanation.output == "actions" else "explain_output"
+        default = (
+            "global_summary"
+            if index is None
+            else "explain_action"
+            if explanation.output == "actions"
+            else "explain_output"
+        )
         tpl = prompts.load(template or default, prompt_dirs)
         if (tpl.spec.kind == "global") != (index is None):
-            raise InputError(f"template '{tpl.name}' is a {tpl.spec.kind} template; use "
-                             f"{'index=None' if tpl.spec.kind == 'global' else 'a state index'} with it.")
+            raise InputError(
+                f"template '{tpl.name}' is a {tpl.spec.kind} template; use "
+                f"{'index=None' if tpl.spec.kind == 'global' else 'a state index'} with it."
+            )
         if index is not None and explanation.output not in tpl.spec.outputs:
-            raise InputError(f"template '{tpl.name}' narrates {' or '.join(tpl.spec.outputs)} outputs; this policy's "
-                             f"output is {explanation.output}: use template '{default}'.")
+            raise InputError(
+                f"template '{tpl.name}' narrates {' or '.join(tpl.spec.outputs)} outputs; this policy's "
+                f"output is {explanation.output}: use template '{default}'."
+            )
         # an image is narrated in regions, not pixels (the confidence's robustness still reads the pixels); a
         # continuous action: each dimension is its own output, narrated and verified on its own
         narrated = in_regions(explanation)
-        views = [narrated.output_slice(j) for j in range(narrated.values.shape[2])] \
-            if index is not None and explanation.output == "continuous" else [narrated]
+        views = (
+            [narrated.output_slice(j) for j in range(narrated.values.shape[2])]
+            if index is not None and explanation.output == "continuous"
+            else [narrated]
+        )
         texts, claims, ok, sources, rejected, scores, comps, sentences = [], [], True, [], [], [], [], []
         for j, view in enumerate(views):
             text, check, source, bad = self._words(view, index, tpl, policy, k, history)
@@ -114,23 +140,42 @@ class Narrator:
             ok &= check.ok
             sources.append(source)
             rejected += [bad] if bad else []
-            score, comp = confidence(explanation, index, check.ok, policy, background, robustness,
-                                     output=j if len(views) > 1 else None, coverage=check.coverage)
+            score, comp = confidence(
+                explanation,
+                index,
+                check.ok,
+                policy,
+                background,
+                robustness,
+                output=j if len(views) > 1 else None,
+                coverage=check.coverage,
+            )
             scores.append(score)
             comps.append(comp)
         worst = int(np.argmin(scores))  # a continuous action is as trustworthy as its least trustworthy dimension
-        told = Narrative(text=" ".join(texts), claims=tuple(claims), verified=ok, confidence=scores[worst],
-                         components=comps[worst], source=next((s for s in sources if s != self.name), self.name),
-                         template=tpl.name, index=index, rejected=" ".join(rejected) or None,
-                         extras={"method": explanation.method}, sentences=tuple(sentences))
+        told = Narrative(
+            text=" ".join(texts),
+            claims=tuple(claims),
+            verified=ok,
+            confidence=scores[worst],
+            components=comps[worst],
+            source=next((s for s in sources if s != self.name), self.name),
+            template=tpl.name,
+            index=index,
+            rejected=" ".join(rejected) or None,
+            extras={"method": explanation.method},
+            sentences=tuple(sentences),
+        )
         return replace(told, evidence=evidence(narrated, told))
 
-    def _words(self, explanation: Explanation, index: int | None, tpl, policy: Policy | None, k: int,
-               history=None):
+    def _words(self, explanation: Explanation, index: int | None, tpl, policy: Policy | None, k: int, history=None):
         """(text, verification, source, rejected text) for one explanation: the subclass's words, verified, or the
         template's first phrasings when they fail."""
-        facts = global_facts(explanation, policy, k=max(k, 3)) if index is None else decision_facts(
-            explanation, index, policy, k, history)
+        facts = (
+            global_facts(explanation, policy, k=max(k, 3))
+            if index is None
+            else decision_facts(explanation, index, policy, k, history)
+        )
         context = facts.context()
         variants = tpl.render_variants(context)
         text, source, rejected = self._compose(variants, context), self.name, None

@@ -15,6 +15,7 @@ components) explain the one state three more times: once with the second method,
 They run only with ``robustness=True`` and a policy and background; otherwise they are left out (shown as None) and
 the weights of the others are renormalised.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -43,7 +44,7 @@ def _agreement(exp: Explanation, index: int, policy: Policy, bg: np.ndarray, c: 
 
     second = "deep_shap" if exp.method == "integrated_gradients" else "integrated_gradients"
     try:
-        other = explain(policy, exp.states[index:index + 1], background=bg, method=second).values[0, :, c]
+        other = explain(policy, exp.states[index : index + 1], background=bg, method=second).values[0, :, c]
     except (XairlError, RuntimeError):  # the second method may not support this network: not measured
         return None
     return (1 + _spearman(np.abs(exp.values[index, :, c]), np.abs(other))) / 2
@@ -58,22 +59,37 @@ def _stability(exp: Explanation, index: int, policy: Policy, bg: np.ndarray, see
     rhos = []
     for _ in range(2):
         half = bg[rng.choice(len(bg), size=max(1, len(bg) // 2), replace=False)]
-        again = explain(policy, exp.states[index:index + 1], background=half, method=exp.method,
-                        options=dict(exp.options)).values[0, :, c]
+        again = explain(
+            policy, exp.states[index : index + 1], background=half, method=exp.method, options=dict(exp.options)
+        ).values[0, :, c]
         rhos.append((1 + _spearman(exp.values[index, :, c], again)) / 2)
     return float(np.mean(rhos))
 
 
-def components(exp: Explanation, index: int | None, verified: bool, policy: Policy | None = None,
-               background=None, robustness: bool = True, seed: int = 0, output: int | None = None,
-               coverage: float | None = None) -> dict[str, float | None]:
+def components(
+    exp: Explanation,
+    index: int | None,
+    verified: bool,
+    policy: Policy | None = None,
+    background=None,
+    robustness: bool = True,
+    seed: int = 0,
+    output: int | None = None,
+    coverage: float | None = None,
+) -> dict[str, float | None]:
     """Every component of the confidence (None where not measured); see the module doc.
 
     :param output: the output narrated when nothing is chosen (a value, one dimension of a continuous action);
         there the margin does not apply. Default: the chosen action.
     :param coverage: the verifier's coverage of the text (:attr:`xairl.Verification.coverage`); None: not known."""
-    comp: dict[str, float | None] = {"verification": 1.0 if verified else 0.0, "coverage": coverage,
-                                     "additivity": None, "margin": None, "agreement": None, "stability": None}
+    comp: dict[str, float | None] = {
+        "verification": 1.0 if verified else 0.0,
+        "coverage": coverage,
+        "additivity": None,
+        "margin": None,
+        "agreement": None,
+        "stability": None,
+    }
     if index is None:  # a global summary: only verification and additivity apply
         comp["additivity"] = _additivity(float(exp.additivity_gap.max()), float(np.abs(exp.outputs).max()))
         return comp
@@ -89,9 +105,17 @@ def components(exp: Explanation, index: int | None, verified: bool, policy: Poli
     return comp
 
 
-def confidence(exp: Explanation, index: int | None, verified: bool, policy: Policy | None = None,
-               background=None, robustness: bool = True, seed: int = 0, output: int | None = None,
-               coverage: float | None = None) -> tuple[float, dict[str, float | None]]:
+def confidence(
+    exp: Explanation,
+    index: int | None,
+    verified: bool,
+    policy: Policy | None = None,
+    background=None,
+    robustness: bool = True,
+    seed: int = 0,
+    output: int | None = None,
+    coverage: float | None = None,
+) -> tuple[float, dict[str, float | None]]:
     """The confidence of a narrative and its components (formula and cost in the module doc)."""
     comp = components(exp, index, verified, policy, background, robustness, seed, output, coverage)
     measured = {k: v for k, v in comp.items() if k in WEIGHTS and v is not None}

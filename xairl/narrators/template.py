@@ -1,4 +1,5 @@
 """The deterministic narrator: the first phrasing of every sentence. Always available, instant; no options."""
+
 from __future__ import annotations
 
 from .base import Narrator, first_phrasings

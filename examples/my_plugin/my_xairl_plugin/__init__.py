@@ -4,6 +4,7 @@ Installed with pip, found through the entry point group ``xairl``. The hooks bel
 (``"module:attr"`` strings) or define light functions, so ``xairl --help`` imports neither torch nor this
 plugin's heavy parts. Everything it uses comes from ``import xairl`` (the public surface), nothing private.
 """
+
 from pathlib import Path
 
 import xairl
@@ -11,20 +12,27 @@ import xairl
 
 @xairl.plugin.hookimpl
 def register_policies(register):
-    register("thermostat", "my_xairl_plugin.thermostat:thermostat_policy",
-             "heat or idle, from temperature and occupancy")
+    register(
+        "thermostat", "my_xairl_plugin.thermostat:thermostat_policy", "heat or idle, from temperature and occupancy"
+    )
 
 
 @xairl.plugin.hookimpl
 def register_attributors(register):
-    register("occlusion", "my_xairl_plugin.occlusion:Occlusion",
-             "occlusion: score drop when one feature is replaced by background values (not additive)")
+    register(
+        "occlusion",
+        "my_xairl_plugin.occlusion:Occlusion",
+        "occlusion: score drop when one feature is replaced by background values (not additive)",
+    )
 
 
 @xairl.plugin.hookimpl
 def register_narrators(register):
-    register("shortest", "my_xairl_plugin.shortest:ShortestNarrator",
-             "the shortest phrasing of each sentence, at most max_sentences sentences")
+    register(
+        "shortest",
+        "my_xairl_plugin.shortest:ShortestNarrator",
+        "the shortest phrasing of each sentence, at most max_sentences sentences",
+    )
 
 
 @xairl.plugin.hookimpl

@@ -5,6 +5,7 @@ Unlike Shapley values these need not add up to f(x) - E[f]; the base class repor
 xairl's ``Attributor.explain`` does the shared work (checks, eval mode, hook clean-up, the Explanation); this
 class only implements ``_attribute`` and declares its options.
 """
+
 import numpy as np
 import torch
 from pydantic import Field

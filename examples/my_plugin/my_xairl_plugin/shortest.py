@@ -3,6 +3,7 @@
 xairl's ``Narrator.narrate`` does the shared work (facts, template, verification, fallback, confidence); this
 class only declares its options and implements ``_compose``.
 """
+
 from pydantic import Field
 
 import xairl

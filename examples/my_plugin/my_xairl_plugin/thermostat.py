@@ -1,4 +1,5 @@
 """The example policy: a hand-written 2-feature Q-network with feature metadata and a background sampler."""
+
 import numpy as np
 import torch
 
@@ -11,8 +12,11 @@ def thermostat_policy() -> xairl.Policy:
     with torch.no_grad():
         net.weight.copy_(torch.tensor([[-1.0, 0.2], [1.0, -0.2]]))  # columns: temperature, occupancy
         net.bias.copy_(torch.tensor([20.0, -20.0]))
-    return xairl.Policy(net, ["temperature", "occupancy"], ["heat", "idle"],
-                        features={"temperature": xairl.FeatureInfo("degC", "the room temperature", "cold", "warm")},
-                        background_sampler=lambda n, seed: np.random.default_rng(seed).normal(
-                            [20.0, 1.0], [3.0, 1.0], size=(n, 2)),
-                        name="thermostat")
+    return xairl.Policy(
+        net,
+        ["temperature", "occupancy"],
+        ["heat", "idle"],
+        features={"temperature": xairl.FeatureInfo("degC", "the room temperature", "cold", "warm")},
+        background_sampler=lambda n, seed: np.random.default_rng(seed).normal([20.0, 1.0], [3.0, 1.0], size=(n, 2)),
+        name="thermostat",
+    )

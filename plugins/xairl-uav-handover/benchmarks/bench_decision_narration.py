@@ -16,6 +16,7 @@ The old chosen-score view (``explain_score``) is measured the same way for compa
 
     .venv/bin/python plugins/xairl-uav-handover/benchmarks/bench_decision_narration.py [--n 500]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -24,10 +25,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-from xairl_uav_handover.env import HandoverVecEnv
-from xairl_uav_handover.policy import background_states, greedy, load_checkpoint, uav_policy
 
 import xairl
+from xairl_uav_handover.env import HandoverVecEnv
+from xairl_uav_handover.policy import background_states, greedy, load_checkpoint, uav_policy
 
 REAL = Path(__file__).resolve().parents[4] / "shared" / "data" / "ukm-uav-lte" / "raw"
 DIRECTION = re.compile(r"\b(push\w*|favou?r\w*|toward|against|raised?|lowered?)\b", re.IGNORECASE)
@@ -45,7 +46,7 @@ def simulated(ckpt, n: int, seed: int = 0):
     traj = np.stack(seen, axis=1)  # (flights, T, features)
     rng = np.random.default_rng(seed)
     picks = [(int(rng.integers(len(traj))), int(rng.integers(1, traj.shape[1]))) for _ in range(n)]
-    return np.array([traj[f, t] for f, t in picks]), [traj[f, max(0, t - 10):t] for f, t in picks]
+    return np.array([traj[f, t] for f, t in picks]), [traj[f, max(0, t - 10) : t] for f, t in picks]
 
 
 def real(ckpt, n: int, seed: int = 0):
@@ -58,7 +59,7 @@ def real(ckpt, n: int, seed: int = 0):
     for _ in range(n):
         w = walks[int(rng.integers(len(walks)))]
         picks.append((w, int(rng.integers(1, len(w)))))
-    return np.array([w[t] for w, t in picks]), [w[max(0, t - 10):t] for w, t in picks]
+    return np.array([w[t] for w, t in picks]), [w[max(0, t - 10) : t] for w, t in picks]
 
 
 def measure(policy, exp, histories, template: str) -> dict:
@@ -66,8 +67,14 @@ def measure(policy, exp, histories, template: str) -> dict:
     names = exp.feature_names
     idx = {f: j for j, f in enumerate(names)}
     groups = policy.reason_groups
-    out = dict(opposing_lead=0, identifier_cause=0, level_contradicts_range=0, not_verified=0, partial_coverage=0,
-               n=len(histories))
+    out = dict(
+        opposing_lead=0,
+        identifier_cause=0,
+        level_contradicts_range=0,
+        not_verified=0,
+        partial_coverage=0,
+        n=len(histories),
+    )
     for i, hist in enumerate(histories):
         n = xairl.narrate(exp, i, template=template, policy=policy, robustness=False, history=hist)
         out["not_verified"] += not n.verified  # checked with the facts the hook stated from the history
@@ -108,16 +115,20 @@ def main() -> None:
     sets = [("simulated", *simulated(ckpt, args.n))]
     if REAL.is_dir():
         sets.append(("real", *real(ckpt, args.n)))
-    print(f"{'states':<10}{'template':<16}{'n':>5}{'opposing lead':>15}{'id as cause':>13}{'level vs range':>16}"
-          f"{'not verified':>14}{'coverage<1':>12}{'s':>7}")
+    print(
+        f"{'states':<10}{'template':<16}{'n':>5}{'opposing lead':>15}{'id as cause':>13}{'level vs range':>16}"
+        f"{'not verified':>14}{'coverage<1':>12}{'s':>7}"
+    )
     for label, states, hist in sets:
         exp = xairl.explain(policy, states, background=bg)
         for template in ("handover", "explain_action", "explain_score"):
             t0 = time.time()
             r = measure(policy, exp, hist, template)
-            print(f"{label:<10}{template:<16}{r['n']:>5}{r['opposing_lead']:>15}{r['identifier_cause']:>13}"
-                  f"{r['level_contradicts_range']:>16}{r['not_verified']:>14}{r['partial_coverage']:>12}"
-                  f"{time.time() - t0:>7.1f}")
+            print(
+                f"{label:<10}{template:<16}{r['n']:>5}{r['opposing_lead']:>15}{r['identifier_cause']:>13}"
+                f"{r['level_contradicts_range']:>16}{r['not_verified']:>14}{r['partial_coverage']:>12}"
+                f"{time.time() - t0:>7.1f}"
+            )
 
 
 if __name__ == "__main__":

@@ -3,6 +3,7 @@ stepped through the vectorised Gymnasium env as training and evaluation do.
 
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/bench_simulator.py
 """
+
 import os
 import platform
 import time

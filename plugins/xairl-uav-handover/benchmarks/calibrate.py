@@ -7,6 +7,7 @@ with any feature outside the simulated range.
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/calibrate.py [--real DIR] [--checkpoint PATH]
      [--set observation.l3_filter_k=4 ...]   (overrides of the checkpoint's simulator settings)
 """
+
 import argparse
 import dataclasses
 import json
@@ -14,6 +15,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+
 from xairl_uav_handover.baselines import CHM
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.env import HandoverVecEnv
@@ -62,24 +64,34 @@ def main():
     flights, _ = load_folder(args.real)
     walks = [walk(f, cfg) for f in flights]
     chm_real = [chm_handovers(f, sim_config=cfg) for f in flights]
-    print(f"{len(flights)} real flights; live network {sum(f.observed_handovers for f in flights) / sum(f.t[-1] / 60 for f in flights):.2f} HO/min")
+    print(
+        f"{len(flights)} real flights; live network {sum(f.observed_handovers for f in flights) / sum(f.t[-1] / 60 for f in flights):.2f} HO/min"
+    )
     print(f"{'band':<12}{'flights':>8}{'live/min':>10}{'CHM real/min':>14}{'CHM sim/min':>13}{'sim/real':>10}")
     for r in band_rows(flights, chm_real, cfg, seed=0):
-        print(f"{r.band:<12}{r.flights:>8}{r.live_per_min:>10.2f}{r.chm_real_per_min:>14.2f}{r.chm_sim_per_min:>13.2f}"
-              f"{r.sim_over_real:>10.2f}")
+        print(
+            f"{r.band:<12}{r.flights:>8}{r.live_per_min:>10.2f}{r.chm_real_per_min:>14.2f}{r.chm_sim_per_min:>13.2f}"
+            f"{r.sim_over_real:>10.2f}"
+        )
     cap, q_sim = simulated_link(cfg)
     q_real = np.concatenate([w.queue_bits for w in walks])
     full = cfg.buffer.q_max_bits
-    print(f"uplink capacity under CHM: median {np.median(cap) / 1e6:.1f} Mbit/s (video {cfg.buffer.video_rate_mbps:g}); "
-          f"buffer non-empty / full: simulated {100 * np.mean(q_sim > 0):.1f} / {100 * np.mean(q_sim >= full):.1f} %, "
-          f"real {100 * np.mean(q_real > 0):.1f} / {100 * np.mean(q_real >= full):.1f} % (target full < 20 %)")
+    print(
+        f"uplink capacity under CHM: median {np.median(cap) / 1e6:.1f} Mbit/s (video {cfg.buffer.video_rate_mbps:g}); "
+        f"buffer non-empty / full: simulated {100 * np.mean(q_sim > 0):.1f} / {100 * np.mean(q_sim >= full):.1f} %, "
+        f"real {100 * np.mean(q_real > 0):.1f} / {100 * np.mean(q_real >= full):.1f} % (target full < 20 %)"
+    )
     real = np.concatenate([w.states for w in walks])
     sim = dqn_decision_states(ckpt, 5000, seed=2, epsilon=0.5, n_flights=256)
-    print(f"real states with any feature outside the simulated 0.5-99.5 % range: "
-          f"{100 * outside(real, sim).any(axis=1).mean():.1f} % (target <= 5 %); per feature (p5 / p50 / p95):")
+    print(
+        f"real states with any feature outside the simulated 0.5-99.5 % range: "
+        f"{100 * outside(real, sim).any(axis=1).mean():.1f} % (target <= 5 %); per feature (p5 / p50 / p95):"
+    )
     for r in quantile_rows(sim, real):
-        print(f"  {r.feature:<18} sim {r.sim_p5:9.1f} {r.sim_p50:9.1f} {r.sim_p95:9.1f}   real {r.real_p5:9.1f} "
-              f"{r.real_p50:9.1f} {r.real_p95:9.1f}   outside {r.real_outside_pct:5.1f} %")
+        print(
+            f"  {r.feature:<18} sim {r.sim_p5:9.1f} {r.sim_p50:9.1f} {r.sim_p95:9.1f}   real {r.real_p5:9.1f} "
+            f"{r.real_p50:9.1f} {r.real_p95:9.1f}   outside {r.real_outside_pct:5.1f} %"
+        )
     print(f"({time.time() - t0:.0f} s)")
 
 

@@ -10,6 +10,7 @@ serving uplink is below the video rate and some candidate's is above it (a hando
 
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/full_buffer.py [--checkpoint PATH] [--flights 200]
 """
+
 import argparse
 
 import numpy as np
@@ -57,16 +58,24 @@ def main():
     waited = [full_run(full[t::-1, k]) for t, k in zip(*np.nonzero(from_full))]
     onset = q[:-1][full[1:] & ~full[:-1]]
     share = lambda x: f"{100 * np.mean(x):.1f} %"  # noqa: E731
-    print(f"{args.flights} held-out flights, {int(ho.sum())} handovers; with a full buffer: {share(full[ho])}, "
-          f"partial: {share(partial[ho])}, empty: {share(q[ho] == 0)}")
-    print(f"full-buffer handovers, the decision before: full {share(before >= b.q_max_bits)}, partial "
-          f"{share((before > 0) & (before < b.q_max_bits))}, empty {share(before == 0)}; decisions already full "
-          f"before them: median {np.median(waited):.0f}, 90th percentile {np.percentile(waited, 90):.0f}")
-    print(f"onsets of a full buffer preceded by a partial one: {share(onset > 0)}; a partial buffer full at the next "
-          f"decision: {share(full[1:][partial[:-1]])}, empty: {share(q[1:][partial[:-1]] == 0)}")
-    print(f"full-buffer states: {share(full)} of decisions; serving uplink below the video rate in "
-          f"{share(caps[full, 0] < video)}; some candidate above it in {share(np.nanmax(caps[full][:, 1:], 1, initial=0) > video)}; "
-          f"the DQN hands over in {share(ho[full])} of them, to a cell above it in {share(target_ok(caps, ho & full, video))}")
+    print(
+        f"{args.flights} held-out flights, {int(ho.sum())} handovers; with a full buffer: {share(full[ho])}, "
+        f"partial: {share(partial[ho])}, empty: {share(q[ho] == 0)}"
+    )
+    print(
+        f"full-buffer handovers, the decision before: full {share(before >= b.q_max_bits)}, partial "
+        f"{share((before > 0) & (before < b.q_max_bits))}, empty {share(before == 0)}; decisions already full "
+        f"before them: median {np.median(waited):.0f}, 90th percentile {np.percentile(waited, 90):.0f}"
+    )
+    print(
+        f"onsets of a full buffer preceded by a partial one: {share(onset > 0)}; a partial buffer full at the next "
+        f"decision: {share(full[1:][partial[:-1]])}, empty: {share(q[1:][partial[:-1]] == 0)}"
+    )
+    print(
+        f"full-buffer states: {share(full)} of decisions; serving uplink below the video rate in "
+        f"{share(caps[full, 0] < video)}; some candidate above it in {share(np.nanmax(caps[full][:, 1:], 1, initial=0) > video)}; "
+        f"the DQN hands over in {share(ho[full])} of them, to a cell above it in {share(target_ok(caps, ho & full, video))}"
+    )
 
 
 def full_run(backwards: np.ndarray) -> int:

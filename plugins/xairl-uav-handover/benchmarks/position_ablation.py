@@ -13,12 +13,14 @@ intervals.
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/position_ablation.py [--flights 200] [--eval-seeds 0]
      [--real DIR] [--states 400]            (about 3 minutes on 2 cores: one training run of 40 episodes)
 """
+
 import argparse
 import tempfile
 from pathlib import Path
 
 import numpy as np
 from reproduce import real_sample, real_walks
+
 from xairl_uav_handover.baselines import CHM
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.evaluate import importance, ranked
@@ -32,8 +34,10 @@ def ranks(ckpt, states: np.ndarray) -> str:
     """The position group's and the buffer's rank by mean |contribution to the margin|, and the top four."""
     imp = importance(ckpt, states, groups={"position": GROUPS["position"]})
     order = ranked(imp)
-    return (f"position {order.index('position') + 1} of {len(order)}, buffer {order.index('buffer_queue_size') + 1}"
-            f" (top four: {', '.join(order[:4])})")
+    return (
+        f"position {order.index('position') + 1} of {len(order)}, buffer {order.index('buffer_queue_size') + 1}"
+        f" (top four: {', '.join(order[:4])})"
+    )
 
 
 def main():
@@ -60,8 +64,10 @@ def main():
     res = {"CHM": with_intervals(flights(CHM(), committed.sim_config, args.flights, args.eval_seeds))}
     for name, ckpt in dqns.items():
         res[name] = with_intervals(flights(DQNController(ckpt.net), ckpt.sim_config, args.flights, args.eval_seeds))
-    print(f"\nTable I: {args.flights} held-out flights x evaluation seeds {args.eval_seeds}, value [bootstrap 95 % "
-          "interval]\n" + format_rows(res))
+    print(
+        f"\nTable I: {args.flights} held-out flights x evaluation seeds {args.eval_seeds}, value [bootstrap 95 % "
+        "interval]\n" + format_rows(res)
+    )
     for a, b in (("DQN without position", "DQN"), ("DQN", "DQN without position")):
         print(verdict(res, a, b))
 

@@ -14,16 +14,18 @@ Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reproduce.py [--seed
      [--demonstrations N] [--reward w_lost=2 w_pingpong=80 ...]   trains with these RewardConfig weights
 or:  ... reproduce.py --checkpoints A.safetensors B.safetensors ...   measures existing checkpoints
 """
+
 import argparse
 import json
 import tempfile
 from pathlib import Path
 
-from table_one import print_targets, targets
-from xairl_uav_handover.baselines import CHM, SAMRO
-from xairl_uav_handover.config import SimConfig
 import numpy as np
 from scipy.stats import spearmanr
+from table_one import print_targets, targets
+
+from xairl_uav_handover.baselines import CHM, SAMRO
+from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.evaluate import importance, ranked
 from xairl_uav_handover.policy import DQNController, dqn_decision_states, load_checkpoint
 from xairl_uav_handover.table import flights, format_rows, with_intervals
@@ -41,10 +43,19 @@ def main():
     ap.add_argument("--states", type=int, default=400, help="decision states explained for the feature ranks")
     ap.add_argument("--real", default=None, help="a folder of real UKM flight exports (targets 5 and 6)")
     ap.add_argument("--json", default=None, help="also write the per-seed results here")
-    ap.add_argument("--demonstrations", type=int, default=TrainConfig().demonstrations,
-                    help="episodes of the RSRQ rule's flights to learn from (0: a plain DQN)")
-    ap.add_argument("--reward", nargs="+", default=[], metavar="KEY=VALUE",
-                    help="train with these reward weights (RewardConfig) instead of the defaults")
+    ap.add_argument(
+        "--demonstrations",
+        type=int,
+        default=TrainConfig().demonstrations,
+        help="episodes of the RSRQ rule's flights to learn from (0: a plain DQN)",
+    )
+    ap.add_argument(
+        "--reward",
+        nargs="+",
+        default=[],
+        metavar="KEY=VALUE",
+        help="train with these reward weights (RewardConfig) instead of the defaults",
+    )
     args = ap.parse_args()
     folder = Path(args.out_dir or tempfile.mkdtemp(prefix="xairl-reproduce-"))
     folder.mkdir(parents=True, exist_ok=True)
@@ -58,8 +69,10 @@ def main():
     ckpts = [load_checkpoint(p) for p in paths]
     cfg = ckpts[0].sim_config
     if any(c.sim_config != cfg for c in ckpts[1:]):
-        raise SystemExit("the checkpoints were trained on different simulator settings; compare them one at a time "
-                         "(CHM, SA-MRO and the real walks use one setting)")
+        raise SystemExit(
+            "the checkpoints were trained on different simulator settings; compare them one at a time "
+            "(CHM, SA-MRO and the real walks use one setting)"
+        )
     walks = real_walks(args.real, cfg) if args.real else None
     n = args.flights * len(args.eval_seeds)
     res = {c.name: with_intervals(flights(c, cfg, args.flights, args.eval_seeds)) for c in (CHM(), SAMRO())}
@@ -76,15 +89,27 @@ def main():
         ranks = {f"{data} {view}": ranked(views, view) for data, views in imp.items() for view in ("margin", "score")}
         buffer = {k: r.index("buffer_queue_size") + 1 for k, r in ranks.items()}
         met.append(("6a. buffer in the top 2 everywhere", bool(max(buffer.values()) <= 2), str(buffer)))
-        per_seed.append({"checkpoint": path, "name": name, "train_seconds": ckpt.meta.get("train_seconds"),
-                         "targets": met, "rankings": ranks, "buffer_rank": buffer})
-    print(f"Table I: {args.flights} held-out flights x evaluation seeds {args.eval_seeds}; value [bootstrap 95 % "
-          f"interval]; reward: {cfg.reward}")
+        per_seed.append(
+            {
+                "checkpoint": path,
+                "name": name,
+                "train_seconds": ckpt.meta.get("train_seconds"),
+                "targets": met,
+                "rankings": ranks,
+                "buffer_rank": buffer,
+            }
+        )
+    print(
+        f"Table I: {args.flights} held-out flights x evaluation seeds {args.eval_seeds}; value [bootstrap 95 % "
+        f"interval]; reward: {cfg.reward}"
+    )
     print(format_rows(res))
     for s in per_seed:
-        print(f"\n{s['name']} ({s['train_seconds']} s of training): "
-              f"{sum(ok for _, ok, _ in s['targets'])} of {len(s['targets'])} targets met; first four by the margin "
-              f"on simulated states: {', '.join(s['rankings']['simulated margin'][:4])}")
+        print(
+            f"\n{s['name']} ({s['train_seconds']} s of training): "
+            f"{sum(ok for _, ok, _ in s['targets'])} of {len(s['targets'])} targets met; first four by the margin "
+            f"on simulated states: {', '.join(s['rankings']['simulated margin'][:4])}"
+        )
         print_targets(s["targets"])
     if args.json:
         with open(args.json, "w") as fh:
@@ -121,8 +146,10 @@ def real_figures(ckpt, walks: list, n_states: int) -> tuple[dict, tuple[str, boo
 
     dqn = agreement_rows(walks, ckpt, ckpt.sim_config)[0]
     return importance(ckpt, real_sample(walks, n_states)), (
-        "5. real: new proposals <= 2 x the network's rate", bool(dqn.new_proposals_per_min <= 2 * dqn.network_per_min),
-        f"{dqn.new_proposals_per_min:.2f} vs 2 x {dqn.network_per_min:.2f} per minute")
+        "5. real: new proposals <= 2 x the network's rate",
+        bool(dqn.new_proposals_per_min <= 2 * dqn.network_per_min),
+        f"{dqn.new_proposals_per_min:.2f} vs 2 x {dqn.network_per_min:.2f} per minute",
+    )
 
 
 if __name__ == "__main__":

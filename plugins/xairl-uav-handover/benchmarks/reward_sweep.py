@@ -9,11 +9,13 @@ Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reward_sweep.py [--s
      [--seeds 0] [--episodes 40] [--flights 100] [--eval-seeds 0] [--keep DIR] [--demonstrations N]
 The sweeps in docs/uav-reference.md dated before 2026-12-03 evening trained plain DQNs: --demonstrations 0.
 """
+
 import argparse
 import tempfile
 from pathlib import Path
 
 from table_one import targets
+
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.policy import DQNController, load_checkpoint
@@ -30,15 +32,23 @@ def config(weights: str) -> SimConfig:
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--sets", nargs="+", default=["1,3,30,80"],
-                    help="w_lost,w_rsrq,w_handover,w_pingpong per set (default: the best set found so far)")
+    ap.add_argument(
+        "--sets",
+        nargs="+",
+        default=["1,3,30,80"],
+        help="w_lost,w_rsrq,w_handover,w_pingpong per set (default: the best set found so far)",
+    )
     ap.add_argument("--seeds", type=int, nargs="+", default=[0], help="training seeds")
     ap.add_argument("--episodes", type=int, default=40)
     ap.add_argument("--flights", type=int, default=100, help="held-out flights per evaluation seed")
     ap.add_argument("--eval-seeds", type=int, nargs="+", default=[0])
     ap.add_argument("--keep", default=None, help="folder for the checkpoints (default: a temporary one)")
-    ap.add_argument("--demonstrations", type=int, default=TrainConfig().demonstrations,
-                    help="episodes of the RSRQ rule's flights to learn from (0: a plain DQN)")
+    ap.add_argument(
+        "--demonstrations",
+        type=int,
+        default=TrainConfig().demonstrations,
+        help="episodes of the RSRQ rule's flights to learn from (0: a plain DQN)",
+    )
     args = ap.parse_args()
     folder = Path(args.keep or tempfile.mkdtemp())
     folder.mkdir(parents=True, exist_ok=True)

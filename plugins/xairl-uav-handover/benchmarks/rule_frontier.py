@@ -9,10 +9,12 @@ and acts at the DQN's decision period. One rule per combination of the values gi
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/rule_frontier.py [--flights 100] [--seeds 0]
      [--thresholds -14 -10] [--margins 2 3] [--full-shares 0.5]
 """
+
 import argparse
 import itertools
 
 from table_one import print_targets, targets
+
 from xairl_uav_handover.baselines import CHM, RSRQRule
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.table import flights, format_rows, with_intervals
@@ -23,8 +25,9 @@ def main():
     ap.add_argument("--flights", type=int, default=100, help="held-out flights per evaluation seed")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0], help="evaluation seeds (flights pooled)")
     ap.add_argument("--thresholds", type=float, nargs="+", default=[-14.0], help="serving RSRQ triggers (dB)")
-    ap.add_argument("--margins", type=float, nargs="+", default=[2.0, 3.0], help="how much better the target's "
-                                                                                 "RSRQ must be (dB)")
+    ap.add_argument(
+        "--margins", type=float, nargs="+", default=[2.0, 3.0], help="how much better the target's RSRQ must be (dB)"
+    )
     ap.add_argument("--full-shares", type=float, nargs="+", default=[0.5], help="buffer share that triggers")
     args = ap.parse_args()
     cfg = SimConfig()

@@ -5,6 +5,7 @@ A3 rule on what operators pay for" checked one by one.
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/table_one.py [--flights 200] [--seeds 0 1 2]
      [--checkpoint PATH ...]   (default: the committed checkpoint; several: one DQN column each, flights pooled)
 """
+
 import argparse
 import json
 
@@ -19,20 +20,41 @@ def targets(res: dict, n_flights: int) -> list[tuple[str, bool, str]]:
     v = {k: x[0] for k, x in d.items()}
     w = {k: x[0] for k, x in c.items()}
     return [
-        ("1. handovers <= 0.5 x CHM", v["handovers"] <= 0.5 * w["handovers"],
-         f"{v['handovers']:.2f} vs 0.5 x {w['handovers']:.2f}"),
-        ("2a. ping-pongs per flight-minute <= CHM", v["pp_per_min"] <= w["pp_per_min"],
-         f"{v['pp_per_min']:.3f} vs {w['pp_per_min']:.3f}"),
-        ("2b. at most 1 flight in 200 with > 5 ping-pongs", v["pp_over_5"] <= 0.5,
-         f"{v['pp_over_5']:.2f} % of {n_flights} flights"),
-        ("3a. lost data <= CHM + 1 %", v["lost_mbit"] <= 1.01 * w["lost_mbit"],
-         f"{v['lost_mbit']:.1f} vs {w['lost_mbit']:.1f} Mbit"),
-        ("3b. availability mean >= CHM - 0.1 point", v["availability"] >= w["availability"] - 0.1,
-         f"{v['availability']:.2f} vs {w['availability']:.2f} %"),
-        ("3c. availability worst 5 % >= CHM's", v["availability_worst5"] >= w["availability_worst5"],
-         f"{v['availability_worst5']:.2f} vs {w['availability_worst5']:.2f} %"),
-        ("3d. RSRQ violation time <= CHM + 2 points", v["rsrq_violation"] <= w["rsrq_violation"] + 2,
-         f"{v['rsrq_violation']:.2f} vs {w['rsrq_violation']:.2f} %"),
+        (
+            "1. handovers <= 0.5 x CHM",
+            v["handovers"] <= 0.5 * w["handovers"],
+            f"{v['handovers']:.2f} vs 0.5 x {w['handovers']:.2f}",
+        ),
+        (
+            "2a. ping-pongs per flight-minute <= CHM",
+            v["pp_per_min"] <= w["pp_per_min"],
+            f"{v['pp_per_min']:.3f} vs {w['pp_per_min']:.3f}",
+        ),
+        (
+            "2b. at most 1 flight in 200 with > 5 ping-pongs",
+            v["pp_over_5"] <= 0.5,
+            f"{v['pp_over_5']:.2f} % of {n_flights} flights",
+        ),
+        (
+            "3a. lost data <= CHM + 1 %",
+            v["lost_mbit"] <= 1.01 * w["lost_mbit"],
+            f"{v['lost_mbit']:.1f} vs {w['lost_mbit']:.1f} Mbit",
+        ),
+        (
+            "3b. availability mean >= CHM - 0.1 point",
+            v["availability"] >= w["availability"] - 0.1,
+            f"{v['availability']:.2f} vs {w['availability']:.2f} %",
+        ),
+        (
+            "3c. availability worst 5 % >= CHM's",
+            v["availability_worst5"] >= w["availability_worst5"],
+            f"{v['availability_worst5']:.2f} vs {w['availability_worst5']:.2f} %",
+        ),
+        (
+            "3d. RSRQ violation time <= CHM + 2 points",
+            v["rsrq_violation"] <= w["rsrq_violation"] + 2,
+            f"{v['rsrq_violation']:.2f} vs {w['rsrq_violation']:.2f} %",
+        ),
         ("4a. handovers with a full buffer <= 50 %", v["ho_full"] <= 50, f"{v['ho_full']:.1f} %"),
         ("4b. handovers with an empty buffer <= 5 %", v["ho_empty"] <= 5, f"{v['ho_empty']:.1f} %"),
     ]
@@ -56,11 +78,14 @@ def main():
     n = args.flights * len(args.seeds)
     res = {c.name: with_intervals(flights(c, cfg, args.flights, args.seeds)) for c in (CHM(), SAMRO())}
     for k, ckpt in enumerate(ckpts):
-        res["DQN" if len(ckpts) == 1 else f"DQN {k}"] = with_intervals(flights(DQNController(ckpt.net), cfg,
-                                                                               args.flights, args.seeds))
+        res["DQN" if len(ckpts) == 1 else f"DQN {k}"] = with_intervals(
+            flights(DQNController(ckpt.net), cfg, args.flights, args.seeds)
+        )
     f = cfg.flight
-    print(f"Table I: {args.flights} held-out flights of {f.duration_s:g} s x evaluation seeds {args.seeds} ({n} "
-          f"flights per policy); value [bootstrap 95 % interval]; reward of the DQN: {ckpts[0].sim_config.reward}")
+    print(
+        f"Table I: {args.flights} held-out flights of {f.duration_s:g} s x evaluation seeds {args.seeds} ({n} "
+        f"flights per policy); value [bootstrap 95 % interval]; reward of the DQN: {ckpts[0].sim_config.reward}"
+    )
     print(format_rows(res))
     for name in [k for k in res if k.startswith("DQN")]:
         print(f"\ntargets, {name}:")

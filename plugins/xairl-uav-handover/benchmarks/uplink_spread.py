@@ -7,12 +7,14 @@ Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/uplink_spread.py [--
      [--states 400] [--demonstrations N]   (about 2 minutes of training per spread on 2 cores; the figures in
      docs/uav-reference.md, 2026-12-02, trained plain DQNs: --demonstrations 0)
 """
+
 import argparse
 import shutil
 import tempfile
 from pathlib import Path
 
 import numpy as np
+
 import xairl
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.features import FEATURES
@@ -22,8 +24,11 @@ from xairl_uav_handover.train import TrainConfig, train_checkpoint
 
 def ranks(ckpt, n_states: int, seed: int = 0) -> tuple[int, int, list[str]]:
     """(the buffer's rank by margin, by chosen score, the top 3 by margin), ranks counted from 1."""
-    exp = xairl.explain(uav_policy(ckpt), dqn_decision_states(ckpt, n_states, seed),
-                        background=background_states(100, seed=seed + 7, config=ckpt.sim_config))
+    exp = xairl.explain(
+        uav_policy(ckpt),
+        dqn_decision_states(ckpt, n_states, seed),
+        background=background_states(100, seed=seed + 7, config=ckpt.sim_config),
+    )
     by_margin = [FEATURES[j] for j in np.argsort(-np.abs(exp.margin()).mean(axis=0))]
     by_score = [FEATURES[j] for j in np.argsort(-np.abs(exp.for_chosen()).mean(axis=0))]
     return by_margin.index("buffer_queue_size") + 1, by_score.index("buffer_queue_size") + 1, by_margin[:3]
@@ -35,8 +40,12 @@ def main():
     ap.add_argument("--episodes", type=int, default=40)
     ap.add_argument("--states", type=int, default=400)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--demonstrations", type=int, default=TrainConfig().demonstrations,
-                    help="episodes of the RSRQ rule's flights to learn from (0: a plain DQN)")
+    ap.add_argument(
+        "--demonstrations",
+        type=int,
+        default=TrainConfig().demonstrations,
+        help="episodes of the RSRQ rule's flights to learn from (0: a plain DQN)",
+    )
     args = ap.parse_args()
     folder = Path(tempfile.mkdtemp())  # the checkpoints of this run; removed at the end
     print(f"{'spread dB':>9} {'buffer rank (margin)':>21} {'(chosen score)':>15}  top 3 by margin")

@@ -1,4 +1,5 @@
 """The reference plugin's tests run with this plugin selected and no other."""
+
 import pytest
 
 from xairl import plugins

@@ -1,4 +1,5 @@
 """TR 36.777 oracle values (DESIGN.md) and the buffer recursion on hand-computed cases."""
+
 import numpy as np
 import pytest
 
@@ -21,7 +22,7 @@ def test_uma_oracle_values():
 def test_los_probability_shape():
     d = np.array([10.0, 200.0, 1000.0, 5000.0])
     assert (los_probability("UMa-AV", 120, d) == 1).all()  # LoS certain above 100 m
-    assert (los_probability("RMa-AV", 60, d) == 1).all()    # and above 40 m in RMa
+    assert (los_probability("RMa-AV", 60, d) == 1).all()  # and above 40 m in RMa
     for sc in SCENARIOS:
         p = los_probability(sc, 30, d)
         assert p[0] == 1 and (np.diff(p) <= 1e-12).all() and (p > 0).all()
@@ -58,10 +59,11 @@ def test_uplink_interference_rises_with_height_and_matches_the_link_budget():
 
 
 def test_buffer_recursion_by_hand():
-    q, lost = buffer_step(np.array([1000.0, 1000.0, 1.9e6]), np.array([500.0, 3000.0, 2e5]),
-                          np.array([2000.0, 1500.0, 0.0]), q_max=2e6)
-    np.testing.assert_allclose(q, [0.0, 2500.0, 2e6])   # clipped at 0; 1000+3000-1500; capped at q_max
-    np.testing.assert_allclose(lost, [0.0, 0.0, 1e5])   # overflow is lost data
+    q, lost = buffer_step(
+        np.array([1000.0, 1000.0, 1.9e6]), np.array([500.0, 3000.0, 2e5]), np.array([2000.0, 1500.0, 0.0]), q_max=2e6
+    )
+    np.testing.assert_allclose(q, [0.0, 2500.0, 2e6])  # clipped at 0; 1000+3000-1500; capped at q_max
+    np.testing.assert_allclose(lost, [0.0, 0.0, 1e5])  # overflow is lost data
 
 
 def test_uma_av_is_terrestrial_uma_up_to_22_5_m():
@@ -74,8 +76,9 @@ def test_uma_av_is_terrestrial_uma_up_to_22_5_m():
     assert path_loss("UMa-AV", 20, 500, 2.0, True) == path_loss("UMa-AV", 30, 500, 2.0, True)
     assert shadow_sigma("UMa-AV", 20, True) == 4.0
     # above 22.5 m the aerial model again
-    assert los_probability("UMa-AV", 23, 500) == pytest.approx(18 / 500 + np.exp(-500 / (4300 * np.log10(23) - 3800))
-                                                              * (1 - 18 / 500))
+    assert los_probability("UMa-AV", 23, 500) == pytest.approx(
+        18 / 500 + np.exp(-500 / (4300 * np.log10(23) - 3800)) * (1 - 18 / 500)
+    )
 
 
 def test_cells_differ_in_uplink_interference():

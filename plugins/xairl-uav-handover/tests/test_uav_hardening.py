@@ -2,6 +2,7 @@
 where a policy acts, and UKM zips that are encrypted, have over-long member names, are empty or truncated. Each is
 refused with one line that names the file (and the row), from the API and from ``xairl report``. Tests that build
 their files from a real export skip where ../shared/data/ukm-uav-lte is absent; the others need no data."""
+
 import io
 import re
 import zipfile
@@ -10,6 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
+
+from xairl import InputError
+from xairl.cli import main
+from xairl.plugin import CheckpointError
 from xairl_uav_handover import ukm
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.env import HandoverVecEnv
@@ -18,10 +23,6 @@ from xairl_uav_handover.features import FEATURES
 from xairl_uav_handover.policy import DQNController, build_qnet, greedy, load_checkpoint, save_checkpoint
 from xairl_uav_handover.real_data import PCI, RSRP, RealFlight, Walk, agreement, load_flight, walk
 from xairl_uav_handover.report import real_source
-
-from xairl import InputError
-from xairl.cli import main
-from xairl.plugin import CheckpointError
 
 UKM = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "ukm-uav-lte" / "raw"
 needs_data = pytest.mark.skipif(not UKM.is_dir(), reason="../shared/data/ukm-uav-lte is not here")
@@ -46,8 +47,21 @@ def one_line_error(capsys, argv) -> str:
 
 def report_argv(real, out: Path) -> list[str]:
     """The cheapest report that loads real flights (on a build that does not refuse them: a few seconds)."""
-    return ["report", "--plugin", "uav-handover", "--n", "10", "-o", f"real={real}", "-o", "flights=1",
-            "-o", "timelines=0", "--out", str(out)]
+    return [
+        "report",
+        "--plugin",
+        "uav-handover",
+        "--n",
+        "10",
+        "-o",
+        f"real={real}",
+        "-o",
+        "flights=1",
+        "-o",
+        "timelines=0",
+        "--out",
+        str(out),
+    ]
 
 
 # ---------------------------------------------------------------- item 3: non-finite measurements in real flights
@@ -85,8 +99,10 @@ def test_non_finite_measurement_is_refused_by_file_and_line(tmp_path, column, va
 
 
 @needs_data
-@pytest.mark.parametrize("column, value", [(RSRP, "1e300"), (RSRP, "-3.4e38"), ("RSRQ (LTE pcell)", "-1e30"),
-                                           ("RS SNR", "9e99"), (PCI, "1e20")])
+@pytest.mark.parametrize(
+    "column, value",
+    [(RSRP, "1e300"), (RSRP, "-3.4e38"), ("RSRQ (LTE pcell)", "-1e30"), ("RS SNR", "9e99"), (PCI, "1e20")],
+)
 def test_finite_but_impossible_measurement_is_refused(tmp_path, column, value):
     """Finite values no UE reports overflow the DQN's float32 input to inf: refused like inf."""
     path, line = hostile_export(tmp_path, column, value)
@@ -124,17 +140,29 @@ def test_report_names_the_skipped_hostile_flight(tmp_path, capsys):
 
 def small_flight(**changes) -> dict:
     n = 4
-    fields = dict(name="50m.csv", altitude_m=50.0, t=np.arange(n, dtype=float), xy=np.zeros((n, 2)),
-                  pci=np.array([1.0, 1, 2, 2]), rsrp=np.full(n, -80.0), rsrq=np.full(n, -10.0), snr=np.full(n, 5.0),
-                  nb_pci=np.array([[2.0], [2], [1], [1]]), nb_rsrp=np.full((n, 1), -82.0),
-                  nb_rsrq=np.full((n, 1), -11.0))
+    fields = dict(
+        name="50m.csv",
+        altitude_m=50.0,
+        t=np.arange(n, dtype=float),
+        xy=np.zeros((n, 2)),
+        pci=np.array([1.0, 1, 2, 2]),
+        rsrp=np.full(n, -80.0),
+        rsrq=np.full(n, -10.0),
+        snr=np.full(n, 5.0),
+        nb_pci=np.array([[2.0], [2], [1], [1]]),
+        nb_rsrp=np.full((n, 1), -82.0),
+        nb_rsrq=np.full((n, 1), -11.0),
+    )
     return fields | changes
 
 
 def test_a_flight_built_in_code_is_checked_too():
     walk(RealFlight(**small_flight()))  # a sane one walks
-    for field, bad in (("rsrp", np.array([-80.0, np.inf, -80, -80])), ("xy", np.array([[0, 0], [0, np.nan]] * 2)),
-                       ("nb_rsrp", np.array([[-82.0], [np.inf], [-82], [-82]]))):
+    for field, bad in (
+        ("rsrp", np.array([-80.0, np.inf, -80, -80])),
+        ("xy", np.array([[0, 0], [0, np.nan]] * 2)),
+        ("nb_rsrp", np.array([[-82.0], [np.inf], [-82], [-82]])),
+    ):
         with pytest.raises(InputError, match=rf"50m.csv: .*{field}.* sample 1") as info:
             walk(RealFlight(**small_flight(**{field: bad})))
         assert "\n" not in str(info.value)
@@ -172,8 +200,9 @@ def test_nan_q_values_raise_instead_of_picking_stay(ckpt):
 
 
 def test_evaluation_with_a_nan_network_raises(ckpt):
-    cfg = SimConfig.model_validate(ckpt.sim_config.model_dump() | {"flight": ckpt.sim_config.flight.model_dump()
-                                                                   | {"duration_s": 1.0}})
+    cfg = SimConfig.model_validate(
+        ckpt.sim_config.model_dump() | {"flight": ckpt.sim_config.flight.model_dump() | {"duration_s": 1.0}}
+    )
     with pytest.raises(CheckpointError, match="NaN or inf"):
         run_flights(DQNController(nan_net(ckpt)), cfg, 2, seed=0)
 
@@ -204,9 +233,9 @@ def small_walk() -> Walk:
 
 @pytest.mark.parametrize("action", [np.nan, -1, 7, 0.5])
 def test_open_loop_replay_refuses_a_nan_action(action):
-    assert agreement([small_walk()], lambda w: (lambda s, c, t: 1)).handover_agreement == 1.0
+    assert agreement([small_walk()], lambda w: lambda s, c, t: 1).handover_agreement == 1.0
     with pytest.raises(InputError, match="action") as info:
-        agreement([small_walk()], lambda w: (lambda s, c, t: action if t == 2 else 0))
+        agreement([small_walk()], lambda w: lambda s, c, t: action if t == 2 else 0)
     assert "sample 2" in str(info.value) and "\n" not in str(info.value)
 
 
@@ -238,11 +267,13 @@ def encrypted(data: bytes) -> bytes:
 def hostile_zips(tmp_path: Path) -> dict[str, tuple[Path, str]]:
     """name: (the zip, a regex its one-line refusal must match)."""
     good = zip_bytes({"Measured Data/100m.csv": CSV, "Measured Data/25m.csv": CSV})
-    made = {"encrypted": (encrypted(good), r"'Measured Data/100m.csv' is encrypted"),
-            "long-name": (zip_bytes({f"Measured Data/{'a' * 300}100m.csv": CSV}), r"longer than the 255 bytes"),
-            "empty": (b"", r"is empty \(0 bytes\)"),
-            "truncated": (good[: len(good) * 2 // 3], r"truncated"),
-            "not-a-zip": (CSV, r"neither a folder nor a zip")}
+    made = {
+        "encrypted": (encrypted(good), r"'Measured Data/100m.csv' is encrypted"),
+        "long-name": (zip_bytes({f"Measured Data/{'a' * 300}100m.csv": CSV}), r"longer than the 255 bytes"),
+        "empty": (b"", r"is empty \(0 bytes\)"),
+        "truncated": (good[: len(good) * 2 // 3], r"truncated"),
+        "not-a-zip": (CSV, r"neither a folder nor a zip"),
+    }
     out = {}
     for name, (data, match) in made.items():
         path = tmp_path / f"{name}.zip"

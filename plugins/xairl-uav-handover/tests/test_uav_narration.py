@@ -1,16 +1,17 @@
 """Narrating the reference DQN: the handover template, domain comparisons, and the verifier's mutation corpus."""
+
 import collections
 import re
 
 import numpy as np
 import pytest
-from xairl_uav_handover.features import LABEL_WORDS, handover_facts
-from xairl_uav_handover.policy import uav_policy
 
 import xairl
 from xairl import prompts
 from xairl.facts import decision_facts
 from xairl.testing import corpus
+from xairl_uav_handover.features import LABEL_WORDS, handover_facts
+from xairl_uav_handover.policy import uav_policy
 
 
 @pytest.fixture(scope="module")
@@ -32,13 +33,25 @@ def test_handover_facts():
     state = [0, 0, 100, 0, 7, -70, -66, -80, -90, -12, -8, -20, -25]
     f = handover_facts(state, 1, 0)
     assert isinstance(f, xairl.facts.DomainFacts)
-    assert f.extras == {"decision": "hand over", "serving_bs": 7, "target_candidate": 1, "compared_candidate": 1,
-                        "runner_up_candidate": 0, "buffer_fill": 0.0, "buffer_trend": "", "a3_decisions": 1,
-                        "chm": "start its time-to-trigger"}
-    assert f.comparisons == (xairl.facts.Comparison("the strongest neighbour's RSRP was 4.0 dB above the serving BS's "
-                                              "RSRP", 4.0, "dB"),)
-    assert handover_facts(state, 0, 2).comparisons[0].text.startswith("the second strongest neighbour's RSRP "
-                                                                      "was 10.0 dB below")
+    assert f.extras == {
+        "decision": "hand over",
+        "serving_bs": 7,
+        "target_candidate": 1,
+        "compared_candidate": 1,
+        "runner_up_candidate": 0,
+        "buffer_fill": 0.0,
+        "buffer_trend": "",
+        "a3_decisions": 1,
+        "chm": "start its time-to-trigger",
+    }
+    assert f.comparisons == (
+        xairl.facts.Comparison("the strongest neighbour's RSRP was 4.0 dB above the serving BS's RSRP", 4.0, "dB"),
+    )
+    assert (
+        handover_facts(state, 0, 2)
+        .comparisons[0]
+        .text.startswith("the second strongest neighbour's RSRP was 10.0 dB below")
+    )
 
 
 def test_handover_facts_with_history():
@@ -52,8 +65,11 @@ def test_handover_facts_with_history():
     f = handover_facts(now, 0, 1, history=np.array([weak, now, emptier]))
     assert f.extras["a3_decisions"] == 3 and f.extras["chm"] == "hand over to candidate 1"
     assert f.extras["buffer_fill"] == 25.0 and f.extras["buffer_trend"] == "rising"
-    assert f.comparisons[1] == xairl.facts.Comparison("the strongest neighbour has been more than 2 dB above the serving BS "
-                                                "for 3 consecutive decisions", 3, "consecutive")
+    assert f.comparisons[1] == xairl.facts.Comparison(
+        "the strongest neighbour has been more than 2 dB above the serving BS for 3 consecutive decisions",
+        3,
+        "consecutive",
+    )
     assert handover_facts(now, 0, 1, history=np.array([now, weak])).extras["chm"] == "start its time-to-trigger"
     assert handover_facts(weak, 0, 1).extras["chm"] == "stay"
 
@@ -62,14 +78,17 @@ def test_a3_sentence_verifies_when_the_compared_candidate_is_not_the_strongest_n
     """The A3 sentence cites the rule's 2 dB offset while the first comparison is about another candidate (a real
     state where the DQN stayed with candidate 3 as runner-up and candidate 1 had met A3 for two decisions)."""
     policy, _, bg = uav
-    state = np.array([61.9, -505.2, 20.0, 0.0, 6.0, -82.0, -79.0, -81.0, -81.0, -16.0, -14.0, -16.0, -12.0],
-                     dtype=np.float32)
+    state = np.array(
+        [61.9, -505.2, 20.0, 0.0, 6.0, -82.0, -79.0, -81.0, -81.0, -16.0, -14.0, -16.0, -12.0], dtype=np.float32
+    )
     exp = xairl.explain(policy, state[None], background=bg)
     facts = handover_facts(state, 0, 3, history=state[None])  # with the state itself: two decisions
     assert facts.extras["chm"] == "hand over to candidate 1"
-    text = ("The third strongest neighbour's RSRP was {} dB above the serving BS's RSRP; the strongest neighbour has "
-            "been more than {} dB above the serving BS for 2 consecutive decisions, so the conventional A3 rule (CHM) "
-            "would hand over to candidate 1.")
+    text = (
+        "The third strongest neighbour's RSRP was {} dB above the serving BS's RSRP; the strongest neighbour has "
+        "been more than {} dB above the serving BS for 2 consecutive decisions, so the conventional A3 rule (CHM) "
+        "would hand over to candidate 1."
+    )
     assert xairl.verify(text.format("1.0", "2"), exp, 0, policy, facts=facts).ok
     assert not xairl.verify(text.format("1.0", "5"), exp, 0, policy, facts=facts).ok  # a wrong offset is caught
     assert not xairl.verify(text.format("4.0", "2"), exp, 0, policy, facts=facts).ok  # and a wrong gap
@@ -78,8 +97,9 @@ def test_a3_sentence_verifies_when_the_compared_candidate_is_not_the_strongest_n
 def test_mutation_corpus_on_the_reference_policy(uav):
     policy, exp, _ = uav
     # 20 states keep every kind of mutation (the full corpus of 7,641: benchmarks/bench_narration.py --verifier-only)
-    cases = corpus(exp, policy, ("explain_action", "explain_score", "why_not", "handover"), range(20),
-                   label_words=LABEL_WORDS)
+    cases = corpus(
+        exp, policy, ("explain_action", "explain_score", "why_not", "handover"), range(20), label_words=LABEL_WORDS
+    )
     wrongly = [(c.kind, c.text) for c in cases if xairl.verify(c.text, exp, c.index, policy).ok != c.should_pass]
     kinds = collections.Counter(c.kind for c in cases)
     assert len(cases) > 1500 and len(kinds) >= 8
@@ -142,11 +162,17 @@ def test_wrong_numbers_that_equal_another_fact_stay_contradicted(uav):
         margin = exp.values[i, :, chosen] - exp.values[i, :, runner]
         if chosen != runner and abs(margin[r1] - margin[r2]) > 1:
             c = f"{margin[r1]:+.1f}"
-            text = (f"The strongest neighbour's RSRP pushed toward {exp.action_names[chosen]} over "
-                    f"{exp.action_names[runner]} by {c}; the second strongest neighbour's RSRP pushed toward "
-                    f"{exp.action_names[chosen]} over {exp.action_names[runner]} by {c}.")
-            claims = [cl for s in xairl.verify(text, exp, i, policy).sentences for cl in s.claims
-                      if cl.kind == "number" and cl.text == c]
+            text = (
+                f"The strongest neighbour's RSRP pushed toward {exp.action_names[chosen]} over "
+                f"{exp.action_names[runner]} by {c}; the second strongest neighbour's RSRP pushed toward "
+                f"{exp.action_names[chosen]} over {exp.action_names[runner]} by {c}."
+            )
+            claims = [
+                cl
+                for s in xairl.verify(text, exp, i, policy).sentences
+                for cl in s.claims
+                if cl.kind == "number" and cl.text == c
+            ]
             assert [cl.status for cl in claims] == ["verified", "contradicted"], (text, claims)
             checked += 1
         other = float(exp.outputs[i, runner])

@@ -1,19 +1,20 @@
 """Plugin registration, checkpoints, the pretrained DQN, training smoke test and the `xairl uav` commands."""
+
 import json
 
 import numpy as np
 import pytest
 import torch
-from xairl_uav_handover.baselines import CHM, SAMRO
-from xairl_uav_handover.evaluate import rankings
-from xairl_uav_handover.features import FEATURES
-from xairl_uav_handover.policy import DQNController, build_qnet, load_checkpoint, save_checkpoint, uav_policy
-from xairl_uav_handover.table import ROWS, flights, with_intervals
 
 import xairl
 from xairl import plugins
 from xairl.cli import main
 from xairl.plugin import CheckpointError
+from xairl_uav_handover.baselines import CHM, SAMRO
+from xairl_uav_handover.evaluate import rankings
+from xairl_uav_handover.features import FEATURES
+from xairl_uav_handover.policy import DQNController, build_qnet, load_checkpoint, save_checkpoint, uav_policy
+from xairl_uav_handover.table import ROWS, flights, with_intervals
 
 
 def test_registered_through_entry_point():
@@ -36,8 +37,9 @@ def test_pretrained_dqn_deep_shap_matches_shap():
     policy = uav_policy()
     bg, x = policy.background(40, seed=1), policy.background(10, seed=2)
     ours = xairl.explain(policy, x, background=bg, method="deep_shap")
-    ref = np.asarray(shap.DeepExplainer(policy.module, torch.as_tensor(bg)).shap_values(
-        torch.as_tensor(x), check_additivity=False))
+    ref = np.asarray(
+        shap.DeepExplainer(policy.module, torch.as_tensor(bg)).shap_values(torch.as_tensor(x), check_additivity=False)
+    )
     np.testing.assert_allclose(ours.values, ref, rtol=0, atol=1e-5)
     assert ours.additivity_gap.max() < 1e-4
 
@@ -50,8 +52,10 @@ def test_pretrained_dqn_on_table_one():
     decisions, service kept. The rest of what the DQN pays is measured, not hidden: benchmarks/table_one.py and the
     report's Table I."""
     ckpt = load_checkpoint()
-    res = {c.name: with_intervals(flights(c, ckpt.sim_config, 100, [0]), resamples=200)
-           for c in (CHM(), SAMRO(), DQNController(ckpt.net))}
+    res = {
+        c.name: with_intervals(flights(c, ckpt.sim_config, 100, [0]), resamples=200)
+        for c in (CHM(), SAMRO(), DQNController(ckpt.net))
+    }
     chm, sa, dqn = ({k: v[0] for k, v in res[name].items()} for name in ("CHM", "SA-MRO", "DQN"))
     assert chm["handovers"] > sa["handovers"] > dqn["handovers"] and dqn["handovers"] <= 0.5 * chm["handovers"]
     assert res["DQN"]["handovers"][2] < res["CHM"]["handovers"][1]
@@ -78,27 +82,37 @@ def test_corrupt_and_mismatched_checkpoints(tmp_path):
     with pytest.raises(CheckpointError, match="no such checkpoint"):
         load_checkpoint(tmp_path / "missing.safetensors")
     other = tmp_path / "other.safetensors"
-    save_checkpoint(build_qnet(np.zeros(len(FEATURES)), np.ones(len(FEATURES)), hidden=(8,)), other, {"hidden": [64, 64]})
-    with pytest.raises(CheckpointError, match=r"metadata says hidden=\[64, 64\] but its tensors have hidden widths \[8\]"):
+    save_checkpoint(
+        build_qnet(np.zeros(len(FEATURES)), np.ones(len(FEATURES)), hidden=(8,)), other, {"hidden": [64, 64]}
+    )
+    with pytest.raises(
+        CheckpointError, match=r"metadata says hidden=\[64, 64\] but its tensors have hidden widths \[8\]"
+    ):
         load_checkpoint(other)
 
 
 def test_checkpoint_metadata_is_checked_against_its_tensors_before_anything_is_built(tmp_path, monkeypatch):
     """(issue 27) a 200-byte file whose metadata says hidden=[100000]*3 used to allocate 40 GB before the shape
     check: the widths are now read from the tensors and the network is never built."""
-    import xairl_uav_handover.policy as module
     from safetensors.torch import save_file
+
+    import xairl_uav_handover.policy as module
 
     built = []
     monkeypatch.setattr(module, "build_qnet", lambda *a, **k: built.append(a) or pytest.fail("network built"))
     tiny = tmp_path / "tiny.safetensors"
     save_file({"0.weight": torch.zeros(2)}, str(tiny), metadata={"xairl": json.dumps({"hidden": [100000] * 3})})
     assert tiny.stat().st_size < 300
-    with pytest.raises(CheckpointError, match=r"hidden=\[100000, 100000, 100000\] but its tensors have hidden "
-                                              r"widths \[\]"):
+    with pytest.raises(
+        CheckpointError,
+        match=r"hidden=\[100000, 100000, 100000\] but its tensors have hidden "
+        r"widths \[\]",
+    ):
         load_checkpoint(tiny)
-    for meta, tensors, message in [([1], {"0.weight": torch.zeros(2)}, "metadata is not a JSON object"),
-                                   ({"hidden": [64]}, {"a.weight": torch.zeros(())}, "tensors are not those")]:
+    for meta, tensors, message in [
+        ([1], {"0.weight": torch.zeros(2)}, "metadata is not a JSON object"),
+        ({"hidden": [64]}, {"a.weight": torch.zeros(())}, "tensors are not those"),
+    ]:
         save_file(tensors, str(tiny), metadata={"xairl": json.dumps(meta)})
         with pytest.raises(CheckpointError, match=message):
             load_checkpoint(tiny)
@@ -107,15 +121,54 @@ def test_checkpoint_metadata_is_checked_against_its_tensors_before_anything_is_b
 
 def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
     ckpt = tmp_path / "tiny.safetensors"
-    assert main(["uav", "train", "--episodes", "1", "--flights", "2", "--duration", "3", "--seed", "4",
-                 "--demonstrations", "1", "--pretrain-updates", "5", "--no-progress", "--out", str(ckpt)]) == 0
+    assert (
+        main(
+            [
+                "uav",
+                "train",
+                "--episodes",
+                "1",
+                "--flights",
+                "2",
+                "--duration",
+                "3",
+                "--seed",
+                "4",
+                "--demonstrations",
+                "1",
+                "--pretrain-updates",
+                "5",
+                "--no-progress",
+                "--out",
+                str(ckpt),
+            ]
+        )
+        == 0
+    )
     meta = load_checkpoint(ckpt).meta
     assert meta["seed"] == 4 and meta["train_config"]["episodes"] == 1 and len(meta["history"]) == 1
     assert meta["train_config"]["demonstrations"] == 1 and meta["train_config"]["pretrain_updates"] == 5
     assert "--demonstrations 1 --pretrain-updates 5 --eps-start 0.2 --seed 4" in meta["command"]
     capsys.readouterr()
-    assert main(["uav", "evaluate", "--checkpoint", str(ckpt), "--flights", "3", "--seeds", "0", "1", "--duration",
-                 "2", "--json"]) == 0
+    assert (
+        main(
+            [
+                "uav",
+                "evaluate",
+                "--checkpoint",
+                str(ckpt),
+                "--flights",
+                "3",
+                "--seeds",
+                "0",
+                "1",
+                "--duration",
+                "2",
+                "--json",
+            ]
+        )
+        == 0
+    )
     report = json.loads(capsys.readouterr().out)
     assert report["flights"] == 3 and report["seeds"] == [0, 1]
     assert set(report["policies"]) == {"CHM", "SA-MRO", "DQN"}
@@ -128,15 +181,18 @@ def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
     assert "ping-pong share, 10 s window (%)" in out and "beyond the intervals on" in out
 
 
-@pytest.mark.parametrize("argv, match", [
-    (["uav", "evaluate", "--duration", "-1"], "flight.duration_s"),
-    (["uav", "evaluate", "--checkpoint", "/nope.safetensors"], "no such checkpoint"),
-    (["uav", "train", "--episodes", "0"], "at least 1"),
-    (["uav", "train", "--demonstrations", "-1"], "--demonstrations: Input should be greater than or equal to 0"),
-    (["uav", "train", "--eps-start", "2"], "--eps-start: Input should be less than or equal to 1"),
-    (["uav", "evaluate", "--seeds", "0", "0"], "distinct"),
-    (["uav", "evaluate", "--seeds", "-1"], "at least 0"),
-])
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (["uav", "evaluate", "--duration", "-1"], "flight.duration_s"),
+        (["uav", "evaluate", "--checkpoint", "/nope.safetensors"], "no such checkpoint"),
+        (["uav", "train", "--episodes", "0"], "at least 1"),
+        (["uav", "train", "--demonstrations", "-1"], "--demonstrations: Input should be greater than or equal to 0"),
+        (["uav", "train", "--eps-start", "2"], "--eps-start: Input should be less than or equal to 1"),
+        (["uav", "evaluate", "--seeds", "0", "0"], "distinct"),
+        (["uav", "evaluate", "--seeds", "-1"], "at least 0"),
+    ],
+)
 def test_uav_command_errors_are_one_line(capsys, argv, match):
     assert main(argv) == 2
     err = capsys.readouterr().err

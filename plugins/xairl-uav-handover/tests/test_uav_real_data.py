@@ -1,10 +1,15 @@
 """Real flight data (../shared/data, never committed) and the report. Skips cleanly where the data is absent."""
+
 import json
 import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from xairl import InputError
+from xairl.cli import main
+from xairl.plugin import StateRecord
 from xairl_uav_handover.config import CHMConfig
 from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint
 from xairl_uav_handover.real_data import (
@@ -16,10 +21,6 @@ from xairl_uav_handover.real_data import (
     walk,
 )
 from xairl_uav_handover.report import agreement_rows, band_rows, outside
-
-from xairl import InputError
-from xairl.cli import main
-from xairl.plugin import StateRecord
 
 DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
 UKM = DATA / "ukm-uav-lte" / "raw"
@@ -39,25 +40,29 @@ def test_load_one_flight():
     assert int((w.next_serving != w.serving).sum()) == f.observed_handovers
     assert (w.states[:, 5] == f.rsrp).all(), "candidate 0 is the network's serving cell"
     for state, cand in zip(w.states, w.candidates):
-        assert (np.diff(state[6:5 + len(cand)]) <= 0).all(), "measured neighbours sorted by RSRP"
-        assert (state[9 + len(cand):] == -24.0).all(), "empty slots at the detection limit"
+        assert (np.diff(state[6 : 5 + len(cand)]) <= 0).all(), "measured neighbours sorted by RSRP"
+        assert (state[9 + len(cand) :] == -24.0).all(), "empty slots at the detection limit"
     assert 0 < (w.queue_bits > 0).mean() < 1 and w.queue_bits.max() <= 2e6
 
 
 @needs_data
 def test_open_loop_agreement_on_known_deciders():
     w = walk(load_flight(UKM / "100m.csv"))
-    stay = agreement([w], lambda _w: (lambda s, c, t: 0))
+    stay = agreement([w], lambda _w: lambda s, c, t: 0)
     assert (stay.proposals, stay.stay_agreement, stay.handover_agreement) == (0, 1.0, 0.0)
     assert stay.network_handovers == int((w.next_serving != w.serving).sum())
     follow = dict(zip(w.t.tolist(), w.next_serving.tolist()))  # an oracle that does what the network did next
-    oracle = agreement([w], lambda _w: (lambda s, c, t: c.index(follow[t]) if follow[t] in c else 0))
+    oracle = agreement([w], lambda _w: lambda s, c, t: c.index(follow[t]) if follow[t] in c else 0)
     assert oracle.stay_agreement == 1.0 and oracle.target_agreement == oracle.handover_agreement > 0.5
     assert oracle.new_proposals == oracle.proposals  # each of its proposals is carried out, so none stands
     # a decider that always proposes the strongest neighbour: one standing proposal per (serving, neighbour) pair
-    eager = agreement([w], lambda _w: (lambda s, c, t: 1 if len(c) > 1 else 0))
-    runs = sum(1 for i in range(len(w.t) - 1) if len(w.candidates[i]) > 1 and (
-        i == 0 or len(w.candidates[i - 1]) < 2 or w.candidates[i - 1][:2] != w.candidates[i][:2]))
+    eager = agreement([w], lambda _w: lambda s, c, t: 1 if len(c) > 1 else 0)
+    runs = sum(
+        1
+        for i in range(len(w.t) - 1)
+        if len(w.candidates[i]) > 1
+        and (i == 0 or len(w.candidates[i - 1]) < 2 or w.candidates[i - 1][:2] != w.candidates[i][:2])
+    )
     assert eager.new_proposals == runs < eager.proposals
     assert chm_handovers(load_flight(UKM / "100m.csv")) > 0
 
@@ -101,8 +106,9 @@ def test_malformed_files_name_file_and_column(tmp_path):
     (tmp_path / "20m.csv").write_text("\n".join(src[:1]) + "\n")  # truncated: a header and nothing else
     header = src[0].split(",")
     k = header.index("RS SNR")
-    (tmp_path / "30m.csv").write_text("\n".join(",".join(c for i, c in enumerate(line.split(",")) if i != k)
-                                                for line in src[:400]))
+    (tmp_path / "30m.csv").write_text(
+        "\n".join(",".join(c for i, c in enumerate(line.split(",")) if i != k) for line in src[:400])
+    )
     j = header.index("RSRP (LTE pcell)")
     rows = [line.split(",") for line in src[1:400]]
     for r in rows:
@@ -111,9 +117,12 @@ def test_malformed_files_name_file_and_column(tmp_path):
     (tmp_path / "40m.csv").write_text("\n".join([src[0]] + [",".join(r) for r in rows]))
     (tmp_path / "noheight.csv").write_text("\n".join(src[:400]))
     shutil.copy(UKM / "25m.csv", tmp_path / "25m.csv")
-    for name, match in (("20m.csv", "no rows with a parseable Time"), ("30m.csv", "missing column 'RS SNR'"),
-                        ("40m.csv", r"'RSRP \(LTE pcell\)' has median .* wrong units"),
-                        ("noheight.csv", "altitude is read from the file name")):
+    for name, match in (
+        ("20m.csv", "no rows with a parseable Time"),
+        ("30m.csv", "missing column 'RS SNR'"),
+        ("40m.csv", r"'RSRP \(LTE pcell\)' has median .* wrong units"),
+        ("noheight.csv", "altitude is read from the file name"),
+    ):
         with pytest.raises(InputError, match=match) as info:
             load_flight(tmp_path / name)
         assert name in str(info.value)
@@ -131,7 +140,10 @@ def test_baltaci_rates():
 def sim_report(tmp_path_factory):
     """One report without real data, read by the tests below (a report costs seconds)."""
     out = tmp_path_factory.mktemp("sim") / "rep"
-    assert main(["report", "--plugin", "uav-handover", "--n", "40", "-o", "flights=20", "--narrate", "--out", str(out)]) == 0
+    assert (
+        main(["report", "--plugin", "uav-handover", "--n", "40", "-o", "flights=20", "--narrate", "--out", str(out)])
+        == 0
+    )
     return out
 
 
@@ -156,8 +168,24 @@ def test_report_with_real_data(tmp_path):
         shutil.copy(UKM / name, real / name)
     shutil.copytree(BALTACI, tmp_path / "data" / "baltaci-imc22-handovers")
     out = tmp_path / "rep"
-    assert main(["report", "--plugin", "uav-handover", "--n", "30", "-o", f"real={real}", "-o", "flights=20", "--out",
-                 str(out)]) == 0
+    assert (
+        main(
+            [
+                "report",
+                "--plugin",
+                "uav-handover",
+                "--n",
+                "30",
+                "-o",
+                f"real={real}",
+                "-o",
+                "flights=20",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     html = (out / "report.html").read_text()
     assert "Calibration: handovers per minute by altitude band (2 real flights" in html and "Baltaci" in html
     assert "Open-loop agreement with the live network" in html and "Spearman rank correlation real vs simulated" in html
@@ -172,8 +200,23 @@ def test_report_renders_in_headless_chromium(sim_report, tmp_path):
 
     out = sim_report
     shot = tmp_path / "shot.png"
-    subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
-                    "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                    f"--user-data-dir={tmp_path / 'profile'}", f"--screenshot={shot}", "--window-size=1200,2000",
-                    (out / "report.html").as_uri()], check=True, capture_output=True, timeout=120)
+    subprocess.run(
+        [
+            "chromium",
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            f"--user-data-dir={tmp_path / 'profile'}",
+            f"--screenshot={shot}",
+            "--window-size=1200,2000",
+            (out / "report.html").as_uri(),
+        ],
+        check=True,
+        capture_output=True,
+        timeout=120,
+    )
     assert shot.stat().st_size > 20_000

@@ -1,4 +1,5 @@
 """Simulator, Gymnasium env, baselines and configs."""
+
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
@@ -67,11 +68,11 @@ def test_handover_bookkeeping_and_pingpong():
     sim = Simulator(cfg, n_uavs=1, seed=0)
     a, b = sim.serving[0], (sim.serving[0] + 1) % sim.N
     assert sim.step(np.array([b])).handover[0]
-    info = sim.step(np.array([a]))            # back to A after 1 step (0.04 s < 0.2 s): ping-pong
+    info = sim.step(np.array([a]))  # back to A after 1 step (0.04 s < 0.2 s): ping-pong
     assert info.handover[0] and info.pingpong[0] and not info.available[0]
     for _ in range(10):
         sim.step(np.array([a]))
-    info = sim.step(np.array([b]))            # to B after a long stay in A: a handover, not a ping-pong
+    info = sim.step(np.array([b]))  # to B after a long stay in A: a handover, not a ping-pong
     assert info.handover[0] and not info.pingpong[0]
 
 
@@ -166,13 +167,16 @@ def test_chm_and_samro_behaviour_on_flights():
     assert ctl.mro.cio.max() > 0 and (ctl.mro.cio != 0).sum() < ctl.mro.cio.size / 4  # a few pairs, not all
 
 
-@pytest.mark.parametrize("data, field", [
-    ({"radio": {"bs_tx_power_dbm": -5}}, "radio.bs_tx_power_dbm"),
-    ({"flight": {"altitude_m": (1, 150)}}, "altitude_m"),
-    ({"channel": {"scenario": "Mars-AV"}}, "channel.scenario"),
-    ({"channel": {"scenarios": "UMa-AV"}}, "channel.scenarios"),
-    ({"flight": {"dt_s": 0}}, "flight.dt_s"),
-])
+@pytest.mark.parametrize(
+    "data, field",
+    [
+        ({"radio": {"bs_tx_power_dbm": -5}}, "radio.bs_tx_power_dbm"),
+        ({"flight": {"altitude_m": (1, 150)}}, "altitude_m"),
+        ({"channel": {"scenario": "Mars-AV"}}, "channel.scenario"),
+        ({"channel": {"scenarios": "UMa-AV"}}, "channel.scenarios"),
+        ({"flight": {"dt_s": 0}}, "flight.dt_s"),
+    ],
+)
 def test_invalid_config_names_the_field(data, field):
     with pytest.raises(ValidationError) as info:
         SimConfig.model_validate(data)

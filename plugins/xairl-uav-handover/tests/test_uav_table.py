@@ -1,5 +1,6 @@
 """Table I with intervals: ping-pongs at every window agree with the simulator's own count, and each figure's
 bootstrap interval holds its value."""
+
 import numpy as np
 
 from xairl_uav_handover.baselines import CHM

@@ -1,5 +1,6 @@
 """ukm.py on a fresh machine: download from a loopback server, cache, checksum, offline, env var, unsafe zips, and
 the report's ``-o real=ukm`` when the data cannot be had. Offline; skips where ../shared/data is absent."""
+
 import hashlib
 import http.server
 import io

@@ -16,13 +16,13 @@ report. :class:`A3Trigger` runs on time stamps, so the same rule also runs on re
   where the handovers/RSRQ/availability frontier lies (benchmarks/rule_frontier.py) and is the demonstrator a DQN can
   learn from (``TrainConfig.demonstrations``).
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 from .config import CHMConfig, SAMROConfig
 from .features import BUFFER, RSRP, RSRQ, available_actions
-
 
 
 class A3Trigger:
@@ -84,8 +84,9 @@ class CHM:
         self.a3 = A3Trigger(env.sim.K, env.sim.N, env.sim.dt)
 
     def __call__(self, env) -> np.ndarray:
-        return _action_of(env, self.a3.targets(_candidate_rsrp(env), env.sim.serving, self.cfg.offset_db,
-                                               self.cfg.ttt_s))
+        return _action_of(
+            env, self.a3.targets(_candidate_rsrp(env), env.sim.serving, self.cfg.offset_db, self.cfg.ttt_s)
+        )
 
 
 class MobilityRobustness:
@@ -154,8 +155,9 @@ class SAMRO:
         if sim.last is not None:
             k, nb = np.arange(sim.K), env.candidates[:, 1]
             stronger = np.where((nb >= 0) & (rsrp[k, np.maximum(nb, 0)] > rsrp[k, sim.serving]), nb, -1)
-            self.mro.observe(sim.t * sim.dt, sim.serving, sim.last.radio_ok, stronger,
-                             sim.last.handover.astype(bool), self.previous)
+            self.mro.observe(
+                sim.t * sim.dt, sim.serving, sim.last.radio_ok, stronger, sim.last.handover.astype(bool), self.previous
+            )
         self.previous = sim.serving.copy()
         return _action_of(env, self.a3.targets(rsrp, sim.serving, self.mro.offsets(sim.serving), self.cfg.ttt_s))
 
@@ -223,8 +225,14 @@ class SAMROOnSamples(CHMOnSamples):
         rsrp = state[RSRP]
         stronger = self.col[candidates[1]] if len(candidates) > 1 and rsrp[1] > rsrp[0] else -1
         handed = previous is not None and previous != candidates[0]
-        self.mro.observe(t, serving, np.array([self._radio_ok(state)]), np.array([stronger]), np.array([handed]),
-                         np.array([self.col[previous] if previous is not None else serving[0]]))
+        self.mro.observe(
+            t,
+            serving,
+            np.array([self._radio_ok(state)]),
+            np.array([stronger]),
+            np.array([handed]),
+            np.array([self.col[previous] if previous is not None else serving[0]]),
+        )
         return self.mro.offsets(serving), self.sa.ttt_s
 
 

@@ -2,6 +2,7 @@
 
 The service rate is the uplink capacity (uplink.py).
 """
+
 from __future__ import annotations
 
 import numpy as np

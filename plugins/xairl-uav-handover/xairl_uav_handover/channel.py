@@ -6,6 +6,7 @@ UEs as terrestrial ones (its Table B-1 points to the UMa model of TR 36.873); th
 38.901's form (Tables 7.4.1-1, 7.4.2-1; shadowing 4 / 6 dB) for UMa-AV from 1.5 m, so flights as low as the real
 ones (20 m) can be simulated. The two models meet with a step at 22.5 m, as in the TR.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -36,7 +37,7 @@ def _terrestrial_uma_loss(h, d3d, fc_ghz, bs_height_m):
     d_bp = 4 * (bs_height_m - 1) * np.maximum(h - 1, 0.5) * fc_ghz * 1e9 / 3e8
     lg_fc = 20.0 * np.log10(fc_ghz)
     pl1 = 28.0 + 22.0 * np.log10(d3d) + lg_fc
-    pl2 = 28.0 + 40.0 * np.log10(d3d) + lg_fc - 9.0 * np.log10(d_bp ** 2 + (bs_height_m - h) ** 2)
+    pl2 = 28.0 + 40.0 * np.log10(d3d) + lg_fc - 9.0 * np.log10(d_bp**2 + (bs_height_m - h) ** 2)
     pl_los = np.where(d3d <= d_bp, pl1, pl2)
     return pl_los, np.maximum(pl_los, 13.54 + 39.08 * np.log10(d3d) + lg_fc - 0.6 * (h - 1.5))
 
@@ -60,8 +61,9 @@ def los_probability(scenario: str, h, d2d):
     h, d2d = np.asarray(h, dtype=float), np.asarray(d2d, dtype=float)
     lg = np.log10(h)
     if scenario == "UMa-AV":  # LoS certain above 100 m; terrestrial at or below 22.5 m
-        p = np.where(h > 100, 1.0, _los_from_d1_p1(d2d, np.maximum(460 * lg - 700, 18.0),
-                                                   np.maximum(4300 * lg - 3800, 1.0)))
+        p = np.where(
+            h > 100, 1.0, _los_from_d1_p1(d2d, np.maximum(460 * lg - 700, 18.0), np.maximum(4300 * lg - 3800, 1.0))
+        )
         return _where_low(h, p, lambda hl, dl: (_terrestrial_uma_los(hl, dl),), d2d)[0]
     if scenario == "UMi-AV":
         return _los_from_d1_p1(d2d, np.maximum(294.05 * lg - 432.94, 18.0), 233.98 * lg - 0.95)
@@ -79,8 +81,9 @@ def path_loss(scenario: str, h, d3d, fc_ghz: float, los, bs_height_m: float = 25
     if scenario == "UMa-AV":
         pl_los = 28.0 + 22.0 * lg_d + 20.0 * np.log10(fc_ghz)
         pl_nlos = -17.5 + (46.0 - 7.0 * lg_h) * lg_d + 20.0 * np.log10(40.0 * np.pi * fc_ghz / 3.0)
-        pl_los, pl_nlos = _where_low(h, (pl_los, pl_nlos),
-                                     lambda hl, dl: _terrestrial_uma_loss(hl, dl, fc_ghz, bs_height_m), d3d)
+        pl_los, pl_nlos = _where_low(
+            h, (pl_los, pl_nlos), lambda hl, dl: _terrestrial_uma_loss(hl, dl, fc_ghz, bs_height_m), d3d
+        )
     elif scenario == "UMi-AV":
         fspl = 32.45 + 20.0 * np.log10(fc_ghz) + 20.0 * lg_d
         pl_los = np.maximum(fspl, 30.9 + (22.25 - 0.5 * lg_h) * lg_d + 20.0 * np.log10(fc_ghz))

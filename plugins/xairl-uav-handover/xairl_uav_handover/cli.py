@@ -1,4 +1,5 @@
 """``xairl uav train`` and ``xairl uav evaluate``. Light at import: torch loads inside the commands."""
+
 from __future__ import annotations
 
 import argparse
@@ -11,25 +12,44 @@ def configure(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--episodes", type=int, default=40, help="training episodes (each flies --flights flights)")
     p.add_argument("--flights", type=int, default=64, help="flights simulated in parallel per episode")
     p.add_argument("--duration", type=float, default=None, help="seconds per flight (default: the sim config's)")
-    p.add_argument("--demonstrations", type=int, default=None, help="episodes of the RSRQ rule's flights to learn "
-                   "from (DQfD; default: TrainConfig's 10); 0: a plain DQN, as in the paper")
-    p.add_argument("--pretrain-updates", type=int, default=None, help="gradient steps on the demonstrations alone "
-                   "before the DQN flies (default: TrainConfig's 3000)")
-    p.add_argument("--eps-start", type=float, default=None, help="exploration at the start (default: 0.2 with "
-                   "demonstrations, as the pretrained network already acts like the rule; 1 without)")
+    p.add_argument(
+        "--demonstrations",
+        type=int,
+        default=None,
+        help="episodes of the RSRQ rule's flights to learn "
+        "from (DQfD; default: TrainConfig's 10); 0: a plain DQN, as in the paper",
+    )
+    p.add_argument(
+        "--pretrain-updates",
+        type=int,
+        default=None,
+        help="gradient steps on the demonstrations alone before the DQN flies (default: TrainConfig's 3000)",
+    )
+    p.add_argument(
+        "--eps-start",
+        type=float,
+        default=None,
+        help="exploration at the start (default: 0.2 with "
+        "demonstrations, as the pretrained network already acts like the rule; 1 without)",
+    )
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", default="uav-dqn.safetensors", help="checkpoint path (metadata holds the configs)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(run=run_train)
-    p = sub.add_parser("evaluate", help="CHM, SA-MRO and the DQN on the same held-out flights: Table I, each figure "
-                       "with its bootstrap 95 %% interval")
+    p = sub.add_parser(
+        "evaluate",
+        help="CHM, SA-MRO and the DQN on the same held-out flights: Table I, each figure "
+        "with its bootstrap 95 %% interval",
+    )
     p.add_argument("--flights", type=int, default=100, help="held-out flights per evaluation seed")
-    p.add_argument("--seeds", type=int, nargs="+", default=[0], help="evaluation seeds, distinct and >= 0 (their "
-                   "flights pooled)")
+    p.add_argument(
+        "--seeds", type=int, nargs="+", default=[0], help="evaluation seeds, distinct and >= 0 (their flights pooled)"
+    )
     p.add_argument("--duration", type=float, default=None, help="seconds per flight")
     p.add_argument("--checkpoint", default=None, help="DQN checkpoint (default: the plugin's pretrained one)")
-    p.add_argument("--json", action="store_true", help="print the table as JSON: per policy, per figure, "
-                   "[value, low, high]")
+    p.add_argument(
+        "--json", action="store_true", help="print the table as JSON: per policy, per figure, [value, low, high]"
+    )
     p.set_defaults(run=run_evaluate)
 
 
@@ -51,8 +71,14 @@ def _sim_config(base, duration=None):
 
 
 #: TrainConfig's fields that ``xairl uav train`` sets, by their flags
-_TRAIN_FLAGS = {"episodes": "--episodes", "n_flights": "--flights", "seed": "--seed",
-                "demonstrations": "--demonstrations", "pretrain_updates": "--pretrain-updates", "eps_start": "--eps-start"}
+_TRAIN_FLAGS = {
+    "episodes": "--episodes",
+    "n_flights": "--flights",
+    "seed": "--seed",
+    "demonstrations": "--demonstrations",
+    "pretrain_updates": "--pretrain-updates",
+    "eps_start": "--eps-start",
+}
 
 
 def run_train(args) -> int:
@@ -72,8 +98,9 @@ def run_train(args) -> int:
         tc = TrainConfig.model_validate({k: v for k, v in given.items() if v is not None})
     except ValidationError as exc:  # named by the flags the user typed
         message = validation_message(exc, "training settings")
-        raise InputError(re.sub(r"\b(" + "|".join(_TRAIN_FLAGS) + r")\b", lambda m: _TRAIN_FLAGS[m.group(1)],
-                                message)) from None
+        raise InputError(
+            re.sub(r"\b(" + "|".join(_TRAIN_FLAGS) + r")\b", lambda m: _TRAIN_FLAGS[m.group(1)], message)
+        ) from None
     seconds = train_checkpoint(tc, _sim_config(None, args.duration), args.out, progress=not args.no_progress)
     print(f"trained {args.episodes} episodes in {seconds} s; wrote {args.out}")
     return 0
@@ -89,17 +116,23 @@ def run_evaluate(args) -> int:
     if args.flights < 1:
         raise InputError("--flights must be at least 1.")
     if min(args.seeds) < 0 or len(set(args.seeds)) < len(args.seeds):
-        raise InputError(f"--seeds must be distinct and at least 0 (the same flights twice would narrow the "
-                         f"intervals falsely), got {' '.join(map(str, args.seeds))}.")
+        raise InputError(
+            f"--seeds must be distinct and at least 0 (the same flights twice would narrow the "
+            f"intervals falsely), got {' '.join(map(str, args.seeds))}."
+        )
     ckpt = load_checkpoint(args.checkpoint)
     cfg = _sim_config(ckpt.sim_config, args.duration)
-    res = {c.name: with_intervals(flights(c, cfg, args.flights, args.seeds))
-           for c in (CHM(), SAMRO(), DQNController(ckpt.net))}
+    res = {
+        c.name: with_intervals(flights(c, cfg, args.flights, args.seeds))
+        for c in (CHM(), SAMRO(), DQNController(ckpt.net))
+    }
     if args.json:
         print(json.dumps({"flights": args.flights, "seeds": args.seeds, "policies": res}, indent=2))
     else:
-        print(f"Table I: {args.flights} held-out flights of {cfg.flight.duration_s:g} s x evaluation seeds "
-              f"{args.seeds}, value [bootstrap 95 % interval]; a ping-pong is a handover back to the previous BS "
-              f"within the window its row names\n{format_rows(res)}\n"
-              f"{verdict(res)}")
+        print(
+            f"Table I: {args.flights} held-out flights of {cfg.flight.duration_s:g} s x evaluation seeds "
+            f"{args.seeds}, value [bootstrap 95 % interval]; a ping-pong is a handover back to the previous BS "
+            f"within the window its row names\n{format_rows(res)}\n"
+            f"{verdict(res)}"
+        )
     return 0

@@ -1,4 +1,5 @@
 """Every setting of the simulator, the reward and the baselines, as pydantic models (unknown keys are errors)."""
+
 from __future__ import annotations
 
 from typing import Literal
@@ -18,9 +19,13 @@ class ChannelConfig(_Strict):
     bs_height_m: float = Field(25.0, gt=0, le=50)
     shadow_corr_m: float = Field(50.0, gt=0, description="decorrelation distance of shadowing and LoS state")
     fading_db: float = Field(3.0, ge=0, le=10, description="std of the fast fading in each 40 ms sample")
-    fading_corr_s: float = Field(0.02, gt=0, description="its correlation time: at 2 GHz and a few m/s small-scale "
-                                                       "fading decorrelates within tens of ms, so the L1 average "
-                                                       "over a measurement period smooths it")
+    fading_corr_s: float = Field(
+        0.02,
+        gt=0,
+        description="its correlation time: at 2 GHz and a few m/s small-scale "
+        "fading decorrelates within tens of ms, so the L1 average "
+        "over a measurement period smooths it",
+    )
 
 
 class RadioConfig(_Strict):
@@ -31,27 +36,44 @@ class RadioConfig(_Strict):
     bs_tx_power_dbm: float = Field(46.0, ge=0, le=60, description="total BS transmit power")
     ue_tx_power_dbm: float = Field(23.0, ge=0, le=33, description="UAV uplink transmit power")
     n_rb: int = Field(50, gt=0, le=275, description="resource blocks of the carrier (50 = 10 MHz)")
-    bs_antenna_gain_db: float = Field(-19.0, ge=-40, le=20,
-                                      description="BS antenna gain towards the UAV (side lobes; calibrated to real RSRP)")
+    bs_antenna_gain_db: float = Field(
+        -19.0, ge=-40, le=20, description="BS antenna gain towards the UAV (side lobes; calibrated to real RSRP)"
+    )
     ue_noise_figure_db: float = Field(9.0, ge=0, le=20)
     bs_noise_figure_db: float = Field(5.0, ge=0, le=20)
-    ul_activity: float = Field(0.06, ge=0, le=1, description="share of time each other cell's aerial UE sends on "
-                                                            "the UAV's resource blocks (see uplink.py). Calibrated "
-                                                            "with the cells' spread below: median capacity 38 Mbit/s "
-                                                            "in simulation and on the real flights (IMC'22 operator "
-                                                            "B: 37.7); real buffer full in 13-19 % of real states "
-                                                            "over 5 seeds (0.065: 15-20 %)")
-    load_range: tuple[float, float] = Field((0.1, 1.0), description="downlink load of the cells (RSSI for RSRQ), "
-                                            "drawn per flight: real networks are loaded anywhere in between")
-    gain_spread_db: float = Field(8.0, ge=0, le=20, description="per-flight antenna gain deviation, uniform +-: "
-                                                               "real antenna patterns and tilts differ")
+    ul_activity: float = Field(
+        0.06,
+        ge=0,
+        le=1,
+        description="share of time each other cell's aerial UE sends on "
+        "the UAV's resource blocks (see uplink.py). Calibrated "
+        "with the cells' spread below: median capacity 38 Mbit/s "
+        "in simulation and on the real flights (IMC'22 operator "
+        "B: 37.7); real buffer full in 13-19 % of real states "
+        "over 5 seeds (0.065: 15-20 %)",
+    )
+    load_range: tuple[float, float] = Field(
+        (0.1, 1.0),
+        description="downlink load of the cells (RSSI for RSRQ), "
+        "drawn per flight: real networks are loaded anywhere in between",
+    )
+    gain_spread_db: float = Field(
+        8.0,
+        ge=0,
+        le=20,
+        description="per-flight antenna gain deviation, uniform +-: real antenna patterns and tilts differ",
+    )
     ul_interference_spread_db: float = Field(
-        9.0, ge=0, le=20, description="per-flight deviation of each cell's uplink interference level, uniform +-: "
-                                      "cells carry different uplink loads, so a UE's uplink quality is not its "
-                                      "downlink RSRP alone (uplink.py). Measured (40 episodes, 100 held-out "
-                                      "flights, w_buffer 1, ul_activity 0.08): buffer_queue_size by mean |margin "
-                                      "contribution| ranks 4th at 6 dB (seed 0), 1st/2nd/1st at 10 dB (seeds 0-2); "
-                                      "7th-10th without it (the earlier calibration)")
+        9.0,
+        ge=0,
+        le=20,
+        description="per-flight deviation of each cell's uplink interference level, uniform +-: "
+        "cells carry different uplink loads, so a UE's uplink quality is not its "
+        "downlink RSRP alone (uplink.py). Measured (40 episodes, 100 held-out "
+        "flights, w_buffer 1, ul_activity 0.08): buffer_queue_size by mean |margin "
+        "contribution| ranks 4th at 6 dB (seed 0), 1st/2nd/1st at 10 dB (seeds 0-2); "
+        "7th-10th without it (the earlier calibration)",
+    )
 
 
 class LayoutConfig(_Strict):
@@ -106,16 +128,27 @@ class ObservationConfig(_Strict):
     at the threshold, RSRP as much below the serving cell's as that RSRQ is), in simulation and real data alike."""
 
     measurement_period_s: float = Field(0.2, gt=0, le=2, description="L1 measurement period")
-    l3_filter_k: int = Field(5, ge=0, le=19, description="filterCoefficient k (0: no filtering). Calibrated: "
-                                                        "simulated CHM over CHM on the real UKM measurements per "
-                                                        "altitude band 20-60/60-100/100-160 m is 2.25/1.59/1.08 at "
-                                                        "k=4, 1.93/1.33/0.83 at 5, 1.68/1.16/0.71 at 6; 5 is the "
-                                                        "lowest k within 2x everywhere (benchmarks/calibrate.py)")
-    detection_rsrq_db: float = Field(-24.0, ge=-40, le=0, description="weakest RSRQ at which a neighbour is "
-                                                                     "measured: the real UKM neighbours' 1st percentile")
+    l3_filter_k: int = Field(
+        5,
+        ge=0,
+        le=19,
+        description="filterCoefficient k (0: no filtering). Calibrated: "
+        "simulated CHM over CHM on the real UKM measurements per "
+        "altitude band 20-60/60-100/100-160 m is 2.25/1.59/1.08 at "
+        "k=4, 1.93/1.33/0.83 at 5, 1.68/1.16/0.71 at 6; 5 is the "
+        "lowest k within 2x everywhere (benchmarks/calibrate.py)",
+    )
+    detection_rsrq_db: float = Field(
+        -24.0,
+        ge=-40,
+        le=0,
+        description="weakest RSRQ at which a neighbour is measured: the real UKM neighbours' 1st percentile",
+    )
     position_grid_m: float = Field(0.0, ge=0, le=1000, description="quantise x, y to this grid (0: not quantised)")
-    position_hidden: bool = Field(False, description="report x, y, z as 0: what a DQN learns without its position "
-                                                     "(benchmarks/position_ablation.py)")
+    position_hidden: bool = Field(
+        False,
+        description="report x, y, z as 0: what a DQN learns without its position (benchmarks/position_ablation.py)",
+    )
 
 
 class HandoverConfig(_Strict):
@@ -135,25 +168,45 @@ class RewardConfig(_Strict):
     w_rsrq, w_handover, w_pingpong) met 7 of issue 26's 9 simulated targets on each of 3 training seeds; without
     demonstrations 1.5, 0.5, 25, 80 met the most (5-6); the paper's reward (0, 0.5, 20, 0) met 5 of 12."""
 
-    w_handover: float = Field(40.0, ge=0, description="measured (3 training seeds, 600 held-out flights, with "
-                                                       "demonstrations): 40 with w_rsrq 4 leaves the DQN at 0.48-0.49x "
-                                                       "CHM's handovers; without demonstrations 25 gives 0.43-0.56x")
-    w_buffer: float = Field(2.0, ge=0, description="measured (40 episodes, 100 held-out flights, seeds 0 and 1, "
-                                                   "ul_activity 0.055, spread 10 dB): 1 leaves buffer_queue_size "
-                                                   "2nd-3rd by mean |margin contribution| and the DQN losing 7-10 % "
-                                                   "more data than CHM; 2 puts it 1st with the DQN losing as much as "
-                                                   "CHM (-1 to 0 %)")
+    w_handover: float = Field(
+        40.0,
+        ge=0,
+        description="measured (3 training seeds, 600 held-out flights, with "
+        "demonstrations): 40 with w_rsrq 4 leaves the DQN at 0.48-0.49x "
+        "CHM's handovers; without demonstrations 25 gives 0.43-0.56x",
+    )
+    w_buffer: float = Field(
+        2.0,
+        ge=0,
+        description="measured (40 episodes, 100 held-out flights, seeds 0 and 1, "
+        "ul_activity 0.055, spread 10 dB): 1 leaves buffer_queue_size "
+        "2nd-3rd by mean |margin contribution| and the DQN losing 7-10 % "
+        "more data than CHM; 2 puts it 1st with the DQN losing as much as "
+        "CHM (-1 to 0 %)",
+    )
     w_rsrp: float = Field(0.5, ge=0)
-    w_rsrq: float = Field(4.0, ge=0, description="the paper's is 0.5; raising it trades handovers for time below "
-                                                 "the RSRQ threshold (without demonstrations, 2: 8.3 % at 0.56x "
-                                                 "CHM's handovers, 4 with w_handover 40: 6.2 % at 0.56x, 6: 5.1 % at "
-                                                 "0.92x; with them, 4 and 40: 8.1-8.4 % at 0.48x; CHM 4.2-5.1 %)")
-    w_lost: float = Field(1.5, ge=0, description="per Mbit of uplink data lost to buffer overflow in the decision "
-                                                 "period (0: the paper's reward; with 0 the DQN loses 3 % more data "
-                                                 "than CHM, with 1.5 1-6 % less)")
-    w_pingpong: float = Field(80.0, ge=0, description="per handover back to the previous BS within 5 s (a ping-pong "
-                                                      "as operators count it; 0: the paper's reward, under which the "
-                                                      "DQN ping-pongs more per minute than CHM)")
+    w_rsrq: float = Field(
+        4.0,
+        ge=0,
+        description="the paper's is 0.5; raising it trades handovers for time below "
+        "the RSRQ threshold (without demonstrations, 2: 8.3 % at 0.56x "
+        "CHM's handovers, 4 with w_handover 40: 6.2 % at 0.56x, 6: 5.1 % at "
+        "0.92x; with them, 4 and 40: 8.1-8.4 % at 0.48x; CHM 4.2-5.1 %)",
+    )
+    w_lost: float = Field(
+        1.5,
+        ge=0,
+        description="per Mbit of uplink data lost to buffer overflow in the decision "
+        "period (0: the paper's reward; with 0 the DQN loses 3 % more data "
+        "than CHM, with 1.5 1-6 % less)",
+    )
+    w_pingpong: float = Field(
+        80.0,
+        ge=0,
+        description="per handover back to the previous BS within 5 s (a ping-pong "
+        "as operators count it; 0: the paper's reward, under which the "
+        "DQN ping-pongs more per minute than CHM)",
+    )
 
 
 class SimConfig(_Strict):
@@ -172,8 +225,10 @@ class SimConfig(_Strict):
         lo, hi = HEIGHT_RANGE[self.channel.scenario]
         a, b = self.flight.altitude_m
         if not (lo < a <= b <= hi):
-            raise ValueError(f"flight.altitude_m {self.flight.altitude_m} is outside {self.channel.scenario}'s "
-                             f"range ({lo}, {hi}] m; choose heights in it (and low <= high)")
+            raise ValueError(
+                f"flight.altitude_m {self.flight.altitude_m} is outside {self.channel.scenario}'s "
+                f"range ({lo}, {hi}] m; choose heights in it (and low <= high)"
+            )
         s0, s1 = self.flight.speed_mps
         if not (0 <= s0 <= s1):
             raise ValueError("flight.speed_mps must be (low, high) with 0 <= low <= high")

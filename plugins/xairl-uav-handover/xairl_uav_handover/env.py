@@ -11,6 +11,7 @@ An action naming an empty candidate slot (fewer neighbours measured) keeps the s
 ``info`` carries, per flight, the sums over the decision's simulator steps of :data:`METRICS`, and the candidate
 BS ids (``info["candidates"]``, (K, 4)).
 """
+
 from __future__ import annotations
 
 import gymnasium as gym
@@ -71,15 +72,22 @@ class HandoverVecEnv(gym.vector.VectorEnv):
         n = 0
         while n < self.decision_every and not sim.done:
             info = sim.step(target if n == 0 else sim.serving)
-            gain += (w.w_buffer / (1 + info.queue_bits / 1e6) - w.w_rsrp * info.rsrp_violation
-                     - w.w_rsrq * info.rsrq_violation)
+            gain += (
+                w.w_buffer / (1 + info.queue_bits / 1e6)
+                - w.w_rsrp * info.rsrp_violation
+                - w.w_rsrq * info.rsrq_violation
+            )
             for key in METRICS:
                 sums[key] += getattr(info, key)
             for window in PINGPONG_WINDOWS_S:
                 sums[f"pingpong_{window:g}s"] += info.back_after_s < window
             n += 1
-        reward = (-w.w_handover * sums["handover"] - w.w_lost * sums["lost_bits"] / 1e6
-                  - w.w_pingpong * sums["pingpong_5s"] + gain / max(n, 1))
+        reward = (
+            -w.w_handover * sums["handover"]
+            - w.w_lost * sums["lost_bits"] / 1e6
+            - w.w_pingpong * sums["pingpong_5s"]
+            + gain / max(n, 1)
+        )
         self._observe()
         ended = np.full(sim.K, sim.done)
         return self.obs, reward, np.zeros(sim.K, dtype=bool), ended, sums | {"candidates": self.candidates}
@@ -90,8 +98,10 @@ class HandoverVecEnv(gym.vector.VectorEnv):
         bad = ~np.isfinite(self.obs)
         if bad.any():
             k, j = (int(i[0]) for i in np.nonzero(bad))
-            raise InputError(f"the simulator gave flight {k} a state whose {FEATURES[j]} is {self.obs[k, j]:g}; "
-                             "check the simulator settings (a policy cannot act on it).")
+            raise InputError(
+                f"the simulator gave flight {k} a state whose {FEATURES[j]} is {self.obs[k, j]:g}; "
+                "check the simulator settings (a policy cannot act on it)."
+            )
 
 
 class UAVHandoverEnv(gym.Env):
@@ -106,7 +116,7 @@ class UAVHandoverEnv(gym.Env):
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
-        obs, info = self.vec.reset(seed=int(self.np_random.integers(2 ** 31)))
+        obs, info = self.vec.reset(seed=int(self.np_random.integers(2**31)))
         return obs[0], {"candidates": info["candidates"][0]}
 
     def step(self, action):

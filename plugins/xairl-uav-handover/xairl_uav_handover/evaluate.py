@@ -1,4 +1,5 @@
 """Run controllers on the same held-out flights (per-flight metrics; table.py makes them Table I)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -36,8 +37,8 @@ def run_flights(controller, config: SimConfig, n_flights: int, seed: int) -> dic
     n = env.sim.n_steps
     return {
         "handovers": tot["handover"],
-        "handovers_buffer_nonempty": ho_nonempty,   # decided with a non-empty buffer
-        "handovers_buffer_full": ho_full,           # and with a full one
+        "handovers_buffer_nonempty": ho_nonempty,  # decided with a non-empty buffer
+        "handovers_buffer_full": ho_full,  # and with a full one
         "buffer_nonempty_pct": 100 * nonempty / decisions,
         "pingpongs": tot["pingpong"],
         **{f"pingpongs_{w:g}s": tot[f"pingpong_{w:g}s"] for w in PINGPONG_WINDOWS_S},
@@ -58,11 +59,15 @@ def importance(ckpt, states: np.ndarray, seed: int = 0, groups: dict | None = No
 
     from .policy import background_states, uav_policy
 
-    exp = xairl.explain(uav_policy(ckpt), states,
-                        background=background_states(100, seed=seed + 7, config=ckpt.sim_config))
+    exp = xairl.explain(
+        uav_policy(ckpt), states, background=background_states(100, seed=seed + 7, config=ckpt.sim_config)
+    )
     exp = exp.grouped(groups) if groups else exp
-    return {"margin": np.abs(exp.margin()).mean(axis=0), "score": np.abs(exp.for_chosen()).mean(axis=0),
-            "names": np.array(exp.feature_names)}
+    return {
+        "margin": np.abs(exp.margin()).mean(axis=0),
+        "score": np.abs(exp.for_chosen()).mean(axis=0),
+        "names": np.array(exp.feature_names),
+    }
 
 
 def ranked(imp: dict[str, np.ndarray], view: str = "margin") -> list[str]:
@@ -78,8 +83,9 @@ def rankings(ckpt, n_states: int, seed: int) -> dict[str, list[str]]:
     return {view: ranked(imp, view) for view in ("margin", "score")}
 
 
-def chm_rate_by_altitude(altitudes, config: SimConfig, n_flights: int = 40, duration_s: float = 60.0,
-                         seed: int = 0) -> np.ndarray:
+def chm_rate_by_altitude(
+    altitudes, config: SimConfig, n_flights: int = 40, duration_s: float = 60.0, seed: int = 0
+) -> np.ndarray:
     """Conventional handovers per minute for flights held at each altitude (simulator)."""
     from .baselines import CHM
 

@@ -3,14 +3,22 @@
 :func:`state_rows` is the one place that lays a state out; the simulator and the real-flight replay build states
 through it, and code that reads a state uses :data:`FEATURES` or the column slice below.
 """
+
 import numpy as np
 
 from xairl import FeatureInfo, InputError
 from xairl.facts import Comparison, DomainFacts
 
 N_CANDIDATES = 4  # candidate 0 is the serving BS (stay); 1..3 the strongest other BSs
-FEATURES = ("x", "y", "z", "buffer_queue_size", "serving_bs",
-            *(f"rsrp_{k}" for k in range(N_CANDIDATES)), *(f"rsrq_{k}" for k in range(N_CANDIDATES)))
+FEATURES = (
+    "x",
+    "y",
+    "z",
+    "buffer_queue_size",
+    "serving_bs",
+    *(f"rsrp_{k}" for k in range(N_CANDIDATES)),
+    *(f"rsrq_{k}" for k in range(N_CANDIDATES)),
+)
 RSRP = slice(5, 5 + N_CANDIDATES)  # the candidates' RSRP columns, serving BS first
 RSRQ = slice(5 + N_CANDIDATES, 5 + 2 * N_CANDIDATES)  # and their RSRQ columns
 BUFFER = FEATURES.index("buffer_queue_size")
@@ -43,8 +51,9 @@ def state_rows(position, queue_bits, serving_id, rsrp, rsrq, observation) -> np.
     # both cells' RSRQ share one RSSI, so RSRP differs by the RSRQ difference: the slot sits exactly at the limit
     rsrp = np.where(empty, rsrp[:, :1] + limit - rsrq[:, :1], rsrp)
     rsrq = np.where(empty, limit, rsrq)
-    return np.concatenate([position, np.reshape(queue_bits, (k, 1)), np.reshape(serving_id, (k, 1)), rsrp, rsrq],
-                          axis=1).astype(np.float32)
+    return np.concatenate(
+        [position, np.reshape(queue_bits, (k, 1)), np.reshape(serving_id, (k, 1)), rsrp, rsrq], axis=1
+    ).astype(np.float32)
 
 
 def available_actions(states, observation) -> np.ndarray:
@@ -72,13 +81,18 @@ def checked_actions(actions, where=lambda k: f"flight {k}") -> np.ndarray:
         k = int(np.flatnonzero(~ok.ravel())[0])
         v = a.ravel()[k]
         v = f"{float(v):g}" if np.asarray(v).dtype.kind in "iufb" else repr(v)[:40]
-        raise InputError(f"the action for {where(k)} is {v}, not one of 0..{len(ACTIONS) - 1} (0 stays, k "
-                         f"hands over to candidate k); a policy whose output is NaN or out of range cannot act.")
+        raise InputError(
+            f"the action for {where(k)} is {v}, not one of 0..{len(ACTIONS) - 1} (0 stays, k "
+            f"hands over to candidate k); a policy whose output is NaN or out of range cannot act."
+        )
     return a.astype(np.int64)
 
 
-GROUPS = {"position": ("x", "y", "z"), "rsrp": ("rsrp_0", "rsrp_1", "rsrp_2", "rsrp_3"),
-          "rsrq": ("rsrq_0", "rsrq_1", "rsrq_2", "rsrq_3")}
+GROUPS = {
+    "position": ("x", "y", "z"),
+    "rsrp": ("rsrp_0", "rsrp_1", "rsrp_2", "rsrp_3"),
+    "rsrq": ("rsrq_0", "rsrq_1", "rsrq_2", "rsrq_3"),
+}
 
 
 _WHO = ("the serving BS", "the strongest neighbour", "the second strongest neighbour", "the third strongest neighbour")
@@ -89,8 +103,11 @@ RSRQ_LEVELS = (-16.0, -10.0)
 
 
 def _signal(kind: str, k: int, unit: str, low: str, high: str, levels) -> FeatureInfo:
-    aliases = (f"{kind} of candidate {k}", f"candidate {k}'s {kind}") if k else (
-        f"serving {kind}", f"the serving cell's {kind}", f"serving cell {kind}")
+    aliases = (
+        (f"{kind} of candidate {k}", f"candidate {k}'s {kind}")
+        if k
+        else (f"serving {kind}", f"the serving cell's {kind}", f"serving cell {kind}")
+    )
     return FeatureInfo(unit, f"{_WHO[k]}'s {kind}", low, high, aliases, thresholds=levels)
 
 
@@ -101,8 +118,14 @@ def feature_info(q_max_bits: float = 2e6) -> dict[str, FeatureInfo]:
         "y": FeatureInfo("m", "the UAV's north position", "south", "north"),
         "z": FeatureInfo("m", "the UAV's altitude", "low altitude", "high altitude"),
         "position": FeatureInfo("", "the UAV's position", kind="group", aliases=("position (x, y, z)",)),
-        "buffer_queue_size": FeatureInfo("bit", "the uplink buffer", "lightly loaded", "heavily loaded",
-                                         ("the uplink buffer queue", "buffer queue"), capacity=q_max_bits),
+        "buffer_queue_size": FeatureInfo(
+            "bit",
+            "the uplink buffer",
+            "lightly loaded",
+            "heavily loaded",
+            ("the uplink buffer queue", "buffer queue"),
+            capacity=q_max_bits,
+        ),
         "serving_bs": FeatureInfo("", "the serving BS's id", kind="identifier"),
         **{f"rsrp_{k}": _signal("RSRP", k, "dBm", "weak signal", "strong signal", RSRP_LEVELS) for k in range(4)},
         **{f"rsrq_{k}": _signal("RSRQ", k, "dB", "poor quality", "good quality", RSRQ_LEVELS) for k in range(4)},
@@ -110,11 +133,23 @@ def feature_info(q_max_bits: float = 2e6) -> dict[str, FeatureInfo]:
 
 
 FEATURE_INFO = feature_info()
-ACTION_ALIASES = {"stay": ("keep the serving BS", "staying"),
-                  **{a: (f"hand over to candidate {k}", f"a handover to candidate {k}", f"switch to candidate {k}",
-                         "switch cells", "change cells", "switching", "leaving")  # shared by every handover:
-                     # the chosen one among them
-                     for k, a in enumerate(ACTIONS) if k}}
+ACTION_ALIASES = {
+    "stay": ("keep the serving BS", "staying"),
+    **{
+        a: (
+            f"hand over to candidate {k}",
+            f"a handover to candidate {k}",
+            f"switch to candidate {k}",
+            "switch cells",
+            "change cells",
+            "switching",
+            "leaving",
+        )  # shared by every handover:
+        # the chosen one among them
+        for k, a in enumerate(ACTIONS)
+        if k
+    },
+}
 
 
 class HandoverFacts:
@@ -138,14 +173,26 @@ class HandoverFacts:
         s = dict(zip(FEATURES, (float(v) for v in state)))
         k = chosen if chosen else runner_up
         fill = 100.0 * s["buffer_queue_size"] / self.q_max
-        extras = {"decision": "hand over" if chosen else "stay", "serving_bs": int(round(s["serving_bs"])),
-                  "target_candidate": int(chosen), "compared_candidate": int(k), "runner_up_candidate": int(runner_up),
-                  "buffer_fill": fill, "buffer_trend": ""}
+        extras = {
+            "decision": "hand over" if chosen else "stay",
+            "serving_bs": int(round(s["serving_bs"])),
+            "target_candidate": int(chosen),
+            "compared_candidate": int(k),
+            "runner_up_candidate": int(runner_up),
+            "buffer_fill": fill,
+            "buffer_trend": "",
+        }
         comparisons = []
         if k:
             diff = s[f"rsrp_{k}"] - s["rsrp_0"]
-            comparisons.append(Comparison(f"{_WHO[k]}'s RSRP was {abs(diff):.1f} dB {'above' if diff >= 0 else 'below'} "
-                                          "the serving BS's RSRP", round(abs(diff), 1), "dB"))
+            comparisons.append(
+                Comparison(
+                    f"{_WHO[k]}'s RSRP was {abs(diff):.1f} dB {'above' if diff >= 0 else 'below'} "
+                    "the serving BS's RSRP",
+                    round(abs(diff), 1),
+                    "dB",
+                )
+            )
         rows = [state] if history is None else [*np.asarray(history)[-50:], state]
         held = 0
         for row in reversed(rows):  # consecutive decisions, ending now, with the strongest neighbour A3-above
@@ -161,8 +208,14 @@ class HandoverFacts:
         else:
             extras["chm"] = "hand over to candidate 1"
         if history is not None and held:
-            comparisons.append(Comparison(f"the strongest neighbour has been more than {self.offset:g} dB above the "
-                                          f"serving BS for {held} consecutive decisions", held, "consecutive"))
+            comparisons.append(
+                Comparison(
+                    f"the strongest neighbour has been more than {self.offset:g} dB above the "
+                    f"serving BS for {held} consecutive decisions",
+                    held,
+                    "consecutive",
+                )
+            )
             # the rule's offset is a fact the sentence above cites in dB, whichever candidate the first one compares
             comparisons.append(Comparison(f"the A3 offset is {self.offset:g} dB", self.offset, "dB"))
         if history is not None and len(history):

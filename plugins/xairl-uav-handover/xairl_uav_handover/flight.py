@@ -11,6 +11,7 @@ reasons with the largest mean |contribution to the margin| over time. The summar
 reason that most often came first, and is checked by :func:`xairl.verify` against the flight's explanation and
 its counts (:class:`xairl.facts.DomainFacts`).
 """
+
 from __future__ import annotations
 
 from collections import Counter
@@ -83,8 +84,15 @@ def simulated_flight(ckpt: Checkpoint, seed: int = 0) -> FlightTimeline:
         if info["handover"][0] > 0:
             chm_times.append(k * cfg.flight.dt_s)
         ended = bool(truncated.all())
-    return FlightTimeline(f"simulated flight (seed {seed})", np.arange(len(states)) * step_s, np.array(states),
-                          np.array(handed), np.array(chm_times), None, True)
+    return FlightTimeline(
+        f"simulated flight (seed {seed})",
+        np.arange(len(states)) * step_s,
+        np.array(states),
+        np.array(handed),
+        np.array(chm_times),
+        None,
+        True,
+    )
 
 
 def real_flight(flight, ckpt: Checkpoint, seed: int = 0) -> FlightTimeline:
@@ -104,7 +112,7 @@ def _first_reasons(tl: FlightTimeline, exp: Explanation, policy: Policy) -> list
     """(chosen action, name of its first reason or None) per decision, with the flight's history."""
     out = []
     for i in range(len(tl.states)):
-        d = decision_facts(exp, i, policy, k=1, history=tl.states[max(0, i - HISTORY):i])
+        d = decision_facts(exp, i, policy, k=1, history=tl.states[max(0, i - HISTORY) : i])
         out.append((int(exp.chosen[i]), d.reasons[0].label if d.reasons else None))
     return out
 
@@ -115,19 +123,28 @@ def summary(tl: FlightTimeline, exp: Explanation, policy: Policy) -> tuple[str, 
     reasons = _first_reasons(tl, exp, policy)
     stays = [r for a, r in reasons if a == 0]
     top = Counter(r for r in stays if r).most_common(1)
-    comparisons = [Comparison(f"{fmt(tl.duration_s)} s", round(tl.duration_s, 1), "s"),
-                   Comparison(f"{len(tl.states)} decisions", len(tl.states), "decisions"),
-                   Comparison(f"{len(stays)} decisions", len(stays), "decisions")]
+    comparisons = [
+        Comparison(f"{fmt(tl.duration_s)} s", round(tl.duration_s, 1), "s"),
+        Comparison(f"{len(tl.states)} decisions", len(tl.states), "decisions"),
+        Comparison(f"{len(stays)} decisions", len(stays), "decisions"),
+    ]
     if tl.closed_loop:
-        first = (f"Over {fmt(tl.duration_s)} s the DQN handed over {dqn} {'time' if dqn == 1 else 'times'}, where CHM "
-                 f"flying the same flight handed over {chm} {'time' if chm == 1 else 'times'}.")
+        first = (
+            f"Over {fmt(tl.duration_s)} s the DQN handed over {dqn} {'time' if dqn == 1 else 'times'}, where CHM "
+            f"flying the same flight handed over {chm} {'time' if chm == 1 else 'times'}."
+        )
         comparisons += [Comparison(f"{dqn} times", dqn, "times"), Comparison(f"{chm} times", chm, "times")]
     else:
         live = len(tl.live_times)
-        first = (f"Over {fmt(tl.duration_s)} s of this real flight the DQN would have proposed a handover at {dqn} "
-                 f"samples and CHM at {chm}; the live network handed over {live} times.")
-        comparisons += [Comparison(f"{dqn} samples", dqn, "samples"), Comparison(f"{chm} samples", chm, "samples"),
-                        Comparison(f"{live} times", live, "times")]
+        first = (
+            f"Over {fmt(tl.duration_s)} s of this real flight the DQN would have proposed a handover at {dqn} "
+            f"samples and CHM at {chm}; the live network handed over {live} times."
+        )
+        comparisons += [
+            Comparison(f"{dqn} samples", dqn, "samples"),
+            Comparison(f"{chm} samples", chm, "samples"),
+            Comparison(f"{live} times", live, "times"),
+        ]
     would = "" if tl.closed_loop else " would have"
     text = [first, f"The DQN{would} stayed at {len(stays)} of its {len(tl.states)} decisions."]
     if top:
@@ -168,7 +185,7 @@ def timeline_figure(tl: FlightTimeline, exp: Explanation, policy: Policy, path: 
     rows = [("DQN", tl.t[tl.dqn_handover], "tab:red"), ("CHM", tl.chm_times, "tab:gray")]
     if tl.live_times is not None:
         rows.append(("network", tl.live_times, "tab:green"))
-    for y, (name, times, color) in enumerate(rows):
+    for y, (_name, times, color) in enumerate(rows):
         ax[2].plot(times, np.full(len(times), y), "|", ms=12, color=color)
     ax[2].set_yticks(range(len(rows)), [f"{n} ({len(t)})" for n, t, _ in rows], fontsize=8)
     ax[2].set_ylim(-0.7, len(rows) - 0.3)

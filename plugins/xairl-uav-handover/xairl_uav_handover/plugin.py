@@ -3,6 +3,7 @@
 Registered by the entry point ``uav-handover`` in group ``xairl``. Targets are ``"module:attr"`` strings, so
 ``xairl --help`` imports nothing heavy from here.
 """
+
 from pathlib import Path
 
 from xairl.plugin import hookimpl
@@ -10,8 +11,11 @@ from xairl.plugin import hookimpl
 
 @hookimpl
 def register_policies(register):
-    register("uav-dqn", "xairl_uav_handover.policy:uav_policy",
-             "DQN handover policy for UAVs (Meer et al.), pretrained on the TR 36.777 simulator")
+    register(
+        "uav-dqn",
+        "xairl_uav_handover.policy:uav_policy",
+        "DQN handover policy for UAVs (Meer et al.), pretrained on the TR 36.777 simulator",
+    )
 
 
 @hookimpl
@@ -26,5 +30,8 @@ def register_commands(register):
 
 @hookimpl
 def register_reports(register):
-    register("uav-handover", "xairl_uav_handover.report:UAVReport",
-             "Table I, real-flight replay (-o real=PATH, or -o real=ukm to fetch the UKM flights), handover rate vs altitude, SHAP figures, narrated handovers")
+    register(
+        "uav-handover",
+        "xairl_uav_handover.report:UAVReport",
+        "Table I, real-flight replay (-o real=PATH, or -o real=ukm to fetch the UKM flights), handover rate vs altitude, SHAP figures, narrated handovers",
+    )

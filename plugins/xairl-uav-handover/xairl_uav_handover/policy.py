@@ -4,6 +4,7 @@ Checkpoints hold tensors only (safetensors) plus JSON metadata (architecture, tr
 unpickled. Inputs are standardised by a frozen diagonal Linear layer inside the network, so attributions are in
 the features' own units.
 """
+
 from __future__ import annotations
 
 import json
@@ -43,8 +44,9 @@ def build_qnet(mean: np.ndarray, std: np.ndarray, hidden=(64, 64)) -> torch.nn.S
 def save_checkpoint(net: torch.nn.Module, path: str | Path, meta: dict) -> None:
     from safetensors.torch import save
 
-    data = save({k: v.detach().cpu().contiguous() for k, v in net.state_dict().items()},
-                metadata={"xairl": json.dumps(meta)})
+    data = save(
+        {k: v.detach().cpu().contiguous() for k, v in net.state_dict().items()}, metadata={"xairl": json.dumps(meta)}
+    )
     with atomic_write(path, "wb") as fh:  # a killed training run never leaves half a checkpoint
         fh.write(data)
 
@@ -73,13 +75,17 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
             meta = json.loads((fh.metadata() or {}).get("xairl", "{}"))
         tensors = load_file(str(path))
     except (SafetensorError, OSError, ValueError) as exc:
-        raise CheckpointError(f"{path}: not a readable safetensors checkpoint ({exc}); re-train or re-download it.")
+        raise CheckpointError(
+            f"{path}: not a readable safetensors checkpoint ({exc}); re-train or re-download it."
+        ) from None
     if not isinstance(meta, dict):
         raise CheckpointError(f"{path}: its metadata is not a JSON object; re-train or re-download it.")
     for name, tensor in tensors.items():
         if tensor.is_floating_point() and not torch.isfinite(tensor).all():
-            raise CheckpointError(f"{path}: tensor '{name}' holds NaN or inf (a corrupt file, or training that "
-                                  "diverged); re-train or re-download it.")
+            raise CheckpointError(
+                f"{path}: tensor '{name}' holds NaN or inf (a corrupt file, or training that "
+                "diverged); re-train or re-download it."
+            )
     hidden = _hidden_widths(path, meta, tensors)
     f = len(FEATURES)
     net = build_qnet(np.zeros(f), np.ones(f), hidden)
@@ -87,7 +93,7 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
         net.load_state_dict(tensors, strict=True)
     except RuntimeError as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise CheckpointError(f"{path}: does not match the UAV DQN architecture (hidden={hidden}): {first}")
+        raise CheckpointError(f"{path}: does not match the UAV DQN architecture (hidden={hidden}): {first}") from None
     try:
         config = SimConfig.model_validate(meta.get("sim_config", {}))
     except ValueError as exc:
@@ -104,11 +110,15 @@ def _hidden_widths(path: Path, meta: dict, tensors: dict) -> tuple[int, ...]:
         weights = sorted((k for k in tensors if k.endswith(".weight")), key=lambda k: int(k.split(".")[0]))
         widths = tuple(int(tensors[k].shape[0]) for k in weights[1:-1])
     except (ValueError, IndexError):
-        raise CheckpointError(f"{path}: its tensors are not those of the UAV DQN ({', '.join(list(tensors)[:4])}); "
-                              "re-train or re-download it.") from None
+        raise CheckpointError(
+            f"{path}: its tensors are not those of the UAV DQN ({', '.join(list(tensors)[:4])}); "
+            "re-train or re-download it."
+        ) from None
     if not (isinstance(stated, list) and all(isinstance(h, int) for h in stated) and tuple(stated) == widths):
-        raise CheckpointError(f"{path}: its metadata says hidden={str(stated)[:60]} but its tensors have hidden "
-                              f"widths {list(widths)}; re-train or re-download it.")
+        raise CheckpointError(
+            f"{path}: its metadata says hidden={str(stated)[:60]} but its tensors have hidden "
+            f"widths {list(widths)}; re-train or re-download it."
+        )
     return widths
 
 
@@ -127,17 +137,23 @@ def _refuse_q(net: torch.nn.Module, x: np.ndarray, i: int) -> None:
     """Say why the Q-values of state ``i`` of ``x`` (the network's float32 input) are NaN or inf."""
     where = f"the DQN cannot act on state {i} of {len(x)}"
     if not all(torch.isfinite(p).all() for p in net.parameters()):
-        raise CheckpointError(f"{where}: the Q-network's weights hold NaN or inf (a corrupt checkpoint, or training "
-                              "that diverged); re-train or re-download it.")
+        raise CheckpointError(
+            f"{where}: the Q-network's weights hold NaN or inf (a corrupt checkpoint, or training "
+            "that diverged); re-train or re-download it."
+        )
     row = x[i].reshape(-1)
     bad = np.flatnonzero(~np.isfinite(row))
     if len(bad):
         j = int(bad[0])
-        raise InputError(f"{where}: {FEATURES[j]} = {row[j]:g} is not a finite number (as float32, the network's "
-                         "input); fix that state.")
+        raise InputError(
+            f"{where}: {FEATURES[j]} = {row[j]:g} is not a finite number (as float32, the network's "
+            "input); fix that state."
+        )
     j = int(np.abs(row).argmax())
-    raise InputError(f"{where}: its Q-values overflow to NaN or inf (largest input {FEATURES[j]} = {row[j]:g}, far "
-                     "beyond any measurement); fix that state.")
+    raise InputError(
+        f"{where}: its Q-values overflow to NaN or inf (largest input {FEATURES[j]} = {row[j]:g}, far "
+        "beyond any measurement); fix that state."
+    )
 
 
 def random_available(rng: np.random.Generator, obs: np.ndarray, config: SimConfig) -> np.ndarray:
@@ -166,14 +182,23 @@ def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
     from .config import CHMConfig
 
     facts = HandoverFacts(config.buffer.q_max_bits, CHMConfig().offset_db, config.observation.detection_rsrq_db)
-    return Policy(ckpt.net, FEATURES, ACTIONS, features=feature_info(config.buffer.q_max_bits), groups=GROUPS,
-                  background_sampler=lambda n, seed: background_states(n, seed, config), name="uav-dqn",
-                  action_aliases=ACTION_ALIASES, facts_hook=facts,
-                  action_mask=lambda x: available_actions(x, config.observation))
+    return Policy(
+        ckpt.net,
+        FEATURES,
+        ACTIONS,
+        features=feature_info(config.buffer.q_max_bits),
+        groups=GROUPS,
+        background_sampler=lambda n, seed: background_states(n, seed, config),
+        name="uav-dqn",
+        action_aliases=ACTION_ALIASES,
+        facts_hook=facts,
+        action_mask=lambda x: available_actions(x, config.observation),
+    )
 
 
-def dqn_decision_states(ckpt: Checkpoint, n: int, seed: int = 0, epsilon: float = 0.0,
-                        n_flights: int = 64) -> np.ndarray:
+def dqn_decision_states(
+    ckpt: Checkpoint, n: int, seed: int = 0, epsilon: float = 0.0, n_flights: int = 64
+) -> np.ndarray:
     """``n`` states at which the DQN decided, sampled from ``n_flights`` held-out flights it flew itself; with
     ``epsilon``, that share of its decisions is random (0.5: the mix of exploration and greedy steps that training
     sees). Flights draw their height uniformly, so a few hundred cover the altitude range to its percentiles."""

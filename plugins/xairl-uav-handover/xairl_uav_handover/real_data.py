@@ -11,6 +11,7 @@ steers, so every instant is a fair comparison). The buffer is not in the data: t
 (uplink.py), driven by the measured serving RSRP at the flight's altitude, fills it, sub-stepped at the simulator's
 time step between samples.
 """
+
 from __future__ import annotations
 
 import re
@@ -39,13 +40,13 @@ TIME_RE = r"^\d{1,2}:\d{2}:\d{2}(\.\d+)?$"
 class RealFlight:
     name: str
     altitude_m: float
-    t: np.ndarray          # seconds since the first sample
-    xy: np.ndarray         # (n, 2) local metres east/north of REF
-    pci: np.ndarray        # (n,) serving PCI
+    t: np.ndarray  # seconds since the first sample
+    xy: np.ndarray  # (n, 2) local metres east/north of REF
+    pci: np.ndarray  # (n,) serving PCI
     rsrp: np.ndarray
     rsrq: np.ndarray
     snr: np.ndarray
-    nb_pci: np.ndarray     # (n, slots) detected cells, NaN where empty
+    nb_pci: np.ndarray  # (n, slots) detected cells, NaN where empty
     nb_rsrp: np.ndarray
     nb_rsrq: np.ndarray
 
@@ -57,8 +58,10 @@ class RealFlight:
             bad = np.isinf(v) if field.startswith("nb_") else ~np.isfinite(v)
             if bad.any():
                 i = int(np.nonzero(bad)[0][0])
-                raise InputError(f"{self.name}: the flight's {field} is {v[np.nonzero(bad)][0]:g} at sample {i}, "
-                                 "not a finite number; measurements must be finite.")
+                raise InputError(
+                    f"{self.name}: the flight's {field} is {v[np.nonzero(bad)][0]:g} at sample {i}, "
+                    "not a finite number; measurements must be finite."
+                )
 
     @property
     def observed_handovers(self) -> int:
@@ -85,13 +88,27 @@ def load_flight(path: str | Path) -> RealFlight:
 
     def nb(kind):
         cols = [f"{kind} (LTE detected) - {s}" for s in slots]
-        return np.stack([g[c].to_numpy(dtype=float) if c in g.columns else np.full(len(g), np.nan) for c in cols],
-                        1) if cols else np.full((len(g), 0), np.nan)
+        return (
+            np.stack([g[c].to_numpy(dtype=float) if c in g.columns else np.full(len(g), np.nan) for c in cols], 1)
+            if cols
+            else np.full((len(g), 0), np.nan)
+        )
 
     snr = g["RS SNR"].to_numpy(dtype=float)
     snr = np.where(np.isnan(snr), np.nanmedian(snr) if np.isfinite(snr).any() else 0.0, snr)
-    return RealFlight(path.name, float(alt.group(1)), t, xy, g[PCI].to_numpy(dtype=float), g[RSRP].to_numpy(float),
-                      g[RSRQ].to_numpy(float), snr, nb("Physical cell identity"), nb("RSRP"), nb("RSRQ"))
+    return RealFlight(
+        path.name,
+        float(alt.group(1)),
+        t,
+        xy,
+        g[PCI].to_numpy(dtype=float),
+        g[RSRP].to_numpy(float),
+        g[RSRQ].to_numpy(float),
+        snr,
+        nb("Physical cell identity"),
+        nb("RSRP"),
+        nb("RSRQ"),
+    )
 
 
 def _read_export(path: Path):
@@ -104,14 +121,26 @@ def _read_export(path: Path):
         raise InputError(f"{path}: cannot read it as CSV ({str(exc).splitlines()[0]}).") from None
     missing = [c for c in REQUIRED if c not in df.columns]
     if missing:
-        raise InputError(f"{path}: missing column '{missing[0]}'" + (f" (and {len(missing) - 1} more)" if
-                                                                      len(missing) > 1 else "") + ".")
+        raise InputError(
+            f"{path}: missing column '{missing[0]}'"
+            + (f" (and {len(missing) - 1} more)" if len(missing) > 1 else "")
+            + "."
+        )
     df["Time"] = df["Time"].astype(str).str.strip()
     df = df[df["Time"].str.match(TIME_RE)].copy()
     if df.empty:
         raise InputError(f"{path}: no rows with a parseable Time (H:MM:SS.mmm); the file looks truncated.")
-    slots = sorted(int(m.group(1)) for c in df.columns if (m := re.match(r"Physical cell identity \(LTE detected\) - "
-                                                                          r"(\d+)$", c)))
+    slots = sorted(
+        int(m.group(1))
+        for c in df.columns
+        if (
+            m := re.match(
+                r"Physical cell identity \(LTE detected\) - "
+                r"(\d+)$",
+                c,
+            )
+        )
+    )
     for c in ["Latitude", "Longitude", PCI, RSRP, RSRQ, "RS SNR", *_neighbour_columns(slots, df.columns)]:
         df[c] = pd.to_numeric(df[c], errors="coerce")
     _check_measurements(df, path)
@@ -120,9 +149,14 @@ def _read_export(path: Path):
 
 #: what a UE can report, with a margin (TS 36.133: RSRP -156..-31 dBm, RSRQ -34..2.5 dB, SINR -23..40 dB; 504 PCIs
 #: in LTE, 1008 in NR): a value outside is a broken file, and as float32 it would reach the DQN as inf
-PLAUSIBLE = {"RSRP": (-200.0, 0.0, "dBm"), "RSRQ": (-60.0, 20.0, "dB"), "RS SNR": (-50.0, 60.0, "dB"),
-             "Physical cell identity": (0.0, 1007.0, ""), "Latitude": (-90.0, 90.0, "deg"),
-             "Longitude": (-180.0, 180.0, "deg")}
+PLAUSIBLE = {
+    "RSRP": (-200.0, 0.0, "dBm"),
+    "RSRQ": (-60.0, 20.0, "dB"),
+    "RS SNR": (-50.0, 60.0, "dB"),
+    "Physical cell identity": (0.0, 1007.0, ""),
+    "Latitude": (-90.0, 90.0, "deg"),
+    "Longitude": (-180.0, 180.0, "deg"),
+}
 
 
 def _check_measurements(df, path: Path) -> None:
@@ -148,14 +182,21 @@ def _check_measurements(df, path: Path) -> None:
                 first = (line, col, float(v[k]), lo, hi, unit)
     if first is not None:
         line, col, value, lo, hi, unit = first
-        what = (f"a non-finite number ({value:g})" if not np.isfinite(value) else
-                f"{value:g}, outside the {lo:g}..{hi:g}{unit} a UE reports")
+        what = (
+            f"a non-finite number ({value:g})"
+            if not np.isfinite(value)
+            else f"{value:g}, outside the {lo:g}..{hi:g}{unit} a UE reports"
+        )
         raise InputError(f"{path}: line {line}: column '{col}' holds {what}; fix or delete that row.")
 
 
 def _neighbour_columns(slots: list[int], present) -> list[str]:
-    return [c for s in slots for k in ("Physical cell identity", "RSRP", "RSRQ")
-            if (c := f"{k} (LTE detected) - {s}") in present]
+    return [
+        c
+        for s in slots
+        for k in ("Physical cell identity", "RSRP", "RSRQ")
+        if (c := f"{k} (LTE detected) - {s}") in present
+    ]
 
 
 def _time_steps(df, slots: list[int], path: Path):
@@ -169,8 +210,12 @@ def _time_steps(df, slots: list[int], path: Path):
     g = g[g[PCI].notna() & g[RSRP].notna() & g[RSRQ].notna() & g["Latitude"].notna() & g["Longitude"].notna()]
     if len(g) < 2:
         raise InputError(f"{path}: fewer than 2 time steps with a serving cell ('{PCI}').")
-    for col, lo, hi, unit in ((RSRP, -160, -20, "dBm"), (RSRQ, -40, 0, "dB"), ("Latitude", -90, 90, "deg"),
-                              ("Longitude", -180, 180, "deg")):
+    for col, lo, hi, unit in (
+        (RSRP, -160, -20, "dBm"),
+        (RSRQ, -40, 0, "dB"),
+        ("Latitude", -90, 90, "deg"),
+        ("Longitude", -180, 180, "deg"),
+    ):
         med = float(g[col].median())
         if not lo <= med <= hi:
             raise InputError(f"{path}: column '{col}' has median {med:g}, outside {lo}..{hi} {unit}; wrong units?")
@@ -189,8 +234,10 @@ def load_folder(folder: str | Path) -> tuple[list[RealFlight], list[str]]:
         except InputError as exc:
             bad.append(str(exc))
     if not flights:
-        raise InputError(f"{folder}: no loadable flight export ({len(bad)} bad file(s)); first: "
-                         f"{bad[0] if bad else 'no *.csv files'}")
+        raise InputError(
+            f"{folder}: no loadable flight export ({len(bad)} bad file(s)); first: "
+            f"{bad[0] if bad else 'no *.csv files'}"
+        )
     return flights, bad
 
 
@@ -198,13 +245,13 @@ def load_folder(folder: str | Path) -> tuple[list[RealFlight], list[str]]:
 class Walk:
     """A real flight as the network flew it, seen as a policy would see it at each sample."""
 
-    t: np.ndarray              # (n,) seconds
-    states: np.ndarray         # (n, 13)
-    candidates: list[list]     # per sample: the serving PCI, then up to 3 measured neighbours by RSRP
-    next_serving: np.ndarray   # (n,) the network's serving PCI at the next sample (its decision); last: itself
-    queue_bits: np.ndarray     # (n,) the modelled uplink buffer
+    t: np.ndarray  # (n,) seconds
+    states: np.ndarray  # (n, 13)
+    candidates: list[list]  # per sample: the serving PCI, then up to 3 measured neighbours by RSRP
+    next_serving: np.ndarray  # (n,) the network's serving PCI at the next sample (its decision); last: itself
+    queue_bits: np.ndarray  # (n,) the modelled uplink buffer
     lost_bits: float
-    name: str = ""             # the flight's
+    name: str = ""  # the flight's
 
     @property
     def serving(self) -> np.ndarray:
@@ -262,7 +309,7 @@ class UplinkBuffer:
 def _candidates(cells: dict, serving, cfg: SimConfig) -> list:
     """The serving cell, then up to 3 neighbours measured above the detection limit, strongest RSRP first."""
     detected = [p for p in cells if p != serving and cells[p][1] > cfg.observation.detection_rsrq_db]
-    return [serving] + sorted(detected, key=lambda p: -cells[p][0])[:N_CANDIDATES - 1]
+    return [serving] + sorted(detected, key=lambda p: -cells[p][0])[: N_CANDIDATES - 1]
 
 
 def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
@@ -277,9 +324,16 @@ def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
         serving = f.pci[i]
         cand = _candidates(cells, serving, cfg)
         pad = [np.nan] * (N_CANDIDATES - len(cand))
-        states.append(state_rows([*f.xy[i], f.altitude_m], link.q, min(ids[serving], max_id),
-                                 [cells[p][0] for p in cand] + pad, [cells[p][1] for p in cand] + pad,
-                                 cfg.observation)[0])
+        states.append(
+            state_rows(
+                [*f.xy[i], f.altitude_m],
+                link.q,
+                min(ids[serving], max_id),
+                [cells[p][0] for p in cand] + pad,
+                [cells[p][1] for p in cand] + pad,
+                cfg.observation,
+            )[0]
+        )
         cands.append(cand)
         queues.append(link.q)
         if i + 1 < len(f.t):
@@ -288,8 +342,10 @@ def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
     bad = ~np.isfinite(states)
     if bad.any():  # finite measurements beyond float32 (the states' type)
         i, j = (int(k[0]) for k in np.nonzero(bad))
-        raise InputError(f"{f.name}: the state at sample {i} has {FEATURES[j]} = {states[i, j]:g} (float32), not a "
-                         "finite number; fix that measurement.")
+        raise InputError(
+            f"{f.name}: the state at sample {i} has {FEATURES[j]} = {states[i, j]:g} (float32), not a "
+            "finite number; fix that measurement."
+        )
     return Walk(f.t, states, cands, np.append(f.pci[1:], f.pci[-1]), np.array(queues), link.lost, f.name)
 
 
@@ -308,7 +364,7 @@ def chm_handovers(f: RealFlight, config=None, sim_config: SimConfig | None = Non
             serving, changes = max(cells, key=lambda p: cells[p][0]), changes + 1
         cand = _candidates(cells, serving, cfg)
         state = np.full(len(FEATURES), np.nan)
-        state[RSRP_COLUMNS.start:RSRP_COLUMNS.start + len(cand)] = [cells[p][0] for p in cand]
+        state[RSRP_COLUMNS.start : RSRP_COLUMNS.start + len(cand)] = [cells[p][0] for p in cand]
         target = cand[chm(state, cand, float(f.t[i]))]
         if target != serving:
             serving, changes = target, changes + 1
@@ -321,11 +377,11 @@ class Agreement:
 
     instants: int
     network_handovers: int
-    proposals: int              # instants at which the policy proposed a handover
-    new_proposals: int          # of those, the ones that start a proposal (not the one of the instant before)
-    stay_agreement: float       # share of the network's stays where the policy also stayed
-    handover_agreement: float   # share of the network's handovers where the policy proposed one
-    target_agreement: float     # share of the network's handovers where the policy proposed the same cell
+    proposals: int  # instants at which the policy proposed a handover
+    new_proposals: int  # of those, the ones that start a proposal (not the one of the instant before)
+    stay_agreement: float  # share of the network's stays where the policy also stayed
+    handover_agreement: float  # share of the network's handovers where the policy proposed one
+    target_agreement: float  # share of the network's handovers where the policy proposed the same cell
     minutes: float
 
     @property
@@ -352,8 +408,11 @@ def agreement(walks: list[Walk], make_decider) -> Agreement:
             cand = w.candidates[i]
             a = decide(w.states[i], cand, float(w.t[i]))
             if type(a) is not int or not 0 <= a < N_CANDIDATES:  # a NaN must not be cast to some action
-                a = int(checked_actions([a], lambda _, i=i, w=w: f"sample {i} (t = {w.t[i]:g} s) of "
-                                                                  f"{w.name or 'a walk'}")[0])
+                a = int(
+                    checked_actions([a], lambda _, i=i, w=w: f"sample {i} (t = {w.t[i]:g} s) of {w.name or 'a walk'}")[
+                        0
+                    ]
+                )
             target = cand[a] if a < len(cand) else cand[0]
             net_ho = w.next_serving[i] != cand[0]
             proposes = target != cand[0]

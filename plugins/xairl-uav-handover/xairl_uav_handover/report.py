@@ -4,6 +4,7 @@ open-loop agreement with the live network, and which of the paper's findings hol
 explanations, figures (beeswarms sim vs real, importance, groups) and narration. Where real flights come from:
 :func:`real_source` (``ukm``: ukm.py).
 """
+
 from __future__ import annotations
 
 import sys
@@ -35,13 +36,20 @@ BANDS = ((20.0, 60.0), (60.0, 100.0), (100.0, 160.0))
 class UAVReportOptions(Options):
     """The UAV report's own settings (``-o key=value``)."""
 
-    real: str | None = Field(None, description="folder of real flight exports (Nemo CSV) or a zip of them, e.g. "
-                                               "../shared/data/ukm-uav-lte/raw; or 'ukm': the UKM flights "
-                                               "($XAIRL_UKM_DATA, else the copy cached in the user data folder, else "
-                                               "downloaded once; skipped with a note when they cannot be had)")
+    real: str | None = Field(
+        None,
+        description="folder of real flight exports (Nemo CSV) or a zip of them, e.g. "
+        "../shared/data/ukm-uav-lte/raw; or 'ukm': the UKM flights "
+        "($XAIRL_UKM_DATA, else the copy cached in the user data folder, else "
+        "downloaded once; skipped with a note when they cannot be had)",
+    )
     flights: int = Field(100, ge=1, le=10_000, description="held-out simulated flights for Table I")
-    timelines: int = Field(2, ge=0, le=20, description="simulated flights shown at a glance (timeline and summary; "
-                                                       "with real data, its first flight too)")
+    timelines: int = Field(
+        2,
+        ge=0,
+        le=20,
+        description="simulated flights shown at a glance (timeline and summary; with real data, its first flight too)",
+    )
 
 
 @dataclass
@@ -55,8 +63,14 @@ class BandRow:
     chm_sim_per_min: float
     sim_over_real: float
 
-    HEADER = ["altitude band", "real flights", "live network HO/min", "CHM on the real measurements HO/min",
-              "CHM simulated HO/min", "simulated / real CHM"]
+    HEADER = [
+        "altitude band",
+        "real flights",
+        "live network HO/min",
+        "CHM on the real measurements HO/min",
+        "CHM simulated HO/min",
+        "simulated / real CHM",
+    ]
 
 
 @dataclass
@@ -71,9 +85,15 @@ class AgreementRow:
     handover_agreement_pct: float
     target_agreement_pct: float
 
-    HEADER = ["policy", "instants proposing a HO, per min", "new HO proposals/min (a standing one counted once)",
-              "network HO/min", "stays when the network stays %", "proposes a HO where the network handed over %",
-              "same target cell %"]
+    HEADER = [
+        "policy",
+        "instants proposing a HO, per min",
+        "new HO proposals/min (a standing one counted once)",
+        "network HO/min",
+        "stays when the network stays %",
+        "proposes a HO where the network handed over %",
+        "same target cell %",
+    ]
 
 
 @dataclass
@@ -89,8 +109,16 @@ class QuantileRow:
     real_p95: float
     real_outside_pct: float
 
-    HEADER = ["feature", "sim p5", "sim p50", "sim p95", "real p5", "real p50", "real p95",
-              "real states outside sim 0.5-99.5 % range"]
+    HEADER = [
+        "feature",
+        "sim p5",
+        "sim p50",
+        "sim p95",
+        "real p5",
+        "real p50",
+        "real p95",
+        "real states outside sim 0.5-99.5 % range",
+    ]
 
 
 def _table(rows: list) -> str:
@@ -109,18 +137,27 @@ class UAVReport(Report):
         ckpt = load_checkpoint()
         cfg = ckpt.sim_config
         content = ReportContent(
-            title="xairl report: UAV handover DQN (Meer et al.), calibrated reproduction", policy=uav_policy(ckpt),
+            title="xairl report: UAV handover DQN (Meer et al.), calibrated reproduction",
+            policy=uav_policy(ckpt),
             background=background_states(100, seed=req.seed + 7, config=cfg),
             datasets=[("simulated", dqn_decision_states(ckpt, req.n_states, seed=req.seed + 1))],
             tables=[self._table_one(ckpt, req.seed)],
-            settings={"checkpoint": ckpt.path.name, "training command": ckpt.meta.get("command"),
-                      "simulated states": req.n_states, "real data": real_setting,
-                      "video rate Mbit/s": cfg.buffer.video_rate_mbps,
-                      "x, y quantised to (m)": cfg.observation.position_grid_m or "not quantised"},
-            template="handover", commentary=findings,
-            notes=["Simulated states: the DQN's own decision states on held-out flights (TR 36.777 UMa-AV, the "
-                   "calibrated link and load of config.py). Contributions are to the chosen action's Q-value; the "
-                   "background is 100 states after 10 s of flight under conventional handover."])
+            settings={
+                "checkpoint": ckpt.path.name,
+                "training command": ckpt.meta.get("command"),
+                "simulated states": req.n_states,
+                "real data": real_setting,
+                "video rate Mbit/s": cfg.buffer.video_rate_mbps,
+                "x, y quantised to (m)": cfg.observation.position_grid_m or "not quantised",
+            },
+            template="handover",
+            commentary=findings,
+            notes=[
+                "Simulated states: the DQN's own decision states on held-out flights (TR 36.777 UMa-AV, the "
+                "calibrated link and load of config.py). Contributions are to the chosen action's Q-value; the "
+                "background is 100 states after 10 s of flight under conventional handover."
+            ],
+        )
         flights = self._add_real_flights(content, ckpt, req, real, *loaded) if loaded else []
         self._add_timelines(content, ckpt, req, flights[:1])
         return content
@@ -138,8 +175,9 @@ class UAVReport(Report):
             text, check = narrate_flight(tl, exp, content.policy)
             mark = "verified" if check.ok else "NOT verified"
             path = timeline_figure(tl, exp, content.policy, Path(req.out) / f"flight_{n}.png")
-            content.figures.append((f"Flight at a glance: {tl.label}. {text} [{mark}, coverage {check.coverage:.0%}]",
-                                    path))
+            content.figures.append(
+                (f"Flight at a glance: {tl.label}. {text} [{mark}, coverage {check.coverage:.0%}]", path)
+            )
 
     def _table_one(self, ckpt: Checkpoint, seed: int) -> tuple[str, str]:
         """Table I with bootstrap 95 % intervals (table.py), and in words where the DQN loses to CHM."""
@@ -148,11 +186,15 @@ class UAVReport(Report):
         n, cfg = self.options.flights, ckpt.sim_config
         res = {c.name: with_intervals(flights(c, cfg, n, [seed])) for c in (CHM(), SAMRO(), DQNController(ckpt.net))}
         paper = ", ".join(f"{name} {ho} handovers and {pp} % ping-pongs" for name, (ho, pp) in PAPER.items())
-        return (f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s, value [bootstrap 95 % "
-                f"interval]. {verdict(res)} (The paper's medians per flight: {paper}.)", table_html(*html_table(res)))
+        return (
+            f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s, value [bootstrap 95 % "
+            f"interval]. {verdict(res)} (The paper's medians per flight: {paper}.)",
+            table_html(*html_table(res)),
+        )
 
-    def _add_real_flights(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest, real: Path,
-                          flights: list, bad: list[str]) -> list:
+    def _add_real_flights(
+        self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest, real: Path, flights: list, bad: list[str]
+    ) -> list:
         """The calibration and agreement tables against the ``flights`` loaded from folder ``real`` (``bad``: why
         the others were skipped); returns the flights."""
         from xairl.plugin import progress
@@ -169,13 +211,21 @@ class UAVReport(Report):
         queue = np.concatenate([w.queue_bits for w in walks])
         where = f"{len(flights)} real flights from {real}" + (f" ({len(bad)} skipped)" if bad else "")
         content.tables += [
-            (f"Calibration: handovers per minute by altitude band ({where})", _table(band_rows(flights, chm_real, cfg, req.seed))),
-            (f"Real states in the training distribution: buffer full in {100 * np.mean(queue >= cfg.buffer.q_max_bits):.1f} "
-             f"% of real states, non-empty in {100 * np.mean(queue > 0):.1f} %; any feature outside the simulated "
-             f"0.5-99.5 % range in {100 * outside(states, sim_ref).any(axis=1).mean():.1f} % of real states",
-             _table(quantile_rows(sim_ref, states))),
-            (f"Open-loop agreement with the live network's decisions ({where})",
-             _table(agreement_rows(walks, ckpt, cfg)))]
+            (
+                f"Calibration: handovers per minute by altitude band ({where})",
+                _table(band_rows(flights, chm_real, cfg, req.seed)),
+            ),
+            (
+                f"Real states in the training distribution: buffer full in {100 * np.mean(queue >= cfg.buffer.q_max_bits):.1f} "
+                f"% of real states, non-empty in {100 * np.mean(queue > 0):.1f} %; any feature outside the simulated "
+                f"0.5-99.5 % range in {100 * outside(states, sim_ref).any(axis=1).mean():.1f} % of real states",
+                _table(quantile_rows(sim_ref, states)),
+            ),
+            (
+                f"Open-loop agreement with the live network's decisions ({where})",
+                _table(agreement_rows(walks, ckpt, cfg)),
+            ),
+        ]
         content.notes += [f"skipped file: {b}" for b in bad] + REAL_NOTES
         content.figures.append(_altitude_figure(req.out, str(real), cfg, flights, chm_real, req.seed))
         return flights
@@ -188,8 +238,11 @@ def _load_real(real: Path) -> tuple[list, list[str]]:
 
     flights, bad = load_folder(real)
     if bad:
-        print(f"xairl: report: skipped {len(bad)} of {len(bad) + len(flights)} flight file(s) (listed in the "
-              f"report's notes); first: {bad[0]}", file=sys.stderr)
+        print(
+            f"xairl: report: skipped {len(bad)} of {len(bad) + len(flights)} flight file(s) (listed in the "
+            f"report's notes); first: {bad[0]}",
+            file=sys.stderr,
+        )
     return flights, bad
 
 
@@ -204,8 +257,10 @@ def real_source(real: str | None) -> tuple[Path | None, str]:
     if real.strip().lower() != ukm.KEYWORD:
         folder = ukm.flights_folder(real)
         if not folder.is_dir():  # before Table I's minutes are spent
-            raise InputError(f"-o real={real}: no such folder or zip of flight exports; give the folder of the "
-                             f"Nemo CSVs, the UKM zip, or -o real={ukm.KEYWORD} to fetch the UKM flights.")
+            raise InputError(
+                f"-o real={real}: no such folder or zip of flight exports; give the folder of the "
+                f"Nemo CSVs, the UKM zip, or -o real={ukm.KEYWORD} to fetch the UKM flights."
+            )
         return folder, real
     try:
         folder = ukm.flights_folder()
@@ -229,7 +284,8 @@ REAL_NOTES = [
     "every sample at which one stands.",
     "Open loop: at every real sample each policy proposes an action for the state the network's own choices led "
     "to; nothing is steered, so every instant compares like with like. CHM and SA-MRO restart their timers when "
-    "the network hands over."]
+    "the network hands over.",
+]
 
 
 def band_rows(flights, chm_real: list[int], cfg, seed: int) -> list[BandRow]:
@@ -270,11 +326,23 @@ def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
         return lambda s, c, t: actions[t]
 
     rows = []
-    for name, make in (("DQN", dqn), ("CHM (A3 2 dB, 160 ms)", lambda w: CHMOnSamples(w.cells)),
-                       ("SA-MRO", lambda w: SAMROOnSamples(w.cells, cfg))):
+    for name, make in (
+        ("DQN", dqn),
+        ("CHM (A3 2 dB, 160 ms)", lambda w: CHMOnSamples(w.cells)),
+        ("SA-MRO", lambda w: SAMROOnSamples(w.cells, cfg)),
+    ):
         a = agreement(walks, make)
-        rows.append(AgreementRow(name, a.proposals_per_min, a.new_proposals_per_min, a.network_handovers / a.minutes,
-                                 100 * a.stay_agreement, 100 * a.handover_agreement, 100 * a.target_agreement))
+        rows.append(
+            AgreementRow(
+                name,
+                a.proposals_per_min,
+                a.new_proposals_per_min,
+                a.network_handovers / a.minutes,
+                100 * a.stay_agreement,
+                100 * a.handover_agreement,
+                100 * a.target_agreement,
+            )
+        )
     return rows
 
 
@@ -289,13 +357,16 @@ def findings(exps: dict[str, Explanation]) -> list[str]:
         by_score = [grouped.feature_names[j] for j in np.argsort(-np.abs(grouped.for_chosen()).mean(axis=0))]
         buf, pos = order.index("buffer_queue_size") + 1, order.index("position") + 1
         holds = "holds" if buf == 1 and pos == 2 else "does not hold"
-        parts = (f"buffer first {'holds' if buf == 1 else 'does not'}, position second "
-                 f"{'holds' if pos == 2 else 'does not'}")
-        out.append(f"Paper's Figure 2 finding (buffer first, position second) {holds} on the {label} states "
-                   f"({parts}): by mean |contribution to the margin over the runner-up| the buffer ranks {buf} and "
-                   f"position (x, y, z) {pos}; the top three are {', '.join(order[:3])}. By mean |contribution to "
-                   f"the chosen action's score| the buffer ranks {by_score.index('buffer_queue_size') + 1} and "
-                   f"position {by_score.index('position') + 1}.")
+        parts = (
+            f"buffer first {'holds' if buf == 1 else 'does not'}, position second {'holds' if pos == 2 else 'does not'}"
+        )
+        out.append(
+            f"Paper's Figure 2 finding (buffer first, position second) {holds} on the {label} states "
+            f"({parts}): by mean |contribution to the margin over the runner-up| the buffer ranks {buf} and "
+            f"position (x, y, z) {pos}; the top three are {', '.join(order[:3])}. By mean |contribution to "
+            f"the chosen action's score| the buffer ranks {by_score.index('buffer_queue_size') + 1} and "
+            f"position {by_score.index('position') + 1}."
+        )
     return out
 
 
@@ -311,12 +382,23 @@ def _altitude_figure(out: Path, real: str, cfg, flights, chm_real: list[int], se
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
     ax.plot(alts, chm_rate_by_altitude(alts, cfg, seed=seed), "o-", label="simulator, CHM (A3 2 dB / 160 ms)")
     long = [(f, n) for f, n in zip(flights, chm_real) if f.t[-1] > 60]
-    ax.plot([f.altitude_m for f, _ in long], [n / (f.t[-1] / 60) for f, n in long], "x",
-            label="CHM on the UKM measurements")
-    ax.plot([f.altitude_m for f, _ in long], [f.observed_handovers / (f.t[-1] / 60) for f, _ in long], "s",
-            label="UKM flights, live network (nominal height)")
-    baltaci = next((p / "baltaci-imc22-handovers" for p in Path(real).resolve().parents
-                    if (p / "baltaci-imc22-handovers" / "handovers.csv").is_file()), None)
+    ax.plot(
+        [f.altitude_m for f, _ in long], [n / (f.t[-1] / 60) for f, n in long], "x", label="CHM on the UKM measurements"
+    )
+    ax.plot(
+        [f.altitude_m for f, _ in long],
+        [f.observed_handovers / (f.t[-1] / 60) for f, _ in long],
+        "s",
+        label="UKM flights, live network (nominal height)",
+    )
+    baltaci = next(
+        (
+            p / "baltaci-imc22-handovers"
+            for p in Path(real).resolve().parents
+            if (p / "baltaci-imc22-handovers" / "handovers.csv").is_file()
+        ),
+        None,
+    )
     caption = "Handover rate vs altitude"
     if baltaci is not None:
         bins, rate, n = baltaci_rate_by_altitude(baltaci)

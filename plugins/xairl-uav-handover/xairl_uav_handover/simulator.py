@@ -13,6 +13,7 @@ see) is the L1 average over each measurement period, layer-3 filtered (``Observa
 measured only above the detection threshold. The uplink (SINR with aerial co-channel interference, capacity) is in
 uplink.py.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -114,8 +115,11 @@ class Simulator:
         h = self.pos[:, 2:3]
         d3d = np.hypot(d2d, h - c.bs_height_m)
         los = ndtr(self.g_los) < los_probability(c.scenario, h, d2d)
-        self.loss_db = (path_loss(c.scenario, h, d3d, c.carrier_ghz, los, c.bs_height_m)
-                        + shadow_sigma(c.scenario, h, los) * self.g_shadow + c.fading_db * self.g_fast)
+        self.loss_db = (
+            path_loss(c.scenario, h, d3d, c.carrier_ghz, los, c.bs_height_m)
+            + shadow_sigma(c.scenario, h, los) * self.g_shadow
+            + c.fading_db * self.g_fast
+        )
         self.rsrp = self._rsrp_offset + self._gain - self.loss_db
         rsrp_mw = 10 ** (self.rsrp / 10)
         n_re = 12 * self.cfg.radio.n_rb
@@ -187,10 +191,18 @@ class Simulator:
         self.interrupt = np.maximum(self.interrupt - 1, 0)
         hc = cfg.handover
         radio_ok = sinr >= hc.sinr_min_db
-        info = StepInfo(ho, pingpong, serving_now & radio_ok, radio_ok,
-                        self.meas_rsrp[k, self.serving] < hc.rsrp_threshold_dbm,
-                        self.meas_rsrq[k, self.serving] < hc.rsrq_threshold_db, self.q.copy(), lost, sinr,
-                        back_after_s)
+        info = StepInfo(
+            ho,
+            pingpong,
+            serving_now & radio_ok,
+            radio_ok,
+            self.meas_rsrp[k, self.serving] < hc.rsrp_threshold_dbm,
+            self.meas_rsrq[k, self.serving] < hc.rsrq_threshold_db,
+            self.q.copy(),
+            lost,
+            sinr,
+            back_after_s,
+        )
         self._move()
         self._measure()
         self._report()
@@ -209,8 +221,8 @@ class Simulator:
         inward = np.arctan2(-self.pos[:, 1], -self.pos[:, 0]) + self.rng.uniform(-np.pi / 4, np.pi / 4, self.K)
         self.heading = np.where(out, inward, self.heading)
         rho = np.exp(-step / self.cfg.channel.shadow_corr_m)[:, None]
-        innov = np.sqrt(1 - rho ** 2)
+        innov = np.sqrt(1 - rho**2)
         self.g_shadow = rho * self.g_shadow + innov * self.rng.standard_normal((self.K, self.N))
         self.g_los = rho * self.g_los + innov * self.rng.standard_normal((self.K, self.N))
         rf = self._rho_fast
-        self.g_fast = rf * self.g_fast + np.sqrt(1 - rf ** 2) * self.rng.standard_normal((self.K, self.N))
+        self.g_fast = rf * self.g_fast + np.sqrt(1 - rf**2) * self.rng.standard_normal((self.K, self.N))

@@ -5,12 +5,14 @@ each figure is a statistic over flights, and its interval comes from resampling 
 (percentile bootstrap, 1,000 resamples, seeded). Shares pooled over handovers (ping-pong share, handovers taken with
 an empty or a full buffer) are ratios of sums, resampled as such.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 from .env import PINGPONG_WINDOWS_S
 from .evaluate import run_flights
+
 
 #: (key, label, statistic of the per-flight arrays ``m``) in the table's order
 def _rows():
@@ -23,21 +25,33 @@ def _rows():
     def worst5(key):
         return lambda m, i: np.sort(m[key][i])[: max(1, len(i) // 20)].mean()
 
-    rows = [("handovers", "handovers per flight", mean("handovers")),
-            ("pp_per_min", "ping-pongs per flight-minute (1 s window)", lambda m, i: m["pingpongs"][i].sum() / m["minutes"][i].sum())]
-    rows += [(f"pp_{w:g}s", f"ping-pong share, {w:g} s window (%)", pooled(f"pingpongs_{w:g}s", "handovers"))
-             for w in PINGPONG_WINDOWS_S]
-    rows += [("pp_over_5", "flights with > 5 ping-pongs, 1 s window (%)", lambda m, i: 100 * (m["pingpongs"][i] > 5).mean()),
-             ("lost_mbit", "lost data per flight (Mbit)", mean("lost_data_kbit", 1e-3)),
-             ("availability", "service availability, mean (%)", mean("service_availability_pct")),
-             ("availability_worst5", "service availability, worst 5 % of flights (%)",
-              worst5("service_availability_pct")),
-             ("rsrq_violation", "time below the RSRQ threshold (%)", mean("rsrq_violation_pct")),
-             ("rsrp_violation", "time below the RSRP threshold (%)", mean("rsrp_violation_pct")),
-             ("ho_empty", "handovers taken with an empty buffer (%)",
-              lambda m, i: 100 - pooled("handovers_buffer_nonempty", "handovers")(m, i)),
-             ("ho_full", "handovers taken with a full buffer (%)", pooled("handovers_buffer_full", "handovers")),
-             ("buffer_in_use", "decisions taken with a non-empty buffer (%)", mean("buffer_nonempty_pct"))]
+    rows = [
+        ("handovers", "handovers per flight", mean("handovers")),
+        (
+            "pp_per_min",
+            "ping-pongs per flight-minute (1 s window)",
+            lambda m, i: m["pingpongs"][i].sum() / m["minutes"][i].sum(),
+        ),
+    ]
+    rows += [
+        (f"pp_{w:g}s", f"ping-pong share, {w:g} s window (%)", pooled(f"pingpongs_{w:g}s", "handovers"))
+        for w in PINGPONG_WINDOWS_S
+    ]
+    rows += [
+        ("pp_over_5", "flights with > 5 ping-pongs, 1 s window (%)", lambda m, i: 100 * (m["pingpongs"][i] > 5).mean()),
+        ("lost_mbit", "lost data per flight (Mbit)", mean("lost_data_kbit", 1e-3)),
+        ("availability", "service availability, mean (%)", mean("service_availability_pct")),
+        ("availability_worst5", "service availability, worst 5 % of flights (%)", worst5("service_availability_pct")),
+        ("rsrq_violation", "time below the RSRQ threshold (%)", mean("rsrq_violation_pct")),
+        ("rsrp_violation", "time below the RSRP threshold (%)", mean("rsrp_violation_pct")),
+        (
+            "ho_empty",
+            "handovers taken with an empty buffer (%)",
+            lambda m, i: 100 - pooled("handovers_buffer_nonempty", "handovers")(m, i),
+        ),
+        ("ho_full", "handovers taken with a full buffer (%)", pooled("handovers_buffer_full", "handovers")),
+        ("buffer_in_use", "decisions taken with a non-empty buffer (%)", mean("buffer_nonempty_pct")),
+    ]
     return rows
 
 
@@ -52,7 +66,9 @@ def flights(controller, config, n_flights: int, seeds) -> dict[str, np.ndarray]:
     return {key: np.concatenate([r[key] for r in runs]) for key in runs[0]}
 
 
-def with_intervals(m: dict[str, np.ndarray], resamples: int = 1000, seed: int = 0) -> dict[str, tuple[float, float, float]]:
+def with_intervals(
+    m: dict[str, np.ndarray], resamples: int = 1000, seed: int = 0
+) -> dict[str, tuple[float, float, float]]:
     """{row key: (value, low, high)}: each statistic on all flights and its percentile bootstrap 95 % interval."""
     n = len(m["handovers"])
     everyone = np.arange(n)
@@ -88,12 +104,20 @@ def worse(res: dict, a: str, b: str) -> list[str]:
 def html_table(res: dict) -> tuple[list[str], list[list[str]]]:
     """(header, rows) for an HTML table: one row per figure, one column per policy, 'value [low, high]'."""
     names = list(res)
-    return (["", *names], [[label, *(f"{res[n][key][0]:.2f} [{res[n][key][1]:.2f}, {res[n][key][2]:.2f}]"
-                                     for n in names)] for key, label, _ in ROWS])
+    return (
+        ["", *names],
+        [
+            [label, *(f"{res[n][key][0]:.2f} [{res[n][key][1]:.2f}, {res[n][key][2]:.2f}]" for n in names)]
+            for key, label, _ in ROWS
+        ],
+    )
 
 
 def verdict(res: dict, a: str = "DQN", b: str = "CHM") -> str:
     """In words, where policy ``a`` loses to ``b`` beyond the intervals (:func:`worse`)."""
     losses = worse(res, a, b)
-    return (f"The {a} is worse than {b} beyond the intervals on: " + "; ".join(losses) + "." if losses else
-            f"The {a} is worse than {b} beyond the intervals on no figure.")
+    return (
+        f"The {a} is worse than {b} beyond the intervals on: " + "; ".join(losses) + "."
+        if losses
+        else f"The {a} is worse than {b} beyond the intervals on no figure."
+    )

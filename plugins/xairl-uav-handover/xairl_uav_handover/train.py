@@ -10,6 +10,7 @@ in the paper's episodic set-up. With ``demonstrations`` > 0 it learns from :clas
 (Hester et al. 2018): :func:`margin_loss` on the rule's actions beside the TD loss, after ``pretrain_updates`` steps on
 the demonstrations alone.
 """
+
 from __future__ import annotations
 
 import time
@@ -43,22 +44,44 @@ class TrainConfig(Options, frozen=True):
     learning_starts: int = Field(5_000, ge=0, description="transitions collected before the first update")
     updates_per_decision: int = Field(1, ge=1)
     target_every: int = Field(500, ge=1, description="gradient steps between target-network copies (M)")
-    eps_start: float | None = Field(None, ge=0, le=1, description="unset: 0.2 with demonstrations (the pretrained "
-                                    "network already acts like the demonstrator), 1 without (a plain DQN)")
+    eps_start: float | None = Field(
+        None,
+        ge=0,
+        le=1,
+        description="unset: 0.2 with demonstrations (the pretrained "
+        "network already acts like the demonstrator), 1 without (a plain DQN)",
+    )
     eps_end: float = Field(0.01, ge=0, le=1)
     eps_fraction: float = Field(0.5, gt=0, le=1)
-    demonstrations: int = Field(10, ge=0, description="episodes of the demonstrator's flights (baselines.RSRQRule) "
-                                "kept in a replay buffer of their own (DQfD, Hester et al. 2018); 0: plain DQN")
-    pretrain_updates: int = Field(3000, ge=0, description="gradient steps on the demonstrations alone before the "
-                                  "DQN flies")
-    expert_margin: float = Field(5.0, ge=0, description="DQfD's large margin: how much higher the demonstrator's "
-                                 "action must score than any other (reward units)")
-    expert_weight: float = Field(10.0, ge=0, description="weight of the margin loss against the TD loss (training "
-                                 "seed 2, 600 held-out flights and the real ones: 1 met 8 of 12 targets, 3 and 10 "
-                                 "met 9)")
-    demonstrator_margin_db: float = Field(3.5, ge=0, description="how much better (RSRQ, dB) the demonstrator's "
-                                          "target must be than the serving cell (3 dB: RSRQ time 7.7-7.9 % but "
-                                          "0.53-0.55x CHM's handovers; 3.5 dB: 8.1-8.4 % at 0.48x)")
+    demonstrations: int = Field(
+        10,
+        ge=0,
+        description="episodes of the demonstrator's flights (baselines.RSRQRule) "
+        "kept in a replay buffer of their own (DQfD, Hester et al. 2018); 0: plain DQN",
+    )
+    pretrain_updates: int = Field(
+        3000, ge=0, description="gradient steps on the demonstrations alone before the DQN flies"
+    )
+    expert_margin: float = Field(
+        5.0,
+        ge=0,
+        description="DQfD's large margin: how much higher the demonstrator's "
+        "action must score than any other (reward units)",
+    )
+    expert_weight: float = Field(
+        10.0,
+        ge=0,
+        description="weight of the margin loss against the TD loss (training "
+        "seed 2, 600 held-out flights and the real ones: 1 met 8 of 12 targets, 3 and 10 "
+        "met 9)",
+    )
+    demonstrator_margin_db: float = Field(
+        3.5,
+        ge=0,
+        description="how much better (RSRQ, dB) the demonstrator's "
+        "target must be than the serving cell (3 dB: RSRQ time 7.7-7.9 % but "
+        "0.53-0.55x CHM's handovers; 3.5 dB: 8.1-8.4 % at 0.48x)",
+    )
     seed: int = 0
 
     @model_validator(mode="after")
@@ -68,7 +91,7 @@ class TrainConfig(Options, frozen=True):
         return self
 
     @classmethod
-    def of_checkpoint(cls, meta: dict) -> "TrainConfig":
+    def of_checkpoint(cls, meta: dict) -> TrainConfig:
         """The settings a checkpoint was trained with; one written before demonstrations existed was a plain DQN."""
         return cls.model_validate({"demonstrations": 0, **meta["train_config"]})
 
@@ -83,9 +106,17 @@ def learning_rate(tc: TrainConfig, episode: int) -> float:
     return tc.lr0 / (1 + tc.eta * episode)
 
 
-def dqn_update(q: torch.nn.Module, target: torch.nn.Module, opt: torch.optim.Optimizer, batch, gamma: float,
-               next_available: torch.Tensor | None = None, expert=None, expert_margin: float = 0.0,
-               expert_weight: float = 0.0) -> float:
+def dqn_update(
+    q: torch.nn.Module,
+    target: torch.nn.Module,
+    opt: torch.optim.Optimizer,
+    batch,
+    gamma: float,
+    next_available: torch.Tensor | None = None,
+    expert=None,
+    expert_margin: float = 0.0,
+    expert_weight: float = 0.0,
+) -> float:
     """One gradient step on the Huber TD error of a replay batch; returns the loss. ``next_available`` (batch,
     actions) bool restricts the bootstrap max to the actions available in the next state. ``expert``: a batch of
     demonstrations whose :func:`margin_loss` is added with ``expert_weight``."""
@@ -156,8 +187,14 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
     q, target = _networks(tc, sim_cfg)
     opt = torch.optim.Adam([p for p in q.parameters() if p.requires_grad], lr=tc.lr0)
     env = HandoverVecEnv(sim_cfg, tc.n_flights)
-    rb = ReplayBuffer(max(tc.replay_size // tc.n_flights, 1) * tc.n_flights, env.single_observation_space,
-                      env.single_action_space, device="cpu", n_envs=tc.n_flights, handle_timeout_termination=False)
+    rb = ReplayBuffer(
+        max(tc.replay_size // tc.n_flights, 1) * tc.n_flights,
+        env.single_observation_space,
+        env.single_action_space,
+        device="cpu",
+        n_envs=tc.n_flights,
+        handle_timeout_termination=False,
+    )
     total = tc.episodes * int(np.ceil(sim_cfg.flight.n_steps / env.decision_every))
     demos = _demonstrations(tc, sim_cfg, env, rb)
     step = updates = 0
@@ -194,8 +231,15 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
                 continue
             for _ in range(tc.updates_per_decision):
                 update()
-        history.append({"episode": ep, "epsilon": round(eps, 4), "mean_return": float(ep_ret.mean()),
-                        "median_handovers": float(np.median(ep_ho)), "seconds": round(time.time() - t0, 2)})
+        history.append(
+            {
+                "episode": ep,
+                "epsilon": round(eps, 4),
+                "mean_return": float(ep_ret.mean()),
+                "median_handovers": float(np.median(ep_ho)),
+                "seconds": round(time.time() - t0, 2),
+            }
+        )
         bar.set_postfix(ho=history[-1]["median_handovers"], ret=round(history[-1]["mean_return"], 1))
     bar.close()
     return q.eval(), history
@@ -209,8 +253,9 @@ class Demonstrations:
 
     def sample(self, rng: np.random.Generator, n: int) -> SimpleNamespace:
         i = rng.integers(len(self.obs), size=n)
-        return SimpleNamespace(observations=torch.as_tensor(self.obs[i]),
-                               actions=torch.as_tensor(self.act[i, None]), available=self.ok[i])
+        return SimpleNamespace(
+            observations=torch.as_tensor(self.obs[i]), actions=torch.as_tensor(self.act[i, None]), available=self.ok[i]
+        )
 
 
 def _demonstrations(tc: TrainConfig, sim_cfg: SimConfig, env: HandoverVecEnv, rb) -> Demonstrations | None:
@@ -242,10 +287,20 @@ def train_checkpoint(tc: TrainConfig, sim_cfg: SimConfig, out, progress: bool = 
     t0 = time.time()
     net, history = train(tc, sim_cfg, progress=progress)
     seconds = round(time.time() - t0, 1)
-    save_checkpoint(net, out, {"hidden": list(tc.hidden), "train_config": tc.model_dump(),
-                               "sim_config": sim_cfg.model_dump(), "seed": tc.seed, "train_seconds": seconds,
-                               "history": history, "command": f"xairl uav train --episodes {tc.episodes} --flights "
-                                                              f"{tc.n_flights} --demonstrations {tc.demonstrations} "
-                                                              f"--pretrain-updates {tc.pretrain_updates} --eps-start "
-                                                              f"{tc.eps_start:g} --seed {tc.seed}"})
+    save_checkpoint(
+        net,
+        out,
+        {
+            "hidden": list(tc.hidden),
+            "train_config": tc.model_dump(),
+            "sim_config": sim_cfg.model_dump(),
+            "seed": tc.seed,
+            "train_seconds": seconds,
+            "history": history,
+            "command": f"xairl uav train --episodes {tc.episodes} --flights "
+            f"{tc.n_flights} --demonstrations {tc.demonstrations} "
+            f"--pretrain-updates {tc.pretrain_updates} --eps-start "
+            f"{tc.eps_start:g} --seed {tc.seed}",
+        },
+    )
     return seconds

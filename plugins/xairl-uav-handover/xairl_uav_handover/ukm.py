@@ -16,6 +16,7 @@ sha256, has only its ``Measured Data/*.csv`` extracted (no path traversal, bound
 stating origin and licence, and is renamed into place in one step, so an interrupted one leaves no half folder under
 the final name. Anything that fails raises :class:`xairl.InputError` with one line saying how to get the data.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -38,16 +39,16 @@ COMMIT = "5fa8f2ad98efde4d28466f5922c61ceb470f840a"
 URL = f"{REPO}/raw/{COMMIT}/raw_dataset.zip"
 SHA256 = "495129a7ccbd6bf1849ad2d56528e8e3179ba63bc6c5bc9a9a34c9f9dbc45c86"
 LICENCE = "GPL-3.0"
-ENV = "XAIRL_UKM_DATA"     # a folder of the CSVs or the zip, used instead of the cache or a download
-KEYWORD = "ukm"            # the report's -o real=ukm
-FOLDER = "ukm-uav-lte"     # the extracted copy under data_home()
+ENV = "XAIRL_UKM_DATA"  # a folder of the CSVs or the zip, used instead of the cache or a download
+KEYWORD = "ukm"  # the report's -o real=ukm
+FOLDER = "ukm-uav-lte"  # the extracted copy under data_home()
 MEMBER_DIR = "Measured Data"
 TIMEOUT_S = 20.0
-MAX_DOWNLOAD = 64 << 20    # bytes; the pinned zip is a few MB
-MAX_MEMBER = 16 << 20      # uncompressed bytes per CSV (the largest is 1.2 MB)
-MAX_TOTAL = 128 << 20      # uncompressed bytes extracted in all (the 29 CSVs: 22 MB)
+MAX_DOWNLOAD = 64 << 20  # bytes; the pinned zip is a few MB
+MAX_MEMBER = 16 << 20  # uncompressed bytes per CSV (the largest is 1.2 MB)
+MAX_TOTAL = 128 << 20  # uncompressed bytes extracted in all (the 29 CSVs: 22 MB)
 MAX_MEMBERS = 1000
-NAME_MAX = 255             # bytes of a file name on the usual file systems (ext4, APFS, NTFS in UTF-16 units)
+NAME_MAX = 255  # bytes of a file name on the usual file systems (ext4, APFS, NTFS in UTF-16 units)
 
 
 def data_home() -> Path:
@@ -56,8 +57,14 @@ def data_home() -> Path:
     return (Path(base) if os.path.isabs(base) else Path.home() / ".local" / "share") / "xairl"
 
 
-def flights_folder(path: str | Path | None = None, *, root: str | Path | None = None, url: str | None = None,
-                   sha256: str | None = None, timeout: float = TIMEOUT_S) -> Path:
+def flights_folder(
+    path: str | Path | None = None,
+    *,
+    root: str | Path | None = None,
+    url: str | None = None,
+    sha256: str | None = None,
+    timeout: float = TIMEOUT_S,
+) -> Path:
     """The folder of flight CSVs: ``path`` (a folder, or a zip extracted once under ``root``), else ``$XAIRL_UKM_DATA``,
     else the UKM copy cached under ``root`` (default :func:`data_home`), else downloaded there from ``url`` (default
     :data:`URL`), checked against ``sha256`` (default :data:`SHA256`).
@@ -108,13 +115,16 @@ def _check_zip_file(path: Path) -> None:
     except OSError as exc:
         raise InputError(f"{path}: cannot read it ({_reason(exc, 0)}); {_GIVE}") from None
     if not head:
-        raise InputError(f"{path}: the file is empty (0 bytes), not a zip of flight exports; download it again "
-                         f"or {_GIVE}")
+        raise InputError(
+            f"{path}: the file is empty (0 bytes), not a zip of flight exports; download it again or {_GIVE}"
+        )
     if zipfile.is_zipfile(path):
         return
     if head == b"PK\x03\x04":  # a zip's first member, but no directory at the end
-        raise InputError(f"{path}: a zip without its directory at the end ({path.stat().st_size} bytes): truncated "
-                         f"(an interrupted download or copy); download it again.")
+        raise InputError(
+            f"{path}: a zip without its directory at the end ({path.stat().st_size} bytes): truncated "
+            f"(an interrupted download or copy); download it again."
+        )
     raise InputError(f"{path}: a file, but neither a folder nor a zip of flight exports; {_GIVE}")
 
 
@@ -132,8 +142,10 @@ def download(root: str | Path, url: str = URL, sha256: str = SHA256, timeout: fl
         with os.fdopen(fd, "wb") as out:
             digest = _fetch(url, out, sha256, timeout)
         if digest != sha256:
-            raise InputError(f"the UKM flights downloaded from {url} have sha256 {digest}, not the pinned {sha256}: "
-                             f"refused and deleted; {_how(url, sha256)}")
+            raise InputError(
+                f"the UKM flights downloaded from {url} have sha256 {digest}, not the pinned {sha256}: "
+                f"refused and deleted; {_how(url, sha256)}"
+            )
         final = root / FOLDER
         _install(tmp, final, _note(url, digest, True))
         return final
@@ -158,8 +170,9 @@ def _fetch(url: str, out, sha256: str, timeout: float) -> str:
             while chunk := resp.read(1 << 16):
                 size += len(chunk)
                 if size > MAX_DOWNLOAD:
-                    raise InputError(f"{url} sends more than {MAX_DOWNLOAD >> 20} MiB, not the UKM zip; refused; "
-                                     f"{_how(url, sha256)}")
+                    raise InputError(
+                        f"{url} sends more than {MAX_DOWNLOAD >> 20} MiB, not the UKM zip; refused; {_how(url, sha256)}"
+                    )
                 digest.update(chunk)
                 out.write(chunk)
         if 0 <= size < announced:
@@ -182,8 +195,10 @@ def _reason(exc: BaseException, timeout: float) -> str:
 
 
 def _how(url: str, sha256: str) -> str:
-    return (f"download {url} (sha256 {sha256}) and pass -o real=PATH or set {ENV}=PATH (PATH: the zip, or a folder of "
-            f"its '{MEMBER_DIR}' CSVs)")
+    return (
+        f"download {url} (sha256 {sha256}) and pass -o real=PATH or set {ENV}=PATH (PATH: the zip, or a folder of "
+        f"its '{MEMBER_DIR}' CSVs)"
+    )
 
 
 def _install(zip_path: Path, final: Path, note: str) -> None:
@@ -225,9 +240,14 @@ def _flight_members(zf: zipfile.ZipFile, zip_path: Path) -> list[zipfile.ZipInfo
         parts = PurePosixPath(info.filename.replace("\\", "/"))
         if parts.is_absolute() or ".." in parts.parts or ":" in info.filename:
             raise InputError(f"{zip_path}: unsafe member name '{_short(info.filename)}' (absolute or '..'); refused.")
-    csvs = [i for i in infos if not i.is_dir() and i.filename.lower().endswith(".csv")
-            and "__MACOSX" not in PurePosixPath(i.filename).parts
-            and not PurePosixPath(i.filename).name.startswith(".")]
+    csvs = [
+        i
+        for i in infos
+        if not i.is_dir()
+        and i.filename.lower().endswith(".csv")
+        and "__MACOSX" not in PurePosixPath(i.filename).parts
+        and not PurePosixPath(i.filename).name.startswith(".")
+    ]
     chosen = [i for i in csvs if PurePosixPath(i.filename).parent.name == MEMBER_DIR] or csvs
     names = [PurePosixPath(i.filename).name for i in chosen]
     if not chosen:
@@ -236,25 +256,31 @@ def _flight_members(zf: zipfile.ZipFile, zip_path: Path) -> list[zipfile.ZipInfo
         raise InputError(f"{zip_path}: two CSVs share a file name; extract it yourself and pass the folder.")
     for info, name in zip(chosen, names):
         if info.flag_bits & 0x1:
-            raise InputError(f"{zip_path}: '{_short(info.filename)}' is encrypted (password-protected); extract "
-                             f"the zip yourself with its password and pass the folder.")
+            raise InputError(
+                f"{zip_path}: '{_short(info.filename)}' is encrypted (password-protected); extract "
+                f"the zip yourself with its password and pass the folder."
+            )
         if len(name.encode("utf-8", "surrogateescape")) > NAME_MAX:
-            raise InputError(f"{zip_path}: the member '{_short(info.filename)}' has a file name longer than "
-                             f"the {NAME_MAX} bytes a file system allows; extract its CSVs under shorter names and "
-                             f"pass the folder.")
+            raise InputError(
+                f"{zip_path}: the member '{_short(info.filename)}' has a file name longer than "
+                f"the {NAME_MAX} bytes a file system allows; extract its CSVs under shorter names and "
+                f"pass the folder."
+            )
     return chosen
 
 
 def _short(name: str, limit: int = 80) -> str:
     """A member name on one line, at most ``limit`` characters (a hostile one can be thousands)."""
     name = " ".join(name.split())
-    return name if len(name) <= limit else f"{name[:limit // 2]}...{name[-limit // 2:]}"
+    return name if len(name) <= limit else f"{name[: limit // 2]}...{name[-limit // 2 :]}"
 
 
 def _copy_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, target: Path, zip_path: Path, budget: int) -> int:
     limit = min(MAX_MEMBER, budget)
-    too_big = InputError(f"{zip_path}: '{_short(info.filename)}' unpacks to more than {limit} bytes (limits: "
-                         f"{MAX_MEMBER} a file, {MAX_TOTAL} in all); refused.")
+    too_big = InputError(
+        f"{zip_path}: '{_short(info.filename)}' unpacks to more than {limit} bytes (limits: "
+        f"{MAX_MEMBER} a file, {MAX_TOTAL} in all); refused."
+    )
     if info.file_size > limit:
         raise too_big
     written = 0
@@ -270,17 +296,21 @@ def _copy_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, target: Path, zip_p
 def _note(origin: str, digest: str, ukm: bool) -> str:
     """The text of SOURCE.txt: where the files came from and under which licence."""
     if not ukm:
-        return (f"Flight exports extracted by xairl-uav-handover from {origin} (sha256 {digest}).\n"
-                "This is not the pinned UKM archive: its licence is whatever its source states.\n")
-    return (f"UKM UAV LTE flights: drive-test exports of a drone over a live 4G LTE network (UKM, Bangi, Malaysia).\n"
-            f"Licence: GNU General Public License v3 ({LICENCE}), the licence of the source repository, which covers "
-            f"this data. Not part of xairl and not redistributed with it.\n"
-            f"Origin: {origin}\nRepository: {REPO}\nCommit: {COMMIT}\n"
-            f"Archive: raw_dataset.zip (sha256 {digest}); folder '{MEMBER_DIR}/', CSVs extracted unmodified.\n"
-            f"Zenodo: doi:10.5281/zenodo.17677745\n"
-            "Cite: M. Behjati, M. A. Zulkifley, H. A. H. Alobaidy, R. Nordin, N. F. Abdullah, \"Reliable Aerial Mobile "
-            "Communications with RSRP & RSRQ Prediction Models for the Internet of Drones: A Machine Learning "
-            "Approach\", Sensors 22(15):5522, 2022, doi:10.3390/s22155522.\n")
+        return (
+            f"Flight exports extracted by xairl-uav-handover from {origin} (sha256 {digest}).\n"
+            "This is not the pinned UKM archive: its licence is whatever its source states.\n"
+        )
+    return (
+        f"UKM UAV LTE flights: drive-test exports of a drone over a live 4G LTE network (UKM, Bangi, Malaysia).\n"
+        f"Licence: GNU General Public License v3 ({LICENCE}), the licence of the source repository, which covers "
+        f"this data. Not part of xairl and not redistributed with it.\n"
+        f"Origin: {origin}\nRepository: {REPO}\nCommit: {COMMIT}\n"
+        f"Archive: raw_dataset.zip (sha256 {digest}); folder '{MEMBER_DIR}/', CSVs extracted unmodified.\n"
+        f"Zenodo: doi:10.5281/zenodo.17677745\n"
+        'Cite: M. Behjati, M. A. Zulkifley, H. A. H. Alobaidy, R. Nordin, N. F. Abdullah, "Reliable Aerial Mobile '
+        "Communications with RSRP & RSRQ Prediction Models for the Internet of Drones: A Machine Learning "
+        'Approach", Sensors 22(15):5522, 2022, doi:10.3390/s22155522.\n'
+    )
 
 
 def _has_csv(folder: Path) -> bool:

@@ -15,6 +15,7 @@ real buffers are thus driven by one uplink model.
 
 Capacity is the paper's ``W_s |B| log2(1 + SINR)``; signal and noise are over the UAV's |B| resource blocks.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -42,8 +43,9 @@ def interference_mw(cfg: SimConfig, bs_xy: np.ndarray, heights: np.ndarray) -> n
     d2d = np.hypot(*(bs_xy[:, None, :] - bs_xy[None, :, :]).transpose(2, 0, 1))[None]  # (1, N, N): site j -> BS b
     d3d = np.hypot(d2d, h - c.bs_height_m)
     p_los = los_probability(c.scenario, h, np.maximum(d2d, 1.0))
-    gain = (p_los * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, True, c.bs_height_m) / 10)
-            + (1 - p_los) * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, False, c.bs_height_m) / 10))
+    gain = p_los * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, True, c.bs_height_m) / 10) + (
+        1 - p_los
+    ) * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, False, c.bs_height_m) / 10)
     n = len(bs_xy)
     gain = gain * (1 - np.eye(n))[None]  # a cell's own UE is the UAV, not an interferer
     per_interferer = 10 ** ((rad.ue_tx_power_dbm + rad.bs_antenna_gain_db) / 10)

@@ -26,6 +26,7 @@ Two verdicts: ``Verification.accurate``, nothing contradicted; ``Verification.ok
 :data:`MIN_COVERAGE` (0.5). How to read a trace and add a rule: docs/verifier.md; what is and is not checked: the
 README ("What the verifier checks").
 """
+
 from __future__ import annotations
 
 import re
@@ -50,8 +51,16 @@ MAX_CHARS = 200_000  # longer texts are cut here (and the cut reported)
 #: the clause readers look back over their sentence, so a bound on its length keeps the time linear in the text
 MAX_SENTENCE = 600
 
-__all__ = ["Claim", "Verification", "SentenceCheck", "verify", "clean_surface", "fact_book", "NUMBER_RE",
-           "MIN_COVERAGE"]
+__all__ = [
+    "Claim",
+    "Verification",
+    "SentenceCheck",
+    "verify",
+    "clean_surface",
+    "fact_book",
+    "NUMBER_RE",
+    "MIN_COVERAGE",
+]
 
 
 @dataclass(frozen=True)
@@ -108,27 +117,34 @@ class Verification:
         """Contradicted claims first, then (for a text that is not ok) the sentences left unchecked."""
         bad = [c for c in self.claims if c.status == "contradicted"]
         if not bad and not self.ok:
-            bad = [Claim("coverage", s.text, "unchecked", f"no checkable claim (coverage {self.coverage:.0%})")
-                   for s in self.sentences if s.status == "unchecked"] or [
-                Claim("coverage", "", "unchecked", "empty text")]
+            bad = [
+                Claim("coverage", s.text, "unchecked", f"no checkable claim (coverage {self.coverage:.0%})")
+                for s in self.sentences
+                if s.status == "unchecked"
+            ] or [Claim("coverage", "", "unchecked", "empty text")]
         return bad
 
 
 _SENTENCE_RE = re.compile(r"(?<=[.!?])\s+(?=\S)|\n+\s*(?:[-•*]\s*)?")
 _ABBREVIATION = re.compile(r"(?:^|[\s(])(?:e\.g|i\.e|vs|approx|ca|etc|no|fig|cf)\.$", re.IGNORECASE)
 _ITEM_NUMBER = re.compile(r"\s*\d{1,2}\.")  # a list item's number, read in place (no copy of the text before it)
-_CLAUSE_RE = re.compile(r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|"
-                        r"however)\b(?!,)"  # ('A, though, pushes it up': an aside)
-                        r"|,\s(?:and\s)?(?=but\b)|\s?[—–]\s?(?=(?:likely|possibly|perhaps|probably|since|as|because|"
-                        r"this|"
-                        r"which|suggesting|unsurprising)\b)|\s(?=because\b(?!\s+of\b))"
-                        r"|,\s(?=(?:as|since)\s(?!(?:well|a result|such|much|many|far|long|of)\b))", re.IGNORECASE)
+_CLAUSE_RE = re.compile(
+    r";|(?<!everything)(?<!anything)(?<!\ball)\s(?:while|whereas|but|yet|although|though|"
+    r"however)\b(?!,)"  # ('A, though, pushes it up': an aside)
+    r"|,\s(?:and\s)?(?=but\b)|\s?[—–]\s?(?=(?:likely|possibly|perhaps|probably|since|as|because|"
+    r"this|"
+    r"which|suggesting|unsurprising)\b)|\s(?=because\b(?!\s+of\b))"
+    r"|,\s(?=(?:as|since)\s(?!(?:well|a result|such|much|many|far|long|of)\b))",
+    re.IGNORECASE,
+)
 #: ', while slightly elevated, was ...': an aside inside the clause (no subject of its own), not a clause
-_APPOSITIVE = re.compile(r"\s(?:while|although|though)\s+(?:\w+ly\s+)?(?:[a-z]+ed|[a-z]+ing|high|low|above|below|"
-                         r"modest|small|large|elevated)\b[^,;.]{0,30},", re.IGNORECASE)
+_APPOSITIVE = re.compile(
+    r"\s(?:while|although|though)\s+(?:\w+ly\s+)?(?:[a-z]+ed|[a-z]+ing|high|low|above|below|"
+    r"modest|small|large|elevated)\b[^,;.]{0,30},",
+    re.IGNORECASE,
+)
 #: 'the house price decreases because A is x and B is y': the reason names what moved the output, in one clause
-_OUTPUT_MOVED = re.compile(rf"\b(?:{checks.OUTPUT_WORDS})\s+(?:\w+ly\s+)?{checks.DIRECTION_RE.pattern}$",
-                           re.IGNORECASE)
+_OUTPUT_MOVED = re.compile(rf"\b(?:{checks.OUTPUT_WORDS})\s+(?:\w+ly\s+)?{checks.DIRECTION_RE.pattern}$", re.IGNORECASE)
 _CELL = re.compile(r"[^|]+")
 #: a table cell that is one item: a label, then a number ('price hike 12% +.141'), not a field's name and value
 #: ('value: 2,112 sq ft') nor a number first ('+4.6 season=winter' after 'blh_m=310|': the number is the last item's)
@@ -139,20 +155,28 @@ def _item_cells(masked: str) -> list[int]:
     """Where a table row's items start: at a '||', and after a '|' between two cells that are items each
     ('M2M +.188 | price hike 12% +.141'; not '| value: 2,112 | SHAP: +39,960', not 'blh_m=310|+4.6')."""
     cells = list(_CELL.finditer(masked))
-    return [b.start() for a, b in zip(cells, cells[1:]) if masked[b.start() - 2:b.start()] == "||" or (
-        _ITEM_CELL.match(a.group(0)) and _ITEM_CELL.match(b.group(0)))]
+    return [
+        b.start()
+        for a, b in zip(cells, cells[1:])
+        if masked[b.start() - 2 : b.start()] == "||" or (_ITEM_CELL.match(a.group(0)) and _ITEM_CELL.match(b.group(0)))
+    ]
 
 
 _IDENT_RE = re.compile(r"\b[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+\b")
+
+
 def sentences(text: str) -> list[tuple[int, int]]:
     """Sentence spans: split after . ! ? before a capital or a sign, and at line breaks and bullets."""
     spans, start = [], 0
     for m in _SENTENCE_RE.finditer(text):
-        if _ABBREVIATION.search(text[max(0, m.start() - 8):m.start()]) or text[max(0, m.start() - 2):m.start() - 1] \
-                .isspace() or _ITEM_NUMBER.fullmatch(text, start, m.start()):  # (the cheap tests first: '! ! !' after
+        if (
+            _ABBREVIATION.search(text[max(0, m.start() - 8) : m.start()])
+            or text[max(0, m.start() - 2) : m.start() - 1].isspace()
+            or _ITEM_NUMBER.fullmatch(text, start, m.start())
+        ):  # (the cheap tests first: '! ! !' after
             # 2,000 tabs read them 2,000 times over, issue 51's fuzz)
             continue  # 'e.g. X', '1. Living area ...', 'over ? (score 2.1)' (a name, not an end): no sentence end
-        if text[start:m.start()].strip():
+        if text[start : m.start()].strip():
             spans.append((start, m.start()))
         start = m.end()
     if text[start:].strip():
@@ -165,20 +189,21 @@ def _pieces(text: str, a: int, b: int) -> list[tuple[int, int]]:
     the limit, again and again."""
     out = []
     while b - a > MAX_SENTENCE:
-        window = text[a:a + MAX_SENTENCE]
+        window = text[a : a + MAX_SENTENCE]
         cut = max(window.rfind(";"), window.rfind(","), window.rfind(" and "))
         cut = cut if cut > MAX_SENTENCE // 3 else window.rfind(" ")
         cut = a + (cut if cut > 0 else MAX_SENTENCE)
         if text[a:cut].strip():
             out.append((a, cut))
-        a = cut + 1 if text[cut:cut + 1] in ";, " else cut
+        a = cut + 1 if text[cut : cut + 1] in ";, " else cut
     if text[a:b].strip():
         out.append((a, b))
     return out
 
 
-def verify(text: str, explanation: Explanation, index: int | None = 0, policy: Policy | None = None,
-           facts=None) -> Verification:
+def verify(
+    text: str, explanation: Explanation, index: int | None = 0, policy: Policy | None = None, facts=None
+) -> Verification:
     """Check every claim of ``text`` against the explanation of state ``index`` (``None``: the global view).
 
     :param policy: optional, for feature descriptions, aliases and units, action aliases and domain facts.
@@ -189,8 +214,9 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
     """
     note = ""
     if not isinstance(text, str):
-        raise InputError(f"verify() reads text (a str), not {type(text).__name__}: decode it first, "
-                         f"e.g. data.decode('utf-8').")
+        raise InputError(
+            f"verify() reads text (a str), not {type(text).__name__}: decode it first, e.g. data.decode('utf-8')."
+        )
     index = None if index is None else explanation.check_index(index)
     explanation = in_regions(explanation)  # an image is read in regions, as it is narrated
     text = normalise(text)
@@ -210,8 +236,10 @@ def verify(text: str, explanation: Explanation, index: int | None = 0, policy: P
     spans = sentences(text)
     read = [_read_sentence(text[a:b], book, vocab, unit_of) for a, b in spans]
     claims = iter(reread.swapped([c for cs in read for c in cs]))  # (two numbers that cross, anywhere in the text)
-    return Verification(tuple(SentenceCheck(text[a:b].strip(), tuple(next(claims) for _ in cs))
-                              for (a, b), cs in zip(spans, read)), note)
+    return Verification(
+        tuple(SentenceCheck(text[a:b].strip(), tuple(next(claims) for _ in cs)) for (a, b), cs in zip(spans, read)),
+        note,
+    )
 
 
 def _read_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]:
@@ -231,8 +259,10 @@ def _read_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]
 
 # a direction verb whose object is an option ('favoured turning', 'helped turning', '+22.0 toward the handover')
 # weighs it against the other one as much as it raises its score: either view, unless the words name the score
-_TOWARD_ACTION = re.compile(r"\b(favou?r(s|ed|ing)?|help(s|ed|ing)?|toward(s)?|held \w+ back|"
-                            r"matter\w* (?:more |less |most )?for|for)\s+(?:the |a |an )?$")
+_TOWARD_ACTION = re.compile(
+    r"\b(favou?r(s|ed|ing)?|help(s|ed|ing)?|toward(s)?|held \w+ back|"
+    r"matter\w* (?:more |less |most )?for|for)\s+(?:the |a |an )?$"
+)
 
 
 def _context(sentence: str, mentions: list[Mention], book: FactBook, offset: int = 0) -> str | None:
@@ -243,18 +273,24 @@ def _context(sentence: str, mentions: list[Mention], book: FactBook, offset: int
         return "chosen"
     low = sentence.lower()
     runner_named = any(m.kind == "action" and checks.resolve_action(m, book) == book.runner_up for m in mentions)
-    if runner_named or re.search(r"\b(rather than|instead of|runner.up|relative to|compared (with|to)|versus|vs\.?|"
-                                 r"margin|lead|edge|advantage|over (going|staying|turning|handing))\b", low):
+    if runner_named or re.search(
+        r"\b(rather than|instead of|runner.up|relative to|compared (with|to)|versus|vs\.?|"
+        r"margin|lead|edge|advantage|over (going|staying|turning|handing))\b",
+        low,
+    ):
         return "margin"
     names_score = re.search(r"\b(score|q.value|q\(|value of)\b", low)
-    toward = any(m.kind == "action" and _TOWARD_ACTION.search(low[max(0, m.start - offset - 24):m.start - offset])
-                 for m in mentions)
-    if re.search(r"\b(argu\w* (for|against)|in favou?r of|in (?:the |its )?[\w' -]{0,40}?favou?r|tip(ped|s)? the "
-                 r"balance|case (for|against)|(?:counted|weighed) (?:\w+ )?against)\b", low) or (
-            toward and not names_score):
+    toward = any(
+        m.kind == "action" and _TOWARD_ACTION.search(low[max(0, m.start - offset - 24) : m.start - offset])
+        for m in mentions
+    )
+    if re.search(
+        r"\b(argu\w* (for|against)|in favou?r of|in (?:the |its )?[\w' -]{0,40}?favou?r|tip(ped|s)? the "
+        r"balance|case (for|against)|(?:counted|weighed) (?:\w+ )?against)\b",
+        low,
+    ) or (toward and not names_score):
         return checks.EITHER  # weighing two options: the margin, or the chosen action's own score
-    if names_score or any(
-            m.kind == "action" and checks.resolve_action(m, book) == book.chosen for m in mentions):
+    if names_score or any(m.kind == "action" and checks.resolve_action(m, book) == book.chosen for m in mentions):
         return "chosen"
     return None
 
@@ -262,7 +298,7 @@ def _context(sentence: str, mentions: list[Mention], book: FactBook, offset: int
 def _mention_claim(sentence: str, m) -> Claim:
     """A feature named: no claim by itself, but the trace shows which reading found it."""
     rule = "names.shorthand" if m.form == "shorthand" else "names.mention"
-    return Claim("feature", sentence[m.start:m.end], "verified", " / ".join(m.keys), rule)
+    return Claim("feature", sentence[m.start : m.end], "verified", " / ".join(m.keys), rule)
 
 
 def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]:
@@ -273,28 +309,61 @@ def _check_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim
         if not docs:
             docs.append(parse.read(sentence, [(m.start, m.end, "|".join(m.keys)) for m in mentions]))
         return docs[0]
+
     ctx = _context(sentence, mentions, book)
     claims: list[Claim] = [_mention_claim(sentence, m) for m in mentions if m.kind == "feature"]
     # 'had X been better, it would have stayed': not what happened; only its numbers are checked
     hypothetical = bool(_HYPOTHETICAL.search(masked.replace("\0", "X")))  # a name first is a word, not space
     for m in mentions:
-        c = None if hypothetical else checks.check_action(sentence, m, book) if m.kind == "action" else \
-            checks.check_label(sentence, m, book) if m.kind == "label" else None
+        c = (
+            None
+            if hypothetical
+            else checks.check_action(sentence, m, book)
+            if m.kind == "action"
+            else checks.check_label(sentence, m, book)
+            if m.kind == "label"
+            else None
+        )
         if c is not None:
             claims.append(binding.named(c, "action.choice" if m.kind == "action" else "category.label"))
             if m.kind == "label" and (c := checks.closed_class_category(masked, m, mentions, book, sentence)):
                 claims.append(c)  # 'outside the ECA' of 'inside_ECA': its word right, its opposite said
-        elif not hypothetical and (c := checks.stated_category(masked, m, mentions, book) or
-                                   checks.closed_class_category(masked, m, mentions, book, sentence) or
-                                   checks.negated_category(masked, m, book)) is not None:
+        elif (
+            not hypothetical
+            and (
+                c := checks.stated_category(masked, m, mentions, book)
+                or checks.closed_class_category(masked, m, mentions, book, sentence)
+                or checks.negated_category(masked, m, book)
+            )
+            is not None
+        ):
             claims.append(c)  # 'aisle congestion is rated medium', 'the summer season' (in winter)
-    bounds = sorted([0] + [m.end() for m in _CLAUSE_RE.finditer(masked) if not _APPOSITIVE.match(masked, m.start())
-                           and not _OUTPUT_MOVED.search(sentence, 0, m.start())] + _item_cells(masked) + [len(masked)])
+    bounds = sorted(
+        [0]
+        + [
+            m.end()
+            for m in _CLAUSE_RE.finditer(masked)
+            if not _APPOSITIVE.match(masked, m.start()) and not _OUTPUT_MOVED.search(sentence, 0, m.start())
+        ]
+        + _item_cells(masked)
+        + [len(masked)]
+    )
     for a, b in zip(bounds, bounds[1:]):
         inside = [m for m in mentions if a <= m.start < b]
         own = _context(sentence[a:b], inside, book, a) if len(bounds) > 2 else None  # '..., yet against staying'
-        found = clauses.check_clause(masked, a, b, inside, book, own or ctx, unit_of, parsed, vocab,
-                                      {k for m in named_features(mentions) for k in m.keys}, sentence)
+        found = clauses.check_clause(
+            masked,
+            a,
+            b,
+            inside,
+            book,
+            own or ctx,
+            unit_of,
+            parsed,
+            vocab,
+            {k for m in named_features(mentions) for k in m.keys},
+            sentence,
+        )
         found = [_unless_modifier(c, inside, book, parsed) for c in found]
         claims += [c for c in found if not hypothetical or c.kind == "number"]  # a value is still a value
     if hypothetical:
@@ -315,8 +384,13 @@ def _unless_modifier(c: Claim, mentions: list[Mention], book: FactBook, parsed) 
     parse.modifier)."""
     if c.status != "contradicted" or c.rule not in _BY_POSITION:
         return c
-    keys = [k for k in book.features if c.detail.startswith((k + " ", k + "'s", k + ":")) or f"not {k}'s" in c.detail
-            or c.detail.startswith(f"|{k}|")]
+    keys = [
+        k
+        for k in book.features
+        if c.detail.startswith((k + " ", k + "'s", k + ":"))
+        or f"not {k}'s" in c.detail
+        or c.detail.startswith(f"|{k}|")
+    ]
     own = [m for m in mentions if m.kind == "feature" and set(m.keys) & set(keys)]
     if not own or len(keys) != 1:
         return c
@@ -327,13 +401,21 @@ def _unless_modifier(c: Claim, mentions: list[Mention], book: FactBook, parsed) 
         n = next(iter(find_numbers(c.text)), None)  # number that states some feature's fact exactly is let go
         if n is None or quantities.any_fact(n, book, book.features, None, strict=True) is None:
             return c
-    return Claim(c.kind, c.text, "unchecked", f"'{nouns[0]}' is what the words are about, and "
-                 f"{keys[0]} only qualifies it (first read as {c.detail})", "parse.modifier")
+    return Claim(
+        c.kind,
+        c.text,
+        "unchecked",
+        f"'{nouns[0]}' is what the words are about, and {keys[0]} only qualifies it (first read as {c.detail})",
+        "parse.modifier",
+    )
 
 
 #: an identifier's word that names a decision-level quantity ('p_churn', 'y_hat', 'sum_shap', 'base_value')
-_DECISION_KEY = re.compile(r"\b(?:pred\w*|yhat|y|hat|out|output|p|prob\w*|score|q|base\w*|ev|delta|margin|gap|"
-                           r"value)\b", re.IGNORECASE)
+_DECISION_KEY = re.compile(
+    r"\b(?:pred\w*|yhat|y|hat|out|output|p|prob\w*|score|q|base\w*|ev|delta|margin|gap|"
+    r"value)\b",
+    re.IGNORECASE,
+)
 
 
 def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None:
@@ -346,12 +428,17 @@ def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None
     if re.fullmatch(r"q_(\w+)", ident.lower()) and book.output == "actions":  # 'Q_recharge': an action's score
         if ident.lower()[2:] in {a.lower() for a in book.scores}:
             return None
-        return Claim("action", ident, "contradicted", f"no action of this explanation is named {ident[2:]!r}",
-                     "identifier.q-of-action")
-    given = re.match(r"\s?[:=(]?\s?(?=[+\-]?[$€£]?\.?\d)", masked[m.end():m.end() + 6])
-    number = next(iter(find_numbers(masked[m.end():m.end() + 40])), None) if given else None
+        return Claim(
+            "action",
+            ident,
+            "contradicted",
+            f"no action of this explanation is named {ident[2:]!r}",
+            "identifier.q-of-action",
+        )
+    given = re.match(r"\s?[:=(]?\s?(?=[+\-]?[$€£]?\.?\d)", masked[m.end() : m.end() + 6])
+    number = next(iter(find_numbers(masked[m.end() : m.end() + 40])), None) if given else None
     pushes = checks.DIRECTION_RE.search(masked, m.end(), m.end() + 30)
-    if pushes is not None and not re.fullmatch(r"(?:\s+[a-z]+){0,2}\s+", masked[m.end():pushes.start()]):
+    if pushes is not None and not re.fullmatch(r"(?:\s+[a-z]+){0,2}\s+", masked[m.end() : pushes.start()]):
         pushes = None  # only a direction word within the next two words: 'wind_speed pushed toward it
     words = [w for w in split_words(ident) if len(w) >= 3]
     ours = any(words and all(any(k.startswith(w) for k in own) for w in words) for own in known.values())
@@ -360,22 +447,35 @@ def _identifier(m: re.Match, masked: str, book: FactBook, known) -> Claim | None
     decision = book.decision_numbers if _DECISION_KEY.search(spaced) else []
     # a log's field ('run_id=7781', 'latency_ms=42', 'n_features=10'): an unsigned value given with '=' or ':' is a
     # record of the run, not a push; an invented feature is given a signed contribution ('battery_temp=+0.3')
-    field = number is not None and not number.sign and re.match(r"\s?[:=]", masked[m.end():m.end() + 2])
-    if ours or field or (number is None and pushes is None) or (number is not None and any(
-            matches(number, x, magnitude_ok=False) for x in [*decision, *totals])):
-        return Claim("feature", ident, "unchecked", "an identifier that names nothing of this explanation",
-                     "identifier.other")
+    field = number is not None and not number.sign and re.match(r"\s?[:=]", masked[m.end() : m.end() + 2])
+    if (
+        ours
+        or field
+        or (number is None and pushes is None)
+        or (number is not None and any(matches(number, x, magnitude_ok=False) for x in [*decision, *totals]))
+    ):
+        return Claim(
+            "feature", ident, "unchecked", "an identifier that names nothing of this explanation", "identifier.other"
+        )
     said = f"given {number.text}" if number is not None else f"'{pushes.group(0)}' is said of it"
-    return Claim("feature", ident, "contradicted", f"{said}, but it is not a feature or action of this explanation",
-                 "identifier.claimed")
+    return Claim(
+        "feature",
+        ident,
+        "contradicted",
+        f"{said}, but it is not a feature or action of this explanation",
+        "identifier.claimed",
+    )
 
 
 #: a sentence about what did not happen: 'Had X been better, ...', 'Without X, it would have ...', 'If it were not
 #: for X'; a modal elsewhere ('chose recharge, which could save battery', 'lower than it would be') leaves the rest
 #: checked
-_HYPOTHETICAL = re.compile(r"^\W*(?:if|had|without|were|absent|but for)\b|(?<!than it )(?<!than they )"
-                           r"\b(?:would|could|might)(?:\s+\w+ly)?\s+"
-                           r"(?:(?:not|never)\s+)?(?:have|be)\b(?!\s+(?:due|because|related|linked|attributed|"
-                           r"explained|caused|associated|indicative|a sign|the result|seen|viewed|considered|"
-                           r"interpreted|reflecting|influenced)\b)"  # ('which could be due to ...': a reason, not
-                           r"|\bif it (?:were|was)(?:n't| not) for\b", re.IGNORECASE)  # what would have been)
+_HYPOTHETICAL = re.compile(
+    r"^\W*(?:if|had|without|were|absent|but for)\b|(?<!than it )(?<!than they )"
+    r"\b(?:would|could|might)(?:\s+\w+ly)?\s+"
+    r"(?:(?:not|never)\s+)?(?:have|be)\b(?!\s+(?:due|because|related|linked|attributed|"
+    r"explained|caused|associated|indicative|a sign|the result|seen|viewed|considered|"
+    r"interpreted|reflecting|influenced)\b)"  # ('which could be due to ...': a reason, not
+    r"|\bif it (?:were|was)(?:n't| not) for\b",
+    re.IGNORECASE,
+)  # what would have been)

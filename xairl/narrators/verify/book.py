@@ -1,5 +1,6 @@
 """FactBook: everything a text may claim about one decision (or, with ``index=None``, about all states), computed
 from the Explanation alone."""
+
 from __future__ import annotations
 
 import re
@@ -11,9 +12,12 @@ from ...explanation import Explanation
 from ...facts import DomainFacts, decision_facts, global_facts, narration_units, unit_ranks
 from ...policy import Policy
 
-_CLAIMY = re.compile(r"[+\-\u2212]\d|\d\.\d|%|\b(toward|towards|against|raises|lowers|increases|decreases|pushes|"
-                     r"favours|favors|opposes|mattered most)\b|\b(most important|main|largest|biggest|strongest|top|"
-                     r"first|second|third)\s+(feature|factor|driver|reason|contributor|influence)s?\b", re.IGNORECASE)
+_CLAIMY = re.compile(
+    r"[+\-\u2212]\d|\d\.\d|%|\b(toward|towards|against|raises|lowers|increases|decreases|pushes|"
+    r"favours|favors|opposes|mattered most)\b|\b(most important|main|largest|biggest|strongest|top|"
+    r"first|second|third)\s+(feature|factor|driver|reason|contributor|influence)s?\b",
+    re.IGNORECASE,
+)
 
 
 #: an index in square brackets ('forecast_price[+6h]', 'lag[-1]', 'obs[0,-2]'): whole numbers, signs and letters
@@ -30,35 +34,35 @@ def clean_surface(text: str) -> bool:
 @dataclass
 class FeatureFacts:
     value: float | None = None
-    label: str | None = None                                  # a categorical value's label
+    label: str | None = None  # a categorical value's label
     contribs: dict[str, float] = field(default_factory=dict)  # context ('chosen', 'margin') -> contribution
-    ranks: dict[str, int] = field(default_factory=dict)       # context -> rank by |contribution|
+    ranks: dict[str, int] = field(default_factory=dict)  # context -> rank by |contribution|
     signed_ranks: dict[str, int] = field(default_factory=dict)  # context -> rank among contributions of its sign
-    shares: dict[str, float] = field(default_factory=dict)    # context -> % of the sum of |contributions|
+    shares: dict[str, float] = field(default_factory=dict)  # context -> % of the sum of |contributions|
     side_shares: dict[str, float] = field(default_factory=dict)  # context -> % of its own side's sum ('57 % of the
     #                                                               positive push')
     net_shares: dict[str, float] = field(default_factory=dict)  # context -> % of the net change, same sign ('43 % of
     #                                                              the net drop')
-    fill: float | None = None                                 # % of the feature's capacity
-    quartiles: tuple[float, float, float] | None = None       # the background's 25th, 50th and 75th percentiles
-    legend: dict[int, str] = field(default_factory=dict)      # code -> its meaning, from the description's legend
-    identifier: bool = False                                  # an id (kind 'identifier'): its number is its value
+    fill: float | None = None  # % of the feature's capacity
+    quartiles: tuple[float, float, float] | None = None  # the background's 25th, 50th and 75th percentiles
+    legend: dict[int, str] = field(default_factory=dict)  # code -> its meaning, from the description's legend
+    identifier: bool = False  # an id (kind 'identifier'): its number is its value
 
 
 @dataclass
 class FactBook:
     features: dict[str, FeatureFacts]
-    output: str                      # 'actions', 'continuous' or 'value'
+    output: str  # 'actions', 'continuous' or 'value'
     chosen: str | None
     runner_up: str | None
-    scores: dict[str, float]         # every action's (or the output's) score
+    scores: dict[str, float]  # every action's (or the output's) score
     margin: float | None
     base: float | None
-    decision_numbers: list[float]    # every decision-level number a text may cite
+    decision_numbers: list[float]  # every decision-level number a text may cite
     by_unit: dict[str, list[float]] = field(default_factory=dict)
     global_view: bool = False
     n_states: int = 1
-    closed: bool = False             # every number must be one of the facts (a summary made from given facts)
+    closed: bool = False  # every number must be one of the facts (a summary made from given facts)
     base_margin: float | None = None  # the margin with no reason either way (the background's average)
     #: sums over all features a text may cite with its cue words ('the positives add up to +0.39', 'the total
     #: absolute attribution of 1.62'): what -> number
@@ -119,8 +123,9 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
             e.ranks["chosen"] = r["rank"]
             if r["direction"] != "mixed":  # the direction it pushed on average, in the summary's view
                 e.contribs["chosen"] = 1.0 if r["direction"] == "toward" else -1.0
-        return FactBook(feats, exp.output, None, None, {}, None, None, [float(g.n_states)], global_view=True,
-                        n_states=g.n_states)
+        return FactBook(
+            feats, exp.output, None, None, {}, None, None, [float(g.n_states)], global_view=True, n_states=g.n_states
+        )
     d = decision_facts(exp, index, policy, k=len(exp.feature_names))
     labels = exp.value_labels
     chosen_i, runner_i = int(exp.chosen[index]), int(exp.runner_up[index])
@@ -132,15 +137,21 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     # members are ranked among all features
     reasons = np.array([u.info.kind != "identifier" for u in us])
     for ctx, contrib in views.items():
-        for names, c, ok in (([u.name for u in us], np.array([contrib[list(u.columns)].sum() for u in us]), reasons),
-                             (exp.feature_names, contrib, np.ones(len(contrib), bool))):
+        for names, c, ok in (
+            ([u.name for u in us], np.array([contrib[list(u.columns)].sum() for u in us]), reasons),
+            (exp.feature_names, contrib, np.ones(len(contrib), bool)),
+        ):
             rank, signed, share = unit_ranks(c, ok)
             for j, f in enumerate(names):
                 e = feats[f]
                 if ctx in e.contribs:  # a feature outside any group: its unit's ranks
                     continue
                 e.contribs[ctx], e.ranks[ctx], e.signed_ranks[ctx], e.shares[ctx] = (
-                    float(c[j]), int(rank[j]) or None, int(signed[j]) or None, float(share[j]))
+                    float(c[j]),
+                    int(rank[j]) or None,
+                    int(signed[j]) or None,
+                    float(share[j]),
+                )
     for j, f in enumerate(exp.feature_names):
         info = policy.features.get(f) if policy else None
         if exp.states is not None:
@@ -159,9 +170,17 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     numbers = [d.score, base, d.score - base, d.additivity_gap, *scores.values()]
     if deciding:
         numbers += [d.runner_up_score, d.q_margin, d.base_margin]
-    book = FactBook(feats, exp.output, d.action, d.runner_up if deciding else None, scores,
-                    d.q_margin if deciding else None, base, numbers,
-                    base_margin=float(d.base_margin) if deciding else None)
+    book = FactBook(
+        feats,
+        exp.output,
+        d.action,
+        d.runner_up if deciding else None,
+        scores,
+        d.q_margin if deciding else None,
+        base,
+        numbers,
+        base_margin=float(d.base_margin) if deciding else None,
+    )
     for ctx, contrib in views.items():
         _add_sums(book, ctx, contrib, exp.feature_names)
     book.aggregates["the number of features"] = float(len(exp.feature_names))
@@ -181,16 +200,19 @@ def _add_sums(book: FactBook, ctx: str, contrib: np.ndarray, names) -> None:
         if net and contrib[j] * net > 0:
             book.features[f].net_shares[ctx] = 100.0 * float(contrib[j]) / net
     of = "" if ctx == "chosen" else " (margin)"
-    book.aggregates |= {f"the sum of the positive contributions{of}": float(contrib[contrib > 0].sum()),
-                        f"the sum of the negative contributions{of}": float(contrib[contrib < 0].sum()),
-                        f"the sum of |contributions|{of}": float(np.abs(contrib).sum()),
-                        f"the sum of the contributions{of}": float(contrib.sum())}
+    book.aggregates |= {
+        f"the sum of the positive contributions{of}": float(contrib[contrib > 0].sum()),
+        f"the sum of the negative contributions{of}": float(contrib[contrib < 0].sum()),
+        f"the sum of |contributions|{of}": float(np.abs(contrib).sum()),
+        f"the sum of the contributions{of}": float(contrib.sum()),
+    }
 
 
 def add_facts(book: FactBook, facts: DomainFacts) -> None:
     """Domain facts a text may cite: numeric extras anywhere, each comparison's value before its unit."""
-    book.decision_numbers += [float(v) for v in facts.extras.values()
-                              if isinstance(v, (int, float)) and not isinstance(v, bool)]
+    book.decision_numbers += [
+        float(v) for v in facts.extras.values() if isinstance(v, (int, float)) and not isinstance(v, bool)
+    ]
     book.decision_numbers += [c.value for c in facts.comparisons]
     for c in facts.comparisons:
         if c.unit:

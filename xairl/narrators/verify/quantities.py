@@ -3,6 +3,7 @@ comparison in its unit (:func:`feature_number`); another fact it states when the
 (:func:`other_reading`, :func:`any_fact`). Decision-level numbers (a score, the margin, the prediction, the baseline,
 the change from it) are :mod:`.decision`, sums over several features :mod:`.sums`, numbers that are no claim at all
 :mod:`.noclaims`."""
+
 from __future__ import annotations
 
 import re
@@ -20,16 +21,19 @@ CONTRIB_BEFORE = re.compile(
     r"edge of|favou?red \w+ by|for \w+ by|\bdown|\bup)\s*(?:(?:\(|about|around|roughly|nearly|almost|"
     r"approximately|some|only|just|a further|another|over|under|(?:somewhere |anywhere )?between)\s*){0,2}"
     r"[+\-]?[$€£]?\s*$",
-    re.IGNORECASE)
-_LISTS_CONTRIBUTIONS = re.compile(r"shap|attribution|contribut|impact|effect|φ|phi|importance|weight|push|margin",
-                                  re.IGNORECASE)
+    re.IGNORECASE,
+)
+_LISTS_CONTRIBUTIONS = re.compile(
+    r"shap|attribution|contribut|impact|effect|φ|phi|importance|weight|push|margin", re.IGNORECASE
+)
 COMPARISON_WORDS = r"(above|below|stronger|weaker|better|worse|higher|lower)"
 #: '1.9 dB above the serving BS's RSRP': a difference in a unit, neither a value nor a contribution
 DIFFERENCE_AFTER = re.compile(rf"\s*[A-Za-z]+\s+{COMPARISON_WORDS}\b", re.IGNORECASE)
 
 
-_SIGNED_NAMED = re.compile(r"(?<![|\w])(?:shap(?: value)?|contribution|attribution)\s*(?:of|is|was|:|=)\s*$",
-                           re.IGNORECASE)
+_SIGNED_NAMED = re.compile(
+    r"(?<![|\w])(?:shap(?: value)?|contribution|attribution)\s*(?:of|is|was|:|=)\s*$", re.IGNORECASE
+)
 
 
 def signed_named(before: str) -> bool:
@@ -42,34 +46,44 @@ def signed_named(before: str) -> bool:
 class _Cues:
     """What the words around a number say it is, whichever feature it is tied to."""
 
-    after: str           # the 16 characters after it
-    contribution: bool   # 'by', 'adds', 'SHAP value of' right before it
-    signed: bool         # 'a SHAP value of 0.3' names the signed quantity: unsigned, it is positive
-    slot: bool           # an unsigned number in brackets right after a name: its value ('distance (0.84)'), unless
+    after: str  # the 16 characters after it
+    contribution: bool  # 'by', 'adds', 'SHAP value of' right before it
+    signed: bool  # 'a SHAP value of 0.3' names the signed quantity: unsigned, it is positive
+    slot: bool  # an unsigned number in brackets right after a name: its value ('distance (0.84)'), unless
     #                      the sentence lists contributions ('Top features by absolute SHAP value: A (0.11)')
-    fill: bool           # '8 % full': a fill of a capacity
-    in_points: bool      # a sentence that counts in points: points of a probability too
-    pushes: bool         # the words before it speak of contributions at all ('The SHAP value of serving_bs is 0.00')
+    fill: bool  # '8 % full': a fill of a capacity
+    in_points: bool  # a sentence that counts in points: points of a probability too
+    pushes: bool  # the words before it speak of contributions at all ('The SHAP value of serving_bs is 0.00')
 
 
 #: a change of the feature itself over time, not a push: 'a GPA trend, down 0.4 since last term'
-_SINCE_AFTER = re.compile(r"\s*(?:points?\s+|[a-zA-Z%]{1,4}\s+)?(?:since\s+(?:last|the last|the previous|"
-                          r"yesterday|\d)|from last|on last|versus last|vs\.? last)\b", re.IGNORECASE)
+_SINCE_AFTER = re.compile(
+    r"\s*(?:points?\s+|[a-zA-Z%]{1,4}\s+)?(?:since\s+(?:last|the last|the previous|"
+    r"yesterday|\d)|from last|on last|versus last|vs\.? last)\b",
+    re.IGNORECASE,
+)
 
 
 def _cues(n: Number, masked: str, book: FactBook) -> _Cues:
-    before, after = masked[max(0, n.start - 40):n.start], masked[n.end:n.end + 16]
+    before, after = masked[max(0, n.start - 40) : n.start], masked[n.end : n.end + 16]
     contribution = bool(CONTRIB_BEFORE.search(before)) and not _SINCE_AFTER.match(after)
-    lists = bool(_LISTS_CONTRIBUTIONS.search(masked[:n.start]))
-    slot = not n.sign and not n.currency and not n.percent and bool(re.search(r"\0\s?\($", before)) and \
-        masked[n.end:n.end + 1] in (")", ",") and not lists
+    lists = bool(_LISTS_CONTRIBUTIONS.search(masked[: n.start]))
+    slot = (
+        not n.sign
+        and not n.currency
+        and not n.percent
+        and bool(re.search(r"\0\s?\($", before))
+        and masked[n.end : n.end + 1] in (")", ",")
+        and not lists
+    )
     fill = bool(n.percent and re.match(r"\s*(full|of (?:its |the )?capacity)\b", after, re.IGNORECASE))
     in_points = book.output != "actions" and not n.percent and bool(re.search(r"\b(?:points?|pts|pp)\b", masked))
     return _Cues(after, contribution, signed_named(before), slot, fill, in_points, contribution or lists)
 
 
-def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook, ctx: str | None,
-                   unit_of, name_after: bool = False) -> Claim:
+def feature_number(
+    n: Number, keys: tuple[str, ...], masked: str, book: FactBook, ctx: str | None, unit_of, name_after: bool = False
+) -> Claim:
     """A number tied to a feature: its value, its contribution (in the sentence's context, or any context when the
     sentence does not say), its share, or a percentage of a probability-like contribution. Cue words before it
     ('by', 'adds', 'SHAP value of') say it is a contribution; the feature's unit after it that it is a value.
@@ -88,16 +102,23 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
             return matches(n, e.fill), f"{key}'s fill is {e.fill:.3g} % of its capacity"
         unit = unit_of(key).lower()
         prefix, scale = written_scale(after, unit_of(key))
-        value_cue = (bool(unit) and bool(re.match(rf"{re.escape(unit.split()[0])}(?![a-z])", after.strip().lower()))
-                     or cue.slot or bool(prefix)) \
-            and not contrib_cue
+        value_cue = (
+            bool(unit)
+            and bool(re.match(rf"{re.escape(unit.split()[0])}(?![a-z])", after.strip().lower()))
+            or cue.slot
+            or bool(prefix)
+        ) and not contrib_cue
         meaning = None if contrib_cue or n.percent else _code_meaning(n, e)
         if meaning is not None:  # 'a balance above 200 DM' for status 4 ('200 DM or more'), before any rounding
             return meaning
         cands = []
         if (not contrib_cue or name_after) and e.value is not None and not (n.points and unit not in ("points", "pts")):
-            cands.append(("value" if scale == 1 else f"value in {prefix}" + ("" if " " in prefix else unit_of(key)),
-                          e.value / scale))
+            cands.append(
+                (
+                    "value" if scale == 1 else f"value in {prefix}" + ("" if " " in prefix else unit_of(key)),
+                    e.value / scale,
+                )
+            )
         if n.percent and not contrib_cue and e.fill is not None:
             cands.append(("fill (% of capacity)", e.fill))
         if not value_cue and (cue.pushes or not e.identifier):
@@ -108,7 +129,8 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
             if " (not " in what and abs(n.value - v) > 0.05 * abs(v):
                 continue  # a value in another unit: its rounding is not the coarser unit's ('2 minutes' is no 90 s)
             if matches(m, v, magnitude_ok=not (cue.signed and contribution)) or (
-                    (n.percent or (cue.in_points and contribution)) and percent_reading(n, v)):
+                (n.percent or (cue.in_points and contribution)) and percent_reading(n, v)
+            ):
                 return True, f"{key}: {what}"
         share = _share(n, e, contexts)
         if share:
@@ -118,8 +140,12 @@ def feature_number(n: Number, keys: tuple[str, ...], masked: str, book: FactBook
 
     if DIFFERENCE_AFTER.match(after):
         ok = comparison(n, after, book)
-        return Claim("number", n.text, "verified" if ok else ("contradicted" if book.by_unit else "unchecked"),
-                     "a domain comparison in its unit" if ok else "a difference no fact states")
+        return Claim(
+            "number",
+            n.text,
+            "verified" if ok else ("contradicted" if book.by_unit else "unchecked"),
+            "a domain comparison in its unit" if ok else "a difference no fact states",
+        )
     claim = over_keys(keys, test, "feature", n.text, "number")
     if claim.status == "contradicted" and comparison(n, after, book):
         return Claim("number", n.text, "verified", "a domain comparison in its unit")
@@ -149,10 +175,16 @@ def _code_meaning(n: Number, e) -> tuple[bool, str] | None:
     here = e.legend.get(int(e.value), "")
     if any(n.value == x.value for x in find_numbers(here)):  # a legend's numbers are exact
         return True, f"the meaning of its code {int(e.value)}: {here}"
-    others = [t for k, t in e.legend.items() if k != int(e.value)
-              and any(n.value == x.value for x in find_numbers(t))]
-    return (False, f"{n.text} is the meaning of another code ({others[0]}); its code {int(e.value)} means "
-                   f"{here or 'nothing in the legend'}") if others else None
+    others = [t for k, t in e.legend.items() if k != int(e.value) and any(n.value == x.value for x in find_numbers(t))]
+    return (
+        (
+            False,
+            f"{n.text} is the meaning of another code ({others[0]}); its code {int(e.value)} means "
+            f"{here or 'nothing in the legend'}",
+        )
+        if others
+        else None
+    )
 
 
 def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, signed: bool = False) -> str | None:
@@ -168,11 +200,15 @@ def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, si
         if n.percent and not n.points:  # a percentage is a share (or a fill the binding already tried), or a value
             facts = [(f"share ({c})", e.shares.get(c), True) for c in views] + [("value", e.value, False)]  # ('12 %')
         else:  # a value as written, sign included; a contribution may be its size
-            facts = [("value", e.value, False), *((f"contribution ({c})", e.contribs.get(c), not signed)
-                                                  for c in views)]
+            facts = [
+                ("value", e.value, False),
+                *((f"contribution ({c})", e.contribs.get(c), not signed) for c in views),
+            ]
         for what, v, size_ok in facts:
-            if v is not None and (matches(replace(n, percent=False), v, magnitude_ok=size_ok, truncated_ok=False) or (
-                    n.points and percent_reading(n, abs(v) if size_ok and not n.sign else v))):  # '12.3 pp'
+            if v is not None and (
+                matches(replace(n, percent=False), v, magnitude_ok=size_ok, truncated_ok=False)
+                or (n.points and percent_reading(n, abs(v) if size_ok and not n.sign else v))
+            ):  # '12.3 pp'
                 return f"{key}'s {what}"
     return None
 
@@ -189,15 +225,25 @@ def contribution_owners(n: Number, book: FactBook) -> list[str]:
     found = []
     for strict in (True, False):
         m = replace(n, hedge="") if strict else n
-        found = [f for f, e in book.features.items()
-                 if any(matches(m, c) or (m.percent and percent_reading(m, c)) for c in e.contribs.values())]
+        found = [
+            f
+            for f, e in book.features.items()
+            if any(matches(m, c) or (m.percent and percent_reading(m, c)) for c in e.contribs.values())
+        ]
         if len(found) == 1:
             return found
     return found
 
 
-def any_fact(n: Number, book: FactBook, keys, ctx: str | None, strict: bool = False, contribution: bool = False,
-             signed: bool = False) -> str | None:
+def any_fact(
+    n: Number,
+    book: FactBook,
+    keys,
+    ctx: str | None,
+    strict: bool = False,
+    contribution: bool = False,
+    signed: bool = False,
+) -> str | None:
     """Another fact of the sentence the number states: a value, contribution (either view, its size) or share of a
     feature named in it (``keys``); a decision-level number; an action's score. ``None``
     when it states none (then it is wrong wherever it is bound). A feature the sentence does not name is no
@@ -208,15 +254,25 @@ def any_fact(n: Number, book: FactBook, keys, ctx: str | None, strict: bool = Fa
     ``ctx``: the sentence's view (contributions and shares in it only), or None / either view."""
     if strict and (n.hedge or abs(n.value) < 10 * n.unit):
         return None  # ('0.06' or 'about 0.1' may match by chance)
+
     def states(v: float | None, size_ok: bool = True) -> bool:
-        return v is not None and (matches(n, v, magnitude_ok=size_ok) or (n.percent and percent_reading(n, v)) or (
-            n.points and percent_reading(n, abs(v))))
+        return v is not None and (
+            matches(n, v, magnitude_ok=size_ok)
+            or (n.percent and percent_reading(n, v))
+            or (n.points and percent_reading(n, abs(v)))
+        )
 
     views = book.contexts if ctx in (None, EITHER) else (ctx,)
     for key, e in ((k, book.features[k]) for k in sorted(keys) if k in book.features):
-        shares = [("fill", e.fill), *((f"share ({c})", e.shares.get(c)) for c in views),
-                  *((f"share of its side ({c})", e.side_shares.get(c)) for c in views)] if n.percent and not \
-            n.points else []  # (a share is a percentage)
+        shares = (
+            [
+                ("fill", e.fill),
+                *((f"share ({c})", e.shares.get(c)) for c in views),
+                *((f"share of its side ({c})", e.side_shares.get(c)) for c in views),
+            ]
+            if n.percent and not n.points
+            else []
+        )  # (a share is a percentage)
         for what, v in (("value", e.value), *shares):
             if states(v, size_ok=False):
                 return f"{key}'s {what}"
@@ -225,26 +281,40 @@ def any_fact(n: Number, book: FactBook, keys, ctx: str | None, strict: bool = Fa
                 return f"{key}'s contribution ({c})"
     if contribution:
         return None
-    for what, v in (*(("a decision-level fact", x) for x in book.decision_numbers),
-                    *((f"{a}'s score", x) for a, x in book.scores.items())):  # (a sum needs its cue words)
+    for what, v in (
+        *(("a decision-level fact", x) for x in book.decision_numbers),
+        *((f"{a}'s score", x) for a, x in book.scores.items()),
+    ):  # (a sum needs its cue words)
         if states(v):
             return what
     return None
 
 
 #: a count of things a name after it holds: 'three robots in the charger queue', 'seven cars waiting at the junction'
-_COUNTED_IN = re.compile(r"^\s+(?:[a-z\0]+\s+){1,2}(?:(?:already|still|now|waiting|queued|parked)\s+)?"
-                         r"(?:in|on|at|inside)\s+(?:the\s+|a\s+|its\s+)?$", re.IGNORECASE)
+_COUNTED_IN = re.compile(
+    r"^\s+(?:[a-z\0]+\s+){1,2}(?:(?:already|still|now|waiting|queued|parked)\s+)?"
+    r"(?:in|on|at|inside)\s+(?:the\s+|a\s+|its\s+)?$",
+    re.IGNORECASE,
+)
 
 
 def owned_by_unit_or_place(n: Number, masked: str, mentions, book: FactBook, unit_of) -> Claim | None:
     """A number first read as another name's and contradicted, that states exactly the value of the one feature its
     unit belongs to ('parked barely 4 m from a charger' of dist_to_charger_m, 4.2) or of the name that holds the things
     it counts ('three robots in the charger queue' of charger_queue_len, 3): verified as that value; else None."""
-    unit = re.match(r"\s*([A-Za-zµ°/%]+)\b", masked[n.end:])
+    unit = re.match(r"\s*([A-Za-zµ°/%]+)\b", masked[n.end :])
     owners = [f for f in book.features if unit and unit_of(f) and unit_of(f).lower() == unit.group(1).lower()]
-    nxt = next((m for m in mentions if m.kind == "feature" and m.start >= n.end and len(m.keys) == 1
-                and _COUNTED_IN.match(masked[n.end:m.start])), None)  # (past the counted noun's own mention)
+    nxt = next(
+        (
+            m
+            for m in mentions
+            if m.kind == "feature"
+            and m.start >= n.end
+            and len(m.keys) == 1
+            and _COUNTED_IN.match(masked[n.end : m.start])
+        ),
+        None,
+    )  # (past the counted noun's own mention)
     if nxt is not None:
         owners, rule = list(nxt.keys), "number.counted-in"
     elif len(owners) == 1:

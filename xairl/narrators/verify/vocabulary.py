@@ -1,6 +1,7 @@
 """The surfaces of an explanation's names, built once per explanation: each feature's name in any spelling, its
 description, aliases and runs of their words; actions by name, alias and verb form; categorical labels and legend
 meanings. :mod:`.names` finds them in a text."""
+
 from __future__ import annotations
 
 import functools
@@ -12,15 +13,52 @@ from ...explanation import Explanation
 from ...observation import REGION_RE
 from ...policy import Policy
 from .book import legend
-from .lexicon import (ABBREVIATIONS, BASE_FORM as _BASE_FORM, GENERIC, IRREGULAR as _IRREGULAR, SPAN, STOP,
-                      SYNONYMS, UNIT_PARTS)
+from .lexicon import ABBREVIATIONS, GENERIC, SPAN, STOP, SYNONYMS, UNIT_PARTS
+from .lexicon import BASE_FORM as _BASE_FORM
+from .lexicon import IRREGULAR as _IRREGULAR
 
 #: what a model's input describes: a word of a feature's description, never a feature on its own
-_INSTANCES = frozenset({"patient", "applicant", "borrower", "customer", "client", "person", "student", "team", "player",
-                        "user", "house", "home", "property", "uav", "drone", "vehicle", "agent"})
+_INSTANCES = frozenset(
+    {
+        "patient",
+        "applicant",
+        "borrower",
+        "customer",
+        "client",
+        "person",
+        "student",
+        "team",
+        "player",
+        "user",
+        "house",
+        "home",
+        "property",
+        "uav",
+        "drone",
+        "vehicle",
+        "agent",
+    }
+)
 #: words that make a label too plain to be recognised away from its feature ('the other features', 'at home')
-_PLAIN_LABEL_WORDS = frozenset({"other", "others", "none", "unknown", "yes", "no", "home", "at", "true", "false", "na",
-                                "missing", "not", "applicable", "some"})
+_PLAIN_LABEL_WORDS = frozenset(
+    {
+        "other",
+        "others",
+        "none",
+        "unknown",
+        "yes",
+        "no",
+        "home",
+        "at",
+        "true",
+        "false",
+        "na",
+        "missing",
+        "not",
+        "applicable",
+        "some",
+    }
+)
 
 
 def split_words(name: str) -> list[str]:
@@ -103,21 +141,34 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
     entries += _action_entries(exp, policy, clean)
     label_entries, short = _label_entries(exp, clean)
     entries += label_entries + _legend_entries(exp, policy)
-    entries += [(name, kind, (name,), "", "literal") for kind, names in (("feature", exp.feature_names),
-                                                                          ("action", exp.action_names))
-                for name in names if name.strip() and clean(name)]  # 'sensors[0]', '速度', '?' as written
+    entries += [
+        (name, kind, (name,), "", "literal")
+        for kind, names in (("feature", exp.feature_names), ("action", exp.action_names))
+        for name in names
+        if name.strip() and clean(name)
+    ]  # 'sensors[0]', '速度', '?' as written
     entries = [e for e in entries if e[0].split()]
     entries.sort(key=lambda e: -len(e[0]))
     names = {w for f in feature_words for w in split_words(f) if len(w) >= 3 and not w.isdigit()}
-    names |= {level.split()[-1].lower() for f in feature_words if (info := policy.features.get(f) if policy else None)
-              for level in (info.low, info.high) if len(level.split()) > 1}  # '(-27.5 dB, poor quality)'
+    names |= {
+        level.split()[-1].lower()
+        for f in feature_words
+        if (info := policy.features.get(f) if policy else None)
+        for level in (info.low, info.high)
+        if len(level.split()) > 1
+    }  # '(-27.5 dB, poor quality)'
     names |= {stem(w) for w in names} | {ws for ws in described_words if len(ws) >= 2}
     compiled = []
     for p, kind, keys, label, form in entries:
         pattern, needle = _literal(p) if form == "literal" else _pattern(p, kind)
         compiled.append((pattern, kind, keys, label, "" if form == "literal" else form, needle))
-    return Vocabulary(compiled + _acronyms(exp.feature_names, exp.categories) + _shorthands(exp.feature_names), short,
-                      feature_words, frozenset(names), _region_aliases(exp))
+    return Vocabulary(
+        compiled + _acronyms(exp.feature_names, exp.categories) + _shorthands(exp.feature_names),
+        short,
+        feature_words,
+        frozenset(names),
+        _region_aliases(exp),
+    )
 
 
 def _regions(exp: Explanation) -> dict[str, str]:
@@ -161,9 +212,12 @@ def _spellings(name_words: list[str]) -> list[str]:
     and each word swapped for a synonym ('battery_pct': 'charge pct'; 'hr_mean_6h': 'pulse mean 6h')."""
     spelled = " ".join(ABBREVIATIONS.get(w, w) for w in name_words)
     out = [spelled] if spelled != " ".join(name_words) else []
-    return out + [" ".join(w if k != i else other for k, w in enumerate(words)) for words in
-                  {tuple(name_words), *(tuple(s.split()) for s in out)} for i, w in enumerate(words)
-                  for other in SYNONYMS.get(w, ())]
+    return out + [
+        " ".join(w if k != i else other for k, w in enumerate(words))
+        for words in {tuple(name_words), *(tuple(s.split()) for s in out)}
+        for i, w in enumerate(words)
+        for other in SYNONYMS.get(w, ())
+    ]
 
 
 def _runs(form: str, f: str) -> list[str]:
@@ -172,8 +226,9 @@ def _runs(form: str, f: str) -> list[str]:
     instance the form is about ('the applicant's age', 'age of the patient': not 'applicant', 'patient'; in a
     description, or a name that is a phrase)."""
     lowered = form.lower()
-    owners = set(re.findall(r"(\w+)'s\b", lowered)) | set(re.findall(r"\bof (?:the |a |an )?(\w+)$", lowered)) | \
-        _INSTANCES
+    owners = (
+        set(re.findall(r"(\w+)'s\b", lowered)) | set(re.findall(r"\bof (?:the |a |an )?(\w+)$", lowered)) | _INSTANCES
+    )
     words = [w for w in split_words(form) if w not in STOP]
     out = []
     for i in range(len(words)):
@@ -181,9 +236,14 @@ def _runs(form: str, f: str) -> list[str]:
             run = words[i:j]
             if not any(re.search(r"[a-z]", w) for w in run):
                 continue  # '2 2' of 'obs[0,2,2]' would name a pixel by any number '22'
-            if len(run) == 1 and (run[0] in GENERIC or run[0] in UNIT_PARTS or len(run[0]) < 3 or run[0].isdigit() or (
-                    run[0] in owners and (form != f or len(words) >= 3)) or (
-                    form != f and len(run[0]) < 5 and run[0] not in split_words(f))):
+            if len(run) == 1 and (
+                run[0] in GENERIC
+                or run[0] in UNIT_PARTS
+                or len(run[0]) < 3
+                or run[0].isdigit()
+                or (run[0] in owners and (form != f or len(words) >= 3))
+                or (form != f and len(run[0]) < 5 and run[0] not in split_words(f))
+            ):
                 continue
             out.append(" ".join(run))
     return out
@@ -238,8 +298,11 @@ def _acronyms(features, categories=None) -> list:
         words = split_words(f)
         if len(words) >= 3 and not any(w.isdigit() for w in words):
             owners.setdefault("".join(w[0] for w in words).upper(), []).append(f)
-    out = [(re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "", _needle(acr))
-           for acr, fs in owners.items() if len(fs) == 1]
+    out = [
+        (re.compile(rf"(?<![\w]){acr}s?(?![\w])"), "feature", (fs[0],), "", "", _needle(acr))
+        for acr, fs in owners.items()
+        if len(fs) == 1
+    ]
     labelled: dict[str, list[tuple[str, str]]] = {}
     for f, labels in (categories or {}).items():
         for label in labels:
@@ -247,13 +310,18 @@ def _acronyms(features, categories=None) -> list:
             for w in words if len(words) >= 2 else ():
                 if re.fullmatch(r"[A-Z]{3,}", w):
                     labelled.setdefault(w, []).append((f, label))
-    return out + [(re.compile(rf"(?<![\w]){w}(?![\w])"), "label", (fl[0][0],), fl[0][1], "", _needle(w))
-                  for w, fl in labelled.items() if len(fl) == 1]
+    return out + [
+        (re.compile(rf"(?<![\w]){w}(?![\w])"), "label", (fl[0][0],), fl[0][1], "", _needle(w))
+        for w, fl in labelled.items()
+        if len(fl) == 1
+    ]
 
 
 #: a number right after a shorthand ('alc 9.4: -0.38', 'Wknd +3.2h'): the only place a shorthand names
-_NUMBER_AFTER = (r"(?=\s*[:=]?\s*\(?\s*(?:[+\-−±]\s?[$€£]?\d|[$€£]?\d[\d.,]*\s*[a-z%]{0,3}\s*(?::\s*[+\-−±]?|"
-                 r"\(?[+\-−±])\s?\d))")
+_NUMBER_AFTER = (
+    r"(?=\s*[:=]?\s*\(?\s*(?:[+\-−±]\s?[$€£]?\d|[$€£]?\d[\d.,]*\s*[a-z%]{0,3}\s*(?::\s*[+\-−±]?|"
+    r"\(?[+\-−±])\s?\d))"
+)
 #: (a signed number, 'Wknd +3.2h', or a value and its push after a colon or with a sign, 'alc 9.4: -0.38', 'alc 13.6
 #: +0.79'; not 'par 3 golf', '3 bed 2 bath', 'Cat 3 storms', 'In the US 3 of 10')
 
@@ -284,24 +352,109 @@ def _shorthands(features) -> list:
     out = []
     for (f, head), shorts in groups.items():
         body = "|".join(re.escape(x) for x in sorted(shorts, key=len, reverse=True))
-        out.append((re.compile(rf"(?<![\w])(?:{body})(?![\w]){_NUMBER_AFTER}", 0 if head.isupper() else re.IGNORECASE),
-                    "feature", (f,), "", "shorthand", _needle(head)))
+        out.append(
+            (
+                re.compile(rf"(?<![\w])(?:{body})(?![\w]){_NUMBER_AFTER}", 0 if head.isupper() else re.IGNORECASE),
+                "feature",
+                (f,),
+                "",
+                "shorthand",
+                _needle(head),
+            )
+        )
     return out
 
 
 #: English words a shorthand must not be, since they stand before numbers in any prose
-_COMMON_SHORT = {"sum", "net", "top", "all", "add", "and", "for", "was", "are", "but", "not", "now", "one", "two",
-                 "six", "ten", "pos", "neg", "see", "set", "get", "out", "off", "its", "has", "had", "got", "put",
-                 "say",
-                 "let", "use", "cut", "max", "min", "avg", "day", "days", "week", "year", "hour", "than", "then",
-                 "with", "from", "over", "only", "just", "each", "some", "more", "less", "most", "down", "gave",
-                 "give", "lift", "push", "drag", "pull", "base", "mean", "total", "score", "value", "shift", "plus",
-                 "per", "par", "bed", "rev", "est", "cat", "mar", "month", "us"}
+_COMMON_SHORT = {
+    "sum",
+    "net",
+    "top",
+    "all",
+    "add",
+    "and",
+    "for",
+    "was",
+    "are",
+    "but",
+    "not",
+    "now",
+    "one",
+    "two",
+    "six",
+    "ten",
+    "pos",
+    "neg",
+    "see",
+    "set",
+    "get",
+    "out",
+    "off",
+    "its",
+    "has",
+    "had",
+    "got",
+    "put",
+    "say",
+    "let",
+    "use",
+    "cut",
+    "max",
+    "min",
+    "avg",
+    "day",
+    "days",
+    "week",
+    "year",
+    "hour",
+    "than",
+    "then",
+    "with",
+    "from",
+    "over",
+    "only",
+    "just",
+    "each",
+    "some",
+    "more",
+    "less",
+    "most",
+    "down",
+    "gave",
+    "give",
+    "lift",
+    "push",
+    "drag",
+    "pull",
+    "base",
+    "mean",
+    "total",
+    "score",
+    "value",
+    "shift",
+    "plus",
+    "per",
+    "par",
+    "bed",
+    "rev",
+    "est",
+    "cat",
+    "mar",
+    "month",
+    "us",
+}
 
 
 def _phrase(text: str) -> str:
-    return " ".join(w for w in re.findall(r"[a-z0-9']+", re.sub(r"(?<=[a-z0-9])(?=[A-Z])|[_\-]+", " ", text).lower())
-                    if w != "the") if text else ""
+    return (
+        " ".join(
+            w
+            for w in re.findall(r"[a-z0-9']+", re.sub(r"(?<=[a-z0-9])(?=[A-Z])|[_\-]+", " ", text).lower())
+            if w != "the"
+        )
+        if text
+        else ""
+    )
 
 
 #: the endings a label's stem takes ('retir~': retired, retirement, retiree; not 'cours~' in 'coursework')
@@ -320,8 +473,10 @@ def _pattern(phrase: str, kind: str) -> tuple[re.Pattern, str]:
         last = words[-1]
         if len(last) > 4 and last.endswith("s") and not last.endswith(("ss", "us", "is")):
             words[-1] = last[:-2] if last.endswith(("sses", "xes", "ches", "shes")) else last[:-1]
-        body = r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+|(?:of|to|in|for)[\s_\-]+)?|)".join(map(re.escape, words)) + \
-            r"(?:s|es)?(?:'s|')?\)?"  # ('state-of-charge' of the run 'state charge' of soc_pct's spelling)
+        body = (
+            r"(?:'s|')?(?:[\s_\-(),]+(?:the\s+|(?:of|to|in|for)[\s_\-]+)?|)".join(map(re.escape, words))
+            + r"(?:s|es)?(?:'s|')?\)?"
+        )  # ('state-of-charge' of the run 'state charge' of soc_pct's spelling)
     pattern = re.compile(rf"(?<![\w]){body}(?![\w])(?![.,]\d)", re.IGNORECASE)  # not 'RSRQ (-3' of 'RSRQ (-3.2 dB)'
     return pattern, _needle(words[0])
 
