@@ -4,7 +4,9 @@ import numpy as np
 import pytest
 import torch
 
+import xairl
 from xairl import plugins
+from xairl.cli import main
 
 
 @pytest.fixture(autouse=True)
@@ -40,3 +42,34 @@ class ReusedActivations(torch.nn.Module):
 @pytest.fixture
 def rng():
     return np.random.default_rng(0)
+
+
+def run(capsys, *argv):
+    """``xairl ARGV`` in this process: (exit status, stdout, stderr)."""
+    rc = main(list(argv))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def one_line_error(rc, err, *words):
+    """A user's error as the CLI must report it: exit status 2, one line, no traceback, naming ``words``."""
+    assert rc == 2 and err.startswith("xairl: error: ") and err.count("\n") == 1, err
+    assert "Traceback" not in err and "internal error" not in err
+    for w in words:
+        assert w in err, (w, err)
+
+
+def small_cnn(observation=(3, 64, 64)):
+    """A two-layer CNN over 3x64x64 frames (NatureCNN-like), its policy, and 10 seeded frames."""
+    torch.manual_seed(0)
+    net = torch.nn.Sequential(
+        torch.nn.Conv2d(3, 4, 8, 4),
+        torch.nn.ReLU(),
+        torch.nn.Conv2d(4, 8, 4, 2),
+        torch.nn.ReLU(),
+        torch.nn.Flatten(),
+        torch.nn.Linear(8 * 6 * 6, 4),
+    )
+    policy = xairl.Policy(net, observation=observation, name="cnn")
+    frames = np.random.default_rng(0).integers(0, 256, (10, 3, 64, 64)).astype(np.float32)
+    return policy, frames

@@ -12,11 +12,7 @@ import xairl
 from xairl.cli import main
 from xairl.toy import FEATURES, toy_policy
 
-
-def run(capsys, *argv):
-    rc = main(list(argv))
-    out, err = capsys.readouterr()
-    return rc, out, err
+from .conftest import run
 
 
 def test_help_does_not_import_heavy_libraries():

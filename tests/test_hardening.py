@@ -21,20 +21,9 @@ from xairl.errors import InputError
 from xairl.inputs import read_states
 from xairl.toy import FEATURES, toy_policy
 
+from .conftest import one_line_error, run
+
 POLICY = toy_policy()
-
-
-def run(capsys, *argv):
-    rc = main(list(argv))
-    out, err = capsys.readouterr()
-    return rc, out, err
-
-
-def one_line_error(rc, err, *words):
-    assert rc == 2 and err.startswith("xairl: error: ") and err.count("\n") == 1, err
-    assert "Traceback" not in err and "internal error" not in err
-    for w in words:
-        assert w in err, (w, err)
 
 
 # 1. non-finite results ---------------------------------------------------------------------------------------------

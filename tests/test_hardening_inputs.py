@@ -9,27 +9,13 @@ import pytest
 import torch
 
 import xairl
-from xairl.cli import main
 from xairl.errors import InputError
 from xairl.toy import FEATURES, toy_policy
 
-from .conftest import ReusedActivations, mlp
+from .conftest import ReusedActivations, mlp, one_line_error, run
 
 POLICY = toy_policy()
 METHODS = ["deep_shap", "integrated_gradients", "kernel_shap", "exact"]
-
-
-def run(capsys, *argv):
-    rc = main(list(argv))
-    out, err = capsys.readouterr()
-    return rc, out, err
-
-
-def one_line_error(rc, err, *words):
-    assert rc == 2 and err.startswith("xairl: error: ") and err.count("\n") == 1, err
-    assert "Traceback" not in err and "internal error" not in err
-    for w in words:
-        assert w in err, (w, err)
 
 
 # 9. float64 networks ----------------------------------------------------------------------------------------------

@@ -13,20 +13,12 @@ from xairl.observation import Observation
 from xairl.regions import in_regions
 from xairl.toy import toy_policy
 
+from .conftest import small_cnn
+
 
 def _cnn(channels: str = "channels"):
-    torch.manual_seed(0)
-    net = torch.nn.Sequential(
-        torch.nn.Conv2d(3, 4, 8, 4),
-        torch.nn.ReLU(),
-        torch.nn.Conv2d(4, 8, 4, 2),
-        torch.nn.ReLU(),
-        torch.nn.Flatten(),
-        torch.nn.Linear(8 * 6 * 6, 4),
-    )
     shape = (3, 64, 64) if channels == "channels" else Observation.array((3, 64, 64), channels=channels)
-    policy = xairl.Policy(net, observation=shape, name="cnn")
-    frames = np.random.default_rng(0).integers(0, 256, (10, 3, 64, 64)).astype(np.float32)
+    policy, frames = small_cnn(shape)
     return policy, xairl.explain(policy, frames[:2], background=frames[2:])
 
 

@@ -10,6 +10,8 @@ from tests.work_budget import calls
 from xairl.regions import in_regions
 from xairl.report import ReportContent, ReportRequest, write_report
 
+from .conftest import small_cnn
+
 NARRATE_CALLS = 1_000_000  # function calls to narrate one state of the CNN below, verification included
 
 REGION = "patch "
@@ -17,17 +19,7 @@ REGION = "patch "
 
 @pytest.fixture(scope="module")
 def cnn():
-    torch.manual_seed(0)
-    net = torch.nn.Sequential(
-        torch.nn.Conv2d(3, 4, 8, 4),
-        torch.nn.ReLU(),
-        torch.nn.Conv2d(4, 8, 4, 2),
-        torch.nn.ReLU(),
-        torch.nn.Flatten(),
-        torch.nn.Linear(8 * 6 * 6, 4),
-    )
-    policy = xairl.Policy(net, observation=(3, 64, 64), name="cnn")
-    frames = np.random.default_rng(0).integers(0, 256, (10, 3, 64, 64)).astype(np.float32)
+    policy, frames = small_cnn()
     return policy, frames, xairl.explain(policy, frames[:2], background=frames[2:])
 
 
