@@ -29,7 +29,7 @@ def make_policy(seed: int = 0, checkpoint: str | None = None) -> xairl.Policy:
     # frames arrive as 0..255; the network sees them / 255 as SB3 does (a linear step, explained through)
     return xairl.Policy(
         torch.nn.Sequential(Scale(1 / 255), net).eval(),
-        observation=(4, 84, 84),
+        observation=xairl.Observation.array((4, 84, 84), channels="frames"),  # a stack of 4 frames
         action_names=ACTIONS,
         name="atari-nature-cnn",
     )
