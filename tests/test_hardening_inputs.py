@@ -289,9 +289,21 @@ def test_outputs_named_as_parameters_of_actions_are_refused(hybrid):
     with pytest.raises(
         InputError,
         match=r"output 'dash_power' reads as a parameter of action 'dash'.*"
-        r"xairl.Policy.heads\(module, output=\[...\]\).*output=\['actions'\] \* 6",
+        r"xairl.Policy.heads\(module, output=\[...\]\).*output='actions'",
     ):
         xairl.Policy(hybrid, feature_names=list("abcd"), action_names=HYBRID)
+
+
+def test_declared_actions_are_taken_at_their_word_also_through_replace(hybrid):
+    """output='actions' (or one 'actions' per column) lets such names be actions, and dataclasses.replace keeps it;
+    axis and direction words name no parameter ('move_x', 'rotate_y', 'keep_speed' are actions of their own)."""
+    from dataclasses import replace
+
+    for output in ("actions", ["actions"] * 6):
+        policy = xairl.Policy(hybrid, feature_names=list("abcd"), action_names=HYBRID, output=output)
+        assert replace(policy, name="renamed").output == "actions"
+    for names in (["move", "move_x", "move_y", "rotate", "rotate_z", "keep"], ["keep", "keep_speed", *"abcd"]):
+        assert xairl.Policy(hybrid, feature_names=list("abcd"), action_names=names).output == "actions"
 
 
 def test_outputs_declared_of_mixed_kinds_are_refused(hybrid):
@@ -323,3 +335,16 @@ def test_heads_explain_the_actions_and_their_parameters_apart(hybrid, method):
     np.testing.assert_allclose(acts.outputs, full[:, :3], atol=1e-6)
     np.testing.assert_allclose(params.outputs, full[:, 3:], atol=1e-6)
     assert set(acts.chosen) <= {0, 1, 2}
+
+
+def test_a_per_run_extra_as_long_as_the_states_is_kept_whole():
+    """Only the per-state extras are cut: one entry per feature, numbering as many as the states, stays whole."""
+    from dataclasses import replace
+
+    policy = toy_policy()
+    exp = xairl.explain(policy, policy.background(len(FEATURES), seed=3), background=policy.background(20))
+    per_feature, delta = np.arange(len(FEATURES), dtype=float), np.arange(len(FEATURES) * 2.0).reshape(-1, 2)
+    exp = replace(exp, extras={"per_feature": per_feature, "convergence_delta": delta})
+    part = exp[1:3]
+    assert np.array_equal(part.extras["per_feature"], per_feature)
+    assert np.array_equal(part.extras["convergence_delta"], delta[1:3])

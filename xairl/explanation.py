@@ -11,6 +11,10 @@ from pydantic import BaseModel, ConfigDict
 
 from .errors import InputError
 
+#: the ``extras`` that hold one entry per state, cut with the states when an Explanation is sliced; every other
+#: extra describes the run and is kept whole
+PER_STATE_EXTRAS = {"convergence_delta"}
+
 
 @dataclass(frozen=True)
 class Explanation:
@@ -138,8 +142,8 @@ class Explanation:
 
         Always an Explanation, never an array: an int gives the one-state Explanation ``exp[i:i + 1]`` (so that
         plots, ``narrate(exp[i], 0)`` and ``verify`` take it as they take any). Every per-state array is cut alike:
-        values, base values, outputs, states, available actions, and each array in ``extras`` whose first axis is
-        the states (IG's convergence delta); per-run fields (names, method, options, background quartiles,
+        values, base values, outputs, states, available actions, and the ``extras`` named in
+        :data:`PER_STATE_EXTRAS` (IG's convergence delta; an attributor of a plugin adds its own there); per-run fields (names, method, options, background quartiles,
         observation) are kept. The states are renumbered from 0 (:meth:`records`). Refused in one line: a
         selection of no state, a mask of another length, positions out of range, or an index into features or
         actions (``exp[:, j]``: use :meth:`grouped` or :meth:`output_slice`).
@@ -180,10 +184,10 @@ class Explanation:
 
         extras = {
             k: cut(v)
-            if isinstance(v, np.ndarray) and v.ndim and len(v) == n
+            if isinstance(v, np.ndarray) and k in PER_STATE_EXTRAS
             else [v[i] for i in rows]
-            if isinstance(v, (list, tuple)) and len(v) == n
-            else v  # (read from JSON)
+            if isinstance(v, (list, tuple)) and k in PER_STATE_EXTRAS  # (read from JSON)
+            else v  # per run: kept whatever its length (one entry per feature may number as many as the states)
             for k, v in self.extras.items()
         }
         return replace(

@@ -29,35 +29,28 @@ def heads(cls, module: torch.nn.Module, output: Sequence[str], action_names: Seq
 PARAMETER_WORDS = {
     "power",
     "angle",
-    "direction",
-    "dir",
     "strength",
     "force",
     "magnitude",
     "amount",
-    "speed",
-    "velocity",
     "duration",
-    "distance",
     "param",
     "parameter",
     "arg",
-    "x",
-    "y",
-    "z",
 }
 
 
-def check_kinds(policy, kinds: tuple[str, ...] | None) -> None:
-    """Refuse outputs of mixed kinds, declared (``output=[...]``) or named so (``kick_power`` beside ``kick``): the
-    chosen action would be taken among parameters' values ("chose kick_power")."""
+def check_kinds(policy, kinds: tuple[str, ...] | None, declared: bool = True) -> None:
+    """Refuse outputs of mixed kinds, declared (``output=[...]``) or, where no output kind is declared, named so
+    (``kick_power`` beside ``kick``): the chosen action would be taken among parameters' values ("chose
+    kick_power"). A declared ``output`` (also the one ``dataclasses.replace`` passes on) is taken at its word."""
     names = policy.action_names
     if kinds is not None and len(kinds) != len(names):
         raise InputError(
             f"policy '{policy.name}': output gives {len(kinds)} kinds for {len(names)} outputs; give "
             "one kind per output column."
         )
-    if kinds is None and policy.output == "actions":
+    if not declared:
         for a in names:
             head, _, word = re.sub(r"[-. ]", "_", a).rpartition("_")
             if word.lower() in PARAMETER_WORDS and head in names:
@@ -65,8 +58,8 @@ def check_kinds(policy, kinds: tuple[str, ...] | None) -> None:
                     f"policy '{policy.name}': output '{a}' reads as a parameter of action '{head}', "
                     "whose value would be ranked against the actions' scores; declare each output's "
                     "kind, e.g. output=['actions', ..., 'continuous', ...], and explain each kind with "
-                    f"xairl.Policy.heads(module, output=[...]); if all are discrete actions, say so: "
-                    f"output=['actions'] * {len(names)}."
+                    "xairl.Policy.heads(module, output=[...]); if all are discrete actions, say so: "
+                    "output='actions'."
                 )
     if kinds is not None and len(set(kinds)) > 1:
         by_kind = "; ".join(

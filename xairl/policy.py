@@ -85,7 +85,8 @@ class Policy:
         dimension) or 'value' (one column: V(s), Q(s, a) or any regressor); or one of them per output column. Outputs
         of mixed kinds (a parametrised action space: action logits and their continuous parameters) are refused,
         since a parameter's value would be ranked against the actions' scores: :meth:`heads` makes one policy per
-        kind. An undeclared output named as a parameter of another (``kick_power`` beside ``kick``) is refused too.
+        kind. Left out (None), it is 'actions', and an output named as a parameter of another (``kick_power`` beside
+        ``kick``) is refused; say ``output="actions"`` where such names really are actions.
     :param features: optional :class:`FeatureInfo` per feature name, and per group name for a group narrated as
         one reason (``kind='group'``).
     :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}`` (plots show each as one bar).
@@ -113,7 +114,7 @@ class Policy:
     facts_hook: Callable[[np.ndarray, int, int], Any] | None = None
     action_mask: Callable[[np.ndarray], np.ndarray] | None = None
     observation: Any = None
-    output: Literal["actions", "continuous", "value"] | Sequence[str] = "actions"
+    output: Literal["actions", "continuous", "value"] | Sequence[str] | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.module, torch.nn.Module):
@@ -122,8 +123,11 @@ class Policy:
         def normalise(name: str, value) -> None:  # a frozen dataclass sets its own fields only here
             object.__setattr__(self, name, value)
 
-        kinds = None if isinstance(self.output, str) else tuple(str(k) for k in self.output or ())
-        if kinds is not None:  # one kind per output column: checked against the names below
+        declared = self.output is not None  # undeclared: discrete actions, unless the names say otherwise
+        kinds = None if isinstance(self.output, str) or not declared else tuple(str(k) for k in self.output)
+        if not declared:
+            normalise("output", "actions")
+        elif kinds is not None:  # one kind per output column: checked against the names below
             normalise("output", kinds[0] if kinds else "")
         if self.output not in OUTPUT_KINDS or (kinds and not set(kinds) <= set(OUTPUT_KINDS)):
             raise InputError(
@@ -154,7 +158,7 @@ class Policy:
                 f"{len(self.feature_names)} feature names for an observation of "
                 f"{self.observation.n_features} columns {self.observation.describe()}; name each column."
             )
-        check_kinds(self, kinds)
+        check_kinds(self, kinds, declared)
         if self.output == "value" and len(self.action_names) != 1:
             raise InputError("a 'value' policy has one output; give one name in action_names (e.g. ['value']).")
         names = set(self.feature_names)

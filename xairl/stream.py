@@ -418,7 +418,8 @@ def _existing_run(out: Path, identity: dict, resume: bool, run: str, total) -> s
         changed = sorted(k for k in identity if earlier.get(k) != json.loads(json.dumps(identity))[k])
         raise InputError(
             f"{out} holds another run (it differs in {', '.join(changed) or 'run.json'}); resume needs "
-            "the same states, policy, background, method, options and chunk size."
+            "the same states, policy, background, method, options and chunk size (if they are the same, "
+            "run.json was damaged: delete it and resume; every part is checked against this run)."
         )
     n, chunk = (total() if files else 0), identity["chunk_size"]
     strays = [

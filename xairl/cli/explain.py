@@ -25,13 +25,13 @@ def cmd_explain(args) -> int:
     policy = plugins.load_policy(args.policy, parse_options(args.policy_arg), _state_shape(args.states))
     method = plugins.get_attributor(args.method)  # unknown names fail before any file is read
     options = method(parse_options(args.option)).options
+    if args.out:  # before anything is read: a folder that cannot be made fails at once
+        make_dir(args.out)
     states = _choose_format(args, policy)
     if args.format == "parquet" and not args.out:
         raise InputError("--format parquet writes a folder: give it with --out DIR.")
     if args.engine == "ray" and args.format != "parquet":
         raise InputError("--engine ray streams into a folder: add --format parquet --out DIR.")
-    if args.out:
-        make_dir(args.out)
     if args.states and args.format == "parquet":
         states = None  # streamed from the file, chunk by chunk
     elif args.states and states is None:
