@@ -18,6 +18,10 @@ from .numbers import find_numbers, matches
 from .vocabulary import split_words, stem
 
 
+#: the numbers of one clause that are read (the rest: unchecked, 'number.too-many')
+MAX_NUMBERS = 40
+
+
 def check_clause(
     masked: str,
     a: int,
@@ -36,13 +40,22 @@ def check_clause(
     if written:  # ('the last 90 days' of support_calls_90d: not days_since_last_upgrade)
         mentions = noclaims.without_window_words(mentions, written, book.features)
     names = named_features(mentions)
+    # a clause of more numbers than prose holds (a table, or hostile text) reads its first ones only: each number's
+    # readings search the clause, so reading them all grows with the numbers times the clause's length
+    found = [n for n in find_numbers(masked[:b]) if n.start >= a]
+    found, unread = found[: 2 * MAX_NUMBERS], found[2 * MAX_NUMBERS :]
+    worded = _worded(book, written)
     numbers = [
         n
-        for n in find_numbers(masked[:b])
-        if n.start >= a
-        and not noclaims.skip_number(n, masked)
-        and not noclaims.window_of_name(n, sentence_keys, written or masked, _worded(book, written))
+        for n in found
+        if not noclaims.skip_number(n, masked)
+        and not noclaims.window_of_name(n, sentence_keys, written or masked, worded)
     ]
+    numbers, unread = numbers[:MAX_NUMBERS], numbers[MAX_NUMBERS:] + unread
+    out.extend(
+        Claim("number", n.text, "unchecked", f"more than {MAX_NUMBERS} numbers in one clause", "number.too-many")
+        for n in unread
+    )
     if book.in_percent:  # 'p_dropout=0.469' of a prediction of 46.9 %: a fraction may state a percentage
         numbers = [
             replace(n, alternatives=(*n.alternatives, 100 * n.value))

@@ -202,6 +202,14 @@ RULES: tuple[Rule, ...] = (
         silent=(("air", "Traffic and wind add 7.2 and 6.9, respectively."),),
     ),
     Rule(
+        "number.too-many",
+        "number",
+        "the numbers of a clause after its 40th (a table or hostile text, not prose), unchecked: reading every one "
+        "would grow with the numbers times the clause's length",
+        fires=(("air", "Traffic raised it by " + "1, " * 45 + "in all."),),
+        silent=(("air", "Traffic raised it by 1.0, wind by 2.0 and the hour by 3.0."),),
+    ),
+    Rule(
         "number.sum-unnamed",
         "number",
         "a number after a sum's cue word in a clause that joins one known name with "
