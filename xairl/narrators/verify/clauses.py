@@ -17,7 +17,6 @@ from .names import Mention, named_features
 from .numbers import find_numbers, matches
 from .vocabulary import split_words, stem
 
-
 #: the numbers of one clause that are read (the rest: unchecked, 'number.too-many')
 MAX_NUMBERS = 40
 
