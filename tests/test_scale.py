@@ -25,7 +25,9 @@ def local_ray():
     ray.shutdown()
 
 
-def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ray):
+def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ray, capsys):
+    """Resume on Ray as on the local engine (issue 51, item 2): lost parts are explained, a bit-flipped one is
+    explained again to the same bits, a stray one is refused by name."""
     from xairl.scale import explain_on_ray
 
     states = tmp_path / "s.npy"
@@ -37,9 +39,14 @@ def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ra
     assert np.array_equal(local.values, distributed.values) and np.array_equal(local.outputs, distributed.outputs)
     assert summary.n == 6_000 and ray.is_initialized()  # a running Ray is used, and left running
     assert (tmp_path / "local" / "summary.json").read_text() == (tmp_path / "ray" / "summary.json").read_text()
-    lost = sorted((tmp_path / "ray" / "explanations.parquet").glob("part-*.parquet"))[2:4]
-    for part in lost:  # as if the run had been killed before these chunks were written
+    parts = sorted((tmp_path / "ray" / "explanations.parquet").glob("part-*.parquet"))
+    for part in parts[2:4]:  # as if the run had been killed before these chunks were written
         part.unlink()
+    whole = parts[1].read_bytes()
+    middle = len(whole) // 2
+    parts[1].write_bytes(whole[:middle] + bytes([whole[middle] ^ 4]) + whole[middle + 1 :])  # a flipped bit
+    stray = parts[0].with_name("part-000000000007.parquet")
+    stray.write_bytes(parts[0].read_bytes())
     argv = [
         "explain",
         "--states",
@@ -56,34 +63,14 @@ def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ra
         "1000",
         "--resume",
     ]
+    capsys.readouterr()
+    assert main(argv + ["--background-size", "30"]) == 2  # a stray part: refused by name, nothing explained
+    assert "part-000000000007.parquet: not a part of this run" in capsys.readouterr().err
+    stray.unlink()
     assert main(argv + ["--background-size", "31"]) == 2  # another background than the run's: refused
     assert main(argv + ["--background-size", "30"]) == 0  # the same run (the sampler's 30 states): resumed
     again = read_parquet(tmp_path / "ray" / "explanations.parquet")
-    assert np.array_equal(again.values, local.values)
-
-
-@pytest.mark.slow
-def test_ray_resume_explains_a_damaged_part_again_and_refuses_a_stray_by_name(tmp_path, local_ray):
-    """Issue 51, item 2, on the Ray engine: the parts carry the same checksums, and resume checks them alike."""
-    import pyarrow.parquet as pq
-
-    from xairl.errors import InputError
-    from xairl.scale import explain_on_ray
-
-    states, bg = POLICY.background(3_000, seed=6), POLICY.background(20)
-    explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=1000, workers=2)
-    parts = tmp_path / "ray" / "explanations.parquet"
-    flipped = parts / "part-000000001000.parquet"
-    whole = flipped.read_bytes()
-    flipped.write_bytes(whole[: len(whole) // 2] + bytes([whole[len(whole) // 2] ^ 4]) + whole[len(whole) // 2 + 1 :])
-    (parts / "part-000000000007.parquet").write_bytes((parts / "part-000000000000.parquet").read_bytes())
-    with pytest.raises(InputError, match="part-000000000007.parquet: not a part of this run"):
-        explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=1000, workers=2, resume=True)
-    (parts / "part-000000000007.parquet").unlink()
-    summary = explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=1000, workers=2, resume=True)
-    assert summary.n == 3_000 and flipped.read_bytes() == whole  # explained again, to the same bits
-    index = pq.read_table(parts, columns=["index"]).column("index").to_numpy()
-    assert len(index) == 3_000 and np.array_equal(np.sort(index), np.arange(3_000))  # every state exactly once
+    assert np.array_equal(again.values, local.values) and parts[1].read_bytes() == whole  # every state once
 
 
 def test_ray_reads_parquet_by_row_group_and_csv_once_rewritten(tmp_path, local_ray):
