@@ -52,19 +52,9 @@ def templates() -> list[tuple[str, float, float]]:
 
 
 def image() -> list[float]:
-    import torch
+    from tests.conftest import small_cnn  # the CNN of tests/test_image_regions.py, whose timing this was
 
-    torch.manual_seed(0)
-    net = torch.nn.Sequential(
-        torch.nn.Conv2d(3, 4, 8, 4),
-        torch.nn.ReLU(),
-        torch.nn.Conv2d(4, 8, 4, 2),
-        torch.nn.ReLU(),
-        torch.nn.Flatten(),
-        torch.nn.Linear(8 * 6 * 6, 4),
-    )
-    policy = xairl.Policy(net, observation=(3, 64, 64), name="cnn")
-    frames = np.random.default_rng(0).integers(0, 256, (10, 3, 64, 64)).astype(np.float32)
+    policy, frames = small_cnn()
     exp = xairl.explain(policy, frames[:2], background=frames[2:])
     xairl.narrate(exp, 0, policy=policy, robustness=False)  # warm
     return [best(lambda i=i: xairl.narrate(exp, i, policy=policy, robustness=False)) for i in range(2)]
