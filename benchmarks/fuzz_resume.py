@@ -96,7 +96,7 @@ def mutate(kind: str, parts: Path, other: Path, rng: random.Random) -> str | Non
 
 def not_a_part_of_the_run(path: Path, run: str) -> bool:
     """run.json when it is no record of a run, a file whose name is no chunk's, or another run's whole part."""
-    from xairl.stream import PART, check_part
+    from xairl.parts import PART, check_part
 
     if path.name == "run.json":
         try:

@@ -26,8 +26,9 @@ import numpy as np
 
 from .chunks import CHUNK, count_states, stage_parquet, state_chunks
 from .errors import InputError, XairlError
+from .parts import part_name, write_part
 from .policy import Policy
-from .stream import RunningSummary, _part_name, finish_run, read_parquet, start_run, write_part
+from .stream import RunningSummary, finish_run, read_parquet, start_run
 
 STAGED = ".states.parquet"  # a CSV, .npz or .json file's states, rewritten for the workers (then removed)
 
@@ -198,7 +199,7 @@ def explain_on_ray(
             Path(source).unlink(missing_ok=True)
     summary = RunningSummary()
     for first in bar(range(0, total, chunk_size), desc="summing", unit="chunk", disable=not progress):
-        summary.add(first, read_parquet(run.parts / _part_name(first)))
+        summary.add(first, read_parquet(run.parts / part_name(first)))
     return finish_run(run, summary, states)
 
 

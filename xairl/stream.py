@@ -12,7 +12,7 @@ run) and ``summary.json`` (mean |contribution| per feature over all states). Eac
 ``.part`` file and renamed when complete, so an interrupted run leaves only whole chunks, and ``resume`` explains
 exactly the chunks that are missing.
 
-A part is trusted by its contents, not its name: its metadata holds the run it belongs to (a hash of ``run.json``'s
+A part (:mod:`xairl.parts`) is trusted by its contents, not its name: its metadata holds the run it belongs to (a hash of ``run.json``'s
 record), its first row, its number of rows, and a SHA-256 of its columns and metadata. ``resume`` reads every part
 first: a damaged one (a flipped bit, cut short, rows other than its name says) is explained again; a whole part of
 another run, or a file that is no part of this run (``part-...07``, a chunk past the end), is refused by name before
@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,11 +39,10 @@ from .chunks import CHUNK, count_states, state_chunks
 from .errors import InputError, one_line
 from .explanation import Explanation
 from .files import write_text
+from .parts import DATASET, existing_parts, part_name, write_part
 from .policy import Policy, model_hash
 
 SAMPLE = 1_000  # states kept (uniformly, by reservoir sampling) for the figures of a streamed run
-DATASET = "explanations.parquet"
-PART = re.compile(r"part-(\d{12})\.parquet")  # a part's name: its first row
 
 
 # ---- explaining ------------------------------------------------------------------------------------------------
@@ -64,91 +62,6 @@ def explain_chunks(
     bg = policy.background() if background is None else policy.check_states(background, "background")
     for first, x in state_chunks(states, policy, chunk_size, start):
         yield first, explain(policy, x, background=bg, method=method, options=options)
-
-
-# ---- writing ---------------------------------------------------------------------------------------------------
-def _part_name(first: int) -> str:
-    return f"part-{first:012d}.parquet"
-
-
-def write_part(folder: Path, first: int, exp: Explanation, meta: dict) -> Path:
-    """One chunk as ``folder/part-<first>.parquet``, written whole or not at all."""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    from .files import atomic_write
-
-    n, f, a = exp.values.shape
-
-    def fixed(arr: np.ndarray, width: int, kind) -> pa.Array:
-        return pa.FixedSizeListArray.from_arrays(pa.array(np.ascontiguousarray(arr).reshape(-1), kind), width)
-
-    decides = exp.output == "actions"
-    columns = {
-        "index": pa.array(np.arange(first, first + n, dtype=np.int64)),
-        "state": fixed(exp.states.astype(np.float32), f, pa.float32()),
-        "values": fixed(exp.values.astype(np.float32), f * a, pa.float32()),
-        "base_values": fixed(exp.base_values, a, pa.float64()),
-        "outputs": fixed(exp.outputs, a, pa.float64()),
-        "additivity_gap": fixed(exp.additivity_gap, a, pa.float64()),
-        "chosen": pa.array(exp.chosen if decides else np.full(n, -1), pa.int32()),
-        "runner_up": pa.array(exp.runner_up if decides else np.full(n, -1), pa.int32()),
-    }
-    if exp.available is not None:  # the action mask: chosen and runner-up are taken among available actions
-        columns["available"] = fixed(exp.available, a, pa.bool_())
-    meta = {**meta, "first": first, "rows": n}
-    table = pa.table(columns)
-    meta["sha256"] = _checksum(table, meta)
-    table = table.replace_schema_metadata({"xairl": json.dumps(meta)})
-    path = folder / _part_name(first)
-    with atomic_write(path, "wb") as fh:
-        pq.write_table(table, fh, compression="zstd")
-    return path
-
-
-def _checksum(table, meta: dict) -> str:
-    """SHA-256 of a part's columns (names, types, values) and of its metadata other than this checksum."""
-    import pyarrow as pa
-
-    digest = hashlib.sha256(json.dumps({k: v for k, v in meta.items() if k != "sha256"}, sort_keys=True).encode())
-    for name in table.column_names:
-        column = table.column(name).combine_chunks()
-        while pa.types.is_fixed_size_list(column.type):
-            column = column.flatten()
-        digest.update(f"\0{name}:{column.type}\0".encode())
-        digest.update(column.to_numpy(zero_copy_only=False).tobytes())
-    return digest.hexdigest()
-
-
-def check_part(path: Path, first: int, rows: int, run: str) -> tuple[str, str]:
-    """("ok", ""), ("bad", why) for a damaged part (explain its chunk again) or ("foreign", why) for a whole part of
-    another run: is ``path`` rows ``first..first + rows - 1`` of run ``run``, as written?"""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    try:
-        table = pq.read_table(path)
-        meta = json.loads(table.schema.metadata[b"xairl"])
-        whole = meta.pop("sha256") == _checksum(table, meta)
-    except (
-        pa.ArrowException,
-        OSError,
-        KeyError,
-        ValueError,
-        TypeError,
-        AttributeError,
-        RecursionError,
-        MemoryError,
-    ) as exc:
-        return "bad", f"unreadable: {one_line(exc, 80)}"
-    if not whole:
-        return "bad", "its checksum does not match its contents"
-    if meta.get("run") != run:
-        return "foreign", "a part written by another run (other states, policy, background, method or chunk size)"
-    index = table.column("index").to_numpy()
-    if meta.get("first") != first or not np.array_equal(index, np.arange(first, first + rows)):
-        return "bad", f"it holds {len(index)} row(s) from {meta.get('first')}, not rows {first}..{first + rows - 1}"
-    return "ok", ""
 
 
 def read_parquet(path: str | Path) -> Explanation:
@@ -317,7 +230,7 @@ def explain_to_parquet(
             if first not in run.done:  # (a whole chunk from an interrupted run is not explained again)
                 exp = explain(policy, x, background=run.background, method=method, options=run.options)
                 write_part(run.parts, first, exp, run.meta)
-            summary.add(first, read_parquet(run.parts / _part_name(first)))  # as written: resumed runs sum the same
+            summary.add(first, read_parquet(run.parts / part_name(first)))  # as written: resumed runs sum the same
             bar.update(len(x))
     return finish_run(run, summary, states)
 
@@ -359,7 +272,7 @@ def start_run(
     bg = policy.background() if background is None else policy.check_states(background, "background")
     identity = run_identity(policy, states, bg, method, options, chunk_size)
     meta = part_meta(policy, method, options, identity)
-    done = _existing_run(out, identity, resume, meta["run"], lambda: count_rows(states, policy))
+    done = existing_parts(out, identity, resume, meta["run"], lambda: count_rows(states, policy))
     try:
         (out / DATASET).mkdir(parents=True, exist_ok=True)
         write_text(out / "run.json", json.dumps(identity, indent=2))
@@ -393,84 +306,3 @@ def part_meta(policy: Policy, method: str, options: dict, identity: dict) -> dic
         "categories": {f: list(i.categories) for f, i in policy.features.items() if i.categories} or None,
         "run": hashlib.sha256(json.dumps(identity, sort_keys=True).encode()).hexdigest()[:16],
     }
-
-
-def _existing_run(out: Path, identity: dict, resume: bool, run: str, total) -> set[int]:
-    """First rows of the chunks an earlier run completed and that are whole (empty for a new folder); refuses
-    another run's folder, and any file in the dataset that is not a part of this run, by name."""
-    import logging
-
-    folder = out / DATASET
-    try:
-        files = sorted(p for p in folder.iterdir() if not p.name.startswith((".", "_"))) if folder.is_dir() else []
-    except OSError as exc:
-        raise InputError(f"cannot read {folder} ({exc.strerror}); give a folder you can read and write.") from None
-    parts = [p for p in files if PART.fullmatch(p.name)]
-    if not files and not (out / "run.json").exists():
-        return set()
-    if not resume and (parts or (out / "run.json").exists()):
-        raise InputError(
-            f"{out} already holds a run ({len(parts)} chunk(s) written); pass --resume to continue it, "
-            "or give another folder."
-        )
-    earlier = _record(out / "run.json")
-    if earlier is not None and earlier != json.loads(json.dumps(identity)):
-        changed = sorted(k for k in identity if earlier.get(k) != json.loads(json.dumps(identity))[k])
-        raise InputError(
-            f"{out} holds another run (it differs in {', '.join(changed) or 'run.json'}); resume needs "
-            "the same states, policy, background, method, options and chunk size (if they are the same, "
-            "run.json was damaged: delete it and resume; every part is checked against this run)."
-        )
-    n, chunk = (total() if files else 0), identity["chunk_size"]
-    strays = [
-        p
-        for p in files
-        if not PART.fullmatch(p.name) or int(p.name[5:17]) % chunk or int(p.name[5:17]) >= n or not p.is_file()
-    ]
-    if strays:
-        raise _not_ours(
-            strays,
-            f"no chunk of this run is named so: its chunks are part-<first row>.parquet, the "
-            f"first rows multiples of {chunk} below {n}",
-            folder,
-        )
-    done = set()
-    for path in parts:
-        first = int(path.name[5:17])
-        verdict, why = check_part(path, first, min(chunk, n - first), run)
-        if verdict == "foreign":
-            raise _not_ours([path], why, folder)
-        if verdict == "ok":
-            done.add(first)
-        else:  # written over when its chunk is explained again
-            logging.getLogger("xairl").warning(f"xairl: {path}: damaged ({why}); its rows are explained again.")
-    return done
-
-
-def _record(path: Path) -> dict | None:
-    """The run recorded in ``run.json`` (None without one); one line when it is not a record xairl wrote."""
-    if not path.exists():
-        return None
-    try:
-        record = json.loads(path.read_text())
-        what = "a JSON " + {str: "string", int: "number", float: "number", bool: "boolean"}.get(type(record), "list")
-        what = "JSON null" if record is None else what
-    except OSError as exc:
-        record, what = None, exc.strerror or one_line(exc, 80)
-    except RecursionError:
-        record, what = None, "JSON nested too deeply"
-    except ValueError:
-        record, what = None, "not JSON"
-    if not isinstance(record, dict):
-        raise InputError(
-            f"{path}: not the record of a run ({what}); delete it and --resume again (each part is "
-            "checked against this run), or give another folder."
-        )
-    return record
-
-
-def _not_ours(paths: list[Path], why: str, folder: Path) -> InputError:
-    more = f" ({len(paths) - 1} more file(s) there are not parts of this run either)" if len(paths) > 1 else ""
-    return InputError(
-        f"{paths[0]}: not a part of this run ({why}); delete it or move it out of {folder} and run again{more}."
-    )
