@@ -191,3 +191,9 @@ def test_the_default_above_which_out_streams_is_50000_states_and_the_help_says_s
     with pytest.raises(SystemExit):
         main(["explain", "--help"])
     assert "above 50,000 states" in " ".join(capsys.readouterr().out.split())
+
+
+def test_progress_false_shows_no_bar(tmp_path, capsys):
+    """The bar's function once shadowed the ``progress`` parameter, so ``progress=False`` still drew a bar."""
+    explain_to_parquet(POLICY, STATES[:40], tmp_path / "quiet", background=BG, chunk_size=20, progress=False)
+    assert capsys.readouterr().err == ""

@@ -214,11 +214,11 @@ def explain_to_parquet(
     states, policy, background, method, options and chunk size; without it, a folder that already holds a run is
     refused (nothing is overwritten)."""
     from .attributors import explain
-    from .display import progress
+    from .display import progress as progress_bar  # (progress: the parameter saying whether to show it)
 
     run = start_run(policy, states, out, background, method, options, chunk_size, resume)
     summary = RunningSummary()
-    bar = progress(
+    bar = progress_bar(
         total=count_states(states, policy),
         unit="states",
         desc=f"explaining ({method})",

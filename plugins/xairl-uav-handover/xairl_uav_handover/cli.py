@@ -56,8 +56,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def _sim_config(base, duration=None):
     from pydantic import ValidationError
 
+    import xairl
     from xairl import InputError
-    from xairl.plugin import validation_message
 
     from .config import SimConfig
 
@@ -67,7 +67,7 @@ def _sim_config(base, duration=None):
     try:
         return SimConfig.model_validate(data)
     except ValidationError as exc:
-        raise InputError(validation_message(exc, "UAV simulator settings")) from None
+        raise InputError(xairl.plugin.validation_message(exc, "UAV simulator settings")) from None
 
 
 #: TrainConfig's fields that ``xairl uav train`` sets, by their flags
@@ -86,8 +86,8 @@ def run_train(args) -> int:
 
     from pydantic import ValidationError
 
+    import xairl
     from xairl import InputError
-    from xairl.plugin import validation_message
 
     from .train import TrainConfig, train_checkpoint
 
@@ -97,7 +97,7 @@ def run_train(args) -> int:
     try:
         tc = TrainConfig.model_validate({k: v for k, v in given.items() if v is not None})
     except ValidationError as exc:  # named by the flags the user typed
-        message = validation_message(exc, "training settings")
+        message = xairl.plugin.validation_message(exc, "training settings")
         raise InputError(
             re.sub(r"\b(" + "|".join(_TRAIN_FLAGS) + r")\b", lambda m: _TRAIN_FLAGS[m.group(1)], message)
         ) from None

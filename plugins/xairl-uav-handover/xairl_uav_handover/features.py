@@ -6,8 +6,8 @@ through it, and code that reads a state uses :data:`FEATURES` or the column slic
 
 import numpy as np
 
+import xairl
 from xairl import FeatureInfo, InputError
-from xairl.facts import Comparison, DomainFacts
 
 N_CANDIDATES = 4  # candidate 0 is the serving BS (stay); 1..3 the strongest other BSs
 FEATURES = (
@@ -169,7 +169,7 @@ class HandoverFacts:
     def __init__(self, q_max_bits: float = 2e6, offset_db: float = 2.0, detection_rsrq_db: float = -24.0):
         self.q_max, self.offset, self.detection = q_max_bits, offset_db, detection_rsrq_db
 
-    def __call__(self, state, chosen: int, runner_up: int, history=None) -> DomainFacts:
+    def __call__(self, state, chosen: int, runner_up: int, history=None) -> xairl.facts.DomainFacts:
         s = dict(zip(FEATURES, (float(v) for v in state)))
         k = chosen if chosen else runner_up
         fill = 100.0 * s["buffer_queue_size"] / self.q_max
@@ -186,7 +186,7 @@ class HandoverFacts:
         if k:
             diff = s[f"rsrp_{k}"] - s["rsrp_0"]
             comparisons.append(
-                Comparison(
+                xairl.facts.Comparison(
                     f"{_WHO[k]}'s RSRP was {abs(diff):.1f} dB {'above' if diff >= 0 else 'below'} "
                     "the serving BS's RSRP",
                     round(abs(diff), 1),
@@ -209,7 +209,7 @@ class HandoverFacts:
             extras["chm"] = "hand over to candidate 1"
         if history is not None and held:
             comparisons.append(
-                Comparison(
+                xairl.facts.Comparison(
                     f"the strongest neighbour has been more than {self.offset:g} dB above the "
                     f"serving BS for {held} consecutive decisions",
                     held,
@@ -217,11 +217,11 @@ class HandoverFacts:
                 )
             )
             # the rule's offset is a fact the sentence above cites in dB, whichever candidate the first one compares
-            comparisons.append(Comparison(f"the A3 offset is {self.offset:g} dB", self.offset, "dB"))
+            comparisons.append(xairl.facts.Comparison(f"the A3 offset is {self.offset:g} dB", self.offset, "dB"))
         if history is not None and len(history):
             before = 100.0 * float(np.asarray(history)[-1][FEATURES.index("buffer_queue_size")]) / self.q_max
             extras["buffer_trend"] = "rising" if fill > before + 1 else "falling" if fill < before - 1 else "steady"
-        return DomainFacts(extras, tuple(comparisons))
+        return xairl.facts.DomainFacts(extras, tuple(comparisons))
 
 
 handover_facts = HandoverFacts()

@@ -20,11 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+import xairl
 from xairl import Explanation, Policy, verify
-from xairl.facts import Comparison, DomainFacts, decision_facts
-from xairl.facts import format_number as fmt
-from xairl.facts import narration_units as units
-from xairl.plugin import save_figure
 
 from .features import BUFFER, RSRP
 from .policy import Checkpoint, greedy
@@ -112,46 +109,49 @@ def _first_reasons(tl: FlightTimeline, exp: Explanation, policy: Policy) -> list
     """(chosen action, name of its first reason or None) per decision, with the flight's history."""
     out = []
     for i in range(len(tl.states)):
-        d = decision_facts(exp, i, policy, k=1, history=tl.states[max(0, i - HISTORY) : i])
+        d = xairl.facts.decision_facts(exp, i, policy, k=1, history=tl.states[max(0, i - HISTORY) : i])
         out.append((int(exp.chosen[i]), d.reasons[0].label if d.reasons else None))
     return out
 
 
-def summary(tl: FlightTimeline, exp: Explanation, policy: Policy) -> tuple[str, DomainFacts]:
+def summary(tl: FlightTimeline, exp: Explanation, policy: Policy) -> tuple[str, xairl.facts.DomainFacts]:
     """The flight in three sentences, and the facts its numbers come from (for :func:`xairl.verify`)."""
     dqn, chm = int(tl.dqn_handover.sum()), len(tl.chm_times)
     reasons = _first_reasons(tl, exp, policy)
     stays = [r for a, r in reasons if a == 0]
     top = Counter(r for r in stays if r).most_common(1)
     comparisons = [
-        Comparison(f"{fmt(tl.duration_s)} s", round(tl.duration_s, 1), "s"),
-        Comparison(f"{len(tl.states)} decisions", len(tl.states), "decisions"),
-        Comparison(f"{len(stays)} decisions", len(stays), "decisions"),
+        xairl.facts.Comparison(f"{xairl.facts.format_number(tl.duration_s)} s", round(tl.duration_s, 1), "s"),
+        xairl.facts.Comparison(f"{len(tl.states)} decisions", len(tl.states), "decisions"),
+        xairl.facts.Comparison(f"{len(stays)} decisions", len(stays), "decisions"),
     ]
     if tl.closed_loop:
         first = (
-            f"Over {fmt(tl.duration_s)} s the DQN handed over {dqn} {'time' if dqn == 1 else 'times'}, where CHM "
+            f"Over {xairl.facts.format_number(tl.duration_s)} s the DQN handed over {dqn} {'time' if dqn == 1 else 'times'}, where CHM "
             f"flying the same flight handed over {chm} {'time' if chm == 1 else 'times'}."
         )
-        comparisons += [Comparison(f"{dqn} times", dqn, "times"), Comparison(f"{chm} times", chm, "times")]
+        comparisons += [
+            xairl.facts.Comparison(f"{dqn} times", dqn, "times"),
+            xairl.facts.Comparison(f"{chm} times", chm, "times"),
+        ]
     else:
         live = len(tl.live_times)
         first = (
-            f"Over {fmt(tl.duration_s)} s of this real flight the DQN would have proposed a handover at {dqn} "
+            f"Over {xairl.facts.format_number(tl.duration_s)} s of this real flight the DQN would have proposed a handover at {dqn} "
             f"samples and CHM at {chm}; the live network handed over {live} times."
         )
         comparisons += [
-            Comparison(f"{dqn} samples", dqn, "samples"),
-            Comparison(f"{chm} samples", chm, "samples"),
-            Comparison(f"{live} times", live, "times"),
+            xairl.facts.Comparison(f"{dqn} samples", dqn, "samples"),
+            xairl.facts.Comparison(f"{chm} samples", chm, "samples"),
+            xairl.facts.Comparison(f"{live} times", live, "times"),
         ]
     would = "" if tl.closed_loop else " would have"
     text = [first, f"The DQN{would} stayed at {len(stays)} of its {len(tl.states)} decisions."]
     if top:
         name, n = top[0]
-        comparisons.append(Comparison(f"{n} decisions", n, "decisions"))
+        comparisons.append(xairl.facts.Comparison(f"{n} decisions", n, "decisions"))
         text.append(f"For staying, its first reason was most often {name}, in {n} decisions.")
-    return " ".join(text), DomainFacts(comparisons=tuple(comparisons))
+    return " ".join(text), xairl.facts.DomainFacts(comparisons=tuple(comparisons))
 
 
 def narrate_flight(tl: FlightTimeline, exp: Explanation, policy: Policy):
@@ -168,7 +168,7 @@ def timeline_figure(tl: FlightTimeline, exp: Explanation, policy: Policy, path: 
     import matplotlib.pyplot as plt
 
     q_max = policy.features["buffer_queue_size"].capacity or 1.0
-    us = units(exp, policy)
+    us = xairl.facts.narration_units(exp, policy)
     margin = exp.margin()
     contrib = np.stack([margin[:, list(u.columns)].sum(axis=1) for u in us], axis=1)
     keep = [j for j, u in enumerate(us) if u.info.kind != "identifier"]
@@ -199,6 +199,6 @@ def timeline_figure(tl: FlightTimeline, exp: Explanation, policy: Policy, path: 
     ax[0].set_title(tl.label, fontsize=10)
     fig.tight_layout()
     path = Path(path)
-    save_figure(fig, path, dpi=80)
+    xairl.plugin.save_figure(fig, path, dpi=80)
     plt.close(fig)
     return path

@@ -6,10 +6,10 @@ Registered by the entry point ``uav-handover`` in group ``xairl``. Targets are `
 
 from pathlib import Path
 
-from xairl.plugin import hookimpl
+import xairl
 
 
-@hookimpl
+@xairl.plugin.hookimpl
 def register_policies(register):
     register(
         "uav-dqn",
@@ -18,17 +18,17 @@ def register_policies(register):
     )
 
 
-@hookimpl
+@xairl.plugin.hookimpl
 def register_prompt_dirs(register):
     register(Path(__file__).parent / "prompts")
 
 
-@hookimpl
+@xairl.plugin.hookimpl
 def register_commands(register):
     register("uav", "xairl_uav_handover.cli:configure", "UAV handover: train the DQN, evaluate Table I")
 
 
-@hookimpl
+@xairl.plugin.hookimpl
 def register_reports(register):
     register(
         "uav-handover",

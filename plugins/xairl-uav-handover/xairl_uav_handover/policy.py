@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
+import xairl
 from xairl import InputError, Policy
-from xairl.plugin import CheckpointError, atomic_write
 
 from .config import SimConfig
 from .env import HandoverVecEnv
@@ -47,7 +47,7 @@ def save_checkpoint(net: torch.nn.Module, path: str | Path, meta: dict) -> None:
     data = save(
         {k: v.detach().cpu().contiguous() for k, v in net.state_dict().items()}, metadata={"xairl": json.dumps(meta)}
     )
-    with atomic_write(path, "wb") as fh:  # a killed training run never leaves half a checkpoint
+    with xairl.plugin.atomic_write(path, "wb") as fh:  # a killed training run never leaves half a checkpoint
         fh.write(data)
 
 
@@ -69,20 +69,22 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
 
     path = Path(path or DEFAULT_CHECKPOINT)
     if not path.is_file():
-        raise CheckpointError(f"{path}: no such checkpoint; train one with `xairl uav train --out {path}`.")
+        raise xairl.plugin.CheckpointError(
+            f"{path}: no such checkpoint; train one with `xairl uav train --out {path}`."
+        )
     try:
         with safe_open(str(path), framework="pt") as fh:
             meta = json.loads((fh.metadata() or {}).get("xairl", "{}"))
         tensors = load_file(str(path))
     except (SafetensorError, OSError, ValueError) as exc:
-        raise CheckpointError(
+        raise xairl.plugin.CheckpointError(
             f"{path}: not a readable safetensors checkpoint ({exc}); re-train or re-download it."
         ) from None
     if not isinstance(meta, dict):
-        raise CheckpointError(f"{path}: its metadata is not a JSON object; re-train or re-download it.")
+        raise xairl.plugin.CheckpointError(f"{path}: its metadata is not a JSON object; re-train or re-download it.")
     for name, tensor in tensors.items():
         if tensor.is_floating_point() and not torch.isfinite(tensor).all():
-            raise CheckpointError(
+            raise xairl.plugin.CheckpointError(
                 f"{path}: tensor '{name}' holds NaN or inf (a corrupt file, or training that "
                 "diverged); re-train or re-download it."
             )
@@ -93,11 +95,15 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
         net.load_state_dict(tensors, strict=True)
     except RuntimeError as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise CheckpointError(f"{path}: does not match the UAV DQN architecture (hidden={hidden}): {first}") from None
+        raise xairl.plugin.CheckpointError(
+            f"{path}: does not match the UAV DQN architecture (hidden={hidden}): {first}"
+        ) from None
     try:
         config = SimConfig.model_validate(meta.get("sim_config", {}))
     except ValueError as exc:
-        raise CheckpointError(f"{path}: its simulator settings are invalid ({str(exc).splitlines()[0]}).") from None
+        raise xairl.plugin.CheckpointError(
+            f"{path}: its simulator settings are invalid ({str(exc).splitlines()[0]})."
+        ) from None
     return Checkpoint(path, net.eval(), meta, config)
 
 
@@ -110,12 +116,12 @@ def _hidden_widths(path: Path, meta: dict, tensors: dict) -> tuple[int, ...]:
         weights = sorted((k for k in tensors if k.endswith(".weight")), key=lambda k: int(k.split(".")[0]))
         widths = tuple(int(tensors[k].shape[0]) for k in weights[1:-1])
     except (ValueError, IndexError):
-        raise CheckpointError(
+        raise xairl.plugin.CheckpointError(
             f"{path}: its tensors are not those of the UAV DQN ({', '.join(list(tensors)[:4])}); "
             "re-train or re-download it."
         ) from None
     if not (isinstance(stated, list) and all(isinstance(h, int) for h in stated) and tuple(stated) == widths):
-        raise CheckpointError(
+        raise xairl.plugin.CheckpointError(
             f"{path}: its metadata says hidden={str(stated)[:60]} but its tensors have hidden "
             f"widths {list(widths)}; re-train or re-download it."
         )
@@ -137,7 +143,7 @@ def _refuse_q(net: torch.nn.Module, x: np.ndarray, i: int) -> None:
     """Say why the Q-values of state ``i`` of ``x`` (the network's float32 input) are NaN or inf."""
     where = f"the DQN cannot act on state {i} of {len(x)}"
     if not all(torch.isfinite(p).all() for p in net.parameters()):
-        raise CheckpointError(
+        raise xairl.plugin.CheckpointError(
             f"{where}: the Q-network's weights hold NaN or inf (a corrupt checkpoint, or training "
             "that diverged); re-train or re-download it."
         )

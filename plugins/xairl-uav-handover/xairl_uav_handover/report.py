@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 from pydantic import Field
 
+import xairl
 from xairl import Explanation, InputError
-from xairl.plugin import Options, Report, ReportContent, ReportRequest, save_figure, table_html
 
 from .baselines import CHM, SAMRO, CHMOnSamples, SAMROOnSamples
 from .evaluate import PAPER, chm_rate_by_altitude
@@ -33,7 +33,7 @@ from .policy import (
 BANDS = ((20.0, 60.0), (60.0, 100.0), (100.0, 160.0))
 
 
-class UAVReportOptions(Options):
+class UAVReportOptions(xairl.plugin.Options):
     """The UAV report's own settings (``-o key=value``)."""
 
     real: str | None = Field(
@@ -122,21 +122,21 @@ class QuantileRow:
 
 
 def _table(rows: list) -> str:
-    return table_html(type(rows[0]).HEADER, [list(astuple(r)) for r in rows])
+    return xairl.plugin.table_html(type(rows[0]).HEADER, [list(astuple(r)) for r in rows])
 
 
-class UAVReport(Report):
+class UAVReport(xairl.plugin.Report):
     """Table I on held-out simulated flights; with ``real``, the calibration and agreement with real flights."""
 
     name = "uav-handover"
     Options = UAVReportOptions
 
-    def build(self, req: ReportRequest) -> ReportContent:
+    def build(self, req: xairl.plugin.ReportRequest) -> xairl.plugin.ReportContent:
         real, real_setting = real_source(self.options.real)
         loaded = _load_real(real) if real is not None else None  # a bad file is named before Table I's minutes
         ckpt = load_checkpoint()
         cfg = ckpt.sim_config
-        content = ReportContent(
+        content = xairl.plugin.ReportContent(
             title="xairl report: UAV handover DQN (Meer et al.), calibrated reproduction",
             policy=uav_policy(ckpt),
             background=background_states(100, seed=req.seed + 7, config=cfg),
@@ -162,7 +162,9 @@ class UAVReport(Report):
         self._add_timelines(content, ckpt, req, flights[:1])
         return content
 
-    def _add_timelines(self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest, real: list) -> None:
+    def _add_timelines(
+        self, content: xairl.plugin.ReportContent, ckpt: Checkpoint, req: xairl.plugin.ReportRequest, real: list
+    ) -> None:
         """A few flights at a glance: ``timelines`` simulated ones, and the ``real`` flights given."""
         from xairl import explain
 
@@ -189,20 +191,28 @@ class UAVReport(Report):
         return (
             f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s, value [bootstrap 95 % "
             f"interval]. {verdict(res)} (The paper's medians per flight: {paper}.)",
-            table_html(*html_table(res)),
+            xairl.plugin.table_html(*html_table(res)),
         )
 
     def _add_real_flights(
-        self, content: ReportContent, ckpt: Checkpoint, req: ReportRequest, real: Path, flights: list, bad: list[str]
+        self,
+        content: xairl.plugin.ReportContent,
+        ckpt: Checkpoint,
+        req: xairl.plugin.ReportRequest,
+        real: Path,
+        flights: list,
+        bad: list[str],
     ) -> list:
         """The calibration and agreement tables against the ``flights`` loaded from folder ``real`` (``bad``: why
         the others were skipped); returns the flights."""
-        from xairl.plugin import progress
 
         from .real_data import chm_handovers, walk
 
         cfg = ckpt.sim_config
-        walks = [walk(f, cfg, seed=req.seed) for f in progress(flights, desc="real flights", disable=not req.progress)]
+        walks = [
+            walk(f, cfg, seed=req.seed)
+            for f in xairl.plugin.progress(flights, desc="real flights", disable=not req.progress)
+        ]
         chm_real = [chm_handovers(f, sim_config=cfg) for f in flights]
         states = np.concatenate([w.states for w in walks])
         pick = np.random.default_rng(req.seed).choice(len(states), size=min(req.n_states, len(states)), replace=False)
@@ -409,6 +419,6 @@ def _altitude_figure(out: Path, real: str, cfg, flights, chm_real: list[int], se
     ax.legend(fontsize=8)
     fig.tight_layout()
     path = Path(out) / "handover_rate_vs_altitude.png"
-    save_figure(fig, path, dpi=90)
+    xairl.plugin.save_figure(fig, path, dpi=90)
     plt.close(fig)
     return caption, path

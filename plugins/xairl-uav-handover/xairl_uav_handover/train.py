@@ -21,7 +21,7 @@ import numpy as np
 import torch
 from pydantic import Field, model_validator
 
-from xairl.plugin import Options
+import xairl
 
 from .baselines import RSRQRule
 from .config import SimConfig
@@ -30,7 +30,7 @@ from .features import available_actions
 from .policy import background_states, build_qnet, greedy, random_available
 
 
-class TrainConfig(Options, frozen=True):
+class TrainConfig(xairl.plugin.Options, frozen=True):
     """Every setting of a training run (stored in the checkpoint's metadata)."""
 
     episodes: int = Field(40, ge=1, description="training episodes; each flies n_flights flights at once")
@@ -179,8 +179,6 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
     from stable_baselines3.common.buffers import ReplayBuffer
     from stable_baselines3.common.utils import set_random_seed
 
-    from xairl.plugin import progress
-
     sim_cfg = sim_cfg or SimConfig()
     set_random_seed(tc.seed)  # python, numpy (the replay buffer samples with it) and torch
     rng = np.random.default_rng(tc.seed)
@@ -212,7 +210,7 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
     for _ in range(tc.pretrain_updates if demos is not None else 0):
         update()
     history = []
-    bar = progress(total=total, desc="training DQN", unit="dec", disable=not progress)
+    bar = xairl.plugin.progress(total=total, desc="training DQN", unit="dec", disable=not progress)
     for ep in range(tc.episodes):
         for g in opt.param_groups:
             g["lr"] = learning_rate(tc, ep)
