@@ -7,7 +7,6 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict
 
 from .errors import InputError
 
@@ -149,33 +148,7 @@ class Explanation:
         actions (``exp[:, j]``: use :meth:`grouped` or :meth:`output_slice`).
         """
         n = len(self.values)
-        if isinstance(key, tuple):
-            raise InputError(
-                "an Explanation is indexed by state only (exp[:n], exp[mask], exp[[i, j]]); for one "
-                "output use exp.output_slice(j), for features exp.grouped(...)."
-            )
-        if isinstance(key, (int, np.integer)) and not isinstance(key, (bool, np.bool_)):
-            if not -n <= key < n:
-                raise InputError(f"index {key} is out of range: the explanation has {n} state(s).")
-            key = [int(key) % n]
-        if not isinstance(key, slice):
-            idx = np.asarray(key.detach().cpu() if hasattr(key, "detach") else key)
-            if idx.size == 0 and idx.ndim == 1:
-                idx = idx.astype(int)
-            if idx.dtype == bool and idx.shape != (n,):
-                raise InputError(f"a state mask has one bool per state: got shape {idx.shape} for {n} state(s).")
-            if idx.dtype != bool and (idx.ndim != 1 or idx.dtype.kind not in "iu"):
-                raise InputError(
-                    f"states are selected by a slice, a bool mask or whole-number positions, not "
-                    f"{type(key).__name__} {str(key)[:40]!r}."
-                )
-            if idx.dtype != bool and idx.size and not (-n <= idx.min() and idx.max() < n):
-                raise InputError(
-                    f"position {idx.max() if idx.max() >= n else idx.min()} is out of range: the "
-                    f"explanation has {n} state(s)."
-                )
-            key = idx
-        rows = np.arange(n)[key]
+        rows = state_rows(key, n)
         if not rows.size:
             raise InputError(f"the selection holds no state (of {n}); an Explanation explains at least one.")
 
@@ -369,30 +342,12 @@ class Explanation:
             a = np.full(n, self.action_names.index(action) if isinstance(action, str) else int(action))
         return self.values[np.arange(n), :, a].reshape(n, *shape)
 
-    def records(self, dataset: str | None = None) -> list[StateRecord]:
-        """One :class:`StateRecord` per explained state (the JSON-lines form); ``dataset`` labels where the states
-        came from (e.g. 'simulated', 'real')."""
-        gap, chosen, runner = self.additivity_gap, self.chosen, self.runner_up
-        acts = self.action_names
-        decides = self.output == "actions"  # continuous dimensions and values have nothing chosen
-        out = []
-        for i in range(len(self.values)):
-            out.append(
-                StateRecord(
-                    index=i,
-                    dataset=dataset,
-                    method=self.method,
-                    state=None if self.states is None else dict(zip(self.feature_names, self.states[i].tolist())),
-                    output=self.output,
-                    chosen=acts[chosen[i]] if decides else None,
-                    runner_up=acts[runner[i]] if decides else None,
-                    scores=dict(zip(acts, self.outputs[i].tolist())),
-                    base_values=dict(zip(acts, self.base_values[i].tolist())),
-                    values={f: dict(zip(acts, self.values[i, j].tolist())) for j, f in enumerate(self.feature_names)},
-                    additivity_gap=dict(zip(acts, gap[i].tolist())),
-                )
-            )
-        return out
+    def records(self, dataset: str | None = None) -> list:
+        """One :class:`xairl.plugin.StateRecord` per explained state (the JSON-lines form); ``dataset`` labels where
+        the states came from (e.g. 'simulated', 'real')."""
+        from .explanation_io import records
+
+        return records(self, dataset)
 
     def to_json(self) -> str:
         """JSON text: each field of this class under its own name, arrays as nested lists (:func:`from_json` reads
@@ -410,19 +365,33 @@ class Explanation:
         return from_json(cls, text)
 
 
-class StateRecord(BaseModel):
-    """One explained state, as written to ``explanations.jsonl`` and by ``xairl explain --format jsonl``."""
-
-    model_config = ConfigDict(extra="forbid")
-
-    index: int
-    dataset: str | None = None
-    method: str
-    state: dict[str, float] | None
-    output: str = "actions"
-    chosen: str | None
-    runner_up: str | None
-    scores: dict[str, float]
-    base_values: dict[str, float]
-    values: dict[str, dict[str, float]]
-    additivity_gap: dict[str, float]
+def state_rows(key, n: int) -> np.ndarray:
+    """The positions of the states ``key`` selects among ``n``: a slice, an int, a bool mask (one per state) or
+    whole-number positions, as arrays, lists or tensors; a one-line InputError for anything else or out of range."""
+    if isinstance(key, tuple):
+        raise InputError(
+            "an Explanation is indexed by state only (exp[:n], exp[mask], exp[[i, j]]); for one "
+            "output use exp.output_slice(j), for features exp.grouped(...)."
+        )
+    if isinstance(key, (int, np.integer)) and not isinstance(key, (bool, np.bool_)):
+        if not -n <= key < n:
+            raise InputError(f"index {key} is out of range: the explanation has {n} state(s).")
+        key = [int(key) % n]
+    if not isinstance(key, slice):
+        idx = np.asarray(key.detach().cpu() if hasattr(key, "detach") else key)
+        if idx.size == 0 and idx.ndim == 1:
+            idx = idx.astype(int)
+        if idx.dtype == bool and idx.shape != (n,):
+            raise InputError(f"a state mask has one bool per state: got shape {idx.shape} for {n} state(s).")
+        if idx.dtype != bool and (idx.ndim != 1 or idx.dtype.kind not in "iu"):
+            raise InputError(
+                f"states are selected by a slice, a bool mask or whole-number positions, not "
+                f"{type(key).__name__} {str(key)[:40]!r}."
+            )
+        if idx.dtype != bool and idx.size and not (-n <= idx.min() and idx.max() < n):
+            raise InputError(
+                f"position {idx.max() if idx.max() >= n else idx.min()} is out of range: the "
+                f"explanation has {n} state(s)."
+            )
+        key = idx
+    return np.arange(n)[key]

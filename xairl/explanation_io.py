@@ -1,4 +1,5 @@
-"""The JSON form of an :class:`xairl.Explanation` (``to_json`` / ``from_json``) and the checks of its structured fields
+"""The JSON forms of an :class:`xairl.Explanation` (``to_json`` / ``from_json``, and one :class:`StateRecord` per
+state for JSON lines) and the checks of its structured fields
 (the observation, the background quartiles) made when one is built or read: pydantic at the edge, one line on error."""
 
 from __future__ import annotations
@@ -177,3 +178,47 @@ def _json_form(Explanation) -> type[BaseModel]:
         spec[f.name] = (kind, default)
     _FORM.append(create_model("ExplanationJSON", __config__=ConfigDict(extra="forbid"), **spec))
     return _FORM[0]
+
+
+class StateRecord(BaseModel):
+    """One explained state, as written to ``explanations.jsonl`` and by ``xairl explain --format jsonl``."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    index: int
+    dataset: str | None = None
+    method: str
+    state: dict[str, float] | None
+    output: str = "actions"
+    chosen: str | None
+    runner_up: str | None
+    scores: dict[str, float]
+    base_values: dict[str, float]
+    values: dict[str, dict[str, float]]
+    additivity_gap: dict[str, float]
+
+
+def records(exp, dataset: str | None = None) -> list[StateRecord]:
+    """One :class:`StateRecord` per state of ``exp`` (the JSON-lines form); ``dataset`` labels where the states
+    came from (e.g. 'simulated', 'real')."""
+    gap, chosen, runner = exp.additivity_gap, exp.chosen, exp.runner_up
+    acts = exp.action_names
+    decides = exp.output == "actions"  # continuous dimensions and values have nothing chosen
+    out = []
+    for i in range(len(exp.values)):
+        out.append(
+            StateRecord(
+                index=i,
+                dataset=dataset,
+                method=exp.method,
+                state=None if exp.states is None else dict(zip(exp.feature_names, exp.states[i].tolist())),
+                output=exp.output,
+                chosen=acts[chosen[i]] if decides else None,
+                runner_up=acts[runner[i]] if decides else None,
+                scores=dict(zip(acts, exp.outputs[i].tolist())),
+                base_values=dict(zip(acts, exp.base_values[i].tolist())),
+                values={f: dict(zip(acts, exp.values[i, j].tolist())) for j, f in enumerate(exp.feature_names)},
+                additivity_gap=dict(zip(acts, gap[i].tolist())),
+            )
+        )
+    return out

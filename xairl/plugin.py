@@ -23,7 +23,7 @@ _LAZY = {
     "ReportRequest": "xairl.report",
     "ReportContent": "xairl.report",
     "table_html": "xairl.report",
-    "StateRecord": "xairl.explanation",
+    "StateRecord": "xairl.explanation_io",
     # options: a plugin's own settings, validated like the built-ins'
     "Options": "xairl.options",
     "parse_options": "xairl.options",

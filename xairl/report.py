@@ -19,7 +19,8 @@ from typing import ClassVar
 import numpy as np
 
 from .evidence import CARD_STYLE, card_html, evidence
-from .explanation import Explanation, StateRecord
+from .explanation import Explanation
+from .explanation_io import StateRecord
 from .files import atomic_write, write_text
 from .options import Options, parse_options
 from .policy import Policy
