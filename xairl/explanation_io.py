@@ -1,6 +1,6 @@
 """The JSON forms of an :class:`xairl.Explanation` (``to_json`` / ``from_json``, and one :class:`StateRecord` per
-state for JSON lines) and the checks of its structured fields
-(the observation, the background quartiles) made when one is built or read: pydantic at the edge, one line on error."""
+state for JSON lines) and the checks of its structured fields (the observation, the background quartiles) made when
+one is built or read: pydantic at the edge, one line on error."""
 
 from __future__ import annotations
 
