@@ -10,8 +10,8 @@ from tests.work_budget import calls
 from xairl import prompts
 from xairl.cli import main
 from xairl.errors import UnknownNameError
-from xairl.facts import sample_context
 from xairl.narrators import check_template
+from xairl.narrators.samples import sample_context
 from xairl.prompts import TemplateError
 from xairl.toy import toy_policy
 

@@ -13,6 +13,7 @@ from .errors import InputError, PluginError
 from .explanation import Explanation
 from .policy import FeatureInfo, Policy
 from .prompts import format_number
+from .values import fill_and_text, state_value_text, value_level, value_text
 
 __all__ = [
     "Comparison",
@@ -211,61 +212,6 @@ def unit_ranks(contrib: np.ndarray, reasons: np.ndarray) -> tuple[np.ndarray, np
     return rank, signed, 100 * size / (float(size.sum()) or 1.0)
 
 
-def value_level(value: float, info: FeatureInfo, quartiles: tuple[float, float] | None) -> tuple[str, str]:
-    """(level, words) of a value: from the feature's thresholds or capacity (a physical range) when it has one,
-    else from the background's quartiles when they are distinct (a degenerate background, e.g. a buffer empty in
-    three states of four, says nothing about 'high'), else unknown."""
-    if info.kind != "numeric" or not np.isfinite(value):
-        return "unknown", ""
-    bounds, middle = info.thresholds, "moderate"
-    if bounds is None and info.capacity is not None:
-        bounds = (0.25 * info.capacity, 0.75 * info.capacity)
-    if bounds is None and quartiles is not None and quartiles[0] < quartiles[1]:
-        bounds, middle = quartiles, "typical"
-    if bounds is None:
-        return "unknown", ""
-    if value < bounds[0]:
-        return "low", info.low
-    if value > bounds[1]:
-        return "high", info.high
-    return "typical", middle
-
-
-def _fill_and_text(
-    value: float, info: FeatureInfo, label: str | None, region: bool = False
-) -> tuple[float | None, str]:
-    if info.kind == "group":
-        return None, ""
-    if label is not None:
-        return None, label
-    if region:  # an image region's value is the mean of its pixels: said so, not a bare number in brackets
-        return None, f"mean pixel value {format_number(value)}"
-    if info.capacity is not None:
-        fill = 100.0 * value / info.capacity
-        return fill, f"{format_number(fill)} % full"
-    return None, f"{format_number(value)} {info.unit}".strip()
-
-
-def value_text(value: float, info: FeatureInfo | None = None, label: str | None = None) -> str:
-    """A feature's value as the narratives write it: a category's ``label``, the fill of a feature with a capacity
-    ('100 % full'), else the number in their format with the feature's unit ('-85.3 dBm'). The one formatter of
-    values: narratives, figures and tables call it."""
-    if info is None:
-        return label if label is not None else format_number(value)
-    return _fill_and_text(float(value), info, label)[1]
-
-
-def state_value_text(exp: Explanation, i: int, j: int, policy: Policy | None = None) -> str:
-    """State ``i``'s value of feature ``j`` as :func:`value_text` writes it, with the unit, capacity and categories
-    ``policy`` declares for it; empty when ``exp`` keeps no states."""
-    if exp.states is None:
-        return ""
-    labels = exp.value_labels
-    label = None if labels is None or labels[i, j] is None else str(labels[i, j])
-    info = None if policy is None else policy.features.get(exp.feature_names[j])
-    return value_text(float(exp.states[i, j]), info, label)
-
-
 def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy | None) -> list[FeatureFact]:
     """A :class:`FeatureFact` per narration unit of state ``i`` for ``contrib`` (one value per feature)."""
     us = narration_units(exp, policy)
@@ -282,7 +228,7 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
         lvl, words = value_level(
             value, u.info, None if q is None or len(u.columns) > 1 else (float(q[0, j]), float(q[2, j]))
         )
-        fill, text = _fill_and_text(value, u.info, label, u.name in regions)
+        fill, text = fill_and_text(value, u.info, label, u.name in regions)
         out.append(
             FeatureFact(
                 u.name,
@@ -416,61 +362,3 @@ def global_facts(exp: Explanation, policy: Policy | None = None, k: int = 5, vie
             }
         )
     return GlobalFacts(len(contrib), exp.method, tuple(ranking), shown, target)
-
-
-class _SampleExtras(dict):
-    """Plugin-defined extras are unknown to the core: any key reads as 1 in a trial rendering."""
-
-    def __missing__(self, key):
-        return 1
-
-
-def sample_context(kind: str) -> dict:
-    """Plausible facts of a template ``kind`` ('decision' or 'global'), for trial renderings
-    (:func:`xairl.narrators.check_template`)."""
-    if kind == "global":
-        return GlobalFacts(
-            10,
-            "deep_shap",
-            tuple(
-                {
-                    "name": f"f{i}",
-                    "label": f"feature {i}",
-                    "unit": "",
-                    "rank": i,
-                    "mean_abs": 1.0 / i,
-                    "mean": 0.5 / i,
-                    "direction": "toward",
-                    "high_values": "toward",
-                    "low_values": "against",
-                }
-                for i in range(1, 4)
-            ),
-        ).context()
-    feats = tuple(
-        FeatureFact(f"f{i}", f"feature {i}", 1.0, "m", 0.5 / i, 30.0, "toward", "high", "high", i, value_text="1.00 m")
-        for i in range(1, 4)
-    )
-    against = FeatureFact("f4", "feature 4", 2.0, "m", -0.1, 10.0, "against", "low", "low", 4, value_text="2.00 m")
-    ident = FeatureFact(
-        "f5", "feature 5", 15.0, "", 0.0, 0.0, "toward", "unknown", "", 0, "identifier", value_text="15"
-    )
-    return DecisionFacts(
-        0,
-        "a",
-        "b",
-        1.0,
-        0.5,
-        0.5,
-        0.2,
-        "deep_shap",
-        0.0,
-        feats,
-        feats,
-        (Comparison("x is 1 dB above y", 1.0, "dB"),),
-        {},
-        reasons=feats,
-        concession=against,
-        base_margin=0.1,
-        identifiers=(ident,),
-    ).context() | {"extras": _SampleExtras()}

@@ -59,7 +59,7 @@ def check_template(path: str | Path) -> list[str]:
     """Problems of a template file, one line each (:func:`xairl.prompts.check`), including a trial rendering with
     sample facts; what ``xairl prompts check`` prints."""
     from .. import prompts
-    from ..facts import sample_context
+    from .samples import sample_context
 
     return prompts.check(path, sample_context)
 
