@@ -50,7 +50,8 @@ def simulated(ckpt, n: int, seed: int = 0):
 
 
 def real(ckpt, n: int, seed: int = 0):
-    from xairl_uav_handover.real_data import load_folder, walk
+    from xairl_uav_handover.exports import load_folder
+    from xairl_uav_handover.real_data import walk
 
     flights, _ = load_folder(REAL)
     walks = [walk(f, ckpt.sim_config, seed=seed).states for f in flights]

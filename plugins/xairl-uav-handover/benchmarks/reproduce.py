@@ -129,7 +129,8 @@ def with_reward(pairs: list[str]) -> SimConfig:
 
 def real_walks(folder: str, cfg) -> list:
     """The real flights as the live network flew them (real_data.walk)."""
-    from xairl_uav_handover.real_data import load_folder, walk
+    from xairl_uav_handover.exports import load_folder
+    from xairl_uav_handover.real_data import walk
 
     return [walk(f, cfg) for f in load_folder(folder)[0]]
 

@@ -19,9 +19,10 @@ from xairl_uav_handover import ukm
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.evaluate import run_flights
+from xairl_uav_handover.exports import PCI, RSRP, RealFlight, load_flight
 from xairl_uav_handover.features import FEATURES
 from xairl_uav_handover.policy import DQNController, build_qnet, greedy, load_checkpoint, save_checkpoint
-from xairl_uav_handover.real_data import PCI, RSRP, RealFlight, Walk, agreement, load_flight, walk
+from xairl_uav_handover.real_data import Walk, agreement, walk
 from xairl_uav_handover.report import real_source
 
 UKM = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "ukm-uav-lte" / "raw"

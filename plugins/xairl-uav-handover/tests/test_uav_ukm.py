@@ -14,7 +14,7 @@ import pytest
 
 from xairl import InputError
 from xairl_uav_handover import ukm
-from xairl_uav_handover.real_data import load_folder
+from xairl_uav_handover.exports import load_folder
 from xairl_uav_handover.report import real_source
 
 UKM = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "ukm-uav-lte" / "raw"

@@ -244,7 +244,7 @@ class UAVReport(xairl.plugin.Report):
 def _load_real(real: Path) -> tuple[list, list[str]]:
     """The flights of folder ``real`` and why the others were skipped, said on stderr too (the report's notes list
     them all): a skipped file is never silent."""
-    from .real_data import load_folder
+    from .exports import load_folder
 
     flights, bad = load_folder(real)
     if bad:
