@@ -14,7 +14,7 @@ from collections.abc import Sequence
 
 from .. import plugins
 from ..errors import InputError, XairlError
-from .args import MARKS, Parser, count, make_dir, narration_arguments, new_file, out_dir, parse_options
+from .args import MARKS, Parser, count, make_dir, narration_arguments, new_file, out_dir, parse_options, report_request
 from .explain import explain_parser
 
 
@@ -57,25 +57,11 @@ def cmd_attributors(args) -> int:
 
 
 def cmd_report(args) -> int:
-    from pathlib import Path
-
-    from ..report import ReportRequest, write_report
+    from ..report import write_report
 
     report = plugins.registry("report").load(args.plugin)(parse_options(args.option))
     method_options = plugins.get_attributor(args.method)(parse_options(args.method_option)).options.model_dump()
-    req = ReportRequest(
-        out=Path(args.out),
-        method=args.method,
-        options=method_options,
-        narrate=args.narrate,
-        narrator=args.narrator,
-        narrator_options=parse_options(args.narrator_option),
-        template=args.template,
-        prompt_dirs=args.prompts,
-        seed=args.seed,
-        n_states=args.n,
-        robustness=not args.no_robustness,
-    )
+    req = report_request(args, args.out, method_options, args.n)
     make_dir(req.out)  # one line, before any work, where the folder cannot be made (--out /proc/x)
     path = write_report(req, report.build(req))
     print(f"report: {path.resolve()}")

@@ -108,6 +108,29 @@ def parse_options(pairs: Sequence[str]) -> dict:
     return opts
 
 
+def report_request(args, out, options: dict, n_states: int, **more):
+    """The :class:`xairl.plugin.ReportRequest` of a command's report options (``--method``, ``--narrate``,
+    ``--narrator``, ``--template``, ``--prompts``, ``--seed``, ``--no-robustness``), for ``n_states`` states."""
+    from pathlib import Path
+
+    from ..report import ReportRequest
+
+    return ReportRequest(
+        out=Path(out),
+        method=args.method,
+        options=options,
+        narrate=args.narrate,
+        narrator=args.narrator,
+        narrator_options=parse_options(args.narrator_option),
+        template=args.template,
+        prompt_dirs=args.prompts,
+        seed=args.seed,
+        n_states=n_states,
+        robustness=not args.no_robustness,
+        **more,
+    )
+
+
 def narration_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--narrate", action="store_true", help="explain decisions in words, checked against the numbers")
     p.add_argument("--narrator", default="template", help="template (default), local_lm, or a plugin's narrator")

@@ -10,7 +10,7 @@ import json
 
 from .. import plugins
 from ..errors import InputError
-from .args import MARKS, count, make_dir, narration_arguments, new_file, out_dir, parse_options
+from .args import MARKS, count, make_dir, narration_arguments, new_file, out_dir, parse_options, report_request
 
 #: above this many states, ``--out DIR`` without a --format streams them into DIR/explanations.parquet (200,000 toy
 #: states as one JSON-lines file: 207 MB built in memory, 1.18 GB peak RSS, written at the end with no progress bar;
@@ -143,22 +143,9 @@ def _write_report(args, exp, policy, bg) -> int:
     """explanations.jsonl, figures and report.html for any policy (``--out DIR``)."""
     from pathlib import Path
 
-    from ..report import ReportContent, ReportRequest, write_report
+    from ..report import ReportContent, write_report
 
-    req = ReportRequest(
-        out=Path(args.out),
-        method=args.method,
-        options=dict(exp.options),
-        narrate=args.narrate,
-        narrator=args.narrator,
-        narrator_options=parse_options(args.narrator_option),
-        template=args.template,
-        prompt_dirs=args.prompts,
-        seed=args.seed,
-        n_states=len(exp.values),
-        robustness=not args.no_robustness,
-        progress=False,
-    )
+    req = report_request(args, Path(args.out), dict(exp.options), len(exp.values), progress=False)
     content = ReportContent(
         title=f"xairl: {policy.name}", policy=policy, background=bg, datasets=[("states", exp.states)]
     )
@@ -173,37 +160,18 @@ def _stream(args, policy, states, bg, options: dict) -> int:
     import time
     from pathlib import Path
 
-    from ..report import ReportContent, ReportRequest, table_html, write_report
+    from ..report import ReportContent, table_html, write_report
     from ..stream import explain_to_parquet
 
     out = Path(args.out)
     t0 = time.time()
+    common = dict(background=bg, method=args.method, options=options, chunk_size=args.chunk_size, resume=args.resume)
     if args.engine == "ray":
         from ..scale import explain_on_ray
 
-        summary = explain_on_ray(
-            policy,
-            states,
-            out,
-            background=bg,
-            method=args.method,
-            options=options,
-            chunk_size=args.chunk_size,
-            resume=args.resume,
-            workers=args.workers,
-            address=args.ray_address,
-        )
+        summary = explain_on_ray(policy, states, out, **common, workers=args.workers, address=args.ray_address)
     else:
-        summary = explain_to_parquet(
-            policy,
-            states,
-            out,
-            background=bg,
-            method=args.method,
-            options=options,
-            chunk_size=args.chunk_size,
-            resume=args.resume,
-        )
+        summary = explain_to_parquet(policy, states, out, **common)
     seconds = time.time() - t0
     means = summary.to_dict(policy.feature_names)["mean_abs_contribution"]
     order = sorted(policy.feature_names, key=lambda f: -means["margin"][f])
@@ -211,21 +179,7 @@ def _stream(args, policy, states, bg, options: dict) -> int:
         ["feature", "mean |contribution| to the margin", "to the chosen score"],
         [[f, f"{means['margin'][f]:.4g}", f"{means['chosen_score'][f]:.4g}"] for f in order],
     )
-    req = ReportRequest(
-        out=out,
-        method=args.method,
-        options=options,
-        narrate=args.narrate,
-        narrator=args.narrator,
-        narrator_options=parse_options(args.narrator_option),
-        template=args.template,
-        prompt_dirs=args.prompts,
-        seed=args.seed,
-        n_states=summary.n,
-        robustness=not args.no_robustness,
-        progress=False,
-        records=False,
-    )
+    req = report_request(args, out, options, summary.n, progress=False, records=False)
     content = ReportContent(
         title=f"xairl: {policy.name}",
         policy=policy,
