@@ -106,21 +106,15 @@ def test_the_issues_cli_resumes_a_bit_flip_whole_and_refuses_part_07(tmp_path, c
     assert len(index) == 3000 and len(np.unique(index)) == 3000
 
 
+def _small_run(out):
+    """The command line of a run of 30 states in chunks of 10 into ``out``."""
+    flags = "--n 30 --format parquet --chunk-size 10 --background-size 10".split()
+    return ["explain", "--out", str(out), *flags]
+
+
 @pytest.mark.parametrize("record", ["[1, 2]", "42", '"a run"', "null", "[" * 100_000 + "]" * 100_000, "{", ""])
 def test_a_run_json_that_is_no_record_is_refused_in_one_line(tmp_path, capsys, record):
-    argv = [
-        "explain",
-        "--n",
-        "30",
-        "--out",
-        str(tmp_path / "r"),
-        "--format",
-        "parquet",
-        "--chunk-size",
-        "10",
-        "--background-size",
-        "10",
-    ]
+    argv = _small_run(tmp_path / "r")
     assert main(argv) == 0
     (tmp_path / "r" / "run.json").write_text(record)
     capsys.readouterr()
@@ -133,19 +127,7 @@ def test_a_run_json_that_is_no_record_is_refused_in_one_line(tmp_path, capsys, r
 
 
 def test_a_truncated_part_is_explained_again_on_resume(tmp_path, capsys):
-    argv = [
-        "explain",
-        "--n",
-        "30",
-        "--out",
-        str(tmp_path / "r"),
-        "--format",
-        "parquet",
-        "--chunk-size",
-        "10",
-        "--background-size",
-        "10",
-    ]
+    argv = _small_run(tmp_path / "r")
     assert main(argv) == 0
     cut = tmp_path / "r" / DATASET / part(10)
     cut.write_bytes(cut.read_bytes()[:100])
