@@ -241,6 +241,34 @@ def _print_narratives(args, exp, policy, bg) -> int:
     return 0
 
 
+def _streaming_arguments(p: argparse.ArgumentParser) -> None:
+    """--chunk-size, --resume, --engine, --workers, --ray-address: a streamed run (--format parquet)."""
+    p.add_argument(
+        "--chunk-size",
+        type=count(1, 10_000_000),
+        default=50_000,
+        help="states per chunk with --format parquet (memory grows with it)",
+    )
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="with --format parquet (or --out alone): continue an interrupted run in --out",
+    )
+    p.add_argument(
+        "--engine",
+        choices=("local", "ray"),
+        default="local",
+        help="with --format parquet: this process (local) or Ray workers (pip install 'xairl[scale]')",
+    )
+    p.add_argument("--workers", type=count(1, 100_000), default=2, help="Ray workers (one CPU each; default 2)")
+    p.add_argument(
+        "--ray-address",
+        default=None,
+        metavar="ADDRESS",
+        help="a running Ray cluster (e.g. auto or ray://host:10001); default: Ray started on this machine",
+    )
+
+
 def explain_parser(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--policy",
@@ -296,30 +324,7 @@ def explain_parser(p: argparse.ArgumentParser) -> None:
         f"of states, resumable with --resume). Default: table, or parquet with --out above {STREAM_ABOVE:,} "
         "states",
     )
-    p.add_argument(
-        "--chunk-size",
-        type=count(1, 10_000_000),
-        default=50_000,
-        help="states per chunk with --format parquet (memory grows with it)",
-    )
-    p.add_argument(
-        "--resume",
-        action="store_true",
-        help="with --format parquet (or --out alone): continue an interrupted run in --out",
-    )
-    p.add_argument(
-        "--engine",
-        choices=("local", "ray"),
-        default="local",
-        help="with --format parquet: this process (local) or Ray workers (pip install 'xairl[scale]')",
-    )
-    p.add_argument("--workers", type=count(1, 100_000), default=2, help="Ray workers (one CPU each; default 2)")
-    p.add_argument(
-        "--ray-address",
-        default=None,
-        metavar="ADDRESS",
-        help="a running Ray cluster (e.g. auto or ray://host:10001); default: Ray started on this machine",
-    )
+    _streaming_arguments(p)
     p.add_argument("--top", type=count(1), default=5, help="features shown per state in the table")
     p.add_argument(
         "--view",

@@ -39,29 +39,11 @@ def check_clause(
     if written:  # ('the last 90 days' of support_calls_90d: not days_since_last_upgrade)
         mentions = noclaims.without_window_words(mentions, written, book.features)
     names = named_features(mentions)
-    # a clause of more numbers than prose holds (a table, or hostile text) reads its first ones only: each number's
-    # readings search the clause, so reading them all grows with the numbers times the clause's length
-    found = [n for n in find_numbers(masked[:b]) if n.start >= a]
-    found, unread = found[: 2 * MAX_NUMBERS], found[2 * MAX_NUMBERS :]
-    worded = _worded(book, written)
-    numbers = [
-        n
-        for n in found
-        if not noclaims.skip_number(n, masked)
-        and not noclaims.window_of_name(n, sentence_keys, written or masked, worded)
-    ]
-    numbers, unread = numbers[:MAX_NUMBERS], numbers[MAX_NUMBERS:] + unread
+    numbers, unread = _numbers(masked, a, b, book, sentence_keys, written)
     out.extend(
         Claim("number", n.text, "unchecked", f"more than {MAX_NUMBERS} numbers in one clause", "number.too-many")
         for n in unread
     )
-    if book.in_percent:  # 'p_dropout=0.469' of a prediction of 46.9 %: a fraction may state a percentage
-        numbers = [
-            replace(n, alternatives=(*n.alternatives, 100 * n.value))
-            if not n.percent and abs(n.value) < 1 and "." in n.text
-            else n
-            for n in numbers
-        ]
     tail, paired, summed = _lists(masked, a, b, names, numbers)
     paired |= comparisons.compared_pairs(masked, a, b, names, numbers)  # 'A mattered twice as much as B (0.88 vs 0.49)'
     actions = [m for m in mentions if m.kind == "action"]
@@ -269,6 +251,29 @@ def _listed(gap: str) -> bool:
         r"\b(?:and|or|points?|pts|pp|min|mins|minutes|h|hours?|kw|kwh|mw|days?|dB|dBm)\b", "", gap, flags=re.IGNORECASE
     )
     return len(gap) <= 24 and not re.search(r"[A-Za-z]{2}|\0", words)
+
+
+def _numbers(masked: str, a: int, b: int, book: FactBook, sentence_keys, written: str) -> tuple[list, list]:
+    """(the numbers of clause ``a..b`` that may be claims, the ones left unread): a clause of more numbers than
+    prose holds (a table, or hostile text) reads its first ``MAX_NUMBERS`` only, since each number's readings search
+    the clause and reading them all would grow with the numbers times the clause's length."""
+    found = [n for n in find_numbers(masked[:b]) if n.start >= a]
+    found, unread = found[: 2 * MAX_NUMBERS], found[2 * MAX_NUMBERS :]
+    worded = _worded(book, written)
+    numbers = [
+        n
+        for n in found
+        if not noclaims.skip_number(n, masked)
+        and not noclaims.window_of_name(n, sentence_keys, written or masked, worded)
+    ]
+    if book.in_percent:  # 'p_dropout=0.469' of a prediction of 46.9 %: a fraction may state a percentage
+        numbers = [
+            replace(n, alternatives=(*n.alternatives, 100 * n.value))
+            if not n.percent and abs(n.value) < 1 and "." in n.text
+            else n
+            for n in numbers
+        ]
+    return numbers[:MAX_NUMBERS], numbers[MAX_NUMBERS:] + unread
 
 
 def _worded(book: FactBook, written: str) -> list[str]:
