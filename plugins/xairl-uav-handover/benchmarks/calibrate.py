@@ -17,12 +17,12 @@ from pathlib import Path
 import numpy as np
 
 from xairl_uav_handover.baselines import CHM
+from xairl_uav_handover.calibration import band_rows, outside, quantile_rows
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.exports import load_folder
 from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint
 from xairl_uav_handover.real_data import chm_handovers, walk
-from xairl_uav_handover.report import band_rows, outside, quantile_rows
 from xairl_uav_handover.uplink import capacity_bps
 
 ROOT = Path(__file__).resolve().parents[3]

@@ -143,7 +143,7 @@ def real_sample(walks: list, n: int) -> np.ndarray:
 
 def real_figures(ckpt, walks: list, n_states: int) -> tuple[dict, tuple[str, bool, str]]:
     """(importance on a sample of the real states, target 5: new proposals per minute <= 2 x the network's rate)."""
-    from xairl_uav_handover.report import agreement_rows
+    from xairl_uav_handover.calibration import agreement_rows
 
     dqn = agreement_rows(walks, ckpt, ckpt.sim_config)[0]
     return importance(ckpt, real_sample(walks, n_states)), (

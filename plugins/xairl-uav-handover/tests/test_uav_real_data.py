@@ -10,11 +10,11 @@ import pytest
 from xairl import InputError
 from xairl.cli import main
 from xairl.plugin import StateRecord
+from xairl_uav_handover.calibration import agreement_rows, band_rows, outside
 from xairl_uav_handover.config import CHMConfig
 from xairl_uav_handover.exports import load_flight, load_folder
 from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint
 from xairl_uav_handover.real_data import agreement, baltaci_rate_by_altitude, chm_handovers, walk
-from xairl_uav_handover.report import agreement_rows, band_rows, outside
 
 DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
 UKM = DATA / "ukm-uav-lte" / "raw"
