@@ -9,6 +9,8 @@ narrative, and :func:`card_html` draws the same card in the HTML report and on t
 from __future__ import annotations
 
 import html
+import re
+from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
@@ -63,6 +65,38 @@ def evidence(exp: Explanation, narrative) -> dict[str, Any]:
     return out
 
 
+#: what may stand between two sentences of a text besides white space: the bullet that the verifier's split at a line
+#: break took off the next sentence (verify._SENTENCE_RE)
+_BULLETS = ("", "-", "\u2022", "*")
+_BULLET = re.compile(r"([-\u2022*])\s+(?=\S)")
+
+
+def sentence_lines(text: str, sentences: Iterable) -> list[tuple[int, str, str, str]]:
+    """(line breaks before it, its list bullet, sentence, status) per (sentence, status) of ``text``, from the text's
+    own separators: a template's list ('Why:\\n- a.\\n- b.') is the sentences 'Why:', 'a.' and 'b.', the last two
+    each after one line break and the bullet '-' (a bullet the sentence itself starts with is taken off it: the
+    verifier's split at a line break leaves it on a sentence after a full stop). A sentence not found in ``text``
+    after the one before it (a text that is not the sentences' own) follows with a space: (0, '', sentence, status).
+    """
+    out, pos = [], 0
+    for s, st in sentences:
+        at = text.find(s, pos) if s else -1
+        sep = text[pos:at]
+        if at < 0 or sep.strip() not in _BULLETS:
+            out.append((0, "", s, st))
+            continue
+        pos = at + len(s)
+        breaks, bullet = sep.count("\n") if out else 0, sep.rsplit("\n", 1)[-1].strip()
+        own = _BULLET.match(s) if (breaks or not out) and not bullet else None  # ('a.\\n- b': '- b' is one sentence)
+        out.append((breaks, own.group(1) if own else bullet, s[own.end() :] if own else s, st))
+    return out
+
+
+def lines_html(text: str) -> str:
+    """``text`` escaped, its line breaks as <br>."""
+    return "<br>".join(html.escape(line) for line in text.splitlines())
+
+
 def _num(x) -> str:
     return html.escape(x) if isinstance(x, str) else f"{x:.4g}"
 
@@ -98,12 +132,16 @@ def waterfall_html(ev: dict) -> str:
 
 
 def card_html(narrative_text: str, ev: dict, meta: str = "", controls: str = "") -> str:
-    """A decision card: the narrative with each sentence marked, the state, the waterfall, the confidence."""
+    """A decision card: the narrative with each sentence marked, the state, the waterfall, the confidence. The
+    text's line breaks (a template's list) are <br> between the sentences, with the list's bullets."""
     sentences = ev.get("sentences") or [[narrative_text, "verified" if ev.get("verified") else "unchecked"]]
-    text = " ".join(
-        f"<span class='s {st}' title='{st}'>{html.escape(s)} <sup>{STATUS_MARK.get(st, '?')}</sup></span>"
-        for s, st in sentences
-    )
+    text = ""
+    for breaks, bullet, s, st in sentence_lines(narrative_text, sentences):
+        sep = "<br>" * min(breaks, 2) if breaks else " " if text else ""
+        text += (
+            f"{sep}{html.escape(bullet) + ' ' if bullet else ''}<span class='s {st}' title='{st}'>{lines_html(s)} "
+            f"<sup>{STATUS_MARK.get(st, '?')}</sup></span>"
+        )
     comps = "".join(f"<tr><td>{html.escape(k)}</td><td>{v:.2f}</td></tr>" for k, v in ev.get("components", {}).items())
     parts = [f"<p class=narrative>{text}</p>"]
     if meta:

@@ -26,7 +26,7 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from urllib.parse import parse_qs, urlencode, urlparse
 
 from .errors import InputError
-from .evidence import CARD_STYLE, card_html
+from .evidence import CARD_STYLE, card_html, lines_html
 from .feedback import FeedbackStore, Record
 
 HOST = "127.0.0.1"
@@ -134,7 +134,7 @@ def _item(r: Record, token: str) -> str:
     meta = (
         f"#{r.id} &middot; {html.escape(r.policy or '?')} &middot; template {html.escape(r.template or '?')} "
         f"&middot; {html.escape(r.source or '?')} &middot; <b class=status>{html.escape(r.status)}</b>"
-        + (f" &middot; correction: <i>{html.escape(r.correction)}</i>" if r.correction else "")
+        + (f" &middot; correction: <i>{lines_html(r.correction)}</i>" if r.correction else "")
     )
     form = (
         f"<form method=post action='/review' class=verdict><input type=hidden name=id value='{r.id}'>"

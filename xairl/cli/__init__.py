@@ -14,8 +14,8 @@ from collections.abc import Sequence
 
 from .. import plugins
 from ..errors import InputError, XairlError
-from .args import MARKS, Parser, count, make_dir, narration_arguments, new_file, out_dir, parse_options, report_request
-from .explain import explain_parser
+from .args import Parser, count, make_dir, narration_arguments, new_file, out_dir, parse_options, report_request
+from .explain import explain_parser, marked_rows
 
 
 def cmd_plugins(args) -> int:
@@ -159,7 +159,7 @@ def cmd_review(args) -> int:
             f"{'verified' if r.verified else f'{len(bad)} unverified claim(s)'}]"
         )
         marked = (r.evidence or {}).get("sentences") or []
-        print("\n".join(f"    {MARKS.get(st, st):<13} {t}" for t, st in marked) or f"    {r.text}")
+        print(marked_rows(r.text, marked))
         while True:
             try:
                 answer = input("[a]ccept  [r]eject  [c]orrect  [s]kip  [q]uit > ").strip().lower()[:1]

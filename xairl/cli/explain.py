@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 
 from .. import plugins
 from ..errors import InputError
@@ -237,8 +238,36 @@ def _print_narratives(args, exp, policy, bg) -> int:
         mark = "verified" if n.verified else "NOT VERIFIED"
         parts = ", ".join(f"{k} {v:.2f}" for k, v in n.components.items() if v is not None)
         print(f"state {i} [{mark}, confidence {n.confidence:.2f}: {parts}; {n.source}]")
-        print("\n".join(f"    {MARKS[status]:<13} {text}" for text, status in n.sentences) or f"    {n.text}")
+        print(marked_rows(n.text, n.sentences))
     return 0
+
+
+#: a list item's bullet or number at the start of a row: the sentences after it on its line are indented past it
+_ITEM = re.compile(r"(?:[-\u2022*]|\d{1,2}[.)])\s+")
+
+
+def marked_rows(text: str, sentences) -> str:
+    """The terminal's narrative: each sentence on a row after its mark (MARKS), aligned. The text's line breaks stay:
+    a sentence that starts a line of a list gets its bullet back, the sentences after it on that line are indented
+    under the item's words, a blank line stays a blank row, and a sentence's own lines (a text without sentences)
+    are indented under its first."""
+    from ..evidence import sentence_lines
+
+    if not sentences:
+        return "\n".join(f"    {line}" for line in text.splitlines())
+    rows, indent = [], ""
+    for j, (breaks, bullet, s, status) in enumerate(sentence_lines(text, sentences)):
+        if breaks or j == 0:
+            rows += [""] if breaks > 1 else []
+            s = f"{bullet} {s}" if bullet else s
+            item = _ITEM.match(s)
+            indent = " " * (item.end() if item else 0)
+        else:
+            s = indent + s
+        first, *more = s.splitlines() or [""]
+        rows.append(f"    {MARKS.get(status, status):<13} {first}")
+        rows += [f"{'':18}{indent}{line}" for line in more]
+    return "\n".join(rows)
 
 
 def _streaming_arguments(p: argparse.ArgumentParser) -> None:
