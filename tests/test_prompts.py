@@ -160,4 +160,5 @@ def test_legitimate_templates_within_bounds_render(tmp_path, text):
     path = tmp_path / "t.yaml"
     path.write_text(f'name: t\nsentences:\n  - ["{text}"]\n')
     out = prompts.load(path).render_variants(sample_context("decision"))[0][0]
-    assert out == " ".join(jinja2.Environment().from_string(text).render().split())
+    lines = (" ".join(line.split()) for line in jinja2.Environment().from_string(text).render().splitlines())
+    assert out == "\n".join(line for line in lines if line)  # spaces collapsed, line breaks kept

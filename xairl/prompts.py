@@ -10,7 +10,7 @@ Lookup of ``NAME``: explicit folders (``--prompts DIR``) > ``$XAIRL_USER_PATH/pr
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 
@@ -23,6 +23,7 @@ from . import sandbox
 from .errors import UnknownNameError, XairlError, validation_message
 from .paths import user_dir
 from .sandbox import MAX_LOOP_DEPTH, loop_depth
+from .tracking import Rendered, TrackedFloat, TrackedInt, TrackedStr, recording, untangle
 
 DECISION_VARS = {
     "index",
@@ -89,15 +90,44 @@ def format_number(x: float, signed: bool = False) -> str:
     return ("+" + s) if signed and not s.startswith("-") else s
 
 
+def _num(x, signed: bool = False) -> str:
+    text = format_number(x, signed)
+    return x.printed(text) if isinstance(x, (TrackedFloat, TrackedInt)) else text
+
+
+def _cap(t) -> str:
+    """The first letter capitalised (past a tracked value's markers)."""
+    s = str(t)
+    i = next((n for n, c in enumerate(s) if not "\ue000" <= c <= "\ue01f"), len(s))
+    return s[:i] + s[i : i + 1].upper() + s[i + 1 :]
+
+
+def _dir(x, toward: str = "toward", against: str = "against") -> str:
+    """``toward`` for a number >= 0, else ``against``; of a tracked number, a tracked direction word (its fact is the
+    number's feature and view, so the verifier judges the word against that feature's sign)."""
+    word = str(toward if x >= 0 else against)
+    if isinstance(x, (TrackedFloat, TrackedInt)):
+        direction = "toward" if x >= 0 else "against"
+        return str(TrackedStr(word, replace(x.fact, quantity="direction", value=direction)))
+    return word
+
+
+def _join(value, d: str = "", attribute=None) -> str:
+    """Jinja's ``join``, with each item as it prints (a tracked value keeps its fact)."""
+    items = list(value)
+    if attribute is not None:
+        for part in str(attribute).split("."):
+            items = [x.get(part) if isinstance(x, dict) else getattr(x, part) for x in items]
+    return str(d).join(str(x) for x in items)
+
+
 def environment() -> ImmutableSandboxedEnvironment:
     """A fresh bounded sandbox (:mod:`xairl.sandbox`) with the template filters: ``num`` and ``signed`` write numbers
-    as :func:`format_number` does, ``cap`` capitalises the first letter."""
+    as :func:`format_number` does, ``cap`` capitalises the first letter, ``dir('raised', 'lowered')`` writes the
+    first word for a number >= 0 and the second for a negative one (default 'toward' / 'against'). Each keeps the
+    fact of a tracked value (:mod:`xairl.tracking`)."""
     return sandbox.environment(
-        {
-            "num": format_number,
-            "signed": lambda x: format_number(x, True),
-            "cap": lambda t: str(t)[:1].upper() + str(t)[1:],
-        }
+        {"num": _num, "signed": lambda x: _num(x, True), "cap": _cap, "dir": _dir, "join": _join}
     )
 
 
@@ -111,8 +141,9 @@ class Template:
     def name(self) -> str:
         return self.spec.name
 
-    def render_variants(self, context: dict) -> list[list[str]]:
-        """Every variant of every sentence, rendered in one sandbox (one budget); raises :class:`TemplateError`
+    def render_variants(self, context: dict) -> list[list[Rendered]]:
+        """Every variant of every sentence, rendered in one sandbox (one budget), each with the spans of the tracked
+        values it printed (:func:`xairl.tracking.track_decision` tracks a context); raises :class:`TemplateError`
         with file and line."""
         env = environment()
         return [
@@ -121,9 +152,11 @@ class Template:
         ]
 
     @staticmethod
-    def _render(env: ImmutableSandboxedEnvironment, text: str, where: str, context: dict) -> str:
+    def _render(env: ImmutableSandboxedEnvironment, text: str, where: str, context: dict) -> Rendered:
         try:
-            return sandbox.render(env, text, context)
+            with recording() as record:
+                marked = sandbox.render(env, text, context)
+            return Rendered(*untangle(marked, record))
         except SecurityError as exc:
             raise TemplateError(f"{where}: refused by the sandbox ({exc}).") from None
         except UndefinedError as exc:

@@ -141,7 +141,7 @@ class _Budget:
 
     def concat(self, *pieces) -> str:
         """The `~` operator, sized before it joins."""
-        texts = [p if isinstance(p, str) else str(p) for p in pieces]
+        texts = [str(p) for p in pieces]  # each as it prints (a tracked value with its markers, xairl.tracking)
         _fits(sum(map(len, texts)), "'~'")
         return self.checked("".join(texts))
 
@@ -197,6 +197,8 @@ class _Sandbox(ImmutableSandboxedEnvironment):
         _fits(_binop_size(operator, left, right), f"'{operator}'")
         if (bits := _int_bits(operator, left, right)) > MAX_INT_BITS:
             raise SecurityError(f"'{operator}' would build a {bits}-bit integer (limit {MAX_INT_BITS})")
+        if operator == "+" and isinstance(left, str) and isinstance(right, str):
+            return self.budget.checked(str(left) + str(right))  # each as it prints, as '~' joins them
         return self.budget.checked(super().call_binop(context, operator, left, right))
 
     def call(__self, __context, __obj, *args, **kwargs):  # noqa: N805 (Jinja's signature: keywords stay free)
@@ -381,12 +383,14 @@ def environment(filters: Mapping[str, Callable] | None = None) -> ImmutableSandb
 
 
 def render(env: ImmutableSandboxedEnvironment, text: str, context: Mapping) -> str:
-    """One variant rendered, streamed so that a runaway loop stops at MAX_OUTPUT, whitespace collapsed; raises
-    jinja2's SecurityError at any bound."""
+    """One variant rendered, streamed so that a runaway loop stops at MAX_OUTPUT, spaces collapsed within each line
+    and blank lines dropped (a template's line breaks are kept: a bullet list stays a list); raises jinja2's
+    SecurityError at any bound."""
     size, chunks = 0, []
     for chunk in compile_variant(env, text).generate(context):
         size += len(chunk)
         if size > MAX_OUTPUT:
             raise SecurityError(f"output longer than {MAX_OUTPUT} characters")
         chunks.append(chunk)
-    return " ".join("".join(chunks).split())
+    lines = (" ".join(line.split()) for line in "".join(chunks).splitlines())
+    return "\n".join(line for line in lines if line)

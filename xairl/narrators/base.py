@@ -60,9 +60,18 @@ class Narrative:
         )
 
 
+def join_sentences(sentences: Iterable[str]) -> str:
+    """Sentences joined by a space, or by a line break next to a sentence of several lines (a template's list)."""
+    out, last = "", ""
+    for s in (s for s in sentences if s):
+        out += (("\n" if "\n" in s + last else " ") + s) if out else s
+        last = s
+    return out
+
+
 def first_phrasings(variants: list[list[str]]) -> str:
     """The deterministic text: the first phrasing of every sentence."""
-    return " ".join(s[0] for s in variants if s and s[0])
+    return join_sentences(s[0] for s in variants if s)
 
 
 class Narrator:

@@ -30,6 +30,7 @@ README ("What the verifier checks").
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -222,6 +223,22 @@ def verify(
     text = normalise(text)
     if len(text) > MAX_CHARS:
         text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
+    read_one = reader(explanation, index, policy, facts)
+    spans = sentences(text)
+    read = [read_one(text[a:b]) for a, b in spans]
+    claims = iter(reread.swapped([c for cs in read for c in cs]))  # (two numbers that cross, anywhere in the text)
+    return Verification(
+        tuple(SentenceCheck(text[a:b].strip(), tuple(next(claims) for _ in cs)) for (a, b), cs in zip(spans, read)),
+        note,
+    )
+
+
+def reader(
+    explanation: Explanation, index: int | None, policy: Policy | None = None, facts=None
+) -> Callable[[str], list[Claim]]:
+    """The reader of one sentence (sentence -> its claims) for state ``index`` of an explanation already in regions:
+    what :func:`verify` applies to each sentence, and :mod:`xairl.narrators.provenance` to the words an own narrative
+    did not track."""
     with np.errstate(all="ignore"):  # sums of contributions near 1e308 overflow: an infinite fact matches no number
         book = fact_book(explanation, index, policy)
     if facts is not None:
@@ -233,13 +250,7 @@ def verify(
         info = policy.features.get(f) if policy else None
         return info.unit if info and info.unit else unit_in_name(f)
 
-    spans = sentences(text)
-    read = [_read_sentence(text[a:b], book, vocab, unit_of) for a, b in spans]
-    claims = iter(reread.swapped([c for cs in read for c in cs]))  # (two numbers that cross, anywhere in the text)
-    return Verification(
-        tuple(SentenceCheck(text[a:b].strip(), tuple(next(claims) for _ in cs)) for (a, b), cs in zip(spans, read)),
-        note,
-    )
+    return lambda sentence: _read_sentence(sentence, book, vocab, unit_of)
 
 
 def _read_sentence(sentence: str, book: FactBook, vocab, unit_of) -> list[Claim]:
