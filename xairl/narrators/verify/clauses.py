@@ -10,7 +10,20 @@ import functools
 import re
 from dataclasses import replace
 
-from . import background, binding, checks, comparisons, decision, directions, noclaims, quantities, ranks, reread, sums
+from . import (
+    background,
+    binding,
+    checks,
+    comparisons,
+    decision,
+    directions,
+    invented,
+    noclaims,
+    quantities,
+    ranks,
+    reread,
+    sums,
+)
 from .book import FactBook
 from .checks import Claim
 from .names import Mention, named_features
@@ -99,8 +112,12 @@ def check_clause(
                 f"an identifier after a word of a longer name ('charger 3'; first read as {c.detail})",
                 "number.identifier-after-word",
             )
+        if c.status == "contradicted" and quantities.WITHOUT_SIGN in c.detail:
+            c = replace(c, rule="number.value-sign")  # ('wind_gust (1.46)' when it is -1.463)
         out.append(c)
-    return out + _word_claims(masked, a, b, mentions, said, numbers, book, ctx, name_words, parsed, written)
+    out += _word_claims(masked, a, b, mentions, said, numbers, book, ctx, name_words, parsed, written)
+    claimed = [c.text for c in out if c.kind == "feature" and c.status == "contradicted"]
+    return out + invented.invented(masked, a, b, mentions, numbers, book, vocab, unit_of, claimed)
 
 
 def _word_claims(

@@ -64,6 +64,44 @@ _SINCE_AFTER = re.compile(
 )
 
 
+#: words that carry a value's minus sign when the number is written without it. Right before it, a movement or a
+#: loss ('a drop of 1.46', 'fell by about 1.46', 'down 1.46', 'a deficit of 1.46'); a few words before it, a sign or
+#: a side of zero ('negative at 1.46', 'a negative reading of 1.46', 'below zero at 1.46'); after it, a side of zero
+#: or of a reference ('1.46 below zero', '1.46 standard deviations under the mean', '1.46 points lower than usual',
+#: '1.46 (negative)', '1.46 in the red', a coordinate's '704 m west')
+_SIGN_BEFORE = re.compile(
+    r"\b(?:(?:deficits?|shortfalls?|drop(?:s|ped|ping)?|declin(?:e|es|ed|ing)|fell|fall(?:s|en|ing)?|"
+    r"decreas(?:e|es|ed|ing)|down(?:ward)?|dip(?:s|ped)?|sank|sunk|slump(?:s|ed)?|plung(?:e|es|ed)|loss(?:es)?|lost|"
+    r"losing|reduc\w*|lower(?:ed)?|less|short|under|below|minus)"
+    r"\s+(?:(?:of|by|at|about|around|roughly|nearly|almost|approximately|some|only|just|a|an|fully)\s+){0,3}|"
+    r"(?:negative(?:ly)?|minus|sub-?zero|below\s+(?:zero|average|the\s+mean|normal|the\s+average))"
+    r"(?:[^\w\0();]+[^\W\d]+){0,4}?[^\w\0();]*)[$€£]?$",
+    re.IGNORECASE,
+)
+_SIGN_AFTER = re.compile(
+    r"^\s*(?:(?:down|lower|less|negative)\b|\(?negative\b|"
+    r"(?:[^\W\d]+[\s/°%.]+){0,4}?(?:below|under|beneath|(?:lower|less|short)\s+(?:than|of)|negative|minus|deficit|"
+    r"in\s+the\s+red|sub-?zero|west|south)\b)",
+    re.IGNORECASE,
+)
+#: the mark of a value written without its sign in a claim's detail (:func:`unsigned_negative`)
+WITHOUT_SIGN = "without its minus sign"
+
+
+def sign_in_words(n: Number, masked: str) -> bool:
+    """Do the words around an unsigned number say that it is below zero ('1.46 below zero', 'a drop of 1.46',
+    'minus 1.46')?"""
+    before = re.split(r"[\d.;]\s", masked[max(0, n.start - 48) : n.start])[-1]  # (not an earlier number's words)
+    return bool(_SIGN_BEFORE.search(before) or _SIGN_AFTER.match(masked[n.end : n.end + 48]))
+
+
+def unsigned_negative(n: Number, v: float, masked: str) -> bool:
+    """A negative value (beyond rounding of zero at the written digits) written without its sign, and no word says
+    so ('wind_gust (1.46)' when it is -1.463): the number does not state it. A bound below ('under 2') is true of
+    it as written."""
+    return v < 0 and not n.sign and n.hedge != "at_most" and abs(v) >= 0.5 * n.unit and not sign_in_words(n, masked)
+
+
 def _cues(n: Number, masked: str, book: FactBook) -> _Cues:
     before, after = masked[max(0, n.start - 40) : n.start], masked[n.end : n.end + 16]
     contribution = bool(CONTRIB_BEFORE.search(before)) and not _SINCE_AFTER.match(after)
@@ -123,11 +161,15 @@ def feature_number(
             cands.append(("fill (% of capacity)", e.fill))
         if not value_cue and (cue.pushes or not e.identifier):
             cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
+        unsigned = None  # a value the number states in size only, its sign neither written nor said
         for what, v in cands:
             contribution = what.startswith("contribution")
             m = n if contribution else replace(n, alternatives=tuple(x for x in n.alternatives if x != 100 * n.value))
             if " (not " in what and abs(n.value - v) > 0.05 * abs(v):
                 continue  # a value in another unit: its rounding is not the coarser unit's ('2 minutes' is no 90 s)
+            if what.startswith("value") and unsigned_negative(n, v, masked):
+                unsigned = unsigned or ((what, v) if matches(m, v) else None)
+                continue  # ('wind_gust (1.46)' when it is -1.463: a wrong value, unless the words say 'below zero')
             if matches(m, v, magnitude_ok=not (cue.signed and contribution)) or (
                 (n.percent or (cue.in_points and contribution)) and percent_reading(n, v)
             ):
@@ -136,6 +178,12 @@ def feature_number(
         if share:
             return True, f"{key}: {share}"
         shown = ", ".join(f"{w} {v:.4g}" for w, v in cands)
+        if unsigned is not None:
+            others = ", ".join(f"{w} {v:.4g}" for w, v in cands if (w, v) != unsigned)
+            return False, (
+                f"{n.text} is {key}'s {unsigned[0]} {unsigned[1]:.4g} {WITHOUT_SIGN}, and no word says it is "
+                f"negative ('-{n.text}', '{n.text} below zero')" + (f"; nor is it {key}'s {others}" if others else "")
+            )
         return False, f"{n.text} is not {key}'s {shown or 'value'}"
 
     if DIFFERENCE_AFTER.match(after):

@@ -46,7 +46,22 @@ def example(name: str) -> Explanation:
     ``robot``: a discrete policy; turn (3.2) chosen over recharge (2.0) and forward (-0.5), base 1.0 each; on the
     chosen score speed +0.5, battery -0.3, obstacle +2.0; on the margin over recharge speed +0.7, battery -1.5,
     obstacle +2.0.
+
+    ``gust``: a discrete policy with a negative value; turn_left (0.4) chosen over turn_right (0.05), base 0 each;
+    wind_gust -1.463 (+0.10 on turn_left's score, +0.15 on the margin), altitude 0.8 (-0.30, -0.50), heading_error
+    2.5 (+0.60, +0.70).
     """
+    if name == "gust":
+        c = np.array([[0.10, -0.05], [-0.30, 0.2], [0.6, -0.1]])
+        return Explanation(
+            values=c[None],
+            base_values=np.zeros((1, 2)),
+            outputs=c.sum(axis=0)[None],
+            states=np.array([[-1.463, 0.8, 2.5]]),
+            feature_names=("wind_gust", "altitude", "heading_error"),
+            action_names=("turn_left", "turn_right"),
+            method="given",
+        )
     if name == "air":
         c = np.array([2.2, 6.9, 14.7, 7.2, -1.0, 0.1])
         return Explanation(
@@ -239,6 +254,32 @@ RULES: tuple[Rule, ...] = (
         "a sum over all features after its cue words ('the positives add up to')",
         fires=(("air", "The positives add up to 31.1."),),
         silent=(("air", "Traffic adds 7.2."),),
+    ),
+    Rule(
+        "number.value-sign",
+        "number",
+        "a feature's value written without its sign when it is negative (beyond rounding of zero) and no word says "
+        "so ('wind_gust (1.46)' when it is -1.463): a wrong value, contradicted; not with words that carry the sign "
+        "('1.46 below zero', 'a drop of 1.46', 'minus 1.46', '1.46 lower than usual') nor for a contribution said "
+        "after a direction word ('lowered it by 0.3')",
+        fires=(
+            ("gust", "wind_gust (1.46) pushed toward turn_left by +0.10."),
+            ("gust", "The wind gust was 1.46."),
+            ("gust", "The wind gust stood at about 1.5, which pushed toward turn_left."),
+            ("gust", "wind_gust=1.463"),
+        ),
+        silent=(
+            ("gust", "wind_gust (-1.46) pushed toward turn_left by +0.10."),
+            ("gust", "The wind gust was 1.46 below zero."),
+            ("gust", "The wind gust reading of minus 1.46 pushed toward turn_left."),
+            ("gust", "The wind gust was negative 1.46."),
+            ("gust", "The wind gust sat 1.46 standard deviations below the mean."),
+            ("gust", "The wind gust, 1.46 lower than usual, pushed toward turn_left."),
+            ("gust", "The wind gust showed a drop of 1.46."),
+            ("gust", "The wind gust was under 2."),
+            ("gust", "Altitude lowered turn_left's score by 0.3."),
+            ("gust", "The wind gust was 1.46 in size and negative."),
+        ),
     ),
     Rule(
         "number.identifier-after-word",
@@ -590,6 +631,31 @@ RULES: tuple[Rule, ...] = (
         "an identifier that is no name, given a number or a direction word: an invented feature",
         fires=(("air", "humidity_pct=+3.1"),),
         silent=(("air", "run_id=7781"),),
+    ),
+    Rule(
+        "identifier.invented",
+        "feature",
+        "a feature-like identifier ('wind_speed', 'windSpeed', 'sensor[7]', 'the feature humidity') that names no "
+        "feature, action, label, unit or word of a description, given a contribution, a number or a direction later "
+        "in its clause: an invented feature, contradicted",
+        fires=(
+            ("gust", "The feature wind_speed contributed +0.50 toward this action."),
+            ("gust", "The feature humidity contributed +0.50 toward turn_left."),
+            ("gust", "Its windSpeed input, at the moment, pushed toward turn_left."),
+            ("gust", "sensor[7] of the gimbal contributed +0.2."),
+            ("robot", "The battery_temp reading, high today, lowered the score by 0.3."),
+        ),
+        silent=(
+            ("gust", "The weather contributed +0.10 toward turn_left."),  # plain words: no identifier
+            ("gust", "The wind_gust reading, at the moment, pushed toward turn_left."),  # a known name
+            ("gust", "With deep_shap as the method, heading_error pushed toward turn_left by +0.60."),
+            ("gust", "Run with kernel_shap and integrated_gradients, the result was the same: +0.60."),
+            ("gust", "Choosing turn_left over turn_right, heading_error added +0.70."),  # actions
+            ("gust", "Not wind_speed but heading_error pushed toward turn_left by +0.60."),  # negated
+            ("gust", "The feature importance of heading_error is +0.60."),
+            ("gust", "See run_log for details; heading_error added +0.60."),  # its claim is another name's
+            ("air", "The wind_speed reading, at the time, added +6.9."),  # part of wind_speed_ms
+        ),
     ),
     Rule(
         "identifier.q-of-action",
