@@ -108,7 +108,7 @@ class FeedbackStore:
             narrative.extras.get("method"),
             narrative.index,
             narrative.text,
-            json.dumps([c.__dict__ for c in narrative.claims]),
+            json.dumps([{k: v for k, v in c.__dict__.items() if k != "span"} for c in narrative.claims]),
             int(narrative.verified),
             narrative.confidence,
             json.dumps(ev) if ev is not None else None,

@@ -9,7 +9,8 @@ from ..explanation import Explanation
 from ..policy import Policy
 from .base import Narrative, Narrator
 from .confidence import confidence
-from .verify import Verification, verify
+from .provenance import verify
+from .verify import Verification
 
 
 def narrate(

@@ -21,8 +21,10 @@ from ..facts import DomainFacts, decision_facts, global_facts
 from ..options import Options, parse_options
 from ..policy import Policy
 from ..regions import in_regions
+from ..tracking import Rendered, Span, joined, locate, track_decision, track_global
 from .confidence import confidence
-from .verify import Claim, verify
+from .provenance import verify
+from .verify import Claim
 
 
 @dataclass(frozen=True)
@@ -35,6 +37,10 @@ class Narrative:
         checkable claim), as the verifier found them; the report and the review page mark each.
     :param evidence: what an operator checks the words against (:func:`xairl.evidence.evidence`: the state, the
         contributions to the margin, the sentences' statuses); a notebook shows it as the report's card.
+    :param claims: every claim the verifier checked; a claim about a value the template printed carries its tracked
+        span (``Claim.span``: where, and the fact it came from).
+    :param provenance: the tracked span of every value xairl printed (:class:`xairl.tracking.Span`); give it back to
+        ``xairl.verify(text, ..., provenance=narrative.provenance)`` to check the text again by its facts.
     """
 
     text: str
@@ -49,6 +55,7 @@ class Narrative:
     extras: dict = field(default_factory=dict)
     sentences: tuple[tuple[str, str], ...] = ()
     evidence: dict | None = field(default=None, repr=False, compare=False)
+    provenance: tuple[Span, ...] = field(default=(), repr=False, compare=False)
 
     def _repr_html_(self) -> str:
         """Jupyter's view: the evidence card of the HTML report (each sentence marked, the state, the waterfall)."""
@@ -60,17 +67,16 @@ class Narrative:
         )
 
 
-def join_sentences(sentences: Iterable[str]) -> str:
-    """Sentences joined by a space, or by a line break next to a sentence of several lines (a template's list)."""
-    out, last = "", ""
-    for s in (s for s in sentences if s):
-        out += (("\n" if "\n" in s + last else " ") + s) if out else s
-        last = s
-    return out
+def join_sentences(sentences: Iterable[str]) -> Rendered:
+    """Sentences joined by a space, or by a line break next to a sentence of several lines (a template's list), with
+    the tracked spans of those that have them (:class:`xairl.tracking.Rendered`)."""
+    parts = [s for s in sentences if s]
+    seps = [("\n" if "\n" in a + b else " ") for a, b in zip(parts, parts[1:])]
+    return joined([(s, getattr(s, "spans", ())) for s in parts], seps)
 
 
-def first_phrasings(variants: list[list[str]]) -> str:
-    """The deterministic text: the first phrasing of every sentence."""
+def first_phrasings(variants: list[list[str]]) -> Rendered:
+    """The deterministic text: the first phrasing of every sentence, with its tracked spans."""
     return join_sentences(s[0] for s in variants if s)
 
 
@@ -143,7 +149,7 @@ class Narrator:
         texts, claims, ok, sources, rejected, scores, comps, sentences = [], [], True, [], [], [], [], []
         for j, view in enumerate(views):
             text, check, source, bad = self._words(view, index, tpl, policy, k, history)
-            texts.append(text)
+            texts.append((text, text.spans))
             claims += check.claims
             sentences += [(s.text, s.status) for s in check.sentences]
             ok &= check.ok
@@ -163,8 +169,9 @@ class Narrator:
             comps.append(comp)
         worst = int(np.argmin(scores))  # a continuous action is as trustworthy as its least trustworthy dimension
         told = Narrative(
-            text=" ".join(texts),
+            text=(text := joined(texts, [" "] * (len(texts) - 1))),
             claims=tuple(claims),
+            provenance=text.spans,
             verified=ok,
             confidence=scores[worst],
             components=comps[worst],
@@ -186,15 +193,16 @@ class Narrator:
             else decision_facts(explanation, index, policy, k, history)
         )
         context = facts.context()
-        variants = tpl.render_variants(context)
+        variants = tpl.render_variants(track_global(context) if index is None else track_decision(context))
         text, source, rejected = self._compose(variants, context), self.name, None
+        text = text if isinstance(text, Rendered) else Rendered(text, locate(text, variants))
         # the domain facts the words were made from (a facts hook given the episode's history states more)
         domain = DomainFacts(facts.extras, facts.comparisons) if index is not None else None
-        check = verify(text, explanation, index, policy, facts=domain)
+        check = verify(text, explanation, index, policy, facts=domain, provenance=text.spans)
         if not check.ok and text != first_phrasings(variants):
             problem = check.problems()[0]
-            rejected, text = text, first_phrasings(variants)
-            check = verify(text, explanation, index, policy, facts=domain)
+            rejected, text = str(text), first_phrasings(variants)
+            check = verify(text, explanation, index, policy, facts=domain, provenance=text.spans)
             source = f"template (fallback: {self.name} text failed verification: {problem.text!r} {problem.status})"
         return text, check, source, rejected
 

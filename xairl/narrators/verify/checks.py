@@ -28,6 +28,9 @@ class Claim:
     #: (the feature a number was bound to, the feature whose fact it states instead), for a number left unchecked
     #: because it states another feature's fact: two numbers of a text that cross this way are swapped
     crosses: tuple[str, ...] = field(default=(), repr=False, compare=False)
+    #: the tracked span (:class:`xairl.tracking.Span`: where, what fact) of a claim about a value xairl printed
+    #: itself; None for a claim the reader made from words
+    span: object = field(default=None, repr=False, compare=False)
 
 
 CHECKED = {"number", "direction", "rank", "action", "category", "magnitude"}
