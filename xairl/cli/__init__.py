@@ -87,10 +87,12 @@ def cmd_prompts(args) -> int:
         return 0
     from ..narrators import check_template
 
-    problems = check_template(args.target)
-    for p in problems:
+    lines = check_template(args.target, notes=True, verbose=print if args.verbose else None)
+    problems = [p for p in lines if not p.startswith("note:")]
+    for p in lines:
         print(p)
-    print(f"{args.target}: {'ok' if not problems else f'{len(problems)} problem(s)'}")
+    notes = f", {len(lines) - len(problems)} note(s)" if len(lines) > len(problems) else ""
+    print(f"{args.target}: {'ok' if not problems else f'{len(problems)} problem(s)'}{notes}")
     return 0 if not problems else 1
 
 
@@ -266,6 +268,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("action", choices=("list", "show", "check"))
     p.add_argument("target", nargs="?", help="template name (show) or .yaml path (check)")
     p.add_argument("--prompts", action="append", default=[], metavar="DIR", help="extra template folder")
+    p.add_argument(
+        "-v", "--verbose", action="store_true", help="check: say how many cases the battery rendered, and in what time"
+    )
     p.set_defaults(run=cmd_prompts)
     p = _command(sub, "verify", help="check a text's claims against an explanation (exit 1 when one is contradicted)")
     p.add_argument("text", help="the text to check, or - to read it from standard input")

@@ -56,13 +56,28 @@ def narrate(
     return narrative
 
 
-def check_template(path: str | Path) -> list[str]:
-    """Problems of a template file, one line each (:func:`xairl.prompts.check`), including a trial rendering with
-    sample facts; what ``xairl prompts check`` prints."""
+def check_template(path: str | Path, *, notes: bool = False, verbose=None) -> list[str]:
+    """Problems of a template file, one line each: the static checks of :func:`xairl.prompts.check` with a trial
+    rendering on sample facts, then the battery (:mod:`xairl.narrators.battery`): the template rendered on
+    generated decisions of every policy kind, each rendering verified by provenance, and each contradicted one
+    reported with the template's file:line, the decision, the sentence and the claim. What ``xairl prompts check``
+    prints.
+
+    :param notes: also return the advice lines, prefixed 'note:' (direction words a template chooses itself where the
+        ``dir`` filter would track them; a plugin template that needs its plugin's extras), after the problems.
+    :param verbose: called with a line saying how many cases and renderings the battery ran, and in what time.
+    """
     from .. import prompts
+    from .battery import run
     from .samples import sample_context
 
-    return prompts.check(path, sample_context)
+    problems = prompts.check(path, sample_context)
+    if problems:
+        return problems
+    report = run(prompts.parse(Path(path)))
+    if verbose is not None:
+        verbose(report.summary())
+    return report.problems + (report.notes if notes else [])
 
 
 __all__ = ["Narrative", "Narrator", "Verification", "check_template", "confidence", "narrate", "verify"]
