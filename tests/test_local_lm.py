@@ -30,7 +30,7 @@ def test_default_model_is_the_packaged_gguf(model_cache):
 def test_choose_mode_picks_template_phrasings_and_verifies(toy):
     policy, exp = toy
     for i in range(len(exp.values)):
-        n = xairl.narrate(exp, i, narrator="local_lm", policy=policy)
+        n = xairl.narrate(exp, i, narrator="local_lm", policy=policy, options={"mode": "choose"})
         assert n.source == "local_lm" and n.verified
         variants = prompts.load("explain_action").render_variants(decision_facts(exp, i, policy).context())
         # every sentence of the text is one of the template's phrasings of that sentence
@@ -102,8 +102,9 @@ def test_import_and_template_narrator_never_import_transformers():
     assert out.stdout.strip().splitlines()[-1] == "[]"
 
 
-def test_default_mode_is_choose_and_rewrite_stays_an_option():
-    """bench_lm_modes.py: choose changes the wording (always verified) in 90 % / 20 % of narratives (toy / UAV);
-    rewrite verifies on the first try in 17 % / 25 % at 10-17 s a text, so it is opt-in only."""
-    assert local_lm.LocalLMOptions().mode == "choose"
+def test_default_mode_is_fill_and_choose_and_rewrite_stay_options():
+    """Issue 52: the model fills around the tracked facts by default (xairl/narrators/fill.py); choose (pick among
+    the template's phrasings) and rewrite (free, read as outside prose) stay options."""
+    assert local_lm.LocalLMOptions().mode == "fill"
+    assert local_lm.LocalLMOptions(mode="choose").mode == "choose"
     assert local_lm.LocalLMOptions(mode="rewrite").mode == "rewrite"

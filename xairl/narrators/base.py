@@ -8,7 +8,7 @@ words fail verification, and the confidence score (xairl.narrators.confidence).
 from __future__ import annotations
 
 import html
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
@@ -147,8 +147,10 @@ class Narrator:
             else [narrated]
         )
         texts, claims, ok, sources, rejected, scores, comps, sentences = [], [], True, [], [], [], [], []
+        tries = 0
         for j, view in enumerate(views):
-            text, check, source, bad = self._words(view, index, tpl, policy, k, history)
+            text, check, source, bad, tried = self._words(view, index, tpl, policy, k, history)
+            tries = max(tries, tried)
             texts.append((text, text.spans))
             claims += check.claims
             sentences += [(s.text, s.status) for s in check.sentences]
@@ -179,7 +181,7 @@ class Narrator:
             template=tpl.name,
             index=index,
             rejected=" ".join(rejected) or None,
-            extras={"method": explanation.method},
+            extras={"method": explanation.method, "tries": tries},
             sentences=tuple(sentences),
         )
         return replace(told, evidence=evidence(narrated, told))
@@ -194,17 +196,30 @@ class Narrator:
         )
         context = facts.context()
         variants = tpl.render_variants(track_global(context) if index is None else track_decision(context))
-        text, source, rejected = self._compose(variants, context), self.name, None
-        text = text if isinstance(text, Rendered) else Rendered(text, locate(text, variants))
         # the domain facts the words were made from (a facts hook given the episode's history states more)
         domain = DomainFacts(facts.extras, facts.comparisons) if index is not None else None
-        check = verify(text, explanation, index, policy, facts=domain, provenance=text.spans)
-        if not check.ok and text != first_phrasings(variants):
-            problem = check.problems()[0]
-            rejected, text = str(text), first_phrasings(variants)
+        first = None
+        for tries, text in enumerate(self._tries(variants, context), 1):
+            if text is None:  # refused by the narrator itself (its words lost a fact)
+                first = first or (None, Claim("words", "", "unchecked", "a try lost or added a name or number"))
+                continue
+            text = text if isinstance(text, Rendered) else Rendered(text, locate(text, variants))
             check = verify(text, explanation, index, policy, facts=domain, provenance=text.spans)
-            source = f"template (fallback: {self.name} text failed verification: {problem.text!r} {problem.status})"
-        return text, check, source, rejected
+            if check.ok or text == first_phrasings(variants):
+                return text, check, self.name, None, tries
+            first = first or (text, check.problems()[0])
+        rejected, problem = first
+        text = first_phrasings(variants)
+        check = verify(text, explanation, index, policy, facts=domain, provenance=text.spans)
+        source = f"template (fallback: {self.name} text failed verification: {problem.text!r} {problem.status})"
+        if rejected is None:
+            source = f"template (fallback: {self.name}: {problem.detail})"
+        return text, check, source, None if rejected is None else str(rejected), tries
+
+    def _tries(self, variants: list[list[Rendered]], context: dict[str, Any]) -> Iterator[str | None]:
+        """The subclass's words, try after try: the first that verifies is shown, and the template's when none does
+        (default: one try, ``_compose``); None is a try the subclass refused itself."""
+        yield self._compose(variants, context)
 
     def _compose(self, variants: list[list[str]], context: dict[str, Any]) -> str:
         """The subclass's words.

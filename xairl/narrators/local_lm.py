@@ -54,6 +54,7 @@ from ..display import quiet_tqdm
 from ..errors import InputError, XairlError
 from ..options import Options
 from ..paths import model_cache_dir
+from ..tracking import Rendered
 from .base import Narrator, first_phrasings
 
 SYSTEM = (
@@ -68,9 +69,12 @@ class LocalLMOptions(Options):
     """Options of the ``local_lm`` narrator (``-n key=value`` on the CLI)."""
 
     model: str | None = Field(None, description="transformers model folder or .gguf file; default SmolLM2-135M")
-    mode: Literal["choose", "rewrite"] = Field(
-        "choose", description="choose: pick among the template's phrasings; rewrite: free rewrite (experimental, slow)"
+    mode: Literal["fill", "choose", "rewrite"] = Field(
+        "fill",
+        description="fill: reword around the facts, which stay tracked; choose: pick among the template's phrasings; "
+        "rewrite: free rewrite, checked as outside prose (experimental, slow)",
     )
+    tries: int = Field(3, ge=1, le=10, description="fill mode: tries before the template is shown")
     max_new_tokens: int = Field(200, ge=8, le=1024, description="rewrite mode: generation budget")
     examples: list[str] = Field(default_factory=list, description="operator-approved narratives used as examples")
     threads: int | None = Field(None, ge=1, description="torch CPU threads (default: torch's choice)")
@@ -174,11 +178,24 @@ class LocalLMNarrator(Narrator):
             return list(ids["input_ids"] if isinstance(ids, dict) or hasattr(ids, "keys") else ids)
         return self.tok("\n".join(m["content"] for m in msgs) + "\n")["input_ids"]
 
-    def _compose(self, variants: list[list[str]], context: dict) -> str:
+    def _tries(self, variants: list[list[Rendered]], context: dict):
+        if self.options.mode != "fill":
+            yield self._compose(variants, context)
+            return
+        self._threads()
+        from .fill import fill
+
+        for attempt in range(self.options.tries):
+            yield fill(self.model, self.tok, self._prefix, [v[0] for v in variants if v and v[0]], attempt, context)
+
+    def _threads(self) -> None:
         import torch
 
         if self.options.threads:
             torch.set_num_threads(self.options.threads)
+
+    def _compose(self, variants: list[list[str]], context: dict) -> str:
+        self._threads()
         if self.options.mode == "rewrite":
             return self._rewrite(first_phrasings(variants))
         prefix = self._prefix("Explain the decision.")

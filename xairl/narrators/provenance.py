@@ -48,6 +48,7 @@ RULES = {
     "tracked.role": "an action named with words of the other role ('chose' the runner-up)",
     "tracked.direction": "a direction word ('raised', 'against', 'favoured B') against its feature's sign",
     "tracked.rank": "a rank word ('most', 'biggest', 'second') against the rank of the feature it names",
+    "tracked.level": "a level word ('low', 'normal', 'high') against the level of the feature it is said of",
     "tracked.comparison": "'A mattered more than B' against the sizes of their contributions",
 }
 
@@ -111,13 +112,19 @@ _RUNNER_AFTER = re.compile(r"^\W*(?:came second|was second|lost|was the runner[-
 _LABELS = (
     (re.compile(r"\b(?:average|expected|baseline|base(?: value)?|background)\b[\w\s']{0,12}\W*$", re.I), "base"),
     (re.compile(r"\b(?:q[- ]?value|score|logit|prediction|estimate)s?\b(?:\s+(?:of|was|is|at))?\W*$", re.I), "score"),
+    (
+        re.compile(
+            r"\b(?:came out at|came out as|ended (?:up )?at|came to|(?:was )?set to|landed at|reached)\W*$", re.I
+        ),
+        "score",
+    ),
     (re.compile(r"\b(?:margin|gap|lead)\b(?:\s+(?:of|was|is))?\W*$", re.I), "margin"),
     (re.compile(r"\b(?:share)\b(?:\s+(?:of|was|is))?\W*$", re.I), "share"),
     (re.compile(r"\b(?:rank(?:ed)?)\b(?:\s+(?:of|was|is))?\W*$", re.I), "rank"),
 )
 _LABEL_FITS = {
     "base": {"base_value", "base_margin", "mean", "mean_abs"},
-    "score": {"score", "base_value", "contribution"},  # ('it raised the score by +0.3': a contribution to it)
+    "score": {"score", "contribution"},  # ('it raised the score by +0.3': a contribution to it)
     "margin": {"margin", "base_margin", "contribution"},
     "share": {"share"},
     "rank": {"rank"},
@@ -143,6 +150,16 @@ _MORE = re.compile(
 )
 _LESS = re.compile(r"\b(?:less than|smaller than|weaker than|behind)\b", re.I)
 _EXTRA_DIRECTIONS = re.compile(r"\b(?:(?P<neg>despite|in spite of)|(?P<for>for))\b", re.IGNORECASE)
+#: words that say a side ('favoured B', 'toward B', 'against B'): about the options, so they need to name one
+_SIDE = re.compile(
+    r"favou?r\w*|in favou?r of|toward|towards|against|for|supports?|supported|supporting|help\w*|argu\w* (?:for|against)",
+    re.IGNORECASE,
+)
+#: the side named in words: the chosen action ('favoured it', 'toward the decision')
+_CHOSEN_SIDE = re.compile(r"\s+(?:it|this|the (?:chosen )?(?:action|decision|choice)|its choice)\b", re.IGNORECASE)
+_LEVEL = re.compile(
+    r"\b(?:low|high|typical|normal|moderate|average)\b(?!\s+(?:value|values|of|score|margin|when))", re.I
+)
 _NEGATED = re.compile(r"(?:\b(?:not|never|no longer|neither|nor)|n't)\b\W*(?:\w+\W+){0,2}$", re.IGNORECASE)
 
 
@@ -228,14 +245,16 @@ def _number(text: str) -> float | None:
         return None
 
 
-def _transformed(x: float, transform: str) -> float:
+def _transformed(x: float, transform: str, percent: bool = False) -> float:
+    """``x`` as the template transformed it; a scaling counts only as a percentage (x100 with '%' written after it):
+    any other multiple of a fact printed as if it were the fact is not that fact."""
     for step in filter(None, transform.split("+")):
         if step == "neg":
             x = -x
         elif step == "abs":
             x = abs(x)
-        elif step.startswith("scale:"):
-            x *= float(step[6:])
+        elif step.startswith("scale:") and percent and float(step[6:]) == 100:
+            x *= 100
     return x
 
 
@@ -253,12 +272,12 @@ def _words_similar(a: str, b: str) -> bool:
     return " ".join(str(a).lower().split()) == " ".join(str(b).lower().split())
 
 
-def check_fact(span: Span, truth: Truth) -> Claim:
-    """The span against its recomputed fact (the claim carries the span)."""
-    return replace(_check_fact(span, truth), span=span)
+def check_fact(span: Span, truth: Truth, after: str = "") -> Claim:
+    """The span against its recomputed fact (the claim carries the span); ``after``: the words that follow it."""
+    return replace(_check_fact(span, truth, bool(re.match(r"\s?(?:%|per ?cent)", after))), span=span)
 
 
-def _check_fact(span: Span, truth: Truth) -> Claim:
+def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
     f = span.fact
     expected = truth.get(span)
     kind = _KINDS.get(f.quantity, "number" if f.quantity in _NUMERIC else "feature")
@@ -271,7 +290,7 @@ def _check_fact(span: Span, truth: Truth) -> Claim:
         )
     if isinstance(expected, (int, float, np.floating)) and not isinstance(expected, bool):
         printed = _number(span.text)
-        want = _transformed(float(expected), span.transform)
+        want = _transformed(float(expected), span.transform, percent)
         ok = printed is not None and _close(printed, want, span.text)
         detail = f"{f.quantity}{' of ' + f.feature if f.feature else ''} = {float(expected):.4g}"
         detail += f" ({span.transform}: {want:.4g})" if span.transform else ""
@@ -498,6 +517,8 @@ class _Sentence:
                 continue  # '-0.97 against +0.88', '3.05 vs 0.71': a comparison of two numbers
             for m, polarity in found:
                 action = self._action_after(p, m.end())
+                if action is None and _SIDE.fullmatch(m.group(0)) and not _CHOSEN_SIDE.match(words, m.end()):
+                    continue  # 'favoured a handover to BS 2': a side the words name without a tracked action
                 if polarity == 0:  # 'for': a direction only toward a named action
                     if action is None:
                         continue
@@ -566,6 +587,37 @@ class _Sentence:
             f"'{word}' is said of {name}, whose contribution is {contribution:+.4g}",
             "tracked.direction",
         )
+
+    def levels(self) -> list[Claim]:
+        """A level word the template or model wrote ('wind (normal)', 'a high load') against the level of the one
+        feature its segment names (or whose value it follows)."""
+        out = []
+        for p in self.parts:
+            if p.span is not None:
+                continue
+            for m in _LEVEL.finditer(self.text[p.start : p.end]):
+                prev = next((q for q in reversed(self.spans) if q.end <= p.start), None)
+                own = {q.span.fact.feature: q for q in self.names if q.segment == p.segment}
+                if (
+                    prev is not None
+                    and prev.segment == p.segment
+                    and prev.span.fact.quantity in ("value", "value_text")
+                ):
+                    name = prev.span.fact.feature
+                elif len(own) == 1:
+                    name = next(iter(own))
+                else:
+                    continue
+                fact = self.feature_fact(name, None)
+                level = getattr(fact, "level", "unknown")
+                said = (
+                    "typical"
+                    if m.group(0).lower() in ("normal", "typical", "moderate", "average")
+                    else m.group(0).lower()
+                )
+                status = "unchecked" if level == "unknown" else "verified" if said == level else "contradicted"
+                out.append(Claim("magnitude", m.group(0), status, f"{name}'s level is {level}", "tracked.level"))
+        return out
 
     def ranks(self) -> list[Claim]:
         """A superlative or ordinal in a segment that names one feature: that feature's rank."""
@@ -660,7 +712,7 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, read, smu
     s = _Sentence(sentence, spans, truth)
     claims = []
     for p in s.spans:
-        claims.append(check_fact(p.span, truth))
+        claims.append(check_fact(p.span, truth, sentence[p.end : p.end + 9]))
         q = p.span.fact.quantity
         extra = []
         if q in _SAID_OF_FEATURE and p.span.fact.feature:
@@ -672,7 +724,7 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, read, smu
         if q == "action" and p.span.fact.role:
             extra.append(s.role(p))
         claims += [c for c in extra if c is not None]
-    claims += s.directions() + s.ranks() + s.comparisons()
+    claims += s.directions() + s.levels() + s.ranks() + s.comparisons()
     literal = _literal(sentence, s.parts, 0, len(sentence))
     if smuggled or re.search(r"\d|[A-Za-z][A-Za-z0-9]*_[A-Za-z0-9]", literal):  # an untracked number or identifier
         claims += [c for c in read(sentence) if _untracked(c, sentence, s.spans, smuggled)]

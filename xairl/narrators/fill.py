@@ -1,0 +1,188 @@
+"""The language model fills, it does not retype: ``local_lm``'s ``fill`` mode.
+
+The model rewords the template's text one sentence at a time, and its decoding is constrained by
+:class:`SpanKeeper`: every tracked span of the sentence (a name, a number, an action, a direction the facts gave) is
+a *slot* it must fill, in order, exactly once. It cannot write a digit of its own; the first token of the next slot's
+text starts that slot and the rest is written for it; a slot it withholds too long is written for it; it cannot stop
+before the last slot. So no number can be invented and none can drift; a name it writes outside the slots that the
+template did not write is refused afterwards (a try of :func:`fill` returns None). The slots keep their spans and
+facts, and the model's own words between them are judged by :mod:`xairl.narrators.provenance` against those facts.
+"""
+
+from __future__ import annotations
+
+import re
+import unicodedata
+from functools import lru_cache
+
+from ..tracking import Rendered, Span
+
+INSTRUCTION = (
+    "Reword this sentence so that it reads well for an operator. Keep every name and number exactly as written, "
+    "in the same order, with the words that say what each one is.\n\nSentence: "
+)
+#: added to the logit of every token of the template's own words: the model rewords, it does not write anew
+COPY_BIAS = 1.0
+#: added to the logit of the next slot's first token: the model is drawn to the next fact, not to words of its own
+SLOT_BIAS = 3.0
+
+
+@lru_cache(maxsize=4)
+def _vocabulary(tok) -> frozenset[int]:
+    """Token ids the model may not write freely: digits (any script), brackets, line breaks."""
+    banned = set()
+    for i in range(len(tok)):
+        piece = tok.decode([i])
+        if re.search(r"[\d\[\]{}<>|\n\ufffd]", piece) or any(
+            unicodedata.numeric(c, None) is not None or unicodedata.category(c)[0] in "CS" for c in piece
+        ):  # (a digit of any script, a symbol, a control or format character, a broken byte)
+            banned.add(i)
+    return frozenset(banned)
+
+
+class SpanKeeper:
+    """A logits processor that keeps the slots (module doc). ``slots``: the token ids of each span's text, as it
+    would follow a space and as it would follow no space; ``gaps``: the template's number of tokens before each slot
+    and after the last one: the model may write twice as many, plus eight, before the next slot is written for it."""
+
+    def __init__(self, tok, slots, gaps: list[int], prompt_len: int, own=(), ending: list[int] = ()):
+        banned = _vocabulary(tok)
+        # the slots' own tokens that the template's words do not have ('standardised', 'typical'): only in a slot
+        self.banned = banned | ({t for a, b in slots for t in a + b} - set(own))
+        self.slots, self.eos, self.seen = slots, tok.eos_token_id, prompt_len
+        self.limits, self.ending = [2 * g + 8 for g in gaps], list(ending)
+        self.own = sorted(set(own) - self.banned)
+        self.next, self.free, self.queue = 0, 0, []
+        self.placed: list[tuple[int, int]] = []  # (first, last + 1) generated token of each slot
+
+    def _advance(self, ids: list[int]) -> None:
+        for k in range(self.seen, len(ids)):
+            t = ids[k]
+            if self.queue:
+                self.queue.pop(0)
+            elif self.next < len(self.slots) and t in (self.slots[self.next][0][0], self.slots[self.next][1][0]):
+                form = self.slots[self.next][0] if t == self.slots[self.next][0][0] else self.slots[self.next][1]
+                self.queue = list(form[1:])
+                self.placed.append((k, k + len(form)))
+            else:
+                self.free += 1
+                continue
+            if not self.queue:  # the slot is complete
+                self.next, self.free = self.next + 1, 0
+        self.seen = len(ids)
+
+    def __call__(self, input_ids, scores):
+        import torch
+
+        self._advance(input_ids[0].tolist())
+        only = None
+        if self.queue:
+            only = self.queue[0]
+        elif self.next < len(self.slots) and self.free >= self.limits[self.next]:
+            only = self.slots[self.next][0][0]
+        elif self.next >= len(self.slots):  # the template's own ending ('.'), then the end
+            only = self.ending[self.free] if self.free < len(self.ending) else self.eos
+        if only is not None:
+            forced = torch.full_like(scores, float("-inf"))
+            forced[:, only] = 0.0
+            return forced
+        allowed = scores.clone()
+        scores[:, self.own] += COPY_BIAS
+        scores[:, list(self.banned)] = float("-inf")
+        for form in self.slots[self.next]:  # the next slot may start (a number only through it)
+            scores[:, form[0]] = allowed[:, form[0]] + SLOT_BIAS
+        scores[:, self.eos] = float("-inf")
+        return scores
+
+
+def _gaps(tok, sentence: Rendered) -> list[int]:
+    """Tokens of the template's words before each span, and after the last."""
+    cuts = [0] + [x for sp in sentence.spans for x in (sp.start, sp.end)] + [len(sentence)]
+    return [len(tok.encode(sentence[a:b], add_special_tokens=False)) for a, b in zip(cuts[::2], cuts[1::2])]
+
+
+def _new_names(words: Rendered, sentence: Rendered, context: dict) -> list[str]:
+    """Feature and action names the model wrote outside the slots more often than the template's own words do."""
+    names = {context.get("action"), context.get("runner_up")}
+    for key in ("top", "margin_top", "ranking", "identifiers"):
+        for f in context.get(key) or ():
+            names |= {f.get("name"), f.get("label")}
+
+    def literal(text: Rendered) -> str:
+        out, pos = [], 0
+        for sp in text.spans:
+            out += [text[pos : sp.start], " "]
+            pos = sp.end
+        return "".join(out + [text[pos:]])
+
+    mine, template = literal(words), literal(sentence)
+    return [
+        str(name)
+        for name in filter(None, names)
+        if len(re.findall(rf"(?<!\w){re.escape(str(name))}(?!\w)", mine, re.I))
+        > len(re.findall(rf"(?<!\w){re.escape(str(name))}(?!\w)", template, re.I))
+    ]
+
+
+def fill(model, tok, prefix, sentences: list[Rendered], attempt: int, context: dict) -> Rendered | None:
+    """One try: the model's rewording of each sentence around its tracked spans (greedy on the first try, sampled
+    after), joined; None when a sentence's output is refused (a name the template did not write outside a slot)."""
+    from .base import join_sentences
+
+    out = []
+    for sentence in sentences:
+        words = _reword(model, tok, prefix, sentence, attempt) if sentence.spans else sentence
+        if words is None or _new_names(words, sentence, context):
+            return None
+        out.append(words)
+    return join_sentences(out)
+
+
+def _reword(model, tok, prefix, sentence: Rendered, attempt: int) -> Rendered | None:
+    """The model's rewording of one sentence, its slots in place (None when a slot's text did not come out whole)."""
+    import torch
+    from transformers import LogitsProcessorList
+
+    prompt = prefix(INSTRUCTION + sentence + "\nRewrite:")
+    slots = [
+        (tok.encode(" " + sp.text, add_special_tokens=False), tok.encode(sp.text, add_special_tokens=False))
+        for sp in sentence.spans
+    ]
+    literal, pos = [], 0
+    for sp in sentence.spans:
+        literal, pos = [*literal, sentence[pos : sp.start]], sp.end
+    own = tok.encode(" ".join([*literal, sentence[pos:]]), add_special_tokens=False)
+    ending = tok.encode(sentence[sentence.spans[-1].end :], add_special_tokens=False)
+    keeper = SpanKeeper(tok, slots, _gaps(tok, sentence), len(prompt), own, ending)
+    ids = torch.tensor([prompt])
+    torch.manual_seed(attempt)
+    with torch.no_grad():
+        out = model.generate(
+            ids,
+            attention_mask=torch.ones_like(ids),
+            logits_processor=LogitsProcessorList([keeper]),
+            do_sample=attempt > 0,
+            temperature=0.3 if attempt else None,
+            top_p=None,
+            top_k=None,
+            max_new_tokens=sum(keeper.limits) + sum(len(s[0]) for s in slots) + 8,
+            pad_token_id=tok.pad_token_id,
+        )
+    generated = out[0, len(prompt) :].tolist()
+    keeper._advance(out[0].tolist())
+    if keeper.next < len(slots):
+        return None
+    text, spans, pos = "", [], 0
+    for (a, b), sp in zip(keeper.placed, sentence.spans):
+        text += tok.decode(generated[pos : a - len(prompt)], skip_special_tokens=True)
+        piece = tok.decode(generated[a - len(prompt) : b - len(prompt)])
+        text += piece[: len(piece) - len(piece.lstrip())]
+        if piece.strip() != sp.text:
+            return None
+        spans.append(Span(len(text), len(text) + len(sp.text), sp.text, sp.fact, sp.transform))
+        text, pos = text + sp.text, b - len(prompt)
+    text += tok.decode(generated[pos:], skip_special_tokens=True)
+    cut = len(text.split("\n")[0].rstrip())
+    if any(sp.end > cut for sp in spans):
+        return None
+    return Rendered(text[:cut], tuple(spans))
