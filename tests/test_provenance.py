@@ -199,13 +199,6 @@ def test_untracked_numbers_are_read_and_must_check_out(tmp_path, exps):
     assert any(c.text == "1.20" and c.span is None and c.status == "verified" for c in v.claims)
 
 
-@pytest.mark.xfail(
-    "tracked.untracked" in provenance.RULES,  # (before that rule the reader left the number unchecked: verified)
-    reason="tracked.untracked: a correct untracked score written right after the tracked action, in a sentence that "
-    "names a feature before it ('obstacle pushed toward turn (score 3.20) by +2.'), is bound by the reader to the "
-    "feature, left unchecked ('states a decision-level fact') and so contradicted as 'not taken from the facts'",
-    strict=True,
-)
 def test_an_untracked_score_after_its_action_is_not_bound_to_a_feature(tmp_path, exps):
     text, v = check(
         tmp_path,

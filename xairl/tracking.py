@@ -155,9 +155,11 @@ class TrackedFloat(float):
 
     def __round__(self, ndigits=None):
         out = round(float(self), ndigits)
-        return out if ndigits is None else self._keep(out, "round")
+        return out if ndigits is None else self._keep(out, f"round:{int(ndigits)}")
 
     def __mul__(self, other):
+        if isinstance(other, (TrackedFloat, TrackedInt)):  # a product of two facts is neither of them
+            return float(self) * float(other)
         if isinstance(other, (int, float)) and not isinstance(other, bool) and math.isfinite(other):
             return self._keep(float(self) * other, f"scale:{float(other):g}")
         return float.__mul__(self, other)
@@ -165,6 +167,8 @@ class TrackedFloat(float):
     __rmul__ = __mul__
 
     def __truediv__(self, other):
+        if isinstance(other, (TrackedFloat, TrackedInt)):  # a ratio of two facts is neither of them
+            return float(self) / float(other) if other else float.__truediv__(self, other)
         if isinstance(other, (int, float)) and not isinstance(other, bool) and other:
             return self._keep(float(self) / other, f"scale:{1 / float(other):g}")
         return float.__truediv__(self, other)

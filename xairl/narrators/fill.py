@@ -11,6 +11,7 @@ facts, and the model's own words between them are judged by :mod:`xairl.narrator
 
 from __future__ import annotations
 
+import difflib
 import re
 import unicodedata
 from functools import lru_cache
@@ -25,6 +26,8 @@ INSTRUCTION = (
 COPY_BIAS = 1.0
 #: added to the logit of the next slot's first token: the model is drawn to the next fact, not to words of its own
 SLOT_BIAS = 3.0
+#: the share of a stretch of the template's words a rewording keeps (difflib's ratio of the two word lists)
+MIN_KEPT = 0.5
 
 
 @lru_cache(maxsize=4)
@@ -124,6 +127,28 @@ def _new_names(words: Rendered, sentence: Rendered, context: dict) -> list[str]:
     ]
 
 
+def _gaps_text(text: Rendered) -> list[str]:
+    cuts = [0] + [x for sp in text.spans for x in (sp.start, sp.end)] + [len(text)]
+    return [text[a:b] for a, b in zip(cuts[::2], cuts[1::2])]
+
+
+#: broken output: empty brackets, punctuation repeated, a dangling word before a stop
+_JUNK = re.compile(r"\(\s*\)|[.,;:]\s*[.,;:]|\s{2,}|\b(?:and|by|of|the|a)\s*[.;]")
+
+
+def _rewording(words: Rendered, sentence: Rendered) -> bool:
+    """The model's words between the slots are a rewording of the template's: each stretch keeps at least
+    :data:`MIN_KEPT` of its words (a tiny model that wanders writes word salad around correct numbers), and no
+    broken punctuation."""
+    if _JUNK.search(str(words)) and not _JUNK.search(str(sentence)):
+        return False
+    for mine, theirs in zip(_gaps_text(words), _gaps_text(sentence)):
+        a, b = mine.lower().split(), theirs.lower().split()
+        if len(a) + len(b) > 2 and difflib.SequenceMatcher(None, a, b).ratio() < MIN_KEPT:
+            return False
+    return True
+
+
 def fill(model, tok, prefix, sentences: list[Rendered], attempt: int, context: dict) -> Rendered | None:
     """One try: the model's rewording of each sentence around its tracked spans (greedy on the first try, sampled
     after), joined; None when a sentence's output is refused (a name the template did not write outside a slot)."""
@@ -132,7 +157,7 @@ def fill(model, tok, prefix, sentences: list[Rendered], attempt: int, context: d
     out = []
     for sentence in sentences:
         words = _reword(model, tok, prefix, sentence, attempt) if sentence.spans else sentence
-        if words is None or _new_names(words, sentence, context):
+        if words is None or _new_names(words, sentence, context) or not _rewording(words, sentence):
             return None
         out.append(words)
     return join_sentences(out)

@@ -2,31 +2,22 @@
 ``narrate`` and the CLI is ``template``; this one needs the lm extra (``pip install 'xairl[lm]'``), else narrating
 with it raises InputError with that hint. ``import xairl`` and the template narrator never import transformers.
 
-Two modes:
+Three modes:
 
-- ``choose`` (default): for each sentence the template offers phrasings that state the same facts; the model picks
-  the one it finds most fluent after the text so far (highest mean token log-probability), and the chosen
-  sentences are joined. Numbers, names and directions come from the facts, so the text verifies by construction
-  and costs only forward passes. What it adds is the choice among the template author's phrasings, nothing more:
-  where a template has one phrasing per sentence, or the model prefers the first ones, the text is the template's.
-- ``rewrite`` (opt-in, experimental): the model rewrites the template rendering freely (greedy decoding); the
-  verifier then decides, and the template's text is shown when the rewrite fails.
+- ``fill`` (default, issue 52): the model rewords each sentence of the template's text around its tracked spans
+  (:mod:`xairl.narrators.fill`): every name, number and direction the facts gave is a slot its constrained decoding
+  must write, in order, exactly as given, and it can write no digit of its own. A try whose words wander from the
+  template's or name something new is refused; the output is verified by provenance (its slots by their facts, its
+  words by the rules of :mod:`xairl.narrators.provenance`); up to ``tries`` tries (greedy, then sampled), then the
+  template's text is shown.
+- ``choose``: for each sentence the template offers phrasings that state the same facts; the model picks the one it
+  finds most fluent after the text so far (highest mean token log-probability). Numbers, names and directions come
+  from the facts, so the text verifies by construction and costs only forward passes.
+- ``rewrite`` (opt-in, experimental): the model rewrites the template rendering freely (greedy decoding); nothing is
+  tracked, so the reader of outside prose decides, and the template's text is shown when the rewrite fails.
 
-What each adds over the template (``benchmarks/bench_lm_modes.py --states 20 --rewrite-states 12 --threads 1``;
-2 busy x86 cores; toy policy / uav-dqn with template handover; 20 states, rewrite on 12):
-
-=========  ==============  ==================  =================  =================  ====================
-mode       verified 1st    shown text differs  word edits (mean)  warm median/text   default threads
-=========  ==============  ==================  =================  =================  ====================
-template   100 % / 100 %   -                   -                  0.05 s / 0.03 s    same
-choose     100 % / 100 %   90 % / 20 %         12.8 / 3.0         3.4 s / 0.65 s     4.6 s / 2.3 s
-rewrite    17 % / 25 %     17 % / 25 %         14.4 / 12.8        16.8 s / 10.8 s    43 s / 132 s (2 texts)
-=========  ==============  ==================  =================  =================  ====================
-
-So ``choose`` stays the default mode: it changes the wording of most toy narratives (a third of their sentences)
-and a fifth of the UAV ones (4 % of sentences), always verified. ``rewrite`` is not a default: 75-83 % of its
-texts fail verification (the template is shown instead), a text takes 10-17 s or more, and the rewrites that did
-verify read worse than the template (they drop reasons and garble directions; see the benchmark's example pairs).
+What each adds over the template: ``benchmarks/bench_lm_fill.py`` (fill) and ``benchmarks/bench_lm_modes.py``
+(choose, rewrite); the figures are in docs/benchmarks.md.
 
 Costs: the first use ever converts the packaged GGUF file to a safetensors copy under the model cache (46 s on
 busy cores, once); after that a new process needs 14 s to its first narrative with ``threads=1`` (import xairl

@@ -49,6 +49,7 @@ RULES = {
     "tracked.direction": "a direction word ('raised', 'against', 'favoured B') against its feature's sign",
     "tracked.rank": "a rank word ('most', 'biggest', 'second') against the rank of the feature it names",
     "tracked.level": "a level word ('low', 'normal', 'high') against the level of the feature it is said of",
+    "tracked.untracked": "a number the template wrote itself that the reader cannot bind and that is no fact of the decision",
     "tracked.comparison": "'A mattered more than B' against the sizes of their contributions",
 }
 
@@ -90,24 +91,49 @@ _SIGNED_CONTEXT = re.compile(
     r"\b(?:side|push\w*|pull\w*|weigh\w*|reasons?|help\w*|hurt\w*|held|back|for|against|toward\w*|favou?r\w*)\b",
     re.IGNORECASE,
 )
-_SIGN_WORDS = re.compile(
-    r"\b(?:below zero|under zero|minus|negative|drop|dropped|fell|fall|down|lower|decrease\w*|less than zero|"
-    r"deficit|short|behind)\b",
+#: words right before a value that carry its sign ('minus 1.46', 'a drop of 1.46'), and right after it ('1.46 below
+#: zero')
+_SIGN_BEFORE = re.compile(
+    r"\b(?:minus|negative|a drop of|a fall of|a deficit of|fell(?: by)?|dropped(?: by)?|down(?: by)?|"
+    r"decreased(?: by)?|short by)\W*$",
     re.IGNORECASE,
 )
+_SIGN_AFTER = re.compile(r"^\W*(?:(?:below|under|less than) (?:zero|0)|in the red|negative|short)\b", re.IGNORECASE)
 _CHOSEN_BEFORE = re.compile(
     r"\b(?:chose|chosen|choose|chooses|picked|picks|selected|selects|took|takes|preferred|prefers|went with|"
-    r"decided on|decision(?: was)?|winner(?: was| is)?|won with|(?<!next )best(?: action)?(?: was| is)?)\W*$",
+    r"decided on|decision(?: was)?|winner(?: was| is)?|won with|(?<!next )best(?: action)?(?: was| is)?|"
+    r"executing|executes|executed|why|action\s*[=:]|chosen\s*[=:]|decision\s*[=:])\W*$",
     re.IGNORECASE,
 )
 _RUNNER_BEFORE = re.compile(
-    r"\b(?:runner[- ]up(?: was| is)?|second(?: was| is| best| choice| place)?|rather than|instead of|beat|beats|next best(?: was| is)?|alternative(?: was| is)?)\W*$",
+    r"\b(?:runner[-_ ]?up(?: was| is)?|second(?: was| is| best| choice| place)?|rather than|instead of|beat|beats|"
+    r"next best(?: was| is)?|alternative(?: was| is)?|why not|preferred to|preferred over|"
+    r"(?:lead|margin|edge|advantage|ahead) over|over)\W*$",
     re.IGNORECASE,
 )
 _CHOSEN_AFTER = re.compile(
-    r"^\W*(?:won|wins|was chosen|is chosen|was picked|was selected|beat|beats|came first)\b", re.I
+    r"^\W*(?:won|wins|was chosen|is chosen|was picked|was selected|was preferred|is preferred|beat|beats|"
+    r"came first)\b",
+    re.I,
 )
 _RUNNER_AFTER = re.compile(r"^\W*(?:came second|was second|lost|was the runner[- ]up|trailed)\b", re.I)
+#: words that make a background average what it is ('on average', 'the background's'); a base value printed in
+#: a sentence without one is the average written as if it were the decision's own number
+_BASE_WORDS = re.compile(
+    r"\b(?:average|averages|expected|expectation|baseline|base|background|typical|usual|mean|prior|start\w*|"
+    r"reference)\b",
+    re.IGNORECASE,
+)
+#: a score named with its action: 'turn (score 3.05)', 'turn won with a score of 3.05', 'score=... for turn'
+_SCORE_OF_BEFORE = re.compile(r"^\W*(?:\w+\W+){0,8}$")
+#: an action's cell, then its score's ('turn | score 3.05', '| turn | score: 3.05')
+_CELL_SCORE = re.compile(r"\s*\|\s*(?:score|q[- ]?value|value)?\s*[=:]?\s*", re.IGNORECASE)
+#: words after a number that make it a contribution ('+0.35 to its margin', '+0.82 (for forward)')
+_AS_CONTRIBUTION = re.compile(
+    r"\s*(?:\(\s*)?(?:to (?:the |its )?(?:margin|score)|(?:for|against|toward|towards|in favou?r of)\s*$)", re.I
+)
+_SCORE_FOR_AFTER = re.compile(r"^\s*(?:for|of|by)\s*$", re.IGNORECASE)
+_SIDE_OF = re.compile(r"^['’]s\s+(?:side|favou?r|camp)\b", re.IGNORECASE)
 #: a label right before a number (key=value, 'score of', '(margin '); quantity group it names
 _LABELS = (
     (re.compile(r"\b(?:average|expected|baseline|base(?: value)?|background)\b[\w\s']{0,12}\W*$", re.I), "base"),
@@ -120,12 +146,21 @@ _LABELS = (
     ),
     (re.compile(r"\b(?:margin|gap|lead)\b(?:\s+(?:of|was|is))?\W*$", re.I), "margin"),
     (re.compile(r"\b(?:share)\b(?:\s+(?:of|was|is))?\W*$", re.I), "share"),
+    (
+        re.compile(
+            r"\b(?:by|added|adds|adding|subtracted|took|cut|cutting|contributed|contributing|gave|worth)"
+            r"(?:\s+(?:about|around|roughly|some|nearly|almost|just))?\W*$",
+            re.I,
+        ),
+        "change",
+    ),
     (re.compile(r"\b(?:rank(?:ed)?)\b(?:\s+(?:of|was|is))?\W*$", re.I), "rank"),
 )
 _LABEL_FITS = {
     "base": {"base_value", "base_margin", "mean", "mean_abs"},
     "score": {"score", "contribution"},  # ('it raised the score by +0.3': a contribution to it)
-    "margin": {"margin", "base_margin", "contribution"},
+    "margin": {"margin", "contribution"},
+    "change": {"margin", "base_margin", "contribution", "share", "mean", "mean_abs", "comparison_value"},
     "share": {"share"},
     "rank": {"rank"},
 }
@@ -258,13 +293,15 @@ def _transformed(x: float, transform: str, percent: bool = False) -> float:
     return x
 
 
-def _close(printed: float, expected: float, text: str) -> bool:
+def _close(printed: float, expected: float, text: str, transform: str = "") -> bool:
     """``printed`` (as ``text`` writes it) is ``expected`` rounded: within half a unit of its last digit (3
-    significant digits at least)."""
+    significant digits at least), or of the digits a ``round:N`` transform kept ('|round' prints -1.0 for -1.21)."""
     if not math.isfinite(expected):
         return False
     digits = re.search(r"\.(\d+)", text)
     step = 10.0 ** -(len(digits.group(1)) if digits else 0)
+    for kept in re.findall(r"round:(-?\d+)", transform):
+        step = max(step, 10.0 ** -int(kept))
     return abs(printed - expected) <= 0.5 * step + 5e-4 * abs(expected) + 1e-12
 
 
@@ -291,7 +328,7 @@ def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
     if isinstance(expected, (int, float, np.floating)) and not isinstance(expected, bool):
         printed = _number(span.text)
         want = _transformed(float(expected), span.transform, percent)
-        ok = printed is not None and _close(printed, want, span.text)
+        ok = printed is not None and _close(printed, want, span.text, span.transform)
         detail = f"{f.quantity}{' of ' + f.feature if f.feature else ''} = {float(expected):.4g}"
         detail += f" ({span.transform}: {want:.4g})" if span.transform else ""
         return Claim("number", span.text, "verified" if ok else "contradicted", detail, "tracked.fact")
@@ -429,7 +466,7 @@ class _Sentence:
         printed = _number(p.span.text)
         if not isinstance(expected, (int, float)) or printed is None or expected >= 0 or printed < 0:
             return None
-        if abs(float(expected)) < 1e-9 or _SIGN_WORDS.search(self.before(p, 30) + " " + self.after(p, 30)):
+        if abs(float(expected)) < 1e-9 or _SIGN_BEFORE.search(self.before(p, 30)) or _SIGN_AFTER.match(self.after(p)):
             return None
         return Claim(
             "number",
@@ -442,17 +479,7 @@ class _Sentence:
     def label(self, p: _Part) -> Claim | None:
         """'score=' / 'margin of' / 'average' right before a number of another quantity."""
         q = p.span.fact.quantity
-        if q not in {
-            "score",
-            "margin",
-            "base_value",
-            "base_margin",
-            "share",
-            "rank",
-            "contribution",
-            "mean",
-            "mean_abs",
-        }:
+        if q not in _NUMERIC | {"value_text"}:
             return None
         before = self.before(p, 24)
         if _DIFFERENCE.match(self.after(p, 20)):  # 'its score was 2.34 higher': a difference, not the score
@@ -468,6 +495,14 @@ class _Sentence:
                     f"written as the {group}, but it is the {q.replace('_', ' ')}",
                     "tracked.label",
                 )
+        if q in ("value", "value_text") and _AS_CONTRIBUTION.match(self.after(p, 30)):
+            return Claim(
+                "number",
+                p.span.text,
+                "contradicted",
+                f"{p.span.fact.feature}'s value, written as its contribution",
+                "tracked.label",
+            )
         if q == "contribution" and (m := _VIEW_AFTER.search(self.after(p, 30))):
             said = "margin" if m.group(1) else "score"
             if said != _view(p.span.fact.view):
@@ -481,11 +516,17 @@ class _Sentence:
         return None
 
     def role(self, p: _Part) -> Claim | None:
-        """An action named with the other role's words."""
+        """An action named with the other role's words, or a score beside the other action."""
         role = p.span.fact.role
         if self.truth.output != "actions" or self.truth.actions.get("chosen") == self.truth.actions.get("runner_up"):
             return None
+        if p.span.fact.quantity == "score":
+            return self._score_role(p)
         before, after = self.before(p, 30), self.after(p, 30)
+        prev = next((q for q in reversed(self.spans) if q.end <= p.start), None)
+        if prev is not None and prev.span.fact.quantity == "action" and re.fullmatch(r"\s+over\s+", before):
+            said = "chosen" if prev.span.fact.role == "runner_up" else "runner_up"  # 'A over B': the other one
+            return None if said == role else self._role_claim(p, role, said)
         said = (
             "chosen"
             if _CHOSEN_BEFORE.search(before) or _CHOSEN_AFTER.search(after)
@@ -493,14 +534,65 @@ class _Sentence:
             if _RUNNER_BEFORE.search(before) or _RUNNER_AFTER.search(after)
             else None
         )
-        if said is None or said == role:
-            return None
+        return None if said is None or said == role else self._role_claim(p, role, said)
+
+    @staticmethod
+    def _role_claim(p: _Part, role: str, said: str) -> Claim:
         return Claim(
             "action",
             p.span.text,
             "contradicted",
             f"{p.span.text} is the {role.replace('_', '-')}, named as the {said.replace('_', '-')}",
             "tracked.role",
+        )
+
+    def _score_role(self, p: _Part) -> Claim | None:
+        """A score is the score of the action its words give it to: a 'runner-up' label, a 'chosen' one, else the
+        action right before it in its segment ('turn (score 3.05)'), else the one right after 'for' ('3.99 for B')."""
+        role, before = p.span.fact.role, self.before(p, 60)
+        said = "runner_up" if re.search(r"runner[-_ ]?up|second|next best", before, re.I) else None
+        said = said or ("chosen" if re.search(r"\b(?:chosen|chose|picked|winner|won)\b", before, re.I) else None)
+        if said is None:
+            earlier = [q for q in self.spans if q.end <= p.start]
+            later = [q for q in self.spans if q.start >= p.end]
+            if earlier and earlier[-1].span.fact.quantity == "action":
+                between = self.text[earlier[-1].end : p.start]
+                if (earlier[-1].block == p.block and _SCORE_OF_BEFORE.match(between)) or _CELL_SCORE.fullmatch(between):
+                    said = earlier[-1].span.fact.role
+            if said is None and later and later[0].span.fact.quantity == "action":
+                if _SCORE_FOR_AFTER.match(self.text[p.end : later[0].start]):
+                    said = later[0].span.fact.role
+            said = said or self._respective_role(p)
+        if said is None or said == role:
+            return None
+        return Claim(
+            "number",
+            p.span.text,
+            "contradicted",
+            f"{p.span.text} is the {role.replace('_', '-')}'s score, written as the {said.replace('_', '-')}'s",
+            "tracked.role",
+        )
+
+    def _respective_role(self, p: _Part) -> str | None:
+        """'A rather than B: ... (x vs y)': two scores after two actions of different roles pair in order."""
+        actions = [q for q in self.spans if q.span.fact.quantity == "action"]
+        scores = [q for q in self.spans if q.span.fact.quantity == "score"]
+        roles = [q.span.fact.role for q in actions]
+        if len(scores) != 2 or len(actions) != 2 or len(set(roles)) != 2 or scores[0].start < actions[-1].end:
+            return None
+        return roles[scores.index(p)]
+
+    def base(self, p: _Part) -> Claim | None:
+        """A background average in a sentence with no word that says it is one."""
+        if _BASE_WORDS.search(_literal(self.text, self.parts, 0, len(self.text))):
+            return None
+        return Claim(
+            "number",
+            p.span.text,
+            "contradicted",
+            f"{p.span.text} is the {p.span.fact.quantity.replace('_', ' ')} (the background's average), written "
+            "with no word that says so",
+            "tracked.label",
         )
 
     def directions(self) -> list[Claim]:
@@ -515,6 +607,13 @@ class _Sentence:
             found += [(m, -1 if m.group("neg") else 0) for m in _EXTRA_DIRECTIONS.finditer(words)]
             if self._between_numbers(p) and re.fullmatch(r"\W*\w+\W*", words):
                 continue  # '-0.97 against +0.88', '3.05 vs 0.71': a comparison of two numbers
+            prev = next((q for q in reversed(self.spans) if q.end <= p.start), None)
+            if prev is not None and prev.end == p.start and prev.span.fact.quantity == "action":
+                side = _SIDE_OF.match(words)  # 'the feature most on B's side': for B
+                target = self._said_of(p) if side else None
+                if target is not None:
+                    polarity = -1 if prev.span.fact.role == "runner_up" else 1
+                    out.append(self._judge(side.group(0), polarity, target, prev))
             for m, polarity in found:
                 action = self._action_after(p, m.end())
                 if action is None and _SIDE.fullmatch(m.group(0)) and not _CHOSEN_SIDE.match(words, m.end()):
@@ -721,14 +820,35 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, read, smu
             extra.append(s.sign(p))
         if q in _NUMERIC:
             extra.append(s.label(p))
-        if q == "action" and p.span.fact.role:
+        if q in ("base_value", "base_margin"):
+            extra.append(s.base(p))
+        if q in ("action", "score") and p.span.fact.role:
             extra.append(s.role(p))
         claims += [c for c in extra if c is not None]
     claims += s.directions() + s.levels() + s.ranks() + s.comparisons()
     literal = _literal(sentence, s.parts, 0, len(sentence))
     if smuggled or re.search(r"\d|[A-Za-z][A-Za-z0-9]*_[A-Za-z0-9]", literal):  # an untracked number or identifier
-        claims += [c for c in read(sentence) if _untracked(c, sentence, s.spans, smuggled)]
+        claims += [_own(c, truth) for c in read(sentence) if _untracked(c, sentence, s.spans, smuggled)]
     return claims
+
+
+def _own(c: Claim, truth: Truth) -> Claim:
+    """A reader's claim in an own narrative: a number the template wrote itself that the reader leaves unchecked
+    must at least be one of the decision's numbers (a score, a value, a contribution, a share, a rank, as printed);
+    one that is none of them is made up, and contradicted."""
+    if c.kind != "number" or c.status != "unchecked":
+        return c
+    printed = _number(c.text)
+    facts = [float(v) for v in truth.values.values() if isinstance(v, (int, float)) and not isinstance(v, bool)]
+    if printed is None or any(_close(abs(printed), abs(v), c.text) for v in facts if math.isfinite(v)):
+        return c
+    return Claim(
+        "number",
+        c.text,
+        "contradicted",
+        f"not taken from the facts, and none of this decision's numbers ({c.detail})",
+        "tracked.untracked",
+    )
 
 
 def _untracked(c: Claim, sentence: str, spans: list[_Part], any_kind: bool = False) -> bool:
@@ -773,12 +893,47 @@ def verify(
     exp = in_regions(explanation)
     book = truth(exp, index, policy, facts)
     read = reader(exp, index, policy, facts)
-    checks = []
+    checks, header = [], None
     for a, b in sentences(text):
         own = [s.shifted(-a) for s in provenance if a <= s.start and s.end <= b]
         sentence = text[a:b]
         smuggled = any(a <= s.start < b for s in claimy)
-        claims = check_sentence(sentence, own, book, read, smuggled) if own else read(sentence)
+        header, labelled = _table_row(sentence, own, header)
+        if labelled is not None:  # a table's row, each cell read after its column's header ('chosen: turn')
+            sentence_read, spans_read, back = labelled
+            claims = check_sentence(sentence_read, spans_read, book, read, smuggled)
+            claims = [replace(c, span=back.get(id(c.span), c.span)) for c in claims]
+        else:
+            claims = (
+                check_sentence(sentence, own, book, read, smuggled) if own else [_own(c, book) for c in read(sentence)]
+            )
         claims = [replace(c, span=c.span.shifted(a)) if c.span is not None else c for c in claims]
         checks.append(SentenceCheck(sentence.strip(), tuple(claims)))
     return Verification(tuple(checks))
+
+
+_SEPARATOR_ROW = re.compile(r"\s*\|?(?:\s*:?-{3,}:?\s*\|)+\s*:?-*:?\s*")
+
+
+def _table_row(sentence: str, spans: list[Span], header: list[str] | None):
+    """(the table's header so far, and for a row under it: the row with each cell after its header's words, its
+    spans moved there, and {id of a moved span: the span}); a line that is no table row ends the table."""
+    if not sentence.strip().startswith("|"):
+        return None, None
+    if _SEPARATOR_ROW.fullmatch(sentence):
+        return header, None
+    bars = [i for i, ch in enumerate(sentence) if ch == "|"]
+    cells = list(zip(bars, bars[1:]))
+    if header is None or not spans:
+        return header or [sentence[x + 1 : y].strip() for x, y in cells], None
+    out, moved, back, pos = "", [], {}, 0
+    for n, (x, y) in enumerate(cells):
+        out += sentence[pos : x + 1] + (f" {header[n]}:" if n < len(header) and header[n] else "")
+        shift = len(out) - (x + 1)
+        for sp in spans:
+            if x < sp.start and sp.end <= y:
+                moved.append(sp.shifted(shift))
+                back[id(moved[-1])] = sp
+        pos = x + 1
+    out += sentence[pos:]
+    return header, (out, moved, back)
