@@ -48,7 +48,7 @@ def run(name: str, template: str, states: int, threads: int) -> tuple[dict, list
     options = {"threads": threads}
     xairl.narrate(exp, 0, narrator="local_lm", policy=policy, template=template, options=options, robustness=False)
     first = accepted = 0
-    times, tries, pages = [], [], []
+    times, tries, pages, sentences = [], [], [], [0, 0]
     for i in range(states):
         t = time.perf_counter()
         n = xairl.narrate(
@@ -59,6 +59,9 @@ def run(name: str, template: str, states: int, threads: int) -> tuple[dict, list
         accepted += ours
         first += ours and n.extras["tries"] == 1
         tries.append(n.extras["tries"])
+        done, total = n.extras.get("reworded", (0, 0)) if ours else (0, 0)
+        sentences[0] += done
+        sentences[1] += total or sum(1 for s in n.provenance[:1])
         if ours:
             plain = xairl.narrate(exp, i, policy=policy, template=template, robustness=False).text
             pages.append(
@@ -74,6 +77,7 @@ def run(name: str, template: str, states: int, threads: int) -> tuple[dict, list
         "median_s": statistics.median(times),
         "p90_s": sorted(times)[int(0.9 * (len(times) - 1))],
         "mean_tries": statistics.mean(tries),
+        "sentences_reworded": sentences[0],
     }
     return row, pages
 
@@ -93,7 +97,8 @@ def main() -> None:
         pages += more
         print(
             f"{name:10s} {template:16s} {row['first_try']:>4d}/{row['states']:<5d} {row['accepted']:>4d}/"
-            f"{row['states']:<4d} {row['median_s']:9.2f} {row['p90_s']:7.2f} {row['mean_tries']:.2f}"
+            f"{row['states']:<4d} {row['median_s']:9.2f} {row['p90_s']:7.2f} {row['mean_tries']:.2f}  "
+            f"{row['sentences_reworded']} sentences reworded"
         )
     with open(args.out, "w") as fh:
         fh.write("# local_lm fill: accepted texts with their facts\n\n" + "\n".join(pages))

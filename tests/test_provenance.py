@@ -262,12 +262,6 @@ def test_direction_words_toward_a_named_action(tmp_path, exps):
     assert v.ok, contradicted(v)
 
 
-@pytest.mark.xfail(
-    reason="provenance._parts cuts a run of literal words only at its first segment break, so in "
-    "'speed (0.40, low) and battery (0.30, high)' the word 'low' lands in battery's segment: it is judged against "
-    "battery (high) and contradicted, and 'speed (0.40, high)' (speed is low) is not contradicted",
-    strict=True,
-)
 def test_level_words_of_a_list_are_each_said_of_their_own_feature(tmp_path, exps):
     levels = exps["levels"]
     assert [(f.name, f.level) for f in decision_facts(levels, 0).top] == [

@@ -147,10 +147,12 @@ class Narrator:
             else [narrated]
         )
         texts, claims, ok, sources, rejected, scores, comps, sentences = [], [], True, [], [], [], [], []
-        tries = 0
+        tries, reworded = 0, [0, 0]
         for j, view in enumerate(views):
             text, check, source, bad, tried = self._words(view, index, tpl, policy, k, history)
             tries = max(tries, tried)
+            if getattr(text, "reworded", None):  # (sentences a narrator reworded, sentences with facts)
+                reworded = [a + b for a, b in zip(reworded, text.reworded)]
             texts.append((text, text.spans))
             claims += check.claims
             sentences += [(s.text, s.status) for s in check.sentences]
@@ -181,7 +183,8 @@ class Narrator:
             template=tpl.name,
             index=index,
             rejected=" ".join(rejected) or None,
-            extras={"method": explanation.method, "tries": tries},
+            extras={"method": explanation.method, "tries": tries}
+            | ({"reworded": tuple(reworded)} if reworded[1] else {}),
             sentences=tuple(sentences),
         )
         return replace(told, evidence=evidence(narrated, told))

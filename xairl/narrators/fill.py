@@ -11,7 +11,6 @@ facts, and the model's own words between them are judged by :mod:`xairl.narrator
 
 from __future__ import annotations
 
-import difflib
 import re
 import unicodedata
 from functools import lru_cache
@@ -26,8 +25,12 @@ INSTRUCTION = (
 COPY_BIAS = 1.0
 #: added to the logit of the next slot's first token: the model is drawn to the next fact, not to words of its own
 SLOT_BIAS = 3.0
-#: the share of a stretch of the template's words a rewording keeps (difflib's ratio of the two word lists)
+#: the share of a stretch of the template's words a rewording keeps
 MIN_KEPT = 0.5
+#: words a rewording may add between two facts
+LINKING = frozenset({"and", "then", "also", "while", "with", "so"})
+#: words that cannot end a stretch before a fact unless the template's does ('a 0.45')
+DANGLING = frozenset({"a", "an", "the", "of", "to", "by", "at", "for", "with"})
 
 
 @lru_cache(maxsize=4)
@@ -136,31 +139,48 @@ def _gaps_text(text: Rendered) -> list[str]:
 _JUNK = re.compile(r"\(\s*\)|[.,;:]\s*[.,;:]|\s{2,}|\b(?:and|by|of|the|a)\s*[.;]")
 
 
+def _is_subsequence(small: list[str], big: list[str]) -> bool:
+    it = iter(big)
+    return all(w in it for w in small)
+
+
 def _rewording(words: Rendered, sentence: Rendered) -> bool:
-    """The model's words between the slots are a rewording of the template's: each stretch keeps at least
-    :data:`MIN_KEPT` of its words (a tiny model that wanders writes word salad around correct numbers), and no
-    broken punctuation."""
+    """The model's words between the slots are a rewording of the template's: in each stretch between two slots it
+    may drop words and add linking words (:data:`LINKING`), but not add others nor change their order (a tiny
+    model moves 'candidate' past its number: 'a handover to 1 candidate 51.0'); it may not end a stretch on a word
+    that wants its noun ('a 0.45'), nor break the punctuation."""
     if _JUNK.search(str(words)) and not _JUNK.search(str(sentence)):
         return False
     for mine, theirs in zip(_gaps_text(words), _gaps_text(sentence)):
-        a, b = mine.lower().split(), theirs.lower().split()
-        if len(a) + len(b) > 2 and difflib.SequenceMatcher(None, a, b).ratio() < MIN_KEPT:
+        a, b = re.findall(r"[\w'’-]+", mine.lower()), re.findall(r"[\w'’-]+", theirs.lower())
+        if not _is_subsequence([w for w in a if w not in LINKING], b):
+            return False
+        if a and a[-1] in DANGLING and (not b or b[-1] != a[-1]):
+            return False
+        if len(a) < MIN_KEPT * len(b):
             return False
     return True
 
 
 def fill(model, tok, prefix, sentences: list[Rendered], attempt: int, context: dict) -> Rendered | None:
     """One try: the model's rewording of each sentence around its tracked spans (greedy on the first try, sampled
-    after), joined; None when a sentence's output is refused (a name the template did not write outside a slot)."""
+    after); a sentence whose rewording is refused (its words wander from the template's, break, or name something
+    the template did not) keeps the template's words. None when no sentence was reworded. The result's
+    ``reworded`` is (sentences reworded, sentences with facts)."""
     from .base import join_sentences
 
-    out = []
+    out, reworded, total = [], 0, 0
     for sentence in sentences:
-        words = _reword(model, tok, prefix, sentence, attempt) if sentence.spans else sentence
-        if words is None or _new_names(words, sentence, context) or not _rewording(words, sentence):
-            return None
-        out.append(words)
-    return join_sentences(out)
+        words = _reword(model, tok, prefix, sentence, attempt) if sentence.spans else None
+        total += bool(sentence.spans)
+        ok = words is not None and not _new_names(words, sentence, context) and _rewording(words, sentence)
+        reworded += ok and str(words) != str(sentence)
+        out.append(words if ok else sentence)
+    if not reworded:
+        return None
+    result = join_sentences(out)
+    result.reworded = (reworded, total)
+    return result
 
 
 def _reword(model, tok, prefix, sentence: Rendered, attempt: int) -> Rendered | None:

@@ -379,12 +379,13 @@ def _parts(sentence: str, spans: Sequence[Span]) -> list[_Part]:
         end = len(sentence) if s is None else s.start
         if end > pos:
             words = sentence[pos:end]
-            cuts = [m.start() for m in _SEGMENT.finditer(words)]
-            if cuts:
-                out.append(_Part(pos, pos + cuts[0], None, seg, block))
+            at = 0
+            for m in _SEGMENT.finditer(words):  # each cut starts a new segment (and a block at ; : | or a break)
+                out.append(_Part(pos + at, pos + m.start(), None, seg, block))
                 seg += 1
-                block += bool(_BLOCK.search(words))
-            out.append(_Part(pos + (cuts[0] if cuts else 0), end, None, seg, block))
+                block += bool(_BLOCK.match(words, m.start()))
+                at = m.start()
+            out.append(_Part(pos + at, end, None, seg, block))
         if s is not None:
             out.append(_Part(s.start, s.end, s, seg, block))
             pos = max(pos, s.end)
@@ -697,11 +698,8 @@ class _Sentence:
             for m in _LEVEL.finditer(self.text[p.start : p.end]):
                 prev = next((q for q in reversed(self.spans) if q.end <= p.start), None)
                 own = {q.span.fact.feature: q for q in self.names if q.segment == p.segment}
-                if (
-                    prev is not None
-                    and prev.segment == p.segment
-                    and prev.span.fact.quantity in ("value", "value_text")
-                ):
+                right_after = prev is not None and not re.search(r"\w", self.text[prev.end : p.start + m.start()])
+                if right_after and prev.span.fact.quantity in ("value", "value_text"):  # '(0.40, low)'
                     name = prev.span.fact.feature
                 elif len(own) == 1:
                     name = next(iter(own))
