@@ -12,12 +12,17 @@ names are the verifier's vocabulary (which also takes a region's extent as its n
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import replace
 
 import numpy as np
 
 from .explanation import Explanation
 from .observation import Observation
+
+#: id of an explanation -> (a weak reference to it, its regioned copy): narrating, verifying and reporting a
+#: decision each ask for the same regions (kept while the explanation lives)
+_MEMO: dict[int, tuple[weakref.ref, Explanation]] = {}
 
 
 def in_regions(exp: Explanation) -> Explanation:
@@ -26,6 +31,17 @@ def in_regions(exp: Explanation) -> Explanation:
     itself when it has no image part with patches larger than a pixel (flat, small or already grouped explanations)."""
     if exp.observation is None:
         return exp
+    hit = _MEMO.get(id(exp))
+    if hit is not None and hit[0]() is exp:
+        return hit[1]
+    out = _in_regions(exp)
+    if out is not exp:
+        key = id(exp)
+        _MEMO[key] = (weakref.ref(exp, lambda _, key=key: _MEMO.pop(key, None)), out)
+    return out
+
+
+def _in_regions(exp: Explanation) -> Explanation:
     observation = Observation.from_dict(exp.observation)
     groups = observation.regions()
     if not groups:

@@ -46,6 +46,11 @@ def _vocabulary(tok) -> frozenset[int]:
     return frozenset(banned)
 
 
+@lru_cache(maxsize=4)
+def _percent(tok) -> frozenset[int]:
+    return frozenset(i for i in range(len(tok)) if "%" in tok.decode([i]))
+
+
 class SpanKeeper:
     """A logits processor that keeps the slots (module doc). ``slots``: the token ids of each span's text, as it
     would follow a space and as it would follow no space; ``gaps``: the template's number of tokens before each slot
@@ -53,6 +58,8 @@ class SpanKeeper:
 
     def __init__(self, tok, slots, gaps: list[int], prompt_len: int, own=(), ending: list[int] = ()):
         banned = _vocabulary(tok)
+        if "%" not in tok.decode(list(own)):  # no percentage the template did not write
+            banned = banned | _percent(tok)
         # the slots' own tokens that the template's words do not have ('standardised', 'typical'): only in a slot
         self.banned = banned | ({t for a, b in slots for t in a + b} - set(own))
         self.slots, self.eos, self.seen = slots, tok.eos_token_id, prompt_len

@@ -240,6 +240,7 @@ def truth(exp: Explanation, index: int | None, policy: Policy | None, domain: Do
         values[("method", None, None, None)] = exp.method
         return Truth(values, features, {}, exp.output)
     d = decision_facts(exp, index, policy, k=len(exp.feature_names))
+    domain = domain or DomainFacts(d.extras, d.comparisons)  # the policy's facts hook, called again
     actions = {"chosen": d.action, "runner_up": d.runner_up}
     values.update(
         {
@@ -320,6 +321,14 @@ def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
     kind = _KINDS.get(f.quantity, "number" if f.quantity in _NUMERIC else "feature")
     if f.quantity == "value_text":
         kind = "number" if re.search(r"\d", span.text) else "category"
+    if percent and f.quantity in _NUMERIC and f.quantity not in ("share", "fill") and "scale:100" not in span.transform:
+        return Claim(
+            kind,
+            span.text,
+            "contradicted",
+            f"the {f.quantity.replace('_', ' ')}, written as a percentage",
+            "tracked.label",
+        )
     if expected is _MISSING:
         what = f"{f.quantity} of {f.feature}" if f.feature else f.quantity
         return Claim(
@@ -826,19 +835,29 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, read, smu
     claims += s.directions() + s.levels() + s.ranks() + s.comparisons()
     literal = _literal(sentence, s.parts, 0, len(sentence))
     if smuggled or re.search(r"\d|[A-Za-z][A-Za-z0-9]*_[A-Za-z0-9]", literal):  # an untracked number or identifier
-        claims += [_own(c, truth) for c in read(sentence) if _untracked(c, sentence, s.spans, smuggled)]
+        named = {p.span.fact.feature for p in s.names}
+        claims += [_own(c, truth, named) for c in read(sentence) if _untracked(c, sentence, s.spans, smuggled)]
     return claims
 
 
-def _own(c: Claim, truth: Truth) -> Claim:
+def _own(c: Claim, truth: Truth, named: set[str] = frozenset()) -> Claim:
     """A reader's claim in an own narrative: a number the template wrote itself that the reader leaves unchecked
-    must at least be one of the decision's numbers (a score, a value, a contribution, a share, a rank, as printed);
-    one that is none of them is made up, and contradicted."""
+    must at least be one of the decision's own numbers (a score, the margin, a base value), a fact of a feature
+    the sentence names, or a count or rank (a whole number up to the number of features); one that is none of them
+    is made up, and contradicted."""
     if c.kind != "number" or c.status != "unchecked":
         return c
     printed = _number(c.text)
-    facts = [float(v) for v in truth.values.values() if isinstance(v, (int, float)) and not isinstance(v, bool)]
-    if printed is None or any(_close(abs(printed), abs(v), c.text) for v in facts if math.isfinite(v)):
+    facts = [
+        float(v)
+        for (quantity, feature, _, _), v in truth.values.items()
+        if isinstance(v, (int, float))
+        and not isinstance(v, bool)
+        and (feature is None or feature in named)
+        and quantity not in ("extra",)
+    ]
+    whole = printed is not None and printed == int(printed) and 0 < printed <= max(len(truth.features), 3)
+    if printed is None or whole or any(_close(abs(printed), abs(v), c.text) for v in facts if math.isfinite(v)):
         return c
     return Claim(
         "number",
@@ -879,7 +898,8 @@ def verify(
     """
     from .verify import verify as read_prose
 
-    if not provenance:
+    several = explanation.output == "continuous" and explanation.values.shape[2] > 1 and index is not None
+    if not provenance or several:  # (the spans of several dimensions do not say which one: narrate checks each)
         return read_prose(text, explanation, index, policy, facts=facts)
     if not isinstance(text, str):
         raise InputError(f"verify() reads text (a str), not {type(text).__name__}.")
@@ -890,7 +910,13 @@ def verify(
     provenance = [s for s in provenance if not _claimy(s)]
     exp = in_regions(explanation)
     book = truth(exp, index, policy, facts)
-    read = reader(exp, index, policy, facts)
+    readers = []
+
+    def read(sentence: str) -> list[Claim]:  # the reader of outside prose, set up only when a sentence needs it
+        if not readers:
+            readers.append(reader(exp, index, policy, facts))
+        return readers[0](sentence)
+
     checks, header = [], None
     for a, b in sentences(text):
         own = [s.shifted(-a) for s in provenance if a <= s.start and s.end <= b]
