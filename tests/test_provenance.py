@@ -1,4 +1,4 @@
-"""Verification of xairl's own words by provenance (xairl/narrators/provenance.py, issue 52): a tracked span is
+"""Verification of xairl's own words by provenance (xairl/narrators/provenance/, issue 52): a tracked span is
 checked by its fact, the template's literal words by the rules of provenance.RULES, each rule shown on a template
 sentence it must contradict and a correct paraphrase it must not."""
 
