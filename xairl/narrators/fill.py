@@ -172,18 +172,19 @@ def _rewording(words: Rendered, sentence: Rendered) -> bool:
 def fill(model, tok, prefix, sentences: list[Rendered], attempt: int, context: dict) -> Rendered | None:
     """One try: the model's rewording of each sentence around its tracked spans (greedy on the first try, sampled
     after); a sentence whose rewording is refused (its words wander from the template's, break, or name something
-    the template did not) keeps the template's words. None when no sentence was reworded. The result's
+    the template did not) keeps the template's words. None when no sentence's rewording was accepted. The result's
     ``reworded`` is (sentences reworded, sentences with facts)."""
     from .base import join_sentences
 
-    out, reworded, total = [], 0, 0
+    out, accepted, reworded, total = [], 0, 0, 0
     for sentence in sentences:
         words = _reword(model, tok, prefix, sentence, attempt) if sentence.spans else None
         total += bool(sentence.spans)
         ok = words is not None and not _new_names(words, sentence, context) and _rewording(words, sentence)
+        accepted += ok
         reworded += ok and str(words) != str(sentence)
         out.append(words if ok else sentence)
-    if not reworded:
+    if not accepted:  # (the model kept no sentence's facts: the template's text is no try of the model's)
         return None
     result = join_sentences(out)
     result.reworded = (reworded, total)

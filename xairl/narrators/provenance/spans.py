@@ -17,6 +17,8 @@ from .lexicon import (
     DIFFERENCE,
     LABEL_FITS,
     LABELS,
+    LESS,
+    MORE,
     NUMERIC,
     RUNNER_AFTER,
     RUNNER_BEFORE,
@@ -56,9 +58,9 @@ class Sentence(WordRules):
 
     # -- rules ------------------------------------------------------------------------------------------------
     def binding(self, p: Part) -> Claim | None:
-        """A feature's number said of another feature: the name before it in its segment, else the first after it in
-        its segment, else the name before it in the sentence; a group of names followed by their numbers ('A and B:
-        a against b') pairs them in order."""
+        """A feature's number said of another feature: the name before it in its block (cut at ; : | and line
+        breaks), else the first after it in its block, else (a block naming none) the name before it in the sentence;
+        a group of names followed by their numbers ('A and B: a against b') pairs them in order."""
         feature, quantity = p.span.fact.feature, p.span.fact.quantity
         own = [q for q in self.names if q.block == p.block]
         before = [q for q in own if q.end <= p.start] or ([] if own else [q for q in self.names if q.end <= p.start])
@@ -80,6 +82,19 @@ class Sentence(WordRules):
         if len(group) > 1 and j < len(group) and group[j].span.fact.feature == feature:
             return None
         return self._crossed(p, last)
+
+    def _sizes_compared(self, p: Part) -> bool:
+        """``p`` stands in the list of numbers after 'A mattered more than B' (a block naming no feature): the sizes
+        compared, which a value is not."""
+        before = [q for q in self.names if q.end <= p.start]
+        return (
+            len(before) >= 2
+            and not any(q.block == p.block for q in self.names)
+            and bool(
+                MORE.search(self.text[before[-2].end : before[-1].start])
+                or LESS.search(self.text[before[-2].end : before[-1].start])
+            )
+        )
 
     def _crossed(self, p: Part, other: Part) -> Claim:
         return Claim(
@@ -126,7 +141,7 @@ class Sentence(WordRules):
                     f"written as the {group}, but it is the {q.replace('_', ' ')}",
                     "tracked.label",
                 )
-        if q in ("value", "value_text") and AS_CONTRIBUTION.match(self.after(p, 30)):
+        if q in ("value", "value_text") and (AS_CONTRIBUTION.match(self.after(p, 30)) or self._sizes_compared(p)):
             return Claim(
                 "number",
                 p.span.text,

@@ -141,7 +141,12 @@ def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
     kind = KINDS.get(f.quantity, "number" if f.quantity in NUMERIC else "feature")
     if f.quantity == "value_text":
         kind = "number" if re.search(r"\d", span.text) else "category"
-    if percent and f.quantity in NUMERIC and f.quantity not in ("share", "fill") and "scale:100" not in span.transform:
+    if (
+        percent
+        and f.quantity in NUMERIC
+        and f.quantity not in ("share", "fill", "value")
+        and "scale:100" not in span.transform
+    ):
         return Claim(
             kind,
             span.text,

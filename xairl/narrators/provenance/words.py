@@ -35,8 +35,7 @@ class WordRules:
         """Each direction word of the literal text against the sign of the feature it is said of."""
         out = []
         for p in self.parts:
-            if p.span is not None:
-                out += self._tracked_direction(p)
+            if p.span is not None:  # (a tracked direction word is checked by its fact: truth.check_fact)
                 continue
             words = self.text[p.start : p.end]
             found = [(m, 1 if m.group("pos") else -1) for m in DIRECTION_RE.finditer(words)]
@@ -66,12 +65,6 @@ class WordRules:
                 if target is not None:
                     out.append(self._judge(m.group(0), polarity, target, action))
         return out
-
-    def _tracked_direction(self, p: Part) -> list[Claim]:
-        f = p.span.fact
-        if f.quantity not in ("direction",) or f.feature is None:
-            return []
-        return []  # its word is checked by check_fact (the direction it prints is the feature's)
 
     def _action_after(self, p: Part, at: int) -> Part | None:
         """The tracked action right after a word at ``at`` of literal part ``p`` ('toward B', 'favoured B')."""
