@@ -4,7 +4,9 @@ narrative takes, and the accepted texts with their facts beside them, for a chec
 For each policy (the toy policy with ``explain_action``, the reference UAV policy ``uav-dqn`` with ``handover``) and
 ``--states`` decisions: ``xairl.narrate(..., narrator="local_lm")`` in its default mode (fill), warm. A narrative is
 accepted on the first try when its source is ``local_lm`` and ``extras["tries"] == 1``; accepted at all when its
-source is ``local_lm``; otherwise the template was shown. ``--out`` writes a Markdown file with every accepted text,
+source is ``local_lm``; otherwise the template was shown. An accepted text may keep the template's words in some or
+all of its sentences (the model copied them, or its rewording of them was refused); the sentences it reworded are
+counted apart. ``--out`` writes a Markdown file with every accepted text,
 the template's text and the decision's facts (the action, the scores, every feature's value and contribution in the
 margin view), which is what a person checks the words against.
 
@@ -48,7 +50,7 @@ def run(name: str, template: str, states: int, threads: int) -> tuple[dict, list
     options = {"threads": threads}
     xairl.narrate(exp, 0, narrator="local_lm", policy=policy, template=template, options=options, robustness=False)
     first = accepted = 0
-    times, tries, pages, sentences = [], [], [], [0, 0]
+    times, tries, pages, sentences, whole = [], [], [], [0, 0], 0
     for i in range(states):
         t = time.perf_counter()
         n = xairl.narrate(
@@ -59,9 +61,10 @@ def run(name: str, template: str, states: int, threads: int) -> tuple[dict, list
         accepted += ours
         first += ours and n.extras["tries"] == 1
         tries.append(n.extras["tries"])
-        done, total = n.extras.get("reworded", (0, 0)) if ours else (0, 0)
-        sentences[0] += done
-        sentences[1] += total or sum(1 for s in n.provenance[:1])
+        done, kept, total = n.extras.get("reworded", (0, 0, 0))
+        sentences[0] += done if ours else 0
+        sentences[1] += total
+        whole += ours and n.extras["tries"] == 1 and kept == total  # no sentence fell back to the template's words
         if ours:
             plain = xairl.narrate(exp, i, policy=policy, template=template, robustness=False).text
             pages.append(
@@ -77,7 +80,9 @@ def run(name: str, template: str, states: int, threads: int) -> tuple[dict, list
         "median_s": statistics.median(times),
         "p90_s": sorted(times)[int(0.9 * (len(times) - 1))],
         "mean_tries": statistics.mean(tries),
+        "first_try_every_sentence": whole,
         "sentences_reworded": sentences[0],
+        "sentences": sentences[1],
     }
     return row, pages
 
@@ -98,7 +103,8 @@ def main() -> None:
         print(
             f"{name:10s} {template:16s} {row['first_try']:>4d}/{row['states']:<5d} {row['accepted']:>4d}/"
             f"{row['states']:<4d} {row['median_s']:9.2f} {row['p90_s']:7.2f} {row['mean_tries']:.2f}  "
-            f"{row['sentences_reworded']} sentences reworded"
+            f"{row['sentences_reworded']}/{row['sentences']} sentences reworded (the others kept the template's "
+            f"words); first try with every sentence accepted from the model: {row['first_try_every_sentence']}"
         )
     with open(args.out, "w") as fh:
         fh.write("# local_lm fill: accepted texts with their facts\n\n" + "\n".join(pages))

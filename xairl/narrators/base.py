@@ -147,11 +147,11 @@ class Narrator:
             else [narrated]
         )
         texts, claims, ok, sources, rejected, scores, comps, sentences = [], [], True, [], [], [], [], []
-        tries, reworded = 0, [0, 0]
+        tries, reworded = 0, [0, 0, 0]
         for j, view in enumerate(views):
             text, check, source, bad, tried = self._words(view, index, tpl, policy, k, history)
             tries = max(tries, tried)
-            if getattr(text, "reworded", None):  # (sentences a narrator reworded, sentences with facts)
+            if getattr(text, "reworded", None):  # (sentences reworded, sentences accepted, sentences with facts)
                 reworded = [a + b for a, b in zip(reworded, text.reworded)]
             texts.append((text, text.spans))
             claims += check.claims
@@ -184,7 +184,7 @@ class Narrator:
             index=index,
             rejected=" ".join(rejected) or None,
             extras={"method": explanation.method, "tries": tries}
-            | ({"reworded": tuple(reworded)} if reworded[1] else {}),
+            | ({"reworded": tuple(reworded)} if reworded[2] else {}),
             sentences=tuple(sentences),
         )
         return replace(told, evidence=evidence(narrated, told))

@@ -173,7 +173,8 @@ def fill(model, tok, prefix, sentences: list[Rendered], attempt: int, context: d
     """One try: the model's rewording of each sentence around its tracked spans (greedy on the first try, sampled
     after); a sentence whose rewording is refused (its words wander from the template's, break, or name something
     the template did not) keeps the template's words. None when no sentence's rewording was accepted. The result's
-    ``reworded`` is (sentences reworded, sentences with facts)."""
+    ``reworded`` is (sentences the model reworded, sentences whose words it kept or reworded and were accepted,
+    sentences with facts)."""
     from .base import join_sentences
 
     out, accepted, reworded, total = [], 0, 0, 0
@@ -187,7 +188,7 @@ def fill(model, tok, prefix, sentences: list[Rendered], attempt: int, context: d
     if not accepted:  # (the model kept no sentence's facts: the template's text is no try of the model's)
         return None
     result = join_sentences(out)
-    result.reworded = (reworded, total)
+    result.reworded = (reworded, accepted, total)
     return result
 
 
