@@ -80,6 +80,28 @@ def first_phrasings(variants: list[list[str]]) -> Rendered:
     return join_sentences(s[0] for s in variants if s)
 
 
+def _template(explanation: Explanation, index: int | None, template: str | None, prompt_dirs: Iterable[str]):
+    """The template to narrate with (``template``, or the default for the output kind), refused in one line when it
+    does not fit a decision or a summary, or the policy's output kind."""
+    from .. import prompts
+
+    default = (
+        "global_summary" if index is None else "explain_action" if explanation.output == "actions" else "explain_output"
+    )
+    tpl = prompts.load(template or default, prompt_dirs)
+    if (tpl.spec.kind == "global") != (index is None):
+        raise InputError(
+            f"template '{tpl.name}' is a {tpl.spec.kind} template; use "
+            f"{'index=None' if tpl.spec.kind == 'global' else 'a state index'} with it."
+        )
+    if index is not None and explanation.output not in tpl.spec.outputs:
+        raise InputError(
+            f"template '{tpl.name}' narrates {' or '.join(tpl.spec.outputs)} outputs; this policy's "
+            f"output is {explanation.output}: use template '{default}'."
+        )
+    return tpl
+
+
 class Narrator:
     """Turns an Explanation into words that are checked against its numbers.
 
@@ -117,27 +139,8 @@ class Narrator:
         :param history: the states before ``index`` in the same episode (oldest first), for a policy whose
             ``facts_hook`` states facts over time ("the neighbour has been stronger for 3 decisions").
         """
-        from .. import prompts
-
         index = None if index is None else explanation.check_index(index)
-        default = (
-            "global_summary"
-            if index is None
-            else "explain_action"
-            if explanation.output == "actions"
-            else "explain_output"
-        )
-        tpl = prompts.load(template or default, prompt_dirs)
-        if (tpl.spec.kind == "global") != (index is None):
-            raise InputError(
-                f"template '{tpl.name}' is a {tpl.spec.kind} template; use "
-                f"{'index=None' if tpl.spec.kind == 'global' else 'a state index'} with it."
-            )
-        if index is not None and explanation.output not in tpl.spec.outputs:
-            raise InputError(
-                f"template '{tpl.name}' narrates {' or '.join(tpl.spec.outputs)} outputs; this policy's "
-                f"output is {explanation.output}: use template '{default}'."
-            )
+        tpl = _template(explanation, index, template, prompt_dirs)
         # an image is narrated in regions, not pixels (the confidence's robustness still reads the pixels); a
         # continuous action: each dimension is its own output, narrated and verified on its own
         narrated = in_regions(explanation)
