@@ -24,7 +24,7 @@ INSTRUCTION = (
 #: added to the logit of every token of the template's own words: the model rewords, it does not write anew
 COPY_BIAS = 1.0
 #: added to the logit of the next slot's first token: the model is drawn to the next fact, not to words of its own
-SLOT_BIAS = 3.0
+SLOT_BIAS = 2.0
 #: the share of a stretch of the template's words a rewording keeps
 MIN_KEPT = 0.5
 #: words a rewording may add between two facts
