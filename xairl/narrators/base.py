@@ -80,6 +80,12 @@ def first_phrasings(variants: list[list[str]]) -> Rendered:
     return join_sentences(s[0] for s in variants if s)
 
 
+def _checks(words: list[tuple]):
+    """(output index, verification) per narrated view: None for a single view, j for dimension j of a continuous
+    action (each its own output)."""
+    return [(j if len(words) > 1 else None, w[1]) for j, w in enumerate(words)]
+
+
 def _template(explanation: Explanation, index: int | None, template: str | None, prompt_dirs: Iterable[str]):
     """The template to narrate with (``template``, or the default for the output kind), refused in one line when it
     does not fit a decision or a summary, or the policy's output kind."""
@@ -149,46 +155,31 @@ class Narrator:
             if index is not None and explanation.output == "continuous"
             else [narrated]
         )
-        texts, claims, ok, sources, rejected, scores, comps, sentences = [], [], True, [], [], [], [], []
-        tries, reworded = 0, [0, 0, 0]
-        for j, view in enumerate(views):
-            text, check, source, bad, tried = self._words(view, index, tpl, policy, k, history)
-            tries = max(tries, tried)
-            if getattr(text, "reworded", None):  # (sentences reworded, sentences accepted, sentences with facts)
-                reworded = [a + b for a, b in zip(reworded, text.reworded)]
-            texts.append((text, text.spans))
-            claims += check.claims
-            sentences += [(s.text, s.status) for s in check.sentences]
-            ok &= check.ok
-            sources.append(source)
-            rejected += [bad] if bad else []
-            score, comp = confidence(
-                explanation,
-                index,
-                check.ok,
-                policy,
-                background,
-                robustness,
-                output=j if len(views) > 1 else None,
-                coverage=check.coverage,
+        words = [self._words(view, index, tpl, policy, k, history) for view in views]
+        scores, comps = zip(
+            *(
+                confidence(explanation, index, c.ok, policy, background, robustness, output=j, coverage=c.coverage)
+                for j, c in _checks(words)
             )
-            scores.append(score)
-            comps.append(comp)
+        )
+        reworded = [sum(counts) for counts in zip(*(getattr(w[0], "reworded", (0, 0, 0)) or (0, 0, 0) for w in words))]
+        sources = [source for _, _, source, _, _ in words]
         worst = int(np.argmin(scores))  # a continuous action is as trustworthy as its least trustworthy dimension
+        text = joined([(w[0], w[0].spans) for w in words], [" "] * (len(words) - 1))
         told = Narrative(
-            text=(text := joined(texts, [" "] * (len(texts) - 1))),
-            claims=tuple(claims),
+            text=text,
+            claims=tuple(c for _, check, _, _, _ in words for c in check.claims),
             provenance=text.spans,
-            verified=ok,
+            verified=all(check.ok for _, check, _, _, _ in words),
             confidence=scores[worst],
             components=comps[worst],
             source=next((s for s in sources if s != self.name), self.name),
             template=tpl.name,
             index=index,
-            rejected=" ".join(rejected) or None,
-            extras={"method": explanation.method, "tries": tries}
+            rejected=" ".join(bad for _, _, _, bad, _ in words if bad) or None,
+            extras={"method": explanation.method, "tries": max(w[4] for w in words)}
             | ({"reworded": tuple(reworded)} if reworded[2] else {}),
-            sentences=tuple(sentences),
+            sentences=tuple((s.text, s.status) for _, check, _, _, _ in words for s in check.sentences),
         )
         return replace(told, evidence=evidence(narrated, told))
 

@@ -108,10 +108,10 @@ class SpanKeeper:
         return scores
 
 
-def _gaps(tok, sentence: Rendered) -> list[int]:
-    """Tokens of the template's words before each span, and after the last."""
-    cuts = [0] + [x for sp in sentence.spans for x in (sp.start, sp.end)] + [len(sentence)]
-    return [len(tok.encode(sentence[a:b], add_special_tokens=False)) for a, b in zip(cuts[::2], cuts[1::2])]
+def _stretches(text: Rendered) -> list[str]:
+    """The literal words of ``text`` before each tracked span, and after the last."""
+    cuts = [0] + [x for sp in text.spans for x in (sp.start, sp.end)] + [len(text)]
+    return [text[a:b] for a, b in zip(cuts[::2], cuts[1::2])]
 
 
 def _new_names(words: Rendered, sentence: Rendered, context: dict) -> list[str]:
@@ -121,25 +121,13 @@ def _new_names(words: Rendered, sentence: Rendered, context: dict) -> list[str]:
         for f in context.get(key) or ():
             names |= {f.get("name"), f.get("label")}
 
-    def literal(text: Rendered) -> str:
-        out, pos = [], 0
-        for sp in text.spans:
-            out += [text[pos : sp.start], " "]
-            pos = sp.end
-        return "".join(out + [text[pos:]])
-
-    mine, template = literal(words), literal(sentence)
+    mine, template = " ".join(_stretches(words)), " ".join(_stretches(sentence))
     return [
         str(name)
         for name in filter(None, names)
         if len(re.findall(rf"(?<!\w){re.escape(str(name))}(?!\w)", mine, re.I))
         > len(re.findall(rf"(?<!\w){re.escape(str(name))}(?!\w)", template, re.I))
     ]
-
-
-def _gaps_text(text: Rendered) -> list[str]:
-    cuts = [0] + [x for sp in text.spans for x in (sp.start, sp.end)] + [len(text)]
-    return [text[a:b] for a, b in zip(cuts[::2], cuts[1::2])]
 
 
 #: broken output: empty brackets, punctuation repeated, a dangling word before a stop
@@ -158,7 +146,7 @@ def _rewording(words: Rendered, sentence: Rendered) -> bool:
     that wants its noun ('a 0.45'), nor break the punctuation."""
     if _JUNK.search(str(words)) and not _JUNK.search(str(sentence)):
         return False
-    for mine, theirs in zip(_gaps_text(words), _gaps_text(sentence)):
+    for mine, theirs in zip(_stretches(words), _stretches(sentence)):
         a, b = re.findall(r"[\w'’-]+", mine.lower()), re.findall(r"[\w'’-]+", theirs.lower())
         if not _is_subsequence([w for w in a if w not in LINKING], b):
             return False
@@ -202,12 +190,9 @@ def _reword(model, tok, prefix, sentence: Rendered, attempt: int) -> Rendered | 
         (tok.encode(" " + sp.text, add_special_tokens=False), tok.encode(sp.text, add_special_tokens=False))
         for sp in sentence.spans
     ]
-    literal, pos = [], 0
-    for sp in sentence.spans:
-        literal, pos = [*literal, sentence[pos : sp.start]], sp.end
-    own = tok.encode(" ".join([*literal, sentence[pos:]]), add_special_tokens=False)
-    ending = tok.encode(sentence[sentence.spans[-1].end :], add_special_tokens=False)
-    keeper = SpanKeeper(tok, slots, _gaps(tok, sentence), len(prompt), own, ending)
+    stretches = [tok.encode(words, add_special_tokens=False) for words in _stretches(sentence)]
+    own = tok.encode(" ".join(_stretches(sentence)), add_special_tokens=False)
+    keeper = SpanKeeper(tok, slots, [len(t) for t in stretches], len(prompt), own, stretches[-1])
     ids = torch.tensor([prompt])
     torch.manual_seed(attempt)
     with torch.no_grad():
