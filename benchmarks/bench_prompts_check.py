@@ -17,7 +17,7 @@ import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 from xairl import prompts  # noqa: E402
-from xairl.narrators import battery, check_template  # noqa: E402
+from xairl.narrators import battery_cases, check_template  # noqa: E402
 from xairl.plugins import prompt_dirs  # noqa: E402
 
 CUSTOM = pathlib.Path(__file__).parent / "data" / "templates" / "custom"
@@ -35,7 +35,7 @@ def main() -> int:
     args = ap.parse_args()
     print(f"machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}")
     t0 = time.perf_counter()
-    loaded = battery.plugin_policies()  # (the first template would otherwise pay the plugins' loading)
+    loaded = battery_cases.plugin_policies()  # (the first template would otherwise pay the plugins' loading)
     print(f"plugin policies: {[n for n, p, _ in loaded if p is not None]} loaded in {time.perf_counter() - t0:.2f} s")
     print(f"{'template':<44} {'cases':>5} {'renders':>7} {'seconds':>7} {'problems':>8} {'notes':>5}")
     slowest, missed = 0.0, []

@@ -7,7 +7,7 @@ import pytest
 
 from xairl import plugins, prompts
 from xairl.cli import main
-from xairl.narrators import battery, check_template
+from xairl.narrators import battery, battery_cases, check_template
 
 HEAD = "name: t\nkind: decision\noutputs: [actions]\nsentences:\n"
 CHOSE = (
@@ -172,7 +172,7 @@ def test_an_installed_plugins_policy_is_in_the_battery(uav_plugin, tmp_path):
 
 
 def test_a_plugin_policy_that_fails_to_load_is_one_line_and_the_battery_goes_on(monkeypatch):
-    monkeypatch.setattr(battery, "plugin_policies", lambda: (("broken", None, "RuntimeError: no checkpoint"),))
+    monkeypatch.setattr(battery_cases, "plugin_policies", lambda: (("broken", None, "RuntimeError: no checkpoint"),))
     decisions, left_out = battery.cases(("actions",))
     assert left_out == ["note: plugin policy 'broken' left out of the battery: RuntimeError: no checkpoint"]
     assert len(decisions) > 20
