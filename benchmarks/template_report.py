@@ -219,104 +219,114 @@ def _pct(a, b):
 
 
 def print_report(report, tsets):
-    kinds = report["kinds"]
     if "timing" in report:
-        print("\nItem 5: verifying an own narrative with provenance, ms per sentence (goal: <= 2 ms)")
-        print(
-            f"  {'kind':<11} {'narr.':>5} {'sent.':>6} {'median':>7} {'p95':>7} | {'reader med':>10} {'p95':>7} | ratio"
-        )
-        for kind, r in report["timing"].items():
-            print(
-                f"  {kind:<11} {r['narratives']:>5} {r['sentences']:>6} {r['provenance_median_ms']:>7.2f} "
-                f"{r['provenance_p95_ms']:>7.2f} | {r['reader_median_ms']:>10.2f} {r['reader_p95_ms']:>7.2f} | "
-                f"{r['ratio_median']:.2f}  (verify(provenance).ok == narrate.verified: "
-                f"{r['verify_agrees_with_narrate']}/{r['narratives']})"
-            )
-            if r.get("note"):
-                print(f"    note ({kind}): {r['note'][:200]}; timed per dimension (Explanation.output_slice)")
+        _print_timing(report["timing"])
     for s, res in report["sets"].items():
         title = {"custom": "Set 1 (custom, frozen)", "heldout": "Set 2 (HELD OUT)", "builtin": "Built-in templates"}
         print(f"\n{title.get(s, s)}")
         if s == "builtin":
-            for r in res["rows"]:
-                na = f"  n/a {r['na']}: {r['message'][:100]}" if r["na"] else ""
-                err = f"  ERRORS {r['errors']}: {r['message'][:100]}" if r["errors"] else ""
-                print(f"  {r['template']:<28} {r['kind']:<11} verified {r['verified']}/{r['rendered']}{na}{err}")
-            sm = res["summary"]
-            print(f"  => built-ins verified {_pct(sm['verified'], sm['rendered'])}; failing: {sm['failing']}")
-            continue
-        header = "  " + f"{'template':<36}" + "".join(f"{k:>12}" for k in kinds)
-        print(header + "   (correct: verified/rendered; wrong: caught/wrong)")
-        by = {(r["template"], r["kind"]): r for r in res["rows"]}
-        for t in tsets[s]:
-            cells = []
-            for k in kinds:
-                r = by.get((t["name"], k))
-                if r is None:
-                    cells.append("-")
-                elif r["rendered"] == 0 and (r["na"] or r["errors"]):
-                    cells.append("n/a" if r["na"] else "ERR")
-                elif t["correct"]:
-                    cells.append(f"{r['verified']}/{r['rendered']}")
-                else:
-                    cells.append(f"{r['caught']}/{r['wrong']}")
-            mark = "" if t["correct"] else " [wrong]"
-            print("  " + f"{t['name'] + mark:<36}" + "".join(f"{c:>12}" for c in cells))
-        for r in res["rows"]:
-            if r["na"] or r["errors"]:
-                print(
-                    f"    n/a {r['template']} on {r['kind']} ({r['na']} n/a, {r['errors']} errors): {r['message'][:160]}"
-                )
-        tw = {(r["template"], r["kind"]): r for r in res["twins"]}
-        if tw:
-            print(
-                "  twins (corrected copies of the wrong templates) verified: "
-                + ", ".join(f"{t}/{k} {r['verified']}/{r['rendered']}" for (t, k), r in tw.items())
-            )
-        sm = res["summary"]
-        print(
-            f"  => correct renderings verified {_pct(sm['correct_verified'], sm['correct_rendered'])}; wrong renderings "
-            f"caught {_pct(sm['wrong_caught'], sm['wrong_renderings'])}; twins verified "
-            f"{_pct(sm['twins_verified'], sm['twins_rendered'])}; n/a {sm['not_applicable']}, errors {sm['errors']}"
-        )
-        print(
-            f"     failing correct templates: {sm['failing_correct_templates']}; wrong templates with misses: "
-            f"{sm['templates_with_missed_wrong']}; twins not verified: {sm['twins_not_verified']}"
-        )
-        if s != "heldout":  # the held-out set's texts are not printed
-            for ex in res["false_rejections"][:MAX_EXAMPLES]:
-                _print_example("FALSE REJECTION", ex)
-            for ex in res["misses"][:MAX_EXAMPLES]:
-                _print_example("MISSED WRONG", ex)
+            _print_builtins(res)
+        else:
+            _print_set(s, res, tsets[s], report["kinds"])
     if s := report.get("sets", {}).get("builtin"):
         for ex in s["false_rejections"][:MAX_EXAMPLES]:
             _print_example("BUILT-IN FALSE REJECTION", ex)
     if "mutations" in report:
-        m = report["mutations"]
-        print("\nMutation corpora (set 1's correct templates and the built-ins): caught / mutated renderings")
-        for c, r in m["categories"].items():
-            print(
-                f"  {c:<11} {_pct(r['caught'], r['mutated']):>24}   ({r['templates']} mutated templates; "
-                f"{r['unchanged']} renderings unchanged, {r['na']} n/a)"
-            )
-        p = m["paraphrases"]
+        _print_mutations(report["mutations"])
+
+
+def _print_timing(timing):
+    print("\nItem 5: verifying an own narrative with provenance, ms per sentence (goal: <= 2 ms)")
+    print(f"  {'kind':<11} {'narr.':>5} {'sent.':>6} {'median':>7} {'p95':>7} | {'reader med':>10} {'p95':>7} | ratio")
+    for kind, r in timing.items():
         print(
-            f"  paraphrases rejected {_pct(p['rejected'], p['rendered'])} ({p['templates']} paraphrased templates; "
-            f"{p['unchanged']} unchanged, {p['na']} n/a, {p['original_not_verified']} on decisions whose original "
-            "was not verified, not counted)"
+            f"  {kind:<11} {r['narratives']:>5} {r['sentences']:>6} {r['provenance_median_ms']:>7.2f} "
+            f"{r['provenance_p95_ms']:>7.2f} | {r['reader_median_ms']:>10.2f} {r['reader_p95_ms']:>7.2f} | "
+            f"{r['ratio_median']:.2f}  (verify(provenance).ok == narrate.verified: "
+            f"{r['verify_agrees_with_narrate']}/{r['narratives']})"
         )
-        print("  by kind of edit (caught/mutated):")
-        for c, r in m["categories"].items():
-            ops = ", ".join(f"{o} {a}/{b}" for o, (a, b) in sorted(r.get("by_operator", {}).items()))
-            print(f"    {c:<11} {ops}")
-        for c, exs in m["misses"].items():
-            print(f"\n  misses: {c} ({m['miss_counts'][c]} in all)")
-            for ex in exs:
-                _print_example("MISS", ex)
-        if m["paraphrase_rejections"]:
-            print(f"\n  paraphrases rejected ({len(m['all_paraphrase_rejections'])} in all)")
-            for ex in m["paraphrase_rejections"]:
-                _print_example("REJECTED PARAPHRASE", ex)
+        if r.get("note"):
+            print(f"    note ({kind}): {r['note'][:200]}; timed per dimension (Explanation.output_slice)")
+
+
+def _print_builtins(res):
+    for r in res["rows"]:
+        na = f"  n/a {r['na']}: {r['message'][:100]}" if r["na"] else ""
+        err = f"  ERRORS {r['errors']}: {r['message'][:100]}" if r["errors"] else ""
+        print(f"  {r['template']:<28} {r['kind']:<11} verified {r['verified']}/{r['rendered']}{na}{err}")
+    sm = res["summary"]
+    print(f"  => built-ins verified {_pct(sm['verified'], sm['rendered'])}; failing: {sm['failing']}")
+
+
+def _print_set(s, res, templates, kinds):
+    header = "  " + f"{'template':<36}" + "".join(f"{k:>12}" for k in kinds)
+    print(header + "   (correct: verified/rendered; wrong: caught/wrong)")
+    by = {(r["template"], r["kind"]): r for r in res["rows"]}
+    for t in templates:
+        cells = []
+        for k in kinds:
+            r = by.get((t["name"], k))
+            if r is None:
+                cells.append("-")
+            elif r["rendered"] == 0 and (r["na"] or r["errors"]):
+                cells.append("n/a" if r["na"] else "ERR")
+            elif t["correct"]:
+                cells.append(f"{r['verified']}/{r['rendered']}")
+            else:
+                cells.append(f"{r['caught']}/{r['wrong']}")
+        mark = "" if t["correct"] else " [wrong]"
+        print("  " + f"{t['name'] + mark:<36}" + "".join(f"{c:>12}" for c in cells))
+    for r in res["rows"]:
+        if r["na"] or r["errors"]:
+            print(f"    n/a {r['template']} on {r['kind']} ({r['na']} n/a, {r['errors']} errors): {r['message'][:160]}")
+    tw = {(r["template"], r["kind"]): r for r in res["twins"]}
+    if tw:
+        print(
+            "  twins (corrected copies of the wrong templates) verified: "
+            + ", ".join(f"{t}/{k} {r['verified']}/{r['rendered']}" for (t, k), r in tw.items())
+        )
+    sm = res["summary"]
+    print(
+        f"  => correct renderings verified {_pct(sm['correct_verified'], sm['correct_rendered'])}; wrong renderings "
+        f"caught {_pct(sm['wrong_caught'], sm['wrong_renderings'])}; twins verified "
+        f"{_pct(sm['twins_verified'], sm['twins_rendered'])}; n/a {sm['not_applicable']}, errors {sm['errors']}"
+    )
+    print(
+        f"     failing correct templates: {sm['failing_correct_templates']}; wrong templates with misses: "
+        f"{sm['templates_with_missed_wrong']}; twins not verified: {sm['twins_not_verified']}"
+    )
+    if s != "heldout":  # the held-out set's texts are not printed
+        for ex in res["false_rejections"][:MAX_EXAMPLES]:
+            _print_example("FALSE REJECTION", ex)
+        for ex in res["misses"][:MAX_EXAMPLES]:
+            _print_example("MISSED WRONG", ex)
+
+
+def _print_mutations(m):
+    print("\nMutation corpora (set 1's correct templates and the built-ins): caught / mutated renderings")
+    for c, r in m["categories"].items():
+        print(
+            f"  {c:<11} {_pct(r['caught'], r['mutated']):>24}   ({r['templates']} mutated templates; "
+            f"{r['unchanged']} renderings unchanged, {r['na']} n/a)"
+        )
+    p = m["paraphrases"]
+    print(
+        f"  paraphrases rejected {_pct(p['rejected'], p['rendered'])} ({p['templates']} paraphrased templates; "
+        f"{p['unchanged']} unchanged, {p['na']} n/a, {p['original_not_verified']} on decisions whose original "
+        "was not verified, not counted)"
+    )
+    print("  by kind of edit (caught/mutated):")
+    for c, r in m["categories"].items():
+        ops = ", ".join(f"{o} {a}/{b}" for o, (a, b) in sorted(r.get("by_operator", {}).items()))
+        print(f"    {c:<11} {ops}")
+    for c, exs in m["misses"].items():
+        print(f"\n  misses: {c} ({m['miss_counts'][c]} in all)")
+        for ex in exs:
+            _print_example("MISS", ex)
+    if m["paraphrase_rejections"]:
+        print(f"\n  paraphrases rejected ({len(m['all_paraphrase_rejections'])} in all)")
+        for ex in m["paraphrase_rejections"]:
+            _print_example("REJECTED PARAPHRASE", ex)
 
 
 def _print_example(what, ex):
