@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from xairl_uav_handover.baselines import CHM
-from xairl_uav_handover.calibration import band_rows, outside, quantile_rows
+from xairl_uav_handover.calibration import band_rows, link_loss_fit, outside, quantile_rows, rsrq_spread, split_flights
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.exports import load_folder
@@ -52,6 +52,32 @@ def simulated_link(cfg: SimConfig, n: int = 100, seconds: float = 60.0, seed: in
     return np.concatenate(caps), np.concatenate(queues)
 
 
+def spread_report(cfg: SimConfig, walks, seed: int = 3) -> None:
+    """The spread of RSRQ - RSRP over a state's candidates, simulated (CHM's flights, sampled once a second) against
+    the real states, with a two-sample Kolmogorov-Smirnov test."""
+    from scipy.stats import ks_2samp
+
+    real = np.concatenate(
+        [rsrq_spread(w.states, np.array([[k < len(c) for k in range(4)] for c in w.candidates])) for w in walks]
+    )
+    env = HandoverVecEnv(cfg, 100, decision_every=1)
+    env.reset(seed=seed)
+    chm, sim = CHM(), []
+    chm.reset(env)
+    for i in range(int(60 / cfg.flight.dt_s)):
+        env.step(chm(env))
+        if i % 25 == 24:
+            sim.append(rsrq_spread(env.obs, env.candidates >= 0))
+    sim = np.concatenate(sim)
+    test = ks_2samp(sim, real)
+    q = [25, 50, 75, 90, 99]
+    print(
+        f"spread of RSRQ - RSRP over a state's candidates (dB, 1 dB resolution; p{'/p'.join(map(str, q))}): "
+        f"real {np.percentile(real, q)} ({len(real)} states), simulated {np.percentile(sim, q)} ({len(sim)}); "
+        f"KS statistic {test.statistic:.3f}, p = {test.pvalue:.2g}"
+    )
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--real", default=str(ROOT.parent / "shared/data/ukm-uav-lte/raw"))
@@ -68,12 +94,22 @@ def main():
     print(
         f"{len(flights)} real flights; live network {sum(f.observed_handovers for f in flights) / sum(f.t[-1] / 60 for f in flights):.2f} HO/min"
     )
-    print(f"{'band':<12}{'flights':>8}{'live/min':>10}{'CHM real/min':>14}{'CHM sim/min':>13}{'sim/real':>10}")
+    print(
+        f"{'band':<12}{'flights':>8}{'live/min':>10}{'CHM real/min':>14}{'CHM sim 40ms':>14}{'CHM sim 1.28s':>15}"
+        f"{'sim/real':>10}"
+    )
     for r in band_rows(flights, chm_real, cfg, seed=0):
         print(
-            f"{r.band:<12}{r.flights:>8}{r.live_per_min:>10.2f}{r.chm_real_per_min:>14.2f}{r.chm_sim_per_min:>13.2f}"
-            f"{r.sim_over_real:>10.2f}"
+            f"{r.band:<12}{r.flights:>8}{r.live_per_min:>10.2f}{r.chm_real_per_min:>14.2f}{r.chm_sim_per_min:>14.2f}"
+            f"{r.chm_sim_sampled_per_min:>15.2f}{r.sim_over_real:>10.2f}"
         )
+    fit = link_loss_fit(flights, cfg)
+    print(
+        f"link loss fitted on {len(split_flights(flights)[0])} real flights: {fit['link_loss_db']:.1f} dB (now "
+        f"{cfg.radio.link_loss_db:g}); held-out flights' serving RSRP median {fit['real_held_out_median']:.1f} dBm, "
+        f"simulated at the fitted loss {fit['sim_held_out_median']:.1f} dBm"
+    )
+    spread_report(cfg, walks)
     cap, q_sim = simulated_link(cfg)
     q_real = np.concatenate([w.queue_bits for w in walks])
     full = cfg.buffer.q_max_bits

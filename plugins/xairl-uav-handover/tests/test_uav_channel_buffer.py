@@ -51,10 +51,10 @@ def test_uplink_interference_rises_with_height_and_matches_the_link_budget():
     layout = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
     i = uplink.interference_mw(cfg, layout, np.array([30.0, 60.0, 100.0, 150.0]))[:, 0]
     assert (np.diff(i) > 0).all()  # more cells in line of sight as the UAV climbs (TR 36.777)
-    # no interference: SINR is the link budget, P_ue + G - PL - noise over the UAV's resource blocks
+    # no interference: SINR is P_ue - coupling loss (antenna gains included) - noise over the UAV's RBs
     quiet = SimConfig.model_validate({"radio": {"ul_activity": 0.0}})
     noise = -174 + 10 * np.log10(50 * 180e3) + 5.0
-    assert uplink.sinr_db(quiet, 100.0, 0.0) == pytest.approx(23.0 - 19.0 - 100.0 - noise)
+    assert uplink.sinr_db(quiet, 100.0, 0.0) == pytest.approx(23.0 - 100.0 - noise)
     assert uplink.sinr_db(cfg, 100.0, i[0]) < uplink.sinr_db(quiet, 100.0, 0.0)
 
 

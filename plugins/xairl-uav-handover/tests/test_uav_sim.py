@@ -64,7 +64,8 @@ def test_same_seed_same_flight():
 
 
 def test_handover_bookkeeping_and_pingpong():
-    cfg = SimConfig(**{"handover": {"min_time_of_stay_s": 0.2, "interruption_s": 0.08}})
+    # handovers to an arbitrary cell would often fail (test_uav_failures.py): bookkeeping alone here
+    cfg = SimConfig(**{"handover": {"min_time_of_stay_s": 0.2, "interruption_s": 0.08, "failures": False}})
     sim = Simulator(cfg, n_uavs=1, seed=0)
     a, b = sim.serving[0], (sim.serving[0] + 1) % sim.N
     assert sim.step(np.array([b])).handover[0]

@@ -72,16 +72,16 @@ def _action_of(env, target: np.ndarray) -> np.ndarray:
 
 
 class CHM:
-    """Conventional A3 handover with fixed offset and time-to-trigger, acting at every measurement."""
+    """Conventional A3 handover with fixed offset and time-to-trigger, acting at every simulator step, or every
+    ``decision_every`` steps (to compare with a log sampled that often)."""
 
     name = "CHM"
-    decision_every = 1
 
-    def __init__(self, config: CHMConfig | None = None):
-        self.cfg = config or CHMConfig()
+    def __init__(self, config: CHMConfig | None = None, decision_every: int = 1):
+        self.cfg, self.decision_every = config or CHMConfig(), decision_every
 
     def reset(self, env) -> None:
-        self.a3 = A3Trigger(env.sim.K, env.sim.N, env.sim.dt)
+        self.a3 = A3Trigger(env.sim.K, env.sim.N, env.sim.dt * env.decision_every)
 
     def __call__(self, env) -> np.ndarray:
         return _action_of(

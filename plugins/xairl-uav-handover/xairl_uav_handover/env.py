@@ -26,7 +26,18 @@ from .features import ACTIONS, FEATURES, checked_actions
 from .simulator import Simulator
 
 #: per-flight quantities summed over each decision's simulator steps (StepInfo fields)
-METRICS = ("handover", "pingpong", "available", "queue_bits", "lost_bits", "rsrp_violation", "rsrq_violation")
+METRICS = (
+    "handover",
+    "pingpong",
+    "available",
+    "queue_bits",
+    "lost_bits",
+    "rsrp_violation",
+    "rsrq_violation",
+    "hof",
+    "rlf",
+    "outage",
+)
 #: ping-pong windows counted beside the configured one (``pingpong_1s`` ...: back to the previous BS within w s)
 PINGPONG_WINDOWS_S = (1.0, 2.0, 5.0, 10.0)
 

@@ -48,6 +48,9 @@ def run_flights(controller, config: SimConfig, n_flights: int, seed: int) -> dic
         "lost_data_kbit": tot["lost_bits"] / 1e3,
         "rsrp_violation_pct": 100 * tot["rsrp_violation"] / n,
         "rsrq_violation_pct": 100 * tot["rsrq_violation"] / n,
+        "handover_failures": tot["hof"],
+        "radio_link_failures": tot["rlf"],
+        "outage_pct": 100 * tot["outage"] / n,
     }
 
 
@@ -84,15 +87,22 @@ def rankings(ckpt, n_states: int, seed: int) -> dict[str, list[str]]:
 
 
 def chm_rate_by_altitude(
-    altitudes, config: SimConfig, n_flights: int = 40, duration_s: float = 60.0, seed: int = 0
+    altitudes,
+    config: SimConfig,
+    n_flights: int = 40,
+    duration_s: float = 60.0,
+    seed: int = 0,
+    sample_s: float | None = None,
 ) -> np.ndarray:
-    """Conventional handovers per minute for flights held at each altitude (simulator)."""
+    """Conventional handovers per minute for flights held at each altitude (simulator); with ``sample_s`` CHM sees
+    the measurements only that often, as CHM replayed on a real log does (calibration.band_rows)."""
     from .baselines import CHM
 
+    every = 1 if sample_s is None else max(1, int(round(sample_s / config.flight.dt_s)))
     rates = []
     for h in altitudes:
         data = config.model_dump()
         data["flight"].update(altitude_m=(h, h), duration_s=duration_s)
-        m = run_flights(CHM(), SimConfig.model_validate(data), n_flights, seed)
+        m = run_flights(CHM(decision_every=every), SimConfig.model_validate(data), n_flights, seed)
         rates.append(float(np.mean(m["handovers"])) / (duration_s / 60.0))
     return np.array(rates)

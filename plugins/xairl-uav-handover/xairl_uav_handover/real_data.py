@@ -21,7 +21,7 @@ from .config import SimConfig
 from .exports import RealFlight
 from .features import FEATURES, N_CANDIDATES, checked_actions, state_rows
 from .features import RSRP as RSRP_COLUMNS
-from .simulator import hex_layout, n_sites
+from .simulator import hex_layout, n_cells
 from .uplink import capacity_bps, cell_deviation, interference_mw, rsrp_offset_db, sinr_db
 
 
@@ -100,7 +100,7 @@ def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
     """The network's own path along ``f`` with the state a policy would see at each sample (see the module doc)."""
     cfg = config or SimConfig()
     ids = {p: k for k, p in enumerate(sorted(set(f.pci.tolist())))}
-    max_id = n_sites(cfg.layout) - 1  # the simulator's ids: a real flight's cells are ranked into that range
+    max_id = n_cells(cfg.layout) - 1  # the simulator's ids: a real flight's cells are ranked into that range
     link = UplinkBuffer(cfg, f.altitude_m, seed, f.name)
     states, cands, queues = [], [], []
     for i in range(len(f.t)):

@@ -1,17 +1,21 @@
-"""Vectorised uplink simulator: K UAV flights over a hexagonal grid of N ground BSs, one numpy step for all.
+"""Vectorised simulator: K UAV flights over a hexagonal grid of sites, three sectored cells each (antenna.py), one
+numpy step for all.
 
-Per step (dt): measurements (RSRP/RSRQ of every BS, uplink SINR at the serving BS) -> the controller's target BS ->
-handover bookkeeping (interruption, control packet, ping-pong) -> buffer -> motion -> channel update.
+Per step (dt): measurements (RSRP/RSRQ of every cell, downlink and uplink SINR) -> the controller's target cell ->
+handover bookkeeping (interruption, control packet, ping-pong) -> handover and radio link failures, with
+re-establishment (failures.py) -> buffer -> motion -> channel update.
 
-Shadow fading and the LoS state are spatially correlated per UAV-BS link: each link carries two standard-normal
+Shadow fading and the LoS state are spatially correlated per UAV-site link: each link carries two standard-normal
 latents that follow an AR(1) process with correlation exp(-distance moved / shadow_corr_m) (Gudmundson). Shadowing
 is sigma(LoS state) times one latent; the link is LoS while Phi(other latent) < P_LOS(h, d2D), so the LoS
 probability of TR 36.777 holds at every point and the state does not flicker from step to step. A third latent,
-correlated in time (fading_corr_s) and scaled by fading_db, is the fast-fading residual that layer-3 filtering
-is left in each 40 ms sample. What the UE reports (``meas_rsrp``, ``meas_rsrq``: what controllers and observations
-see) is the L1 average over each measurement period, layer-3 filtered (``ObservationConfig``); neighbours count as
-measured only above the detection threshold. The uplink (SINR with aerial co-channel interference, capacity) is in
-uplink.py.
+correlated in time (fading_corr_s), is the fast fading left in each 40 ms sample, its size set by the Rician
+K-factor and the looks averaged (:func:`fading_std_db`). A cell's coupling loss is its site's path minus its
+antenna's gain towards the UAV plus ``link_loss_db``, the same both ways. RSRQ uses each cell's own load
+(:meth:`Simulator._measure`). What the UE reports (``meas_rsrp``, ``meas_rsrq``: what controllers and observations
+see) is the L1 average over each measurement period with each cell's measurement error (TS 36.133), layer-3
+filtered (``ObservationConfig``); neighbours count as measured only above the detection threshold. The uplink
+(SINR with aerial co-channel interference, capacity) is in uplink.py.
 """
 
 from __future__ import annotations
@@ -21,9 +25,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtr
 
+from . import antenna
 from .buffer import buffer_step
 from .channel import los_probability, path_loss, shadow_sigma
 from .config import LayoutConfig, SimConfig
+from .failures import RS_SHARE_SYMBOL, LinkMonitor, downlink_sinr_db, rssi_activity
 from .features import N_CANDIDATES, state_rows
 from .uplink import capacity_bps, cell_deviation, interference_mw, rsrp_offset_db, sinr_db
 
@@ -31,6 +37,19 @@ from .uplink import capacity_bps, cell_deviation, interference_mw, rsrp_offset_d
 def n_sites(layout: LayoutConfig) -> int:
     """Sites of the hexagonal grid: the centre plus 6 r sites in ring r."""
     return 1 + 3 * layout.rings * (layout.rings + 1)
+
+
+def n_cells(layout: LayoutConfig) -> int:
+    """Cells of the grid: three sectors per site (antenna.py)."""
+    return len(antenna.SECTOR_AZIMUTHS_DEG) * n_sites(layout)
+
+
+def fading_std_db(k_factor_db: float | None, looks: int) -> float:
+    """Std (dB) of the fast fading left in a sample that averages ``looks`` independent looks at a Rician channel
+    (``k_factor_db``; None: Rayleigh): the power's variance (1 + 2K) / (1 + K)^2 over the looks, in dB to first
+    order (10 / ln 10 times the relative std)."""
+    k = 0.0 if k_factor_db is None else 10 ** (k_factor_db / 10)
+    return float(10 / np.log(10) * np.sqrt((1 + 2 * k) / (1 + k) ** 2 / looks))
 
 
 def hex_layout(isd: float, rings: int) -> np.ndarray:
@@ -61,6 +80,9 @@ class StepInfo:
     lost_bits: np.ndarray
     sinr_db: np.ndarray
     back_after_s: np.ndarray  # a handover back to the previous BS: the seconds spent at the one left; else inf
+    hof: np.ndarray  # a handover that failed (failures.py); the UE re-established instead
+    rlf: np.ndarray  # a radio link failure (T310 expired)
+    outage: np.ndarray  # no service while re-establishing after either
 
 
 class Simulator:
@@ -74,8 +96,10 @@ class Simulator:
     def __init__(self, config: SimConfig | None = None, n_uavs: int = 1, seed: int = 0):
         self.cfg = cfg = config or SimConfig()
         self.rng = rng = np.random.default_rng(seed)
-        self.bs_xy = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
+        self.sites_xy = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
+        self.bs_xy, self.site, self.boresight = antenna.cell_layout(self.sites_xy)  # per cell
         self.K, self.N = n_uavs, len(self.bs_xy)
+        n_site = len(self.sites_xy)
         self.dt = cfg.flight.dt_s
         self.n_steps = cfg.flight.n_steps
         self.radius = (cfg.layout.rings + 0.5) * cfg.layout.isd_m * np.sqrt(3) / 2  # inside the outer ring
@@ -84,18 +108,23 @@ class Simulator:
         self.pos = np.stack([r * np.cos(phi), r * np.sin(phi), rng.uniform(*cfg.flight.altitude_m, n_uavs)], 1)
         self.heading = rng.uniform(0, 2 * np.pi, n_uavs)
         self.speed = rng.uniform(*cfg.flight.speed_mps, n_uavs)
-        self.g_shadow = rng.standard_normal((n_uavs, self.N))
-        self.g_los = rng.standard_normal((n_uavs, self.N))
-        self.g_fast = rng.standard_normal((n_uavs, self.N))
+        # one link per UAV and site: the three cells of a site share its path, differing by their antennas
+        self.g_shadow = rng.standard_normal((n_uavs, n_site))
+        self.g_los = rng.standard_normal((n_uavs, n_site))
+        self.g_fast = rng.standard_normal((n_uavs, n_site))
         self._rho_fast = np.exp(-self.dt / cfg.channel.fading_corr_s)
+        self._fading_db = (
+            fading_std_db(cfg.channel.los_k_factor_db, cfg.channel.fading_looks),
+            fading_std_db(None, cfg.channel.fading_looks),
+        )
         rad, obs = cfg.radio, cfg.observation
         self._rsrp_offset = rsrp_offset_db(cfg)
-        self._dl_noise_mw = 10 ** ((-174 + 10 * np.log10(rad.n_rb * 180e3) + rad.ue_noise_figure_db) / 10)
-        self._ul_interference = interference_mw(cfg, self.bs_xy, self.pos[:, 2])
-        # domain randomisation per flight (RadioConfig): cell load, antenna gain and uplink interference deviations
-        self._load = rng.uniform(*rad.load_range, (n_uavs, 1))
-        self._gain = rng.uniform(-rad.gain_spread_db, rad.gain_spread_db, (n_uavs, 1))
+        self._noise_re_mw = 10 ** ((-174 + 10 * np.log10(15e3) + rad.ue_noise_figure_db) / 10)  # per element
+        self._ul_interference = interference_mw(cfg, self.sites_xy, self.pos[:, 2])[:, self.site]
+        # per flight (RadioConfig): each cell's downlink load and uplink interference deviation
+        self._load = rng.uniform(*rad.load_range, (n_uavs, self.N))
         self._ul_interference = self._ul_interference * cell_deviation(cfg, rng, (n_uavs, self.N))
+        self.monitor = LinkMonitor(cfg.handover, n_uavs, self.dt)
         self._meas_every = max(1, int(round(obs.measurement_period_s / self.dt)))
         self._l3_a = 1.0 / 2 ** (obs.l3_filter_k / 4)
         self._measure()
@@ -105,37 +134,53 @@ class Simulator:
         self.prev_serving = self.serving.copy()
         self.entered = np.zeros(n_uavs, dtype=np.int64)
         self.interrupt = np.zeros(n_uavs, dtype=np.int64)
+        self.outage = np.zeros(n_uavs, dtype=np.int64)  # steps left re-establishing after a failure
         self.q = np.zeros(n_uavs)
         self.t = 0
         self.last: StepInfo | None = None
 
     def _measure(self) -> None:
-        c = self.cfg.channel
-        d2d = np.hypot(self.pos[:, None, 0] - self.bs_xy[None, :, 0], self.pos[:, None, 1] - self.bs_xy[None, :, 1])
-        h = self.pos[:, 2:3]
+        """Coupling loss, RSRP and RSRQ of every cell, and the downlink SINR, at the UAVs' positions now.
+
+        RSRQ = N RSRP / RSSI (TS 36.214 sec. 5.1.3), RSSI measured over the measured cell's own reference-signal
+        symbols. Cells are not frame-synchronised (an FDD network need not be), so in those symbols the measured
+        cell puts its reference signals (4 of 12 elements) and its data at its own load, and every other cell its
+        average over a subframe at its load (failures.rssi_activity). RSRQ therefore carries each cell's load and
+        the measured cell's share of the total power: information RSRP alone does not.
+        """
+        c, a = self.cfg.channel, self.cfg.antenna
+        dx = self.pos[:, None, 0] - self.sites_xy[None, :, 0]
+        dy = self.pos[:, None, 1] - self.sites_xy[None, :, 1]
+        d2d, h = np.hypot(dx, dy), self.pos[:, 2:3]
         d3d = np.hypot(d2d, h - c.bs_height_m)
         los = ndtr(self.g_los) < los_probability(c.scenario, h, d2d)
-        self.loss_db = (
+        site_loss = (
             path_loss(c.scenario, h, d3d, c.carrier_ghz, los, c.bs_height_m)
             + shadow_sigma(c.scenario, h, los) * self.g_shadow
-            + c.fading_db * self.g_fast
-        )
-        self.rsrp = self._rsrp_offset + self._gain - self.loss_db
-        rsrp_mw = 10 ** (self.rsrp / 10)
-        n_re = 12 * self.cfg.radio.n_rb
-        rssi = n_re * self._load * rsrp_mw.sum(axis=1, keepdims=True) + self._dl_noise_mw
-        self.rsrq = 10 * np.log10(self.cfg.radio.n_rb * rsrp_mw / rssi)
+            + np.where(los, self._fading_db[0], self._fading_db[1]) * self.g_fast
+        )[:, self.site]
+        gain = antenna.gain_db(a, dx[:, self.site], dy[:, self.site], h - c.bs_height_m, self.boresight)
+        self.loss_db = site_loss - gain + self.cfg.radio.link_loss_db  # coupling loss, the same both ways
+        self.rsrp = self._rsrp_offset - self.loss_db
+        p = 10 ** (self.rsrp / 10)
+        others = (p * rssi_activity(self._load)).sum(axis=1, keepdims=True) - p * rssi_activity(self._load)
+        own = p * rssi_activity(self._load, RS_SHARE_SYMBOL)
+        self.rsrq = 10 * np.log10(p / (12 * (own + others) + 12 * self._noise_re_mw))
+        self.dl_sinr = downlink_sinr_db(self.rsrp, self._load, self._noise_re_mw)
 
     def _report(self) -> None:
-        """Average the samples of each measurement period, then layer-3 filter them into the reported values."""
+        """Average the samples of each measurement period, add the UE's measurement error (each cell's own,
+        ``ObservationConfig``), then layer-3 filter them into the reported values."""
         acc = self._acc
         acc[0] += self.rsrp
         acc[1] += self.rsrq
         acc[2] += 1
         if acc[2] == self._meas_every:
-            a = self._l3_a
-            self.meas_rsrp = (1 - a) * self.meas_rsrp + a * acc[0] / acc[2]
-            self.meas_rsrq = (1 - a) * self.meas_rsrq + a * acc[1] / acc[2]
+            a, obs = self._l3_a, self.cfg.observation
+            l1_rsrp = acc[0] / acc[2] + obs.rsrp_error_db * self.rng.standard_normal(self.rsrp.shape)
+            l1_rsrq = acc[1] / acc[2] + obs.rsrq_error_db * self.rng.standard_normal(self.rsrq.shape)
+            self.meas_rsrp = (1 - a) * self.meas_rsrp + a * l1_rsrp
+            self.meas_rsrq = (1 - a) * self.meas_rsrq + a * l1_rsrq
             self._acc = [np.zeros_like(self.rsrp), np.zeros_like(self.rsrq), 0]
 
     @property
@@ -145,8 +190,7 @@ class Simulator:
     def ul_sinr_db(self) -> np.ndarray:
         """Uplink SINR of each UAV at its serving BS (uplink.py)."""
         k = np.arange(self.K)
-        loss = self.loss_db[k, self.serving] - self._gain[:, 0]  # the same antenna both ways
-        return sinr_db(self.cfg, loss, self._ul_interference[k, self.serving])
+        return sinr_db(self.cfg, self.loss_db[k, self.serving], self._ul_interference[k, self.serving])
 
     def candidates(self) -> np.ndarray:
         """(K, 4) BS ids: the serving BS, then the strongest measured neighbours by reported RSRP; -1 for a slot
@@ -180,6 +224,7 @@ class Simulator:
         self.entered = np.where(ho, self.t, self.entered)
         self.serving = target
         self.interrupt = np.where(ho, int(round(cfg.handover.interruption_s / self.dt)), self.interrupt)
+        hof, rlf = self._failures(ho)
 
         b = cfg.buffer
         sinr = self.ul_sinr_db()
@@ -202,13 +247,42 @@ class Simulator:
             lost,
             sinr,
             back_after_s,
+            hof,
+            rlf,
+            self.outage > 0,
         )
+        self.outage = np.maximum(self.outage - 1, 0)
         self._move()
         self._measure()
         self._report()
         self.t += 1
         self.last = info
         return info
+
+    def _failures(self, handed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Handover and radio link failures this step (failures.py), each followed by a re-establishment to the
+        strongest measured cell with no service for ``reestablish_s``; (hof, rlf), bool (K,)."""
+        hc, none = self.cfg.handover, np.zeros(self.K, dtype=bool)
+        if not hc.failures:
+            return none, none
+        avg = self.monitor.average_db(self.dl_sinr)
+        hof = self.monitor.handover_fails(avg, self.serving, handed)
+        self.monitor.reset(handed)
+        connected = self.outage == 0
+        rlf = self.monitor.radio_link_fails(np.where(connected, avg[np.arange(self.K), self.serving], np.inf))
+        rlf &= connected & ~hof
+        failed = hof | rlf
+        if failed.any():
+            best = self.meas_rsrp.argmax(axis=1)
+            moved = failed & (best != self.serving)
+            self.prev_serving = np.where(moved, self.serving, self.prev_serving)
+            self.entered = np.where(moved, self.t, self.entered)
+            self.serving = np.where(failed, best, self.serving)
+            steps = int(round(hc.reestablish_s / self.dt))
+            self.outage = np.where(failed, steps, self.outage)
+            self.interrupt = np.where(failed, np.maximum(self.interrupt, steps), self.interrupt)
+            self.monitor.reset(failed)
+        return hof, rlf
 
     def _move(self) -> None:
         f, dt = self.cfg.flight, self.dt
@@ -222,7 +296,7 @@ class Simulator:
         self.heading = np.where(out, inward, self.heading)
         rho = np.exp(-step / self.cfg.channel.shadow_corr_m)[:, None]
         innov = np.sqrt(1 - rho**2)
-        self.g_shadow = rho * self.g_shadow + innov * self.rng.standard_normal((self.K, self.N))
-        self.g_los = rho * self.g_los + innov * self.rng.standard_normal((self.K, self.N))
+        self.g_shadow = rho * self.g_shadow + innov * self.rng.standard_normal(self.g_shadow.shape)
+        self.g_los = rho * self.g_los + innov * self.rng.standard_normal(self.g_los.shape)
         rf = self._rho_fast
-        self.g_fast = rf * self.g_fast + np.sqrt(1 - rf**2) * self.rng.standard_normal((self.K, self.N))
+        self.g_fast = rf * self.g_fast + np.sqrt(1 - rf**2) * self.rng.standard_normal(self.g_fast.shape)

@@ -25,9 +25,10 @@ from .config import SimConfig
 
 
 def rsrp_offset_db(cfg: SimConfig) -> float:
-    """RSRP = offset - path loss: the BS power per resource element plus its antenna gain towards the UAV."""
+    """RSRP = offset - coupling loss: the BS power per resource element (the coupling loss is the path loss and
+    every other loss minus the antenna gain, the same both ways: simulator.py)."""
     rad = cfg.radio
-    return rad.bs_tx_power_dbm - 10 * np.log10(12 * rad.n_rb) + rad.bs_antenna_gain_db
+    return rad.bs_tx_power_dbm - 10 * np.log10(12 * rad.n_rb)
 
 
 def noise_dbm(cfg: SimConfig) -> float:
@@ -59,9 +60,10 @@ def cell_deviation(cfg: SimConfig, rng: np.random.Generator, shape) -> np.ndarra
 
 
 def sinr_db(cfg: SimConfig, loss_db, interference: np.ndarray) -> np.ndarray:
-    """Uplink SINR for a path loss ``loss_db`` to the serving BS and the interference (mW) there."""
+    """Uplink SINR for a coupling loss ``loss_db`` (antenna gains included) to the serving BS and the interference
+    (mW) there."""
     rad = cfg.radio
-    signal_mw = 10 ** ((rad.ue_tx_power_dbm + rad.bs_antenna_gain_db - np.asarray(loss_db)) / 10)
+    signal_mw = 10 ** ((rad.ue_tx_power_dbm - np.asarray(loss_db)) / 10)
     return 10 * np.log10(signal_mw / (10 ** (noise_dbm(cfg) / 10) + interference))
 
 
