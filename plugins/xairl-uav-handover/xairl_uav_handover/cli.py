@@ -16,8 +16,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--demonstrations",
         type=int,
         default=None,
-        help="episodes of the RSRQ rule's flights to learn "
-        "from (DQfD; default: TrainConfig's 10); 0: a plain DQN, as in the paper",
+        help="episodes of the RSRQ rule's flights to learn from (DQfD); default 0: a plain DQN, as in the paper",
     )
     p.add_argument(
         "--pretrain-updates",
@@ -31,6 +30,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="exploration at the start (default: 0.2 with "
         "demonstrations, as the pretrained network already acts like the rule; 1 without)",
+    )
+    p.add_argument(
+        "--reward",
+        choices=("paper", "priced"),
+        default="paper",
+        help="the paper's reward (default), or the operator-priced one that also prices lost data and ping-pongs",
     )
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", default="uav-dqn.safetensors", help="checkpoint path (metadata holds the configs)")
@@ -101,7 +106,10 @@ def run_train(args) -> int:
         raise InputError(
             re.sub(r"\b(" + "|".join(_TRAIN_FLAGS) + r")\b", lambda m: _TRAIN_FLAGS[m.group(1)], message)
         ) from None
-    seconds = train_checkpoint(tc, _sim_config(None, args.duration), args.out, progress=not args.no_progress)
+    from .config import PRICED_REWARD, SimConfig
+
+    base = SimConfig.model_validate({"reward": PRICED_REWARD}) if args.reward == "priced" else None
+    seconds = train_checkpoint(tc, _sim_config(base, args.duration), args.out, progress=not args.no_progress)
     print(f"trained {args.episodes} episodes in {seconds} s; wrote {args.out}")
     return 0
 

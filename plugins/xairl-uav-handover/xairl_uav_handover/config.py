@@ -17,9 +17,11 @@ class _Strict(BaseModel):
 
 
 class ChannelConfig(_Strict):
-    scenario: Literal["UMa-AV", "UMi-AV", "RMa-AV"] = "UMa-AV"
+    scenario: Literal["UMa-AV", "UMi-AV", "RMa-AV"] = Field(
+        "UMa-AV", description="TR 36.777 Annex B scenario: urban macro with aerial UEs, the paper's"
+    )
     carrier_ghz: float = Field(2.0, gt=0.5, le=6.0, description="carrier frequency (TR 36.777: below 6 GHz)")
-    bs_height_m: float = Field(25.0, gt=0, le=50)
+    bs_height_m: float = Field(25.0, gt=0, le=50, description="BS antenna height (TR 36.777 Table B-1, UMa)")
     shadow_corr_m: float = Field(50.0, gt=0, description="decorrelation distance of shadowing and LoS state")
     fading_looks: int = Field(
         2,
@@ -74,8 +76,8 @@ class RadioConfig(_Strict):
         le=20,
         description="gain towards the UAV of the BS antennas that receive the interfering aerial UEs (uplink.py)",
     )
-    ue_noise_figure_db: float = Field(9.0, ge=0, le=20)
-    bs_noise_figure_db: float = Field(5.0, ge=0, le=20)
+    ue_noise_figure_db: float = Field(9.0, ge=0, le=20, description="UE noise figure (TR 36.814 Table A.2.1.1-1)")
+    bs_noise_figure_db: float = Field(5.0, ge=0, le=20, description="BS noise figure (TR 36.814 Table A.2.1.1-1)")
     ul_activity: float = Field(
         0.06,
         ge=0,
@@ -107,8 +109,15 @@ class RadioConfig(_Strict):
 
 
 class LayoutConfig(_Strict):
-    isd_m: float = Field(500.0, gt=50, le=10_000, description="inter-site distance of the hexagonal grid")
-    rings: int = Field(2, ge=1, le=5, description="rings around the centre site (2 -> 19 sites)")
+    isd_m: float = Field(
+        500.0,
+        gt=50,
+        le=10_000,
+        description="inter-site distance of the hexagonal grid (TR 36.777 Table A.1-1, UMa: 500 m)",
+    )
+    rings: int = Field(
+        2, ge=1, le=5, description="rings around the centre site (2 -> 19 sites, 57 cells: TR 36.777 Table A.1-1)"
+    )
 
 
 class FlightConfig(_Strict):
@@ -212,52 +221,26 @@ class HandoverConfig(_Strict):
 
 class RewardConfig(_Strict):
     """r = w_buffer / (1 + q) - w_handover*[handover] - w_rsrp*[RSRP<thr] - w_rsrq*[RSRQ<thr] - w_lost*lost
-    - w_pingpong*[back within 5 s] per decision, q and lost in Mbit (the paper's buffer term omega1 / (1 + q); the
-    lost-data and ping-pong terms are ours: the paper's reward never sees lost data, and a DQN trained on it loses
-    more than CHM). Defaults chosen from benchmarks/reward_sweep.py and reproduce.py (docs/uav-reference.md): with
-    the DQN learning from the RSRQ rule's demonstrations (TrainConfig.demonstrations), 1.5, 4, 40, 80 (w_lost,
-    w_rsrq, w_handover, w_pingpong) met 7 of issue 26's 9 simulated targets on each of 3 training seeds; without
-    demonstrations 1.5, 0.5, 25, 80 met the most (5-6); the paper's reward (0, 0.5, 20, 0) met 5 of 12."""
+    - w_pingpong*[ping-pong] per decision, q and lost in Mbit. The defaults are the paper's reward (its four terms;
+    w_lost = w_pingpong = 0). :data:`PRICED_REWARD` is the operator-priced variant (lost data and ping-pongs
+    priced too), an option reported apart (``xairl uav train --reward priced``)."""
 
-    w_handover: float = Field(
-        40.0,
-        ge=0,
-        description="measured (3 training seeds, 600 held-out flights, with "
-        "demonstrations): 40 with w_rsrq 4 leaves the DQN at 0.48-0.49x "
-        "CHM's handovers; without demonstrations 25 gives 0.43-0.56x",
-    )
+    w_handover: float = Field(20.0, ge=0, description="the paper's handover weight")
     w_buffer: float = Field(
         2.0,
         ge=0,
-        description="measured (40 episodes, 100 held-out flights, seeds 0 and 1, "
-        "ul_activity 0.055, spread 10 dB): 1 leaves buffer_queue_size "
-        "2nd-3rd by mean |margin contribution| and the DQN losing 7-10 % "
-        "more data than CHM; 2 puts it 1st with the DQN losing as much as "
-        "CHM (-1 to 0 %)",
+        description="weight of the paper's buffer term omega1 / (1 + q); 2 measured before issue 53 (40 episodes, "
+        "100 held-out flights, seeds 0 and 1): 1 left the DQN losing 7-10 % more data than CHM, 2 as much",
     )
-    w_rsrp: float = Field(0.5, ge=0)
-    w_rsrq: float = Field(
-        4.0,
-        ge=0,
-        description="the paper's is 0.5; raising it trades handovers for time below "
-        "the RSRQ threshold (without demonstrations, 2: 8.3 % at 0.56x "
-        "CHM's handovers, 4 with w_handover 40: 6.2 % at 0.56x, 6: 5.1 % at "
-        "0.92x; with them, 4 and 40: 8.1-8.4 % at 0.48x; CHM 4.2-5.1 %)",
-    )
-    w_lost: float = Field(
-        1.5,
-        ge=0,
-        description="per Mbit of uplink data lost to buffer overflow in the decision "
-        "period (0: the paper's reward; with 0 the DQN loses 3 % more data "
-        "than CHM, with 1.5 1-6 % less)",
-    )
-    w_pingpong: float = Field(
-        80.0,
-        ge=0,
-        description="per handover back to the previous BS within 5 s (a ping-pong "
-        "as operators count it; 0: the paper's reward, under which the "
-        "DQN ping-pongs more per minute than CHM)",
-    )
+    w_rsrp: float = Field(0.5, ge=0, description="the paper's RSRP-violation weight")
+    w_rsrq: float = Field(0.5, ge=0, description="the paper's RSRQ-violation weight")
+    w_lost: float = Field(0.0, ge=0, description="per Mbit of uplink data lost to buffer overflow (not in the paper)")
+    w_pingpong: float = Field(0.0, ge=0, description="per ping-pong handover (not in the paper)")
+
+
+#: the operator-priced reward (issue 26, measured before issue 53: with the RSRQ rule's demonstrations it met 7 of 9
+#: simulated targets on each of 3 training seeds), an option beside the paper's
+PRICED_REWARD = {"w_handover": 40.0, "w_rsrq": 4.0, "w_lost": 1.5, "w_pingpong": 80.0}
 
 
 class SimConfig(_Strict):

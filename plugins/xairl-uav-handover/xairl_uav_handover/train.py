@@ -54,10 +54,10 @@ class TrainConfig(xairl.plugin.Options, frozen=True):
     eps_end: float = Field(0.01, ge=0, le=1)
     eps_fraction: float = Field(0.5, gt=0, le=1)
     demonstrations: int = Field(
-        10,
+        0,
         ge=0,
         description="episodes of the demonstrator's flights (baselines.RSRQRule) "
-        "kept in a replay buffer of their own (DQfD, Hester et al. 2018); 0: plain DQN",
+        "kept in a replay buffer of their own (DQfD, Hester et al. 2018); 0: a plain DQN, the paper's (default)",
     )
     pretrain_updates: int = Field(
         3000, ge=0, description="gradient steps on the demonstrations alone before the DQN flies"
@@ -277,6 +277,16 @@ def _demonstrations(tc: TrainConfig, sim_cfg: SimConfig, env: HandoverVecEnv, rb
     return Demonstrations(obs, np.concatenate(act_seen), available_actions(obs, sim_cfg.observation))
 
 
+def reward_name(sim_cfg: SimConfig) -> str:
+    """'paper' or 'priced' when the reward is one of the two named ones, else 'custom'."""
+    from .config import PRICED_REWARD, RewardConfig
+
+    for name, weights in (("paper", {}), ("priced", PRICED_REWARD)):
+        if sim_cfg.reward == RewardConfig(**weights):
+            return name
+    return "custom"
+
+
 def train_checkpoint(tc: TrainConfig, sim_cfg: SimConfig, out, progress: bool = True) -> float:
     """Train and write a checkpoint whose metadata holds both configs, the history, the seed, the wall time and the
     command that re-runs it; returns the seconds spent training."""
@@ -298,7 +308,7 @@ def train_checkpoint(tc: TrainConfig, sim_cfg: SimConfig, out, progress: bool = 
             "command": f"xairl uav train --episodes {tc.episodes} --flights "
             f"{tc.n_flights} --demonstrations {tc.demonstrations} "
             f"--pretrain-updates {tc.pretrain_updates} --eps-start "
-            f"{tc.eps_start:g} --seed {tc.seed}",
+            f"{tc.eps_start:g} --reward {reward_name(sim_cfg)} --seed {tc.seed}",
         },
     )
     return seconds
