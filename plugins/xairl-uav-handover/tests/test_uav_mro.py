@@ -32,7 +32,7 @@ def test_samro_gives_the_same_handovers_in_batches_of_8_4_and_1():
             per_flight.append(run_flights(network, SHORT, k, 0, first=first)["handovers"])
             first += k
         counts.append(np.concatenate(per_flight))
-    assert network.flown == 10  # two warm-up flights, then the eight in order
+    assert network.flown == 10 and sum(c.sum() for c in counts) > 0  # two warm-up flights, then the eight in order
     np.testing.assert_array_equal(counts[0], counts[1])
     np.testing.assert_array_equal(counts[0], counts[2])
 

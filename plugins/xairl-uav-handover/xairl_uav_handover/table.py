@@ -137,12 +137,13 @@ def with_intervals(
 
 def format_paper(results: dict[str, dict[str, tuple[float, float, float]]]) -> str:
     """The paper's Table I medians beside ours: one line per policy it reports (a column named CHM, SA-MRO or
-    DQN..., the DQN's first one each)."""
+    DQN..., the one pooled over training seeds where there is one, else the first)."""
     lines = ["medians per flight, ours [95 % interval] vs the paper's (Meer et al., Table I):"]
     for policy, (ho, pp) in PAPER.items():
-        name = next((n for n in results if n == policy or n.startswith(policy)), None)
-        if name is None:
+        names = [n for n in results if n == policy or n.startswith(policy)]
+        if not names:
             continue
+        name = next((n for n in names if "seeds" in n), names[0])  # the pooled column, where there is one
         (h, hlo, hhi), (p, plo, phi) = (results[name][k] for k in PAPER_ROWS)
         lines.append(
             f"  {name:<24} handovers {h:.1f} [{hlo:.1f}, {hhi:.1f}] vs {ho}; "
@@ -154,10 +155,10 @@ def format_paper(results: dict[str, dict[str, tuple[float, float, float]]]) -> s
 def format_rows(results: dict[str, dict[str, tuple[float, float, float]]]) -> str:
     """One line per row, one column per policy: 'value [low, high]'."""
     names = list(results)
-    lines = [f"{'':<48}" + "".join(f"{n:>24}" for n in names)]
+    lines = [f"{'':<62}" + "".join(f"{n:>24}" for n in names)]
     for key, label, _ in ROWS:
         cells = [results[n][key] for n in names]
-        lines.append(f"{label:<48}" + "".join(f"{v:>9.2f} [{lo:.2f}, {hi:.2f}]".rjust(24) for v, lo, hi in cells))
+        lines.append(f"{label:<62}" + "".join(f"{v:>9.2f} [{lo:.2f}, {hi:.2f}]".rjust(24) for v, lo, hi in cells))
     return "\n".join(lines)
 
 
