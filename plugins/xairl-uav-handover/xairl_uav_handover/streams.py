@@ -5,7 +5,8 @@ The simulator draws every random number through one object with numpy's ``Genera
 flight's own draw: flight ``i`` of evaluation seed ``s`` (``default_rng([s, i])``) then sees the same positions,
 channel and arrivals whether it is flown alone, in a batch of 4 or in one of 200. The draws never depend on the
 controller's actions, so a flight's outcome depends only on its own handovers. Cost: one generator call per flight
-and draw (measured in evaluate.py's module doc).
+and kind of draw every ``block`` draws; measured, 0.66 against 0.61 ms per simulator step for 200 flights. A draw
+must be shaped (flights, ...): one shared by all flights has no place in a per-flight stream (ValueError).
 """
 
 from __future__ import annotations
@@ -57,6 +58,15 @@ class FlightStreams:
 
     def poisson(self, lam=1.0, size=None) -> np.ndarray:
         return self._draw(("poisson", float(lam)), size)
+
+    def random(self, size=None) -> np.ndarray:
+        return self._draw(("random",), size)
+
+    def exponential(self, scale=1.0, size=None) -> np.ndarray:
+        return scale * self._draw(("standard_exponential",), size)
+
+    def integers(self, low, high=None, size=None) -> np.ndarray:
+        return self._draw(("integers", low, high), size)
 
 
 def flight_seeds(seed: int, first: int, n: int) -> list[list[int]]:
