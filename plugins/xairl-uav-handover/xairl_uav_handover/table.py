@@ -19,10 +19,11 @@ from .env import PINGPONG_WINDOWS_S
 from .evaluate import PAPER, run_flights
 
 
-def pingpong_share(m: dict, i) -> np.ndarray:
-    """Per-flight ping-pong share (%) at the minimum time of stay, of the flights ``i`` that handed over."""
+def pingpong_share(m: dict, i, key: str = "pingpongs") -> np.ndarray:
+    """Per-flight ping-pong share (%) of the flights ``i`` that handed over; ``key`` the window's count
+    (default the minimum time of stay; ``pingpongs_10s``: 10 s)."""
     ho = m["handovers"][i]
-    return 100 * m["pingpongs"][i][ho > 0] / ho[ho > 0]
+    return 100 * m[key][i][ho > 0] / ho[ho > 0]
 
 
 #: (key, label, statistic of the per-flight arrays ``m``) in the table's order
@@ -56,6 +57,14 @@ def _rows():
     ]
     rows += [
         (
+            f"pp_share_median_{w:g}s",
+            f"ping-pong share per flight, median, {w:g} s window (%)",
+            lambda m, i, key=f"pingpongs_{w:g}s": _share_median(m, i, key),
+        )
+        for w in PINGPONG_WINDOWS_S
+    ]
+    rows += [
+        (
             "pp_over_5",
             "flights with > 5 ping-pongs, minimum time of stay (%)",
             lambda m, i: 100 * (m["pingpongs"][i] > 5).mean(),
@@ -81,8 +90,8 @@ def _rows():
     return rows
 
 
-def _share_median(m: dict, i) -> float:
-    share = pingpong_share(m, i)
+def _share_median(m: dict, i, key: str = "pingpongs") -> float:
+    share = pingpong_share(m, i, key)
     return float(np.median(share)) if len(share) else 0.0
 
 
@@ -91,6 +100,7 @@ ROWS = _rows()
 HIGHER_IS_BETTER = {"availability", "availability_median", "availability_worst5"}
 #: Table I rows the paper reports (its medians per flight), in PAPER's order
 PAPER_ROWS = ("handovers_median", "pp_share_median")
+WINDOWS = " / ".join(f"{w:g}" for w in PINGPONG_WINDOWS_S)
 
 
 def flights(controller, config, n_flights: int, seeds) -> dict[str, np.ndarray]:
@@ -138,16 +148,20 @@ def with_intervals(
 def format_paper(results: dict[str, dict[str, tuple[float, float, float]]]) -> str:
     """The paper's Table I medians beside ours: one line per policy it reports (a column named CHM, SA-MRO or
     DQN..., the one pooled over training seeds where there is one, else the first)."""
-    lines = ["medians per flight, ours [95 % interval] vs the paper's (Meer et al., Table I):"]
+    lines = [
+        "medians per flight, ours [95 % interval] vs the paper's (Meer et al., Table I); ping-pong share at the "
+        "minimum time of stay, the other windows beside it:"
+    ]
     for policy, (ho, pp) in PAPER.items():
         names = [n for n in results if n == policy or n.startswith(policy)]
         if not names:
             continue
         name = next((n for n in names if "seeds" in n), names[0])  # the pooled column, where there is one
         (h, hlo, hhi), (p, plo, phi) = (results[name][k] for k in PAPER_ROWS)
+        beside = " / ".join(f"{results[name][f'pp_share_median_{w:g}s'][0]:.1f}" for w in PINGPONG_WINDOWS_S)
         lines.append(
-            f"  {name:<24} handovers {h:.1f} [{hlo:.1f}, {hhi:.1f}] vs {ho}; "
-            f"ping-pong share {p:.1f} [{plo:.1f}, {phi:.1f}] % vs {pp} %"
+            f"  {name:<24} handovers {h:.1f} [{hlo:.1f}, {hhi:.1f}] vs {ho}; ping-pong share "
+            f"{p:.1f} [{plo:.1f}, {phi:.1f}] % (beside it at {WINDOWS} s: {beside} %) vs {pp} %"
         )
     return "\n".join(lines)
 
