@@ -28,7 +28,7 @@ from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.evaluate import importance, ranked
 from xairl_uav_handover.policy import DQNController, dqn_decision_states, load_checkpoint
-from xairl_uav_handover.table import flights, format_rows, with_intervals
+from xairl_uav_handover.table import flights, format_paper, format_rows, pooled_seeds, with_intervals
 from xairl_uav_handover.train import TrainConfig, train_checkpoint
 
 
@@ -76,10 +76,11 @@ def main():
     walks = real_walks(args.real, cfg) if args.real else None
     n = args.flights * len(args.eval_seeds)
     res = {c.name: with_intervals(flights(c, cfg, args.flights, args.eval_seeds)) for c in (CHM(), SAMRO())}
-    per_seed = []
+    per_seed, runs = [], []
     for k, (path, ckpt) in enumerate(zip(paths, ckpts)):
         name = f"DQN seed {ckpt.meta.get('seed')}" if not args.checkpoints else f"DQN {k + 1}: {Path(path).stem}"
-        res[name] = with_intervals(flights(DQNController(ckpt.net), ckpt.sim_config, args.flights, args.eval_seeds))
+        runs.append(flights(DQNController(ckpt.net), ckpt.sim_config, args.flights, args.eval_seeds))
+        res[name] = with_intervals(runs[-1])
         imp = {"simulated": importance(ckpt, dqn_decision_states(ckpt, args.states, 0))}
         met = [(label, bool(ok), detail) for label, ok, detail in targets({"CHM": res["CHM"], "DQN": res[name]}, n)]
         if walks:
@@ -103,7 +104,11 @@ def main():
         f"Table I: {args.flights} held-out flights x evaluation seeds {args.eval_seeds}; value [bootstrap 95 % "
         f"interval]; reward: {cfg.reward}"
     )
+    if len(runs) > 1:  # intervals over training seeds, then flights
+        pooled, groups = pooled_seeds(runs)
+        res[f"DQN, {len(runs)} seeds"] = with_intervals(pooled, groups=groups)
     print(format_rows(res))
+    print(format_paper(res))
     for s in per_seed:
         print(
             f"\n{s['name']} ({s['train_seconds']} s of training): "

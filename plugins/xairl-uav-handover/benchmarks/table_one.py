@@ -3,7 +3,9 @@ bootstrap 95 % interval (xairl_uav_handover.table), and the targets of the issue
 A3 rule on what operators pay for" checked one by one.
 
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/table_one.py [--flights 200] [--seeds 0 1 2]
-     [--checkpoint PATH ...]   (default: the committed checkpoint; several: one DQN column each, flights pooled)
+     [--checkpoint PATH ...]   (default: the committed checkpoint; several: one DQN column each, and one pooled
+    column whose intervals resample training seeds, then flights)
+Each per-flight figure as mean and median; the paper's medians beside ours (table.format_paper).
 """
 
 import argparse
@@ -11,7 +13,7 @@ import json
 
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.policy import DQNController, load_checkpoint
-from xairl_uav_handover.table import flights, format_rows, with_intervals
+from xairl_uav_handover.table import flights, format_paper, format_rows, pooled_seeds, with_intervals
 
 
 def targets(res: dict, n_flights: int) -> list[tuple[str, bool, str]]:
@@ -77,17 +79,20 @@ def main():
     cfg = ckpts[0].sim_config
     n = args.flights * len(args.seeds)
     res = {c.name: with_intervals(flights(c, cfg, args.flights, args.seeds)) for c in (CHM(), SAMRO())}
-    for k, ckpt in enumerate(ckpts):
-        res["DQN" if len(ckpts) == 1 else f"DQN {k}"] = with_intervals(
-            flights(DQNController(ckpt.net), cfg, args.flights, args.seeds)
-        )
+    runs = [flights(DQNController(ckpt.net), cfg, args.flights, args.seeds) for ckpt in ckpts]
+    for k, run in enumerate(runs):
+        res["DQN" if len(ckpts) == 1 else f"DQN {k}"] = with_intervals(run)
+    if len(runs) > 1:  # intervals over training seeds and flights
+        pooled, groups = pooled_seeds(runs)
+        res[f"DQN, {len(runs)} seeds"] = with_intervals(pooled, groups=groups)
     f = cfg.flight
     print(
         f"Table I: {args.flights} held-out flights of {f.duration_s:g} s x evaluation seeds {args.seeds} ({n} "
         f"flights per policy); value [bootstrap 95 % interval]; reward of the DQN: {ckpts[0].sim_config.reward}"
     )
     print(format_rows(res))
-    for name in [k for k in res if k.startswith("DQN")]:
+    print(format_paper(res))
+    for name in [k for k in res if k.startswith("DQN") and "seeds" not in k]:
         print(f"\ntargets, {name}:")
         print_targets(targets({"CHM": res["CHM"], "DQN": res[name]}, n))
     if args.json:

@@ -5,7 +5,7 @@ import numpy as np
 
 from xairl_uav_handover.baselines import CHM
 from xairl_uav_handover.config import SimConfig
-from xairl_uav_handover.table import ROWS, flights, format_rows, with_intervals
+from xairl_uav_handover.table import ROWS, flights, format_paper, format_rows, pooled_seeds, with_intervals
 
 
 def test_ping_pong_windows_nest_and_the_configured_one_matches_the_simulator():
@@ -28,3 +28,42 @@ def test_every_row_has_an_interval_around_its_value():
     assert res["pp_10s"][0] >= res["pp_1s"][0] and 0 <= res["ho_full"][0] <= 100 - res["ho_empty"][0] + 1e-9
     text = format_rows({"CHM": res})
     assert "ping-pong share, 10 s window (%)" in text and text.count("[") == len(ROWS)
+    for key in ("handovers_median", "pp_share_median", "lost_mbit_median", "rsrq_violation_median"):
+        value, low, high = res[key]
+        assert low <= value <= high, key  # a median's interval holds the median
+
+
+def _known(handovers, pingpongs):
+    n = len(handovers)
+    base = {k: np.zeros(n) for k in ("handovers_buffer_nonempty", "handovers_buffer_full", "buffer_nonempty_pct")}
+    return base | {
+        "handovers": np.array(handovers, float),
+        "pingpongs": np.array(pingpongs, float),
+        **{f"pingpongs_{w:g}s": np.array(pingpongs, float) for w in (1.0, 2.0, 5.0, 10.0)},
+        "minutes": np.full(n, 2.0),
+        "service_availability_pct": np.arange(n, dtype=float),
+        "lost_data_kbit": 1000.0 * np.arange(n),
+        "rsrq_violation_pct": np.zeros(n),
+        "rsrp_violation_pct": np.zeros(n),
+    }
+
+
+def test_medians_and_means_of_a_known_array():
+    m = _known([1, 2, 3, 4, 100], [0, 1, 0, 2, 10])
+    res = with_intervals(m, resamples=200)
+    assert res["handovers_median"][0] == 3 and res["handovers"][0] == 22
+    assert res["pp_share_median"][0] == 10 == res["pp_share_median_10s"][0]  # per-flight shares 0, 50, 0, 50, 10 %
+    assert res["lost_mbit_median"][0] == 2 and res["availability_median"][0] == 2
+    assert res["handovers_median"][2] <= 100 and res["handovers"][1] >= 1
+
+
+def test_intervals_over_training_seeds_hold_the_spread_between_seeds():
+    """Two seeds whose flights all hand over 2 and 10 times: resampling seeds, a resample can hold one seed twice,
+    so the interval of the median reaches both; resampling flights alone pins it near the pooled median."""
+    runs = [_known([2] * 20, [0] * 20), _known([10] * 20, [0] * 20)]
+    m, groups = pooled_seeds(runs)
+    by_seed, by_flight = with_intervals(m, 400, groups=groups), with_intervals(m, 400)
+    assert by_seed["handovers_median"][1:] == (2, 10) and by_seed["handovers"][1:] == (2, 10)
+    assert by_flight["handovers"][2] - by_flight["handovers"][1] < 4
+    text = format_paper({"CHM": by_seed, "DQN seed 0": by_flight})
+    assert "vs 75" in text and "vs 12" in text and "SA-MRO" not in text

@@ -9,8 +9,11 @@ report. :class:`A3Trigger` runs on time stamps, so the same rule also runs on re
   serving RSRP by ``offset_db`` continuously for ``ttt_s`` (TR 36.777 Table A.2.1-1: 2 dB, 160 ms).
 - :class:`SAMRO`: self-adaptive mobility robustness optimisation, as 3GPP describes MRO (TS 36.300 sec. 22.4.2,
   TS 36.902 sec. 4.5): A3 with a cell individual offset per (serving, neighbour) pair, which the network raises after
-  too-early handovers and ping-pongs on that pair and lowers after too-late ones, once per window
-  (:class:`MobilityRobustness` has the events' definitions). Offsets are the network's, shared by every UAV it serves.
+  too-early handovers, handovers to a wrong cell and ping-pongs on that pair and lowers after too-late ones
+  (:class:`MobilityRobustness` has the events' definitions). The offsets are the network's: they persist across
+  flights, which it sees in the order they are flown, and it updates them once every ``update_every_flights``
+  flights, after ``warmup_flights`` training flights; so a result does not depend on how many flights one vector
+  holds. Failures are the simulator's downlink radio link and handover failures (:func:`link_failures`).
 - :class:`RSRQRule`: a two-threshold rule on the DQN's own 13 inputs, at its decision period (ours, not the paper's):
   hand over to the best-RSRQ candidate on poor serving RSRQ with data waiting, or on a nearly full buffer. It marks
   where the handovers/RSRQ/availability frontier lies (benchmarks/rule_frontier.py) and is the demonstrator a DQN can
@@ -90,76 +93,142 @@ class CHM:
 
 
 class MobilityRobustness:
-    """The network's MRO state: a cell individual offset (dB, added to the A3 offset) per (serving, neighbour) pair.
+    """The network's MRO state: a cell individual offset (dB, added to the A3 offset) per (serving, neighbour) pair,
+    kept across flights, and the counts since the last update (TS 36.300 sec. 22.4.2's definitions).
 
-    Events, per UAV: a radio link failure (RLF) is uplink SINR below the minimum for ``rlf_s`` (counted once per
-    failure). An RLF within ``early_s`` of a handover makes that handover too early (on its source, target pair); any
-    other RLF while a neighbour is stronger than the serving cell is a too-late handover (on the serving, strongest
-    neighbour pair: the one that should have happened); a handover back to the source within ``pingpong_s`` counts
-    on the first handover's pair as too early. Every ``window_s`` each pair with more too-early than too-late events
-    gets ``margin_step_db`` more offset (hand over later), one with more too-late ones that much less; the total
-    offset stays in ``margin_range_db``.
+    A radio link failure (or a handover failure) within ``early_s`` of a handover from S to T is *too early* on
+    (S, T) when the UE would re-establish in S (the strongest cell), and *to the wrong cell* when in a third cell X
+    (counted too early on (S, T) and too late on (S, X)). A failure with no recent handover, while a neighbour X is
+    the strongest, is *too late* on (serving, X). A *ping-pong* (back to S within ``min_stay_s``) counts too early
+    on (S, T). :meth:`update` moves each pair with more too-early than too-late counts ``margin_step_db`` up (hand
+    over later), one with more too-late ones that much down, within ``margin_range_db``, and starts new counts.
+
+    :param n: cells; ``min_stay_s``: the ping-pong window (``HandoverConfig.min_time_of_stay_s``).
     """
 
-    def __init__(self, cfg: SAMROConfig, k: int, n: int):
-        self.cfg = cfg
+    def __init__(self, cfg: SAMROConfig, n: int, min_stay_s: float):
+        self.cfg, self.min_stay_s = cfg, min_stay_s
         self.cio = np.zeros((n, n))
         self.early, self.late = np.zeros((n, n)), np.zeros((n, n))
-        self.fail_since = np.full(k, np.nan)
-        self.ho_time, self.source = np.full(k, -np.inf), np.full(k, -1)
-        self.window_start = 0.0
+        self.counted = {"too_early": 0, "too_late": 0, "wrong_cell": 0, "pingpong": 0}
+        self.start(1)
+
+    def start(self, k: int) -> None:
+        """New flights: ``k`` UAVs with no handover yet."""
+        self.ho_time, self.source, self.target = np.full(k, -np.inf), np.full(k, -1), np.full(k, -1)
 
     def offsets(self, serving: np.ndarray) -> np.ndarray:
         """(k, n) A3 offsets of each UAV towards each cell, from its serving cell."""
         return self.cfg.offset_db + self.cio[serving]
 
-    def observe(self, now: float, serving, radio_ok, stronger, handed, previous) -> None:
-        """One step's outcome: ``serving`` cells now, ``radio_ok`` uplink SINR at least the minimum, ``stronger``
-        the strongest neighbour when it beats the serving cell (-1: none), ``handed`` handovers from ``previous``."""
+    def observe(self, now: float, serving, failed, best, handed, previous, pingpong=None) -> None:
+        """One step's outcome per UAV: ``serving`` cells now, ``failed`` a radio link or handover failure,
+        ``best`` the strongest cell (where the UE would re-establish), ``handed`` handovers from ``previous``;
+        ``pingpong`` the simulator's own flags (default: a return within ``min_stay_s`` of the last handover)."""
+        if pingpong is None:
+            pingpong = handed & (serving == self.source) & (now - self.ho_time < self.min_stay_s)
+        self._count("pingpong", self.early, serving, previous, pingpong)
+        self.source = np.where(handed, previous, self.source)
+        self.target = np.where(handed, serving, self.target)
+        self.ho_time = np.where(handed, now, self.ho_time)
+        recent = failed & (now - self.ho_time <= self.cfg.early_s) & (self.source >= 0)
+        self._count("too_early", self.early, self.source, self.target, recent & (best == self.source))
+        wrong = recent & (best != self.source) & (best != self.target)
+        self._count("wrong_cell", self.early, self.source, self.target, wrong)
+        np.add.at(self.late, (self.source[wrong], best[wrong]), 1)
+        self._count("too_late", self.late, serving, best, failed & ~recent & (best != serving))
+
+    def _count(self, name: str, table: np.ndarray, rows, cols, where) -> None:
+        np.add.at(table, (rows[where], cols[where]), 1)
+        self.counted[name] += int(np.count_nonzero(where))
+
+    def update(self) -> None:
+        """The network's periodic step (module doc), then new counts."""
         c = self.cfg
-        back = handed & (serving == self.source) & (now - self.ho_time < c.pingpong_s)
-        np.add.at(self.early, (serving[back], previous[back]), 1)
-        self.source, self.ho_time = np.where(handed, previous, self.source), np.where(handed, now, self.ho_time)
+        step = c.margin_step_db * ((self.early > self.late).astype(float) - (self.late > self.early))
+        low, high = c.margin_range_db
+        self.cio = np.clip(self.cio + step, low - c.offset_db, high - c.offset_db)
+        self.early[:], self.late[:] = 0, 0
+
+
+class UplinkFailure:
+    """A radio link failure on real samples, whose logs record none: the modelled uplink SINR below the minimum for
+    ``rlf_s`` (one event per failure). The simulator reports its own (``StepInfo.rlf``, failures.py)."""
+
+    def __init__(self, rlf_s: float, k: int):
+        self.rlf_s, self.since = rlf_s, np.full(k, np.nan)
+
+    def __call__(self, now: float, radio_ok) -> np.ndarray:
         failing = ~np.asarray(radio_ok, dtype=bool)
-        self.fail_since = np.where(failing, np.where(np.isnan(self.fail_since), now, self.fail_since), np.nan)
-        rlf = failing & (now - self.fail_since >= c.rlf_s)
-        self.fail_since[rlf] = np.inf  # one event per failure
-        early = rlf & (now - self.ho_time <= c.early_s) & (self.source >= 0)
-        np.add.at(self.early, (self.source[early], serving[early]), 1)
-        late = rlf & ~early & (stronger >= 0)
-        np.add.at(self.late, (serving[late], stronger[late]), 1)
-        if now - self.window_start >= c.window_s:
-            step = c.margin_step_db * ((self.early > self.late).astype(float) - (self.late > self.early))
-            low, high = c.margin_range_db
-            self.cio = np.clip(self.cio + step, low - c.offset_db, high - c.offset_db)
-            self.early[:], self.late[:], self.window_start = 0, 0, now
+        self.since = np.where(failing, np.where(np.isnan(self.since), now, self.since), np.nan)
+        rlf = failing & (now - self.since >= self.rlf_s)
+        self.since[rlf] = np.inf
+        return rlf
+
+
+def link_failures(sim) -> np.ndarray:
+    """Radio link or handover failure per flight in the simulator's last step (``StepInfo.rlf | StepInfo.hof``)."""
+    return sim.last.rlf | sim.last.hof
 
 
 class SAMRO:
-    """A3 handover with the network's per-pair offsets adapted by mobility robustness optimisation (module doc)."""
+    """A3 handover with the network's per-pair offsets adapted by mobility robustness optimisation (module doc).
+
+    One instance is one network: its offsets persist across ``reset`` calls, and it counts the flights it has
+    seen. :meth:`batch` tells ``evaluate.run_flights`` how many flights to fly together (up to the next update),
+    :meth:`finish` closes them, and :meth:`warm_up` first flies ``warmup_flights`` training flights, so the result
+    is that of flying every flight in sequence, whatever the batch size."""
 
     name = "SA-MRO"
     decision_every = 1
 
     def __init__(self, config: SAMROConfig | None = None):
         self.cfg = config or SAMROConfig()
+        self.mro: MobilityRobustness | None = None
+        self.flown, self.warm = 0, False
+
+    def batch(self, n: int) -> int:
+        """Flights to fly together next, of ``n`` left: none past the next update of the offsets."""
+        return min(n, self.cfg.update_every_flights - self.flown % self.cfg.update_every_flights)
+
+    def warm_up(self, config) -> None:
+        """Fly ``warmup_flights`` flights on training seeds once, before the first evaluated flight."""
+        if not self.warm:
+            from .evaluate import WARM_UP_SEED, fly_in_order
+            from .streams import flight_seeds
+
+            self.warm = True
+            if self.cfg.warmup_flights:
+                fly_in_order(self, config, flight_seeds(WARM_UP_SEED, 0, self.cfg.warmup_flights))
 
     def reset(self, env) -> None:
         sim = env.sim
+        if self.mro is None:
+            self.mro = MobilityRobustness(self.cfg, sim.N, env.cfg.handover.min_time_of_stay_s)
+        self.mro.start(sim.K)
         self.a3 = A3Trigger(sim.K, sim.N, sim.dt)
-        self.mro = MobilityRobustness(self.cfg, sim.K, sim.N)
+        self.previous = sim.serving.copy()
+
+    def _observe(self, env, rsrp: np.ndarray) -> None:
+        sim = env.sim
+        last = sim.last
+        failed = link_failures(sim)
+        handed = last.handover.astype(bool)
+        self.mro.observe(sim.t * sim.dt, sim.serving, failed, rsrp.argmax(axis=1), handed, self.previous, last.pingpong)
         self.previous = sim.serving.copy()
 
     def __call__(self, env) -> np.ndarray:
         sim, rsrp = env.sim, _candidate_rsrp(env)
         if sim.last is not None:
-            k, nb = np.arange(sim.K), env.candidates[:, 1]
-            stronger = np.where((nb >= 0) & (rsrp[k, np.maximum(nb, 0)] > rsrp[k, sim.serving]), nb, -1)
-            self.mro.observe(
-                sim.t * sim.dt, sim.serving, sim.last.radio_ok, stronger, sim.last.handover.astype(bool), self.previous
-            )
-        self.previous = sim.serving.copy()
+            self._observe(env, rsrp)
         return _action_of(env, self.a3.targets(rsrp, sim.serving, self.mro.offsets(sim.serving), self.cfg.ttt_s))
+
+    def finish(self, env) -> None:
+        """The flights of ``env`` have ended: count their last step, then update the offsets on the cadence."""
+        self._observe(env, _candidate_rsrp(env))
+        self.flown += env.sim.K
+        if self.flown % self.cfg.update_every_flights == 0:
+            self.mro.update()
 
 
 class CHMOnSamples:
@@ -199,15 +268,19 @@ class CHMOnSamples:
 
 class SAMROOnSamples(CHMOnSamples):
     """SA-MRO on real samples: :class:`MobilityRobustness` for one UAV over the flight's cells, fed with the network's
-    own handovers and with radio availability from the uplink model at the sample's serving RSRP and altitude."""
+    own handovers and with radio link failures from the uplink model at the sample's serving RSRP and altitude
+    (:class:`UplinkFailure`; the real logs record none). One flight is too short for the network's cadence, so the
+    offsets are updated once per ``update_every_flights`` x 2 min of samples."""
 
     name = "SA-MRO"
 
     def __init__(self, cells, sim_config, config: SAMROConfig | None = None):
         super().__init__(cells, None)
         self.sa, self.sim_cfg = config or SAMROConfig(), sim_config
-        self.mro = MobilityRobustness(self.sa, 1, len(self.cells))
+        self.mro = MobilityRobustness(self.sa, len(self.cells), sim_config.handover.min_time_of_stay_s)
+        self.failure = UplinkFailure(self.sa.rlf_s, 1)
         self.interference: dict[float, float] = {}
+        self.last_update = None
 
     def _radio_ok(self, state) -> bool:
         from .simulator import hex_layout
@@ -223,16 +296,15 @@ class SAMROOnSamples(CHMOnSamples):
     def _margin_ttt(self, state, candidates, previous, t: float):
         serving = np.array([self.col[candidates[0]]])
         rsrp = state[RSRP]
-        stronger = self.col[candidates[1]] if len(candidates) > 1 and rsrp[1] > rsrp[0] else -1
+        best = self.col[candidates[1]] if len(candidates) > 1 and rsrp[1] > rsrp[0] else serving[0]
         handed = previous is not None and previous != candidates[0]
-        self.mro.observe(
-            t,
-            serving,
-            np.array([self._radio_ok(state)]),
-            np.array([stronger]),
-            np.array([handed]),
-            np.array([self.col[previous] if previous is not None else serving[0]]),
-        )
+        failed = self.failure(t, np.array([self._radio_ok(state)]))
+        prev = np.array([self.col[previous] if previous is not None else serving[0]])
+        self.mro.observe(t, serving, failed, np.array([best]), np.array([handed]), prev)
+        self.last_update = t if self.last_update is None else self.last_update
+        if t - self.last_update >= self.sa.update_every_flights * self.sim_cfg.flight.duration_s:
+            self.mro.update()
+            self.last_update = t
         return self.mro.offsets(serving), self.sa.ttt_s
 
 

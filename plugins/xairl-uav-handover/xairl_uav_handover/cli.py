@@ -119,7 +119,7 @@ def run_evaluate(args) -> int:
 
     from .baselines import CHM, SAMRO
     from .policy import DQNController, load_checkpoint
-    from .table import flights, format_rows, verdict, with_intervals
+    from .table import flights, format_paper, format_rows, verdict, with_intervals
 
     if args.flights < 1:
         raise InputError("--flights must be at least 1.")
@@ -140,7 +140,7 @@ def run_evaluate(args) -> int:
         print(
             f"Table I: {args.flights} held-out flights of {cfg.flight.duration_s:g} s x evaluation seeds "
             f"{args.seeds}, value [bootstrap 95 % interval]; a ping-pong is a handover back to the previous BS "
-            f"within the window its row names\n{format_rows(res)}\n"
+            f"within the window its row names\n{format_rows(res)}\n{format_paper(res)}\n"
             f"{verdict(res)}"
         )
     return 0

@@ -5,8 +5,11 @@ decision per flight among its 4 candidates (0 = stay), held for ``decision_every
 of one vector end together, after the flight's duration (truncation, no autoreset: call ``reset`` again).
 :class:`UAVHandoverEnv` is the single-flight ``gymnasium.Env`` for tools that want one (``check_env`` passes).
 
-Reward per flight and decision (the paper's four terms, weights in ``RewardConfig``, q in Mbit):
-``-w_handover*[handover] + mean over the steps of (w_buffer/(1 + q) - w_rsrp*[RSRP<thr] - w_rsrq*[RSRQ<thr])``.
+Reward per flight and decision (the paper's four terms and our two, weights in ``RewardConfig``, q in Mbit):
+``-w_handover*[handover] - w_lost*lost - w_pingpong*[ping-pong]`` plus the mean over the steps of
+``w_buffer/(1 + q) - w_rsrp*[RSRP<thr] - w_rsrq*[RSRQ<thr]``.
+A ping-pong is a return within ``HandoverConfig.min_time_of_stay_s``, the one window of the metrics, the reward
+and SA-MRO (``info["pingpong"]``); :data:`PINGPONG_WINDOWS_S` are counted beside it for Table I only.
 An action naming an empty candidate slot (fewer neighbours measured) keeps the serving BS.
 ``info`` carries, per flight, the sums over the decision's simulator steps of :data:`METRICS`, and the candidate
 BS ids (``info["candidates"]``, (K, 4)).
@@ -96,7 +99,7 @@ class HandoverVecEnv(gym.vector.VectorEnv):
         reward = (
             -w.w_handover * sums["handover"]
             - w.w_lost * sums["lost_bits"] / 1e6
-            - w.w_pingpong * sums["pingpong_5s"]
+            - w.w_pingpong * sums["pingpong"]  # the one window, HandoverConfig.min_time_of_stay_s
             + gain / max(n, 1)
         )
         self._observe()

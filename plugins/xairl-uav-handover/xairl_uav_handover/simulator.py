@@ -31,6 +31,7 @@ from .channel import los_probability, path_loss, shadow_sigma
 from .config import LayoutConfig, SimConfig
 from .failures import RS_SHARE_SYMBOL, LinkMonitor, downlink_sinr_db, rssi_activity
 from .features import N_CANDIDATES, state_rows
+from .streams import random_source
 from .uplink import capacity_bps, cell_deviation, interference_mw, rsrp_offset_db, sinr_db
 
 
@@ -90,12 +91,13 @@ class Simulator:
 
     :param config: :class:`SimConfig`.
     :param n_uavs: flights simulated in parallel.
-    :param seed: every random draw (flights, channel, arrivals) comes from this seed.
+    :param seed: every random draw (flights, channel, arrivals) comes from this seed; or one seed per flight
+        (a list of ``n_uavs``: each flight its own stream, the same flight in any batch; streams.py).
     """
 
     def __init__(self, config: SimConfig | None = None, n_uavs: int = 1, seed: int = 0):
         self.cfg = cfg = config or SimConfig()
-        self.rng = rng = np.random.default_rng(seed)
+        self.rng = rng = random_source(seed, n_uavs)
         self.sites_xy = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
         self.bs_xy, self.site, self.boresight = antenna.cell_layout(self.sites_xy)  # per cell
         self.K, self.N = n_uavs, len(self.bs_xy)
