@@ -25,7 +25,8 @@ from .buffer import buffer_step
 from .channel import los_probability, path_loss, shadow_sigma
 from .config import LayoutConfig, SimConfig
 from .features import N_CANDIDATES, state_rows
-from .uplink import capacity_bps, cell_deviation, interference_mw, rsrp_offset_db, sinr_db
+from .trajectory import Waypoints
+from .uplink import capacity_bps, interference_mw, rsrp_offset_db, sinr_db
 
 
 def n_sites(layout: LayoutConfig) -> int:
@@ -79,11 +80,8 @@ class Simulator:
         self.dt = cfg.flight.dt_s
         self.n_steps = cfg.flight.n_steps
         self.radius = (cfg.layout.rings + 0.5) * cfg.layout.isd_m * np.sqrt(3) / 2  # inside the outer ring
-        r = self.radius * np.sqrt(rng.uniform(0, 1, n_uavs))
-        phi = rng.uniform(0, 2 * np.pi, n_uavs)
-        self.pos = np.stack([r * np.cos(phi), r * np.sin(phi), rng.uniform(*cfg.flight.altitude_m, n_uavs)], 1)
-        self.heading = rng.uniform(0, 2 * np.pi, n_uavs)
-        self.speed = rng.uniform(*cfg.flight.speed_mps, n_uavs)
+        self.route = Waypoints(cfg.flight, self.radius, rng, n_uavs)  # flights through waypoints (trajectory.py)
+        self.pos = self.route.start.copy()
         self.g_shadow = rng.standard_normal((n_uavs, self.N))
         self.g_los = rng.standard_normal((n_uavs, self.N))
         self.g_fast = rng.standard_normal((n_uavs, self.N))
@@ -91,11 +89,10 @@ class Simulator:
         rad, obs = cfg.radio, cfg.observation
         self._rsrp_offset = rsrp_offset_db(cfg)
         self._dl_noise_mw = 10 ** ((-174 + 10 * np.log10(rad.n_rb * 180e3) + rad.ue_noise_figure_db) / 10)
-        self._ul_interference = interference_mw(cfg, self.bs_xy, self.pos[:, 2])
-        # domain randomisation per flight (RadioConfig): cell load, antenna gain and uplink interference deviations
+        self._ul_interference = interference_mw(cfg, self.bs_xy, rng, n_uavs)  # (K, N): one uplink drop per flight
+        # domain randomisation per flight (RadioConfig): cell load and antenna gain deviations
         self._load = rng.uniform(*rad.load_range, (n_uavs, 1))
         self._gain = rng.uniform(-rad.gain_spread_db, rad.gain_spread_db, (n_uavs, 1))
-        self._ul_interference = self._ul_interference * cell_deviation(cfg, rng, (n_uavs, self.N))
         self._meas_every = max(1, int(round(obs.measurement_period_s / self.dt)))
         self._l3_a = 1.0 / 2 ** (obs.l3_filter_k / 4)
         self._measure()
@@ -211,15 +208,9 @@ class Simulator:
         return info
 
     def _move(self) -> None:
-        f, dt = self.cfg.flight, self.dt
-        turn = self.rng.uniform(0, 1, self.K) < dt / f.turn_every_s
-        self.heading = self.heading + turn * self.rng.normal(0, np.pi / 3, self.K)
-        step = self.speed * dt
-        self.pos[:, 0] += step * np.cos(self.heading)
-        self.pos[:, 1] += step * np.sin(self.heading)
-        out = np.hypot(self.pos[:, 0], self.pos[:, 1]) > self.radius  # turn back towards the centre, with jitter
-        inward = np.arctan2(-self.pos[:, 1], -self.pos[:, 0]) + self.rng.uniform(-np.pi / 4, np.pi / 4, self.K)
-        self.heading = np.where(out, inward, self.heading)
+        new = self.route.advance(self.pos, self.dt)
+        step = np.linalg.norm(new - self.pos, axis=1)  # distance moved: the channel decorrelates over it
+        self.pos = new
         rho = np.exp(-step / self.cfg.channel.shadow_corr_m)[:, None]
         innov = np.sqrt(1 - rho**2)
         self.g_shadow = rho * self.g_shadow + innov * self.rng.standard_normal((self.K, self.N))
