@@ -76,3 +76,15 @@ def test_real_flight_cells_take_levels_of_one_drop():
     for cell in range(30):
         link.sinr_db(-85.0, cell)
     assert set(link._interference.values()) <= set(link.site_interference.tolist())
+
+
+def test_settings_retired_by_issue_53_are_dropped_from_old_checkpoints():
+    from xairl_uav_handover.config import without_retired
+
+    old = SimConfig().model_dump()
+    old["radio"].update(ul_activity=0.06, ul_interference_spread_db=9.0)
+    old["flight"]["turn_every_s"] = 30.0
+    old["buffer"]["rb_per_uav"] = 50
+    with pytest.raises(ValueError):
+        SimConfig.model_validate(old)
+    assert SimConfig.model_validate(without_retired(old)) == SimConfig()

@@ -48,9 +48,9 @@ class RadioConfig(_Strict):
         description="P0_PUSCH, dBm per resource block, of open-loop power control (TS 36.213 sec. 5.1.1.1; "
         "each operator broadcasts its own, TS 36.331 p0-NominalPUSCH -126..24). Fitted: median uplink capacity "
         "on the even-numbered real UKM flights (measured RSRP, real_data.UplinkBuffer) towards IMC'22 operator "
-        "B's 37.7 Mbit/s; it saturates (interference grows with every UE's power) at 33.5 Mbit/s, reached from "
-        "-79 (-85, a typical evaluation value with alpha 0.8: 22.6; -82: 28.9; -80: 32.8; -70: 33.5); odd "
-        "flights 34.0 (-10 % of 37.7, +8 % of operator A's 31.5). benchmarks/uplink_check.py",
+        "B's 37.7 Mbit/s; it saturates at 33.5 Mbit/s from -79 on, where the UAV often sends at P_CMAX over the "
+        "whole carrier (-85, a typical evaluation value with alpha 0.8: 22.6; -82: 28.9; -80: 32.8; -70: 33.5); "
+        "odd flights 34.0 (-10 % of 37.7, +8 % of operator A's 31.5). benchmarks/uplink_check.py",
     )
     pc_alpha: float = Field(
         0.8,
