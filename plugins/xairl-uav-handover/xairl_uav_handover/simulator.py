@@ -1,7 +1,8 @@
 """Vectorised uplink simulator: K UAV flights over a hexagonal grid of N ground BSs, one numpy step for all.
 
 Per step (dt): measurements (RSRP/RSRQ of every BS, uplink SINR at the serving BS) -> the controller's target BS ->
-handover bookkeeping (interruption, control packet, ping-pong) -> buffer -> motion -> channel update.
+handover bookkeeping (interruption, control packet, ping-pong) -> buffer -> motion (waypoints, trajectory.py) ->
+channel update.
 
 Shadow fading and the LoS state are spatially correlated per UAV-BS link: each link carries two standard-normal
 latents that follow an AR(1) process with correlation exp(-distance moved / shadow_corr_m) (Gudmundson). Shadowing
