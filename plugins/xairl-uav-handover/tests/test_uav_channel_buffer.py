@@ -3,11 +3,8 @@
 import numpy as np
 import pytest
 
-from xairl_uav_handover import uplink
 from xairl_uav_handover.buffer import buffer_step
 from xairl_uav_handover.channel import SCENARIOS, los_probability, path_loss, shadow_sigma
-from xairl_uav_handover.config import SimConfig
-from xairl_uav_handover.simulator import hex_layout
 
 
 def test_uma_oracle_values():
@@ -39,25 +36,6 @@ def test_unknown_scenario():
         path_loss("XYZ", 50, 100, 2.0, True)
 
 
-def test_capacity_is_shannon_rate():
-    cfg = SimConfig.model_validate({"buffer": {"rb_per_uav": 6}})
-    # SINR 0 dB -> log2(2) = 1 bit/s/Hz: W_s |B| = 180 kHz * 6
-    assert uplink.capacity_bps(cfg, 0.0) == pytest.approx(1_080_000.0)
-    assert uplink.capacity_bps(cfg, 10 * np.log10(3)) == pytest.approx(2 * 1_080_000.0)
-
-
-def test_uplink_interference_rises_with_height_and_matches_the_link_budget():
-    cfg = SimConfig()
-    layout = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
-    i = uplink.interference_mw(cfg, layout, np.array([30.0, 60.0, 100.0, 150.0]))[:, 0]
-    assert (np.diff(i) > 0).all()  # more cells in line of sight as the UAV climbs (TR 36.777)
-    # no interference: SINR is P_ue - coupling loss (antenna gains included) - noise over the UAV's RBs
-    quiet = SimConfig.model_validate({"radio": {"ul_activity": 0.0}})
-    noise = -174 + 10 * np.log10(50 * 180e3) + 5.0
-    assert uplink.sinr_db(quiet, 100.0, 0.0) == pytest.approx(23.0 - 100.0 - noise)
-    assert uplink.sinr_db(cfg, 100.0, i[0]) < uplink.sinr_db(quiet, 100.0, 0.0)
-
-
 def test_buffer_recursion_by_hand():
     q, lost = buffer_step(
         np.array([1000.0, 1000.0, 1.9e6]), np.array([500.0, 3000.0, 2e5]), np.array([2000.0, 1500.0, 0.0]), q_max=2e6
@@ -79,15 +57,3 @@ def test_uma_av_is_terrestrial_uma_up_to_22_5_m():
     assert los_probability("UMa-AV", 23, 500) == pytest.approx(
         18 / 500 + np.exp(-500 / (4300 * np.log10(23) - 3800)) * (1 - 18 / 500)
     )
-
-
-def test_cells_differ_in_uplink_interference():
-    """Each cell's interference level is drawn per flight within +-spread dB; with no spread the cells of a flight
-    share the layout's mean levels."""
-    from xairl_uav_handover.simulator import Simulator
-
-    flat = Simulator(SimConfig.model_validate({"radio": {"ul_interference_spread_db": 0}}), n_uavs=4, seed=3)
-    spread = Simulator(SimConfig(), n_uavs=4, seed=3)
-    ratio_db = 10 * np.log10(spread._ul_interference / flat._ul_interference)
-    s = SimConfig().radio.ul_interference_spread_db
-    assert s > 0 and (np.abs(ratio_db) <= s + 1e-9).all() and ratio_db.std() > s / 4

@@ -11,7 +11,7 @@ from xairl import InputError
 from xairl.cli import main
 from xairl.plugin import StateRecord
 from xairl_uav_handover.calibration import agreement_rows, band_rows, outside
-from xairl_uav_handover.config import CHMConfig
+from xairl_uav_handover.config import CHMConfig, SimConfig
 from xairl_uav_handover.exports import load_flight, load_folder
 from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint
 from xairl_uav_handover.real_data import agreement, baltaci_rate_by_altitude, chm_handovers, walk
@@ -36,7 +36,7 @@ def test_load_one_flight():
     for state, cand in zip(w.states, w.candidates):
         assert (np.diff(state[6 : 5 + len(cand)]) <= 0).all(), "measured neighbours sorted by RSRP"
         assert (state[9 + len(cand) :] == -24.0).all(), "empty slots at the detection limit"
-    assert 0 < (w.queue_bits > 0).mean() < 1 and w.queue_bits.max() <= 2e6
+    assert 0 < (w.queue_bits > 0).mean() < 1 and w.queue_bits.max() <= SimConfig().buffer.q_max_bits
 
 
 @needs_data

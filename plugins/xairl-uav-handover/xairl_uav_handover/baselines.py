@@ -286,11 +286,11 @@ class SAMROOnSamples(CHMOnSamples):
         from .simulator import hex_layout
         from .uplink import interference_mw, rsrp_offset_db, sinr_db
 
-        cfg, h = self.sim_cfg, float(state[2])
-        if h not in self.interference:
+        cfg = self.sim_cfg
+        if not self.interference:  # the centre cell of one uplink drop (seed 0), as the real flights' buffer
             layout = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
-            self.interference[h] = float(interference_mw(cfg, layout, np.array([h]))[0, 0])
-        sinr = sinr_db(cfg, rsrp_offset_db(cfg) - float(state[RSRP][0]), self.interference[h])
+            self.interference[0] = float(interference_mw(cfg, layout, np.random.default_rng(0), 1)[0, 0])
+        sinr = sinr_db(cfg, rsrp_offset_db(cfg) - float(state[RSRP][0]), self.interference[0])
         return bool(sinr >= cfg.handover.sinr_min_db)
 
     def _margin_ttt(self, state, candidates, previous, t: float):

@@ -70,41 +70,54 @@ class RadioConfig(_Strict):
         "the real network's power per element): fitted so that the simulated serving RSRP's median equals the "
         "median of half of the real UKM flights (the other half held out; benchmarks/calibrate.py --rsrp)",
     )
-    bs_antenna_gain_db: float = Field(
-        -19.0,
-        ge=-40,
-        le=20,
-        description="gain towards the UAV of the BS antennas that receive the interfering aerial UEs (uplink.py)",
-    )
     ue_noise_figure_db: float = Field(9.0, ge=0, le=20, description="UE noise figure (TR 36.814 Table A.2.1.1-1)")
     bs_noise_figure_db: float = Field(5.0, ge=0, le=20, description="BS noise figure (TR 36.814 Table A.2.1.1-1)")
-    ul_activity: float = Field(
-        0.06,
+    p0_pusch_dbm: float = Field(
+        -79.0,
+        ge=-126,
+        le=24,
+        description="P0_PUSCH, dBm per resource block, of open-loop power control (TS 36.213 sec. 5.1.1.1; "
+        "each operator broadcasts its own, TS 36.331 p0-NominalPUSCH -126..24). Fitted: median uplink capacity "
+        "on the even-numbered real UKM flights (measured RSRP, real_data.UplinkBuffer) towards IMC'22 operator "
+        "B's 37.7 Mbit/s; it saturates at 33.5 Mbit/s from -79 on, where the UAV often sends at P_CMAX over the "
+        "whole carrier (-85, a typical evaluation value with alpha 0.8: 22.6; -82: 28.9; -80: 32.8; -70: 33.5); "
+        "odd flights 34.0 (-10 % of 37.7, +8 % of operator A's 31.5). benchmarks/uplink_check.py",
+    )
+    pc_alpha: float = Field(
+        0.8,
         ge=0,
         le=1,
-        description="share of time each other cell's aerial UE sends on "
-        "the UAV's resource blocks (see uplink.py). Calibrated "
-        "with the cells' spread below: median capacity 38 Mbit/s "
-        "in simulation and on the real flights (IMC'22 operator "
-        "B: 37.7); real buffer full in 13-19 % of real states "
-        "over 5 seeds (0.065: 15-20 %)",
+        description="fractional path-loss compensation alpha (TS 36.213 sec. 5.1.1.1; one of TS 36.331's "
+        "0, 0.4..1); 0.8 as in TR 36.814-style evaluations (TR 36.777's value not confirmed here)",
     )
+    ues_per_cell: int = Field(
+        15,
+        ge=1,
+        le=100,
+        description="UEs per cell of TR 36.777's uplink evaluation drop (Annex A; not confirmed here)",
+    )
+    aerial_ue_ratio: float = Field(
+        0.0067,
+        ge=0,
+        le=1,
+        description="share of the cell's UEs that are aerial: TR 36.777's Case 2 (0.67 %; its cases are "
+        "0, 0.67, 7.1, 25 and 50 %, not confirmed here); the sparsest case with drones, as in today's networks",
+    )
+    ground_ue_height_m: float = Field(1.5, gt=0, le=22.5, description="terrestrial UE height (TR 36.777 UMa)")
+    ul_attenuation: float = Field(
+        0.4,
+        gt=0,
+        le=1,
+        description="implementation attenuation of Shannon's capacity in the uplink (TR 36.942 Annex A)",
+    )
+    ul_sinr_min_db: float = Field(-10.0, description="below this SINR nothing is carried (TR 36.942 Annex A)")
+    ul_max_se: float = Field(4.4, gt=0, le=10, description="maximum spectral efficiency, bit/s/Hz (TR 36.942 Annex A)")
     load_range: tuple[float, float] = Field(
         (0.1, 1.0),
         description="downlink load of each cell (the share of its data resource elements in use: RSSI, RSRQ, "
-        "downlink SINR), drawn per cell and flight, uniform: a modelling choice, no source prescribes the "
-        "distribution; the spread of RSRQ - RSRP it causes is compared with the real flights' (calibrate.py --rsrq)",
-    )
-    ul_interference_spread_db: float = Field(
-        9.0,
-        ge=0,
-        le=20,
-        description="per-flight deviation of each cell's uplink interference level, uniform +-: "
-        "cells carry different uplink loads, so a UE's uplink quality is not its "
-        "downlink RSRP alone (uplink.py). Measured (40 episodes, 100 held-out "
-        "flights, w_buffer 1, ul_activity 0.08): buffer_queue_size by mean |margin "
-        "contribution| ranks 4th at 6 dB (seed 0), 1st/2nd/1st at 10 dB (seeds 0-2); "
-        "7th-10th without it (the earlier calibration)",
+        "downlink SINR) and its uplink load (its chance to schedule a UE on the UAV's blocks, uplink.py), drawn per "
+        "cell and flight, uniform: a modelling choice, no source prescribes the distribution; the spread of "
+        "RSRQ - RSRP it causes is compared with the real flights' (benchmarks/calibrate.py)",
     )
 
 
@@ -121,15 +134,32 @@ class LayoutConfig(_Strict):
 
 
 class FlightConfig(_Strict):
-    """Flights: heights cover the real UKM flights' (20-155 m, with margin so that 20 m lies inside the simulated
-    0.5-99.5 % range; below 22.5 m the channel is TR 36.777's terrestrial UMa, channel.py), speeds their measured
-    ones (median 3.8 m/s, p90 7.9 m/s)."""
+    """Flights through random waypoints (trajectory.py): heights cover the real UKM flights' (20-155 m, with margin
+    so that 20 m lies inside the simulated 0.5-99.5 % range; below 22.5 m the channel is TR 36.777's terrestrial
+    UMa, channel.py), horizontal speeds their measured ones (median 3.8 m/s, p90 7.9 m/s)."""
 
-    altitude_m: tuple[float, float] = Field((18.0, 160.0), description="uniform range of flight heights")
-    speed_mps: tuple[float, float] = Field((2.0, 8.0), description="uniform range of horizontal speeds")
+    altitude_m: tuple[float, float] = Field(
+        (18.0, 160.0), description="range of take-off and waypoint heights (uniform)"
+    )
+    speed_mps: tuple[float, float] = Field(
+        (2.0, 8.0), description="uniform range of horizontal speeds (one per flight)"
+    )
     duration_s: float = Field(120.0, gt=0, le=3600)
     dt_s: float = Field(0.04, gt=0, le=1, description="simulation step; TTT and time of stay are multiples of it")
-    turn_every_s: float = Field(30.0, gt=0, description="mean time between random heading changes")
+    climb_mps: float = Field(
+        5.0,
+        gt=0,
+        le=20,
+        description="vertical speed climbing to a waypoint. Measured: the IMC'22 DJI flight logs at their 2457 "
+        "handovers climb at up to 4.9 m/s (p95; p99 5.06), a DJI's P-mode maximum ascent speed (benchmarks/"
+        "uplink_check.py; the UKM data has no per-sample height)",
+    )
+    descent_mps: float = Field(
+        3.0,
+        gt=0,
+        le=20,
+        description="vertical speed descending. Measured: the same logs descend at up to 3.0 m/s (p5; p1 3.13)",
+    )
 
     @property
     def n_steps(self) -> int:
@@ -140,19 +170,42 @@ class FlightConfig(_Strict):
 class BufferConfig(_Strict):
     """Uplink traffic of the remote-piloting use case (Baltaci et al., IMC 2022, the study behind the shipped
     handover data): fixed-rate video streamed at 25 Mbit/s urban and 8 Mbit/s rural; measured UAV uplink throughput
-    medians 31.5 / 37.7 Mbit/s urban (two operators), 22.9 / 9.1 rural. The default is the urban video on a link
-    whose median capacity is ~40 Mbit/s (radio.ul_activity, calibrated near operator B's 37.7 while keeping the real
-    flights' buffer full in under 20 % of their states), a load of ~0.63 of median capacity, inside the documented
-    0.35-0.88; under it the buffer is non-empty in about a third of the states and depends on the serving cell's
-    uplink, which the downlink measurements do not show (radio.ul_interference_spread_db; a handover's interruption
-    alone queues 1 Mbit)."""
+    medians 31.5 / 37.7 Mbit/s urban (two operators), 22.9 / 9.1 rural. The UAV is granted a share of the uplink
+    carrier's resource blocks (the cell's other users take the rest); with ``radio.p0_pusch_dbm`` it is set from
+    the median capacity on the real UKM flights' measured RSRP against operator B's 37.7 Mbit/s
+    (benchmarks/uplink_check.py)."""
 
     video_rate_mbps: float = Field(25.0, ge=0, le=1000, description="video bit rate (Poisson packets of F_d bits)")
     data_packet_bits: float = Field(12_000.0, gt=0, description="F_d")
     control_packet_bits: float = Field(4_000.0, ge=0, description="F_c, added at each handover")
-    rb_per_uav: int = Field(50, gt=0, description="|B|: resource blocks granted to the UAV (the whole 10 MHz carrier)")
+    ul_carrier_rb: int = Field(
+        100,
+        gt=0,
+        le=275,
+        description="resource blocks of the uplink carrier: 20 MHz. Inferred, not confirmed: IMC'22's median "
+        "37.7 Mbit/s exceeds LTE's 10 MHz uplink peak (64QAM, 50 PRB: 36.7 Mbit/s, TS 36.213 TBS table)",
+    )
+    ul_share: float = Field(
+        1.0,
+        gt=0,
+        le=1,
+        description="the UAV's share of the uplink carrier's resource blocks (M = share x ul_carrier_rb; the "
+        "cell's other users take the rest). Implied by the measurement: under TR 36.942's bound and this "
+        "interference the median real-flight capacity saturates at 31.1 Mbit/s for share 0.9 (P0 -70) and 33.8 "
+        "for 1.0, so IMC'22's 37.7 (31.5 for operator A) leaves no room for a smaller share",
+    )
     rb_bandwidth_hz: float = Field(180e3, gt=0, description="W_s")
-    q_max_bits: float = Field(2e6, gt=0, description="buffer size; overflow is lost data")
+    q_max_bits: float = Field(
+        15.2e6,
+        gt=0,
+        description="buffer size; overflow is lost data. The modem's layer-2 buffer of an LTE UE category 4 "
+        "(1,900,000 bytes, TS 36.306 Table 4.1-1; not confirmed here): 0.6 s of the 25 Mbit/s video",
+    )
+
+    @property
+    def rb_per_uav(self) -> int:
+        """M: resource blocks the scheduler grants the UAV."""
+        return max(1, int(round(self.ul_share * self.ul_carrier_rb)))
 
     @property
     def packet_rate_hz(self) -> float:
@@ -252,6 +305,25 @@ class RewardConfig(_Strict):
 #: the operator-priced reward (issue 26, measured before issue 53: with the RSRQ rule's demonstrations it met 7 of 9
 #: simulated targets on each of 3 training seeds), an option beside the paper's
 PRICED_REWARD = {"w_handover": 40.0, "w_rsrq": 4.0, "w_lost": 1.5, "w_pingpong": 80.0}
+
+
+#: settings issue 53 retired (the uplink spread, the random walk's turns, the fixed resource blocks, the constant
+#: antenna gain and its per-flight spread, the fitted fading): a checkpoint
+#: trained before it still loads, its simulator read without them
+RETIRED = {
+    "channel": ("fading_db",),
+    "radio": ("ul_activity", "ul_interference_spread_db", "bs_antenna_gain_db", "gain_spread_db"),
+    "flight": ("turn_every_s",),
+    "buffer": ("rb_per_uav",),
+}
+
+
+def without_retired(data: dict) -> dict:
+    """``data`` (a SimConfig as a dict) without the :data:`RETIRED` settings."""
+    return {
+        k: ({f: x for f, x in v.items() if f not in RETIRED.get(k, ())} if isinstance(v, dict) else v)
+        for k, v in data.items()
+    }
 
 
 class SimConfig(_Strict):

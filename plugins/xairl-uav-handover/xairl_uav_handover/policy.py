@@ -17,7 +17,7 @@ import torch
 import xairl
 from xairl import InputError, Policy
 
-from .config import SimConfig
+from .config import SimConfig, without_retired
 from .env import HandoverVecEnv
 from .features import ACTION_ALIASES, ACTIONS, FEATURES, GROUPS, HandoverFacts, available_actions, feature_info
 
@@ -99,7 +99,7 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
             f"{path}: does not match the UAV DQN architecture (hidden={hidden}): {first}"
         ) from None
     try:
-        config = SimConfig.model_validate(meta.get("sim_config", {}))
+        config = SimConfig.model_validate(without_retired(meta.get("sim_config", {})))
     except ValueError as exc:
         raise xairl.plugin.CheckpointError(
             f"{path}: its simulator settings are invalid ({str(exc).splitlines()[0]})."

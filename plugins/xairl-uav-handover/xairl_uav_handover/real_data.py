@@ -2,7 +2,7 @@
 along a real flight and gives, at each sample, the state a policy would see (the same layout, detection limit and position frame as in simulation), its candidate cells and what the
 network did next; :func:`agreement` compares a policy's proposals with those decisions (open loop: the policy never
 steers, so every instant is a fair comparison). The buffer is not in the data: the simulator's uplink model
-(uplink.py), driven by the measured serving RSRP at the flight's altitude, fills it, sub-stepped at the simulator's
+(uplink.py), driven by the measured serving RSRP, fills it, sub-stepped at the simulator's
 time step between samples.
 """
 
@@ -22,7 +22,7 @@ from .exports import RealFlight
 from .features import FEATURES, N_CANDIDATES, checked_actions, state_rows
 from .features import RSRP as RSRP_COLUMNS
 from .simulator import hex_layout, n_cells
-from .uplink import capacity_bps, cell_deviation, interference_mw, rsrp_offset_db, sinr_db
+from .uplink import capacity_bps, interference_mw, rsrp_offset_db, sinr_db
 
 
 @dataclass
@@ -57,9 +57,9 @@ def _measured(f: RealFlight, i: int) -> dict[float, tuple[float, float]]:
 
 class UplinkBuffer:
     """The simulator's buffer and uplink model on a real flight: SINR from the measured serving RSRP (path loss =
-    RSRP offset - RSRP) with the aerial interference at the flight's altitude, sub-stepped at the sim's dt. Each
-    real cell gets the interference level of a cell of the simulated layout drawn at random, times its own deviation
-    (once per cell and flight, as the simulator draws them), so real and simulated links share one distribution.
+    RSRP offset - RSRP, power control on it) with the interference of one uplink drop of the simulated layout
+    (uplink.py), sub-stepped at the sim's dt. Each real cell gets the interference of a cell of that drop drawn at
+    random (once per cell and flight), so real and simulated links share one distribution.
 
     :param flight: the flight's name: each flight draws its own cells' levels.
     """
@@ -68,13 +68,12 @@ class UplinkBuffer:
         self.cfg, self.rng, self.q, self.lost = cfg, np.random.default_rng(seed), 0.0, 0.0
         self._cell_rng, self._interference = np.random.default_rng([seed, zlib.crc32(flight.encode())]), {}
         layout = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
-        self.site_interference = interference_mw(cfg, layout, np.array([altitude_m]))[0]  # (N,) mW per site
+        self.site_interference = interference_mw(cfg, layout, self._cell_rng, 1)[0]  # (N,) mW per resource block
 
     def sinr_db(self, rsrp_dbm: float, cell) -> float:
         if cell not in self._interference:
             site = self._cell_rng.integers(len(self.site_interference))
-            deviation = cell_deviation(self.cfg, self._cell_rng, ())
-            self._interference[cell] = float(self.site_interference[site] * deviation)
+            self._interference[cell] = float(self.site_interference[site])
         return float(sinr_db(self.cfg, rsrp_offset_db(self.cfg) - rsrp_dbm, self._interference[cell]))
 
     def advance(self, rsrp_dbm: float, cell, seconds: float, handed: bool) -> None:

@@ -3,7 +3,7 @@ numpy step for all.
 
 Per step (dt): measurements (RSRP/RSRQ of every cell, downlink and uplink SINR) -> the controller's target cell ->
 handover bookkeeping (interruption, control packet, ping-pong) -> handover and radio link failures, with
-re-establishment (failures.py) -> buffer -> motion -> channel update.
+re-establishment (failures.py) -> buffer -> motion (waypoints, trajectory.py) -> channel update.
 
 Shadow fading and the LoS state are spatially correlated per UAV-site link: each link carries two standard-normal
 latents that follow an AR(1) process with correlation exp(-distance moved / shadow_corr_m) (Gudmundson). Shadowing
@@ -32,7 +32,8 @@ from .config import LayoutConfig, SimConfig
 from .failures import RS_SHARE_SYMBOL, LinkMonitor, downlink_sinr_db, rssi_activity
 from .features import N_CANDIDATES, state_rows
 from .streams import random_source
-from .uplink import capacity_bps, cell_deviation, interference_mw, rsrp_offset_db, sinr_db
+from .trajectory import Waypoints
+from .uplink import capacity_bps, interference_mw, rsrp_offset_db, sinr_db
 
 
 def n_sites(layout: LayoutConfig) -> int:
@@ -105,11 +106,8 @@ class Simulator:
         self.dt = cfg.flight.dt_s
         self.n_steps = cfg.flight.n_steps
         self.radius = (cfg.layout.rings + 0.5) * cfg.layout.isd_m * np.sqrt(3) / 2  # inside the outer ring
-        r = self.radius * np.sqrt(rng.uniform(0, 1, n_uavs))
-        phi = rng.uniform(0, 2 * np.pi, n_uavs)
-        self.pos = np.stack([r * np.cos(phi), r * np.sin(phi), rng.uniform(*cfg.flight.altitude_m, n_uavs)], 1)
-        self.heading = rng.uniform(0, 2 * np.pi, n_uavs)
-        self.speed = rng.uniform(*cfg.flight.speed_mps, n_uavs)
+        self.route = Waypoints(cfg.flight, self.radius, rng, n_uavs)  # flights through waypoints (trajectory.py)
+        self.pos = self.route.start.copy()
         # one link per UAV and site: the three cells of a site share its path, differing by their antennas
         self.g_shadow = rng.standard_normal((n_uavs, n_site))
         self.g_los = rng.standard_normal((n_uavs, n_site))
@@ -122,10 +120,8 @@ class Simulator:
         rad, obs = cfg.radio, cfg.observation
         self._rsrp_offset = rsrp_offset_db(cfg)
         self._noise_re_mw = 10 ** ((-174 + 10 * np.log10(15e3) + rad.ue_noise_figure_db) / 10)  # per element
-        self._ul_interference = interference_mw(cfg, self.sites_xy, self.pos[:, 2])[:, self.site]
-        # per flight (RadioConfig): each cell's downlink load and uplink interference deviation
-        self._load = rng.uniform(*rad.load_range, (n_uavs, self.N))
-        self._ul_interference = self._ul_interference * cell_deviation(cfg, rng, (n_uavs, self.N))
+        self._ul_interference = interference_mw(cfg, self.sites_xy, rng, n_uavs)  # (K, N): one uplink drop a flight
+        self._load = rng.uniform(*rad.load_range, (n_uavs, self.N))  # each cell's downlink load, per flight
         self.monitor = LinkMonitor(cfg.handover, n_uavs, self.dt)
         self._meas_every = max(1, int(round(obs.measurement_period_s / self.dt)))
         self._l3_a = 1.0 / 2 ** (obs.l3_filter_k / 4)
@@ -287,15 +283,9 @@ class Simulator:
         return hof, rlf
 
     def _move(self) -> None:
-        f, dt = self.cfg.flight, self.dt
-        turn = self.rng.uniform(0, 1, self.K) < dt / f.turn_every_s
-        self.heading = self.heading + turn * self.rng.normal(0, np.pi / 3, self.K)
-        step = self.speed * dt
-        self.pos[:, 0] += step * np.cos(self.heading)
-        self.pos[:, 1] += step * np.sin(self.heading)
-        out = np.hypot(self.pos[:, 0], self.pos[:, 1]) > self.radius  # turn back towards the centre, with jitter
-        inward = np.arctan2(-self.pos[:, 1], -self.pos[:, 0]) + self.rng.uniform(-np.pi / 4, np.pi / 4, self.K)
-        self.heading = np.where(out, inward, self.heading)
+        new = self.route.advance(self.pos, self.dt)
+        step = np.linalg.norm(new - self.pos, axis=1)  # distance moved: the channel decorrelates over it
+        self.pos = new
         rho = np.exp(-step / self.cfg.channel.shadow_corr_m)[:, None]
         innov = np.sqrt(1 - rho**2)
         self.g_shadow = rho * self.g_shadow + innov * self.rng.standard_normal(self.g_shadow.shape)

@@ -1,25 +1,31 @@
-"""The UAV's uplink: SINR at its serving BS, with the co-channel interference aerial UEs cause, and its capacity.
+"""The UAV's uplink: power control, the interference other cells' users cause, SINR and a bounded capacity.
 
-Interference (TR 36.777: aerial UEs see line of sight to many cells, so the uplink interference they cause rises
-with height): every other cell j has a co-channel aerial UE on the UAV's resource blocks a share ``ul_activity`` of
-the time, flying at the UAV's height over cell j's site and sending at full power (no power control: a stated
-simplification). Its mean received power at BS b mixes the LoS and NLoS path losses of TR 36.777 by P_LOS(h, d),
-so it grows with height as P_LOS does. The sum over j is precomputed per flight (heights are constant in flight).
-Cells differ in uplink load (how many UEs they serve, and where): each cell's interference level deviates from the
-layout's mean by a per-flight draw, uniform within +-``ul_interference_spread_db`` (:func:`cell_deviation`; a
-modelling choice, its size measured in config.py). The downlink RSRP the UE measures does not show this; only the
-uplink buffer does, so the buffer tells a handover policy something its radio measurements do not.
-A real flight uses the same model at its altitude: each real cell takes the mean level of a random cell of the
-layout times its own deviation, and the path loss is read from the measured RSRP (real_data.UplinkBuffer); sim and
-real buffers are thus driven by one uplink model.
+Power control (TS 36.213 sec. 5.1.1.1, open loop): a UE sending on M resource blocks uses
+P = min(P_CMAX, P0 + 10 lg M + alpha PL), PL being its coupling loss to its own cell as it estimates it
+(referenceSignalPower - RSRP: its coupling loss, antenna gain and link loss included). Per resource block that is min(P_CMAX - 10 lg M, P0 + alpha PL) (:func:`psd_dbm`).
+The UAV and every interfering UE follow it, each towards its own cell; the UAV's follows its height through its
+path loss, which the simulator updates at every step.
 
-Capacity is the paper's ``W_s |B| log2(1 + SINR)``; signal and noise are over the UAV's |B| resource blocks.
+Interference (objection 2 of issue 53, from TR 36.777's evaluation drop): each cell serves ``ues_per_cell`` UEs,
+each one aerial with probability ``aerial_ue_ratio`` (flying at a height of the flight range) and otherwise
+terrestrial (1.5 m), dropped uniformly over the cell's sector. In a TTI a cell schedules one of its UEs on the
+UAV's resource blocks with probability equal to its uplink load, so the mean interference cell j causes at cell b
+is load_j times the mean over j's UEs of their power per resource block times their coupling gain to b (LoS and
+NLoS mixed by P_LOS, TR 36.777, and b's sector antenna towards them, antenna.py). One drop per flight: cells differ because their
+loads and their UEs differ, above all in whether they hold an aerial UE, which is seen in line of sight by many
+cells. The interference at the serving cell does not depend on the UAV's own height (other UEs cause it); the
+UAV's own signal does. A real flight takes, for each real cell, a random cell of one such drop
+(real_data.UplinkBuffer): sim and real buffers are driven by one uplink model.
+
+Capacity (TR 36.942 Annex A, truncated Shannon): M W (0 below SINR_min, else min(att log2(1 + SINR), SE_max)),
+with M the UAV's scheduler share of the uplink carrier's resource blocks (BufferConfig).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from . import antenna
 from .channel import los_probability, path_loss
 from .config import SimConfig
 
@@ -32,42 +38,77 @@ def rsrp_offset_db(cfg: SimConfig) -> float:
 
 
 def noise_dbm(cfg: SimConfig) -> float:
-    """Thermal noise plus the BS noise figure over the UAV's resource blocks."""
-    b = cfg.buffer
-    return -174 + 10 * np.log10(b.rb_per_uav * b.rb_bandwidth_hz) + cfg.radio.bs_noise_figure_db
+    """Thermal noise plus the BS noise figure over one resource block."""
+    return -174 + 10 * np.log10(cfg.buffer.rb_bandwidth_hz) + cfg.radio.bs_noise_figure_db
 
 
-def interference_mw(cfg: SimConfig, bs_xy: np.ndarray, heights: np.ndarray) -> np.ndarray:
-    """(K, N): mean co-channel interference at each BS for UAVs at ``heights`` (K,) (see the module doc)."""
-    c, rad = cfg.channel, cfg.radio
-    h = np.asarray(heights, dtype=float)[:, None, None]
-    d2d = np.hypot(*(bs_xy[:, None, :] - bs_xy[None, :, :]).transpose(2, 0, 1))[None]  # (1, N, N): site j -> BS b
+def psd_dbm(cfg: SimConfig, coupling_db) -> np.ndarray:
+    """Open-loop PUSCH power per resource block (dBm) of a UE on the UAV's M blocks at ``coupling_db`` to its cell."""
+    rad = cfg.radio
+    m = cfg.buffer.rb_per_uav
+    return np.minimum(rad.ue_tx_power_dbm - 10 * np.log10(m), rad.p0_pusch_dbm + rad.pc_alpha * np.asarray(coupling_db))
+
+
+def _mean_gain(cfg: SimConfig, xy, h, site_xy, boresight) -> np.ndarray:
+    """Linear coupling gain of UEs at ``xy`` (..., 2), heights ``h`` to a cell at ``site_xy`` with ``boresight``:
+    the path gain averaged over LoS and NLoS by P_LOS, times the cell's antenna gain towards them (antenna.py),
+    less the link loss (RadioConfig.link_loss_db)."""
+    c = cfg.channel
+    dx, dy = xy[..., 0] - site_xy[0], xy[..., 1] - site_xy[1]
+    d2d = np.hypot(dx, dy)
     d3d = np.hypot(d2d, h - c.bs_height_m)
     p_los = los_probability(c.scenario, h, np.maximum(d2d, 1.0))
-    gain = p_los * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, True, c.bs_height_m) / 10) + (
-        1 - p_los
-    ) * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, False, c.bs_height_m) / 10)
-    n = len(bs_xy)
-    gain = gain * (1 - np.eye(n))[None]  # a cell's own UE is the UAV, not an interferer
-    per_interferer = 10 ** ((rad.ue_tx_power_dbm + rad.bs_antenna_gain_db) / 10)
-    return rad.ul_activity * per_interferer * gain.sum(axis=1)
+    g = p_los * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, True, c.bs_height_m) / 10)
+    g = g + (1 - p_los) * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, False, c.bs_height_m) / 10)
+    gain_db = antenna.gain_db(cfg.antenna, dx, dy, h - c.bs_height_m, boresight) - cfg.radio.link_loss_db
+    return g * 10 ** (gain_db / 10)
 
 
-def cell_deviation(cfg: SimConfig, rng: np.random.Generator, shape) -> np.ndarray:
-    """Factors (``shape``) on each cell's mean interference: 10^(u/10), u uniform in +-ul_interference_spread_db."""
-    spread = cfg.radio.ul_interference_spread_db
-    return 10 ** (rng.uniform(-spread, spread, shape) / 10)
+def drop_ues(cfg: SimConfig, sites_xy: np.ndarray, rng: np.random.Generator, n_flights: int):
+    """One TR 36.777 drop per flight: positions (K, N, U, 2) and heights (K, N, U) of each cell's UEs, uniform over
+    its sector (the 120-degree wedge of a disc of the site's hexagon area around its boresight)."""
+    rad, u = cfg.radio, cfg.radio.ues_per_cell
+    cell_xy, _, boresight = antenna.cell_layout(sites_xy)
+    n = len(cell_xy)
+    site_r = cfg.layout.isd_m * np.sqrt(np.sqrt(3) / (2 * np.pi))  # a disc of the site's hexagon area
+    r = site_r * np.sqrt(rng.uniform(0, 1, (n_flights, n, u)))
+    phi = boresight[None, :, None] + rng.uniform(-np.pi / 3, np.pi / 3, (n_flights, n, u))
+    xy = cell_xy[None, :, None, :] + np.stack([r * np.cos(phi), r * np.sin(phi)], -1)
+    aerial = rng.uniform(0, 1, (n_flights, n, u)) < rad.aerial_ue_ratio
+    h = np.where(aerial, rng.uniform(*cfg.flight.altitude_m, (n_flights, n, u)), rad.ground_ue_height_m)
+    return xy, h
+
+
+def interference_mw(cfg: SimConfig, sites_xy: np.ndarray, rng: np.random.Generator, n_flights: int) -> np.ndarray:
+    """(K, N): mean interference per resource block (mW) at each of the sites' cells, one drop per flight (see the
+    module doc)."""
+    cell_xy, _, boresight = antenna.cell_layout(sites_xy)
+    xy, h = drop_ues(cfg, sites_xy, rng, n_flights)
+    k, n, u = h.shape
+    load = rng.uniform(*cfg.radio.load_range, (k, n))  # each cell's uplink load: its chance to use the UAV's blocks
+    own = np.stack([_mean_gain(cfg, xy[:, j], h[:, j], cell_xy[j], boresight[j]) for j in range(n)], axis=1)
+    psd_mw = 10 ** (psd_dbm(cfg, -10 * np.log10(own)) / 10)  # (K, N, U)
+    out = np.zeros((k, n))
+    for b in range(n):  # victim cell b; a loop over cells keeps memory at K x N x U
+        to_b = _mean_gain(cfg, xy, h, cell_xy[b], boresight[b])
+        per_cell = load * (psd_mw * to_b).mean(axis=2)  # (K, N): what each cell j sends towards b
+        per_cell[:, b] = 0.0  # b's own UE on these blocks is the UAV
+        out[:, b] = per_cell.sum(axis=1)
+    return out
 
 
 def sinr_db(cfg: SimConfig, loss_db, interference: np.ndarray) -> np.ndarray:
-    """Uplink SINR for a coupling loss ``loss_db`` (antenna gains included) to the serving BS and the interference
-    (mW) there."""
-    rad = cfg.radio
-    signal_mw = 10 ** ((rad.ue_tx_power_dbm - np.asarray(loss_db)) / 10)
+    """Uplink SINR per resource block for a coupling loss ``loss_db`` to the serving cell (path loss and link loss
+    minus its antenna gain, the same both ways) and the interference (mW per resource block) there; the UAV's
+    power follows :func:`psd_dbm`."""
+    coupling = np.asarray(loss_db)
+    signal_mw = 10 ** ((psd_dbm(cfg, coupling) - coupling) / 10)
     return 10 * np.log10(signal_mw / (10 ** (noise_dbm(cfg) / 10) + interference))
 
 
 def capacity_bps(cfg: SimConfig, sinr: np.ndarray) -> np.ndarray:
-    """W_s |B| log2(1 + SINR), bits per second."""
-    b = cfg.buffer
-    return b.rb_bandwidth_hz * b.rb_per_uav * np.log2(1.0 + 10.0 ** (np.asarray(sinr) / 10.0))
+    """Truncated Shannon (TR 36.942 Annex A) over the UAV's M resource blocks, bits per second."""
+    rad, b = cfg.radio, cfg.buffer
+    s = np.asarray(sinr, dtype=float)
+    se = np.minimum(rad.ul_attenuation * np.log2(1.0 + 10.0 ** (s / 10.0)), rad.ul_max_se)
+    return b.rb_bandwidth_hz * b.rb_per_uav * np.where(s < rad.ul_sinr_min_db, 0.0, se)

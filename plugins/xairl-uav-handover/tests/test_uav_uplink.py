@@ -1,0 +1,96 @@
+"""The uplink (uplink.py): open-loop power control and SINR worked by hand, TR 36.942's truncated Shannon, the
+interference of one drop against a brute-force sum, and the real flights on the same drop."""
+
+import numpy as np
+import pytest
+
+from xairl_uav_handover import uplink
+from xairl_uav_handover.config import SimConfig
+from xairl_uav_handover.simulator import hex_layout
+
+
+def _cfg(radio=None, buffer=None) -> SimConfig:
+    return SimConfig.model_validate({"radio": radio or {}, "buffer": buffer or {}})
+
+
+def test_power_control_by_hand():
+    """TS 36.213 5.1.1.1 per resource block: min(P_CMAX - 10 lg M, P0 + alpha PL)."""
+    cfg = _cfg({"p0_pusch_dbm": -85.0, "pc_alpha": 0.8, "ue_tx_power_dbm": 23.0}, {"ul_share": 0.1})
+    assert cfg.buffer.rb_per_uav == 10
+    assert uplink.psd_dbm(cfg, 100.0) == pytest.approx(-85.0 + 80.0)  # -5 dBm per block, 5 dBm in all
+    assert uplink.psd_dbm(cfg, 130.0) == pytest.approx(23.0 - 10.0)  # 19 dBm asked, capped at 13 per block
+
+
+def test_sinr_without_interference_by_hand():
+    """Coupling loss 119 dB (antenna gain and link loss included); power -85 + 0.8 * 119 = 10.2 dBm per block;
+    noise -174 + 10 lg 180e3 + 5 = -116.447 dBm per block."""
+    cfg = _cfg({"p0_pusch_dbm": -85.0, "pc_alpha": 0.8}, {"ul_share": 0.1})
+    expected = (-85.0 + 0.8 * 119.0) - 119.0 - (-174.0 + 10 * np.log10(180e3) + 5.0)
+    assert uplink.sinr_db(cfg, 119.0, 0.0) == pytest.approx(expected)
+    assert uplink.sinr_db(cfg, 119.0, 1e-12) < expected
+
+
+def test_truncated_shannon():
+    """TR 36.942 Annex A: 0 below -10 dB, 0.4 log2(1 + SINR) between, 4.4 bit/s/Hz at most; over M blocks."""
+    cfg = _cfg({"ul_attenuation": 0.4, "ul_sinr_min_db": -10.0, "ul_max_se": 4.4}, {"ul_share": 0.06})
+    w = 180e3 * 6
+    assert uplink.capacity_bps(cfg, 0.0) == pytest.approx(0.4 * w)
+    assert uplink.capacity_bps(cfg, 10 * np.log10(3)) == pytest.approx(0.8 * w)
+    assert uplink.capacity_bps(cfg, 60.0) == pytest.approx(4.4 * w)  # the ceiling
+    assert uplink.capacity_bps(cfg, -10.5) == 0.0
+
+
+def test_interference_is_the_brute_force_sum():
+    """Two sites (six cells), two UEs a cell, loads 1: cell b hears every other cell's UEs' mean power (towards
+    their own cell) times their coupling gain to b, its sector antenna included."""
+    from xairl_uav_handover.antenna import cell_layout
+
+    cfg = _cfg({"ues_per_cell": 2, "aerial_ue_ratio": 0.5, "load_range": (1.0, 1.0)})
+    sites = np.array([[0.0, 0.0], [500.0, 0.0]])
+    cells, _, boresight = cell_layout(sites)
+    got = uplink.interference_mw(cfg, sites, np.random.default_rng(4), 3)
+    xy, h = uplink.drop_ues(cfg, sites, np.random.default_rng(4), 3)
+    assert got.shape == (3, 6)
+    for k in range(3):
+        for b in range(6):
+            total = 0.0
+            for j in range(6):
+                for u in range(2 * (j != b)):
+                    own = uplink._mean_gain(cfg, xy[k, j, u], h[k, j, u], cells[j], boresight[j])
+                    to_b = uplink._mean_gain(cfg, xy[k, j, u], h[k, j, u], cells[b], boresight[b])
+                    total += 10 ** (uplink.psd_dbm(cfg, -10 * np.log10(own)) / 10) * to_b / 2
+            assert got[k, b] == pytest.approx(total, rel=1e-9)
+
+
+def test_aerial_ues_raise_the_interference_and_loads_scale_it():
+    cfg = SimConfig()
+    layout = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
+    ground = uplink.interference_mw(_cfg({"aerial_ue_ratio": 0.0}), layout, np.random.default_rng(0), 20)
+    aerial = uplink.interference_mw(_cfg({"aerial_ue_ratio": 0.5}), layout, np.random.default_rng(0), 20)
+    # line of sight to many cells (TR 36.777), though through the side lobes of their sector antennas
+    assert np.median(aerial) > 3 * np.median(ground)
+    full = uplink.interference_mw(_cfg({"load_range": (1.0, 1.0)}), layout, np.random.default_rng(1), 5)
+    half = uplink.interference_mw(_cfg({"load_range": (0.5, 0.5)}), layout, np.random.default_rng(1), 5)
+    np.testing.assert_allclose(half, full / 2)
+
+
+def test_real_flight_cells_take_levels_of_one_drop():
+    from xairl_uav_handover.real_data import UplinkBuffer
+
+    cfg = SimConfig()
+    link = UplinkBuffer(cfg, 60.0, seed=0, flight="f")
+    for cell in range(30):
+        link.sinr_db(-85.0, cell)
+    assert set(link._interference.values()) <= set(link.site_interference.tolist())
+
+
+def test_settings_retired_by_issue_53_are_dropped_from_old_checkpoints():
+    from xairl_uav_handover.config import without_retired
+
+    old = SimConfig().model_dump()
+    old["radio"].update(ul_activity=0.06, ul_interference_spread_db=9.0)
+    old["flight"]["turn_every_s"] = 30.0
+    old["buffer"]["rb_per_uav"] = 50
+    with pytest.raises(ValueError):
+        SimConfig.model_validate(old)
+    assert SimConfig.model_validate(without_retired(old)) == SimConfig()
