@@ -69,7 +69,9 @@ def ranking(meas_rsrp: np.ndarray, meas_rsrq: np.ndarray, detection_db: float) -
     detected = meas_rsrq > detection_db
     masked = np.where(detected, meas_rsrp, -np.inf)
     top = np.argsort(-masked, axis=1)[:, :N_CANDIDATES]
-    return np.where(np.isfinite(np.take_along_axis(masked, top, axis=1)), top, -1), detected
+    top = np.where(np.isfinite(np.take_along_axis(masked, top, axis=1)), top, -1)
+    pad = np.full((len(top), N_CANDIDATES - top.shape[1]), -1)  # fewer cells than candidate slots
+    return np.concatenate([top, pad], axis=1), detected
 
 
 def record(config: SimConfig, n_flights: int, seed: int) -> Record:

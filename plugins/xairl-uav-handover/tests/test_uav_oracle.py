@@ -1,0 +1,140 @@
+"""The hindsight bound (oracle.py): the simulator's draws do not depend on the actions, the shortest path equals brute
+force over every schedule, its bookkeeping reproduces the simulator's own sums exactly, and a receding horizon that
+sees the whole flight is the exact bound."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from xairl_uav_handover import oracle
+from xairl_uav_handover.baselines import CHM
+from xairl_uav_handover.config import SimConfig
+from xairl_uav_handover.evaluate import run_flights
+from xairl_uav_handover.policy import DQNController, load_checkpoint
+from xairl_uav_handover.simulator import Simulator
+
+SHORT = {"flight": {"duration_s": 12.0}}
+
+
+@pytest.fixture(scope="module")
+def ckpt():
+    return load_checkpoint()
+
+
+@pytest.fixture(scope="module")
+def cfg(ckpt):
+    data = ckpt.sim_config.model_dump()
+    data["flight"].update(SHORT["flight"])
+    return SimConfig.model_validate(data)
+
+
+@pytest.fixture(scope="module")
+def rec(cfg):
+    return oracle.record(cfg, 16, seed=3)
+
+
+def test_draws_do_not_depend_on_the_actions(cfg):
+    """Two schedules (always stay; a different cell at every step) draw the same trajectories, channel latents and
+    arrivals: the generator is in the same state after every step and every per-cell measurement is identical."""
+    a, b = Simulator(cfg, n_uavs=5, seed=11), Simulator(cfg, n_uavs=5, seed=11)
+    for _ in range(60):
+        ia, ib = a.step(a.serving), b.step((b.serving + 1) % b.N)
+        assert ib.handover.all() and not ia.handover.any()  # the schedules differ at every step
+        assert a.rng.bit_generator.state == b.rng.bit_generator.state
+        for name in ("pos", "heading", "g_shadow", "g_los", "g_fast", "meas_rsrp", "meas_rsrq", "rsrp", "rsrq"):
+            np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def _candidates(rsrp, rsrq, serving, detection):
+    """The env's offer from ``serving``, written as Simulator.candidates writes it (not through oracle.ranking)."""
+    masked = np.where(rsrq > detection, rsrp, -np.inf)
+    masked[serving] = -np.inf
+    top = np.argsort(-masked)[:3]
+    return {serving} | {int(c) for c in top if np.isfinite(masked[c])}
+
+
+def _tiny(n_cells, seed, decisions=4, every=2, flights=3):
+    rng = np.random.default_rng(seed)
+    rsrp = rng.normal(-90, 6, (decisions, flights, n_cells))
+    rsrq = rng.normal(-12, 5, (decisions, flights, n_cells))
+    ranked = [oracle.ranking(rsrp[d], rsrq[d], -14.0) for d in range(decisions)]
+    below = rng.uniform(size=(decisions * every, flights, n_cells)) < 0.4
+    rec = oracle.Record(
+        below,
+        below.astype(np.float32),
+        np.stack([r[0] for r in ranked]),
+        np.stack([r[1] for r in ranked]),
+        rng.integers(0, n_cells, flights),
+        0.04,
+        every,
+    )
+    return rec, rsrp, rsrq
+
+
+def _brute(rec, rsrp, rsrq, k, w_ho, any_measured):
+    """The least cost over every schedule of flight k the env (or, any_measured, detection) allows."""
+    t_all, _, n_cells, d_all = rec.shape
+    best = np.inf
+    for cells in itertools.product(range(n_cells), repeat=d_all):
+        prev, ok = int(rec.initial[k]), True
+        for d, c in enumerate(cells):
+            offer = (
+                {prev} | set(np.flatnonzero(rsrq[d, k] > -14.0).tolist())
+                if any_measured
+                else _candidates(rsrp[d, k], rsrq[d, k], prev, -14.0)
+            )
+            ok, prev = ok and c in offer, c
+        if ok:
+            serving = np.repeat(cells, rec.every)[:t_all]
+            ho = np.count_nonzero(np.diff(np.concatenate([[rec.initial[k]], serving])))
+            best = min(best, w_ho * ho + rec.dt * rec.below[np.arange(t_all), k, serving].sum())
+    return best
+
+
+@pytest.mark.parametrize("n_cells, any_measured", [(3, False), (5, False), (5, True)])
+def test_shortest_path_equals_brute_force(n_cells, any_measured):
+    for seed, w_ho in itertools.product(range(3), (0.01, 0.05, 0.2)):
+        rec, rsrp, rsrq = _tiny(n_cells, seed)
+        s = oracle.solve(rec, w_ho, any_measured)
+        for k in range(rec.shape[1]):
+            assert s.total[k] == pytest.approx(_brute(rec, rsrp, rsrq, k, w_ho, any_measured))
+        full = oracle.receding(rec, w_ho, horizon_s=1e3, any_measured=any_measured)
+        np.testing.assert_allclose(full.total, s.total)
+
+
+@pytest.mark.parametrize("which", ["CHM", "DQN"])
+def test_cost_reproduces_the_simulator_sums(cfg, rec, ckpt, which):
+    controller = oracle.Recorded(CHM() if which == "CHM" else DQNController(ckpt.net))
+    metrics = run_flights(controller, cfg, 16, seed=3)
+    c = oracle.cost(rec, controller.serving)
+    np.testing.assert_array_equal(c.handovers, controller.handovers)
+    np.testing.assert_array_equal(c.rsrq_steps, controller.rsrq_steps)
+    np.testing.assert_array_equal(c.handovers, metrics["handovers"])
+    np.testing.assert_allclose(100 * c.rsrq_steps / cfg.flight.n_steps, metrics["rsrq_violation_pct"])
+    assert c.handovers.sum() > 0 and c.rsrq_steps.sum() > 0  # the check has something to get wrong
+
+
+@pytest.mark.parametrize("w_ho", [0.04, 0.5])
+def test_the_bound_replays_exactly(cfg, rec, ckpt, w_ho):
+    """The bound's schedule flown through the env realises the planned cells, the planned costs and the simulator's
+    own sums, and costs no more than the DQN's on every flight."""
+    s = oracle.solve(rec, w_ho)
+    controller = oracle.Recorded(oracle.ScheduleController(s.cells, cfg.decision_every))
+    run_flights(controller, cfg, 16, seed=3)
+    np.testing.assert_array_equal(controller.serving, oracle.per_step(rec, s.cells))
+    np.testing.assert_array_equal(controller.handovers, s.cost.handovers)
+    np.testing.assert_array_equal(controller.rsrq_steps, s.cost.rsrq_steps)
+    assert s.cost.handovers.sum() > 0
+    dqn = oracle.Recorded(DQNController(ckpt.net))  # the DQN decides among the same offers: within the bound's reach
+    run_flights(dqn, cfg, 16, seed=3)
+    c = oracle.cost(rec, dqn.serving)
+    assert np.all(s.total <= w_ho * c.handovers + c.rsrq_s + 1e-9)
+
+
+def test_receding_with_the_whole_flight_is_the_bound(rec):
+    for w_ho in (0.04, 0.3, 2.0):
+        exact = oracle.solve(rec, w_ho)
+        np.testing.assert_allclose(oracle.receding(rec, w_ho, horizon_s=1e3).total, exact.total)
+        short = oracle.receding(rec, w_ho, horizon_s=0.2)
+        assert np.all(short.total >= exact.total - 1e-9)
