@@ -317,11 +317,12 @@ def frontier_figure(data: dict, path) -> str:
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     ax.plot(data["frontier"]["handovers"], data["frontier"]["rsrq_pct"], "k-o", ms=3, label="hindsight bound")
     for h, pts in data.get("receding", {}).items():
-        ax.plot(pts["handovers"], pts["rsrq_pct"], "--", lw=1, label=f"{h} s of foresight")
-    for name, p in data.get("policies", {}).items():
-        ax.plot(p["handovers"], p["rsrq_pct"], "s", ms=7, label=name)
-        ax.annotate(name, (p["handovers"], p["rsrq_pct"]), textcoords="offset points", xytext=(5, 4), fontsize=8)
-    ax.set_xscale("symlog", linthresh=1)
+        ax.plot(pts["handovers"], pts["rsrq_pct"], "--.", lw=1, label=f"{h} s of foresight")
+    policies = data.get("policies", {})
+    for (name, p), marker in zip(policies.items(), "s^Dvp", strict=False):
+        ax.plot(p["handovers"], p["rsrq_pct"], marker, ms=8, label=name)
+    seen = [p["rsrq_pct"] for p in policies.values()] + data["frontier"]["rsrq_pct"]
+    ax.set_ylim(0.9 * min(seen), 2.5 * max([p["rsrq_pct"] for p in policies.values()] or seen))
     ax.set_xlabel("handovers per flight (mean)")
     ax.set_ylabel("time below the RSRQ threshold (%)")
     ax.set_title(f"What hindsight allows: {data.get('flights', '?')} held-out flights")
