@@ -60,6 +60,7 @@ def _tiny(n_cells, seed, decisions=4, every=2, flights=3):
     rsrq = rng.normal(-12, 5, (decisions, flights, n_cells))
     ranked = [oracle.ranking(rsrp[d], rsrq[d], -14.0) for d in range(decisions)]
     below = rng.uniform(size=(decisions * every, flights, n_cells)) < 0.4
+    short = rng.uniform(0, 0.6, below.shape).astype(np.float32) * (rng.uniform(size=below.shape) < 0.5)
     rec = oracle.Record(
         below,
         below.astype(np.float32),
@@ -68,11 +69,14 @@ def _tiny(n_cells, seed, decisions=4, every=2, flights=3):
         rng.integers(0, n_cells, flights),
         0.04,
         every,
+        short,
+        1.0,
+        1,
     )
     return rec, rsrp, rsrq
 
 
-def _brute(rec, rsrp, rsrq, k, w_ho, any_measured):
+def _brute(rec, rsrp, rsrq, k, w_ho, any_measured, w_cap):
     """The least cost over every schedule of flight k the env (or, any_measured, detection) allows."""
     t_all, _, n_cells, d_all = rec.shape
     best = np.inf
@@ -87,19 +91,21 @@ def _brute(rec, rsrp, rsrq, k, w_ho, any_measured):
             ok, prev = ok and c in offer, c
         if ok:
             serving = np.repeat(cells, rec.every)[:t_all]
-            ho = np.count_nonzero(np.diff(np.concatenate([[rec.initial[k]], serving])))
-            best = min(best, w_ho * ho + rec.dt * rec.below[np.arange(t_all), k, serving].sum())
+            handed = np.diff(np.concatenate([[rec.initial[k]], serving])) != 0  # interrupts its own step only
+            short = np.where(handed, rec.offered_mbit, rec.short[np.arange(t_all), k, serving]).sum()
+            rsrq_s = rec.dt * rec.below[np.arange(t_all), k, serving].sum()
+            best = min(best, w_ho * handed.sum() + rsrq_s + w_cap * short)
     return best
 
 
-@pytest.mark.parametrize("n_cells, any_measured", [(3, False), (5, False), (5, True)])
-def test_shortest_path_equals_brute_force(n_cells, any_measured):
+@pytest.mark.parametrize("n_cells, any_measured, w_cap", [(3, False, 0), (5, False, 0), (5, True, 0), (5, False, 0.2)])
+def test_shortest_path_equals_brute_force(n_cells, any_measured, w_cap):
     for seed, w_ho in itertools.product(range(3), (0.01, 0.05, 0.2)):
         rec, rsrp, rsrq = _tiny(n_cells, seed)
-        s = oracle.solve(rec, w_ho, any_measured)
+        s = oracle.solve(rec, w_ho, any_measured, w_cap)
         for k in range(rec.shape[1]):
-            assert s.total[k] == pytest.approx(_brute(rec, rsrp, rsrq, k, w_ho, any_measured))
-        full = oracle.receding(rec, w_ho, horizon_s=1e3, any_measured=any_measured)
+            assert s.total[k] == pytest.approx(_brute(rec, rsrp, rsrq, k, w_ho, any_measured, w_cap))
+        full = oracle.receding(rec, w_ho, horizon_s=1e3, any_measured=any_measured, w_cap=w_cap)
         np.testing.assert_allclose(full.total, s.total)
 
 
@@ -113,6 +119,12 @@ def test_cost_reproduces_the_simulator_sums(cfg, rec, ckpt, which):
     np.testing.assert_array_equal(c.handovers, metrics["handovers"])
     np.testing.assert_allclose(100 * c.rsrq_steps / cfg.flight.n_steps, metrics["rsrq_violation_pct"])
     assert c.handovers.sum() > 0 and c.rsrq_steps.sum() > 0  # the check has something to get wrong
+    # the shortfall's parts: the SINR at the serving cell, and no service exactly on the interrupted steps
+    sinr = np.take_along_axis(rec.sinr, controller.serving.T[:, :, None], axis=2)[:, :, 0].T
+    np.testing.assert_array_equal(sinr, controller.realised("sinr_db").astype(np.float32))
+    ok = controller.realised("radio_ok")
+    np.testing.assert_array_equal(controller.realised("available")[ok], ~c.interrupted[ok])
+    assert c.interrupted.sum() == c.handovers.sum() * rec.interrupt > 0
 
 
 @pytest.mark.parametrize("w_ho", [0.04, 0.5])

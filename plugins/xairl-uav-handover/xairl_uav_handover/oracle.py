@@ -16,8 +16,11 @@ schedules and compares every draw). So one flight, flown once, fixes every cell'
   ``w_ho x handovers + seconds below the RSRQ threshold``. A handover happens only at a decision (every
   ``SimConfig.decision_every`` steps), to a cell the env offers then: the serving cell's 3 strongest detected
   neighbours (``any_measured=True``: any detected cell). It plans commanded handovers as if every one succeeds.
-  No capacity term: the uplink shortfall depends on the interruption after each handover and the buffer, which a
-  per-cell record cannot hold without the policy; it is left out.
+  With ``w_cap`` it adds ``w_cap x capacity shortfall`` (Mbit): per step, how far the serving cell's uplink
+  capacity (``uplink.capacity_bps`` of the SINR ``Simulator.step`` computes there) falls short of the mean offered
+  video rate, and the whole offered rate on the steps a handover interrupts (``HandoverConfig.interruption_s``).
+  It is defined without the buffer (a buffer carries data over; the shortfall does not), so it is the bound's own
+  measure and has no simulator sum to match; its SINR and interruptions do match the simulator's (tests).
 - :func:`receding` solves the same problem over the next ``horizon_s`` only at each decision, commits the first
   decision, and moves on: how much foresight the bound needs.
 - :class:`ScheduleController` replays a schedule through :class:`env.HandoverVecEnv` (evaluate.run_flights);
@@ -36,6 +39,7 @@ from .config import SimConfig
 from .evaluate import HELD_OUT_SEED
 from .features import N_CANDIDATES
 from .simulator import Simulator
+from .uplink import capacity_bps, sinr_db
 
 
 @dataclass
@@ -49,6 +53,10 @@ class Record:
     initial: np.ndarray  # (K,) the serving cell before the first step
     dt: float
     every: int  # simulator steps per decision
+    short: np.ndarray | None = None  # (T, K, N) float32 Mbit: uplink capacity short of the offered rate, per step
+    offered_mbit: float = 0.0  # offered data per step (Mbit): what an interrupted step lacks
+    interrupt: int = 0  # steps without service from a handover on (the handover's step included)
+    sinr: np.ndarray | None = None  # (T, K, N) float32: uplink SINR (dB) at each cell, as Simulator.step computes it
 
     @property
     def shape(self) -> tuple[int, int, int, int]:
@@ -56,11 +64,19 @@ class Record:
         t, k, n = self.below.shape
         return t, k, n, len(self.top)
 
-    def step_costs(self) -> np.ndarray:
-        """(D, K, N) seconds below the threshold during each decision's steps, serving each cell."""
-        t = self.below.shape[0]
-        counts = np.add.reduceat(self.below, np.arange(0, t, self.every), axis=0, dtype=np.int32)
-        return counts * self.dt
+    def step_costs(self, w_cap: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """(D, K, N) cost of serving each cell through each decision's steps: seconds below the threshold (+ w_cap x
+        shortfall), and (D, K, N) what a handover into the cell adds there (w_cap x the interrupted steps' loss)."""
+        starts = np.arange(0, self.below.shape[0], self.every)
+        cost = np.add.reduceat(self.below, starts, axis=0, dtype=np.int32) * self.dt
+        extra = np.zeros_like(cost)
+        if w_cap:
+            if self.short is None or self.interrupt > self.every:
+                raise InputError("w_cap needs a record with uplink shortfalls and interruptions within a decision.")
+            cost = cost + w_cap * np.add.reduceat(self.short, starts, axis=0, dtype=np.float64)
+            for j in range(self.interrupt):
+                extra += w_cap * (self.offered_mbit - self.short[starts + j])
+        return cost, extra
 
 
 def ranking(meas_rsrp: np.ndarray, meas_rsrq: np.ndarray, detection_db: float) -> tuple[np.ndarray, np.ndarray]:
@@ -83,7 +99,8 @@ def record(config: SimConfig, n_flights: int, seed: int) -> Record:
     rsrq = np.empty((t_all, sim.K, sim.N), dtype=np.float32)
     top = np.empty((d_all, sim.K, N_CANDIDATES), dtype=np.int16)
     detected = np.empty((d_all, sim.K, sim.N), dtype=bool)
-    initial = sim.serving.copy()
+    initial, short, sinr = sim.serving.copy(), np.empty_like(rsrq), np.empty_like(rsrq)
+    offered = config.buffer.packet_rate_hz * config.buffer.data_packet_bits * sim.dt
     for t in range(t_all):
         if t % every == 0:
             top[t // every], detected[t // every] = ranking(
@@ -91,8 +108,16 @@ def record(config: SimConfig, n_flights: int, seed: int) -> Record:
             )
         below[t] = sim.meas_rsrq < thr
         rsrq[t] = sim.meas_rsrq
+        sinr[t] = cell_sinr = all_cells_sinr_db(sim)
+        short[t] = np.maximum(offered - capacity_bps(config, cell_sinr) * sim.dt, 0.0) / 1e6
         sim.step(sim.serving)
-    return Record(below, rsrq, top, detected, initial, sim.dt, every)
+    n_int = int(round(config.handover.interruption_s / sim.dt))
+    return Record(below, rsrq, top, detected, initial, sim.dt, every, short, offered / 1e6, n_int, sinr)
+
+
+def all_cells_sinr_db(sim: Simulator) -> np.ndarray:
+    """(K, N) uplink SINR of every UAV at every cell, as ``Simulator.ul_sinr_db`` computes it at the serving one."""
+    return sinr_db(sim.cfg, sim.loss_db - sim._gain, sim._ul_interference)
 
 
 @dataclass
@@ -102,6 +127,8 @@ class Cost:
     handovers: np.ndarray  # int
     rsrq_steps: np.ndarray  # int: steps below the RSRQ threshold
     rsrq_s: np.ndarray  # seconds below it
+    shortfall_mbit: np.ndarray | None = None  # uplink capacity short of the offered rate (record.short)
+    interrupted: np.ndarray | None = None  # (K, T) bool: steps without service after a handover
 
 
 def cost(rec: Record, serving: np.ndarray) -> Cost:
@@ -113,9 +140,16 @@ def cost(rec: Record, serving: np.ndarray) -> Cost:
             f"serving must be (flights, steps) = {(k_all, t_all)}, got {serving.shape}; one cell per step."
         )
     previous = np.concatenate([rec.initial[:, None], serving[:, :-1]], axis=1)
-    handovers = (serving != previous).sum(axis=1)
+    ho = serving != previous
     steps = np.take_along_axis(rec.below, serving.T[:, :, None], axis=2)[:, :, 0].sum(axis=0)
-    return Cost(handovers, steps, steps * rec.dt)
+    if rec.short is None:
+        return Cost(ho.sum(axis=1), steps, steps * rec.dt)
+    interrupted = np.zeros_like(ho)
+    for j in range(rec.interrupt):  # a handover at step t interrupts t .. t + interrupt - 1
+        interrupted[:, j:] |= ho[:, : t_all - j]
+    short = np.take_along_axis(rec.short, serving.T[:, :, None], axis=2)[:, :, 0].T
+    shortfall = np.where(interrupted, rec.offered_mbit, short).sum(axis=1)
+    return Cost(ho.sum(axis=1), steps, steps * rec.dt, shortfall, interrupted)
 
 
 def per_step(rec: Record, cells: np.ndarray) -> np.ndarray:
@@ -178,69 +212,78 @@ def _out_of(value: np.ndarray, top: np.ndarray, any_measured: bool, detected: np
 
 @dataclass
 class Schedule:
-    """A schedule (serving cell per decision, (K, D)) and its cost parts; ``total`` = w_ho x handovers + rsrq_s."""
+    """A schedule (serving cell per decision, (K, D)) and its cost parts; ``total`` = w_ho x handovers + rsrq_s
+    (+ w_cap x shortfall_mbit)."""
 
     cells: np.ndarray
     cost: Cost
     total: np.ndarray
 
 
-def _scheduled(rec: Record, cells: np.ndarray, w_ho: float) -> Schedule:
+def _scheduled(rec: Record, cells: np.ndarray, w_ho: float, w_cap: float) -> Schedule:
     c = cost(rec, per_step(rec, cells))
-    return Schedule(cells, c, w_ho * c.handovers + c.rsrq_s)
+    return Schedule(cells, c, w_ho * c.handovers + c.rsrq_s + (w_cap * c.shortfall_mbit if w_cap else 0.0))
 
 
-def solve(rec: Record, w_ho: float, any_measured: bool = False) -> Schedule:
-    """The exact least ``w_ho x handovers + seconds below the RSRQ threshold`` per flight (forward shortest path
-    over (decision, serving cell), vectorised over flights and cells), and the schedule that reaches it."""
+def solve(rec: Record, w_ho: float, any_measured: bool = False, w_cap: float = 0.0) -> Schedule:
+    """The exact least ``w_ho x handovers + seconds below the RSRQ threshold (+ w_cap x shortfall)`` per flight
+    (forward shortest path over (decision, serving cell), vectorised over flights and cells), and its schedule."""
     _, k_all, n_all, d_all = rec.shape
-    step = rec.step_costs()
+    step, extra = rec.step_costs(w_cap)
     value = np.full((k_all, n_all), np.inf)
     value[np.arange(k_all), rec.initial] = 0.0
     parent = np.empty((d_all, k_all, n_all), dtype=np.int16)
     stay_cell = np.broadcast_to(np.arange(n_all), (k_all, n_all))
     for d in range(d_all):
         into, src = _into(value, rec.top[d], any_measured, rec.detected[d])
-        take = into + w_ho < value
-        value = np.where(take, into + w_ho, value) + step[d]
+        into = into + w_ho + extra[d]
+        take = into < value
+        value = np.where(take, into, value) + step[d]
         parent[d] = np.where(take, src, stay_cell)
     cells = np.empty((k_all, d_all), dtype=np.int64)
     cells[:, -1] = value.argmin(axis=1)
     rows = np.arange(k_all)
     for d in range(d_all - 1, 0, -1):
         cells[:, d - 1] = parent[d][rows, cells[:, d]]
-    return _scheduled(rec, cells, w_ho)
+    return _scheduled(rec, cells, w_ho, w_cap)
 
 
-def receding(rec: Record, w_ho: float, horizon_s: float, any_measured: bool = False) -> Schedule:
+def receding(rec: Record, w_ho: float, horizon_s: float, any_measured: bool = False, w_cap: float = 0.0) -> Schedule:
     """At each decision, the best first decision over the next ``horizon_s`` seconds (at least one decision) as
     :func:`solve` would take it with nothing known beyond; commit it and move on."""
     _, k_all, n_all, d_all = rec.shape
     h = max(1, int(round(horizon_s / (rec.dt * rec.every))))
-    step, rows = rec.step_costs(), np.arange(k_all)
+    (step, extra), rows = rec.step_costs(w_cap), np.arange(k_all)
     serving, cells = rec.initial.astype(np.int64), np.empty((k_all, d_all), dtype=np.int64)
     for d in range(d_all):
         to_go = np.zeros((k_all, n_all))
         for j in range(min(d + h, d_all) - 1, d - 1, -1):  # backward over the horizon
             here = step[j] + to_go
-            away, target = _out_of(here, rec.top[j], any_measured, rec.detected[j])
+            away, target = _out_of(here + extra[j], rec.top[j], any_measured, rec.detected[j])
             to_go = np.minimum(here, away + w_ho)
         move = away[rows, serving] + w_ho < here[rows, serving]
         serving = np.where(move, target[rows, serving], serving)
         cells[:, d] = serving
-    return _scheduled(rec, cells, w_ho)
+    return _scheduled(rec, cells, w_ho, w_cap)
 
 
-def frontier(rec: Record, w_hos, horizon_s: float | None = None, any_measured: bool = False) -> dict[str, list]:
-    """Mean handovers per flight and % of time below the RSRQ threshold for each ``w_ho`` (exact, or receding with
-    ``horizon_s`` of foresight)."""
+def frontier(
+    rec: Record, w_hos, horizon_s: float | None = None, any_measured: bool = False, w_cap: float = 0.0
+) -> dict[str, list]:
+    """Mean handovers per flight, % of time below the RSRQ threshold and uplink shortfall (Mbit per flight) for
+    each ``w_ho`` (exact, or receding with ``horizon_s`` of foresight)."""
     t_all = rec.shape[0]
-    out = {"w_ho": [], "handovers": [], "rsrq_pct": []}
+    out = {"w_ho": [], "handovers": [], "rsrq_pct": [], "shortfall_mbit": []}
     for w in w_hos:
-        s = solve(rec, w, any_measured) if horizon_s is None else receding(rec, w, horizon_s, any_measured)
+        if horizon_s is None:
+            s = solve(rec, w, any_measured, w_cap)
+        else:
+            s = receding(rec, w, horizon_s, any_measured, w_cap)
         out["w_ho"].append(float(w))
         out["handovers"].append(float(s.cost.handovers.mean()))
         out["rsrq_pct"].append(float(100 * s.cost.rsrq_steps.mean() / t_all))
+        short = s.cost.shortfall_mbit
+        out["shortfall_mbit"].append(None if short is None else float(short.mean()))
     return out
 
 
@@ -254,8 +297,8 @@ def handovers_at(points: dict[str, list], rsrq_pct: float) -> float:
 def rsrq_at(points: dict[str, list], handovers: float) -> float:
     """% time below the RSRQ threshold the frontier ``points`` reaches at ``handovers`` per flight (linear)."""
     h, r = np.asarray(points["handovers"]), np.asarray(points["rsrq_pct"])
-    o = np.argsort(h)
-    return float(np.interp(handovers, h[o], r[o], left=np.nan, right=np.nan))
+    o = np.argsort(h)  # beyond the most handovers swept, more handovers cannot cost the bound RSRQ time
+    return float(np.interp(handovers, h[o], r[o], left=np.nan, right=r[o][-1]))
 
 
 class ScheduleController:
@@ -279,7 +322,7 @@ class ScheduleController:
 
 class Recorded:
     """Any controller, with what the simulator realised under it: the serving cell after each step (``serving``,
-    (K, T)) and the sums of ``StepInfo.handover`` and ``rsrq_violation`` per flight."""
+    (K, T)), the sums of ``StepInfo.handover`` and ``rsrq_violation`` per flight, and :meth:`realised`."""
 
     def __init__(self, controller):
         self.inner, self.name, self.decision_every = controller, controller.name, controller.decision_every
@@ -288,10 +331,12 @@ class Recorded:
         self.inner.reset(env)
         sim, sim_step, served = env.sim, env.sim.step, []
         self.served, self.handovers, self.rsrq_steps = served, np.zeros(sim.K, int), np.zeros(sim.K, int)
+        self.infos = []
 
         def step(target):  # the simulator's own step, then what it realised
             info = sim_step(target)
             served.append(sim.serving.copy())
+            self.infos.append((info.sinr_db, info.available, info.radio_ok))
             self.handovers += info.handover
             self.rsrq_steps += info.rsrq_violation
             return info
@@ -304,6 +349,10 @@ class Recorded:
     @property
     def serving(self) -> np.ndarray:
         return np.stack(self.served, axis=1)
+
+    def realised(self, name: str) -> np.ndarray:
+        """(K, T) ``sinr_db``, ``available`` or ``radio_ok`` of each step (StepInfo)."""
+        return np.stack([i[("sinr_db", "available", "radio_ok").index(name)] for i in self.infos], axis=1)
 
 
 def frontier_figure(data: dict, path) -> str:
