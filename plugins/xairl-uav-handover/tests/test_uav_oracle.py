@@ -150,3 +150,25 @@ def test_receding_with_the_whole_flight_is_the_bound(rec):
         np.testing.assert_allclose(oracle.receding(rec, w_ho, horizon_s=1e3).total, exact.total)
         short = oracle.receding(rec, w_ho, horizon_s=0.2)
         assert np.all(short.total >= exact.total - 1e-9)
+
+
+def test_frontier_section_reads_the_benchmark_json(rec, tmp_path):
+    """The report's figure and caption come from the JSON's figures; a missing file is one clear error."""
+    import json
+
+    from xairl import InputError
+    from xairl_uav_handover.report import frontier_section
+
+    w_hos = [0.04, 0.3, 3.0]
+    data = {"flights": 16, "decision_s": 0.2, "frontier": oracle.frontier(rec, w_hos)}
+    data["receding"] = {"1": oracle.frontier(rec, w_hos, horizon_s=1.0)}
+    point = {"handovers": 0.9, "rsrq_pct": data["frontier"]["rsrq_pct"][1] + 0.5}
+    point["bound_handovers_at_rsrq"] = oracle.handovers_at(data["frontier"], point["rsrq_pct"])
+    point["bound_rsrq_at_handovers"] = oracle.rsrq_at(data["frontier"], point["handovers"])
+    data["policies"] = {"CHM": point, "DQN": point}
+    (tmp_path / "frontier.json").write_text(json.dumps(data))
+    caption, png = frontier_section(str(tmp_path / "frontier.json"), tmp_path)
+    assert png.stat().st_size > 0
+    assert f"needs {point['bound_handovers_at_rsrq']:.2f} handovers" in caption
+    with pytest.raises(InputError, match="frontier.json"):
+        frontier_section(str(tmp_path / "missing.json"), tmp_path)
