@@ -79,17 +79,19 @@ def _tiny(n_cells, seed, decisions=4, every=2, flights=3):
 def _brute(rec, rsrp, rsrq, k, w_ho, any_measured, w_cap):
     """The least cost over every schedule of flight k the env (or, any_measured, detection) allows."""
     t_all, _, n_cells, d_all = rec.shape
+    offers = [
+        [
+            {prev} | set(np.flatnonzero(rsrq[d, k] > -14.0).tolist())
+            if any_measured
+            else _candidates(rsrp[d, k], rsrq[d, k], prev, -14.0)
+            for prev in range(n_cells)
+        ]
+        for d in range(d_all)
+    ]
     best = np.inf
     for cells in itertools.product(range(n_cells), repeat=d_all):
-        prev, ok = int(rec.initial[k]), True
-        for d, c in enumerate(cells):
-            offer = (
-                {prev} | set(np.flatnonzero(rsrq[d, k] > -14.0).tolist())
-                if any_measured
-                else _candidates(rsrp[d, k], rsrq[d, k], prev, -14.0)
-            )
-            ok, prev = ok and c in offer, c
-        if ok:
+        prevs = (int(rec.initial[k]),) + cells[:-1]
+        if all(c in offers[d][p] for d, (p, c) in enumerate(zip(prevs, cells, strict=True))):
             serving = np.repeat(cells, rec.every)[:t_all]
             handed = np.diff(np.concatenate([[rec.initial[k]], serving])) != 0  # interrupts its own step only
             short = np.where(handed, rec.offered_mbit, rec.short[np.arange(t_all), k, serving]).sum()
