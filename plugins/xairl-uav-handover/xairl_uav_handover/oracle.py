@@ -30,6 +30,7 @@ schedules and compares every draw). So one flight, flown once, fixes every cell'
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -67,16 +68,27 @@ class Record:
     def step_costs(self, w_cap: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """(D, K, N) cost of serving each cell through each decision's steps: seconds below the threshold (+ w_cap x
         shortfall), and (D, K, N) what a handover into the cell adds there (w_cap x the interrupted steps' loss)."""
+        if not w_cap:
+            return self._sums[0], np.zeros_like(self._sums[0])
+        if self.short is None or self.interrupt > self.every:
+            raise InputError("w_cap needs a record with uplink shortfalls and interruptions within a decision.")
+        rsrq_s, short, interrupted = self._sums
+        return rsrq_s + w_cap * short, w_cap * interrupted
+
+    @cached_property
+    def _sums(self) -> tuple[np.ndarray, ...]:
+        """Per decision and cell: seconds below the RSRQ threshold, shortfall (Mbit), and the shortfall a handover
+        adds on its interrupted steps (offered minus what those steps would have lacked anyway)."""
         starts = np.arange(0, self.below.shape[0], self.every)
-        cost = np.add.reduceat(self.below, starts, axis=0, dtype=np.int32) * self.dt
-        extra = np.zeros_like(cost)
-        if w_cap:
-            if self.short is None or self.interrupt > self.every:
-                raise InputError("w_cap needs a record with uplink shortfalls and interruptions within a decision.")
-            cost = cost + w_cap * np.add.reduceat(self.short, starts, axis=0, dtype=np.float64)
-            for j in range(self.interrupt):
-                extra += w_cap * (self.offered_mbit - self.short[starts + j])
-        return cost, extra
+        rsrq_s = np.add.reduceat(self.below, starts, axis=0, dtype=np.int32) * self.dt
+        if self.short is None:
+            return rsrq_s, None, None
+        short = np.add.reduceat(self.short, starts, axis=0, dtype=np.float64)
+        interrupted = np.zeros_like(short)
+        for j in range(min(self.interrupt, self.every)):
+            there = starts + j < len(self.short)  # a short last decision has fewer steps to interrupt
+            interrupted[there] += self.offered_mbit - self.short[starts[there] + j]
+        return rsrq_s, short, interrupted
 
 
 def ranking(meas_rsrp: np.ndarray, meas_rsrq: np.ndarray, detection_db: float) -> tuple[np.ndarray, np.ndarray]:
