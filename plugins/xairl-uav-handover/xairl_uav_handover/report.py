@@ -48,6 +48,11 @@ class UAVReportOptions(xairl.plugin.Options):
         le=20,
         description="simulated flights shown at a glance (timeline and summary; with real data, its first flight too)",
     )
+    frontier: str | None = Field(
+        None,
+        description="frontier.json written by benchmarks/oracle_frontier.py: adds the hindsight bound's figure "
+        "(the frontier, 0.2-5 s of foresight, CHM, SA-MRO and the DQN on it)",
+    )
 
 
 def _table(rows: list) -> str:
@@ -89,6 +94,8 @@ class UAVReport(xairl.plugin.Report):
         )
         flights = self._add_real_flights(content, ckpt, req, real, *loaded) if loaded else []
         self._add_timelines(content, ckpt, req, flights[:1])
+        if self.options.frontier:
+            content.figures.append(frontier_section(self.options.frontier, req.out))
         return content
 
     def _add_timelines(
@@ -168,6 +175,30 @@ class UAVReport(xairl.plugin.Report):
         content.notes += [f"skipped file: {b}" for b in bad] + REAL_NOTES
         content.figures.append(_altitude_figure(req.out, str(real), cfg, flights, chm_real, req.seed))
         return flights
+
+
+def frontier_section(path: str, out) -> tuple[str, Path]:
+    """The hindsight bound's figure from benchmarks/oracle_frontier.py's JSON at ``path``, and its caption."""
+    import json
+
+    from .oracle import frontier_figure
+
+    try:
+        data = json.loads(Path(path).read_text())
+        chm, dqn = data["policies"]["CHM"], data["policies"]["DQN"]
+    except (OSError, ValueError, KeyError) as e:
+        raise InputError(
+            f"cannot read the frontier {path} ({e}); give the frontier.json that benchmarks/oracle_frontier.py wrote."
+        ) from None
+    caption = (
+        f"What hindsight allows on {data['flights']} held-out flights: the least time below the RSRQ threshold for "
+        f"each number of handovers, exact over decisions every {data['decision_s']:g} s among the env's candidates, "
+        f"and with 0.2-5 s of foresight. At CHM's RSRQ time ({chm['rsrq_pct']:.1f} %) the bound needs "
+        f"{chm['bound_handovers_at_rsrq']:.2f} handovers per flight (CHM {chm['handovers']:.2f}); at the DQN's "
+        f"{dqn['handovers']:.2f} it reaches {dqn['bound_rsrq_at_handovers']:.1f} % (DQN {dqn['rsrq_pct']:.1f} %). "
+        "The bound knows each flight's future: the gap to it is what prediction could win, not what physics forbids."
+    )
+    return caption, Path(frontier_figure(data, Path(out) / "frontier.png"))
 
 
 def _load_real(real: Path) -> tuple[list, list[str]]:
