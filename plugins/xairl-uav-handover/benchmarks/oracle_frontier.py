@@ -153,7 +153,7 @@ def main():
     args = ap.parse_args()
     t_start = time.perf_counter()
     ckpt = load_checkpoint()
-    cfg = ckpt.sim_config
+    cfg = oracle.bound_config(ckpt.sim_config)  # every policy placed on the bound flies without failures too
     rec = oracle.record(cfg, args.flights, args.seed)
     w_hos = np.geomspace(0.02, 50.0, args.points)
     data = {"flights": args.flights, "seed": args.seed, "cells": rec.shape[2], "w_ho": w_hos.tolist()}

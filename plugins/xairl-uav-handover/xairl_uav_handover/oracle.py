@@ -11,7 +11,9 @@ schedules and compares every draw). So one flight, flown once, fixes every cell'
 - :func:`cost` is the simulator's own bookkeeping on any *realised* serving sequence (``sim.serving`` after each
   step): handovers are changes of the serving cell, RSRQ time is the steps whose serving cell reads below the
   threshold. It reproduces the simulator's sums exactly for any policy (tests: CHM, the DQN, the bound's own schedule).
-  Written on what was served, not on what was commanded, it stays exact if a commanded handover can fail.
+  The bound is over handover schedules: a failed handover or a radio link failure (failures.py) moves the UE to
+  another cell by re-establishment, which is no handover and depends on the history of the link, so the bound
+  and every policy placed on it fly with failures off (:func:`bound_config`).
 - :func:`solve` is the shortest path over (decision step, serving cell) minimising
   ``w_ho x handovers + seconds below the RSRQ threshold``. A handover happens only at a decision (every
   ``SimConfig.decision_every`` steps), to a cell the env offers then: the serving cell's 3 strongest detected
@@ -40,6 +42,7 @@ from .config import SimConfig
 from .evaluate import HELD_OUT_SEED
 from .features import N_CANDIDATES
 from .simulator import Simulator
+from .streams import flight_seeds
 from .uplink import capacity_bps, sinr_db
 
 
@@ -102,9 +105,19 @@ def ranking(meas_rsrp: np.ndarray, meas_rsrq: np.ndarray, detection_db: float) -
     return np.concatenate([top, pad], axis=1), detected
 
 
+def bound_config(config: SimConfig) -> SimConfig:
+    """``config`` with handover and radio link failures off: the simulator the bound is exact on (module doc)."""
+    data = config.model_dump()
+    data["handover"]["failures"] = False
+    return SimConfig.model_validate(data)
+
+
 def record(config: SimConfig, n_flights: int, seed: int) -> Record:
-    """Fly the held-out flights of ``seed`` (the ones evaluate.run_flights flies) once and record them."""
-    sim = Simulator(config, n_uavs=n_flights, seed=HELD_OUT_SEED + seed)
+    """Fly the held-out flights of ``seed`` (the ones evaluate.run_flights flies) once and record them; ``config``
+    must have failures off (:func:`bound_config`)."""
+    if config.handover.failures:
+        raise InputError("the bound is exact without handover failures: record on oracle.bound_config(config).")
+    sim = Simulator(config, n_uavs=n_flights, seed=flight_seeds(HELD_OUT_SEED + seed, 0, n_flights))
     t_all, every, thr = sim.n_steps, config.decision_every, config.handover.rsrq_threshold_db
     d_all = -(-t_all // every)
     below = np.empty((t_all, sim.K, sim.N), dtype=bool)
@@ -129,7 +142,7 @@ def record(config: SimConfig, n_flights: int, seed: int) -> Record:
 
 def all_cells_sinr_db(sim: Simulator) -> np.ndarray:
     """(K, N) uplink SINR of every UAV at every cell, as ``Simulator.ul_sinr_db`` computes it at the serving one."""
-    return sinr_db(sim.cfg, sim.loss_db - sim._gain, sim._ul_interference)
+    return sinr_db(sim.cfg, sim.loss_db, sim._ul_interference)
 
 
 @dataclass
