@@ -45,7 +45,7 @@ def test_interference_is_the_brute_force_sum():
     their own cell) times their coupling gain to b, its sector antenna included."""
     from xairl_uav_handover.antenna import cell_layout
 
-    cfg = _cfg({"ues_per_cell": 2, "aerial_ue_ratio": 0.5, "load_range": (1.0, 1.0)})
+    cfg = _cfg({"ues_per_cell": 2, "aerial_ue_ratio": 0.5, "ul_load_range": (1.0, 1.0)})
     sites = np.array([[0.0, 0.0], [500.0, 0.0]])
     cells, _, boresight = cell_layout(sites)
     got = uplink.interference_mw(cfg, sites, np.random.default_rng(4), 3)
@@ -69,8 +69,8 @@ def test_aerial_ues_raise_the_interference_and_loads_scale_it():
     aerial = uplink.interference_mw(_cfg({"aerial_ue_ratio": 0.5}), layout, np.random.default_rng(0), 20)
     # line of sight to many cells (TR 36.777), though through the side lobes of their sector antennas
     assert np.median(aerial) > 3 * np.median(ground)
-    full = uplink.interference_mw(_cfg({"load_range": (1.0, 1.0)}), layout, np.random.default_rng(1), 5)
-    half = uplink.interference_mw(_cfg({"load_range": (0.5, 0.5)}), layout, np.random.default_rng(1), 5)
+    full = uplink.interference_mw(_cfg({"ul_load_range": (1.0, 1.0)}), layout, np.random.default_rng(1), 5)
+    half = uplink.interference_mw(_cfg({"ul_load_range": (0.5, 0.5)}), layout, np.random.default_rng(1), 5)
     np.testing.assert_allclose(half, full / 2)
 
 

@@ -9,7 +9,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from .channel import HEIGHT_RANGE
 
 #: fitted to the real flights' serving RSRP (RadioConfig.link_loss_db)
-LINK_LOSS_DB = 10.6
+LINK_LOSS_DB = 8.0
 
 
 class _Strict(BaseModel):
@@ -61,7 +61,13 @@ class RadioConfig(_Strict):
 
     bs_tx_power_dbm: float = Field(46.0, ge=0, le=60, description="total BS transmit power (TR 36.777 Table A.1-1)")
     ue_tx_power_dbm: float = Field(23.0, ge=0, le=33, description="UAV uplink transmit power (TS 36.101 class 3)")
-    n_rb: int = Field(50, gt=0, le=275, description="resource blocks of the carrier (50 = 10 MHz)")
+    n_rb: int = Field(
+        100,
+        gt=0,
+        le=275,
+        description="downlink resource blocks (100 = 20 MHz): the real UKM logs' RSRQ - RSRP + RSSI, which is "
+        "10 lg N by RSRQ's definition (TS 36.214 sec. 5.1.3), has a median of 20 dB",
+    )
     link_loss_db: float = Field(
         LINK_LOSS_DB,
         ge=0,
@@ -115,9 +121,15 @@ class RadioConfig(_Strict):
     load_range: tuple[float, float] = Field(
         (0.1, 1.0),
         description="downlink load of each cell (the share of its data resource elements in use: RSSI, RSRQ, "
-        "downlink SINR) and its uplink load (its chance to schedule a UE on the UAV's blocks, uplink.py), drawn per "
-        "cell and flight, uniform: a modelling choice, no source prescribes the distribution; the spread of "
-        "RSRQ - RSRP it causes is compared with the real flights' (benchmarks/calibrate.py)",
+        "downlink SINR), drawn per cell and flight, uniform: a modelling choice, no source prescribes the "
+        "distribution; the spread of RSRQ - RSRP it causes is compared with the real flights' (calibrate.py)",
+    )
+    ul_load_range: tuple[float, float] = Field(
+        (0.01, 0.1),
+        description="each other cell's uplink load (its chance to schedule a UE on the UAV's blocks, uplink.py), "
+        "drawn per cell and flight, uniform. Fitted: the median uplink capacity on the even-numbered real UKM "
+        "flights towards IMC'22 operator B's measured 37.7 Mbit/s (0.1-1.0: 17.1; 0.05-0.5: 22.6; 0.02-0.2: 29.5; "
+        "0.01-0.1: 33.7 Mbit/s, where the UAV's own power caps it; odd flights 34.5); benchmarks/uplink_check.py",
     )
 
 
@@ -144,7 +156,13 @@ class FlightConfig(_Strict):
     speed_mps: tuple[float, float] = Field(
         (2.0, 8.0), description="uniform range of horizontal speeds (one per flight)"
     )
-    duration_s: float = Field(120.0, gt=0, le=3600)
+    duration_s: float = Field(
+        120.0,
+        gt=0,
+        le=3600,
+        description="one episode's length: a modelling choice for the cost of training (the real UKM flights last a "
+        "median 56 min; per-minute figures compare across lengths, per-flight ones do not: the paper's 75 are per flight)",
+    )
     dt_s: float = Field(0.04, gt=0, le=1, description="simulation step; TTT and time of stay are multiples of it")
     climb_mps: float = Field(
         5.0,
@@ -350,9 +368,10 @@ class SimConfig(_Strict):
         s0, s1 = self.flight.speed_mps
         if not (0 <= s0 <= s1):
             raise ValueError("flight.speed_mps must be (low, high) with 0 <= low <= high")
-        l0, l1 = self.radio.load_range
-        if not (0 < l0 <= l1 <= 1):
-            raise ValueError("radio.load_range must be (low, high) with 0 < low <= high <= 1")
+        for name in ("load_range", "ul_load_range"):
+            l0, l1 = getattr(self.radio, name)
+            if not (0 < l0 <= l1 <= 1):
+                raise ValueError(f"radio.{name} must be (low, high) with 0 < low <= high <= 1")
         return self
 
 

@@ -84,6 +84,9 @@ def _rows():
             lambda m, i: 100 - pooled("handovers_buffer_nonempty", "handovers")(m, i),
         ),
         ("ho_full", "handovers taken with a full buffer (%)", pooled("handovers_buffer_full", "handovers")),
+        ("rlf", "radio link failures per flight, mean", mean("radio_link_failures")),
+        ("hof", "handover failures per flight, mean", mean("handover_failures")),
+        ("outage", "time re-establishing after a failure, mean (%)", mean("outage_pct")),
         ("buffer_in_use", "decisions taken with a non-empty buffer, mean (%)", mean("buffer_nonempty_pct")),
         ("buffer_in_use_median", "decisions taken with a non-empty buffer, median (%)", median("buffer_nonempty_pct")),
     ]

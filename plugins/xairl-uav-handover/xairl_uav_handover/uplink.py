@@ -85,7 +85,7 @@ def interference_mw(cfg: SimConfig, sites_xy: np.ndarray, rng: np.random.Generat
     cell_xy, _, boresight = antenna.cell_layout(sites_xy)
     xy, h = drop_ues(cfg, sites_xy, rng, n_flights)
     k, n, u = h.shape
-    load = rng.uniform(*cfg.radio.load_range, (k, n))  # each cell's uplink load: its chance to use the UAV's blocks
+    load = rng.uniform(*cfg.radio.ul_load_range, (k, n))  # each cell's uplink load: its chance to use the UAV's blocks
     own = np.stack([_mean_gain(cfg, xy[:, j], h[:, j], cell_xy[j], boresight[j]) for j in range(n)], axis=1)
     psd_mw = 10 ** (psd_dbm(cfg, -10 * np.log10(own)) / 10)  # (K, N, U)
     out = np.zeros((k, n))
