@@ -35,7 +35,8 @@ def test_every_row_has_an_interval_around_its_value():
 
 def _known(handovers, pingpongs):
     n = len(handovers)
-    base = {k: np.zeros(n) for k in ("handovers_buffer_nonempty", "handovers_buffer_full", "buffer_nonempty_pct")}
+    zero = ("handovers_buffer_nonempty", "handovers_buffer_full", "buffer_nonempty_pct")
+    base = {k: np.zeros(n) for k in (*zero, "radio_link_failures", "handover_failures", "outage_pct")}
     return base | {
         "handovers": np.array(handovers, float),
         "pingpongs": np.array(pingpongs, float),

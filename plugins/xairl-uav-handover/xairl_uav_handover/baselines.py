@@ -136,7 +136,8 @@ class MobilityRobustness:
         wrong = recent & (best != self.source) & (best != self.target)
         self._count("wrong_cell", self.early, self.source, self.target, wrong)
         np.add.at(self.late, (self.source[wrong], best[wrong]), 1)
-        self._count("too_late", self.late, serving, best, failed & ~recent & (best != serving))
+        # too late: the link failed on the cell served before (``previous``) and the UE re-established elsewhere
+        self._count("too_late", self.late, previous, best, failed & ~recent & (best != previous))
 
     def _count(self, name: str, table: np.ndarray, rows, cols, where) -> None:
         np.add.at(table, (rows[where], cols[where]), 1)
@@ -214,7 +215,8 @@ class SAMRO:
         last = sim.last
         failed = link_failures(sim)
         handed = last.handover.astype(bool)
-        self.mro.observe(sim.t * sim.dt, sim.serving, failed, rsrp.argmax(axis=1), handed, self.previous, last.pingpong)
+        best = np.where(failed, sim.serving, rsrp.argmax(axis=1))  # after a failure: where the UE re-established
+        self.mro.observe(sim.t * sim.dt, sim.serving, failed, best, handed, self.previous, last.pingpong)
         self.previous = sim.serving.copy()
 
     def __call__(self, env) -> np.ndarray:

@@ -90,7 +90,7 @@ class QuantileRow:
     ]
 
 
-def band_rows(flights, chm_real: list[int], cfg, seed: int) -> list[BandRow]:
+def band_rows(flights, chm_real: list[int], cfg, seed: int, n_flights: int = 40) -> list[BandRow]:
     """One row per altitude band with flights; ``chm_real``: CHM's closed-loop handovers on each flight. Simulated
     CHM flies at the band's real flights' own heights, weighted by their minutes, so both sides cover one mix."""
     rows = []
@@ -103,8 +103,8 @@ def band_rows(flights, chm_real: list[int], cfg, seed: int) -> list[BandRow]:
         real = sum(n for _, n in inside) / minutes.sum()
         heights, where = np.unique([f.altitude_m for f, _ in inside], return_inverse=True)
         weight = np.bincount(where, weights=minutes)
-        sim = float(np.average(chm_rate_by_altitude(heights, cfg, seed=seed), weights=weight))
-        sampled = chm_rate_by_altitude(heights, cfg, seed=seed, sample_s=LOG_INTERVAL_S)
+        sim = float(np.average(chm_rate_by_altitude(heights, cfg, n_flights, seed=seed), weights=weight))
+        sampled = chm_rate_by_altitude(heights, cfg, n_flights, seed=seed, sample_s=LOG_INTERVAL_S)
         sampled = float(np.average(sampled, weights=weight))
         rows.append(BandRow(f"{lo:g}-{hi:g} m", len(inside), live, real, sim, sampled, sampled / max(real, 1e-9)))
     return rows

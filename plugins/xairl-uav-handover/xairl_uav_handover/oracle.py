@@ -1,8 +1,8 @@
 """The hindsight bound: the fewest handovers and the least time below the RSRQ threshold that any handover policy
 could reach on the same flights, knowing each flight's future.
 
-Why it is exact. The simulator's random draws (trajectories, the channel latents, packet arrivals) come from one
-generator per batch in a fixed order and in fixed sizes, whatever the policy does (tests/test_uav_oracle.py flies two
+Why it is exact. The simulator's random draws (trajectories, the channel latents, packet arrivals) come from each
+flight's own stream (streams.py) in a fixed order and in fixed sizes, whatever the policy does (tests/test_uav_oracle.py flies two
 schedules and compares every draw). So one flight, flown once, fixes every cell's reported RSRQ at every step.
 :func:`record` keeps, per simulator step and cell, whether the reported RSRQ (``sim.meas_rsrq`` as
 ``Simulator.step`` reads it for ``rsrq_violation``) is below the threshold, and, per decision, the cells ranked as
@@ -142,7 +142,7 @@ def record(config: SimConfig, n_flights: int, seed: int) -> Record:
 
 def all_cells_sinr_db(sim: Simulator) -> np.ndarray:
     """(K, N) uplink SINR of every UAV at every cell, as ``Simulator.ul_sinr_db`` computes it at the serving one."""
-    return sinr_db(sim.cfg, sim.loss_db, sim._ul_interference)
+    return sinr_db(sim.cfg, sim.loss_db, sim._ul_interference, sim._rsrp_offset - sim.meas_rsrp)
 
 
 @dataclass

@@ -186,9 +186,11 @@ class Simulator:
         return self.t >= self.n_steps
 
     def ul_sinr_db(self) -> np.ndarray:
-        """Uplink SINR of each UAV at its serving BS (uplink.py)."""
+        """Uplink SINR of each UAV at its serving cell (uplink.py): its power set from the path loss it estimates
+        from its reported RSRP, received through the coupling loss of now."""
         k = np.arange(self.K)
-        return sinr_db(self.cfg, self.loss_db[k, self.serving], self._ul_interference[k, self.serving])
+        estimate = self._rsrp_offset - self.meas_rsrp[k, self.serving]
+        return sinr_db(self.cfg, self.loss_db[k, self.serving], self._ul_interference[k, self.serving], estimate)
 
     def candidates(self) -> np.ndarray:
         """(K, 4) BS ids: the serving BS, then the strongest measured neighbours by reported RSRP; -1 for a slot
@@ -212,7 +214,8 @@ class Simulator:
     def step(self, target: np.ndarray) -> StepInfo:
         """Associate every UAV with ``target`` (BS ids, (K,)), then advance one dt."""
         cfg, k = self.cfg, np.arange(self.K)
-        target = np.asarray(target, dtype=np.int64)
+        # a UE re-establishing after a failure has no connection to hand over: it stays where it re-establishes
+        target = np.where(self.outage > 0, self.serving, np.asarray(target, dtype=np.int64))
         ho = target != self.serving
         stay_steps = self.t - self.entered
         back = ho & (target == self.prev_serving)
@@ -221,7 +224,9 @@ class Simulator:
         self.prev_serving = np.where(ho, self.serving, self.prev_serving)
         self.entered = np.where(ho, self.t, self.entered)
         self.serving = target
-        self.interrupt = np.where(ho, int(round(cfg.handover.interruption_s / self.dt)), self.interrupt)
+        self.interrupt = np.where(
+            ho, np.maximum(self.interrupt, int(round(cfg.handover.interruption_s / self.dt))), self.interrupt
+        )
         hof, rlf = self._failures(ho)
 
         b = cfg.buffer
@@ -259,7 +264,7 @@ class Simulator:
 
     def _failures(self, handed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Handover and radio link failures this step (failures.py), each followed by a re-establishment to the
-        strongest measured cell with no service for ``reestablish_s``; (hof, rlf), bool (K,)."""
+        strongest cell it measures now with no service for ``reestablish_s``; (hof, rlf), bool (K,)."""
         hc, none = self.cfg.handover, np.zeros(self.K, dtype=bool)
         if not hc.failures:
             return none, none
@@ -271,7 +276,7 @@ class Simulator:
         rlf &= connected & ~hof
         failed = hof | rlf
         if failed.any():
-            best = self.meas_rsrp.argmax(axis=1)
+            best = self.rsrp.argmax(axis=1)  # cell selection on what the UE measures now (TS 36.331 sec. 5.3.7)
             moved = failed & (best != self.serving)
             self.prev_serving = np.where(moved, self.serving, self.prev_serving)
             self.entered = np.where(moved, self.t, self.entered)

@@ -97,12 +97,14 @@ def interference_mw(cfg: SimConfig, sites_xy: np.ndarray, rng: np.random.Generat
     return out
 
 
-def sinr_db(cfg: SimConfig, loss_db, interference: np.ndarray) -> np.ndarray:
+def sinr_db(cfg: SimConfig, loss_db, interference: np.ndarray, estimate_db=None) -> np.ndarray:
     """Uplink SINR per resource block for a coupling loss ``loss_db`` to the serving cell (path loss and link loss
     minus its antenna gain, the same both ways) and the interference (mW per resource block) there; the UAV's
-    power follows :func:`psd_dbm`."""
+    power follows :func:`psd_dbm` of the path loss it estimates (``estimate_db``: referenceSignalPower - its
+    filtered RSRP; default: the coupling loss itself)."""
     coupling = np.asarray(loss_db)
-    signal_mw = 10 ** ((psd_dbm(cfg, coupling) - coupling) / 10)
+    estimate = coupling if estimate_db is None else np.asarray(estimate_db)
+    signal_mw = 10 ** ((psd_dbm(cfg, estimate) - coupling) / 10)
     return 10 * np.log10(signal_mw / (10 ** (noise_dbm(cfg) / 10) + interference))
 
 
