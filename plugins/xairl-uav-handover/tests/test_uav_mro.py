@@ -4,7 +4,7 @@ metrics, the reward and MRO."""
 
 import numpy as np
 
-from xairl_uav_handover.baselines import CHM, SAMRO
+from xairl_uav_handover.baselines import CHM, SAMRO, MobilityRobustness
 from xairl_uav_handover.config import SAMROConfig, SimConfig
 from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.evaluate import run_flights
@@ -67,3 +67,15 @@ def test_one_ping_pong_window_in_the_metrics_the_reward_and_mro():
     m = run_flights(network, cfg, 16, 0)
     assert m["pingpongs"].sum() > 0 and (m["pingpongs"] == m["pingpongs_5s"]).all()
     assert network.mro.counted["pingpong"] == m["pingpongs"].sum()  # MRO counts the metrics' ping-pongs
+
+
+def test_a_radio_link_failure_re_established_elsewhere_is_too_late_and_lowers_that_pair():
+    """The link fails on cell 0 with no recent handover and the UE re-establishes on cell 2: too late on (0, 2), so
+    the network hands over from 0 to 2 earlier after its update; a failure re-established on the same cell is none."""
+    mro = MobilityRobustness(SAMROConfig(), n=3, min_stay_s=1.0)
+    one = np.array([True])
+    mro.observe(10.0, np.array([2]), one, np.array([2]), ~one, np.array([0]), ~one)
+    mro.observe(20.0, np.array([1]), one, np.array([1]), ~one, np.array([1]), ~one)
+    assert mro.counted["too_late"] == 1 and mro.late[0, 2] == 1 and mro.late.sum() == 1
+    mro.update()
+    assert mro.cio[0, 2] < 0 and (mro.cio[[0, 1, 2], [1, 0, 0]] == 0).all()

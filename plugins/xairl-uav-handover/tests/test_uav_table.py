@@ -2,6 +2,7 @@
 bootstrap interval holds its value."""
 
 import numpy as np
+import pytest
 
 from xairl_uav_handover.baselines import CHM
 from xairl_uav_handover.config import SimConfig
@@ -68,3 +69,9 @@ def test_intervals_over_training_seeds_hold_the_spread_between_seeds():
     assert by_flight["handovers"][2] - by_flight["handovers"][1] < 4
     text = format_paper({"CHM": by_seed, "DQN seed 0": by_flight})
     assert "vs 75" in text and "vs 12" in text and "SA-MRO" not in text
+
+
+def test_intervals_over_training_seeds_of_unequal_sizes():
+    m, groups = pooled_seeds([_known([1, 2, 3], [0, 0, 1]), _known([5, 6], [1, 0])])
+    res = with_intervals(m, resamples=100, groups=groups)
+    assert res["handovers"][0] == pytest.approx(17 / 5) and res["handovers"][1] <= res["handovers"][2]

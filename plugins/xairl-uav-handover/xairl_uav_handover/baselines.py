@@ -98,8 +98,8 @@ class MobilityRobustness:
 
     A radio link failure (or a handover failure) within ``early_s`` of a handover from S to T is *too early* on
     (S, T) when the UE would re-establish in S (the strongest cell), and *to the wrong cell* when in a third cell X
-    (counted too early on (S, T) and too late on (S, X)). A failure with no recent handover, while a neighbour X is
-    the strongest, is *too late* on (serving, X). A *ping-pong* (back to S within ``min_stay_s``) counts too early
+    (counted too early on (S, T) and too late on (S, X)). A failure with no recent handover, after which the UE
+    re-establishes in another cell X, is *too late* on (the failed cell, X). A *ping-pong* (back to S within ``min_stay_s``) counts too early
     on (S, T). :meth:`update` moves each pair with more too-early than too-late counts ``margin_step_db`` up (hand
     over later), one with more too-late ones that much down, within ``margin_range_db``, and starts new counts.
 

@@ -119,17 +119,18 @@ def pooled_seeds(runs: list[dict[str, np.ndarray]]) -> tuple[dict[str, np.ndarra
     return {key: np.concatenate([r[key] for r in runs]) for key in runs[0]}, groups
 
 
-def resample(n: int, resamples: int, seed: int, groups=None) -> np.ndarray:
-    """(resamples, n) flight indices: flights with replacement, or (``groups``: a group id per flight) groups with
-    replacement, then flights with replacement within each drawn group."""
+def resample(n: int, resamples: int, seed: int, groups=None) -> list[np.ndarray]:
+    """``resamples`` arrays of flight indices: flights with replacement, or (``groups``: a group id per flight)
+    groups with replacement, then flights with replacement within each drawn group (groups of unequal sizes give
+    draws of unequal lengths)."""
     rng = np.random.default_rng(seed)
     if groups is None:
-        return rng.integers(0, n, size=(resamples, n))
+        return list(rng.integers(0, n, size=(resamples, n)))
     members = [np.flatnonzero(groups == g) for g in np.unique(groups)]
-    out = np.empty((resamples, n), dtype=np.int64)
-    for r in range(resamples):
+    out = []
+    for _ in range(resamples):
         picked = rng.integers(0, len(members), size=len(members))
-        out[r] = np.concatenate([rng.choice(members[g], size=len(members[g])) for g in picked])[:n]
+        out.append(np.concatenate([rng.choice(members[g], size=len(members[g])) for g in picked]))
     return out
 
 

@@ -308,7 +308,10 @@ def train_checkpoint(tc: TrainConfig, sim_cfg: SimConfig, out, progress: bool = 
             "command": f"xairl uav train --episodes {tc.episodes} --flights "
             f"{tc.n_flights} --demonstrations {tc.demonstrations} "
             f"--pretrain-updates {tc.pretrain_updates} --eps-start "
-            f"{tc.eps_start:g} --reward {reward_name(sim_cfg)} --seed {tc.seed}",
+            f"{tc.eps_start:g} --reward {reward_name(sim_cfg)} --seed {tc.seed}"
+            + (
+                " (a custom reward: the sim_config above holds its weights)" if reward_name(sim_cfg) == "custom" else ""
+            ),
         },
     )
     return seconds
