@@ -75,7 +75,10 @@ def main():
         )
     walks = real_walks(args.real, cfg) if args.real else None
     n = args.flights * len(args.eval_seeds)
-    res = {c.name: with_intervals(flights(c, cfg, args.flights, args.eval_seeds)) for c in (CHM(), SAMRO())}
+    res = {
+        c.name: with_intervals(flights(c, cfg, args.flights, args.eval_seeds))
+        for c in (CHM(), CHM(decision_every=cfg.decision_every), SAMRO())
+    }
     per_seed, runs = [], []
     for k, (path, ckpt) in enumerate(zip(paths, ckpts)):
         name = f"DQN seed {ckpt.meta.get('seed')}" if not args.checkpoints else f"DQN {k + 1}: {Path(path).stem}"

@@ -78,7 +78,10 @@ def main():
     ckpts = [load_checkpoint(p) for p in args.checkpoint]
     cfg = ckpts[0].sim_config
     n = args.flights * len(args.seeds)
-    res = {c.name: with_intervals(flights(c, cfg, args.flights, args.seeds)) for c in (CHM(), SAMRO())}
+    res = {
+        c.name: with_intervals(flights(c, cfg, args.flights, args.seeds))
+        for c in (CHM(), CHM(decision_every=cfg.decision_every), SAMRO())
+    }
     runs = [flights(DQNController(ckpt.net), cfg, args.flights, args.seeds) for ckpt in ckpts]
     for k, run in enumerate(runs):
         res["DQN" if len(ckpts) == 1 else f"DQN {k}"] = with_intervals(run)

@@ -10,7 +10,7 @@ import xairl
 from xairl import plugins
 from xairl.cli import main
 from xairl.plugin import CheckpointError
-from xairl_uav_handover.baselines import CHM, SAMRO
+from xairl_uav_handover.baselines import CHM
 from xairl_uav_handover.evaluate import rankings
 from xairl_uav_handover.features import FEATURES
 from xairl_uav_handover.policy import DQNController, build_qnet, load_checkpoint, save_checkpoint, uav_policy
@@ -45,33 +45,27 @@ def test_pretrained_dqn_deep_shap_matches_shap():
 
 
 def test_pretrained_dqn_on_table_one():
-    """The committed checkpoint on 100 held-out flights (Table I with intervals, table.py): CHM > SA-MRO > DQN in
-    handovers per flight, the DQN's mean at most half of CHM's (issue 26's target 1) and its interval wholly below
-    CHM's, the DQN ping-ponging no more per minute than CHM and losing no more data than CHM + 1 %, SA-MRO
-    ping-ponging no more per minute than CHM (what MRO is for), the buffer in use in at least 30 % of the DQN's
-    decisions, service kept. The rest of what the DQN pays is measured, not hidden: benchmarks/table_one.py and the
-    report's Table I."""
+    """The committed checkpoint, the paper's DQN (a plain DQN on the paper's reward), on 100 held-out flights
+    (Table I with intervals, table.py): at most half of CHM's handovers per flight with its interval wholly below
+    CHM's (the paper: a sixth), ping-ponging no more per minute than CHM, service kept within 5 %. What it pays
+    (radio link failures, lost data, RSRQ time) is measured, not hidden: benchmarks/reproduce.py and the report."""
     ckpt = load_checkpoint()
     res = {
         c.name: with_intervals(flights(c, ckpt.sim_config, 100, [0]), resamples=200)
-        for c in (CHM(), SAMRO(), DQNController(ckpt.net))
+        for c in (CHM(), DQNController(ckpt.net))
     }
-    chm, sa, dqn = ({k: v[0] for k, v in res[name].items()} for name in ("CHM", "SA-MRO", "DQN"))
-    assert chm["handovers"] > sa["handovers"] > dqn["handovers"] and dqn["handovers"] <= 0.5 * chm["handovers"]
-    assert res["DQN"]["handovers"][2] < res["CHM"]["handovers"][1]
-    assert dqn["pp_per_min"] <= chm["pp_per_min"] and dqn["lost_mbit"] <= 1.01 * chm["lost_mbit"]
-    assert sa["pp_per_min"] <= chm["pp_per_min"] and dqn["buffer_in_use"] >= 30
-    assert dqn["availability"] >= 0.95 * chm["availability"]
+    chm, dqn = ({k: v[0] for k, v in res[name].items()} for name in ("CHM", "DQN"))
+    assert dqn["handovers"] <= 0.5 * chm["handovers"] and res["DQN"]["handovers"][2] < res["CHM"]["handovers"][1]
+    assert dqn["pp_per_min"] <= chm["pp_per_min"] and dqn["availability"] >= 0.95 * chm["availability"]
 
 
-def test_buffer_leads_the_pretrained_dqns_score_and_the_neighbour_its_margin():
+def test_buffer_leads_the_pretrained_dqns_score_not_its_margin():
     """The paper's Figure 2 finding, at small scale, on the committed DQN's own decision states: buffer_queue_size
-    has the largest mean |contribution| to the chosen score; to the margin over the runner-up, the strongest
-    neighbour's RSRQ and RSRP lead and the buffer comes third (a DQN that learnt from the RSRQ rule's demonstrations
-    weighs which cell to take by its quality: docs/uav-reference.md)."""
+    has the largest mean |contribution| to the chosen score; to the margin over the runner-up the serving cell's and
+    the strongest neighbour's RSRP lead and the buffer is not in the top 3 (docs/uav-reference.md, 'Findings')."""
     ranked = rankings(load_checkpoint(), n_states=150, seed=0)
     assert ranked["score"][0] == "buffer_queue_size"
-    assert set(ranked["margin"][:2]) == {"rsrq_1", "rsrp_1"} and ranked["margin"][2] == "buffer_queue_size"
+    assert set(ranked["margin"][:2]) == {"rsrp_0", "rsrp_1"} and ranked["margin"].index("buffer_queue_size") >= 3
 
 
 def test_corrupt_and_mismatched_checkpoints(tmp_path):
@@ -148,7 +142,7 @@ def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
     meta = load_checkpoint(ckpt).meta
     assert meta["seed"] == 4 and meta["train_config"]["episodes"] == 1 and len(meta["history"]) == 1
     assert meta["train_config"]["demonstrations"] == 1 and meta["train_config"]["pretrain_updates"] == 5
-    assert "--demonstrations 1 --pretrain-updates 5 --eps-start 0.2 --seed 4" in meta["command"]
+    assert "--demonstrations 1 --pretrain-updates 5 --eps-start 0.2 --reward paper --seed 4" in meta["command"]
     capsys.readouterr()
     assert (
         main(
@@ -171,7 +165,7 @@ def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
     )
     report = json.loads(capsys.readouterr().out)
     assert report["flights"] == 3 and report["seeds"] == [0, 1]
-    assert set(report["policies"]) == {"CHM", "SA-MRO", "DQN"}
+    assert set(report["policies"]) == {"CHM", "CHM, every 5 steps", "SA-MRO", "DQN"}  # CHM at the DQN's cadence too
     for row in report["policies"].values():
         assert set(row) == {key for key, _, _ in ROWS}
         assert all(lo <= value <= hi for value, lo, hi in row.values())

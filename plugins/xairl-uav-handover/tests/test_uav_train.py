@@ -81,7 +81,7 @@ def test_pretraining_on_demonstrations_imitates_the_rule():
 
 
 def test_exploration_follows_demonstrations_and_old_checkpoints_read_as_plain():
-    assert TrainConfig().eps_start == 0.2 and TrainConfig(demonstrations=0).eps_start == 1.0
+    assert TrainConfig().eps_start == 1.0 and TrainConfig(demonstrations=10).eps_start == 0.2  # plain by default
     assert TrainConfig(demonstrations="0").eps_start == 1.0 and TrainConfig(eps_start=0.5).eps_start == 0.5
     assert TrainConfig.model_validate(TrainConfig().model_dump()) == TrainConfig()
     old = TrainConfig.of_checkpoint({"train_config": {"episodes": 40, "n_flights": 64, "eps_start": 1.0, "seed": 2}})

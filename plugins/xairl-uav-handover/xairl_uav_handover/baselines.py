@@ -82,6 +82,8 @@ class CHM:
 
     def __init__(self, config: CHMConfig | None = None, decision_every: int = 1):
         self.cfg, self.decision_every = config or CHMConfig(), decision_every
+        if decision_every > 1:
+            self.name = f"CHM, every {decision_every} steps"
 
     def reset(self, env) -> None:
         self.a3 = A3Trigger(env.sim.K, env.sim.N, env.sim.dt * env.decision_every)

@@ -132,7 +132,7 @@ def run_evaluate(args) -> int:
     cfg = _sim_config(ckpt.sim_config, args.duration)
     res = {
         c.name: with_intervals(flights(c, cfg, args.flights, args.seeds))
-        for c in (CHM(), SAMRO(), DQNController(ckpt.net))
+        for c in (CHM(), CHM(decision_every=ckpt.sim_config.decision_every), SAMRO(), DQNController(ckpt.net))
     }
     if args.json:
         print(json.dumps({"flights": args.flights, "seeds": args.seeds, "policies": res}, indent=2))

@@ -159,7 +159,7 @@ class UAVReport(xairl.plugin.Report):
         content.tables += [
             (
                 f"Calibration: handovers per minute by altitude band ({where})",
-                _table(band_rows(flights, chm_real, cfg, req.seed)),
+                _table(band_rows(flights, chm_real, cfg, req.seed, n_flights=16)),
             ),
             (
                 f"Real states in the training distribution: buffer full in {100 * np.mean(queue >= cfg.buffer.q_max_bits):.1f} "
