@@ -35,8 +35,14 @@ def cell_layout(sites_xy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
 def gain_db(antenna, dx, dy, dz, boresight) -> np.ndarray:
     """Gain (dBi) of cells with ``boresight`` (radians) towards points dx, dy east/north and dz above the antenna
     (metres; broadcast together): TR 36.814 Table A.2.1.1-2's pattern, as the module doc writes it."""
-    phi = np.angle(np.exp(1j * (np.arctan2(dy, dx) - boresight)), deg=True)  # off boresight, in (-180, 180]
-    below = np.degrees(np.arctan2(-dz, np.hypot(dx, dy)))  # elevation below the horizon
+    return pattern_db(antenna, np.arctan2(dy, dx), np.degrees(np.arctan2(-dz, np.hypot(dx, dy))), boresight)
+
+
+def pattern_db(antenna, azimuth, below_deg, boresight) -> np.ndarray:
+    """:func:`gain_db` from the angles: ``azimuth`` (radians from east) and ``below_deg`` (degrees below the
+    horizon) of the points as seen from the antenna (so a site's three cells share them)."""
+    phi = np.angle(np.exp(1j * (azimuth - boresight)), deg=True)  # off boresight, in (-180, 180]
+    below = below_deg
     a_h = -np.minimum(12 * (phi / antenna.h_beamwidth_deg) ** 2, antenna.front_back_db)
     a_v = -np.minimum(12 * ((below - antenna.downtilt_deg) / antenna.v_beamwidth_deg) ** 2, antenna.side_lobe_db)
     return antenna.max_gain_dbi - np.minimum(-(a_h + a_v), antenna.front_back_db)

@@ -90,7 +90,9 @@ class QuantileRow:
     ]
 
 
-def band_rows(flights, chm_real: list[int], cfg, seed: int, n_flights: int = 40) -> list[BandRow]:
+def band_rows(
+    flights, chm_real: list[int], cfg, seed: int, n_flights: int = 40, duration_s: float = 60.0
+) -> list[BandRow]:
     """One row per altitude band with flights; ``chm_real``: CHM's closed-loop handovers on each flight. Simulated
     CHM flies at the band's real flights' own heights, weighted by their minutes, so both sides cover one mix."""
     rows = []
@@ -103,8 +105,9 @@ def band_rows(flights, chm_real: list[int], cfg, seed: int, n_flights: int = 40)
         real = sum(n for _, n in inside) / minutes.sum()
         heights, where = np.unique([f.altitude_m for f, _ in inside], return_inverse=True)
         weight = np.bincount(where, weights=minutes)
-        sim = float(np.average(chm_rate_by_altitude(heights, cfg, n_flights, seed=seed), weights=weight))
-        sampled = chm_rate_by_altitude(heights, cfg, n_flights, seed=seed, sample_s=LOG_INTERVAL_S)
+        sim = chm_rate_by_altitude(heights, cfg, n_flights, duration_s, seed=seed)
+        sim = float(np.average(sim, weights=weight))
+        sampled = chm_rate_by_altitude(heights, cfg, n_flights, duration_s, seed=seed, sample_s=LOG_INTERVAL_S)
         sampled = float(np.average(sampled, weights=weight))
         rows.append(BandRow(f"{lo:g}-{hi:g} m", len(inside), live, real, sim, sampled, sampled / max(real, 1e-9)))
     return rows

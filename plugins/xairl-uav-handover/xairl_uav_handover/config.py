@@ -408,16 +408,16 @@ class SAMROConfig(_Strict):
         ge=1,
         description="the network updates the offsets from the counts of each this many flights, in the order "
         "flown (ours: TS 36.902 sec. 4.5 sets no period; real MRO counts over OAM periods of minutes to hours; 20 "
-        "flights of 2 min = 40 UAV-minutes of counts, so 200 held-out flights see 10 updates. Measured on 200 "
-        "held-out flights after 200 warm-up flights: every 10 flights 0.79x CHM's handovers in 67 s, every 20 "
-        "0.79x in 36 s)",
+        "flights of 2 min = 40 UAV-minutes of counts, so 200 held-out flights see 10 updates. Measured before "
+        "the simulator's downlink failures (issue 53): every 10 flights 0.79x CHM's handovers in 67 s, every 20 "
+        "0.79x in 36 s; with them, 1.05x: docs/uav-reference.md)",
     )
     warmup_flights: int = Field(
         200,
         ge=0,
         description="flights on training seeds (below evaluate.HELD_OUT_SEED) the network adapts on before the first "
-        "evaluated flight (ours: as many as one evaluation seed's flights. The offsets have not settled by then: "
-        "200 held-out flights after 200 warm-up flights hand over 0.79x as often as CHM, after 400 0.74x)",
+        "evaluated flight (ours: as many as one evaluation seed's flights. Before the simulator's downlink "
+        "failures the offsets had not settled by then: 0.79x CHM's handovers after 200, 0.74x after 400)",
     )
     rlf_s: float = Field(
         0.5,

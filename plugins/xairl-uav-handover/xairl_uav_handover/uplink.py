@@ -49,10 +49,9 @@ def psd_dbm(cfg: SimConfig, coupling_db) -> np.ndarray:
     return np.minimum(rad.ue_tx_power_dbm - 10 * np.log10(m), rad.p0_pusch_dbm + rad.pc_alpha * np.asarray(coupling_db))
 
 
-def _mean_gain(cfg: SimConfig, xy, h, site_xy, boresight) -> np.ndarray:
-    """Linear coupling gain of UEs at ``xy`` (..., 2), heights ``h`` to a cell at ``site_xy`` with ``boresight``:
-    the path gain averaged over LoS and NLoS by P_LOS, times the cell's antenna gain towards them (antenna.py),
-    less the link loss (RadioConfig.link_loss_db)."""
+def _path_gain(cfg: SimConfig, xy, h, site_xy):
+    """Linear path gain of UEs at ``xy`` (..., 2), heights ``h`` to a site's antennas, averaged over LoS and NLoS by
+    P_LOS, and the UEs' azimuth (radians) and elevation below the horizon (degrees) as the site sees them."""
     c = cfg.channel
     dx, dy = xy[..., 0] - site_xy[0], xy[..., 1] - site_xy[1]
     d2d = np.hypot(dx, dy)
@@ -60,8 +59,16 @@ def _mean_gain(cfg: SimConfig, xy, h, site_xy, boresight) -> np.ndarray:
     p_los = los_probability(c.scenario, h, np.maximum(d2d, 1.0))
     g = p_los * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, True, c.bs_height_m) / 10)
     g = g + (1 - p_los) * 10 ** (-path_loss(c.scenario, h, d3d, c.carrier_ghz, False, c.bs_height_m) / 10)
-    gain_db = antenna.gain_db(cfg.antenna, dx, dy, h - c.bs_height_m, boresight) - cfg.radio.link_loss_db
-    return g * 10 ** (gain_db / 10)
+    return g, np.arctan2(dy, dx), np.degrees(np.arctan2(-(h - c.bs_height_m), d2d))
+
+
+def _mean_gain(cfg: SimConfig, xy, h, site_xy, boresight) -> np.ndarray:
+    """Linear coupling gain of UEs at ``xy`` (..., 2), heights ``h`` to a cell at ``site_xy`` with ``boresight``:
+    the path gain (:func:`_path_gain`) times the cell's antenna gain towards them (antenna.py), less the link loss
+    (RadioConfig.link_loss_db)."""
+    path, azimuth, below = _path_gain(cfg, xy, h, site_xy)
+    pattern = antenna.pattern_db(cfg.antenna, azimuth, below, boresight) - cfg.radio.link_loss_db
+    return path * 10 ** (pattern / 10)
 
 
 def drop_ues(cfg: SimConfig, sites_xy: np.ndarray, rng: np.random.Generator, n_flights: int):
@@ -81,7 +88,7 @@ def drop_ues(cfg: SimConfig, sites_xy: np.ndarray, rng: np.random.Generator, n_f
 
 def interference_mw(cfg: SimConfig, sites_xy: np.ndarray, rng: np.random.Generator, n_flights: int) -> np.ndarray:
     """(K, N): mean interference per resource block (mW) at each of the sites' cells, one drop per flight (see the
-    module doc)."""
+    module doc). A site's three cells share the path and the angles to every UE; only their patterns differ."""
     cell_xy, _, boresight = antenna.cell_layout(sites_xy)
     xy, h = drop_ues(cfg, sites_xy, rng, n_flights)
     k, n, u = h.shape
@@ -89,11 +96,14 @@ def interference_mw(cfg: SimConfig, sites_xy: np.ndarray, rng: np.random.Generat
     own = np.stack([_mean_gain(cfg, xy[:, j], h[:, j], cell_xy[j], boresight[j]) for j in range(n)], axis=1)
     psd_mw = 10 ** (psd_dbm(cfg, -10 * np.log10(own)) / 10)  # (K, N, U)
     out = np.zeros((k, n))
-    for b in range(n):  # victim cell b; a loop over cells keeps memory at K x N x U
-        to_b = _mean_gain(cfg, xy, h, cell_xy[b], boresight[b])
-        per_cell = load * (psd_mw * to_b).mean(axis=2)  # (K, N): what each cell j sends towards b
-        per_cell[:, b] = 0.0  # b's own UE on these blocks is the UAV
-        out[:, b] = per_cell.sum(axis=1)
+    sectors = len(antenna.SECTOR_AZIMUTHS_DEG)
+    for site, site_xy in enumerate(sites_xy):  # a loop over sites keeps memory at K x N x U
+        path, azimuth, below = _path_gain(cfg, xy, h, site_xy)
+        for b in range(site * sectors, (site + 1) * sectors):  # victim cell b
+            pattern = antenna.pattern_db(cfg.antenna, azimuth, below, boresight[b]) - cfg.radio.link_loss_db
+            per_cell = load * (psd_mw * (path * 10 ** (pattern / 10))).mean(axis=2)  # (K, N): each cell j towards b
+            per_cell[:, b] = 0.0  # b's own UE on these blocks is the UAV
+            out[:, b] = per_cell.sum(axis=1)
     return out
 
 
