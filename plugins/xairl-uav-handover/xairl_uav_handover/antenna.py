@@ -42,7 +42,6 @@ def pattern_db(antenna, azimuth, below_deg, boresight) -> np.ndarray:
     """:func:`gain_db` from the angles: ``azimuth`` (radians from east) and ``below_deg`` (degrees below the
     horizon) of the points as seen from the antenna (so a site's three cells share them)."""
     phi = np.angle(np.exp(1j * (azimuth - boresight)), deg=True)  # off boresight, in (-180, 180]
-    below = below_deg
     a_h = -np.minimum(12 * (phi / antenna.h_beamwidth_deg) ** 2, antenna.front_back_db)
-    a_v = -np.minimum(12 * ((below - antenna.downtilt_deg) / antenna.v_beamwidth_deg) ** 2, antenna.side_lobe_db)
+    a_v = -np.minimum(12 * ((below_deg - antenna.downtilt_deg) / antenna.v_beamwidth_deg) ** 2, antenna.side_lobe_db)
     return antenna.max_gain_dbi - np.minimum(-(a_h + a_v), antenna.front_back_db)

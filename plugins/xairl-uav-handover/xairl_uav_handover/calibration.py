@@ -11,7 +11,7 @@ import numpy as np
 
 from .baselines import CHMOnSamples, SAMROOnSamples
 from .evaluate import chm_rate_by_altitude
-from .features import FEATURES
+from .features import FEATURES, RSRP, RSRQ
 from .policy import Checkpoint, greedy
 
 BANDS = ((20.0, 60.0), (60.0, 100.0), (100.0, 160.0))
@@ -157,8 +157,6 @@ def rsrq_spread(states: np.ndarray, measured: np.ndarray, resolution_db: float =
     """Per state with at least two measured candidates (``measured`` (n, 4) bool): the spread (max - min) over
     them of RSRQ - RSRP, after rounding both to ``resolution_db`` as the real flights' logs report them. A spread
     of 0 means RSRQ is RSRP plus one offset common to every cell, so the two carry the same information."""
-    from .features import RSRP, RSRQ
-
     rsrp, rsrq = states[:, RSRP].astype(float), states[:, RSRQ].astype(float)
     if resolution_db > 0:
         rsrp, rsrq = np.round(rsrp / resolution_db) * resolution_db, np.round(rsrq / resolution_db) * resolution_db
