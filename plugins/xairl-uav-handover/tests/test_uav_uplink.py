@@ -40,25 +40,49 @@ def test_truncated_shannon():
     assert uplink.capacity_bps(cfg, -10.5) == 0.0
 
 
+def _gain_by_hand(cfg, ue_xy, ue_h, site_xy, boresight_deg) -> float:
+    """One UE's linear coupling gain to one cell, written out from the standards (not from uplink.py or antenna.py):
+    P_LOS-weighted path gain (TR 36.777), TR 36.814's sector pattern, less the link loss."""
+    from xairl_uav_handover.channel import los_probability, path_loss
+
+    c, a = cfg.channel, cfg.antenna
+    dx, dy = ue_xy[0] - site_xy[0], ue_xy[1] - site_xy[1]
+    d2d = float(np.hypot(dx, dy))
+    d3d = float(np.hypot(d2d, ue_h - c.bs_height_m))
+    p = float(los_probability(c.scenario, ue_h, max(d2d, 1.0)))
+    path = p * 10 ** (-float(path_loss(c.scenario, ue_h, d3d, c.carrier_ghz, True, c.bs_height_m)) / 10)
+    path += (1 - p) * 10 ** (-float(path_loss(c.scenario, ue_h, d3d, c.carrier_ghz, False, c.bs_height_m)) / 10)
+    phi = (np.degrees(np.arctan2(dy, dx)) - boresight_deg + 180) % 360 - 180
+    theta = np.degrees(np.arctan2(c.bs_height_m - ue_h, d2d))  # below the horizon
+    a_h = -min(12 * (phi / a.h_beamwidth_deg) ** 2, a.front_back_db)
+    a_v = -min(12 * ((theta - a.downtilt_deg) / a.v_beamwidth_deg) ** 2, a.side_lobe_db)
+    gain_db = a.max_gain_dbi - min(-(a_h + a_v), a.front_back_db) - cfg.radio.link_loss_db
+    return path * 10 ** (gain_db / 10)
+
+
 def test_interference_is_the_brute_force_sum():
-    """Two sites (six cells), two UEs a cell, loads 1: cell b hears every other cell's UEs' mean power (towards
-    their own cell) times their coupling gain to b, its sector antenna included."""
-    from xairl_uav_handover.antenna import cell_layout
+    """Two sites (six cells), two UEs a cell, loads 1: cell b hears every other cell's UEs, each sending at its
+    open-loop power towards its own cell (P0 + alpha PL, capped at P_CMAX over M blocks), through its coupling gain
+    to b; every gain and power written out by hand here."""
+    from xairl_uav_handover.antenna import SECTOR_AZIMUTHS_DEG
 
     cfg = _cfg({"ues_per_cell": 2, "aerial_ue_ratio": 0.5, "ul_load_range": (1.0, 1.0)})
     sites = np.array([[0.0, 0.0], [500.0, 0.0]])
-    cells, _, boresight = cell_layout(sites)
+    cells = [(sites[s], SECTOR_AZIMUTHS_DEG[j]) for s in range(2) for j in range(3)]
     got = uplink.interference_mw(cfg, sites, np.random.default_rng(4), 3)
     xy, h = uplink.drop_ues(cfg, sites, np.random.default_rng(4), 3)
+    rad, m = cfg.radio, cfg.buffer.rb_per_uav
     assert got.shape == (3, 6)
     for k in range(3):
         for b in range(6):
             total = 0.0
             for j in range(6):
                 for u in range(2 * (j != b)):
-                    own = uplink._mean_gain(cfg, xy[k, j, u], h[k, j, u], cells[j], boresight[j])
-                    to_b = uplink._mean_gain(cfg, xy[k, j, u], h[k, j, u], cells[b], boresight[b])
-                    total += 10 ** (uplink.psd_dbm(cfg, -10 * np.log10(own)) / 10) * to_b / 2
+                    own = _gain_by_hand(cfg, xy[k, j, u], h[k, j, u], *cells[j])
+                    psd = min(
+                        rad.ue_tx_power_dbm - 10 * np.log10(m), rad.p0_pusch_dbm - rad.pc_alpha * 10 * np.log10(own)
+                    )
+                    total += 10 ** (psd / 10) * _gain_by_hand(cfg, xy[k, j, u], h[k, j, u], *cells[b]) / 2
             assert got[k, b] == pytest.approx(total, rel=1e-9)
 
 
