@@ -105,7 +105,7 @@ def test_real_flight_cells_take_levels_of_one_drop():
     link = UplinkBuffer(cfg, 60.0, seed=0, flight="f")
     for cell in range(30):
         link.sinr_db(-85.0, cell)
-    assert set(link._interference.values()) <= set(link.site_interference.tolist())
+    assert set(link._interference.values()) <= set(link.cell_interference.tolist())
 
 
 def test_settings_retired_by_issue_53_are_dropped_from_old_checkpoints():

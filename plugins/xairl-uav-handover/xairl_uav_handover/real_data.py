@@ -61,6 +61,8 @@ class UplinkBuffer:
     (uplink.py), sub-stepped at the sim's dt. Each real cell gets the interference of a cell of that drop drawn at
     random (once per cell and flight), so real and simulated links share one distribution.
 
+    :param altitude_m: the flight's height; unused since issue 53 (the interference at a cell comes from the other
+        cells' UEs, not from the UAV's height), kept so callers need not change.
     :param flight: the flight's name: each flight draws its own cells' levels.
     """
 
@@ -68,12 +70,14 @@ class UplinkBuffer:
         self.cfg, self.rng, self.q, self.lost = cfg, np.random.default_rng(seed), 0.0, 0.0
         self._cell_rng, self._interference = np.random.default_rng([seed, zlib.crc32(flight.encode())]), {}
         layout = hex_layout(cfg.layout.isd_m, cfg.layout.rings)
-        self.site_interference = interference_mw(cfg, layout, self._cell_rng, 1)[0]  # (N,) mW per resource block
+        self.cell_interference = interference_mw(cfg, layout, self._cell_rng, 1)[
+            0
+        ]  # (N,) mW per resource block, per cell
 
     def sinr_db(self, rsrp_dbm: float, cell) -> float:
         if cell not in self._interference:
-            site = self._cell_rng.integers(len(self.site_interference))
-            self._interference[cell] = float(self.site_interference[site])
+            drawn = self._cell_rng.integers(len(self.cell_interference))
+            self._interference[cell] = float(self.cell_interference[drawn])
         return float(sinr_db(self.cfg, rsrp_offset_db(self.cfg) - rsrp_dbm, self._interference[cell]))
 
     def advance(self, rsrp_dbm: float, cell, seconds: float, handed: bool) -> None:
