@@ -28,6 +28,7 @@ from xairl_uav_handover import oracle
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.evaluate import run_flights
 from xairl_uav_handover.policy import DQNController, load_checkpoint
+from xairl_uav_handover.report import frontier_figure
 from xairl_uav_handover.table import with_intervals
 
 HORIZONS_S = (0.2, 1.0, 2.0, 5.0)
@@ -177,7 +178,7 @@ def main():
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "frontier.json").write_text(json.dumps(data, indent=1))
-    oracle.frontier_figure(data, out / "frontier.png")
+    frontier_figure(data, out / "frontier.png")
     report(data)
     print(f"\nwrote {out / 'frontier.json'}, {out / 'frontier.png'}; {data['seconds']['total']:.0f} s in all")
 

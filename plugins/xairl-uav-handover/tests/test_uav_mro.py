@@ -4,8 +4,8 @@ metrics, the reward and MRO."""
 
 import numpy as np
 
-from xairl_uav_handover.baselines import CHM, SAMRO, MobilityRobustness
-from xairl_uav_handover.config import SAMROConfig, SimConfig
+from xairl_uav_handover.baselines import CHM, SAMRO, MobilityRobustness, SAMROConfig
+from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.evaluate import run_flights
 from xairl_uav_handover.simulator import Simulator

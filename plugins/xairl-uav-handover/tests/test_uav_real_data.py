@@ -10,8 +10,9 @@ import pytest
 from xairl import InputError
 from xairl.cli import main
 from xairl.plugin import StateRecord
+from xairl_uav_handover.baselines import CHMConfig
 from xairl_uav_handover.calibration import agreement_rows, outside
-from xairl_uav_handover.config import CHMConfig, SimConfig
+from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.exports import load_flight, load_folder
 from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint
 from xairl_uav_handover.real_data import agreement, baltaci_rate_by_altitude, chm_handovers, walk

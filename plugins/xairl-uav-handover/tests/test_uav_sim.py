@@ -5,8 +5,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 from pydantic import ValidationError
 
-from xairl_uav_handover.baselines import A3Trigger, CHMOnSamples
-from xairl_uav_handover.config import CHMConfig, SimConfig
+from xairl_uav_handover.baselines import A3Trigger, CHMConfig, CHMOnSamples
+from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.env import HandoverVecEnv, UAVHandoverEnv
 from xairl_uav_handover.features import ACTIONS, FEATURES, RSRQ, available_actions
 from xairl_uav_handover.simulator import Simulator, hex_layout

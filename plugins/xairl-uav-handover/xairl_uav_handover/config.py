@@ -1,4 +1,5 @@
-"""Every setting of the simulator, the reward and the baselines, as pydantic models (unknown keys are errors)."""
+"""Every setting of the simulator and its reward, as pydantic models (unknown keys are errors); CHM's and SA-MRO's
+are in baselines.py."""
 
 from __future__ import annotations
 
@@ -12,11 +13,13 @@ from .channel import HEIGHT_RANGE
 LINK_LOSS_DB = 11.0
 
 
-class _Strict(BaseModel):
+class Strict(BaseModel):
+    """Settings: unknown keys are errors, values are frozen (the simulator's here, the controllers' in baselines.py)."""
+
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
-class ChannelConfig(_Strict):
+class ChannelConfig(Strict):
     scenario: Literal["UMa-AV", "UMi-AV", "RMa-AV"] = Field(
         "UMa-AV", description="TR 36.777 Annex B scenario: urban macro with aerial UEs, the paper's"
     )
@@ -42,7 +45,7 @@ class ChannelConfig(_Strict):
     )
 
 
-class AntennaConfig(_Strict):
+class AntennaConfig(Strict):
     """The BS sector antenna (antenna.py): TR 36.814 Table A.2.1.1-2's 3D pattern, three sectors per site."""
 
     max_gain_dbi: float = Field(14.0, ge=0, le=30, description="G_max (TR 36.814 Table A.2.1.1-2)")
@@ -55,7 +58,7 @@ class AntennaConfig(_Strict):
     )
 
 
-class RadioConfig(_Strict):
+class RadioConfig(Strict):
     """Link budget: a macro BS (49 dBm over 20 MHz, 25 m high), the sector antenna of ``AntennaConfig``, and one
     loss fitted to the real flights (``link_loss_db``)."""
 
@@ -135,7 +138,7 @@ class RadioConfig(_Strict):
     )
 
 
-class LayoutConfig(_Strict):
+class LayoutConfig(Strict):
     isd_m: float = Field(
         500.0,
         gt=50,
@@ -147,7 +150,7 @@ class LayoutConfig(_Strict):
     )
 
 
-class FlightConfig(_Strict):
+class FlightConfig(Strict):
     """Flights through random waypoints (trajectory.py): heights cover the real UKM flights' (20-155 m, with margin
     so that 20 m lies inside the simulated 0.5-99.5 % range; below 22.5 m the channel is TR 36.777's terrestrial
     UMa, channel.py), horizontal speeds their measured ones (median 3.8 m/s, p90 7.9 m/s)."""
@@ -187,7 +190,7 @@ class FlightConfig(_Strict):
         return int(round(self.duration_s / self.dt_s))
 
 
-class BufferConfig(_Strict):
+class BufferConfig(Strict):
     """Uplink traffic of the remote-piloting use case (Baltaci et al., IMC 2022, the study behind the shipped
     handover data): fixed-rate video streamed at 25 Mbit/s urban and 8 Mbit/s rural; measured UAV uplink throughput
     medians 31.5 / 37.7 Mbit/s urban (two operators), 22.9 / 9.1 rural. The UAV is granted a share of the uplink
@@ -233,7 +236,7 @@ class BufferConfig(_Strict):
         return self.video_rate_mbps * 1e6 / self.data_packet_bits
 
 
-class ObservationConfig(_Strict):
+class ObservationConfig(Strict):
     """What the UE reports, as in LTE (TS 36.331): RSRP/RSRQ averaged over each measurement period, then layer-3
     filtered F_n = (1 - a) F_(n-1) + a M_n with a = 1/2^(k/4); neighbours count as measured only while their
     filtered RSRQ is above the detection threshold. An empty candidate slot is reported at the detection limit (RSRQ
@@ -270,7 +273,7 @@ class ObservationConfig(_Strict):
     )
 
 
-class HandoverConfig(_Strict):
+class HandoverConfig(Strict):
     interruption_s: float = Field(0.04, ge=0, description="no uplink service while a handover executes")
     min_time_of_stay_s: float = Field(
         1.0,
@@ -309,7 +312,7 @@ class HandoverConfig(_Strict):
     )
 
 
-class RewardConfig(_Strict):
+class RewardConfig(Strict):
     """r = w_buffer / (1 + q) - w_handover*[handover] - w_rsrp*[RSRP<thr] - w_rsrq*[RSRQ<thr] - w_lost*lost
     - w_pingpong*[ping-pong] per decision, q and lost in Mbit. The defaults are the paper's reward (its four terms;
     w_lost = w_pingpong = 0). :data:`PRICED_REWARD` is the operator-priced variant (lost data and ping-pongs
@@ -357,7 +360,7 @@ def without_retired(data: dict) -> dict:
     }
 
 
-class SimConfig(_Strict):
+class SimConfig(Strict):
     channel: ChannelConfig = ChannelConfig()
     antenna: AntennaConfig = AntennaConfig()
     radio: RadioConfig = RadioConfig()
@@ -386,54 +389,3 @@ class SimConfig(_Strict):
             if not (0 < l0 <= l1 <= 1):
                 raise ValueError(f"radio.{name} must be (low, high) with 0 < low <= high <= 1")
         return self
-
-
-class CHMConfig(_Strict):
-    """Conventional handover: A3 event (TR 36.777 Table A.2.1-1 defaults)."""
-
-    offset_db: float = Field(2.0, description="A3 offset: neighbour RSRP must exceed serving RSRP by this")
-    ttt_s: float = Field(0.16, ge=0, description="time-to-trigger")
-
-
-class SAMROConfig(_Strict):
-    """Mobility robustness optimisation (see baselines.SAMRO): A3 with a cell individual offset per (serving,
-    neighbour) pair, kept by the network across flights and adapted from the too-late, too-early, wrong-cell and
-    ping-pong handovers counted on each pair (3GPP TS 36.300 sec. 22.4.2, TS 36.902 sec. 4.5). A ping-pong is a
-    return within ``HandoverConfig.min_time_of_stay_s``."""
-
-    offset_db: float = Field(2.0, description="A3 offset every pair starts from (CHM's)")
-    ttt_s: float = Field(0.16, ge=0, description="time-to-trigger (CHM's; MRO tunes offsets only)")
-    update_every_flights: int = Field(
-        20,
-        ge=1,
-        description="the network updates the offsets from the counts of each this many flights, in the order "
-        "flown (ours: TS 36.902 sec. 4.5 sets no period; real MRO counts over OAM periods of minutes to hours; 20 "
-        "flights of 2 min = 40 UAV-minutes of counts, so 200 held-out flights see 10 updates. Measured before "
-        "the simulator's downlink failures (issue 53): every 10 flights 0.79x CHM's handovers in 67 s, every 20 "
-        "0.79x in 36 s; with them, 1.05x: docs/uav-reference.md)",
-    )
-    warmup_flights: int = Field(
-        200,
-        ge=0,
-        description="flights on training seeds (below evaluate.HELD_OUT_SEED) the network adapts on before the first "
-        "evaluated flight (ours: as many as one evaluation seed's flights. Before the simulator's downlink "
-        "failures the offsets had not settled by then: 0.79x CHM's handovers after 200, 0.74x after 400)",
-    )
-    rlf_s: float = Field(
-        0.5,
-        gt=0,
-        description="on real logs, which record no failures (SAMROOnSamples): a failure is the modelled uplink "
-        "SINR below the minimum this long (ours, not a standard's); in simulation MRO reads StepInfo.rlf and .hof",
-    )
-    early_s: float = Field(
-        2.0,
-        gt=0,
-        description="a failure this soon after a handover makes it too early or to the wrong cell (TS 36.300 sec. "
-        "22.4.2 says 'shortly after'; the value is ours, not confirmed in a standard)",
-    )
-    margin_step_db: float = Field(
-        1.0, gt=0, description="change of a pair's offset per update (ours; CIO steps are whole dB, TS 36.331)"
-    )
-    margin_range_db: tuple[float, float] = Field(
-        (-4.0, 10.0), description="range of A3 offset plus cell individual offset (ours; within TS 36.331's +/-24 dB)"
-    )

@@ -378,31 +378,3 @@ class Recorded:
     def realised(self, name: str) -> np.ndarray:
         """(K, T) ``sinr_db``, ``available`` or ``radio_ok`` of each step (StepInfo)."""
         return np.stack([i[("sinr_db", "available", "radio_ok").index(name)] for i in self.infos], axis=1)
-
-
-def frontier_figure(data: dict, path) -> str:
-    """The frontier of ``data`` (benchmarks/oracle_frontier.py's frontier.json) with the receding horizons and each
-    policy's place, as a PNG at ``path``; returns the path."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    ax.plot(data["frontier"]["handovers"], data["frontier"]["rsrq_pct"], "k-o", ms=3, label="hindsight bound")
-    for h, pts in data.get("receding", {}).items():
-        ax.plot(pts["handovers"], pts["rsrq_pct"], "--.", lw=1, label=f"{h} s of foresight")
-    policies = data.get("policies", {})
-    for (name, p), marker in zip(policies.items(), "s^Dvp", strict=False):
-        ax.plot(p["handovers"], p["rsrq_pct"], marker, ms=8, label=name)
-    seen = [p["rsrq_pct"] for p in policies.values()] + data["frontier"]["rsrq_pct"]
-    ax.set_ylim(0.9 * min(seen), 2.5 * max([p["rsrq_pct"] for p in policies.values()] or seen))
-    ax.set_xlabel("handovers per flight (mean)")
-    ax.set_ylabel("time below the RSRQ threshold (%)")
-    ax.set_title(f"What hindsight allows: {data.get('flights', '?')} held-out flights")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return str(path)

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from pydantic import BaseModel
 
-from .config import CHMConfig, SAMROConfig, SimConfig
+from .baselines import CHMConfig, SAMROConfig
+from .config import SimConfig
 
 #: where the docs table starts and ends
 BEGIN, END = "<!-- parameters: begin -->", "<!-- parameters: end -->"

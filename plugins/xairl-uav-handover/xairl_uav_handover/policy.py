@@ -185,7 +185,7 @@ def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
     """The trained handover DQN as an xairl Policy (the plugin's ``uav-dqn``)."""
     ckpt = checkpoint if isinstance(checkpoint, Checkpoint) else load_checkpoint(checkpoint)
     config = ckpt.sim_config
-    from .config import CHMConfig
+    from .baselines import CHMConfig
 
     facts = HandoverFacts(config.buffer.q_max_bits, CHMConfig().offset_db, config.observation.detection_rsrq_db)
     return Policy(

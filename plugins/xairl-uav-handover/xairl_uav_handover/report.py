@@ -17,9 +17,8 @@ from pydantic import Field
 import xairl
 from xairl import Explanation, InputError
 
-from .baselines import CHM, SAMRO
+from .baselines import CHM, SAMRO, SAMROConfig
 from .calibration import agreement_rows, band_rows, outside, quantile_rows
-from .config import SAMROConfig
 from .evaluate import PAPER, chm_rate_by_altitude
 from .features import GROUPS
 from .policy import (
@@ -183,8 +182,6 @@ def frontier_section(path: str, out) -> tuple[str, Path]:
     """The hindsight bound's figure from benchmarks/oracle_frontier.py's JSON at ``path``, and its caption."""
     import json
 
-    from .oracle import frontier_figure
-
     try:
         data = json.loads(Path(path).read_text())
         chm, dqn = data["policies"]["CHM"], data["policies"]["DQN"]
@@ -330,3 +327,31 @@ def _altitude_figure(out: Path, real: str, cfg, flights, chm_real: list[int], se
     xairl.plugin.save_figure(fig, path, dpi=90)
     plt.close(fig)
     return caption, path
+
+
+def frontier_figure(data: dict, path) -> str:
+    """The frontier of ``data`` (benchmarks/oracle_frontier.py's frontier.json) with the receding horizons and each
+    policy's place, as a PNG at ``path``; returns the path."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    ax.plot(data["frontier"]["handovers"], data["frontier"]["rsrq_pct"], "k-o", ms=3, label="hindsight bound")
+    for h, pts in data.get("receding", {}).items():
+        ax.plot(pts["handovers"], pts["rsrq_pct"], "--.", lw=1, label=f"{h} s of foresight")
+    policies = data.get("policies", {})
+    for (name, p), marker in zip(policies.items(), "s^Dvp", strict=False):
+        ax.plot(p["handovers"], p["rsrq_pct"], marker, ms=8, label=name)
+    seen = [p["rsrq_pct"] for p in policies.values()] + data["frontier"]["rsrq_pct"]
+    ax.set_ylim(0.9 * min(seen), 2.5 * max([p["rsrq_pct"] for p in policies.values()] or seen))
+    ax.set_xlabel("handovers per flight (mean)")
+    ax.set_ylabel("time below the RSRQ threshold (%)")
+    ax.set_title(f"What hindsight allows: {data.get('flights', '?')} held-out flights")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return str(path)

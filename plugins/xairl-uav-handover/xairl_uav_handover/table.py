@@ -26,25 +26,30 @@ def pingpong_share(m: dict, i, key: str = "pingpongs") -> np.ndarray:
     return 100 * m[key][i][ho > 0] / ho[ho > 0]
 
 
+# statistics of the per-flight arrays ``m`` over the flights ``i``
+def _pooled(num, den):
+    return lambda m, i: 100 * m[num][i].sum() / max(m[den][i].sum(), 1)
+
+
+def _mean(key, scale=1.0):
+    return lambda m, i: scale * m[key][i].mean()
+
+
+def _median(key, scale=1.0):
+    return lambda m, i: scale * float(np.median(m[key][i]))
+
+
+def _worst5(key):
+    return lambda m, i: np.sort(m[key][i])[: max(1, len(i) // 20)].mean()
+
+
 #: (key, label, statistic of the per-flight arrays ``m``) in the table's order
 def _rows():
-    def pooled(num, den):
-        return lambda m, i: 100 * m[num][i].sum() / max(m[den][i].sum(), 1)
-
-    def mean(key, scale=1.0):
-        return lambda m, i: scale * m[key][i].mean()
-
-    def median(key, scale=1.0):
-        return lambda m, i: scale * float(np.median(m[key][i]))
-
-    def worst5(key):
-        return lambda m, i: np.sort(m[key][i])[: max(1, len(i) // 20)].mean()
-
     rows = [
-        ("handovers", "handovers per flight, mean", mean("handovers")),
-        ("handovers_median", "handovers per flight, median", median("handovers")),
+        ("handovers", "handovers per flight, mean", _mean("handovers")),
+        ("handovers_median", "handovers per flight, median", _median("handovers")),
         ("pp_share_median", "ping-pong share per flight, median, minimum time of stay (%)", _share_median),
-        ("pp_share", "ping-pong share, minimum time of stay (%)", pooled("pingpongs", "handovers")),
+        ("pp_share", "ping-pong share, minimum time of stay (%)", _pooled("pingpongs", "handovers")),
         (
             "pp_per_min",
             "ping-pongs per flight-minute, minimum time of stay",
@@ -52,7 +57,7 @@ def _rows():
         ),
     ]
     rows += [
-        (f"pp_{w:g}s", f"ping-pong share, {w:g} s window (%)", pooled(f"pingpongs_{w:g}s", "handovers"))
+        (f"pp_{w:g}s", f"ping-pong share, {w:g} s window (%)", _pooled(f"pingpongs_{w:g}s", "handovers"))
         for w in PINGPONG_WINDOWS_S
     ]
     rows += [
@@ -69,26 +74,26 @@ def _rows():
             "flights with > 5 ping-pongs, minimum time of stay (%)",
             lambda m, i: 100 * (m["pingpongs"][i] > 5).mean(),
         ),
-        ("lost_mbit", "lost data per flight, mean (Mbit)", mean("lost_data_kbit", 1e-3)),
-        ("lost_mbit_median", "lost data per flight, median (Mbit)", median("lost_data_kbit", 1e-3)),
-        ("availability", "service availability, mean (%)", mean("service_availability_pct")),
-        ("availability_median", "service availability, median (%)", median("service_availability_pct")),
-        ("availability_worst5", "service availability, worst 5 % of flights (%)", worst5("service_availability_pct")),
-        ("rsrq_violation", "time below the RSRQ threshold, mean (%)", mean("rsrq_violation_pct")),
-        ("rsrq_violation_median", "time below the RSRQ threshold, median (%)", median("rsrq_violation_pct")),
-        ("rsrp_violation", "time below the RSRP threshold, mean (%)", mean("rsrp_violation_pct")),
-        ("rsrp_violation_median", "time below the RSRP threshold, median (%)", median("rsrp_violation_pct")),
+        ("lost_mbit", "lost data per flight, mean (Mbit)", _mean("lost_data_kbit", 1e-3)),
+        ("lost_mbit_median", "lost data per flight, median (Mbit)", _median("lost_data_kbit", 1e-3)),
+        ("availability", "service availability, mean (%)", _mean("service_availability_pct")),
+        ("availability_median", "service availability, median (%)", _median("service_availability_pct")),
+        ("availability_worst5", "service availability, worst 5 % of flights (%)", _worst5("service_availability_pct")),
+        ("rsrq_violation", "time below the RSRQ threshold, mean (%)", _mean("rsrq_violation_pct")),
+        ("rsrq_violation_median", "time below the RSRQ threshold, median (%)", _median("rsrq_violation_pct")),
+        ("rsrp_violation", "time below the RSRP threshold, mean (%)", _mean("rsrp_violation_pct")),
+        ("rsrp_violation_median", "time below the RSRP threshold, median (%)", _median("rsrp_violation_pct")),
         (
             "ho_empty",
             "handovers taken with an empty buffer (%)",
-            lambda m, i: 100 - pooled("handovers_buffer_nonempty", "handovers")(m, i),
+            lambda m, i: 100 - _pooled("handovers_buffer_nonempty", "handovers")(m, i),
         ),
-        ("ho_full", "handovers taken with a full buffer (%)", pooled("handovers_buffer_full", "handovers")),
-        ("rlf", "radio link failures per flight, mean", mean("radio_link_failures")),
-        ("hof", "handover failures per flight, mean", mean("handover_failures")),
-        ("outage", "time re-establishing after a failure, mean (%)", mean("outage_pct")),
-        ("buffer_in_use", "decisions taken with a non-empty buffer, mean (%)", mean("buffer_nonempty_pct")),
-        ("buffer_in_use_median", "decisions taken with a non-empty buffer, median (%)", median("buffer_nonempty_pct")),
+        ("ho_full", "handovers taken with a full buffer (%)", _pooled("handovers_buffer_full", "handovers")),
+        ("rlf", "radio link failures per flight, mean", _mean("radio_link_failures")),
+        ("hof", "handover failures per flight, mean", _mean("handover_failures")),
+        ("outage", "time re-establishing after a failure, mean (%)", _mean("outage_pct")),
+        ("buffer_in_use", "decisions taken with a non-empty buffer, mean (%)", _mean("buffer_nonempty_pct")),
+        ("buffer_in_use_median", "decisions taken with a non-empty buffer, median (%)", _median("buffer_nonempty_pct")),
     ]
     return rows
 
