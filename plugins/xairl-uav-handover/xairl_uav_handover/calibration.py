@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .baselines import CHMOnSamples, SAMROOnSamples
-from .evaluate import chm_rate_by_altitude
+from .evaluate import chm_rate_by_altitude, held_at
 from .features import FEATURES, RSRP, RSRQ
 from .policy import Checkpoint, greedy
 
@@ -179,9 +179,7 @@ def serving_rsrp_median(cfg, altitudes, n_flights: int = 40, seconds: float = 60
 
     values = []
     for h in altitudes:
-        data = cfg.model_dump()
-        data["flight"].update(altitude_m=(h, h), duration_s=seconds)
-        env = HandoverVecEnv(type(cfg).model_validate(data), n_flights, decision_every=1)
+        env = HandoverVecEnv(held_at(cfg, h, seconds), n_flights, decision_every=1)
         env.reset(seed=seed)
         chm = CHM()
         chm.reset(env)

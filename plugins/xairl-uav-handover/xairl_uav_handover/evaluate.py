@@ -124,6 +124,13 @@ def rankings(ckpt, n_states: int, seed: int) -> dict[str, list[str]]:
     return {view: ranked(imp, view) for view in ("margin", "score")}
 
 
+def held_at(config: SimConfig, height_m: float, duration_s: float) -> SimConfig:
+    """``config`` with every flight held at ``height_m`` (all its waypoints there) for ``duration_s``."""
+    data = config.model_dump()
+    data["flight"].update(altitude_m=(height_m, height_m), duration_s=duration_s)
+    return SimConfig.model_validate(data)
+
+
 def chm_rate_by_altitude(
     altitudes,
     config: SimConfig,
@@ -139,8 +146,6 @@ def chm_rate_by_altitude(
     every = 1 if sample_s is None else max(1, int(round(sample_s / config.flight.dt_s)))
     rates = []
     for h in altitudes:
-        data = config.model_dump()
-        data["flight"].update(altitude_m=(h, h), duration_s=duration_s)
-        m = run_flights(CHM(decision_every=every), SimConfig.model_validate(data), n_flights, seed)
+        m = run_flights(CHM(decision_every=every), held_at(config, h, duration_s), n_flights, seed)
         rates.append(float(np.mean(m["handovers"])) / (duration_s / 60.0))
     return np.array(rates)
