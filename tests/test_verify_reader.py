@@ -1,0 +1,54 @@
+"""The rule-table reader (xairl.verify, issue 54 stage 1): every rule's examples from rules/rules.yaml, the table's
+shape, and the claims it makes on sentences written for these tests."""
+
+import pytest
+
+from xairl.narrators.verify.rules import example
+from xairl.verify import read, rules, trace
+
+RULES = rules.table()
+
+
+def test_every_rule_has_an_id_a_pattern_a_claim_and_examples():
+    ids = [r.id for r in RULES]
+    assert len(ids) == len(set(ids))
+    for r in RULES:
+        assert r.claim in ("number", "direction", "rank") and r.binding in ("adjacent", "grammar")
+        assert r.pattern and r.fires, r.id
+        if r.kind == "dependency":
+            roles = {node["RIGHT_ID"] for node in r.pattern}
+            assert "name" in roles and roles & {"num", "dir", "rank"}, r.id
+
+
+@pytest.mark.parametrize(
+    "rule,case,text,fires",
+    [(r.id, case, text, True) for r in RULES for case, text in r.fires]
+    + [(r.id, case, text, False) for r in RULES for case, text in r.silent],
+)
+def test_rule_examples(rule, case, text, fires):
+    made = {c.rule for c in read(text, example(case), 0).claims}
+    assert (rule in made) == fires, "\n".join(trace(text, example(case), 0))
+
+
+@pytest.mark.parametrize(
+    "text,status",
+    [
+        ("Traffic index raised the forecast by 7.2.", "verified"),
+        ("Traffic index lowered the forecast by 7.2.", "contradicted"),  # direction flipped
+        ("traffic index: 3.5", "contradicted"),  # neither its value nor its contribution
+        ("Wind speed (+14.7) and pm2_5_lag1 (+6.9) raised it.", "contradicted"),  # two numbers swapped
+        ("The season (+1.0) raised it.", "contradicted"),  # the sign of a contribution
+        ("pm2_5_lag1 was the biggest driver.", "verified"),
+        ("Traffic index was the biggest driver.", "contradicted"),
+        ("Traffic index did not lower the forecast.", "unchecked"),  # negated: not read as a direction
+        ("In the city, 7.2 km of sensors were built for the traffic index.", "unchecked"),  # bound by no rule
+    ],
+)
+def test_claims_only_where_grammar_or_adjacency_binds(text, status):
+    assert read(text, example("air"), 0).sentences[0].status == status, "\n".join(trace(text, example("air"), 0))
+
+
+def test_a_number_next_to_its_name_outranks_the_parse():
+    lines = trace("The season lowered it a little, and wind speed (SHAP +6.9) pushed it up.", example("air"), 0)
+    assert any(line.startswith("  * number.parenthesis") for line in lines), lines
+    assert read("The season lowered it a little, and wind speed (SHAP +6.9) pushed it up.", example("air"), 0).accurate

@@ -1,0 +1,102 @@
+"""The reader of outside prose: a text checked against an Explanation by rules that are data.
+
+Layers, each using only those before it: numbers -> names -> parse (sentences with names and numbers as single
+tokens) -> rules (rules/rules.yaml: spaCy Matcher and DependencyMatcher patterns, word lists in rules/lexicon.yaml)
+-> resolve (one reading per number, direction or rank word: priority, then the nearest name) -> check (each claim
+against the fact book). A claim is contradicted only where a rule binds it to its name by adjacency ('A +0.3',
+'A (0.3)', 'A=0.3') or grammar (subject, object, 'by'); anything else verifies or stays unchecked.
+
+Stage 1 of issue 54: numbers, names, the fact book and the sentence splitter are still those of
+``xairl.narrators.verify``; they move here when this reader replaces that one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from ..explanation import Explanation
+from ..narrators.verify import MAX_CHARS, SentenceCheck, Verification, sentences
+from ..narrators.verify.book import clean_surface, fact_book
+from ..narrators.verify.checks import Claim
+from ..narrators.verify.numbers import normalise, unit_in_name
+from ..narrators.verify.vocabulary import vocabulary
+from ..policy import Policy
+from ..regions import in_regions
+from . import check, rules
+from .parse import Sentence, parse
+from .resolve import Decision, resolve
+
+__all__ = ["read", "trace"]
+
+
+def read(text: str, explanation: Explanation, index: int = 0, policy: Policy | None = None) -> Verification:
+    """Check every claim of ``text`` against the explanation of decision ``index``; never raises on odd text."""
+    sentences_, book, unit_of, note = _prepare(text, explanation, index, policy)
+    out = []
+    for s in sentences_:
+        out.append(SentenceCheck(s.text.strip(), tuple(_claims(s, book, unit_of)[0])))
+    return Verification(tuple(out), note)
+
+
+def trace(text: str, explanation: Explanation, index: int = 0, policy: Policy | None = None) -> list[str]:
+    """Per sentence: every rule's candidate reading and the one that won, then the claims."""
+    sentences_, book, unit_of, _ = _prepare(text, explanation, index, policy)
+    lines = []
+    for s in sentences_:
+        claims, decisions = _claims(s, book, unit_of)
+        lines.append(f"sentence: {s.text.strip()}")
+        for d in decisions:
+            for c in d.candidates:
+                mark = "*" if c is d.winner else " "
+                lines.append(
+                    f"  {mark} {c.rule.id} (priority {c.rule.priority}): {s.doc[c.name].text} <- {s.doc[c.anchor].text}"
+                )
+        lines += [f"  -> {c.kind} '{c.text}': {c.status} ({c.detail}) [{c.rule}]" for c in claims]
+    return lines
+
+
+def _prepare(text, explanation, index, policy):
+    if not isinstance(text, str):
+        raise InputError(f"read() takes text (a str), not {type(text).__name__}: decode it first.")
+    index = explanation.check_index(index)
+    explanation = in_regions(explanation)
+    text, note = normalise(text), ""
+    if len(text) > MAX_CHARS:
+        text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
+    with np.errstate(all="ignore"):
+        book = fact_book(explanation, index, policy)
+    vocab = vocabulary(explanation, policy, clean_surface)
+
+    def unit_of(f: str) -> str:
+        info = policy.features.get(f) if policy else None
+        return info.unit if info and info.unit else unit_in_name(f)
+
+    pieces = [(a, text[a:b]) for a, b in sentences(text)]
+    return parse(pieces, vocab), book, unit_of, note
+
+
+def _claims(s: Sentence, book, unit_of) -> tuple[list[Claim], list[Decision]]:
+    names = [t for t in s.doc if t.ent_type_ == "FEATURE"]
+    out = [Claim("feature", t.text, "verified", " / ".join(t._.keys), "names.mention") for t in names]
+    if s.text.rstrip().endswith("?"):  # a question asserts nothing
+        return out, []
+    decisions = resolve(rules.candidates(s.doc))
+    ctx = check.view(s, book)
+    bound = set()
+    for d in decisions:
+        try:
+            out.append(check.claim(d.winner, s, book, unit_of, ctx))
+        except Exception as e:  # noqa: BLE001 - a reader bug must not take the narration down with it
+            out.append(Claim("internal", s.text.strip(), "unchecked", f"the reader failed ({type(e).__name__}: {e})"))
+        if d.winner.rule.claim == "number":
+            bound.add(d.winner.anchor)
+    named = {k for t in names for k in t._.keys}
+    for t in s.doc:
+        if t.ent_type_ == "NUM" and t.i not in bound:
+            out.append(check.free_number(t, book))
+        elif t.ent_type_ == "LABEL":
+            c = check.label_claim(t, book, named)
+            if c is not None:
+                out.append(c)
+    return out, decisions

@@ -1,0 +1,67 @@
+"""Sentences parsed with their names and numbers as one token each.
+
+A name found by the vocabulary (any spelling of a feature, an action's verb forms, a categorical value's label) and a
+number as people write it ('+$1,204', '~12 %', 'minus 0.4') become one token, with ``ENT_TYPE`` FEATURE, ACTION,
+LABEL or NUM and the custom attributes ``keys`` (the features or actions it may mean), ``label`` and ``number``
+(the :class:`Number` read). The rules (rules.py) match these tokens, so a pattern never spells a name or a number.
+Every sentence of a text is parsed in one ``nlp.pipe``-style batch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from spacy.tokens import Doc, Token
+
+from ..narrators.verify.names import Mention, find_mentions
+from ..narrators.verify.numbers import Number, find_numbers
+from ..narrators.verify.parse import _symbol_runs, pipeline
+
+for _attr, _default in (("keys", ()), ("label", ""), ("number", None), ("form", "")):
+    if not Token.has_extension(_attr):
+        Token.set_extension(_attr, default=_default)
+
+_KIND = {"feature": "FEATURE", "action": "ACTION", "label": "LABEL"}
+
+
+@dataclass
+class Sentence:
+    """One sentence: its text, where it starts in the text, its parse, and the masked text (names as NUL)."""
+
+    text: str
+    start: int
+    doc: Doc
+    masked: str
+    mentions: list[Mention]
+    numbers: list[Number]
+
+
+def parse(pieces: list[tuple[int, str]], vocab) -> list[Sentence]:
+    """Parse each (start, sentence) with its names and numbers merged into single tokens, all in one batch."""
+    nlp = pipeline()
+    out = []
+    for start, text in pieces:
+        mentions, masked = find_mentions(text, vocab)
+        numbers = find_numbers(masked)
+        doc = nlp.make_doc(text)
+        taken: set[int] = set()
+        with doc.retokenize() as retokenizer:
+            spans = [
+                (m.start, m.end, _KIND[m.kind], {"keys": m.keys, "label": m.label, "form": m.form}) for m in mentions
+            ]
+            spans += [(n.start, n.end, "NUM", {"number": n}) for n in numbers]
+            for a, b, kind, ext in sorted(spans, key=lambda s: s[0]):
+                span = doc.char_span(a, b, alignment_mode="expand")
+                if span is None or taken & set(range(span.start, span.end)):
+                    continue
+                taken |= set(range(span.start, span.end))
+                retokenizer.merge(span, attrs={"ENT_TYPE": kind, "ENT_IOB": 3, "_": ext})
+            for a, b in _symbol_runs(doc, taken):
+                retokenizer.merge(doc[a:b])
+        out.append(Sentence(text, start, doc, masked, mentions, numbers))
+    docs = [s.doc for s in out]
+    for _, component in nlp.pipeline:
+        docs = list(component.pipe(docs)) if hasattr(component, "pipe") else [component(d) for d in docs]
+    for s, d in zip(out, docs):
+        s.doc = d
+    return out

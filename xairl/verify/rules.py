@@ -1,0 +1,174 @@
+"""The rule table (rules/rules.yaml) and its word lists (rules/lexicon.yaml), compiled into spaCy matchers.
+
+A rule is data: an id, the claim it makes, how it binds a name (adjacent or grammar), a priority, a Matcher or
+DependencyMatcher pattern over a parse whose names and numbers are single tokens (parse.py), and examples that must
+fire and must not. :func:`candidates` runs every rule on a sentence and returns what each one read; which reading
+wins is decided by resolve.py, never by the order of the table.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+from spacy.matcher import DependencyMatcher, Matcher
+
+RULES_DIR = Path(__file__).parent / "rules"
+_VERB_LISTS = ("up", "down", "phrasal")
+
+
+@dataclass(frozen=True, eq=False)
+class Rule:
+    id: str
+    claim: str  # number | direction | rank
+    binding: str  # adjacent | grammar
+    priority: int
+    pattern: list
+    kind: str  # token | dependency
+    polarity: str = ""
+    fires: tuple = ()
+    silent: tuple = ()
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One rule's reading of a sentence: the name token it binds, the anchor (the number, direction or rank word)
+    and, for a direction, its polarity (+1 / -1), for a rank, the rank said."""
+
+    rule: Rule
+    name: int  # token index of the name
+    anchor: int  # token index of the number / direction word / rank word
+    polarity: int = 0
+    rank: int = 0
+    negated: bool = False
+
+
+def forms(word: str) -> set[str]:
+    """A verb's base form and its -s, -ed and -ing forms (raise: raises, raised, raising; cut: cuts, cutting)."""
+    if not word.isalpha() or len(word) < 3:
+        return {word}
+    vowels = "aeiou"
+    double = len(word) <= 4 and word[-1] in "bdgmnpt" and word[-2] in vowels and word[-3] not in vowels
+    consonant_y = word.endswith("y") and word[-2] not in vowels
+    if consonant_y:
+        return {word, word[:-1] + "ies", word[:-1] + "ied", word + "ing"}
+    third = word + "es" if word.endswith(("sh", "ch", "s", "x")) else word + "s"
+    if word.endswith("e") and not word.endswith("ee"):
+        return {word, third, word + "d", word[:-1] + "ing"}
+    stem = word + word[-1] if double else word
+    return {word, third, stem + "ed", stem + "ing"}
+
+
+@functools.cache
+def lexicon() -> dict:
+    """The word lists, verbs with their forms; ``ordinals`` a word -> rank map."""
+    raw = yaml.safe_load((RULES_DIR / "lexicon.yaml").read_text(encoding="utf-8"))
+    out = {}
+    for key, words in raw.items():
+        if isinstance(words, dict):
+            out[key] = {str(k).lower(): int(v) for k, v in words.items()}
+        else:
+            words = [str(w).lower() for w in words]
+            out[key] = sorted({f for w in words for f in forms(w)}) if key in _VERB_LISTS else words
+    return out
+
+
+def _expand(node):
+    """A pattern with every "$a+b" list replaced by the lexicon's lists a and b."""
+    if isinstance(node, dict):
+        return {k: _expand(v) for k, v in node.items()}
+    if isinstance(node, list):
+        return [_expand(v) for v in node]
+    if isinstance(node, str) and node.startswith("$"):
+        lex = lexicon()
+        return sorted({w for part in node[1:].split("+") for w in lex[part]})
+    return node
+
+
+@functools.cache
+def table() -> tuple[Rule, ...]:
+    rules = []
+    for entry in yaml.safe_load((RULES_DIR / "rules.yaml").read_text(encoding="utf-8")):
+        kind = "token" if "token" in entry else "dependency"
+        rules.append(
+            Rule(
+                entry["id"],
+                entry["claim"],
+                entry["binding"],
+                int(entry["priority"]),
+                _expand(entry[kind]),
+                kind,
+                entry.get("polarity", ""),
+                tuple(tuple(x) for x in entry.get("fires", ())),
+                tuple(tuple(x) for x in entry.get("silent", ())),
+            )
+        )
+    return tuple(rules)
+
+
+@functools.cache
+def by_id() -> dict[str, Rule]:
+    return {r.id: r for r in table()}
+
+
+@functools.cache
+def matchers(vocab):
+    """(Matcher, DependencyMatcher) holding every rule of the table, for spaCy vocabulary ``vocab``."""
+    token, dependency = Matcher(vocab), DependencyMatcher(vocab)
+    for r in table():
+        (token if r.kind == "token" else dependency).add(r.id, [r.pattern])
+    return token, dependency
+
+
+def candidates(doc) -> list[Candidate]:
+    """Every rule's readings of one parsed sentence."""
+    token, dependency = matchers(doc.vocab)
+    out = []
+    for match_id, start, end in token(doc):
+        rule = by_id()[doc.vocab.strings[match_id]]
+        out += _token_reading(rule, doc, start, end)
+    for match_id, ids in dependency(doc):
+        rule = by_id()[doc.vocab.strings[match_id]]
+        roles = {node["RIGHT_ID"]: i for node, i in zip(rule.pattern, ids)}
+        out.append(_reading(rule, doc, roles["name"], roles.get("num", roles.get("dir", roles.get("rank"))), roles))
+    return out
+
+
+def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
+    span = range(start, end)
+    names = [i for i in span if doc[i].ent_type_ == "FEATURE"]
+    if not names:
+        return []
+    if rule.claim == "number":
+        nums = [i for i in span if doc[i].ent_type_ == "NUM"]
+        if not nums:
+            return []
+        name = min(names, key=lambda i: abs(i - nums[0]))
+        return [_reading(rule, doc, name, nums[0], {})]
+    lex = lexicon()
+    said = [i for i in span if doc[i].lower_ in lex["superlatives"] or doc[i].lower_ in lex["ordinals"]]
+    anchor = said[0] if said else next(i for i in span if doc[i].ent_type_ != "FEATURE")
+    return [_reading(rule, doc, names[0], anchor, {"span": (start, end)})]
+
+
+def _reading(rule: Rule, doc, name: int, anchor: int, roles: dict) -> Candidate:
+    lex = lexicon()
+    polarity = rank = 0
+    if rule.claim == "direction":
+        word = doc[anchor].lower_
+        if rule.polarity == "particle":
+            way = doc[roles["way"]].lower_
+            polarity = 1 if way in lex["particle_up"] else -1
+        elif rule.polarity == "sign":
+            polarity = 1 if word in lex["sign_up"] else -1
+        else:
+            polarity = 1 if word in lex["up"] else -1
+    if rule.claim == "rank":
+        start, end = roles.get("span", (anchor, anchor + 1))
+        words = [doc[i].lower_ for i in range(start, end)]
+        rank = next((lex["ordinals"][w] for w in words if w in lex["ordinals"]), 1)
+    verb = doc[anchor] if rule.claim == "direction" else doc[name].head
+    negated = any(c.dep_ == "neg" or c.lower_ in lex["negations"] for c in verb.children)
+    return Candidate(rule, name, anchor, polarity, rank, negated)
