@@ -1,4 +1,6 @@
-"""The verifier on prose it did not write: each pipeline step on its own, the held-out corpus, bad input."""
+"""The verifier on prose it did not write: each pipeline step on its own, the held-out corpus, bad input.
+
+The parametrised case lists live in benchmarks/data/verify_cases/*.yaml (loaded by tests/cases.py), one item per case."""
 
 import json
 import pathlib
@@ -10,6 +12,7 @@ import torch
 
 import xairl
 from benchmarks.bench_verifier import explanation_from_tuples, load_corpus, run, shapstories_case
+from tests import cases
 from tests import narrative_domains as domains
 from tests.work_budget import calls
 from xairl.narrators.verify.book import clean_surface
@@ -19,25 +22,7 @@ from xairl.narrators.verify.vocabulary import vocabulary
 
 
 @pytest.mark.parametrize(
-    "text,value,unit,hedge",
-    [
-        ("22,5 dB", 22.5, 0.1, ""),
-        ("0,098", 0.098, 0.001, ""),
-        ("USD 39 960", 39960, 10, ""),
-        ("between $500 and", 500, 100, "at_least"),
-        ("minus 1.37", -1.37, 0.01, ""),
-        ("$12,757.84", 12757.84, 0.01, ""),
-        (".9", 0.9, 0.1, ""),
-        ("about $12,000", 12000, 1000, "approx"),
-        ("262KB", 262, 1, ""),
-        ("-4330.84", -4330.84, 0.01, ""),
-        ("~$21k", 21000, 1000, "approx"),
-        ("nearly 2 dB", 2, 1, "below"),
-        ("1.2e-3", 0.0012, 1e-4, ""),
-        ("five thousand dollars", 5000, 1000, ""),
-        ("up to 31.1", 31.1, 0.1, "at_most"),
-        ("the positives add up to 31.1", 31.1, 0.1, ""),  # a sum, not a bound
-    ],
+    "text,value,unit,hedge", cases.params("numbers", "numbers_as_people_write_them", ("text", "value", "unit", "hedge"))
 )
 def test_numbers_as_people_write_them(text, value, unit, hedge):
     n = find_numbers(normalise(text))[0]
@@ -245,13 +230,7 @@ def test_an_invented_feature_needs_the_parse_to_agree():
 
 
 @pytest.mark.parametrize(
-    "text,accurate",
-    [
-        ("pm2_5_lag1 48.2 +14.7 and traffic 2.4 +7.2 dominate.", True),  # the top two
-        ("Precip 0 +2.2 and wind 0.8 +6.9 dominate.", False),
-        ("The season is the main thing holding the forecast down.", True),  # the largest negative
-        ("The road is the main thing holding the forecast down.", False),
-    ],
+    "text,accurate", cases.params("phrasings", "ranks_of_several_names_and_of_one_side", ("text", "accurate"))
 )
 def test_ranks_of_several_names_and_of_one_side(text, accurate):
     from xairl.narrators.verify import rules
@@ -262,19 +241,7 @@ def test_ranks_of_several_names_and_of_one_side(text, accurate):
 
 
 @pytest.mark.parametrize(
-    "text,accurate",
-    [
-        ("Claims on this policy are expected to cost around $1,560.", True),  # the output's own word: no push, but
-        ("Claims on this policy are expected to cost around $2,600.", False),  # the output (1,563)
-        ("Students like her drop out more often, so the model adds about 4.4 points.", True),
-        ("Her age, 44, works in your favour by roughly $88.", True),  # whose favour: the reader's, unsaid
-        ("Her age does the heaviest lifting.", True),  # an idiom of size, not of way
-        ("Her age raises the expected cost by roughly $88.", False),
-        ("Her age pushes the cost up.", False),  # the output named as the verb's object: still a push
-        ("The evening enrolment lowers the dropout probability.", False),
-        ("The risk factors add 21.9 points in total.", True),  # a sum in the explanation's own points
-        ("The risk factors add 25.9 points in total.", False),
-    ],
+    "text,accurate", cases.params("phrasings", "outputs_own_words_idioms_and_totals", ("text", "accurate"))
 )
 def test_the_outputs_own_words_idioms_and_totals(text, accurate):
     from benchmarks.bench_verifier import one_output
@@ -292,14 +259,7 @@ def test_the_outputs_own_words_idioms_and_totals(text, accurate):
     assert result.accurate == accurate, [(c.status, c.text, c.detail) for c in result.claims]
 
 
-@pytest.mark.parametrize(
-    "text,accurate",
-    [
-        ("About 7.2 of that comes from the traffic, and 6.9 from the wind.", True),  # where a push comes from
-        ("About 7.2 of that comes from the traffic, and 4.9 from the wind.", False),
-        ("The traffic is about one and a half times the wind.", True),  # 'one': a ratio word, no value
-    ],
-)
+@pytest.mark.parametrize("text,accurate", cases.params("phrasings", "where_a_push_comes_from", ("text", "accurate")))
 def test_where_a_push_comes_from(text, accurate):
     from xairl.narrators.verify import rules
 
@@ -340,16 +300,7 @@ def test_a_sum_of_probabilities_in_points():
 
 
 @pytest.mark.parametrize(
-    "text,accurate",
-    [
-        ("Reviewed: traffic (+7.2), dry soil (+0.1), 31.5 °C (+2.2).", True),  # each '(x), ' starts a list's item
-        ("Reviewed: traffic (+7.2), wind (+6.1).", False),
-        ("22.0 baseline, 52.1 predicted.", True),
-        ("22.0 baseline, 48.1 predicted.", False),
-        ("The model starts from an average forecast of 22.0.", True),
-        ("Traffic plus the junction make up 9.9.", True),  # a sum over a thing the vocabulary lacks: unchecked
-        ("Traffic and wind together add 19.9.", False),
-    ],
+    "text,accurate", cases.params("phrasings", "list_items_outputs_and_sums", ("text", "accurate"))
 )
 def test_list_items_outputs_named_after_and_sums_with_unknown_members(text, accurate):
     from xairl.narrators.verify import rules
@@ -400,18 +351,7 @@ def test_a_signed_number_ends_the_item_before_the_next_name():
 
 
 @pytest.mark.parametrize(
-    "text,status",
-    [
-        ("Traffic explains another 24%.", "verified"),  # 7.2 of the 30.1 net change
-        ("Traffic explains another 34%.", "contradicted"),
-        ("The precip effect is roughly 32% of the wind effect.", "verified"),  # 2.2 / 6.9
-        ("The precip effect is roughly 60% of the wind effect.", "contradicted"),
-        ("The wind effect is about 3 times the precip effect.", "verified"),
-        ("The wind effect is about 5 times the precip effect.", "contradicted"),
-        ("Wind and traffic together add 14.1, about 47% of it.", "verified"),  # 14.1 of 30.1
-        ("Wind and traffic together add 14.1, about 67% of it.", "contradicted"),
-        ("The three wind-and-traffic factors (wind, traffic and precip) add up.", "verified"),  # a count, no claim
-    ],
+    "text,status", cases.params("phrasings", "shares_ratios_and_counts_of_factors", ("text", "status"))
 )
 def test_shares_ratios_and_counts_of_factors(text, status):
     """A percentage of the net change, a ratio to another named feature ('% of', 'times'), the share of a sum, and a
@@ -685,231 +625,12 @@ def test_dev10_number_formats():
     assert find_numbers("~14 pts")[0].points and not find_numbers("14 %")[0].points
 
 
-#: (case, text, status): each rule tuned on dev8 and dev10, with a right and a wrong figure on its own corpus case
-ON_CASES = [
-    # uav-1: the serving BS id counts -1.37 in the margin (+0.22 for the handover's own score): either view
-    ("uav-1", "Serving BS id 14 counted slightly against the handover (minus 1.37).", "verified"),
-    ("uav-1", "Serving BS id 14 counted slightly against the handover (minus 2.37).", "contradicted"),
-    # a feature's '+x for <action>' is its push in either view (the serving RSRQ: +22.02 in the margin)
-    ("uav-0", "The serving RSRQ (-22.5 dB) was worth +22.0 for the handover.", "verified"),
-    ("uav-0", "The serving RSRQ (-22.5 dB) was worth +12.0 for the handover.", "contradicted"),
-    ("toy-2", "Obstacle barely affected the turn score (-0.09).", "verified"),
-    ("toy-2", "Obstacle barely affected the turn score (-0.19).", "contradicted"),
-    # 'the strongest reason' ranks among the reasons for the decision (toy-3: battery +1.46, distance -2.15)
-    ("toy-3", "Turn won over forward; battery was the strongest reason.", "verified"),
-    ("toy-3", "Turn won over forward; distance was the strongest reason.", "contradicted"),
-    ("uav-3", "Q-value gap: 3.88 in favour of handing over to candidate 1.", "verified"),
-    ("housing-2", "The fair kitchen chipped away $23,750; everything else was positive except the lot.", "verified"),
-    (
-        "housing-2",
-        "The fair kitchen chipped away $23,750; everything else was positive except the garage.",
-        "contradicted",
-    ),
-    ("toy-0", "Low speed was worth +7.61 to recharging, almost four times what obstacle added (+2.05).", "verified"),
-    # a range is two bounds (the lot: -715)
-    ("housing-1", "The lot takes off somewhere between $500 and $1,000.", "verified"),
-    ("housing-1", "The lot takes off somewhere between $800 and $1,000.", "contradicted"),
-    # points are not a share (credit-3: the history lowers the risk by 4.4 points, 13 % of the total)
-    ("credit-3", "A 20-year credit history lowers the risk by ~4 pts.", "verified"),
-    ("credit-3", "A 20-year credit history lowers the risk by ~14 pts.", "contradicted"),
-    # an acronym of a three-word name
-    ("credit-3", "DTI of 60 % adds 0.11 to the predicted probability.", "verified"),
-    ("credit-3", "DTI of 60 % lowers the predicted probability.", "contradicted"),
-    ("uav-1", "The serving RSRQ adds about 12 to the margin, roughly 1.3x candidate 1's RSRP.", "verified"),
-    ("housing-2", "The 2010 construction year takes 17.8K off the estimate.", "contradicted"),
-    # toy-2: turning chosen over recharging; '+5.48' given to recharging is speed's -5.48 in that margin
-    ("toy-2", "Speed (-1.70) gives recharging +5.48.", "verified"),
-    ("toy-2", "Speed (-1.70) gives recharging +4.48.", "contradicted"),
-    # dev13: 'from x to y' is the baseline and the prediction; 'a 12-point drop' is in percentage points
-    ("credit-0", "The applicant's features move the predicted default risk from 34.1 % to 43.0 %.", "verified"),
-    ("credit-0", "The applicant's features move the predicted default risk from 34.1 % to 53.0 %.", "contradicted"),
-    ("housing-3", "The price falls from an average of $230,061 to $195,878.", "verified"),
-    ("credit-0", "Retirement brings a 12-point drop in the default probability.", "verified"),
-    ("credit-0", "Retirement brings a 19-point drop in the default probability.", "contradicted"),
-    # dev14: a feature's typical value is checked against the background's quartiles (credit age 36 / 48 / 62.25:
-    # Tukey's fences at -3.4 and 101.6); the output's average is the baseline
-    (
-        "credit-0",
-        "The applicant's age of 28, younger than the typical borrower of about 48, raised the risk.",
-        "verified",
-    ),
-    (
-        "credit-0",
-        "The applicant's age of 28, younger than the typical borrower of about 110, raised the risk.",
-        "contradicted",
-    ),
-    ("housing-1", "The model estimated this house at $316,107, above the average sale price of $230,061.", "verified"),
-    (
-        "housing-1",
-        "The model estimated this house at $316,107, above the average sale price of $250,061.",
-        "contradicted",
-    ),
-    ("housing-1", "Overall, size and quality drove the price far above the baseline of $230,061.", "verified"),
-    # 'on the positive side' and 'the lower quartile' are places, not pushes
-    ("credit-0", "On the positive side, the loan purpose (home improvement) slightly lowered the risk.", "verified"),
-    ("toy-1", "The distance of -0.80, close to the lower quartile, added about 1.03 to the turn score.", "verified"),
-    ("credit-0", "Overall, this leads to a 43% predicted probability of default.", "verified"),
-    ("credit-0", "Overall, this leads to a 53% predicted probability of default.", "contradicted"),
-    # 'A and B outweighed C': together (credit-0: age 0.081 + ratio 0.067 against retirement's 0.123)
-    ("credit-0", "The applicant's age and debt-to-income ratio outweighed retirement.", "verified"),
-    ("credit-0", "The applicant's age and debt-to-income ratio both outweighed retirement.", "contradicted"),
-    # dev15: net effects are the change from the baseline; '>' chains and 'A first, then B' rank; shares add up
-    ("credit-0", "Net effect of the eight features: +0.089 (0.341 -> 0.430).", "verified"),
-    ("credit-0", "Net effect of the eight features: +0.129 (0.341 -> 0.430).", "contradicted"),
-    ("housing-1", "Net uplift over the base value: +$86,046, of which +$39,963 from living area.", "verified"),
-    ("housing-1", "Net uplift over the base value: +$96,046, of which +$39,963 from living area.", "contradicted"),
-    ("credit-0", "|phi| ranking: employment > age > DTI > credit history.", "verified"),
-    ("credit-0", "|phi| ranking: age > employment > DTI > credit history.", "contradicted"),
-    ("uav-0", "Margin drivers: RSRQ_0 first (+22.0), then RSRP_1 (+11.0).", "verified"),
-    ("uav-0", "Margin drivers: RSRP_1 first (+11.0), then RSRQ_0 (+22.0).", "contradicted"),
-    ("credit-0", "Age and employment together carry about 46 % of the total attribution.", "verified"),
-    ("credit-0", "Age and employment together carry about 66 % of the total attribution.", "contradicted"),
-    ("credit-2", "p(default) = 0.14 vs base 0.34.", "verified"),
-    ("credit-0", "Retirement alone offsets most of the push from age and debt, taking 12.3 pp off.", "verified"),
-    # an elliptical 'A for <chosen action> (+x)' weighs the options: either view (toy-3: battery +1.46 in the margin)
-    ("toy-3", "Distance argues for forward (-2.15 in the margin); battery for turn (+1.46).", "verified"),
-    ("toy-3", "Distance argues for forward (-2.15 in the margin); battery for turn (+2.46).", "contradicted"),
-    # a list's next item named by a word the vocabulary lacks is not the previous item's
-    ("housing-3", "Kitchen (Fa) -23.6k, living area 1,270 sq ft -12.1k, year 1945 -9.5k.", "verified"),
-    ("uav-1", "Candidate 1's RSRP, which was -83.6 dBm, added 6.8 to the margin.", "contradicted"),
-    # dev16: lists. A numbered item ranks its name; 'in order of size: A, B' and 'largest first: A, B' rank the list
-    ("housing-1", "1. Living area (2,112 sq ft): +$39,963\n2. Overall quality (10): +$31,370", "verified"),
-    ("housing-1", "1. Overall quality (10): +$31,370\n2. Living area (2,112 sq ft): +$39,963", "contradicted"),
-    ("credit-1", "Risk 38 %. In order of size: debt-to-income, employment, credit history.", "verified"),
-    ("credit-1", "Risk 38 %. In order of size: credit history, debt-to-income, employment.", "contradicted"),
-    ("uav-2", "Largest first: candidate 1 RSRQ (+14.6), serving RSRQ (+10.6), serving RSRP (+7.1).", "verified"),
-    ("uav-2", "Largest first: serving RSRQ (+10.6), candidate 1 RSRQ (+14.6), serving RSRP (+7.1).", "contradicted"),
-    # 'Runner-up: X' names the runner-up; a name's digit is not the start of a number ('RSRQ (-3.2 dB)')
-    ("toy-1", "Chosen: turn (6.27). Runner-up: recharge (3.88).", "verified"),
-    ("toy-1", "Chosen: turn (6.27). Runner-up: forward (3.88).", "contradicted"),
-    ("uav-2", "For the handover: candidate 1 RSRQ (-3.2 dB), serving RSRQ (-17.0 dB).", "verified"),
-    # a signed number right after its name is its own, whatever another feature's value; 'below base by x'
-    ("toy-1", "Pushing turn up: speed +1.71, battery +1.70.", "contradicted"),
-    ("housing-3", "Below base by $34,184. Negatives: kitchen (Fa) -23.6k; CollgCr -5.8k.", "verified"),
-    ("housing-3", "Below base by $44,184. Negatives: kitchen (Fa) -23.6k; CollgCr -5.8k.", "contradicted"),
-    # a list item named by something that is no feature
-    ("housing-3", "Negatives: kitchen (Fa) -23.6k; roof condition -12.1k; CollgCr -5.8k.", "contradicted"),
-    ("housing-3", "Net: -34.2k. Kitchen (Fa) -23.6k; CollgCr -5.8k.", "verified"),
-    # dev17: everyday hedges; a participle after a comma says what the clause's subject does; 'to about x' after a
-    # motion verb is where the output ends; a number in points is never a value, and a sentence in points counts its
-    # bare numbers in points too
-    ("housing-0", "The estimate lands north of $298k, a bit over $68k above the average house.", "verified"),
-    ("housing-0", "The estimate lands north of $318k, a bit over $88k above the average house.", "contradicted"),
-    ("housing-1", "The lot barely registers: it takes off just shy of $1,000.", "verified"),
-    ("housing-1", "Living area alone is worth upwards of $59k here.", "contradicted"),
-    ("credit-0", "Being retired shaves off something like 12 points.", "verified"),
-    ("credit-0", "Retirement alone offsets most of the push from age and debt, taking 12.3 pp off.", "verified"),
-    ("credit-2", "Everything else drags it well below the 34 % base, to about 14 %.", "verified"),
-    ("credit-2", "Everything else drags it well below the 34 % base, to about 24 %.", "contradicted"),
-    (
-        "credit-1",
-        "The low debt ratio takes the risk down by close to 10 points, the salaried job by a bit under 9.",
-        "verified",
-    ),
-    (
-        "credit-1",
-        "The low debt ratio takes the risk down by close to 10 points, the salaried job by a bit under 5.",
-        "contradicted",
-    ),
-    ("uav-1", "Candidate 1's RSRQ takes a good 9 points off the handover's margin.", "contradicted"),
-    ("uav-0", "The handover wins by a whisker, about 0.14.", "verified"),
-    ("uav-0", "The handover wins by a whisker, about 1.4.", "contradicted"),
-    ("toy-3", "Forward comes out ahead of turn by roughly 1.5.", "contradicted"),
-    # dev18: plain language. 'N in 100' is a percentage; "it's worth $x" is the prediction (not a pair list with
-    # 'the usual $y'); 'about average (33%)' may be the prediction; 'lower than it would be' is a claim, 'lower than
-    # average' is not; 'It turned, helped by X' is X's push toward the choice; ', though,' is an aside
-    (
-        "credit-0",
-        "Your chance of default is put at 43 in 100, compared with 34 in 100 for a typical applicant.",
-        "verified",
-    ),
-    (
-        "credit-0",
-        "Your chance of default is put at 53 in 100, compared with 34 in 100 for a typical applicant.",
-        "contradicted",
-    ),
-    (
-        "housing-1",
-        "Big house, top quality, good area: that's why it's worth about $316k instead of the usual $230k.",
-        "verified",
-    ),
-    (
-        "housing-1",
-        "Big house, top quality, good area: that's why it's worth about $416k instead of the usual $230k.",
-        "contradicted",
-    ),
-    ("credit-3", "Your risk is about average (33%).", "verified"),
-    (
-        "credit-0",
-        "Mostly because you're retired, the risk is lower than it would be; your age pushes it back up.",
-        "verified",
-    ),
-    ("credit-0", "Because of your age, the risk is lower than it would be.", "contradicted"),
-    ("toy-1", "It turned, helped by the wind.", "verified"),
-    ("toy-1", "It turned, helped by the low battery.", "contradicted"),
-    ("credit-1", "Your salaried job brings the risk down. Your low debt, though, pushes it up.", "contradicted"),
-    ("toy-0", "It went to recharge because it was barely moving.", "verified"),
-    ("toy-0", "It went to turn because it was barely moving.", "contradicted"),
-    # dev19: long reports. 'overall' is an adverb, not overall_quality; 'it' names what came before; 'the 8.32-point
-    # lead' is the margin; 'two inputs dominate: A ..., B ...' ranks them top two
-    (
-        "housing-2",
-        "The one real weakness is the kitchen. Rated fair, it takes $23,750 off, the third-largest effect overall.",
-        "verified",
-    ),
-    ("toy-0", "Speed is worth 5.56 of the 8.32-point lead.", "verified"),
-    ("toy-0", "Speed is worth 5.56 of the 9.32-point lead.", "contradicted"),
-    (
-        "toy-2",
-        "Two inputs dominate the comparison with recharging: wind favours turning by 5.31 and speed favours "
-        "recharging by 5.48.",
-        "verified",
-    ),
-    (
-        "toy-2",
-        "Two inputs dominate the comparison with recharging: wind favours turning by 5.31 and the obstacle by 1.50.",
-        "contradicted",
-    ),
-    # 'of the three' counts the things compared, it is no claim (a rewrite of the local LM)
-    ("uav-1", "Candidate 1's RSRP (-83.6 dBm) was the strongest of the three neighbours.", "verified"),
-    # dev21: engineers' notes. 'the deciding input', 'largest margin term' rank; 'Q_recharge' is an action's score
-    ("uav-1", "Handover to neighbour 1. The deciding input was candidate 1's RSRP.", "verified"),
-    ("uav-1", "Handover to neighbour 1. The deciding input was the serving RSRP.", "contradicted"),
-    ("toy-3", "t=3: TURN (4.07) vs FWD (2.52). Largest margin term: distance (-2.15).", "verified"),
-    ("toy-3", "t=3: TURN (4.07) vs FWD (2.52). Largest margin term: battery (+1.46).", "contradicted"),
-    ("toy-0", "Driver: speed -1.79 sigma (+7.61 on Q_recharge).", "verified"),
-    ("toy-0", "Driver: speed -1.79 sigma (+7.61 on Q_charging).", "contradicted"),
-    # dev20: a colleague writing in a second language
-    ("credit-0", "Employment (retired) is making the risk more low, of 0.12 approximately.", "verified"),
-    ("credit-0", "Employment (retired) is making the risk more high, of 0.12 approximately.", "contradicted"),
-    ("credit-1", "Debt-to-income of 0,24 decrease risk for 0,098; salaried employment decrease for 0,086.", "verified"),
-    ("credit-1", "Debt-to-income of 0,24 decrease risk for 0,198.", "contradicted"),
-    # ranks among one sign (credit-2: employment +0.128 first overall, the ratio -0.127 first of those lowering it)
-    ("credit-2", "The biggest factor working against default was the low debt-to-income ratio.", "verified"),
-    ("credit-2", "The biggest factor working against default was the 26-year credit history.", "contradicted"),
-    (
-        "credit-3",
-        "The ratio raised the risk most; salaried employment was the strongest factor pulling the other way.",
-        "verified",
-    ),
-    (
-        "credit-3",
-        "The ratio raised the risk most; the credit history was the strongest factor pulling the other way.",
-        "contradicted",
-    ),
-    ("housing-1", "The house sits in Somerst, one of the pricier neighbourhoods, adding about $14,200.", "verified"),
-    # a coordinated clause's own subject that is no feature
-    (
-        "housing-3",
-        "The fair kitchen lowered the price by about $23,600, and the lack of a finished basement cost "
-        "another $12,000.",
-        "contradicted",
-    ),
-]
-
-
-@pytest.mark.parametrize("case,text,status", ON_CASES)
+@pytest.mark.parametrize(
+    "case,text,status", cases.params("on_corpus_cases", "on_corpus_cases", ("case", "text", "status"))
+)
 def test_phrasings_on_corpus_cases(case, text, status):
+    """Each rule tuned on dev8 and dev10 (and later dev splits), with a right and a wrong figure on its own corpus
+    case (benchmarks/data/verify_cases/on_corpus_cases.yaml)."""
     assert _on_case(text, case).status == status
 
 
@@ -927,364 +648,12 @@ def _outside(text, dataset, index):
     return xairl.verify(text, exp, 0, policy)
 
 
-OUTSIDE = [
-    # fifa-105: goals 0 (-0.20), corners 7 (+0.04), attempts 13 (+0.02), on target 1 (-0.015); a plural name in the
-    # singular, the head of a compound and the object of 'on' belong to the name before them
-    ("fifa", 105, "The team took 7 corner kicks, which slightly boosted their probability.", "verified"),
-    ("fifa", 105, "The team took 7 corner kicks, which slightly lowered their probability.", "contradicted"),
-    ("fifa", 105, "Their 13 attempts on goal, close to the average of 12.33, added a little.", "verified"),
-    ("fifa", 105, "Their 13 attempts on goal, close to the average of 12.33, lowered it slightly.", "contradicted"),
-    ("fifa", 105, "The team took 7 corners.", "verified"),
-    ("fifa", 105, "The team took 9 corners.", "contradicted"),
-    # a typical value by habit; a side word whose object is the classifier's lower class
-    (
-        "fifa",
-        105,
-        "Failing to score (the average team typically scores around 1.3 goals) hurt the team most.",
-        "verified",
-    ),
-    ("fifa", 96, 'The lack of corners and fewer attempts tipped the prediction toward "no."', "verified"),
-    ("fifa", 96, 'The four goals tipped the prediction toward "no."', "contradicted"),
-    # student-375: failures 0 (+0.12; quartiles 0 / 0 / 0), goout 2 (+0.05), absences 2 (+0.03), Mjob other (-0.01)
-    (
-        "student",
-        375,
-        "Going out with friends moderately often (2 out of 5, below the average of ~3) also helped.",
-        "verified",
-    ),
-    ("student", 375, "Fewer absences than average (2 vs. ~5.75) further supported the prediction.", "verified"),
-    ("student", 375, "Fewer absences than average (3 vs. ~5.75) further supported the prediction.", "contradicted"),
-    ("student", 375, "Fewer absences than average (2 vs. ~25) further supported the prediction.", "contradicted"),
-    ("student", 375, "No past class failures (0 compared to the average of ~0.36) strongly boosted it.", "verified"),
-    (
-        "student",
-        375,
-        "Unlike 95% of their peers, the student had no past class failures, which boosted the odds.",
-        "verified",
-    ),
-    # a description's legend is not needed to name the feature ('weekly study time (1: <2 hours, ...)')
-    ("student", 221, "Their weekly study time (3, compared to the average of ~2) helped.", "verified"),
-    ("student", 221, "Their weekly study time (3, compared to the average of ~2) lowered the odds.", "contradicted"),
-    # a plain label ('other') only next to its feature, and not after a negation
-    ("student", 300, "The student's mother's job wasn't in the 'other' category, which added a little.", "verified"),
-    ("student", 375, "The mother's job (other) was the only minor detractor.", "verified"),
-    ("student", 300, "The mother's job (other) added a little.", "contradicted"),
-    (
-        "student",
-        82,
-        "Like the other students, this one had no past class failures, which boosted the prediction.",
-        "verified",
-    ),
-    # a rank over a list counts the items the verifier does not know too
-    (
-        "student",
-        261,
-        "The student's low absences, no failures, and balanced social life were the key drivers.",
-        "verified",
-    ),
-    ("student", 261, "The student's low absences and no failures were the key drivers.", "contradicted"),
-    # diabetes-725 (Pima): age 38 (+0.08), pedigree 0.236 (-0.07), BMI 39.4 (+0.05), glucose 112 (-0.02); the
-    # output's word 'diabetes' is not a part of 'DiabetesPedigreeFunction', 'outcome 1' is a class
-    ("diabetes", 725, "The model predicted a 32% probability of diabetes (outcome 1).", "verified"),
-    ("diabetes", 725, "The model predicted a 42% probability of diabetes (outcome 1).", "contradicted"),
-    (
-        "diabetes",
-        725,
-        "While age and BMI pushed the prediction toward diabetes, low genetic predisposition and "
-        "relatively lower glucose levels outweighed these risks.",
-        "verified",
-    ),
-    ("diabetes", 725, "Age and BMI pushed the prediction away from diabetes.", "contradicted"),
-    (
-        "diabetes",
-        725,
-        "Their below-average Diabetes Pedigree Function score (0.236 vs. 0.469) reduced the probability.",
-        "verified",
-    ),
-    # diabetes-210: glucose 81 (-0.20), age 25 (-0.08), BMI 27.7 (-0.04), pregnancies 2 (-0.02)
-    (
-        "diabetes",
-        210,
-        "A BMI of 27.7, while slightly elevated, was still lower than average and contributed modestly "
-        "to lowering the risk.",
-        "verified",
-    ),
-    (
-        "diabetes",
-        210,
-        "A BMI of 27.7, while slightly elevated, was still lower than average and contributed modestly "
-        "to raising the risk.",
-        "contradicted",
-    ),
-    # a rank said of several features at once: together against all the others
-    (
-        "diabetes",
-        490,
-        "Overall, the combination of favorable glucose, age, and insulin levels dominated the prediction.",
-        "verified",
-    ),
-    ("diabetes", 490, "Overall, the combination of insulin and BMI dominated the prediction.", "contradicted"),
-    # stroke (Kaggle columns): 'the patient' in 'age of the patient' names no feature; a one-hot column is a label
-    ("stroke", 243, "The most influential factor was the patient's high average glucose level (247.51).", "verified"),
-    ("stroke", 243, "The most influential factor was the patient's age (68 years).", "contradicted"),
-    ("stroke", 2819, "Being a child (work_type_children) slightly lowered the risk.", "verified"),
-    ("stroke", 2819, "Being in private work (work_type_Private) slightly lowered the risk.", "contradicted"),
-    # a label after 'compared to' is no claim about this patient; 'a positive prediction' is a class
-    ("stroke", 5029, "Having never smoked slightly reduced the risk compared to smokers.", "verified"),
-    ("stroke", 5029, "Being a smoker slightly reduced the risk.", "contradicted"),
-    ("stroke", 237, "Age and glucose raised the risk, though not enough for a positive prediction.", "verified"),
-    # what might seem or would be: no claim
-    (
-        "stroke",
-        242,
-        "The high BMI (42.4) might intuitively suggest increased risk, but it slightly lowered it.",
-        "verified",
-    ),
-    (
-        "stroke",
-        15,
-        "Other factors were not severe enough to make age a dominant predictor; age lowered the risk.",
-        "verified",
-    ),
-    # South German Credit (good-credit probability): a number of the meaning of a code in the description's legend
-    # (status 4 = '200 DM or more', savings 3 = '100 to 500 DM')
-    ("credit", 175, "Having a checking account balance above 200 DM strongly increased the likelihood.", "verified"),
-    ("credit", 175, "Having a checking account balance below 0 DM strongly increased the likelihood.", "contradicted"),
-    (
-        "credit",
-        175,
-        "Their savings account balance (between 100 and 500 DM) further reinforced the prediction.",
-        "verified",
-    ),
-    ("credit", 175, "Their savings account balance (over 1000 DM) further reinforced the prediction.", "contradicted"),
-    ("credit", 124, "Another key factor was their long employment duration (over 7 years).", "verified"),
-    ("credit", 124, "The key factor was their long employment duration (over 7 years).", "contradicted"),
-    ("credit", 675, "The loan duration of 6 months was much shorter than average (21 months).", "verified"),
-    ("credit", 675, "The loan duration of 6 months was much shorter than average (91 months).", "contradicted"),
-    # a good outcome's 'risk' is its inverse framing; 'raised concerns', 'this negative impact', 'balanced X against
-    # Y' and a 'because' clause's subject claim no direction of a feature; 'added to the negative outlook' lowers
-    ("credit", 571, "The loan amount of 9,055 DM raised concerns; the purpose slightly reduced risk.", "verified"),
-    (
-        "credit",
-        319,
-        "However, this negative impact was partially offset by the customer's status (value: 4), which "
-        "boosted the prediction.",
-        "verified",
-    ),
-    (
-        "credit",
-        700,
-        "The prediction balanced the customer's financial gaps against their strong savings, which boosted it.",
-        "verified",
-    ),
-    ("credit", 990, "Having no savings account (value 1) added to the negative outlook.", "verified"),
-    ("credit", 990, "Being unemployed (value 1) added to the positive outlook.", "contradicted"),
-    (
-        "credit",
-        319,
-        "Other installment plans (value: 1) slightly lowered the probability, because existing debt "
-        "obligations increase repayment risk.",
-        "verified",
-    ),
-    # other LLMs' narratives of the same cases (baseline_narratives_best.json): 'this boost' refers back; a risk
-    # output's 'risk' is the output itself; counting nouns and 'type 2' are no values; ', as ...' gives a reason
-    (
-        "fifa",
-        69,
-        "However, this boost was offset by the team having only 1 corner kick, which significantly reduced "
-        "the probability.",
-        "verified",
-    ),
-    (
-        "fifa",
-        69,
-        "However, this boost was offset by the team having only 1 corner kick, which significantly raised "
-        "the probability.",
-        "contradicted",
-    ),
-    ("diabetes", 66, "The patient's age of 38 also contributed positively to the risk.", "verified"),
-    ("diabetes", 66, "The patient's age of 38 also contributed negatively to the risk.", "contradicted"),
-    (
-        "diabetes",
-        66,
-        "The glucose level of 109 lowered the probability, leaving a nearly equal split between the two outcomes.",
-        "verified",
-    ),
-    (
-        "diabetes",
-        66,
-        "The glucose level of 119 lowered the probability, leaving a nearly equal split between the two outcomes.",
-        "contradicted",
-    ),
-    (
-        "diabetes",
-        66,
-        "Next, the age of 38 raised the risk, as older age is generally associated with higher diabetes likelihood.",
-        "verified",
-    ),
-    ("student", 300, "Going out with friends, rated 4 on a 5-point scale, reduced the probability.", "verified"),
-    ("student", 300, "Going out with friends, rated 3 on a 5-point scale, reduced the probability.", "contradicted"),
-    ("diabetes", 375, "The patient's age of 58 raised the risk of type 2 diabetes.", "verified"),
-    ("diabetes", 375, "The patient's age of 48 raised the risk of type 2 diabetes.", "contradicted"),
-    # 'the contributions from A and B dominated' is said of the two together
-    ("diabetes", 490, "The strong protective contributions from low glucose and young age dominated.", "verified"),
-    ("diabetes", 66, "The strong contributions from glucose and BMI dominated.", "contradicted"),
-    # a gerund of a name's word and all the words of a description are vague mentions, not invented features; a
-    # flag's one-word legend ('sex (1 = male)') names its value
-    (
-        "fifa",
-        19,
-        "Next, one goal gave a slight positive contribution, though scoring only once did not strongly boost "
-        "the probability.",
-        "verified",
-    ),
-    (
-        "fifa",
-        19,
-        "Next, one goal gave a slight positive contribution, though the team's singing did not strongly "
-        "boost the probability.",
-        "contradicted",
-    ),
-    (
-        "student",
-        375,
-        'However, the student\'s mother having a job categorized as "other" slightly reduced the probability.',
-        "unchecked",
-    ),
-    ("student", 375, "However, the student's love of chess slightly reduced the probability.", "contradicted"),
-    ("student", 246, "Finally, being male provided a slight positive contribution.", "verified"),
-    ("student", 252, "Finally, being male provided a slight positive contribution.", "contradicted"),
-    # the worst LLM's narratives (baseline_narratives_worst.json, FIFA, student, diabetes): 'driven by' of one output
-    # says what mattered, not which way ('drives it up' does); ranks scoped to where the prediction went ('the
-    # primary reasons for the model's prediction', 'the factors that led to ... a low probability')
-    (
-        "diabetes",
-        668,
-        "The prediction was largely driven by the patient's glucose level, which was lower than expected.",
-        "verified",
-    ),
-    ("diabetes", 668, "The glucose level drives the probability up.", "contradicted"),
-    (
-        "fifa",
-        84,
-        "Their lack of goal scoring and limited attacking threat were the primary reasons for the model's prediction.",
-        "verified",
-    ),
-    (
-        "fifa",
-        84,
-        "Their corner kicks and limited attacking threat were the primary reasons for the model's prediction.",
-        "contradicted",
-    ),
-    (
-        "fifa",
-        105,
-        "The team's lack of goal scoring and relatively low number of shots on target were the primary "
-        "factors that led to the model's prediction of a low probability.",
-        "verified",
-    ),
-    (
-        "fifa",
-        105,
-        "The team's lack of goal scoring and its seven corner kicks were the primary factors that led to "
-        "the model's prediction of a low probability.",
-        "contradicted",
-    ),
-    ("fifa", 118, "The goals led to a predicted probability of 66.00% for receiving the award.", "verified"),
-    ("fifa", 118, "The goals led to a predicted probability of 76.00% for receiving the award.", "contradicted"),
-    # 'which could be due to' gives a reason (no hypothetical); 'not effective in increasing' negates; 'the opposing
-    # team', 'dominate the game', 'the negative contributions from other areas' claim nothing of a feature
-    (
-        "fifa",
-        40,
-        "The number of attempts also had a negative impact, which could be due to the team's inability to "
-        "convert them.",
-        "verified",
-    ),
-    (
-        "fifa",
-        40,
-        "The number of attempts also had a positive impact, which could be due to the team's inability to "
-        "convert them.",
-        "contradicted",
-    ),
-    ("fifa", 40, "The team's corner kicks were not effective in increasing their chances.", "verified"),
-    ("fifa", 105, "The team's corner kicks were not effective in increasing their chances.", "contradicted"),
-    (
-        "fifa",
-        96,
-        "Scoring four goals raised the probability, but not enough to outweigh the negative contributions "
-        "from other areas.",
-        "verified",
-    ),
-    (
-        "fifa",
-        56,
-        "The 8 corner kicks put pressure on the opposing team's defense and raised the probability.",
-        "verified",
-    ),
-    (
-        "fifa",
-        40,
-        "The 3 corner kicks put pressure on the opposing team's defense and raised the probability.",
-        "contradicted",
-    ),
-    ("fifa", 81, "The 719 passes suggest that the team was able to dominate the game.", "verified"),
-    # 'A and B being the most significant', 'X and Y were the most important factors' with X unknown: top 2
-    (
-        "fifa",
-        84,
-        "The prediction was shaped by many factors, with the team's inability to score goals and convert "
-        "attempts being the most significant.",
-        "verified",
-    ),
-    (
-        "fifa",
-        40,
-        "The prediction was shaped by many factors, with the team's inability to score goals and convert "
-        "attempts being the most significant.",
-        "contradicted",
-    ),
-    (
-        "student",
-        82,
-        "The student's relatively low level of socializing and lack of past failures were likely the most "
-        "important factors.",
-        "verified",
-    ),
-    (
-        "student",
-        300,
-        "The student's relatively high level of socializing and high number of absences were likely the "
-        "most important factors.",
-        "contradicted",
-    ),
-    # a label's stem takes inflections, not compounds ('coursework' is no 'course'); a label given after its
-    # feature ("the mother's job, which is categorized as 'other'")
-    (
-        "student",
-        252,
-        "Having one past failure suggests that the student has struggled with their coursework, which "
-        "lowered the probability.",
-        "verified",
-    ),
-    (
-        "student",
-        82,
-        'Additionally, the mother\'s job, which is categorized as "other", had a small positive contribution.',
-        "contradicted",
-    ),
-    (
-        "student",
-        375,
-        'Additionally, the mother\'s job, which is categorized as "other", had a small negative contribution.',
-        "verified",
-    ),
-]
-
-
-@pytest.mark.parametrize("dataset,index,text,status", OUTSIDE)
+@pytest.mark.parametrize(
+    "dataset,index,text,status", cases.params("outside", "outside", ("dataset", "index", "text", "status"))
+)
 def test_phrasings_on_outside_cases(dataset, index, text, status):
+    """Sentences on outside cases: FIFA, UCI student, Pima diabetes, stroke, South German Credit
+    (benchmarks/data/verify_cases/outside.yaml)."""
     assert _outside(text, dataset, index).status == status
 
 
@@ -1742,71 +1111,25 @@ def test_twice_the_size_of_and_more_than_twice_that_of():
     assert [c.status for c in said.claims if c.kind == "number"] == ["contradicted", "contradicted"]
 
 
-FIRE = (
-    ["month", "aspect", "days_since_rain", "campfire_ban", "wind_kmh"],
-    ["August", "south-west", 15, "yes", 11],
-    [1.9, 0.6, 2.2, -1.6, -0.8],
-    4.0,
-    "probability of ignition in %",
-)
-LOAN = (
-    ["dti", "grade", "income", "term"],
-    [28.0, "C", 52000, "60 months"],
-    [0.9, 0.6, -0.2, 0.53],
-    -2.1,
-    "log-odds of default",
-)  # prediction -0.27: 43 %; baseline 10.9 %
-MED = (["fever", "cough", "age", "test_result"], ["yes", "no", 54, "negative"], [1.3, -0.4, 0.6, -0.9], 10.0, "risk")
-
-
 @pytest.mark.parametrize(
-    "case,text",
-    [  # accurate sentences a second review wrote against this session's readings
-        (FIRE, "Since June, the month term has grown; in August it added +1.9."),
-        (FIRE, "The month (August, two months after June) added 1.9."),
-        (FIRE, "Fifteen dry days since early July raised the risk by 2.2, and the month added 1.9."),
-        (FIRE, "The month added 1.9, so fire crews will march in early."),
-        (FIRE, "The aspect added 0.6: south-west slopes dry out faster than north-facing ones."),
-        (FIRE, "The aspect added 0.6 while the wind, blowing from the north at 11 km/h, lowered risk by 0.8."),
-        (FIRE, "It would need to drop by 2.2 points to reach the alert threshold."),
-        (LOAN, "The baseline is about 11%."),
-        (LOAN, "Up from a baseline of about 11%, the default probability is 43%."),
-        (MED, "The negative test lowered the risk by 0.9, not the fever."),
-        (MED, "The risk is high because of age, not fever alone."),
-        (MED, "The patient is not without fever: +1.3."),
-        (
-            (["verification_status", "income"], ["Not Verified", 5], [0.4, 0.1], 1.0, "risk"),
-            "Verified or not, the verification status added 0.4.",
-        ),
-        (
-            (["verification_status", "income"], ["Verified", 5], [-0.4, 0.1], 1.0, "risk"),
-            "An unverified income would raise the risk; here the verification status lowered it by 0.4.",
-        ),
-        (
-            (
-                ["user_segment", "parties_involved", "bedrooms", "category"],
-                ["premium", 2, 3, "toys"],
-                [0.3, 0.2, 1.2, -1.3],
-                1.0,
-                "sales",
-            ),
-            "In the US 3 of 10 applicants were flagged; par 3 golf aside, a 3 bed house; Cat 3 storms too.",
-        ),
-        ((["lag[-1]", "load_mw"], [48.5, 300], [-1.2, 0.8], 1.0, "load"), "The lag removed 1.2 [2]."),
-    ],
+    "explanation,text,accurate",
+    cases.params("second_review", "accurate_sentences", ("explanation", "text", "accurate")),
 )
-def test_accurate_sentences_of_a_second_review_stay_accurate(case, text):
+def test_accurate_sentences_of_a_second_review_stay_accurate(explanation, text, accurate):
+    """Accurate sentences a second review wrote against this session's readings (second_review.yaml)."""
     from benchmarks.bench_verifier import one_output
 
-    result = xairl.verify(text, one_output(*case), 0)
-    assert result.accurate, [(c.rule, c.text, c.detail) for c in result.claims if c.status == "contradicted"]
+    result = xairl.verify(text, one_output(**cases.explanation(explanation)), 0)
+    assert result.accurate == accurate, [
+        (c.rule, c.text, c.detail) for c in result.claims if c.status == "contradicted"
+    ]
 
 
 def test_log_odds_are_no_percentages():
     """'The probability of default is 27%' of log-odds -0.27 (a probability of 43 %): contradicted."""
     from benchmarks.bench_verifier import one_output
 
-    claims = xairl.verify("The probability of default is 27%.", one_output(*LOAN), 0).claims
+    claims = xairl.verify("The probability of default is 27%.", one_output(**cases.explanation("loan")), 0).claims
     assert [c.status for c in claims if c.kind == "number"] == ["contradicted"]
 
 
@@ -1823,47 +1146,31 @@ def test_odds_of_a_larger_number_to_a_smaller_one():
     assert claims("Income outweighs the late payments by about 5 to 2.") == [("rank.comparison", "contradicted")]
 
 
-FIRE = (["wind_kmh", "humidity_pct", "crew_size"], [35, 20, 4], [1.5, 0.8, -0.6], 2.0, "fire risk")
-GATE = (["queue_len", "eta_min"], [5, 12.0], [0.4, -0.2], 1.0, "Q-value of the action 'open gate 4'")
-DAIRY = (["temp_c", "rain_mm", "lag[-1] yield (L)"], [31, 0, 30.5], [-1.4, 0.5, 2.1], 20.0, "milk yield")
-
-
 @pytest.mark.parametrize(
-    "case, text",
-    [
-        (FIRE, "If the wind had contributed nothing, the fire risk would be about 2.2."),
-        (FIRE, "Had the crew size been removed (its -0.6), the risk would sit near 4.3."),
-        (GATE, "Opening gate 4 scores 1.2, mostly for the queue (+0.4)."),
-        (GATE, "Despite that, the Q-value ends above the baseline because of several positive terms."),
-        (DAIRY, "pred=21.2 lag[-1]=+2.1 temp=-1.4"),
-        (DAIRY, "The heat itself (-1.4) hurt more than twice as much as the rain (+0.5) helped."),
-        (FIRE, "Most of the positive push (1.5 of 2.3) came from the wind."),
-    ],
+    "explanation,text,accurate",
+    cases.params("second_review", "counterfactuals_output_names_and_pushes", ("explanation", "text", "accurate")),
 )
-def test_counterfactuals_output_names_and_pushes_in_other_words_stay_accurate(case, text):
+def test_counterfactuals_output_names_and_pushes_in_other_words_stay_accurate(explanation, text, accurate):
     """A removal said after the name ('if A had contributed nothing'), a number of the output's name ('gate 4'), an
     index in brackets ('lag[-1]'), a subject in other words with its push in brackets, 'positive terms' and 'most of
     the positive push' (no subject of their own)."""
     from benchmarks.bench_verifier import one_output
 
-    result = xairl.verify(text, one_output(*case), 0)
-    assert result.accurate, [(c.rule, c.text, c.detail) for c in result.claims if c.status == "contradicted"]
+    result = xairl.verify(text, one_output(**cases.explanation(explanation)), 0)
+    assert result.accurate == accurate, [
+        (c.rule, c.text, c.detail) for c in result.claims if c.status == "contradicted"
+    ]
 
 
 @pytest.mark.parametrize(
-    "case, text",
-    [
-        (GATE, "If the queue had contributed nothing, the Q-value would be about 2.0."),
-        (FIRE, "The drought index (+0.9) raised the risk."),
-        (GATE, "Opening gate 4 scores 2.2."),
-    ],
+    "explanation,text,accurate", cases.params("second_review", "near_misses", ("explanation", "text", "accurate"))
 )
-def test_their_near_misses_are_contradicted(case, text):
+def test_their_near_misses_are_contradicted(explanation, text, accurate):
     """The same readings with a wrong counterfactual, an invented name whose bracketed number is no contribution, a
     wrong score beside the output's number."""
     from benchmarks.bench_verifier import one_output
 
-    assert not xairl.verify(text, one_output(*case), 0).accurate
+    assert xairl.verify(text, one_output(**cases.explanation(explanation)), 0).accurate == accurate
 
 
 def test_an_opposite_of_the_label_is_a_wrong_category():
