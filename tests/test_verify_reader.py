@@ -13,7 +13,7 @@ def test_every_rule_has_an_id_a_pattern_a_claim_and_examples():
     ids = [r.id for r in RULES]
     assert len(ids) == len(set(ids))
     for r in RULES:
-        assert r.claim in ("number", "direction", "rank") and r.binding in ("adjacent", "grammar")
+        assert r.claim in ("number", "direction", "rank", "skip") and r.binding in ("adjacent", "grammar")
         assert r.pattern and r.fires, r.id
         if r.kind == "dependency":
             roles = {node["RIGHT_ID"] for node in r.pattern}
@@ -52,3 +52,12 @@ def test_a_number_next_to_its_name_outranks_the_parse():
     lines = trace("The season lowered it a little, and wind speed (SHAP +6.9) pushed it up.", example("air"), 0)
     assert any(line.startswith("  * number.parenthesis") for line in lines), lines
     assert read("The season lowered it a little, and wind speed (SHAP +6.9) pushed it up.", example("air"), 0).accurate
+
+
+def test_xairl_verify_stays_the_public_verifier_after_the_package_is_imported():
+    import xairl
+    import xairl.verify as package
+
+    for verifier in (xairl.verify, package):
+        assert verifier("pm2_5_lag1 (+14.7) raised the forecast.", example("air"), 0).accurate
+    assert callable(xairl.verify) and package.read is read

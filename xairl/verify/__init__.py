@@ -8,9 +8,16 @@ against the fact book). A claim is contradicted only where a rule binds it to it
 
 Stage 1 of issue 54: numbers, names, the fact book and the sentence splitter are still those of
 ``xairl.narrators.verify``; they move here when this reader replaces that one.
+
+``xairl.verify(text, explanation, ...)`` stays the public verifier whichever way this package was imported: the
+module is callable and calls :func:`xairl.narrators.verify` (importing ``xairl.verify`` as a package would otherwise
+replace the function of that name on ``xairl``).
 """
 
 from __future__ import annotations
+
+import sys
+import types
 
 import numpy as np
 
@@ -28,6 +35,16 @@ from .parse import Sentence, parse
 from .resolve import Decision, resolve
 
 __all__ = ["read", "trace"]
+
+
+class _CallableModule(types.ModuleType):
+    def __call__(self, *args, **kwargs) -> Verification:
+        from ..narrators import verify
+
+        return verify(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule
 
 
 def read(text: str, explanation: Explanation, index: int = 0, policy: Policy | None = None) -> Verification:
@@ -89,7 +106,7 @@ def _claims(s: Sentence, book, unit_of) -> tuple[list[Claim], list[Decision]]:
             out.append(check.claim(d.winner, s, book, unit_of, ctx))
         except Exception as e:  # noqa: BLE001 - a reader bug must not take the narration down with it
             out.append(Claim("internal", s.text.strip(), "unchecked", f"the reader failed ({type(e).__name__}: {e})"))
-        if d.winner.rule.claim == "number":
+        if d.winner.rule.claim in ("number", "skip"):
             bound.add(d.winner.anchor)
     named = {k for t in names for k in t._.keys}
     for t in s.doc:

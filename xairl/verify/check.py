@@ -14,6 +14,7 @@ from ..narrators.verify.checks import EITHER, Claim, check_direction, over_keys,
 from ..narrators.verify.names import Mention
 from ..narrators.verify.numbers import matches
 from ..narrators.verify.quantities import feature_number
+from .lexicon import lexicon
 from .parse import Sentence
 from .rules import Candidate
 
@@ -36,16 +37,42 @@ def _mention(token) -> Mention:
     return Mention(token.idx, token.idx + len(token), kind, tuple(token._.keys), token._.label, token._.form)
 
 
+def coordinated(token) -> list:
+    """The features said together with a name ('A and B raised it'): the name first, then its conjuncts."""
+    head = token
+    while head.dep_ == "conj" and head.head.ent_type_ == "FEATURE":
+        head = head.head
+    group = [t for t in head.subtree if t.ent_type_ == "FEATURE" and (t is head or t.dep_ == "conj")]
+    return [token] + [t for t in group if t is not token]
+
+
 def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Claim:
+    """The claim a resolved reading makes, checked; contradicted only where its name is sure (module doc)."""
+    made = _checked(c, s, book, unit_of, ctx)
+    name = s.doc[c.name]
+    if made.status == "contradicted" and name._.form == "part" and name.lower_.strip() in lexicon()["generic"]:
+        made = replace(made, status="unchecked", detail=f"{made.detail} ('{name.text}' alone: no sure binding)")
+    return replace(made, rule=c.rule.id)
+
+
+def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Claim:
     name = s.doc[c.name]
     keys = tuple(name._.keys)
+    anchor = s.doc[c.anchor]
+    if c.rule.claim == "skip":
+        return Claim("number", anchor.text, "unchecked", "a ratio, a pair or a part of a total")
+    together = coordinated(name)
     if c.rule.claim == "number":
-        n = s.doc[c.anchor]._.number
-        made = feature_number(n, keys, s.masked, book, ctx, unit_of, name_after=c.rule.id == "number.name-after")
-    elif c.rule.claim == "direction":
-        word = s.doc[c.anchor].text
+        if len(together) > 1:
+            return Claim("number", anchor.text, "unchecked", "said of several features together")
+        return feature_number(anchor._.number, keys, s.masked, book, ctx, unit_of)
+    if c.rule.claim == "direction":
+        word = anchor.text
         if c.negated:
-            return Claim("direction", word, "unchecked", "a negated direction", c.rule.id)
+            return Claim("direction", word, "unchecked", "a negated direction")
+        signed = [t for t in anchor.subtree if t.ent_type_ == "NUM" and t._.numform == "signed"]
+        if signed:
+            return Claim("direction", word, "unchecked", f"its number's sign ({signed[0].text}) says the way")
         polarity, where = c.polarity, ctx
         target = next((t for t in s.doc[c.anchor].subtree if t.ent_type_ == "ACTION"), None)
         if target is not None and book.runner_up:
@@ -53,11 +80,10 @@ def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Claim
             if meant == book.runner_up:  # 'A favoured recharging' when turning was chosen: against the margin
                 polarity, where = -polarity, "margin"
             elif meant != book.chosen:
-                return Claim("direction", word, "unchecked", "toward an action neither chosen nor runner-up", c.rule.id)
-        made = check_direction([_mention(name)], polarity, where, word, book)[0]
-    else:
-        made = _rank(keys, c.rank, s.doc[c.anchor].text, book)
-    return replace(made, rule=c.rule.id)
+                return Claim("direction", word, "unchecked", "toward an action neither chosen nor runner-up")
+        checked = check_direction([_mention(t) for t in together], polarity, where, word, book)
+        return next((x for x in checked if x.status == "contradicted"), checked[0])
+    return _rank(keys, c.rank, anchor.text, book)
 
 
 def _rank(keys: tuple[str, ...], rank: int, word: str, book: FactBook) -> Claim:

@@ -2,8 +2,8 @@
 
 A name found by the vocabulary (any spelling of a feature, an action's verb forms, a categorical value's label) and a
 number as people write it ('+$1,204', '~12 %', 'minus 0.4') become one token, with ``ENT_TYPE`` FEATURE, ACTION,
-LABEL or NUM and the custom attributes ``keys`` (the features or actions it may mean), ``label`` and ``number``
-(the :class:`Number` read). The rules (rules.py) match these tokens, so a pattern never spells a name or a number.
+LABEL or NUM and the custom attributes ``keys`` (the features or actions it may mean), ``label``, ``form`` ('part':
+a run of a longer name's words), ``number`` (the :class:`Number` read) and ``numform`` (:func:`numform`). The rules (rules.py) match these tokens, so a pattern never spells a name or a number.
 Every sentence of a text is parsed in one ``nlp.pipe``-style batch.
 """
 
@@ -16,8 +16,9 @@ from spacy.tokens import Doc, Token
 from ..narrators.verify.names import Mention, find_mentions
 from ..narrators.verify.numbers import Number, find_numbers
 from ..narrators.verify.parse import _symbol_runs, pipeline
+from .lexicon import lexicon
 
-for _attr, _default in (("keys", ()), ("label", ""), ("number", None), ("form", "")):
+for _attr, _default in (("keys", ()), ("label", ""), ("number", None), ("form", ""), ("numform", "")):
     if not Token.has_extension(_attr):
         Token.set_extension(_attr, default=_default)
 
@@ -36,6 +37,25 @@ class Sentence:
     numbers: list[Number]
 
 
+def numform(n: Number) -> str:
+    """How a number is written, for patterns: 'word' (three), 'signed' (+0.3), 'decimal' (0.3, 12 %), 'integer'."""
+    if not any(ch.isdigit() for ch in n.text):
+        return "word"
+    if n.sign:
+        return "signed"
+    return "decimal" if n.unit < 1 or n.percent else "integer"
+
+
+def _hedged(text: str, n: Number) -> int:
+    """Where a number's token starts: at its hedge, when it has one ('by about 0.4' is 'by' + one number), so the
+    parser does not read the hedge as a preposition of its own."""
+    if not n.hedge:
+        return n.start
+    before = text[: n.start].rstrip()
+    word = before.split()[-1] if before.split() else ""
+    return len(before) - len(word) if word.lower() in lexicon()["hedges"] else n.start
+
+
 def parse(pieces: list[tuple[int, str]], vocab) -> list[Sentence]:
     """Parse each (start, sentence) with its names and numbers merged into single tokens, all in one batch."""
     nlp = pipeline()
@@ -49,7 +69,7 @@ def parse(pieces: list[tuple[int, str]], vocab) -> list[Sentence]:
             spans = [
                 (m.start, m.end, _KIND[m.kind], {"keys": m.keys, "label": m.label, "form": m.form}) for m in mentions
             ]
-            spans += [(n.start, n.end, "NUM", {"number": n}) for n in numbers]
+            spans += [(_hedged(text, n), n.end, "NUM", {"number": n, "numform": numform(n)}) for n in numbers]
             for a, b, kind, ext in sorted(spans, key=lambda s: s[0]):
                 span = doc.char_span(a, b, alignment_mode="expand")
                 if span is None or taken & set(range(span.start, span.end)):

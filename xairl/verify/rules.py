@@ -10,19 +10,17 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from pathlib import Path
 
 import yaml
 from spacy.matcher import DependencyMatcher, Matcher
 
-RULES_DIR = Path(__file__).parent / "rules"
-_VERB_LISTS = ("up", "down", "phrasal")
+from .lexicon import RULES_DIR, lexicon
 
 
 @dataclass(frozen=True, eq=False)
 class Rule:
     id: str
-    claim: str  # number | direction | rank
+    claim: str  # number | direction | rank | skip
     binding: str  # adjacent | grammar
     priority: int
     pattern: list
@@ -43,36 +41,6 @@ class Candidate:
     polarity: int = 0
     rank: int = 0
     negated: bool = False
-
-
-def forms(word: str) -> set[str]:
-    """A verb's base form and its -s, -ed and -ing forms (raise: raises, raised, raising; cut: cuts, cutting)."""
-    if not word.isalpha() or len(word) < 3:
-        return {word}
-    vowels = "aeiou"
-    double = len(word) <= 4 and word[-1] in "bdgmnpt" and word[-2] in vowels and word[-3] not in vowels
-    consonant_y = word.endswith("y") and word[-2] not in vowels
-    if consonant_y:
-        return {word, word[:-1] + "ies", word[:-1] + "ied", word + "ing"}
-    third = word + "es" if word.endswith(("sh", "ch", "s", "x")) else word + "s"
-    if word.endswith("e") and not word.endswith("ee"):
-        return {word, third, word + "d", word[:-1] + "ing"}
-    stem = word + word[-1] if double else word
-    return {word, third, stem + "ed", stem + "ing"}
-
-
-@functools.cache
-def lexicon() -> dict:
-    """The word lists, verbs with their forms; ``ordinals`` a word -> rank map."""
-    raw = yaml.safe_load((RULES_DIR / "lexicon.yaml").read_text(encoding="utf-8"))
-    out = {}
-    for key, words in raw.items():
-        if isinstance(words, dict):
-            out[key] = {str(k).lower(): int(v) for k, v in words.items()}
-        else:
-            words = [str(w).lower() for w in words]
-            out[key] = sorted({f for w in words for f in forms(w)}) if key in _VERB_LISTS else words
-    return out
 
 
 def _expand(node):
@@ -139,10 +107,12 @@ def candidates(doc) -> list[Candidate]:
 def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
     span = range(start, end)
     names = [i for i in span if doc[i].ent_type_ == "FEATURE"]
+    nums = [i for i in span if doc[i].ent_type_ == "NUM"]
+    if rule.claim == "skip":  # every number it matches is left unchecked
+        return [Candidate(rule, i, i) for i in nums]
     if not names:
         return []
     if rule.claim == "number":
-        nums = [i for i in span if doc[i].ent_type_ == "NUM"]
         if not nums:
             return []
         name = min(names, key=lambda i: abs(i - nums[0]))
@@ -163,6 +133,8 @@ def _reading(rule: Rule, doc, name: int, anchor: int, roles: dict) -> Candidate:
             polarity = 1 if way in lex["particle_up"] else -1
         elif rule.polarity == "sign":
             polarity = 1 if word in lex["sign_up"] else -1
+        elif rule.polarity == "output":
+            polarity = 1 if word in lex["output_up"] else -1
         else:
             polarity = 1 if word in lex["up"] else -1
     if rule.claim == "rank":

@@ -1,0 +1,42 @@
+"""The reader's word lists (rules/lexicon.yaml), loaded once: the one place a hedge, a direction verb, a rank word
+or a negation is listed. Verbs are listed in their base form; :func:`forms` makes the rest."""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import yaml
+
+RULES_DIR = Path(__file__).parent / "rules"
+_VERB_LISTS = ("up", "down", "phrasal", "output_up", "output_down")
+
+
+def forms(word: str) -> set[str]:
+    """A verb's base form and its -s, -ed and -ing forms (raise: raises, raised, raising; cut: cuts, cutting)."""
+    if not word.isalpha() or len(word) < 3:
+        return {word}
+    vowels = "aeiou"
+    double = len(word) <= 4 and word[-1] in "bdgmnpt" and word[-2] in vowels and word[-3] not in vowels
+    consonant_y = word.endswith("y") and word[-2] not in vowels
+    if consonant_y:
+        return {word, word[:-1] + "ies", word[:-1] + "ied", word + "ing"}
+    third = word + "es" if word.endswith(("sh", "ch", "s", "x")) else word + "s"
+    if word.endswith("e") and not word.endswith("ee"):
+        return {word, third, word + "d", word[:-1] + "ing"}
+    stem = word + word[-1] if double else word
+    return {word, third, stem + "ed", stem + "ing"}
+
+
+@functools.cache
+def lexicon() -> dict:
+    """The word lists, verbs with their forms; ``ordinals`` a word -> rank map."""
+    raw = yaml.safe_load((RULES_DIR / "lexicon.yaml").read_text(encoding="utf-8"))
+    out = {}
+    for key, words in raw.items():
+        if isinstance(words, dict):
+            out[key] = {str(k).lower(): int(v) for k, v in words.items()}
+        else:
+            words = [str(w).lower() for w in words]
+            out[key] = sorted({f for w in words for f in forms(w)}) if key in _VERB_LISTS else words
+    return out
