@@ -13,11 +13,11 @@ def test_every_rule_has_an_id_a_pattern_a_claim_and_examples():
     ids = [r.id for r in RULES]
     assert len(ids) == len(set(ids))
     for r in RULES:
-        assert r.claim in ("number", "direction", "rank", "skip") and r.binding in ("adjacent", "grammar")
+        assert r.claim in ("number", "direction", "rank", "category", "invented", "skip") and r.binding in ("adjacent", "grammar")
         assert r.pattern and r.fires, r.id
         if r.kind == "dependency":
             roles = {node["RIGHT_ID"] for node in r.pattern}
-            assert "name" in roles and roles & {"num", "dir", "rank"}, r.id
+            assert "name" in roles and roles & {"num", "dir", "rank", "word"}, r.id
 
 
 @pytest.mark.parametrize(

@@ -49,19 +49,19 @@ sys.modules[__name__].__class__ = _CallableModule
 
 def read(text: str, explanation: Explanation, index: int = 0, policy: Policy | None = None) -> Verification:
     """Check every claim of ``text`` against the explanation of decision ``index``; never raises on odd text."""
-    sentences_, book, unit_of, note = _prepare(text, explanation, index, policy)
+    sentences_, book, unit_of, note, known = _prepare(text, explanation, index, policy)
     out = []
     for s in sentences_:
-        out.append(SentenceCheck(s.text.strip(), tuple(_claims(s, book, unit_of)[0])))
+        out.append(SentenceCheck(s.text.strip(), tuple(_claims(s, book, unit_of, known)[0])))
     return Verification(tuple(out), note)
 
 
 def trace(text: str, explanation: Explanation, index: int = 0, policy: Policy | None = None) -> list[str]:
     """Per sentence: every rule's candidate reading and the one that won, then the claims."""
-    sentences_, book, unit_of, _ = _prepare(text, explanation, index, policy)
+    sentences_, book, unit_of, _, known = _prepare(text, explanation, index, policy)
     lines = []
     for s in sentences_:
-        claims, decisions = _claims(s, book, unit_of)
+        claims, decisions = _claims(s, book, unit_of, known)
         lines.append(f"sentence: {s.text.strip()}")
         for d in decisions:
             for c in d.candidates:
@@ -90,10 +90,10 @@ def _prepare(text, explanation, index, policy):
         return info.unit if info and info.unit else unit_in_name(f)
 
     pieces = [(a, text[a:b]) for a, b in sentences(text)]
-    return parse(pieces, vocab), book, unit_of, note
+    return parse(pieces, vocab), book, unit_of, note, vocab.name_words
 
 
-def _claims(s: Sentence, book, unit_of) -> tuple[list[Claim], list[Decision]]:
+def _claims(s: Sentence, book, unit_of, known) -> tuple[list[Claim], list[Decision]]:
     names = [t for t in s.doc if t.ent_type_ == "FEATURE"]
     out = [Claim("feature", t.text, "verified", " / ".join(t._.keys), "names.mention") for t in names]
     if s.text.rstrip().endswith("?"):  # a question asserts nothing
@@ -103,7 +103,9 @@ def _claims(s: Sentence, book, unit_of) -> tuple[list[Claim], list[Decision]]:
     bound = set()
     for d in decisions:
         try:
-            out.append(check.claim(d.winner, s, book, unit_of, ctx))
+            made = check.claim(d.winner, s, book, unit_of, ctx, known)
+            if made is not None:
+                out.append(made)
         except Exception as e:  # noqa: BLE001 - a reader bug must not take the narration down with it
             out.append(Claim("internal", s.text.strip(), "unchecked", f"the reader failed ({type(e).__name__}: {e})"))
         if d.winner.rule.claim in ("number", "skip"):

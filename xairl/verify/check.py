@@ -14,6 +14,7 @@ from ..narrators.verify.checks import EITHER, Claim, check_direction, over_keys,
 from ..narrators.verify.names import Mention
 from ..narrators.verify.numbers import matches
 from ..narrators.verify.quantities import feature_number
+from ..narrators.verify.vocabulary import split_words, stem
 from .lexicon import lexicon
 from .parse import Sentence
 from .rules import Candidate
@@ -38,17 +39,26 @@ def _mention(token) -> Mention:
 
 
 def coordinated(token) -> list:
-    """The features said together with a name ('A and B raised it'): the name first, then its conjuncts."""
+    """What is said together with a name ('A and B raised it', 'A and the weather add 3'): the name first, then its
+    conjuncts (any conjunct, named or not: a number said of them is a sum)."""
     head = token
-    while head.dep_ == "conj" and head.head.ent_type_ == "FEATURE":
+    while head.dep_ == "conj":
         head = head.head
-    group = [t for t in head.subtree if t.ent_type_ == "FEATURE" and (t is head or t.dep_ == "conj")]
+    group = [t for t in head.subtree if t is head or (t.dep_ == "conj" and t.head.i in {head.i, *(x.i for x in head.conjuncts)})]
     return [token] + [t for t in group if t is not token]
 
 
-def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Claim:
-    """The claim a resolved reading makes, checked; contradicted only where its name is sure (module doc)."""
-    made = _checked(c, s, book, unit_of, ctx)
+def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: frozenset) -> Claim | None:
+    """The claim a resolved reading makes, checked; contradicted only where its name is sure (module doc). ``known``:
+    the words of every name and description (a phrase with one of them may mean a feature in other words)."""
+    if c.rule.claim == "category":
+        made = _category(s.doc[c.name], s.doc[c.anchor], book, known)
+    elif c.rule.claim == "invented":
+        made = _invented(s.doc[c.name], s.doc[c.anchor], known)
+    else:
+        made = _checked(c, s, book, unit_of, ctx)
+    if made is None:
+        return None
     name = s.doc[c.name]
     if made.status == "contradicted" and name._.form == "part" and name.lower_.strip() in lexicon()["generic"]:
         made = replace(made, status="unchecked", detail=f"{made.detail} ('{name.text}' alone: no sure binding)")
@@ -81,7 +91,8 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
                 polarity, where = -polarity, "margin"
             elif meant != book.chosen:
                 return Claim("direction", word, "unchecked", "toward an action neither chosen nor runner-up")
-        checked = check_direction([_mention(t) for t in together], polarity, where, word, book)
+        named = [t for t in together if t.ent_type_ == "FEATURE"]
+        checked = check_direction([_mention(t) for t in named], polarity, where, word, book)
         return next((x for x in checked if x.status == "contradicted"), checked[0])
     return _rank(keys, c.rank, anchor.text, book)
 
@@ -117,3 +128,51 @@ def free_number(token, book: FactBook) -> Claim:
     if any(matches(n, f, magnitude_ok=False) for f in facts):
         return Claim("number", n.text, "verified", "a decision-level number", "number.decision")
     return Claim("number", n.text, "unchecked", "bound to no name", "number.unbound")
+
+
+def _words(text: str) -> set[str]:
+    words = {w for w in split_words(text) if w}
+    return words | {stem(w).rstrip("~") for w in words}
+
+
+def _category(name, word, book: FactBook, known: frozenset) -> Claim | None:
+    """A word said of a categorical feature ('the hilly course', 'congestion is rated medium'): verified when it is
+    a word of its value, contradicted when it is another (or drops its value's 'non-'), else no claim."""
+    keys = [k for k in name._.keys if k in book.features and book.features[k].label is not None]
+    if len(keys) != 1 or len(name._.keys) != 1:
+        return None
+    key, lex = keys[0], lexicon()
+    label = book.features[key].label
+    inside = {t.i for t in name.subtree} if name.i in {t.i for t in word.subtree} else {name.i}
+    said = " ".join(t.text for t in word.subtree if t.i not in inside).replace(" - ", "-")
+    if word.lower_ in lex["plain_modifiers"] or word.lower_ in lex["generic"]:
+        return None
+    label_words, said_words = _words(label), _words(said) - _words(key) - set(lex["plain_modifiers"])
+    if not said_words:
+        return None
+    negated = label_words & {"non", "no", "not", "un", "without"}
+    if said_words <= label_words | _words(key) and (not negated or said_words & negated):
+        return Claim("category", said, "verified", f"{key} is {label}")
+    if said_words & label_words and not negated:
+        return None  # part of its value ('the flat course' for 'flat terrain')
+    return Claim("category", said, "contradicted", f"{key} is {label}, not {said}")
+
+
+def _invented(subject, verb, known: frozenset) -> Claim | None:
+    """The subject of a direction verb that names nothing of the explanation ('construction dust raised it by 1.0'):
+    contradicted, unless a word of it belongs to a name or a description (a vague mention) or it is the model, the
+    output or a group of reasons."""
+    lex = lexicon()
+    tokens = list(subject.subtree)
+    if (
+        any(t.ent_type_ in ("FEATURE", "ACTION", "LABEL", "NUM") for t in tokens)
+        or subject.lower_ in lex["vague"]
+        or subject.tag_ == "VBG"
+        or any(t.lower_ in lex["pointing"] for t in tokens)
+    ):  # a name, a value, the output, a gerund, or a phrase that points back ('your coupe', 'those two facts')
+        return None
+    content = [t for t in tokens if t.pos_ in ("NOUN", "PROPN", "ADJ") and t.lower_ not in lex["generic"]]
+    if not content or any(w in known for t in content for w in _words(t.text)):
+        return None
+    phrase = " ".join(t.text for t in tokens)
+    return Claim("feature", phrase, "contradicted", f"'{phrase}' {verb.text}: it names no input of the explanation")

@@ -20,7 +20,7 @@ from .lexicon import RULES_DIR, lexicon
 @dataclass(frozen=True, eq=False)
 class Rule:
     id: str
-    claim: str  # number | direction | rank | skip
+    claim: str  # number | direction | rank | category | invented | skip
     binding: str  # adjacent | grammar
     priority: int
     pattern: list
@@ -100,7 +100,8 @@ def candidates(doc) -> list[Candidate]:
     for match_id, ids in dependency(doc):
         rule = by_id()[doc.vocab.strings[match_id]]
         roles = {node["RIGHT_ID"]: i for node, i in zip(rule.pattern, ids)}
-        out.append(_reading(rule, doc, roles["name"], roles.get("num", roles.get("dir", roles.get("rank"))), roles))
+        anchor = next(roles[k] for k in ("num", "dir", "rank", "word") if k in roles)
+        out.append(_reading(rule, doc, roles["name"], anchor, roles))
     return out
 
 
@@ -117,6 +118,8 @@ def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
             return []
         name = min(names, key=lambda i: abs(i - nums[0]))
         return [_reading(rule, doc, name, nums[0], {})]
+    if rule.claim == "category":  # the word said of the name: the last of the match
+        return [_reading(rule, doc, names[0], end - 1, {})]
     lex = lexicon()
     said = [i for i in span if doc[i].lower_ in lex["superlatives"] or doc[i].lower_ in lex["ordinals"]]
     anchor = said[0] if said else next(i for i in span if doc[i].ent_type_ != "FEATURE")
