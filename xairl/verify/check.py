@@ -135,17 +135,33 @@ def _words(text: str) -> set[str]:
     return words | {stem(w).rstrip("~") for w in words}
 
 
+_PHRASE_DEPS = ("compound", "amod", "npadvmod", "nmod", "nummod", "advmod", "neg", "punct", "hyph")
+
+
+def _value_phrase(word, name) -> list:
+    """The words that say a value: ``word`` and the modifiers before it ('ground-level field', 'north-facing'),
+    without the name itself or anything the parse hangs after it."""
+    out = [word]
+    for child in word.lefts:
+        if child.dep_ in _PHRASE_DEPS and child.i != name.i and name.i not in {t.i for t in child.subtree}:
+            out += [t for t in child.subtree if not (t.is_punct and t.text != "-")]
+    return sorted(out, key=lambda t: t.i)
+
+
 def _category(name, word, book: FactBook, known: frozenset) -> Claim | None:
     """A word said of a categorical feature ('the hilly course', 'congestion is rated medium'): verified when it is
-    a word of its value, contradicted when it is another (or drops its value's 'non-'), else no claim."""
+    a word of its value; contradicted when it reads as another value (a name, a number, a hyphenated compound, a
+    word of the value's closed class, or the value without its 'non-'); else no claim ('the long contract')."""
     keys = [k for k in name._.keys if k in book.features and book.features[k].label is not None]
     if len(keys) != 1 or len(name._.keys) != 1:
         return None
     key, lex = keys[0], lexicon()
     label = book.features[key].label
-    inside = {t.i for t in name.subtree} if name.i in {t.i for t in word.subtree} else {name.i}
-    said = " ".join(t.text for t in word.subtree if t.i not in inside).replace(" - ", "-")
-    if word.lower_ in lex["plain_modifiers"] or word.lower_ in lex["generic"]:
+    tokens = _value_phrase(word, name)
+    said = " ".join(t.text for t in tokens).replace(" - ", "-")
+    if word.lower_ in lex["plain_modifiers"] or word.lower_ in lex["generic"] or word.lower_ in lex["stated_as"]:
+        return None
+    if len(tokens) > 4:
         return None
     label_words, said_words = _words(label), _words(said) - _words(key) - set(lex["plain_modifiers"])
     if not said_words:
@@ -153,8 +169,17 @@ def _category(name, word, book: FactBook, known: frozenset) -> Claim | None:
     negated = label_words & {"non", "no", "not", "un", "without"}
     if said_words <= label_words | _words(key) and (not negated or said_words & negated):
         return Claim("category", said, "verified", f"{key} is {label}")
-    if said_words & label_words and not negated:
-        return None  # part of its value ('the flat course' for 'flat terrain')
+    same_class = any(said_words & group and label_words & group for group in lex["closed_classes"])
+    near = (word.head, *word.head.children, word.head.head)
+    stated = any(t.lower_ in lex["stated_as"] for t in near)  # 'is rated medium', 'was classed as an emergency'
+    value_like = (
+        stated
+        or same_class
+        or (negated and said_words & label_words)
+        or any(t.pos_ == "PROPN" or t.like_num or t.text == "-" for t in tokens)
+    )
+    if not value_like or (said_words & label_words and not negated):
+        return None
     return Claim("category", said, "contradicted", f"{key} is {label}, not {said}")
 
 
@@ -172,7 +197,7 @@ def _invented(subject, verb, known: frozenset) -> Claim | None:
     ):  # a name, a value, the output, a gerund, or a phrase that points back ('your coupe', 'those two facts')
         return None
     content = [t for t in tokens if t.pos_ in ("NOUN", "PROPN", "ADJ") and t.lower_ not in lex["generic"]]
-    if not content or any(w in known for t in content for w in _words(t.text)):
-        return None
+    if len(content) < 2 or any(w in known for t in content for w in _words(t.text)):
+        return None  # one plain noun ('the sunshine', 'youth') is more often a paraphrase than a new input
     phrase = " ".join(t.text for t in tokens)
     return Claim("feature", phrase, "contradicted", f"'{phrase}' {verb.text}: it names no input of the explanation")

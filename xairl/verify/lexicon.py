@@ -34,7 +34,9 @@ def lexicon() -> dict:
     raw = yaml.safe_load((RULES_DIR / "lexicon.yaml").read_text(encoding="utf-8"))
     out = {}
     for key, words in raw.items():
-        if isinstance(words, dict):
+        if key == "closed_classes":
+            out[key] = [frozenset(str(w).lower() for w in group) for group in words]
+        elif isinstance(words, dict):
             out[key] = {str(k).lower(): int(v) for k, v in words.items()}
         else:
             words = [str(w).lower() for w in words]

@@ -118,8 +118,11 @@ def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
             return []
         name = min(names, key=lambda i: abs(i - nums[0]))
         return [_reading(rule, doc, name, nums[0], {})]
-    if rule.claim == "category":  # the word said of the name: the last of the match
-        return [_reading(rule, doc, names[0], end - 1, {})]
+    if rule.claim == "category":  # the word said of the name: the last of the match, or the noun it modifies
+        word = doc[end - 1]
+        while word.dep_ in ("compound", "amod", "nmod", "npadvmod") and word.head.i > word.i:
+            word = word.head
+        return [_reading(rule, doc, names[0], word.i, {})]
     lex = lexicon()
     said = [i for i in span if doc[i].lower_ in lex["superlatives"] or doc[i].lower_ in lex["ordinals"]]
     anchor = said[0] if said else next(i for i in span if doc[i].ent_type_ != "FEATURE")
