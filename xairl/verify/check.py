@@ -11,6 +11,7 @@ from dataclasses import replace
 
 from ..narrators.verify.book import FactBook
 from ..narrators.verify.checks import EITHER, Claim, check_direction, over_keys, resolve_action
+from ..narrators.verify.comparisons import check_comparison
 from ..narrators.verify.names import Mention
 from ..narrators.verify.numbers import matches
 from ..narrators.verify.quantities import feature_number
@@ -44,14 +45,23 @@ def coordinated(token) -> list:
     head = token
     while head.dep_ == "conj":
         head = head.head
-    group = [t for t in head.subtree if t is head or (t.dep_ == "conj" and t.head.i in {head.i, *(x.i for x in head.conjuncts)})]
+    group = [
+        t
+        for t in head.subtree
+        if t is head or (t.dep_ == "conj" and t.head.i in {head.i, *(x.i for x in head.conjuncts)})
+    ]
     return [token] + [t for t in group if t is not token]
 
 
 def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: frozenset) -> Claim | None:
     """The claim a resolved reading makes, checked; contradicted only where its name is sure (module doc). ``known``:
     the words of every name and description (a phrase with one of them may mean a feature in other words)."""
-    if c.rule.claim == "category":
+    if c.rule.claim == "comparison":
+        a, b = s.doc[c.name], s.doc[c.other]
+        if len(b._.keys) != 1 or len(coordinated(a)) > 1:
+            return None
+        made = check_comparison(tuple(a._.keys), b._.keys[0], c.polarity, ctx, book, s.doc[c.anchor].text)
+    elif c.rule.claim == "category":
         made = _category(s.doc[c.name], s.doc[c.anchor], book, known)
     elif c.rule.claim == "invented":
         made = _invented(s.doc[c.name], s.doc[c.anchor], known)

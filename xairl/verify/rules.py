@@ -20,7 +20,7 @@ from .lexicon import RULES_DIR, lexicon
 @dataclass(frozen=True, eq=False)
 class Rule:
     id: str
-    claim: str  # number | direction | rank | category | invented | skip
+    claim: str  # number | direction | rank | comparison | category | invented | skip
     binding: str  # adjacent | grammar
     priority: int
     pattern: list
@@ -41,6 +41,7 @@ class Candidate:
     polarity: int = 0
     rank: int = 0
     negated: bool = False
+    other: int = -1  # a comparison's second name
 
 
 def _expand(node):
@@ -118,6 +119,10 @@ def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
             return []
         name = min(names, key=lambda i: abs(i - nums[0]))
         return [_reading(rule, doc, name, nums[0], {})]
+    if rule.claim == "comparison":  # the first name against the last, at the comparative
+        way = next(i for i in span if doc[i].lower_ in lexicon()["more"] + lexicon()["less"])
+        polarity = 1 if doc[way].lower_ in lexicon()["more"] else -1
+        return [Candidate(rule, names[0], way, polarity, other=names[-1])] if len(names) > 1 else []
     if rule.claim == "category":  # the word said of the name: the last of the match, or the noun it modifies
         word = doc[end - 1]
         while word.dep_ in ("compound", "amod", "nmod", "npadvmod") and word.head.i > word.i:
