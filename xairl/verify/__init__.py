@@ -94,20 +94,28 @@ def _prepare(text, explanation, index, policy):
 
 
 def _claims(s: Sentence, book, unit_of, known) -> tuple[list[Claim], list[Decision]]:
+    """A sentence's claims (a name alone claims nothing checkable), and the decisions the trace shows. A failure of
+    the reader leaves the sentence unchecked with the reason: never an exception to the caller."""
     names = [t for t in s.doc if t.ent_type_ == "FEATURE"]
     out = [Claim("feature", t.text, "verified", " / ".join(t._.keys), "names.mention") for t in names]
     if s.text.rstrip().endswith("?"):  # a question asserts nothing
         return out, []
-    decisions = resolve(rules.candidates(s.doc))
+    try:
+        decisions = resolve(rules.candidates(s.doc))
+        return out + _checked(s, decisions, names, book, unit_of, known), decisions
+    except Exception as e:  # noqa: BLE001 - a reader bug must not take the narration down with it
+        return out + [
+            Claim("internal", s.text.strip(), "unchecked", f"the reader failed ({type(e).__name__}: {e})")
+        ], []
+
+
+def _checked(s: Sentence, decisions: list[Decision], names, book, unit_of, known) -> list[Claim]:
     ctx = check.view(s, book)
-    bound = set()
+    out, bound = [], set()
     for d in decisions:
-        try:
-            made = check.claim(d.winner, s, book, unit_of, ctx, known)
-            if made is not None:
-                out.append(made)
-        except Exception as e:  # noqa: BLE001 - a reader bug must not take the narration down with it
-            out.append(Claim("internal", s.text.strip(), "unchecked", f"the reader failed ({type(e).__name__}: {e})"))
+        made = check.claim(d.winner, s, book, unit_of, ctx, known)
+        if made is not None:
+            out.append(made)
         if d.winner.rule.claim in ("number", "skip"):
             bound.add(d.winner.anchor)
     named = {k for t in names for k in t._.keys}
@@ -118,4 +126,4 @@ def _claims(s: Sentence, book, unit_of, known) -> tuple[list[Claim], list[Decisi
             c = check.label_claim(t, book, named)
             if c is not None:
                 out.append(c)
-    return out, decisions
+    return out

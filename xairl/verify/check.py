@@ -39,12 +39,22 @@ def _mention(token) -> Mention:
     return Mention(token.idx, token.idx + len(token), kind, tuple(token._.keys), token._.label, token._.form)
 
 
+def _verb_of(token):
+    """The nearest verb above a token (its clause's verb)."""
+    head = token.head
+    while head.pos_ not in ("VERB", "AUX") and head.head.i != head.i:
+        head = head.head
+    return head
+
+
 def coordinated(token) -> list:
     """What is said together with a name ('A and B raised it', 'A and the weather add 3'): the name first, then its
     conjuncts (any conjunct, named or not: a number said of them is a sum)."""
     head = token
     while head.dep_ == "conj":
         head = head.head
+    if head.pos_ not in ("NOUN", "PROPN") and head.ent_type_ != "FEATURE":
+        return [token]  # ('lowered it a little, and wind speed ...': a parse's slip, not a list of names)
     group = [
         t
         for t in head.subtree
@@ -90,7 +100,9 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         word = anchor.text
         if c.negated:
             return Claim("direction", word, "unchecked", "a negated direction")
-        signed = [t for t in anchor.subtree if t.ent_type_ == "NUM" and t._.numform == "signed"]
+        signed = [
+            t for t in anchor.subtree if t.ent_type_ == "NUM" and t._.numform == "signed" and _verb_of(t) == anchor
+        ]
         if signed:
             return Claim("direction", word, "unchecked", f"its number's sign ({signed[0].text}) says the way")
         polarity, where = c.polarity, ctx

@@ -39,6 +39,11 @@ def lexicon() -> dict:
         elif isinstance(words, dict):
             out[key] = {str(k).lower(): int(v) for k, v in words.items()}
         else:
-            words = [str(w).lower() for w in words]
+            bad = [w for w in words if not isinstance(w, str)]
+            if bad:
+                raise ValueError(
+                    f"lexicon.yaml: '{key}' holds {bad}, not words: quote them (YAML reads yes/no/off as booleans)"
+                )
+            words = [w.lower() for w in words]
             out[key] = sorted({f for w in words for f in forms(w)}) if key in _VERB_LISTS else words
     return out

@@ -103,7 +103,16 @@ def candidates(doc) -> list[Candidate]:
         roles = {node["RIGHT_ID"]: i for node, i in zip(rule.pattern, ids)}
         anchor = next(roles[k] for k in ("num", "dir", "rank", "word") if k in roles)
         out.append(_reading(rule, doc, roles["name"], anchor, roles))
-    return out
+    return [c for c in out if not (_dir_is_led(c.rule) and _own_subject(doc, c))]
+
+
+def _dir_is_led(rule: Rule) -> bool:
+    """Is the direction word reached from another verb (a participle, 'adding ...'), not the pattern's root?"""
+    return (
+        rule.claim == "direction"
+        and rule.kind == "dependency"
+        and any(n["RIGHT_ID"] == "dir" and "LEFT_ID" in n for n in rule.pattern)
+    )
 
 
 def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
@@ -155,3 +164,14 @@ def _reading(rule: Rule, doc, name: int, anchor: int, roles: dict) -> Candidate:
     verb = doc[anchor] if rule.claim == "direction" else doc[name].head
     negated = any(c.dep_ == "neg" or c.lower_ in lex["negations"] for c in verb.children)
     return Candidate(rule, name, anchor, polarity, rank, negated)
+
+
+def _own_subject(doc, candidate: Candidate) -> bool:
+    """Does a led direction verb belong to another name: a subject of its own that is not its name's phrase, or
+    another name nearer before it ('A lowered it, and B pushed it up': 'pushed' is B's, not A's)?"""
+    verb, name = doc[candidate.anchor], doc[candidate.name]
+    subjects = [c for c in verb.children if c.dep_ in ("nsubj", "nsubjpass", "csubj")]
+    if subjects and not any(name.i in {t.i for t in s.subtree} for s in subjects):
+        return True
+    nearest = [t.i for t in doc[: verb.i] if t.ent_type_ == "FEATURE"]
+    return bool(nearest) and nearest[-1] != name.i
