@@ -116,7 +116,7 @@ def _checked(s: Sentence, decisions: list[Decision], names, book, unit_of, known
         made = check.claim(d.winner, s, book, unit_of, ctx, known)
         if made is not None:
             out.append(made)
-        if d.winner.rule.claim in ("number", "skip"):
+        if d.winner.rule.claim in ("number", "output", "net", "skip"):
             bound.add(d.winner.anchor)
     named = {k for t in names for k in t._.keys}
     for t in s.doc:

@@ -13,7 +13,7 @@ from ..narrators.verify.book import FactBook
 from ..narrators.verify.checks import EITHER, Claim, check_direction, over_keys, resolve_action
 from ..narrators.verify.comparisons import check_comparison
 from ..narrators.verify.names import Mention
-from ..narrators.verify.numbers import matches
+from ..narrators.verify.numbers import matches, percent_reading
 from ..narrators.verify.quantities import feature_number
 from ..narrators.verify.vocabulary import split_words, stem
 from .lexicon import lexicon
@@ -66,7 +66,9 @@ def coordinated(token) -> list:
 def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: frozenset) -> Claim | None:
     """The claim a resolved reading makes, checked; contradicted only where its name is sure (module doc). ``known``:
     the words of every name and description (a phrase with one of them may mean a feature in other words)."""
-    if c.rule.claim == "comparison":
+    if c.rule.claim in ("output", "net"):
+        made = _output(s.doc[c.anchor]._.number, c.rule.claim, book)
+    elif c.rule.claim == "comparison":
         a, b = s.doc[c.name], s.doc[c.other]
         if len(b._.keys) != 1 or len(coordinated(a)) > 1:
             return None
@@ -141,6 +143,27 @@ def label_claim(token, book: FactBook, named: set[str]) -> Claim | None:
         return Claim("category", token.text, "verified", f"{key} is {actual}", "category.label")
     status = "contradicted" if key in named else "unchecked"
     return Claim("category", token.text, status, f"{key} is {actual}, not {token._.label}", "category.label")
+
+
+def _output(n, what: str, book: FactBook) -> Claim:
+    """A number said of the output ('the estimate lands at 12.4 %') or of its net change from the baseline: verified
+    when it states one (of any action, the baseline, the margin), contradicted when it states none."""
+    scores = list(book.scores.values())
+    if what == "net":
+        facts = [s - book.base for s in scores] if book.base is not None else []
+        facts += [book.margin] if book.margin is not None else []
+    else:
+        facts = [*scores, *([book.base] if book.base is not None else []), *book.decision_numbers]
+    if not facts:
+        return Claim("number", n.text, "unchecked", "no output to compare with")
+    ok = any(matches(n, f, magnitude_ok=what == "net") or (n.percent and percent_reading(n, f)) for f in facts)
+    told = ", ".join(f"{f:.4g}" for f in facts[:3])
+    return Claim(
+        "number",
+        n.text,
+        "verified" if ok else "contradicted",
+        f"the {'net change' if what == 'net' else 'output'}: {told}",
+    )
 
 
 def free_number(token, book: FactBook) -> Claim:

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 from .rules import Candidate
 
+_NUMBERS = ("number", "output", "net", "skip")  # claims on a number: they compete for it
+
 
 @dataclass(frozen=True)
 class Decision:
@@ -19,8 +21,8 @@ class Decision:
 def resolve(candidates: list[Candidate]) -> list[Decision]:
     """Group the candidates by (claim, anchor) and pick one per group; in the order of the anchors."""
     groups: dict[tuple[str, int], list[Candidate]] = defaultdict(list)
-    for c in candidates:  # a skip rule competes with the number rules for its numbers
-        groups[("number" if c.rule.claim == "skip" else c.rule.claim, c.anchor)].append(c)
+    for c in candidates:
+        groups[("number" if c.rule.claim in _NUMBERS else c.rule.claim, c.anchor)].append(c)
     out = []
     for key in sorted(groups, key=lambda k: k[1]):
         group = sorted(set(groups[key]), key=lambda c: (-c.rule.priority, abs(c.name - c.anchor), c.rule.id))

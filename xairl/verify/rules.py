@@ -20,12 +20,13 @@ from .lexicon import RULES_DIR, lexicon
 @dataclass(frozen=True, eq=False)
 class Rule:
     id: str
-    claim: str  # number | direction | rank | comparison | category | invented | skip
+    claim: str  # number | output | net | direction | rank | comparison | category | invented | skip
     binding: str  # adjacent | grammar
     priority: int
     pattern: list
     kind: str  # token | dependency
     polarity: str = ""
+    same_clause: tuple = ()
     fires: tuple = ()
     silent: tuple = ()
 
@@ -70,6 +71,7 @@ def table() -> tuple[Rule, ...]:
                 _expand(entry[kind]),
                 kind,
                 entry.get("polarity", ""),
+                tuple(entry.get("same_clause", ())),
                 tuple(tuple(x) for x in entry.get("fires", ())),
                 tuple(tuple(x) for x in entry.get("silent", ())),
             )
@@ -101,9 +103,21 @@ def candidates(doc) -> list[Candidate]:
     for match_id, ids in dependency(doc):
         rule = by_id()[doc.vocab.strings[match_id]]
         roles = {node["RIGHT_ID"]: i for node, i in zip(rule.pattern, ids)}
+        if rule.same_clause and _clause_between(doc, *(roles[k] for k in rule.same_clause)):
+            continue
         anchor = next(roles[k] for k in ("num", "dir", "rank", "word") if k in roles)
         out.append(_reading(rule, doc, roles["name"], anchor, roles))
     return [c for c in out if not (_dir_is_led(c.rule) and _own_subject(doc, c))]
+
+
+def _clause_between(doc, top: int, below: int) -> bool:
+    """Is there a verb with a subject of its own on the way up from ``below`` to ``top`` (a relative clause)?"""
+    t = doc[below].head
+    while t.i != top and t.head.i != t.i:
+        if t.pos_ in ("VERB", "AUX") and any(c.dep_ in ("nsubj", "nsubjpass", "csubj") for c in t.children):
+            return True
+        t = t.head
+    return False
 
 
 def _dir_is_led(rule: Rule) -> bool:
@@ -121,6 +135,11 @@ def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
     nums = [i for i in span if doc[i].ent_type_ == "NUM"]
     if rule.claim == "skip":  # every number it matches is left unchecked
         return [Candidate(rule, i, i) for i in nums]
+    if rule.claim in ("output", "net"):  # a number of the output: its word heads its own phrase ('the forecast
+        before = doc[start - 1] if start else None  # is 52', not 'the wind forecast of 3')
+        if not nums or (before is not None and (before.pos_ in ("NOUN", "PROPN", "ADJ", "NUM") or before.ent_type_)):
+            return []
+        return [Candidate(rule, nums[-1], nums[-1])]
     if not names:
         return []
     if rule.claim == "number":
