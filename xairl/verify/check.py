@@ -95,7 +95,8 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         return Claim("number", anchor.text, "unchecked", "a ratio, a pair or a part of a total")
     together = coordinated(name)
     if c.rule.claim == "number":
-        if len(together) > 1:
+        verb = _verb_of(anchor)
+        if len(together) > 1 or any(t.lower_ in lexicon()["together"] for t in verb.children):
             return Claim("number", anchor.text, "unchecked", "said of several features together")
         return feature_number(anchor._.number, keys, s.masked, book, ctx, unit_of)
     if c.rule.claim == "direction":
@@ -206,11 +207,13 @@ def _category(name, word, book: FactBook, known: frozenset) -> Claim | None:
     said = " ".join(t.text for t in tokens).replace(" - ", "-")
     if word.lower_ in lex["plain_modifiers"] or word.lower_ in lex["generic"] or word.lower_ in lex["stated_as"]:
         return None
-    if len(tokens) > 4:
+    if word.pos_ == "VERB" and word.dep_ == "amod" and not any(t.text == "-" for t in tokens):
+        return None  # a verb as a modifier is a value only in a compound ('north-facing'), not 'outweighs'
+    if len(tokens) > 4 or any(t.ent_type_ == "NUM" and t._.numform != "word" for t in tokens):
         return None
     label_words, said_words = _words(label), _words(said) - _words(key) - set(lex["plain_modifiers"])
-    if not said_words:
-        return None
+    if not said_words or (said_words <= known and not said_words & label_words):
+        return None  # words of the names and descriptions ('the IP geolocation check'): no value said
     negated = label_words & {"non", "no", "not", "un", "without"}
     if said_words <= label_words | _words(key) and (not negated or said_words & negated):
         return Claim("category", said, "verified", f"{key} is {label}")
