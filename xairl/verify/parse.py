@@ -46,6 +46,18 @@ def numform(n: Number) -> str:
     return "decimal" if n.unit < 1 or n.percent else "integer"
 
 
+def _split_at(doc: Doc, cuts: set[int]) -> Doc:
+    """``doc`` with its tokens cut where a name or a number starts or ends inside one ('pm2_5_lag1=48.2' is a name,
+    '=' and a number), so that each becomes a token of its own."""
+    words, spaces = [], []
+    for t in doc:
+        inner = sorted(c - t.idx for c in cuts if t.idx < c < t.idx + len(t.text))
+        pieces = [t.text[a:b] for a, b in zip([0, *inner], [*inner, len(t.text)])]
+        words += pieces
+        spaces += [False] * (len(pieces) - 1) + [bool(t.whitespace_)]
+    return doc if len(words) == len(doc) else Doc(doc.vocab, words=words, spaces=spaces)
+
+
 def _hedged(text: str, n: Number) -> int:
     """Where a number's token starts: at its hedge, when it has one ('by about 0.4' is 'by' + one number), so the
     parser does not read the hedge as a preposition of its own."""
@@ -63,7 +75,10 @@ def parse(pieces: list[tuple[int, str]], vocab) -> list[Sentence]:
     for start, text in pieces:
         mentions, masked = find_mentions(text, vocab)
         numbers = find_numbers(masked)
-        doc = nlp.make_doc(text)
+        doc = _split_at(
+            nlp.make_doc(text),
+            {b for m in mentions for b in (m.start, m.end)} | {b for n in numbers for b in (_hedged(text, n), n.end)},
+        )
         taken: set[int] = set()
         with doc.retokenize() as retokenizer:
             spans = [

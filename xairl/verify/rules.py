@@ -131,7 +131,7 @@ def _dir_is_led(rule: Rule) -> bool:
 
 def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
     span = range(start, end)
-    names = [i for i in span if doc[i].ent_type_ == "FEATURE"]
+    names = [i for i in span if doc[i].ent_type_ in ("FEATURE", "LABEL")]
     nums = [i for i in span if doc[i].ent_type_ == "NUM"]
     if rule.claim == "skip":  # every number it matches is left unchecked
         return [Candidate(rule, i, i) for i in nums]
@@ -145,8 +145,8 @@ def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
     if rule.claim == "number":
         if not nums:
             return []
-        name = min(names, key=lambda i: abs(i - nums[0]))
-        return [_reading(rule, doc, name, nums[0], {})]
+        name = min(names, key=lambda i: abs(i - nums[-1]))  # the last number: 'A=48.2 -> +14.7' says +14.7 of A
+        return [_reading(rule, doc, name, nums[-1], {})]
     if rule.claim == "comparison":  # the first name against the last, at the comparative
         way = next(i for i in span if doc[i].lower_ in lexicon()["more"] + lexicon()["less"])
         polarity = 1 if doc[way].lower_ in lexicon()["more"] else -1
