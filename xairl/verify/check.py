@@ -98,7 +98,13 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         verb = _verb_of(anchor)
         if len(together) > 1 or any(t.lower_ in lexicon()["together"] for t in verb.children):
             return Claim("number", anchor.text, "unchecked", "said of several features together")
-        return feature_number(anchor._.number, keys, s.masked, book, ctx, unit_of)
+        made = feature_number(anchor._.number, keys, s.masked, book, ctx, unit_of)
+        if made.status == "contradicted" and book.in_percent:  # '+0.096' for 9.6 points of a percent output
+            n = anchor._.number
+            scaled = replace(n, value=n.value * 100, unit=n.unit * 100, alternatives=())
+            again = feature_number(scaled, keys, s.masked, book, ctx, unit_of)
+            made = again if again.status == "verified" else made
+        return made
     if c.rule.claim == "direction":
         word = anchor.text
         if c.negated:
@@ -207,7 +213,10 @@ def _category(name, word, book: FactBook, known: frozenset) -> Claim | None:
     said = " ".join(t.text for t in tokens).replace(" - ", "-")
     if word.lower_ in lex["plain_modifiers"] or word.lower_ in lex["generic"] or word.lower_ in lex["stated_as"]:
         return None
-    if word.pos_ == "VERB" and word.dep_ == "amod" and not any(t.text == "-" for t in tokens):
+    if any(ch.isdigit() for ch in said):
+        return None  # an id or a count ('T-90577', 'P3'), not a value's words
+    compound = word.tag_ in ("VBN", "VBG") and any(t.text == "-" for t in tokens)
+    if word.pos_ == "VERB" and word.dep_ == "amod" and not compound:
         return None  # a verb as a modifier is a value only in a compound ('north-facing'), not 'outweighs'
     if len(tokens) > 4 or any(t.ent_type_ == "NUM" and t._.numform != "word" for t in tokens):
         return None
