@@ -247,14 +247,19 @@ def _invented(subject, verb, known: frozenset) -> Claim | None:
     lex = lexicon()
     tokens = list(subject.subtree)
     if (
-        any(t.ent_type_ in ("FEATURE", "ACTION", "LABEL", "NUM") for t in tokens)
+        any(t.ent_type_ in ("FEATURE", "ACTION", "LABEL") for t in tokens)
+        or any(t.ent_type_ == "NUM" and "appos" not in (t.dep_, t.head.dep_) for t in tokens)
         or subject.lower_ in lex["vague"]
         or subject.tag_ == "VBG"
         or any(t.lower_ in lex["pointing"] for t in tokens)
     ):  # a name, a value, the output, a gerund, or a phrase that points back ('your coupe', 'those two facts')
         return None
-    content = [t for t in tokens if t.pos_ in ("NOUN", "PROPN", "ADJ") and t.lower_ not in lex["generic"]]
-    if len(content) < 2 or any(w in known for t in content for w in _words(t.text)):
+    owners = {t.i for c in subject.children if c.dep_ == "poss" for t in c.subtree}  # 'the wine's' of 'the wine's
+    content = [  # tannin level': whose, not what
+        t for t in tokens if t.pos_ in ("NOUN", "PROPN", "ADJ") and t.lower_ not in lex["generic"] and t.i not in owners
+    ]
+    nouns = [t for t in content if t.pos_ != "ADJ"]
+    if len(content) < 2 or not nouns or any(w in known for t in nouns for w in _words(t.text)):
         return None  # one plain noun ('the sunshine', 'youth') is more often a paraphrase than a new input
     phrase = " ".join(t.text for t in tokens)
     return Claim("feature", phrase, "contradicted", f"'{phrase}' {verb.text}: it names no input of the explanation")
