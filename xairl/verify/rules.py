@@ -103,6 +103,9 @@ def candidates(doc) -> list[Candidate]:
     for match_id, ids in dependency(doc):
         rule = by_id()[doc.vocab.strings[match_id]]
         roles = {node["RIGHT_ID"]: i for node, i in zip(rule.pattern, ids)}
+        if rule.claim == "comparison":  # 'A outweighed B'
+            out.append(Candidate(rule, roles["name"], roles["way"], 1, other=roles["other"]))
+            continue
         if rule.same_clause and _clause_between(doc, *(roles[k] for k in rule.same_clause)):
             continue
         anchor = next(roles[k] for k in ("num", "dir", "rank", "word") if k in roles)
@@ -179,6 +182,8 @@ def _reading(rule: Rule, doc, name: int, anchor: int, roles: dict) -> Candidate:
     if rule.claim == "rank":
         start, end = roles.get("span", (anchor, anchor + 1))
         words = [doc[i].lower_ for i in range(start, end)]
+        if "attr" in roles:  # 'the second-largest factor': the ordinal is a modifier of the noun or of the superlative
+            words += [t.lower_ for t in doc[roles["attr"]].children] + [t.lower_ for t in doc[anchor].children]
         rank = next((lex["ordinals"][w] for w in words if w in lex["ordinals"]), 1)
     verb = doc[anchor] if rule.claim == "direction" else doc[name].head
     negated = any(c.dep_ == "neg" or c.lower_ in lex["negations"] for c in verb.children)
