@@ -13,7 +13,17 @@ def test_every_rule_has_an_id_a_pattern_a_claim_and_examples():
     ids = [r.id for r in RULES]
     assert len(ids) == len(set(ids))
     for r in RULES:
-        assert r.claim in ("number", "output", "net", "direction", "rank", "comparison", "category", "invented", "skip") and r.binding in ("adjacent", "grammar")
+        assert r.claim in (
+            "number",
+            "output",
+            "net",
+            "direction",
+            "rank",
+            "comparison",
+            "category",
+            "invented",
+            "skip",
+        ) and r.binding in ("adjacent", "grammar")
         assert r.pattern and r.fires, r.id
         if r.kind == "dependency":
             roles = {node["RIGHT_ID"] for node in r.pattern}
