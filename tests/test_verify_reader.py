@@ -71,3 +71,11 @@ def test_xairl_verify_stays_the_public_verifier_after_the_package_is_imported():
     for verifier in (xairl.verify, package):
         assert verifier("pm2_5_lag1 (+14.7) raised the forecast.", example("air"), 0).accurate
     assert callable(xairl.verify) and package.read is read
+
+
+def test_tokens_show_names_and_numbers_as_the_rules_see_them():
+    from xairl.verify import tokens
+
+    (sentence,) = tokens("The effect of the traffic index was +7.2.", example("air"))
+    kinds = {text: kind for text, kind, _, _ in sentence}
+    assert kinds["traffic index"] == "FEATURE" and kinds["+7.2"] == "NUM" and kinds["effect"] == ""

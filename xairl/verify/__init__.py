@@ -31,10 +31,11 @@ from ..narrators.verify.vocabulary import vocabulary
 from ..policy import Policy
 from ..regions import in_regions
 from . import check, rules
-from .parse import Sentence, parse
+from .parse import Sentence
+from .parse import parse as parse_sentences
 from .resolve import Decision, resolve
 
-__all__ = ["read", "trace"]
+__all__ = ["read", "trace", "tokens"]
 
 
 class _CallableModule(types.ModuleType):
@@ -73,6 +74,13 @@ def trace(text: str, explanation: Explanation, index: int = 0, policy: Policy | 
     return lines
 
 
+def tokens(text: str, explanation: Explanation, index: int = 0, policy: Policy | None = None) -> list[list[tuple]]:
+    """What the rules see, per sentence: (token, ENT_TYPE, dependency, head) for each token, names and numbers merged
+    (the first step of adding a rule, docs/verifier.md)."""
+    sentences_ = _prepare(text, explanation, index, policy)[0]
+    return [[(t.text, t.ent_type_, t.dep_, t.head.text) for t in s.doc] for s in sentences_]
+
+
 def _prepare(text, explanation, index, policy):
     if not isinstance(text, str):
         raise InputError(f"read() takes text (a str), not {type(text).__name__}: decode it first.")
@@ -90,7 +98,7 @@ def _prepare(text, explanation, index, policy):
         return info.unit if info and info.unit else unit_in_name(f)
 
     pieces = [(a, text[a:b]) for a, b in sentences(text)]
-    return parse(pieces, vocab), book, unit_of, note, vocab.name_words
+    return parse_sentences(pieces, vocab), book, unit_of, note, vocab.name_words
 
 
 def _claims(s: Sentence, book, unit_of, known) -> tuple[list[Claim], list[Decision]]:
