@@ -106,8 +106,8 @@ def _claims(s: Sentence, book, unit_of, known) -> tuple[list[Claim], list[Decisi
     the reader leaves the sentence unchecked with the reason: never an exception to the caller."""
     names = [t for t in s.doc if t.ent_type_ == "FEATURE"]
     out = [Claim("feature", t.text, "verified", " / ".join(t._.keys), "names.mention") for t in names]
-    if s.text.rstrip().endswith("?"):  # a question asserts nothing
-        return out, []
+    if s.text.rstrip().endswith("?") or not any(t.ent_type_ for t in s.doc):
+        return out, []  # a question asserts nothing; a sentence with no name nor number gives no rule a hold
     try:
         decisions = resolve(rules.candidates(s.doc))
         return out + _checked(s, decisions, names, book, unit_of, known), decisions

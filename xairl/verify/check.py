@@ -109,9 +109,7 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         word = anchor.text
         if c.negated:
             return Claim("direction", word, "unchecked", "a negated direction")
-        signed = [
-            t for t in anchor.subtree if t.ent_type_ == "NUM" and t._.numform == "signed" and _verb_of(t) == anchor
-        ]
+        signed = [t for t in anchor.subtree if t.ent_type_ == "NUM" and t.ent_id_ == "signed" and _verb_of(t) == anchor]
         if signed:
             return Claim("direction", word, "unchecked", f"its number's sign ({signed[0].text}) says the way")
         polarity, where = c.polarity, ctx
@@ -218,7 +216,7 @@ def _category(name, word, book: FactBook, known: frozenset) -> Claim | None:
     compound = word.tag_ in ("VBN", "VBG") and any(t.text == "-" for t in tokens)
     if word.pos_ == "VERB" and word.dep_ == "amod" and not compound:
         return None  # a verb as a modifier is a value only in a compound ('north-facing'), not 'outweighs'
-    if len(tokens) > 4 or any(t.ent_type_ == "NUM" and t._.numform != "word" for t in tokens):
+    if len(tokens) > 4 or any(t.ent_type_ == "NUM" and t.ent_id_ != "word" for t in tokens):
         return None
     label_words, said_words = _words(label), _words(said) - _words(key) - set(lex["plain_modifiers"])
     if not said_words or (said_words <= known and not said_words & label_words):

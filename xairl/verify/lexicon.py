@@ -36,6 +36,8 @@ def lexicon() -> dict:
     for key, words in raw.items():
         if key == "closed_classes":
             out[key] = [frozenset(str(w).lower() for w in group) for group in words]
+        elif key == "tag_pos":
+            out[key] = {str(k): str(v) for k, v in words.items()}
         elif isinstance(words, dict):
             out[key] = {str(k).lower(): int(v) for k, v in words.items()}
         else:

@@ -3,7 +3,8 @@
 A name found by the vocabulary (any spelling of a feature, an action's verb forms, a categorical value's label) and a
 number as people write it ('+$1,204', '~12 %', 'minus 0.4') become one token, with ``ENT_TYPE`` FEATURE, ACTION,
 LABEL or NUM and the custom attributes ``keys`` (the features or actions it may mean), ``label``, ``form`` ('part':
-a run of a longer name's words), ``number`` (the :class:`Number` read) and ``numform`` (:func:`numform`). The rules (rules.py) match these tokens, so a pattern never spells a name or a number.
+a run of a longer name's words) and ``number`` (the :class:`Number` read); a number's ``ENT_ID`` is how it is
+written (:func:`numform`). The rules (rules.py) match these tokens, so a pattern never spells a name or a number.
 Every sentence of a text is parsed in one ``nlp.pipe``-style batch.
 """
 
@@ -18,7 +19,7 @@ from ..narrators.verify.numbers import Number, find_numbers
 from ..narrators.verify.parse import _symbol_runs, pipeline
 from .lexicon import lexicon
 
-for _attr, _default in (("keys", ()), ("label", ""), ("number", None), ("form", ""), ("numform", "")):
+for _attr, _default in (("keys", ()), ("label", ""), ("number", None), ("form", "")):
     if not Token.has_extension(_attr):
         Token.set_extension(_attr, default=_default)
 
@@ -82,21 +83,28 @@ def parse(pieces: list[tuple[int, str]], vocab) -> list[Sentence]:
         taken: set[int] = set()
         with doc.retokenize() as retokenizer:
             spans = [
-                (m.start, m.end, _KIND[m.kind], {"keys": m.keys, "label": m.label, "form": m.form}) for m in mentions
+                (m.start, m.end, _KIND[m.kind], {"keys": m.keys, "label": m.label, "form": m.form}, "")
+                for m in mentions
             ]
-            spans += [(_hedged(text, n), n.end, "NUM", {"number": n, "numform": numform(n)}) for n in numbers]
-            for a, b, kind, ext in sorted(spans, key=lambda s: s[0]):
+            spans += [(_hedged(text, n), n.end, "NUM", {"number": n}, numform(n)) for n in numbers]
+            for a, b, kind, ext, form in sorted(spans, key=lambda s: s[0]):
                 span = doc.char_span(a, b, alignment_mode="expand")
                 if span is None or taken & set(range(span.start, span.end)):
                     continue
                 taken |= set(range(span.start, span.end))
-                retokenizer.merge(span, attrs={"ENT_TYPE": kind, "ENT_IOB": 3, "_": ext})
+                retokenizer.merge(span, attrs={"ENT_TYPE": kind, "ENT_ID": form, "ENT_IOB": 3, "_": ext})
             for a, b in _symbol_runs(doc, taken):
                 retokenizer.merge(doc[a:b])
         out.append(Sentence(text, start, doc, masked, mentions, numbers))
     docs = [s.doc for s in out]
-    for _, component in nlp.pipeline:
-        docs = list(component.pipe(docs)) if hasattr(component, "pipe") else [component(d) for d in docs]
+    for name, component in nlp.pipeline:
+        if name != "attribute_ruler":  # (its tag -> part-of-speech map is a lookup below)
+            docs = list(component.pipe(docs)) if hasattr(component, "pipe") else [component(d) for d in docs]
+    lex = lexicon()
+    for d in docs:
+        for t in d:
+            pos = lex["tag_pos"].get(t.tag_, "X")
+            t.pos_ = "AUX" if pos == "VERB" and t.lower_ in lex["auxiliaries"] else pos
     for s, d in zip(out, docs):
         s.doc = d
     return out
