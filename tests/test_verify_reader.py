@@ -79,3 +79,19 @@ def test_tokens_show_names_and_numbers_as_the_rules_see_them():
     (sentence,) = tokens("The effect of the traffic index was +7.2.", example("air"))
     kinds = {text: kind for text, kind, _, _ in sentence}
     assert kinds["traffic index"] == "FEATURE" and kinds["+7.2"] == "NUM" and kinds["effect"] == ""
+
+
+def test_no_sentence_of_the_tuning_voices_breaks_the_reader():
+    """Every narrative of two tuning files (outside voices: logs, letters, tables, Q&A) is read without a reader
+    failure: a failure would leave its sentence unchecked, silently (the reader never raises)."""
+    from benchmarks.bench_heldout import HELDOUT, load
+
+    items = [it for name in ("voices_a", "voices_h") for it in load(HELDOUT / "tuning" / f"{name}.yaml")]
+    failed = [
+        (it["text"], c.detail)
+        for it in items
+        if not it["wrong_facts"]
+        for c in read(it["text"], it["explanation"], 0).claims
+        if c.kind == "internal"
+    ]
+    assert len(items) > 200 and not failed, failed[:3]

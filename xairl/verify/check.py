@@ -120,8 +120,10 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
                 polarity, where = -polarity, "margin"
             elif meant != book.chosen:
                 return Claim("direction", word, "unchecked", "toward an action neither chosen nor runner-up")
-        named = [t for t in together if t.ent_type_ == "FEATURE"]
+        named = [t for t in together if t.ent_type_ in ("FEATURE", "LABEL") and t._.keys]
         checked = check_direction([_mention(t) for t in named], polarity, where, word, book)
+        if not checked:
+            return Claim("direction", word, "unchecked", "said of no name")
         return next((x for x in checked if x.status == "contradicted"), checked[0])
     return _rank(keys, c.rank, anchor.text, book)
 

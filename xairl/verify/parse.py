@@ -59,6 +59,15 @@ def _split_at(doc: Doc, cuts: set[int]) -> Doc:
     return doc if len(words) == len(doc) else Doc(doc.vocab, words=words, spaces=spaces)
 
 
+def _with_unit(text: str, n: Number) -> int:
+    """Where a number's token ends: after the unit written right after it ('about 900 kW'), if there is one."""
+    rest = text[n.end :]
+    bare = rest.split(maxsplit=1)[0].rstrip(".,;:)") if rest.strip() else ""
+    if not bare or bare.lower() not in lexicon()["units"] or rest.find(bare) > 1:
+        return n.end
+    return n.end + rest.find(bare) + len(bare)
+
+
 def _hedged(text: str, n: Number) -> int:
     """Where a number's token starts: at its hedge, when it has one ('by about 0.4' is 'by' + one number), so the
     parser does not read the hedge as a preposition of its own."""
@@ -78,7 +87,8 @@ def parse(pieces: list[tuple[int, str]], vocab) -> list[Sentence]:
         numbers = [n for n in find_numbers(masked) if not (n.start and masked[n.start - 1].isalnum())]  # ('PM2.5')
         doc = _split_at(
             nlp.make_doc(text),
-            {b for m in mentions for b in (m.start, m.end)} | {b for n in numbers for b in (_hedged(text, n), n.end)},
+            {b for m in mentions for b in (m.start, m.end)}
+            | {b for n in numbers for b in (_hedged(text, n), _with_unit(text, n))},
         )
         taken: set[int] = set()
         with doc.retokenize() as retokenizer:
@@ -86,7 +96,7 @@ def parse(pieces: list[tuple[int, str]], vocab) -> list[Sentence]:
                 (m.start, m.end, _KIND[m.kind], {"keys": m.keys, "label": m.label, "form": m.form}, "")
                 for m in mentions
             ]
-            spans += [(_hedged(text, n), n.end, "NUM", {"number": n}, numform(n)) for n in numbers]
+            spans += [(_hedged(text, n), _with_unit(text, n), "NUM", {"number": n}, numform(n)) for n in numbers]
             for a, b, kind, ext, form in sorted(spans, key=lambda s: s[0]):
                 span = doc.char_span(a, b, alignment_mode="expand")
                 if span is None or taken & set(range(span.start, span.end)):
