@@ -9,7 +9,7 @@ from pathlib import Path
 import yaml
 
 RULES_DIR = Path(__file__).parent / "rules"
-_VERB_LISTS = ("up", "down", "phrasal", "output_up", "output_down", "outweigh")
+_VERB_LISTS = ("up", "down", "phrasal", "output_up", "output_down", "outweigh", "give")
 
 
 def forms(word: str) -> set[str]:

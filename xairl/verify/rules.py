@@ -177,6 +177,8 @@ def _reading(rule: Rule, doc, name: int, anchor: int, roles: dict) -> Candidate:
             polarity = 1 if word in lex["sign_up"] else -1
         elif rule.polarity == "output":
             polarity = 1 if word in lex["output_up"] else -1
+        elif rule.polarity == "noun":
+            polarity = 1 if word in lex["noun_up"] else -1
         else:
             polarity = 1 if word in lex["up"] else -1
     if rule.claim == "rank":
