@@ -139,8 +139,12 @@ def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
     if rule.claim == "skip":  # every number it matches is left unchecked
         return [Candidate(rule, i, i) for i in nums]
     if rule.claim in ("output", "net"):  # a number of the output: its word heads its own phrase ('the forecast
-        before = doc[start - 1] if start else None  # is 52', not 'the wind forecast of 3')
-        if not nums or (before is not None and (before.pos_ in ("NOUN", "PROPN", "ADJ", "NUM") or before.ent_type_)):
+        before = doc[start - 1] if start else None  # is 52', not 'the wind forecast of 3' nor 'raised the forecast:
+        if (  # +7.2', where the output is an object)
+            not nums
+            or doc[start].dep_ in ("dobj", "pobj", "dative")
+            or (before is not None and (before.pos_ in ("NOUN", "PROPN", "ADJ", "NUM") or before.ent_type_))
+        ):
             return []
         return [Candidate(rule, nums[-1], nums[-1])]
     if not names:
