@@ -15,6 +15,9 @@ are read here:
     .venv/bin/python benchmarks/bench_heldout.py                 # every file, held-out and tuning apart
     .venv/bin/python benchmarks/bench_heldout.py --show tuning   # also every disagreement of the tuning files
     .venv/bin/python benchmarks/bench_heldout.py --tuning-only --show tuning   # while tuning: no held-out figure
+    .venv/bin/python benchmarks/bench_heldout.py --reader new --rules   # the rule-table reader (xairl.verify.read),
+        # and per rule and file: the claims it made, the labelled errors it contradicted, the accurate texts it
+        # falsely contradicted (what a new rule's note reports before it is kept)
 """
 
 from __future__ import annotations
@@ -86,8 +89,7 @@ def _name(path: pathlib.Path) -> str:
     return f"{'tuning' if path.parent.name == 'tuning' else 'held out'}: {path.stem}"
 
 
-def run(items: list[dict], reader=None) -> None:
-    reader = reader or xairl.verify
+def run(items: list[dict], reader) -> None:
     for it in items:
         t = time.perf_counter()
         it["result"] = reader(it["text"], it["explanation"], 0)
@@ -141,7 +143,28 @@ def report(items: list[dict], show: str | None) -> None:
     )
 
 
-def long_text(items: list[dict], words: int = 1000) -> None:
+def rule_effects(items: list[dict]) -> None:
+    """Per rule of the table and per file: claims made / labelled errors contradicted / accurate texts falsely
+    contradicted (only the rule-table reader names its rules by the table)."""
+    from xairl.verify import rules
+
+    files = sorted({it["file"] for it in items})
+    made = collections.Counter()
+    for it in items:
+        if it["wrong_facts"]:
+            continue
+        for c in it["result"].claims:
+            made[(c.rule, it["file"])] += 1
+        for rule in {c.rule for c in it["result"].claims if c.status == "contradicted"}:
+            made[(rule, it["file"], "caught" if not it["accurate"] else "false")] += 1
+    print("\n| rule | " + " | ".join(f.split(": ")[1] for f in files) + " |  (claims / errors caught / false)")
+    print("|---|" + "---|" * len(files))
+    for r in rules.table():
+        cells = [f"{made[(r.id, f)]}/{made[(r.id, f, 'caught')]}/{made[(r.id, f, 'false')]}" for f in files]
+        print(f"| {r.id} | " + " | ".join(cells) + " |")
+
+
+def long_text(items: list[dict], reader, words: int = 1000) -> None:
     """A 1,000-word narrative (one case's accurate texts, repeated, one paragraph each) verified after the model is
     loaded: the median of 5 runs (target 50 ms). Measured twice: as written (line breaks kept, so a bullet list is a
     list of sentences) and flattened onto one line (a list becomes one run-on sentence: the worst case)."""
@@ -156,7 +179,7 @@ def long_text(items: list[dict], words: int = 1000) -> None:
         runs = []
         for _ in range(5):
             t = time.perf_counter()
-            xairl.verify(written, items[0]["explanation"], 0)
+            reader(written, items[0]["explanation"], 0)
             runs.append(time.perf_counter() - t)
         print(f"a {words}-word narrative ({case}, {shape}): median {1000 * statistics.median(runs):.0f} ms over 5 runs")
 
@@ -181,6 +204,7 @@ def main() -> None:
         default="old",
         help="new: xairl.verify.read (issue 54's rule-table reader); old: xairl.verify, the reader in use",
     )
+    ap.add_argument("--rules", action="store_true", help="with --reader new: each rule's effect per file")
     args = ap.parse_args()
     files = ([] if args.tuning_only else sorted(HELDOUT.glob("*.yaml"))) + sorted(HELDOUT.glob("tuning/*.yaml"))
     items = [it for path in files for it in load(path)]
@@ -190,13 +214,14 @@ def main() -> None:
     parse.pipeline()
     print(f"spaCy model load: {time.perf_counter() - t:.2f} s")
     if args.reader == "new":
-        from xairl.verify import read
-
-        run(items, read)
+        from xairl.verify import read as reader
     else:
-        run(items)
+        from xairl.narrators import verify as reader
+    run(items, reader)
     report(items, args.show)
-    long_text(items)
+    if args.rules and args.reader == "new":
+        rule_effects(items)
+    long_text(items, reader)
 
 
 if __name__ == "__main__":
