@@ -200,7 +200,9 @@ def _own_subject(doc, candidate: Candidate) -> bool:
     """Does a led direction verb belong to another name: a subject of its own that is not its name's phrase, or
     another name nearer before it ('A lowered it, and B pushed it up': 'pushed' is B's, not A's)?"""
     verb, name = doc[candidate.anchor], doc[candidate.name]
-    subjects = [c for c in verb.children if c.dep_ in ("nsubj", "nsubjpass", "csubj")]
+    subjects = [  # ('which', 'it': a pronoun stands for the name)
+        c for c in verb.children if c.dep_ in ("nsubj", "nsubjpass", "csubj") and c.pos_ != "PRON"
+    ]
     if subjects and not any(name.i in {t.i for t in s.subtree} for s in subjects):
         return True
     nearest = [t.i for t in doc[: verb.i] if t.ent_type_ == "FEATURE"]
