@@ -21,6 +21,7 @@ def test_every_rule_has_an_id_a_pattern_a_claim_and_examples():
             "rank",
             "comparison",
             "category",
+            "class",
             "invented",
             "skip",
         ) and r.binding in ("adjacent", "grammar")

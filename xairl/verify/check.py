@@ -73,6 +73,8 @@ def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: f
         if len(b._.keys) != 1 or len(coordinated(a)) > 1:
             return None
         made = check_comparison(tuple(a._.keys), b._.keys[0], c.polarity, ctx, book, s.doc[c.anchor].text)
+    elif c.rule.claim == "class":
+        made = _class(s.doc[c.anchor], s, book)
     elif c.rule.claim == "category":
         made = _category(s.doc[c.name], s.doc[c.anchor], book, known)
     elif c.rule.claim == "invented":
@@ -238,6 +240,27 @@ def _category(name, word, book: FactBook, known: frozenset) -> Claim | None:
     if not value_like or (said_words & label_words and not negated):
         return None
     return Claim("category", said, "contradicted", f"{key} is {label}, not {said}")
+
+
+def _class(word, s: Sentence, book: FactBook) -> Claim | None:
+    """A word of a closed class ('June', 'north', 'late') in a sentence that names exactly one feature whose value is
+    of that class: its value, or another (contradicted). Not a word after 'than', 'since', 'from', 'unlike', nor a
+    sentence that also says the right value ('more than in winter')."""
+    lex = lexicon()
+    group = next((g for g in lex["closed_classes"] if word.lower_ in g), None)
+    named = {k for t in s.doc if t.ent_type_ in ("FEATURE", "LABEL") for k in t._.keys}
+    owners = [
+        k for k in named if book.features.get(k) and book.features[k].label and _words(book.features[k].label) & group
+    ]
+    if group is None or len(owners) != 1 or word.ent_type_ or (word.i and word.nbor(-1).lower_ in lex["set_aside"]):
+        return None
+    key = owners[0]
+    label_words = _words(book.features[key].label)
+    if word.lower_ in label_words:
+        return Claim("category", word.text, "verified", f"{key} is {book.features[key].label}")
+    if any(t.lower_ in label_words & group for t in s.doc):
+        return None  # the right value is said too: a comparison
+    return Claim("category", word.text, "contradicted", f"{key} is {book.features[key].label}, not {word.text}")
 
 
 def _invented(subject, verb, known: frozenset) -> Claim | None:

@@ -48,4 +48,5 @@ def lexicon() -> dict:
                 )
             words = [w.lower() for w in words]
             out[key] = sorted({f for w in words for f in forms(w)}) if key in _VERB_LISTS else words
+    out["closed_words"] = sorted({w for group in out.get("closed_classes", ()) for w in group})
     return out

@@ -20,7 +20,7 @@ from .lexicon import RULES_DIR, lexicon
 @dataclass(frozen=True, eq=False)
 class Rule:
     id: str
-    claim: str  # number | output | net | direction | rank | comparison | category | invented | skip
+    claim: str  # number | output | net | direction | rank | comparison | category | class | invented | skip
     binding: str  # adjacent | grammar
     priority: int
     pattern: list
@@ -147,6 +147,8 @@ def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
         ):
             return []
         return [Candidate(rule, nums[-1], nums[-1])]
+    if rule.claim == "class":  # its name is found by its value's class, in check.py
+        return [Candidate(rule, start, start)]
     if not names:
         return []
     if rule.claim == "number":
