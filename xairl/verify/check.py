@@ -250,10 +250,14 @@ def _class(word, s: Sentence, book: FactBook) -> Claim | None:
     group = next((g for g in lex["closed_classes"] if word.lower_ in g), None)
     named = {k for t in s.doc if t.ent_type_ in ("FEATURE", "LABEL") for k in t._.keys}
     owners = [
-        k for k in named if book.features.get(k) and book.features[k].label and _words(book.features[k].label) & group
+        k
+        for k in named
+        if book.features.get(k) and book.features[k].label and _words(book.features[k].label) & (group or set())
     ]
-    if group is None or len(owners) != 1 or word.ent_type_ or (word.i and word.nbor(-1).lower_ in lex["set_aside"]):
-        return None
+    aside = word.i and word.nbor(-1).lower_ in lex["set_aside"]
+    hyphened = any(0 <= word.i + d < len(word.doc) and word.doc[word.i + d].text == "-" for d in (-1, 1))
+    if group is None or len(owners) != 1 or word.ent_type_ or aside or hyphened:
+        return None  # ('since June', 'east-west traffic': a value of something else)
     key = owners[0]
     label_words = _words(book.features[key].label)
     if word.lower_ in label_words:
