@@ -270,22 +270,24 @@ def _class(word, s: Sentence, book: FactBook) -> Claim | None:
 def _invented(subject, verb, known: frozenset) -> Claim | None:
     """The subject of a direction verb that names nothing of the explanation ('construction dust raised it by 1.0'):
     contradicted, unless a word of it belongs to a name or a description (a vague mention) or it is the model, the
-    output or a group of reasons."""
+    output or a group of reasons. Whose it is ('the guest's', 'her') is no part of what it is."""
     lex = lexicon()
-    tokens = list(subject.subtree)
+    owners = {t.i for c in subject.children if c.dep_ == "poss" for t in c.subtree}
+    tokens = [t for t in subject.subtree if t.i not in owners]
     if (
         any(t.ent_type_ in ("FEATURE", "ACTION", "LABEL") for t in tokens)
-        or any(t.ent_type_ == "NUM" and "appos" not in (t.dep_, t.head.dep_) for t in tokens)
+        or any(t.ent_type_ == "NUM" and "appos" not in (t.dep_, t.head.dep_) and t.head.lower_ != "of" for t in tokens)
         or subject.lower_ in lex["vague"]
         or subject.tag_ == "VBG"
         or any(t.lower_ in lex["pointing"] for t in tokens)
-    ):  # a name, a value, the output, a gerund, or a phrase that points back ('your coupe', 'those two facts')
+    ):  # a name, a value, the output, a gerund, or a phrase that points back ('those two facts')
         return None
-    owners = {t.i for c in subject.children if c.dep_ == "poss" for t in c.subtree}  # 'the wine's' of 'the wine's
-    content = [  # tannin level': whose, not what
-        t for t in tokens if t.pos_ in ("NOUN", "PROPN", "ADJ") and t.lower_ not in lex["generic"] and t.i not in owners
+    content = [
+        t
+        for t in tokens
+        if (t.pos_ in ("NOUN", "PROPN", "ADJ") or t.tag_ in ("VBG", "VBN")) and t.lower_ not in lex["generic"]
     ]
-    nouns = [t for t in content if t.pos_ != "ADJ"]
+    nouns = [t for t in content if t.pos_ in ("NOUN", "PROPN")]
     if len(content) < 2 or not nouns or any(w in known for t in nouns for w in _words(t.text)):
         return None  # one plain noun ('the sunshine', 'youth') is more often a paraphrase than a new input
     phrase = " ".join(t.text for t in tokens)
