@@ -127,13 +127,19 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         if not checked:
             return Claim("direction", word, "unchecked", "said of no name")
         return next((x for x in checked if x.status == "contradicted"), checked[0])
-    return _rank(keys, c.rank, anchor.text, book)
+    lex = lexicon()
+    sides = set(lex["up"]) | set(lex["down"]) | set(lex["sign_up"]) | set(lex["sign_down"]) | set(lex["side_words"])
+    one_side = any(t.lower_ in sides for t in s.doc)  # 'the biggest factor pulling it down': among the negatives
+    return _rank(keys, c.rank, anchor.text, book, one_side)
 
 
-def _rank(keys: tuple[str, ...], rank: int, word: str, book: FactBook) -> Claim:
+def _rank(keys: tuple[str, ...], rank: int, word: str, book: FactBook, one_side: bool) -> Claim:
+    """A rank said of a name: its rank by |contribution| in either view, or among its own side's when the sentence
+    speaks of one side."""
+
     def test(key):
         e = book.features[key]
-        said = {r for r in (*e.ranks.values(), *e.signed_ranks.values()) if r}
+        said = {r for r in (*e.ranks.values(), *(e.signed_ranks.values() if one_side else ())) if r}
         if not said:
             return None
         return rank in said, f"{key} ranks {', '.join(map(str, sorted(said)))}"
