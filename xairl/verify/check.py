@@ -229,7 +229,7 @@ def _category(name, word, book: FactBook, known: frozenset) -> Claim | None:
     if len(tokens) > 4 or any(t.ent_type_ == "NUM" and t.ent_id_ != "word" for t in tokens):
         return None
     label_words, said_words = _words(label), _words(said) - _words(key) - set(lex["plain_modifiers"])
-    if not said_words or (said_words <= known and not said_words & label_words):
+    if not said_words or (said_words & known and not said_words & label_words):
         return None  # words of the names and descriptions ('the IP geolocation check'): no value said
     negated = label_words & {"non", "no", "not", "un", "without"}
     if said_words <= label_words | _words(key) and (not negated or said_words & negated):
@@ -282,7 +282,7 @@ def _invented(subject, verb, known: frozenset) -> Claim | None:
     tokens = [t for t in subject.subtree if t.i not in owners]
     if (
         any(t.ent_type_ in ("FEATURE", "ACTION", "LABEL") for t in tokens)
-        or any(t.ent_type_ == "NUM" and "appos" not in (t.dep_, t.head.dep_) and t.head.lower_ != "of" for t in tokens)
+        or any(t.ent_type_ == "NUM" and t.head.lower_ != "of" for t in tokens)
         or subject.lower_ in lex["vague"]
         or subject.tag_ == "VBG"
         or any(t.lower_ in lex["pointing"] for t in tokens)

@@ -84,7 +84,7 @@ def parse(pieces: list[tuple[int, str]], vocab) -> list[Sentence]:
     out = []
     for start, text in pieces:
         mentions, masked = find_mentions(text, vocab)
-        numbers = [n for n in find_numbers(masked) if not (n.start and masked[n.start - 1].isalnum())]  # ('PM2.5')
+        numbers = [n for n in find_numbers(masked) if not (n.start and text[n.start - 1].isalnum())]  # ('PM2.5')
         doc = _split_at(
             nlp.make_doc(text),
             {b for m in mentions for b in (m.start, m.end)}
