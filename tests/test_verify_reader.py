@@ -65,13 +65,31 @@ def test_a_number_next_to_its_name_outranks_the_parse():
     assert read("The season lowered it a little, and wind speed (SHAP +6.9) pushed it up.", example("air"), 0).accurate
 
 
-def test_xairl_verify_stays_the_public_verifier_after_the_package_is_imported():
-    import xairl
-    import xairl.verify as package
+@pytest.mark.parametrize(
+    "imports",
+    [
+        "import xairl; import xairl.verify",
+        "import xairl.verify; import xairl",
+        "from xairl import verify; import xairl",
+    ],
+)
+def test_xairl_verify_stays_the_public_verifier_in_any_import_order(imports):
+    """Importing the package ``xairl.verify`` sets the attribute ``xairl.verify`` to it; the package is callable, so
+    ``xairl.verify(text, explanation)`` stays the public verifier whatever was imported first (a fresh process each)."""
+    import subprocess
+    import sys
 
-    for verifier in (xairl.verify, package):
-        assert verifier("pm2_5_lag1 (+14.7) raised the forecast.", example("air"), 0).accurate
-    assert callable(xairl.verify) and package.read is read
+    code = (
+        f"{imports}\n"
+        "from xairl.narrators.verify.rules import example\n"
+        "from xairl.narrators import verify as public\n"
+        "text = 'pm2_5_lag1 (+14.7) raised the forecast.'\n"
+        "got = xairl.verify(text, example('air'), 0)\n"
+        "assert type(got) is type(public(text, example('air'), 0)) and got.accurate, got\n"
+        "assert not xairl.verify('pm2_5_lag1 (-3.0) lowered the forecast.', example('air'), 0).accurate\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
 
 
 def test_tokens_show_names_and_numbers_as_the_rules_see_them():

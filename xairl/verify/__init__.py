@@ -1,9 +1,9 @@
 """The reader of outside prose: a text checked against an Explanation by rules that are data.
 
-Layers, each using only those before it: numbers -> names -> parse (sentences with names and numbers as single
-tokens) -> rules (rules/rules.yaml: spaCy Matcher and DependencyMatcher patterns, word lists in rules/lexicon.yaml)
--> resolve (one reading per number, direction or rank word: priority, then the nearest name) -> check (each claim
-against the fact book). A claim is contradicted only where a rule binds it to its name by adjacency ('A +0.3',
+Layers, each using only those before it (the import contract in pyproject.toml): lexicon (the word lists of
+rules/lexicon.yaml) -> parse (sentences with names and numbers as single tokens) -> rules (rules/rules.yaml: spaCy
+Matcher and DependencyMatcher patterns) -> resolve (one reading per number, direction or rank word: priority, then the
+nearest name) -> check (each claim against the fact book). A claim is contradicted only where a rule binds it to its name by adjacency ('A +0.3',
 'A (0.3)', 'A=0.3') or grammar (subject, object, 'by'); anything else verifies or stays unchecked.
 
 Stage 1 of issue 54: numbers, names, the fact book and the sentence splitter are still those of
@@ -49,8 +49,15 @@ sys.modules[__name__].__class__ = _CallableModule
 
 
 def read(text: str, explanation: Explanation, index: int = 0, policy: Policy | None = None) -> Verification:
-    """Check every claim of ``text`` against the explanation of decision ``index``; never raises on odd text."""
-    sentences_, book, unit_of, note, known = _prepare(text, explanation, index, policy)
+    """Check every claim of ``text`` against the explanation of decision ``index``; never raises on odd text (a
+    failure of the parse leaves the text unchecked with the reason)."""
+    try:
+        sentences_, book, unit_of, note, known = _prepare(text, explanation, index, policy)
+    except InputError:
+        raise
+    except Exception as e:  # noqa: BLE001 - a reader bug must not take the narration down with it
+        failed = Claim("internal", text[:200], "unchecked", f"the reader failed ({type(e).__name__}: {e})")
+        return Verification((SentenceCheck(text.strip()[:200], (failed,)),), "")
     out = []
     for s in sentences_:
         out.append(SentenceCheck(s.text.strip(), tuple(_claims(s, book, unit_of, known)[0])))
@@ -86,7 +93,7 @@ def _prepare(text, explanation, index, policy):
         raise InputError(f"read() takes text (a str), not {type(text).__name__}: decode it first.")
     index = explanation.check_index(index)
     explanation = in_regions(explanation)
-    text, note = normalise(text), ""
+    text, note = normalise(text).encode("utf-8", "replace").decode("utf-8"), ""  # (a lone surrogate: one '?')
     if len(text) > MAX_CHARS:
         text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
     with np.errstate(all="ignore"):
@@ -97,7 +104,7 @@ def _prepare(text, explanation, index, policy):
         info = policy.features.get(f) if policy else None
         return info.unit if info and info.unit else unit_in_name(f)
 
-    pieces = [(a, text[a:b]) for a, b in sentences(text)]
+    pieces = [text[a:b] for a, b in sentences(text)]
     return parse_sentences(pieces, vocab), book, unit_of, note, vocab.name_words
 
 
@@ -126,7 +133,7 @@ def _checked(s: Sentence, decisions: list[Decision], names, book, unit_of, known
             out.append(made)
         if d.winner.rule.claim in ("number", "output", "net", "skip"):
             bound.add(d.winner.anchor)
-    named = {k for t in names for k in t._.keys}
+    named = {k for t in names for k in t._.keys} | {k for d in decisions for k in s.doc[d.winner.name]._.keys}
     for t in s.doc:
         if t.ent_type_ == "NUM" and t.i not in bound:
             out.append(check.free_number(t, book))

@@ -83,6 +83,8 @@ def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: f
         made = _checked(c, s, book, unit_of, ctx)
     if made is None:
         return None
+    if made.status == "contradicted" and c.rule.binding not in ("adjacent", "grammar"):
+        made = replace(made, status="unchecked", detail=f"{made.detail} (bound by position only)")
     name = s.doc[c.name]
     if made.status == "contradicted" and name._.form == "part" and name.lower_.strip() in lexicon()["generic"]:
         made = replace(made, status="unchecked", detail=f"{made.detail} ('{name.text}' alone: no sure binding)")
@@ -98,7 +100,8 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
     together = coordinated(name)
     if c.rule.claim == "number":
         verb = _verb_of(anchor)
-        if len(together) > 1 or any(t.lower_ in lexicon()["together"] for t in verb.children):
+        summed = len(together) > 1 or any(t.lower_ in lexicon()["together"] for t in verb.children)
+        if summed and c.rule.binding == "grammar":  # ('A (+0.3) and B (+0.2) raised it': each its own number)
             return Claim("number", anchor.text, "unchecked", "said of several features together")
         made = feature_number(anchor._.number, keys, s.masked, book, ctx, unit_of)
         if made.status == "contradicted" and book.in_percent:  # '+0.096' for 9.6 points of a percent output
@@ -110,8 +113,13 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
     if c.rule.claim == "direction":
         word = anchor.text
         if c.negated:
-            return Claim("direction", word, "unchecked", "a negated direction")
-        signed = [t for t in anchor.subtree if t.ent_type_ == "NUM" and t.ent_id_ == "signed" and _verb_of(t) == anchor]
+            return Claim("direction", word, "unchecked", "a negated or hypothetical direction")
+        subjects = {t.i for c in anchor.children if c.dep_ in ("nsubj", "csubj") for t in c.subtree}
+        signed = [  # the verb's own signed number ('lowered it by -0.3'), not one of its subject ('A (+0.3) raised')
+            t
+            for t in anchor.subtree
+            if t.ent_type_ == "NUM" and t.ent_id_ == "signed" and _verb_of(t) == anchor and t.i not in subjects
+        ]
         if signed:
             return Claim("direction", word, "unchecked", f"its number's sign ({signed[0].text}) says the way")
         polarity, where = c.polarity, ctx
@@ -127,6 +135,8 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         if not checked:
             return Claim("direction", word, "unchecked", "said of no name")
         return next((x for x in checked if x.status == "contradicted"), checked[0])
+    if c.negated:  # 'A was not the largest factor'
+        return Claim("rank", anchor.text, "unchecked", "a negated rank")
     lex = lexicon()
     sides = set(lex["up"]) | set(lex["down"]) | set(lex["sign_up"]) | set(lex["sign_down"]) | set(lex["side_words"])
     one_side = any(t.lower_ in sides for t in s.doc)  # 'the biggest factor pulling it down': among the negatives
@@ -156,6 +166,8 @@ def label_claim(token, book: FactBook, named: set[str]) -> Claim | None:
     actual = book.features[key].label
     if actual.lower() == token._.label.lower():
         return Claim("category", token.text, "verified", f"{key} is {actual}", "category.label")
+    if _set_aside(token):  # 'unlike summer', 'winter rather than summer'
+        return None
     status = "contradicted" if key in named else "unchecked"
     return Claim("category", token.text, status, f"{key} is {actual}, not {token._.label}", "category.label")
 
@@ -184,7 +196,7 @@ def _output(n, what: str, book: FactBook) -> Claim:
 def free_number(token, book: FactBook) -> Claim:
     """A number no rule bound to a name: verified when it is a decision-level fact, else unchecked."""
     n = token._.number
-    facts = [*book.decision_numbers, *book.aggregates.values()]
+    facts = [*book.decision_numbers, *(v for k, v in book.aggregates.items() if k != "the number of features")]
     if any(matches(n, f, magnitude_ok=False) for f in facts):
         return Claim("number", n.text, "verified", "a decision-level number", "number.decision")
     return Claim("number", n.text, "unchecked", "bound to no name", "number.unbound")
@@ -248,6 +260,12 @@ def _category(name, word, book: FactBook, known: frozenset) -> Claim | None:
     return Claim("category", said, "contradicted", f"{key} is {label}, not {said}")
 
 
+def _set_aside(token) -> bool:
+    """Is a value set aside by a word up to three before it ('more than a north slope', 'unlike in June')?"""
+    aside = lexicon()["set_aside"]
+    return any(t.lower_ in aside for t in token.doc[max(0, token.i - 3) : token.i])
+
+
 def _class(word, s: Sentence, book: FactBook) -> Claim | None:
     """A word of a closed class ('June', 'north', 'late') in a sentence that names exactly one feature whose value is
     of that class: its value, or another (contradicted). Not a word after 'than', 'since', 'from', 'unlike', nor a
@@ -260,7 +278,7 @@ def _class(word, s: Sentence, book: FactBook) -> Claim | None:
         for k in named
         if book.features.get(k) and book.features[k].label and _words(book.features[k].label) & (group or set())
     ]
-    aside = word.i and word.nbor(-1).lower_ in lex["set_aside"]
+    aside = _set_aside(word)
     hyphened = any(0 <= word.i + d < len(word.doc) and word.doc[word.i + d].text == "-" for d in (-1, 1))
     if group is None or len(owners) != 1 or word.ent_type_ or aside or hyphened:
         return None  # ('since June', 'east-west traffic': a value of something else)

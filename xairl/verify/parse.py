@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from spacy.tokens import Doc, Token
 
-from ..narrators.verify.names import Mention, find_mentions
+from ..narrators.verify.names import find_mentions
 from ..narrators.verify.numbers import Number, find_numbers
 from ..narrators.verify.parse import _symbol_runs, pipeline
 from .lexicon import lexicon
@@ -28,14 +28,11 @@ _KIND = {"feature": "FEATURE", "action": "ACTION", "label": "LABEL"}
 
 @dataclass
 class Sentence:
-    """One sentence: its text, where it starts in the text, its parse, and the masked text (names as NUL)."""
+    """One sentence: its text, its parse, and the masked text (names as NUL)."""
 
     text: str
-    start: int
     doc: Doc
     masked: str
-    mentions: list[Mention]
-    numbers: list[Number]
 
 
 def numform(n: Number) -> str:
@@ -78,11 +75,11 @@ def _hedged(text: str, n: Number) -> int:
     return len(before) - len(word) if word.lower() in lexicon()["hedges"] else n.start
 
 
-def parse(pieces: list[tuple[int, str]], vocab) -> list[Sentence]:
-    """Parse each (start, sentence) with its names and numbers merged into single tokens, all in one batch."""
+def parse(pieces: list[str], vocab) -> list[Sentence]:
+    """Parse each sentence with its names and numbers merged into single tokens, all in one batch."""
     nlp = pipeline()
     out = []
-    for start, text in pieces:
+    for text in pieces:
         mentions, masked = find_mentions(text, vocab)
         numbers = [n for n in find_numbers(masked) if not (n.start and text[n.start - 1].isalnum())]  # ('PM2.5')
         doc = _split_at(
@@ -105,8 +102,12 @@ def parse(pieces: list[tuple[int, str]], vocab) -> list[Sentence]:
                 retokenizer.merge(span, attrs={"ENT_TYPE": kind, "ENT_ID": form, "ENT_IOB": 3, "_": ext})
             for a, b in _symbol_runs(doc, taken):
                 retokenizer.merge(doc[a:b])
-        out.append(Sentence(text, start, doc, masked, mentions, numbers))
+        out.append(Sentence(text, doc, masked))
     docs = [s.doc for s in out]
+    for d in docs:  # a name reads as a noun to the tagger and parser ('Wind speed raised it' is no interjection)
+        for t in d:
+            if t.ent_type_ in ("FEATURE", "LABEL"):
+                t.norm_ = "factor"
     for name, component in nlp.pipeline:
         if name != "attribute_ruler":  # (its tag -> part-of-speech map is a lookup below)
             docs = list(component.pipe(docs)) if hasattr(component, "pipe") else [component(d) for d in docs]

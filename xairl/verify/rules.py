@@ -194,7 +194,9 @@ def _reading(rule: Rule, doc, name: int, anchor: int, roles: dict) -> Candidate:
             words += [t.lower_ for t in doc[roles["attr"]].children] + [t.lower_ for t in doc[anchor].children]
         rank = next((lex["ordinals"][w] for w in words if w in lex["ordinals"]), 1)
     verb = doc[anchor] if rule.claim == "direction" else doc[name].head
-    negated = any(c.dep_ == "neg" or c.lower_ in lex["negations"] for c in verb.children)
+    negated = any(  # 'did not raise', 'would have raised', 'if A had raised'
+        c.dep_ == "neg" or c.lower_ in lex["negations"] or c.lower_ in lex["hypothetical"] for c in verb.children
+    )
     return Candidate(rule, name, anchor, polarity, rank, negated)
 
 
