@@ -2,7 +2,8 @@
 
 A claim is contradicted only when its rule binds the name by adjacency or grammar; a number bound to nothing is
 verified when it states a decision-level fact (the prediction, the baseline, a score, the margin) and else left
-unchecked. A negated direction ('did not raise') is left unchecked.
+unchecked. A negated or hypothetical direction or rank ('did not raise', 'would have lowered') is left unchecked. A
+categorical value's label and a closed-class word bind by what they are (:func:`label_claim`, :func:`_class`).
 """
 
 from __future__ import annotations
@@ -114,7 +115,7 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         word = anchor.text
         if c.negated:
             return Claim("direction", word, "unchecked", "a negated or hypothetical direction")
-        subjects = {t.i for c in anchor.children if c.dep_ in ("nsubj", "csubj") for t in c.subtree}
+        subjects = {t.i for child in anchor.children if child.dep_ in ("nsubj", "csubj") for t in child.subtree}
         signed = [  # the verb's own signed number ('lowered it by -0.3'), not one of its subject ('A (+0.3) raised')
             t
             for t in anchor.subtree
