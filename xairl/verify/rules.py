@@ -100,8 +100,7 @@ def candidates(doc) -> list[Candidate]:
     for match_id, start, end in token(doc):
         rule = by_id()[doc.vocab.strings[match_id]]
         out += _token_reading(rule, doc, start, end)
-    named = any(t.ent_type_ in ("FEATURE", "LABEL") for t in doc)  # every dependency rule binds a name
-    for match_id, ids in dependency(doc) if named else ():
+    for match_id, ids in dependency(doc):
         rule = by_id()[doc.vocab.strings[match_id]]
         roles = {node["RIGHT_ID"]: i for node, i in zip(rule.pattern, ids)}
         if rule.claim == "comparison":  # 'A outweighed B'
