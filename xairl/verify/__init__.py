@@ -19,17 +19,11 @@ from __future__ import annotations
 import sys
 import types
 
-import numpy as np
-
 from ..errors import InputError
 from ..explanation import Explanation
-from ..narrators.verify import MAX_CHARS, SentenceCheck, Verification, sentences
-from ..narrators.verify.book import clean_surface, fact_book
+from ..narrators.verify import SentenceCheck, Verification, aids, inputs, sentences
 from ..narrators.verify.checks import Claim
-from ..narrators.verify.numbers import normalise, unit_in_name
-from ..narrators.verify.vocabulary import vocabulary
 from ..policy import Policy
-from ..regions import in_regions
 from . import check, rules
 from .parse import Sentence
 from .parse import parse as parse_sentences
@@ -89,21 +83,11 @@ def tokens(text: str, explanation: Explanation, index: int = 0, policy: Policy |
 
 
 def _prepare(text, explanation, index, policy):
-    if not isinstance(text, str):
-        raise InputError(f"read() takes text (a str), not {type(text).__name__}: decode it first.")
-    index = explanation.check_index(index)
-    explanation = in_regions(explanation)
-    text, note = normalise(text).encode("utf-8", "replace").decode("utf-8"), ""  # (a lone surrogate: one '?')
-    if len(text) > MAX_CHARS:
-        text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
-    with np.errstate(all="ignore"):
-        book = fact_book(explanation, index, policy)
-    vocab = vocabulary(explanation, policy, clean_surface)
-
-    def unit_of(f: str) -> str:
-        info = policy.features.get(f) if policy else None
-        return info.unit if info and info.unit else unit_in_name(f)
-
+    """The parsed sentences, the fact book, ``unit_of``, the note and the names' words (the shared preamble of the
+    readers, :func:`xairl.narrators.verify.inputs` and :func:`~xairl.narrators.verify.aids`)."""
+    text, explanation, index, note = inputs(text, explanation, explanation.check_index(index), caller="read")
+    text = text.encode("utf-8", "replace").decode("utf-8")  # (a lone surrogate: one '?', the length kept)
+    book, vocab, unit_of = aids(explanation, index, policy)
     pieces = [text[a:b] for a, b in sentences(text)]
     return parse_sentences(pieces, vocab), book, unit_of, note, vocab.name_words
 

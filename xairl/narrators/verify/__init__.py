@@ -213,16 +213,7 @@ def verify(
         taken to be made from them: a number that is none of the facts is contradicted, not unchecked.
     :returns: a :class:`Verification`; never raises on odd text (empty, very long, another language).
     """
-    note = ""
-    if not isinstance(text, str):
-        raise InputError(
-            f"verify() reads text (a str), not {type(text).__name__}: decode it first, e.g. data.decode('utf-8')."
-        )
-    index = None if index is None else explanation.check_index(index)
-    explanation = in_regions(explanation)  # an image is read in regions, as it is narrated
-    text = normalise(text)
-    if len(text) > MAX_CHARS:
-        text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
+    text, explanation, index, note = inputs(text, explanation, index)
     read_one = reader(explanation, index, policy, facts)
     spans = sentences(text)
     read = [read_one(text[a:b]) for a, b in spans]
@@ -233,12 +224,24 @@ def verify(
     )
 
 
-def reader(
-    explanation: Explanation, index: int | None, policy: Policy | None = None, facts=None
-) -> Callable[[str], list[Claim]]:
-    """The reader of one sentence (sentence -> its claims) for state ``index`` of an explanation already in regions:
-    what :func:`verify` applies to each sentence, and :mod:`xairl.narrators.provenance` to the words an own narrative
-    did not track."""
+def inputs(text, explanation: Explanation, index: int | None, caller: str = "verify") -> tuple:
+    """(text, explanation, index, note): a str checked (else a one-line error), the index checked (``None``: the
+    global view), the explanation in regions (an image is read as it is narrated), the text normalised and cut at
+    :data:`MAX_CHARS` (the note says so). What every reader of prose does first."""
+    if not isinstance(text, str):
+        raise InputError(
+            f"{caller}() reads text (a str), not {type(text).__name__}: decode it first, e.g. data.decode('utf-8')."
+        )
+    index = None if index is None else explanation.check_index(index)
+    explanation, text, note = in_regions(explanation), normalise(text), ""
+    if len(text) > MAX_CHARS:
+        text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
+    return text, explanation, index, note
+
+
+def aids(explanation: Explanation, index: int | None, policy: Policy | None = None, facts=None) -> tuple:
+    """(fact book, vocabulary, unit_of): what a reader checks claims with, for state ``index`` of an explanation
+    already in regions; ``unit_of(feature)`` is its unit (the policy's, else its name's ending)."""
     with np.errstate(all="ignore"):  # sums of contributions near 1e308 overflow: an infinite fact matches no number
         book = fact_book(explanation, index, policy)
     if facts is not None:
@@ -250,6 +253,16 @@ def reader(
         info = policy.features.get(f) if policy else None
         return info.unit if info and info.unit else unit_in_name(f)
 
+    return book, vocab, unit_of
+
+
+def reader(
+    explanation: Explanation, index: int | None, policy: Policy | None = None, facts=None
+) -> Callable[[str], list[Claim]]:
+    """The reader of one sentence (sentence -> its claims) for state ``index`` of an explanation already in regions:
+    what :func:`verify` applies to each sentence, and :mod:`xairl.narrators.provenance` to the words an own narrative
+    did not track."""
+    book, vocab, unit_of = aids(explanation, index, policy, facts)
     return lambda sentence: _read_sentence(sentence, book, vocab, unit_of)
 
 
