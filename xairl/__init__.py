@@ -17,7 +17,7 @@ _LAZY = {
     "FeatureInfo": "xairl.policy",
     "from_sb3": "xairl.sb3",
     "Observation": "xairl.observation",
-    "patches": "xairl.observation",
+    "patches": "xairl.region_names",
     "in_regions": "xairl.regions",
     "Explanation": "xairl.explanation",
     "get_policy": "xairl.plugins",

@@ -306,6 +306,19 @@ class Explanation:
             observation=None,
         )
 
+    def by_signal(self) -> Explanation:
+        """Per signal, for a policy that sees time (:mod:`xairl.windows`): each signal's contribution summed over the
+        window's steps (a frame stack's: each region over its frames); exact by additivity."""
+        from .windows import by_signal
+
+        return by_signal(self)
+
+    def by_step(self) -> Explanation:
+        """Per time step ('t-3' ... 't'; a frame stack's 'frame 0' ...): the contributions of its signals summed."""
+        from .windows import by_step
+
+        return by_step(self)
+
     def output_slice(self, j: int) -> Explanation:
         """The explanation of output ``j`` alone (one dimension of a continuous action, narrated on its own)."""
         if not 0 <= j < self.values.shape[2]:

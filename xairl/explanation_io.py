@@ -16,6 +16,15 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 from .errors import InputError, validation_message
 
 
+class _Window(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    signals: list[str] = Field(min_length=1)
+    steps: Annotated[int, Field(ge=2)]
+    layout: Literal["sequence", "stacked"] = "sequence"
+    step_s: Annotated[float, Field(gt=0, allow_inf_nan=False)] | None = None
+
+
 class _Part(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
@@ -23,6 +32,7 @@ class _Part(BaseModel):
     shape: list[Annotated[int, Field(ge=1)]]
     categories: Annotated[int, Field(ge=1)] | None = None
     channels: Literal["channels", "frames"] = "channels"  # an image's channels, or the frames of a stack
+    window: _Window | None = None  # a window of observations: its signals are the shape's second axis
 
 
 class _Observation(BaseModel):
@@ -30,7 +40,7 @@ class _Observation(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    kind: Literal["flat", "array", "dict", "tuple"]
+    kind: Literal["flat", "array", "dict", "tuple", "window"]
     parts: list[_Part] = Field(min_length=1)
 
 
@@ -44,7 +54,7 @@ def check_observation(observation: Any, n_features: int) -> dict:
             f"Explanation.observation is not what Observation.to_dict() writes: "
             f"{validation_message(exc, 'observation', 'unknown field')}"
         ) from None
-    if obs.kind in ("flat", "array") and len(obs.parts) != 1:
+    if obs.kind in ("flat", "array", "window") and len(obs.parts) != 1:
         raise InputError(f"Explanation.observation of kind '{obs.kind}' has {len(obs.parts)} parts; it has one.")
     columns = sum(p.categories or math.prod(p.shape) for p in obs.parts)
     if columns != n_features:
@@ -52,7 +62,16 @@ def check_observation(observation: Any, n_features: int) -> dict:
             f"Explanation.observation describes {columns} input columns but the values have "
             f"{n_features} features; give the observation of the explained policy (or None)."
         )
-    return obs.model_dump()
+    window = obs.parts[0].window
+    if (obs.kind == "window") != (window is not None) or (
+        window is not None and obs.parts[0].shape != [window.steps, len(window.signals)]
+    ):
+        raise InputError("Explanation.observation: a 'window' has one part of shape (steps, signals) with its window.")
+    out = obs.model_dump()
+    for p in out["parts"]:
+        if p["window"] is None:
+            del p["window"]
+    return out
 
 
 def check_quartiles(quartiles: Any, n_features: int) -> None:

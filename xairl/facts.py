@@ -14,6 +14,7 @@ from .explanation import Explanation
 from .policy import FeatureInfo, Policy
 from .prompts import format_number
 from .values import fill_and_text, state_value_text, value_level, value_text
+from .windows import Window, trend
 
 __all__ = [
     "Comparison",
@@ -48,6 +49,10 @@ class FeatureFact:
     :param fill: for a feature with a capacity, its value as a percentage of it; else None.
     :param value_text: the value as a narrative writes it: '-85.3 dBm', '12.0 % full', a category's label, 'mean
         pixel value 33.1' for an image region (:func:`xairl.in_regions`), or empty for a group.
+    :param change: for a signal of a window (:mod:`xairl.windows`): its newest value minus its oldest (``value`` is
+        its newest); None for other features.
+    :param trend: for such a signal: 'rose' or 'fell' when it is said as a trend (its earlier steps carry at least a
+        third of its push, and it changed), else ''; ``window`` the span in words ('the last 0.8 s').
     """
 
     name: str
@@ -63,6 +68,9 @@ class FeatureFact:
     kind: str = "numeric"
     fill: float | None = None
     value_text: str = ""
+    change: float | None = None
+    trend: str = ""
+    window: str = ""
 
 
 @dataclass(frozen=True)
@@ -113,6 +121,8 @@ class DecisionFacts:
         margin is when no reason pushes either way.
     :param identifiers: the identifiers (``FeatureInfo(kind='identifier')``) with their values: context for the words
         ("while on BS 15"), never a reason.
+    :param trends: the signals of a window said as trends (:attr:`FeatureFact.trend`), in the decision view (the
+        margin; the score when nothing is chosen), largest first, at most ``k``.
     :param comparisons: the plugin's :class:`Comparison` facts; ``extras`` its named values (``DomainFacts``).
     :param output: the policy's output kind. For 'value' and 'continuous' (one dimension at a time) nothing is
         chosen: ``action`` names the output, ``score`` is its value, ``runner_up`` is ``action`` again and
@@ -137,6 +147,7 @@ class DecisionFacts:
     concession: FeatureFact | None = None
     base_margin: float = 0.0
     identifiers: tuple[FeatureFact, ...] = ()
+    trends: tuple[FeatureFact, ...] = ()
 
     def context(self) -> dict[str, Any]:
         """Variables a decision template sees: every field (feature facts as dicts) and ``k``."""
@@ -182,19 +193,33 @@ class Unit:
     name: str
     columns: tuple[int, ...]
     info: FeatureInfo
+    window: Window | None = None  # a window's signal: its columns are its steps, oldest first
 
 
 def narration_units(exp: Explanation, policy: Policy | None) -> list[Unit]:
-    """The narration units of an explanation: each group narrated as one reason, then every feature outside them."""
+    """The narration units of an explanation: each group narrated as one reason, each signal of a window (over its
+    steps), then every feature outside them."""
     index = {f: j for j, f in enumerate(exp.feature_names)}
     out, taken = [], set()
+    window = _window(exp)
+    for s, cols in (window.signal_columns() if window else {}).items():
+        out.append(Unit(s, tuple(int(j) for j in cols), _info(policy, s), window))
+        taken.update(out[-1].columns)
     for g, members in (policy.reason_groups if policy else {}).items():
         cols = tuple(index[f] for f in members if f in index)
-        if cols and len(cols) == len(members):
+        if cols and len(cols) == len(members) and not taken.intersection(cols):
             out.append(Unit(g, cols, _info(policy, g)))
             taken.update(cols)
     out += [Unit(f, (j,), _info(policy, f)) for j, f in enumerate(exp.feature_names) if j not in taken]
     return out
+
+
+def _window(exp: Explanation) -> Window | None:
+    """The window of an explanation of a window policy, with its states; None for any other."""
+    obs = exp.observation
+    if obs is None or obs["kind"] != "window" or exp.states is None or len(exp.feature_names) != len(exp.states[0]):
+        return None
+    return Window.from_dict(obs["parts"][0]["window"])
 
 
 def unit_ranks(contrib: np.ndarray, reasons: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -222,13 +247,13 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
     regions = (exp.extras or {}).get("regions") or {}  # an image's regions (xairl.in_regions)
     out = []
     for n, u in enumerate(us):
-        j = u.columns[0]
-        value = float(exp.states[i, j]) if len(u.columns) == 1 else float("nan")
-        label = None if len(u.columns) > 1 or labels is None or labels[i, j] is None else str(labels[i, j])
-        lvl, words = value_level(
-            value, u.info, None if q is None or len(u.columns) > 1 else (float(q[0, j]), float(q[2, j]))
-        )
+        single = len(u.columns) == 1 or u.window is not None  # a signal's value is its newest
+        j = u.columns[-1]
+        value = float(exp.states[i, j]) if single else float("nan")
+        label = None if not single or labels is None or labels[i, j] is None else str(labels[i, j])
+        lvl, words = value_level(value, u.info, None if q is None or not single else (float(q[0, j]), float(q[2, j])))
         fill, text = fill_and_text(value, u.info, label, u.name in regions)
+        moved = trend(exp.states[i, list(u.columns)], contrib[list(u.columns)]) if u.window else None
         out.append(
             FeatureFact(
                 u.name,
@@ -244,6 +269,9 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
                 u.info.kind,
                 fill,
                 text,
+                None if moved is None else moved.change,
+                "" if moved is None else moved.word,
+                "" if moved is None else u.window.span_text(),
             )
         )
     return out
@@ -292,6 +320,7 @@ def decision_facts(
         concession=next((f for f in ranked if f.contribution < 0), None),
         base_margin=float(exp.base_values[index, c] - exp.base_values[index, r]) if deciding else 0.0,
         identifiers=tuple(f for f in chosen if f.kind == "identifier"),
+        trends=tuple(f for f in (ranked if deciding else _top(chosen, len(chosen)))[:k] if f.trend),
     )
 
 
@@ -335,6 +364,8 @@ def _direction(contrib: np.ndarray) -> str:
 def global_facts(exp: Explanation, policy: Policy | None = None, k: int = 5, view: str = "margin") -> GlobalFacts:
     """Features ranked by mean |contribution| in ``view`` ('margin' over the runner-up by default, as the plots rank
     them; 'score': the chosen action's), each with the direction it pushed on average and for high and low values."""
+    if _window(exp) is not None:  # a window is summarised per signal, never slot by slot
+        exp = exp.by_signal()
     contrib = exp.contributions(view)[0]
     shown = view if exp.decides else "score" if exp.output == "actions" else "output"
     output = exp.action_names[0] if exp.action_names[0].lower().startswith("the ") else f"the {exp.action_names[0]}"

@@ -8,7 +8,6 @@ method sees through them).
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from itertools import product
@@ -17,8 +16,10 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError
+from .region_names import region_extent, region_name, region_size
+from .windows import Window
 
-KINDS = ("flat", "array", "dict", "tuple")
+KINDS = ("flat", "array", "dict", "tuple", "window")
 #: what an image's channels are: 'channels' (colours, feature maps) or 'frames' (a frame stack)
 CHANNELS = ("channels", "frames")
 
@@ -33,12 +34,15 @@ class Part:
         many one-hot columns ``key=v``); ``None`` for numbers used as they are.
     :param channels: what the first axis of an image (C, H, W) holds: 'channels' (colours, feature maps), or
         'frames' for a frame stack (4 stacked Atari frames), whose regions are then said as 'patch F6 of frame 2'.
+    :param window: for a window of observations (:mod:`xairl.windows`): its signals, steps and layout; ``shape``
+        is then (steps, signals).
     """
 
     key: str
     shape: tuple[int, ...]
     categories: int | None = None
     channels: str = "channels"
+    window: Window | None = None
 
     def __post_init__(self) -> None:
         if self.channels not in CHANNELS:
@@ -52,6 +56,8 @@ class Part:
         return self.categories if self.categories else int(np.prod(self.shape, dtype=np.int64))
 
     def names(self, single: bool) -> list[str]:
+        if self.window is not None:
+            return self.window.names()
         if self.categories:
             return [f"{self.key}={v}" for v in range(self.categories)]
         if not self.shape:
@@ -105,6 +111,16 @@ class Observation:
         return cls("dict", tuple(parts))
 
     @classmethod
+    def window(
+        cls, signals: Sequence[str], steps: int, layout: str = "sequence", step_s: float | None = None
+    ) -> Observation:
+        """The last ``steps`` observations of ``signals`` (:class:`xairl.windows.Window`): states (n, steps,
+        signals) or flat (n, steps * signals), time-major, oldest first; the module takes (n, steps, signals)
+        (``layout='sequence'``: a GRU/LSTM with batch_first, an MLP that flattens) or the flat rows ('stacked')."""
+        w = Window(tuple(signals), steps, layout, step_s)
+        return cls("window", (Part("obs", w.shape, window=w),))
+
+    @classmethod
     def several(cls, shapes: Sequence[Sequence[int]]) -> Observation:
         """Several inputs, passed to the module as positional tensors ``module(x0, x1, ...)``."""
         return cls("tuple", tuple(Part(f"input{i}", tuple(int(s) for s in sh)) for i, sh in enumerate(shapes)))
@@ -131,7 +147,7 @@ class Observation:
     def describe(self) -> str:
         """The states' form in messages: ``(n, 4, 84, 84)``, ``{image: (n, 3, 8, 8), v: (n, 5)}``, ``((n, 4), (n, 2))``."""
         shapes = [f"(n, {', '.join(map(str, p.shape))})" for p in self.parts]
-        if self.kind in ("flat", "array"):
+        if self.kind in ("flat", "array", "window"):
             return shapes[0]
         if self.kind == "dict":
             return "{" + ", ".join(f"{p.key}: {s}" for p, s in zip(self.parts, shapes)) + "}"
@@ -162,7 +178,7 @@ class Observation:
             )
         arr = _numeric(states, what)
         f = self.n_features
-        if self.kind == "array":
+        if self.kind in ("array", "window"):
             shape = self.parts[0].shape
             if arr.shape == shape:
                 arr = arr[None]
@@ -210,13 +226,13 @@ class Observation:
 
     def unflatten(self, x):
         """A torch (n, F) tensor -> what the module takes: one tensor, a dict of tensors, or a tuple of them."""
-        if self.kind == "flat":
+        if self.kind == "flat" or (self.kind == "window" and self.parts[0].window.layout == "stacked"):
             return x
         out = {
             p.key: x[:, s].reshape(len(x), *(p.shape if not p.categories else (p.categories,)))
             for p, s in zip(self.parts, self.slices().values())
         }
-        if self.kind == "array":
+        if self.kind in ("array", "window"):
             return out[self.parts[0].key]
         return out if self.kind == "dict" else tuple(out.values())
 
@@ -228,20 +244,38 @@ class Observation:
 
     def regions(self) -> dict[str, np.ndarray]:
         """Named patches of each channel of each image part (2-D or 3-D), for :meth:`Explanation.grouped`: what
-        narration speaks of instead of pixels (:func:`region_name`: 'patch F6 of frame 2'); empty when no image part
-        has patches larger than one pixel (a small image is narrated pixel by pixel)."""
+        narration speaks of instead of pixels (:func:`xairl.region_names.region_name`: 'patch F6 of frame 2');
+        empty when no image part has patches larger than one pixel (a small image is narrated pixel by pixel)."""
         return {name: idx for name, _, idx in self._patches()}
+
+    def time_groups(self) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]] | None:
+        """(per signal, per step) column groups of an observation that holds time, for :meth:`Explanation.grouped`:
+        a window's signals over their steps and its steps ('t-3' ... 't') over their signals; a frame stack's
+        regions over its frames ('patch F6') and its frames ('frame 0' ... oldest first). None for other kinds."""
+        p = self.parts[0]
+        if self.kind == "window":
+            return p.window.signal_columns(), p.window.step_columns()
+        if self.kind != "array" or p.channels != "frames" or len(p.shape) != 3:
+            return None
+        c, h, w = p.shape
+        size = region_size(h, w)
+        idx = np.arange(c * h * w).reshape(c, h, w)
+        regions = {
+            region_name(r // size, q // size): idx[:, r : r + size, q : q + size].ravel()
+            for r, q in product(range(0, h, size), range(0, w, size))
+        }
+        return regions, {f"frame {k}": idx[k].ravel() for k in range(c)}
 
     def region_extents(self) -> dict[str, str]:
         """Each region's name -> the pixels it covers in words, for tables, hover texts and details ('the 12x12 patch
-        at rows 60 to 71, columns 60 to 71 of frame 2': :data:`REGION_EXTENT`, counting from 0)."""
+        at rows 60 to 71, columns 60 to 71 of frame 2': :data:`xairl.region_names.REGION_EXTENT`, counting from 0)."""
         return {name: extent for name, extent, _ in self._patches()}
 
     def _patches(self):
         """(name, extent, flat columns) of every region, in channel, row, column order."""
         single = len(self.parts) == 1
         for p, cols in zip(self.parts, self.slices().values()):
-            if p.categories or len(p.shape) not in (2, 3):
+            if p.categories or p.window is not None or len(p.shape) not in (2, 3):
                 continue
             c, h, w = (1, *p.shape) if len(p.shape) == 2 else p.shape
             size = region_size(h, w)
@@ -264,6 +298,7 @@ class Observation:
             "parts": [
                 {"key": p.key, "shape": list(p.shape), "categories": p.categories}
                 | ({"channels": p.channels} if p.channels != "channels" else {})
+                | ({"window": p.window.to_dict()} if p.window is not None else {})
                 for p in self.parts
             ],
         }
@@ -273,87 +308,16 @@ class Observation:
         return cls(
             d["kind"],
             tuple(
-                Part(p["key"], tuple(p["shape"]), p.get("categories"), p.get("channels", "channels"))
+                Part(
+                    p["key"],
+                    tuple(p["shape"]),
+                    p.get("categories"),
+                    p.get("channels", "channels"),
+                    Window.from_dict(p["window"]) if p.get("window") else None,
+                )
                 for p in d["parts"]
             ),
         )
-
-
-def patches(shape: Sequence[int], size: int | Sequence[int], prefix: str = "patch") -> dict[str, np.ndarray]:
-    """Groups of an image's flat columns: one group per ``size`` x ``size`` patch over all channels.
-
-    :param shape: the image, (C, H, W) or (H, W); patches at the edges are smaller when ``size`` does not divide.
-    :returns: ``{"patch[r,c]": column indices}`` in row-major patch order, for :meth:`Explanation.grouped`.
-    """
-    shape = tuple(int(s) for s in shape)
-    c, h, w = (1, *shape) if len(shape) == 2 else shape
-    ph, pw = (size, size) if isinstance(size, int) else tuple(size)
-    idx = np.arange(c * h * w).reshape(c, h, w)
-    return {
-        f"{prefix}[{r // ph},{q // pw}]": idx[:, r : r + ph, q : q + pw].ravel()
-        for r in range(0, h, ph)
-        for q in range(0, w, pw)
-    }
-
-
-#: how a region is named: a grid reference, 'patch F6' (column letters from the left, A first; row numbers from the
-#: top, 1 first, as on a map or a spreadsheet), then ' of frame 2' (a frame stack) or ' of channel 2' in an image of
-#: several channels (counting from 0, as in the pixels' names 'obs[2,60,60]'), then ' of KEY' in a dict of several
-#: inputs. The pixels a region covers are its extent (:data:`REGION_EXTENT`, :meth:`Observation.region_extents`).
-REGION_FORMAT = "patch {ref}"
-#: the pixels a region covers in words: 'the 12x12 patch at rows 60 to 71, columns 60 to 71' (rows and columns count
-#: from 0), then the channel or frame and the key as in its name; a text may name a region so too
-REGION_EXTENT = "the {h}x{w} patch at rows {r0} to {r1}, columns {c0} to {c1}"
-#: any phrase shaped like a region's name (:data:`REGION_FORMAT`, capital letters) or its extent
-#: (:data:`REGION_EXTENT`, or close to it: 'rows 3-8')
-_SPAN = r"\d+(?:\s*(?:to|-|–|through)\s*\d+)?"
-_LAYER = r"(?:\s+(?:of|in)\s+(?:the\s+)?(?:channel|frame)\s+\d+)?"
-REGION_RE = re.compile(
-    rf"\b(?:(?i:(?:\d+\s*[x×]\s*\d+\s+)?(?:patch|region|block)\s+(?:at|spanning|covering|over)\s+"
-    rf"rows?\s+{_SPAN}\s*,?\s*(?:and\s+)?columns?\s+{_SPAN}{_LAYER})"
-    rf"|(?i:patch)\s+[A-Z]{{1,3}}[1-9]\d{{0,3}}\b(?i:{_LAYER}))"
-)
-
-
-def region_size(h: int, w: int) -> int:
-    """The side of a region's square patch in an h x w image: about a tenth of the longer side (at most ~100 patches
-    per channel), rounded up to a divisor of both sides when one is near (64 -> 8, 84 -> 12), so patches are even."""
-    target = max(1, -(-max(h, w) // 10))
-    even = [s for s in range(target, 2 * target + 1) if h % s == 0 and w % s == 0]
-    return even[0] if even else target
-
-
-def grid_ref(row: int, column: int) -> str:
-    """A patch's grid reference from its row and column among the patches (from 0): (5, 5) -> 'F6', (0, 26) ->
-    'AA1'."""
-    letters, c = "", column + 1
-    while c:
-        c, rest = divmod(c - 1, 26)
-        letters = chr(ord("A") + rest) + letters
-    return f"{letters}{row + 1}"
-
-
-def region_name(
-    row: int, column: int, channel: int | None = None, key: str | None = None, layer: str = "channel"
-) -> str:
-    """A region's name (:data:`REGION_FORMAT`) from its row and column among the patches (from 0): 'patch F6 of
-    frame 2'; ``layer`` is 'channel' or 'frame'."""
-    name = REGION_FORMAT.format(ref=grid_ref(row, column))
-    return name + (f" of {layer} {channel}" if channel is not None else "") + (f" of {key}" if key else "")
-
-
-def region_extent(
-    rows: tuple[int, int],
-    columns: tuple[int, int],
-    channel: int | None = None,
-    key: str | None = None,
-    layer: str = "channel",
-) -> str:
-    """The pixels a region covers in words (:data:`REGION_EXTENT`), from its first and last row and column."""
-    name = REGION_EXTENT.format(
-        h=rows[1] - rows[0] + 1, w=columns[1] - columns[0] + 1, r0=rows[0], r1=rows[1], c0=columns[0], c1=columns[1]
-    )
-    return name + (f" of {layer} {channel}" if channel is not None else "") + (f" of {key}" if key else "")
 
 
 def names_preview(names: Sequence[str], what: str, shown: int = 3) -> str:

@@ -327,3 +327,29 @@ def timeline(exp: Explanation, view: str = "margin", top: int = 5, title: str = 
     ax_act.set_title(title or f"{len(c)} states in order", fontsize=10)
     fig.tight_layout()
     return fig
+
+
+def window_heatmap(exp: Explanation, index: int | None = None, view: str = "margin", top: int = 12):
+    """A policy that sees time (:mod:`xairl.windows`): contributions per signal (rows, the ``top`` largest) and per
+    time step (columns, oldest to newest) for state ``index``, or their mean |contribution| over every state
+    (``index=None``), so a reader sees which signals and which moments of the window drove the decisions."""
+    from .windows import over_time
+
+    signals, steps, cells = over_time(exp, contributions(exp, view))
+    if index is None:
+        heat, cmap, what = np.abs(cells).mean(axis=0), "Reds", f"mean |contribution| over {len(cells)} states"
+    else:
+        heat, cmap, what = cells[exp.check_index(index)], "bwr", f"state {index} (red raises it, blue lowers it)"
+    order = np.argsort(-np.abs(heat).sum(axis=1), kind="stable")[:top]
+    heat = heat[order]
+    lim = float(np.abs(heat).max()) or 1.0
+    fig = _figure(figsize=(max(4.5, 0.8 * len(steps) + 3), max(2.4, 0.32 * len(order) + 1.4)))
+    ax = fig.subplots()
+    image = ax.imshow(heat, cmap=_cmap(cmap), vmin=0 if index is None else -lim, vmax=lim, aspect="auto")
+    ax.set_xticks(range(len(steps)), steps, fontsize=8)
+    ax.set_yticks(range(len(order)), [signals[j] for j in order], fontsize=8)
+    ax.set_xlabel("time step (oldest to newest)")
+    fig.colorbar(image, ax=ax, shrink=0.85).set_label(textwrap.fill(view_label(exp, view), 28), fontsize=8)
+    ax.set_title(textwrap.fill(what, 60), fontsize=9)
+    _layout(fig, [ax])
+    return fig

@@ -101,6 +101,11 @@ class Policy:
     :param action_mask: optional ``f(states (n, n_features)) -> bool (n, n_actions)``, True where an action is
         available in that state (invalid-action masking, as in MaskablePPO). The policy acts, and explanations take
         the chosen action and the runner-up, among available actions only; their scores are still explained.
+    :param window: for a module whose input is its last ``window`` observations, (n, window, signals): an MLP over a
+        window, a GRU/LSTM with ``batch_first``. ``feature_names`` then name the signals of one observation and the
+        features are their slots, ``signal[t-3]`` ... ``signal[t]``; ``features`` may describe a signal once. The
+        same as ``observation=xairl.Observation.window(signals, window)``, which also takes a flat layout and the
+        seconds between observations (:mod:`xairl.windows`).
     """
 
     module: torch.nn.Module
@@ -115,6 +120,7 @@ class Policy:
     action_mask: Callable[[np.ndarray], np.ndarray] | None = None
     observation: Any = None
     output: Literal["actions", "continuous", "value"] | Sequence[str] | None = None
+    window: int | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.module, torch.nn.Module):
@@ -135,7 +141,19 @@ class Policy:
                 f"{', '.join(OUTPUT_KINDS)}, or one of them per output column."
             )
 
+        if self.window is not None:
+            if self.observation is not None or self.feature_names is None:
+                raise InputError(
+                    "window=k takes the signals' names as feature_names and no observation; for another layout "
+                    "give observation=xairl.Observation.window(signals, k, layout) instead."
+                )
+            normalise("observation", Observation.window(self.feature_names, self.window))
         normalise("observation", _observation(self.observation, self.feature_names))
+        window = self.observation.parts[0].window if self.observation.kind == "window" else None
+        if window is not None:
+            if self.feature_names is not None and tuple(map(str, self.feature_names)) == window.signals:
+                normalise("feature_names", None)  # the signals' names: the slots' are generated from them
+            normalise("window", window.steps)
         normalise("name", str(self.name))
         normalise("network", PolicyNetwork(self.module, self.observation, self.name))
         if self.action_names is None:  # count the outputs on one all-zero state
@@ -144,7 +162,7 @@ class Policy:
         names = self.observation.feature_names() if self.feature_names is None else self.feature_names
         normalise("feature_names", tuple(str(f) for f in names))
         normalise("action_names", tuple(str(a) for a in self.action_names))
-        normalise("features", dict(self.features))  # copies: the caller's dicts stay theirs
+        normalise("features", _slot_features(dict(self.features), window))  # copies: the caller's dicts stay theirs
         normalise("groups", {str(g): tuple(m) for g, m in dict(self.groups).items()})
         normalise("action_aliases", {str(a): tuple(v) for a, v in dict(self.action_aliases).items()})
         for what, names in (("feature_names", self.feature_names), ("action_names", self.action_names)):
@@ -161,7 +179,7 @@ class Policy:
         check_kinds(self, kinds, declared)
         if self.output == "value" and len(self.action_names) != 1:
             raise InputError("a 'value' policy has one output; give one name in action_names (e.g. ['value']).")
-        names = set(self.feature_names)
+        names = set(self.feature_names) | set(window.signals if window else ())
         described = {f for f, i in self.features.items() if i.kind != "group"}
         unknown = sorted(described - names) + sorted({str(f) for g in self.groups.values() for f in g} - names)
         if unknown:
@@ -363,6 +381,19 @@ def _module_dtype(module: torch.nn.Module) -> torch.dtype | None:
         if t.is_floating_point():
             return t.dtype
     return None
+
+
+def _slot_features(features: dict, window) -> dict:
+    """A window's :class:`FeatureInfo`: each signal's, given once, for every slot of it too (a slot's own wins)."""
+    if window is None:
+        return features
+    slots = window.signal_columns()
+    names = window.names()
+    for s in window.signals:
+        if s in features:
+            for j in slots[s]:
+                features.setdefault(names[j], features[s])
+    return features
 
 
 def _observation(obs, feature_names) -> Observation:

@@ -45,6 +45,7 @@ DECISION_VARS = {
     "concession",
     "base_margin",
     "identifiers",
+    "trends",
 }
 GLOBAL_VARS = {"n_states", "method", "ranking", "view", "target", "k"}
 

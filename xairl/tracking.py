@@ -307,6 +307,9 @@ _FEATURE_FIELDS = {
     "rank": "rank",
     "kind": "kind",
     "fill": "fill",
+    "change": "value_change",
+    "trend": "trend",
+    "window": "window",
     "mean_abs": "mean_abs",
     "mean": "mean",
     "high_values": "direction_high",
@@ -338,6 +341,10 @@ def track_decision(context: Mapping) -> dict:
         "reasons": [_feature(f, "margin") for f in c["reasons"]],
         "concession": None if c["concession"] is None else _feature(c["concession"], "margin"),
         "identifiers": [_feature(f, "score") for f in c["identifiers"]],
+        "trends": [
+            _feature(f, "margin" if c["output"] == "actions" and c["runner_up"] != c["action"] else "score")
+            for f in c.get("trends", ())
+        ],
         "comparisons": [
             {
                 "text": tracked(d["text"], Fact("comparison", feature=str(d["text"]), value=d["value"])),

@@ -83,7 +83,7 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, read, smu
         if q in ("value", "value_text"):
             extra.append(s.sign(p))
         if q in NUMERIC:
-            extra.append(s.label(p))
+            extra += [s.label(p), s.trend(p)]
         if q in ("base_value", "base_margin"):
             extra.append(s.base(p))
         if q in ("action", "score") and p.span.fact.role:

@@ -8,6 +8,7 @@ import re
 NUMERIC = {
     "value",
     "fill",
+    "value_change",
     "contribution",
     "share",
     "rank",
@@ -32,7 +33,19 @@ KINDS = {
     "comparison": "number",
     "extra": "number",
 }
-SAID_OF_FEATURE = {"value", "value_text", "fill", "contribution", "share", "rank", "level", "mean_abs", "mean"}
+SAID_OF_FEATURE = {
+    "value",
+    "value_text",
+    "fill",
+    "value_change",
+    "trend",
+    "contribution",
+    "share",
+    "rank",
+    "level",
+    "mean_abs",
+    "mean",
+}
 NUMBER = re.compile(r"[+-]?\d[\d,]*(?:\.\d+)?(?:e[+-]?\d+)?", re.IGNORECASE)
 #: literal words that cut a sentence into segments (a rule looks only within its segment)
 SEGMENT = re.compile(r"[;:()\[\]\n]|\s\|(?=\s)|,|\s[—–-]\s|\b(?:but|while|whereas|although|though|yet|despite)\b", re.I)
@@ -146,3 +159,13 @@ LEVEL = re.compile(
     r"\b(?:low|high|typical|normal|moderate|average)\b(?!\s+(?:value|values|of|score|margin|when))", re.I
 )
 NEGATED = re.compile(r"(?:\b(?:not|never|no longer|neither|nor)|n't)\b\W*(?:\w+\W+){0,2}$", re.IGNORECASE)
+#: a trend word right before a number: the number is a signal's change over its window (:mod:`xairl.windows`), and
+#: an 'up' or 'down' word says its sign ('changed', 'moved' say none)
+TREND_BEFORE = re.compile(
+    r"\b(?:(?P<up>rose|risen|rising|climbed|climbing|increased|increasing|grew|growing|went up)|"
+    r"(?P<down>fell|fallen|falling|dropped|dropping|decreased|decreasing|declined|declining|went down)|"
+    r"changed|moved)(?:\s+by)?(?:\s+(?:about|around|roughly|some|nearly|almost|just))?\W*$",
+    re.IGNORECASE,
+)
+#: the quantities a trend word may stand before: a signal's change (a trend's own word, tracked, likewise)
+TREND_FITS = {"value_change"}

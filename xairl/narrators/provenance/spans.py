@@ -26,6 +26,8 @@ from .lexicon import (
     SCORE_OF_BEFORE,
     SIGN_AFTER,
     SIGN_BEFORE,
+    TREND_BEFORE,
+    TREND_FITS,
     VIEW_AFTER,
 )
 from .parts import Part, is_name, literal, parts
@@ -105,6 +107,37 @@ class Sentence(WordRules):
             "tracked.binding",
         )
 
+    def trend(self, p: Part) -> Claim | None:
+        """A number right after a trend word ('fell 4.1 dB', literal or a trend's own tracked word) is a signal's
+        change over its window, and an 'up' or 'down' word has the change's sign."""
+        q, before = p.span.fact.quantity, self.before(p, 24)
+        prev = [r for r in self.spans if r.end <= p.start]
+        tracked_word = bool(prev) and prev[-1].span.fact.quantity == "trend"
+        tracked_word = tracked_word and re.fullmatch(r"\s*(?:by\s*)?", self.text[prev[-1].end : p.start]) is not None
+        m = TREND_BEFORE.search(before)
+        if not (m or tracked_word):
+            return None
+        if q not in TREND_FITS:
+            what = q.replace("_", " ")
+            return Claim(
+                "number",
+                p.span.text,
+                "contradicted",
+                f"the {what}, written as a change over the window",
+                "tracked.trend",
+            )
+        change = self.truth.get(p.span)
+        said = 0 if m is None else 1 if m.group("up") else -1 if m.group("down") else 0
+        if isinstance(change, float) and said and change * said < 0:
+            return Claim(
+                "direction",
+                f"{m.group(0).strip()} {p.span.text}",
+                "contradicted",
+                f"{p.span.fact.feature} changed by {change:+.4g} over its window",
+                "tracked.trend",
+            )
+        return None
+
     def sign(self, p: Part) -> Claim | None:
         """A value printed with another sign than it has, and no word around it that carries the sign."""
         f = p.span.fact
@@ -129,6 +162,8 @@ class Sentence(WordRules):
             return None
         before = self.before(p, 24)
         if DIFFERENCE.match(self.after(p, 20)):  # 'its score was 2.34 higher': a difference, not the score
+            return None
+        if q in TREND_FITS and TREND_BEFORE.search(before):  # 'fell by 4.1 dB': the trend rule judges it
             return None
         for pattern, group in LABELS:
             if pattern.search(before):

@@ -79,8 +79,12 @@ def truth(exp: Explanation, index: int | None, policy: Policy | None, domain: Do
     for view, facts in (("score", d.top), ("margin", d.margin_top)):
         for f in facts + (d.identifiers if view == "score" else ()):
             features.setdefault(f.name, {})[view] = f
-            for q in ("value", "value_text", "unit", "contribution", "share", "direction", "rank", "kind", "fill"):
+            for q in (
+                *("value", "value_text", "unit", "contribution", "share", "direction", "rank", "kind", "fill"),
+                *("trend", "window"),
+            ):
                 values[(q, f.name, view, None)] = getattr(f, q)
+            values[("value_change", f.name, view, None)] = f.change
             values[("name", f.name, view, None)] = f.name
             values[("level", f.name, view, None)] = f.level_text or f.level
     for c in domain.comparisons if domain else ():

@@ -15,7 +15,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from ...observation import REGION_RE
+from ...region_names import REGION_RE
 from .vocabulary import Vocabulary, region_key, split_words
 
 

@@ -5,7 +5,7 @@ region phrase left in the masked text names nothing there."""
 
 from __future__ import annotations
 
-from ...observation import REGION_RE
+from ...region_names import REGION_RE
 from .checks import Claim
 
 

@@ -10,8 +10,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from ...explanation import Explanation
-from ...observation import REGION_RE
 from ...policy import Policy
+from ...region_names import REGION_RE
 from .book import legend
 from .lexicon import ABBREVIATIONS, GENERIC, SPAN, STOP, SYNONYMS, UNIT_PARTS
 from .lexicon import BASE_FORM as _BASE_FORM
@@ -178,7 +178,7 @@ def _regions(exp: Explanation) -> dict[str, str]:
 
 
 def region_key(phrase: str) -> str:
-    """A region phrase (:data:`xairl.observation.REGION_RE`) in one spelling, to look it up: 'The 8×8 patch at rows
+    """A region phrase (:data:`xairl.region_names.REGION_RE`) in one spelling, to look it up: 'The 8×8 patch at rows
     16-23 and columns 40 to 47 in channel 1' -> '8x8 patch at rows 16 to 23 columns 40 to 47 of channel 1'."""
     key = re.sub(r"\s*(?:\bto\b|-|–|\bthrough\b)\s*", " to ", phrase.lower().replace("×", "x").replace(",", " "))
     key = re.sub(r"\b(?:spanning|covering|over)\b", "at", re.sub(r"\bin\b", "of", key))

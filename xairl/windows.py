@@ -1,0 +1,171 @@
+"""Windows: a policy whose input is its last k observations (an MLP over a window, a GRU/LSTM over a sequence, a
+frame stack of vectors) and explanations that speak per signal, per time step and of trends.
+
+A window's flat columns are time-major, oldest step first: ``speed[t-3], angle[t-3], ..., speed[t], angle[t]``;
+``t`` is the newest observation. By additivity, a signal's contribution is the sum over its slots and a step's the
+sum over its signals (:meth:`Explanation.by_signal`, :meth:`Explanation.by_step`); nothing is approximated.
+
+A signal is said as a **trend** when its earlier slots carry at least :data:`TREND_SHARE` of its push (the policy
+weighs where the signal came from, not only where it is) and its value changed over the window: "the serving RSRQ
+fell 4.1 dB over the last 0.8 s". The change, its word and the window are facts of the decision, tracked and
+verified like the contribution (:class:`xairl.facts.FeatureFact`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .errors import InputError
+
+#: how a window reaches the module: 'sequence' (n, steps, signals), as a GRU/LSTM with batch_first and an MLP that
+#: flattens its input take it; 'stacked' (n, steps * signals), time-major, as a vector frame stack (SB3's
+#: VecFrameStack) is
+LAYOUTS = ("sequence", "stacked")
+#: the share of a signal's |contribution| its earlier slots must carry for it to be said as a trend
+TREND_SHARE = 1 / 3
+#: the trend words, by the sign of the change (newest minus oldest value)
+RISE, FALL = "rose", "fell"
+
+
+@dataclass(frozen=True)
+class Window:
+    """The last ``steps`` observations of ``signals``, one row per step, oldest first.
+
+    :param signals: the name of each signal (one column of one observation).
+    :param steps: observations in the window (k).
+    :param layout: one of :data:`LAYOUTS`.
+    :param step_s: seconds between two observations, when they are evenly spaced in time: trends are then said
+        'over the last 0.8 s' instead of 'over the last 5 observations'.
+    """
+
+    signals: tuple[str, ...]
+    steps: int
+    layout: str = "sequence"
+    step_s: float | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "signals", tuple(str(s) for s in self.signals))
+        if self.layout not in LAYOUTS:
+            raise InputError(f"window layout '{self.layout}' is unknown; use one of {', '.join(LAYOUTS)}.")
+        if not self.signals or int(self.steps) < 2:
+            raise InputError(
+                f"a window needs at least one signal and 2 steps, got {len(self.signals)} signal(s) and "
+                f"{self.steps} step(s); a single observation is a plain policy (leave window out)."
+            )
+        if len(set(self.signals)) != len(self.signals):
+            raise InputError(f"the window's signals have duplicates ({', '.join(self.signals)}); name each once.")
+        if self.step_s is not None and not (np.isfinite(self.step_s) and self.step_s > 0):
+            raise InputError(f"the window's step_s must be a positive number of seconds, got {self.step_s}.")
+        object.__setattr__(self, "steps", int(self.steps))
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.steps, len(self.signals)
+
+    def step_names(self) -> list[str]:
+        """``t-3, t-2, t-1, t`` for 4 steps: the oldest first."""
+        return [f"t-{d}" if d else "t" for d in range(self.steps - 1, -1, -1)]
+
+    def names(self) -> list[str]:
+        """Every slot's feature name, time-major: ``signal[t-3]`` ... ``signal[t]``."""
+        return [f"{s}[{step}]" for step in self.step_names() for s in self.signals]
+
+    def signal_columns(self, offset: int = 0) -> dict[str, np.ndarray]:
+        """Each signal's columns, oldest step first (for :meth:`Explanation.grouped`)."""
+        n = len(self.signals)
+        return {s: offset + j + n * np.arange(self.steps) for j, s in enumerate(self.signals)}
+
+    def step_columns(self, offset: int = 0) -> dict[str, np.ndarray]:
+        """Each step's columns, every signal (for :meth:`Explanation.grouped`)."""
+        n = len(self.signals)
+        return {step: offset + n * k + np.arange(n) for k, step in enumerate(self.step_names())}
+
+    def span_text(self) -> str:
+        """The window's span in words: 'the last 0.8 s' from its oldest to its newest observation (with ``step_s``),
+        else 'the last 5 observations'."""
+        if self.step_s is not None:
+            from .prompts import format_number
+
+            return f"the last {format_number((self.steps - 1) * self.step_s)} s"
+        return f"the last {self.steps} observations"
+
+    def to_dict(self) -> dict:
+        return {"signals": list(self.signals), "steps": self.steps, "layout": self.layout, "step_s": self.step_s}
+
+    @classmethod
+    def from_dict(cls, d) -> Window:
+        return cls(tuple(d["signals"]), int(d["steps"]), d.get("layout", "sequence"), d.get("step_s"))
+
+
+@dataclass(frozen=True)
+class Trend:
+    """How one signal moved over the window, and whether its push is said as a trend.
+
+    :param change: the newest value minus the oldest (NaN when states are unknown).
+    :param word: :data:`RISE` or :data:`FALL` when the signal is said as a trend, else ''.
+    :param history: the share of its |contribution| its earlier slots carry (0..1).
+    """
+
+    change: float
+    word: str
+    history: float
+
+
+def trend(values: np.ndarray, contributions: np.ndarray) -> Trend:
+    """The trend of one signal: ``values`` and ``contributions`` are its slots, oldest first."""
+    values, contributions = np.asarray(values, float), np.asarray(contributions, float)
+    change = float(values[-1] - values[0]) if values.size else float("nan")
+    size = np.abs(contributions)
+    history = float(size[:-1].sum() / size.sum()) if size.sum() > 0 else 0.0
+    said = history >= TREND_SHARE and np.isfinite(change) and change != 0
+    return Trend(change, (RISE if change > 0 else FALL) if said else "", history)
+
+
+def over_time(exp, contributions: np.ndarray) -> tuple[list[str], list[str], np.ndarray]:
+    """(signal names, step names, cells (n, signals, steps)) of ``contributions`` (n, F) of an explanation of a
+    policy that sees time: each cell the sum of the columns of that signal at that step (a heat map's cells; a row
+    sums to the signal's contribution, a column to the step's)."""
+    signals, steps, _ = time_groups(exp)
+    f = np.asarray(contributions).shape[1]
+    owner = np.zeros((2, f), dtype=int)
+    for row, groups in enumerate((signals, steps)):
+        for k, cols in enumerate(groups.values()):
+            owner[row, cols] = k
+    cells = np.zeros((len(contributions), len(signals), len(steps)))
+    np.add.at(cells.transpose(1, 2, 0), (owner[0], owner[1]), np.asarray(contributions, float).T)
+    return list(signals), list(steps), cells
+
+
+def time_groups(exp) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], Window | None]:
+    """(per signal, per step) column groups of an explanation of a policy that sees time, and its window (None for
+    a frame stack); a one-line error for any other."""
+    from .observation import Observation
+
+    obs = Observation.from_dict(exp.observation) if exp.observation is not None else None
+    groups = obs.time_groups() if obs is not None else None
+    if groups is None:
+        raise InputError(
+            "this explanation is not of a window or a frame stack: give the policy window=k (or "
+            "observation=xairl.Observation.window(...), or an image with channels='frames')."
+        )
+    return (*groups, obs.parts[0].window)
+
+
+def by_signal(exp):
+    """:meth:`Explanation.by_signal`: one feature per signal, the sum over its steps; a window's states are each
+    signal's newest value."""
+    signals, _, window = time_groups(exp)
+    out = exp.grouped(signals)
+    if window is None or exp.states is None:
+        return out
+    newest = np.stack([cols[-1] for cols in signals.values()])
+    q = exp.background_quantiles
+    return replace(out, states=exp.states[:, newest], background_quantiles=None if q is None else q[:, newest])
+
+
+def by_step(exp):
+    """:meth:`Explanation.by_step`: one feature per step ('t-3' ... 't', or 'frame 0' ...), the sum over its
+    signals."""
+    return exp.grouped(time_groups(exp)[1])
