@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError
+from .explanation_io import state_rows
 
 #: the ``extras`` that hold one entry per state, cut with the states when an Explanation is sliced; every other
 #: extra describes the run and is kept whole
@@ -306,18 +307,34 @@ class Explanation:
             observation=None,
         )
 
-    def by_signal(self) -> Explanation:
-        """Per signal, for a policy that sees time (:mod:`xairl.windows`): each signal's contribution summed over the
-        window's steps (a frame stack's: each region over its frames); exact by additivity."""
-        from .windows import by_signal
+    def time_groups(self) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+        """(per signal, per step) column groups of a policy that sees time (:mod:`xairl.windows`): a window's signals
+        over their steps and its steps ('t-3' ... 't') over their signals; a frame stack's regions over its frames
+        and its frames ('frame 0' ...). A one-line error for any other explanation."""
+        from .observation import Observation
 
-        return by_signal(self)
+        groups = None if self.observation is None else Observation.from_dict(self.observation).time_groups()
+        if groups is None:
+            raise InputError(
+                "this explanation is not of a window or a frame stack: give the policy window=k (or "
+                "observation=xairl.Observation.window(...), or an image with channels='frames')."
+            )
+        return groups
+
+    def by_signal(self) -> Explanation:
+        """Per signal (:meth:`time_groups`): each one's contribution summed over the window's steps, exact by
+        additivity. A window's states are each signal's newest value (a frame stack's none)."""
+        signals, _ = self.time_groups()
+        out = self.grouped(signals)
+        if self.observation["kind"] != "window" or self.states is None:
+            return out
+        newest = np.array([cols[-1] for cols in signals.values()])
+        q = self.background_quantiles
+        return replace(out, states=self.states[:, newest], background_quantiles=None if q is None else q[:, newest])
 
     def by_step(self) -> Explanation:
-        """Per time step ('t-3' ... 't'; a frame stack's 'frame 0' ...): the contributions of its signals summed."""
-        from .windows import by_step
-
-        return by_step(self)
+        """Per time step (:meth:`time_groups`): the contributions of its signals summed."""
+        return self.grouped(self.time_groups()[1])
 
     def output_slice(self, j: int) -> Explanation:
         """The explanation of output ``j`` alone (one dimension of a continuous action, narrated on its own)."""
@@ -376,35 +393,3 @@ class Explanation:
         from .explanation_io import from_json
 
         return from_json(cls, text)
-
-
-def state_rows(key, n: int) -> np.ndarray:
-    """The positions of the states ``key`` selects among ``n``: a slice, an int, a bool mask (one per state) or
-    whole-number positions, as arrays, lists or tensors; a one-line InputError for anything else or out of range."""
-    if isinstance(key, tuple):
-        raise InputError(
-            "an Explanation is indexed by state only (exp[:n], exp[mask], exp[[i, j]]); for one "
-            "output use exp.output_slice(j), for features exp.grouped(...)."
-        )
-    if isinstance(key, (int, np.integer)) and not isinstance(key, (bool, np.bool_)):
-        if not -n <= key < n:
-            raise InputError(f"index {key} is out of range: the explanation has {n} state(s).")
-        key = [int(key) % n]
-    if not isinstance(key, slice):
-        idx = np.asarray(key.detach().cpu() if hasattr(key, "detach") else key)
-        if idx.size == 0 and idx.ndim == 1:
-            idx = idx.astype(int)
-        if idx.dtype == bool and idx.shape != (n,):
-            raise InputError(f"a state mask has one bool per state: got shape {idx.shape} for {n} state(s).")
-        if idx.dtype != bool and (idx.ndim != 1 or idx.dtype.kind not in "iu"):
-            raise InputError(
-                f"states are selected by a slice, a bool mask or whole-number positions, not "
-                f"{type(key).__name__} {str(key)[:40]!r}."
-            )
-        if idx.dtype != bool and idx.size and not (-n <= idx.min() and idx.max() < n):
-            raise InputError(
-                f"position {idx.max() if idx.max() >= n else idx.min()} is out of range: the "
-                f"explanation has {n} state(s)."
-            )
-        key = idx
-    return np.arange(n)[key]

@@ -241,3 +241,35 @@ def records(exp, dataset: str | None = None) -> list[StateRecord]:
             )
         )
     return out
+
+
+def state_rows(key, n: int) -> np.ndarray:
+    """The positions of the states ``key`` selects among ``n``: a slice, an int, a bool mask (one per state) or
+    whole-number positions, as arrays, lists or tensors; a one-line InputError for anything else or out of range."""
+    if isinstance(key, tuple):
+        raise InputError(
+            "an Explanation is indexed by state only (exp[:n], exp[mask], exp[[i, j]]); for one "
+            "output use exp.output_slice(j), for features exp.grouped(...)."
+        )
+    if isinstance(key, (int, np.integer)) and not isinstance(key, (bool, np.bool_)):
+        if not -n <= key < n:
+            raise InputError(f"index {key} is out of range: the explanation has {n} state(s).")
+        key = [int(key) % n]
+    if not isinstance(key, slice):
+        idx = np.asarray(key.detach().cpu() if hasattr(key, "detach") else key)
+        if idx.size == 0 and idx.ndim == 1:
+            idx = idx.astype(int)
+        if idx.dtype == bool and idx.shape != (n,):
+            raise InputError(f"a state mask has one bool per state: got shape {idx.shape} for {n} state(s).")
+        if idx.dtype != bool and (idx.ndim != 1 or idx.dtype.kind not in "iu"):
+            raise InputError(
+                f"states are selected by a slice, a bool mask or whole-number positions, not "
+                f"{type(key).__name__} {str(key)[:40]!r}."
+            )
+        if idx.dtype != bool and idx.size and not (-n <= idx.min() and idx.max() < n):
+            raise InputError(
+                f"position {idx.max() if idx.max() >= n else idx.min()} is out of range: the "
+                f"explanation has {n} state(s)."
+            )
+        key = idx
+    return np.arange(n)[key]

@@ -335,7 +335,9 @@ def window_heatmap(exp: Explanation, index: int | None = None, view: str = "marg
     (``index=None``), so a reader sees which signals and which moments of the window drove the decisions."""
     from .windows import over_time
 
-    signals, steps, cells = over_time(exp, contributions(exp, view))
+    groups = exp.time_groups()
+    signals, steps = (list(g) for g in groups)
+    cells = over_time(contributions(exp, view), *groups)
     if index is None:
         heat, cmap, what = np.abs(cells).mean(axis=0), "Reds", f"mean |contribution| over {len(cells)} states"
     else:

@@ -13,7 +13,7 @@ verified like the contribution (:class:`xairl.facts.FeatureFact`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -86,9 +86,7 @@ class Window:
         """The window's span in words: 'the last 0.8 s' from its oldest to its newest observation (with ``step_s``),
         else 'the last 5 observations'."""
         if self.step_s is not None:
-            from .prompts import format_number
-
-            return f"the last {format_number((self.steps - 1) * self.step_s)} s"
+            return f"the last {(self.steps - 1) * self.step_s:.3g} s"
         return f"the last {self.steps} observations"
 
     def to_dict(self) -> dict:
@@ -123,11 +121,10 @@ def trend(values: np.ndarray, contributions: np.ndarray) -> Trend:
     return Trend(change, (RISE if change > 0 else FALL) if said else "", history)
 
 
-def over_time(exp, contributions: np.ndarray) -> tuple[list[str], list[str], np.ndarray]:
-    """(signal names, step names, cells (n, signals, steps)) of ``contributions`` (n, F) of an explanation of a
-    policy that sees time: each cell the sum of the columns of that signal at that step (a heat map's cells; a row
-    sums to the signal's contribution, a column to the step's)."""
-    signals, steps, _ = time_groups(exp)
+def over_time(contributions: np.ndarray, signals: dict[str, np.ndarray], steps: dict[str, np.ndarray]) -> np.ndarray:
+    """Cells (n, signals, steps) of ``contributions`` (n, F): each the sum of the columns of that signal at that
+    step (:meth:`Explanation.time_groups` gives the groups); a row sums to the signal's contribution, a column to
+    the step's. A heat map's cells."""
     f = np.asarray(contributions).shape[1]
     owner = np.zeros((2, f), dtype=int)
     for row, groups in enumerate((signals, steps)):
@@ -135,37 +132,4 @@ def over_time(exp, contributions: np.ndarray) -> tuple[list[str], list[str], np.
             owner[row, cols] = k
     cells = np.zeros((len(contributions), len(signals), len(steps)))
     np.add.at(cells.transpose(1, 2, 0), (owner[0], owner[1]), np.asarray(contributions, float).T)
-    return list(signals), list(steps), cells
-
-
-def time_groups(exp) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], Window | None]:
-    """(per signal, per step) column groups of an explanation of a policy that sees time, and its window (None for
-    a frame stack); a one-line error for any other."""
-    from .observation import Observation
-
-    obs = Observation.from_dict(exp.observation) if exp.observation is not None else None
-    groups = obs.time_groups() if obs is not None else None
-    if groups is None:
-        raise InputError(
-            "this explanation is not of a window or a frame stack: give the policy window=k (or "
-            "observation=xairl.Observation.window(...), or an image with channels='frames')."
-        )
-    return (*groups, obs.parts[0].window)
-
-
-def by_signal(exp):
-    """:meth:`Explanation.by_signal`: one feature per signal, the sum over its steps; a window's states are each
-    signal's newest value."""
-    signals, _, window = time_groups(exp)
-    out = exp.grouped(signals)
-    if window is None or exp.states is None:
-        return out
-    newest = np.stack([cols[-1] for cols in signals.values()])
-    q = exp.background_quantiles
-    return replace(out, states=exp.states[:, newest], background_quantiles=None if q is None else q[:, newest])
-
-
-def by_step(exp):
-    """:meth:`Explanation.by_step`: one feature per step ('t-3' ... 't', or 'frame 0' ...), the sum over its
-    signals."""
-    return exp.grouped(time_groups(exp)[1])
+    return cells

@@ -107,15 +107,22 @@ class Sentence(WordRules):
             "tracked.binding",
         )
 
+    def trend_word(self, p: Part) -> tuple[bool, int]:
+        """(a trend word stands right before ``p``, the sign it says: +1 'rose', -1 'fell', 0 'changed' or the
+        trend's own tracked word, which its fact checks)."""
+        prev = [r for r in self.spans if r.end <= p.start]
+        if prev and prev[-1].span.fact.quantity == "trend":
+            if re.fullmatch(r"\s*(?:by\s*)?", self.text[prev[-1].end : p.start]):
+                return True, 0
+        m = TREND_BEFORE.search(self.before(p, 24))
+        return m is not None, 0 if m is None else 1 if m.group("up") else -1 if m.group("down") else 0
+
     def trend(self, p: Part) -> Claim | None:
         """A number right after a trend word ('fell 4.1 dB', literal or a trend's own tracked word) is a signal's
         change over its window, and an 'up' or 'down' word has the change's sign."""
-        q, before = p.span.fact.quantity, self.before(p, 24)
-        prev = [r for r in self.spans if r.end <= p.start]
-        tracked_word = bool(prev) and prev[-1].span.fact.quantity == "trend"
-        tracked_word = tracked_word and re.fullmatch(r"\s*(?:by\s*)?", self.text[prev[-1].end : p.start]) is not None
-        m = TREND_BEFORE.search(before)
-        if not (m or tracked_word):
+        q = p.span.fact.quantity
+        after_word, said = self.trend_word(p)
+        if not after_word:
             return None
         if q not in TREND_FITS:
             what = q.replace("_", " ")
@@ -127,11 +134,10 @@ class Sentence(WordRules):
                 "tracked.trend",
             )
         change = self.truth.get(p.span)
-        said = 0 if m is None else 1 if m.group("up") else -1 if m.group("down") else 0
-        if isinstance(change, float) and said and change * said < 0:
+        if isinstance(change, float) and change * said < 0:
             return Claim(
                 "direction",
-                f"{m.group(0).strip()} {p.span.text}",
+                f"{self.before(p, 24).strip()} {p.span.text}",
                 "contradicted",
                 f"{p.span.fact.feature} changed by {change:+.4g} over its window",
                 "tracked.trend",
@@ -163,7 +169,7 @@ class Sentence(WordRules):
         before = self.before(p, 24)
         if DIFFERENCE.match(self.after(p, 20)):  # 'its score was 2.34 higher': a difference, not the score
             return None
-        if q in TREND_FITS and TREND_BEFORE.search(before):  # 'fell by 4.1 dB': the trend rule judges it
+        if q in TREND_FITS and self.trend_word(p)[0]:  # 'fell by 4.1 dB': the trend rule judges it
             return None
         for pattern, group in LABELS:
             if pattern.search(before):

@@ -1,0 +1,186 @@
+"""Windows of observations (issue 55): a policy over its last k observations is explained per slot, grouped per
+signal and per step exactly, drawn as a signal x time heat map, and narrated with trend sentences whose change,
+word and window are tracked facts, so a template that misstates them is contradicted."""
+
+import json
+
+import numpy as np
+import pytest
+import torch
+import yaml
+
+import xairl
+import xairl.region_names
+from xairl import plots
+from xairl.windows import TREND_SHARE, Window, over_time, trend
+
+SIGNALS = ("rsrq", "load")
+STEPS = 5
+
+
+class Falling(torch.nn.Module):
+    """Q(go) - Q(stay) = -2 (rsrq[t] - rsrq[t-4]) + 0.3 load[t]: it hands over on a falling RSRQ."""
+
+    def __init__(self):
+        super().__init__()
+        self.seen = None
+
+    def forward(self, x):
+        self.seen = tuple(x.shape)
+        seq = x if x.dim() == 3 else x.reshape(len(x), STEPS, len(SIGNALS))
+        go = -2.0 * (seq[:, -1, 0] - seq[:, 0, 0]) + 0.3 * seq[:, -1, 1]
+        return torch.stack([torch.zeros_like(go), go], dim=1)
+
+
+def policy(layout="sequence", step_s=0.2):
+    obs = xairl.Observation.window(SIGNALS, STEPS, layout=layout, step_s=step_s)
+    info = {"rsrq": xairl.FeatureInfo("dB", "the serving RSRQ")}
+    return xairl.Policy(Falling(), observation=obs, action_names=["stay", "go"], features=info)
+
+
+@pytest.fixture(scope="module")
+def data():
+    rng = np.random.default_rng(0)
+    bg = rng.normal(size=(24, STEPS, len(SIGNALS)))
+    x = bg[:4].copy()
+    x[0, :, 0] = np.linspace(-8.0, -12.0, STEPS)  # the serving RSRQ fell 4 dB over the window
+    x[1, :, 0] = -10.0  # held: no trend
+    return x, bg
+
+
+@pytest.fixture(scope="module")
+def exp(data):
+    x, bg = data
+    return xairl.explain(policy(), x, method="exact", background=bg)
+
+
+def test_slots_are_named_time_major_and_the_module_gets_its_layout(data):
+    x, bg = data
+    p = xairl.Policy(Falling(), feature_names=list(SIGNALS), window=STEPS)
+    assert p.feature_names[:2] == ("rsrq[t-4]", "load[t-4]") and p.feature_names[-2:] == ("rsrq[t]", "load[t]")
+    p.scores(x)
+    assert p.module.seen == (4, STEPS, 2)
+    stacked = policy("stacked")
+    stacked.scores(x.reshape(4, -1))
+    assert stacked.module.seen == (4, STEPS * 2)
+    same = [xairl.explain(q, x, method="exact", background=bg).values for q in (p, stacked)]
+    np.testing.assert_allclose(same[0], same[1], atol=1e-6)
+
+
+def test_a_signal_described_once_describes_its_slots():
+    p = policy()
+    assert p.features["rsrq[t-2]"].unit == "dB" and p.features["rsrq"].unit == "dB"
+
+
+def test_grouping_per_signal_and_per_step_is_exact(exp, data):
+    x, bg = data
+    sig, step = exp.by_signal(), exp.by_step()
+    assert sig.feature_names == SIGNALS and step.feature_names == ("t-4", "t-3", "t-2", "t-1", "t")
+    for g in (sig, step):
+        np.testing.assert_allclose(g.values.sum(axis=1), exp.values.sum(axis=1), atol=1e-12)
+    np.testing.assert_allclose(sig.states, x[:, -1, :])  # a signal's value is its newest
+    # a linear policy's exact Shapley values: w * (x - background mean), slot by slot
+    mean = bg.mean(axis=0)
+    want = -2.0 * ((x[:, -1, 0] - mean[-1, 0]) - (x[:, 0, 0] - mean[0, 0]))
+    np.testing.assert_allclose(sig.values[:, 0, 1] - sig.values[:, 0, 0], want, atol=1e-5)  # float32 network
+
+
+def test_heat_map_cells_sum_to_the_groups(exp):
+    groups = exp.time_groups()
+    cells = over_time(exp.margin(), *groups)
+    np.testing.assert_allclose(cells.sum(axis=2), exp.by_signal().margin(), atol=1e-12)
+    np.testing.assert_allclose(cells.sum(axis=1), exp.by_step().margin(), atol=1e-12)
+    fig = plots.window_heatmap(exp, 0)
+    labels = [t.get_text() for t in fig.axes[0].get_yticklabels()]
+    assert labels[0] == "rsrq" and set(labels) == set(SIGNALS)
+    assert [t.get_text() for t in fig.axes[0].get_xticklabels()] == ["t-4", "t-3", "t-2", "t-1", "t"]
+    plots.window_heatmap(exp)  # the mean |contribution| over every state
+
+
+def test_trend_needs_history_and_a_change():
+    assert trend([0, 0, -4], [1, 1, 1]).word == "fell"
+    assert trend([0, 0, 4], [0, 0, 1]).word == ""  # the newest step alone pushes: a level, not a trend
+    assert trend([2, 2, 2], [1, 1, 1]).word == ""  # no change
+    t = trend([0, 1, 3], [TREND_SHARE / 2, TREND_SHARE / 2, 1 - TREND_SHARE])
+    assert t.word == "rose" and t.change == 3 and t.history == pytest.approx(TREND_SHARE)
+
+
+def test_a_falling_signal_is_narrated_as_a_trend_and_verified(exp):
+    n = xairl.narrate(exp, 0, policy=policy())
+    assert "The serving RSRQ fell 4 dB over the last 0.8 s (now -12 dB), which favoured go by" in n.text
+    assert n.verified, [c for c in n.claims if c.status != "verified"]
+    facts = xairl.facts.decision_facts(exp, 0, policy())
+    (f,) = facts.trends
+    assert (f.name, f.trend, f.change, f.window) == ("rsrq", "fell", pytest.approx(-4.0), "the last 0.8 s")
+    assert "fell" not in xairl.narrate(exp, 1, policy=policy()).text  # held still: no trend sentence
+
+
+def test_a_window_is_summarised_per_signal(exp):
+    g = xairl.facts.global_facts(exp, policy())
+    assert {r["name"] for r in g.ranking} == set(SIGNALS)
+
+
+MUTANTS = {  # a template that misstates a trend -> the claim that must be contradicted
+    "rose": "{{ f.label|cap }} rose {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}.",
+    "value as change": "{{ f.label|cap }} {{ f.trend }} {{ f.value|abs|num }} {{ f.unit }} over {{ f.window }}.",
+    "push as change": "{{ f.label|cap }} {{ f.trend }} {{ f.contribution|abs|num }} {{ f.unit }} over {{ f.window }}.",
+    "change as push": "{{ f.label|cap }} pushed {{ action }} by {{ f.change|abs|num }}.",
+}
+
+
+@pytest.mark.parametrize("mutant", [*MUTANTS, "right"])
+def test_a_misstated_trend_is_contradicted(exp, tmp_path, mutant):
+    body = MUTANTS.get(
+        mutant, "{{ f.label|cap }} {{ f.trend }} by {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}."
+    )
+    path = tmp_path / "trend.yaml"
+    sentence = "{% for f in trends %}" + body + "{% endfor %}"
+    path.write_text(
+        yaml.safe_dump({"name": "trend", "kind": "decision", "description": "t", "sentences": [[sentence]]})
+    )
+    n = xairl.narrate(exp, 0, policy=policy(), template=str(path))
+    assert n.verified == (mutant == "right"), (n.text, [c for c in n.claims if c.status == "contradicted"])
+
+
+def test_frame_stack_groups_per_region_and_frame():
+    torch.manual_seed(0)
+    cnn = torch.nn.Sequential(torch.nn.Conv2d(4, 2, 8, 8), torch.nn.Flatten(), torch.nn.Linear(2 * 3 * 3, 2))
+    p = xairl.Policy(cnn, observation=xairl.Observation.array((4, 24, 24), channels="frames"))
+    rng = np.random.default_rng(1)
+    e = xairl.explain(p, rng.random((2, 4, 24, 24)), method="deep_shap", background=rng.random((6, 4, 24, 24)))
+    steps, regions = e.by_step(), e.by_signal()
+    assert steps.feature_names == ("frame 0", "frame 1", "frame 2", "frame 3")
+    side = 24 // xairl.region_names.region_size(24, 24)
+    assert regions.feature_names[0] == "patch A1" and len(regions.feature_names) == side * side
+    for g in (steps, regions):
+        np.testing.assert_allclose(g.values.sum(axis=1), e.values.sum(axis=1), atol=1e-9)
+
+
+def test_the_window_survives_json(exp):
+    back = xairl.Explanation.from_json(exp.to_json())
+    assert back.by_signal().feature_names == SIGNALS
+    assert json.loads(exp.to_json())["observation"]["parts"][0]["window"]["step_s"] == 0.2
+
+
+@pytest.mark.parametrize(
+    "make, says",
+    [
+        (lambda: Window(("a",), 1), "2 steps"),
+        (lambda: Window(("a", "a"), 3), "duplicates"),
+        (lambda: Window(("a",), 3, layout="time"), "layout"),
+        (lambda: Window(("a",), 3, step_s=-1), "step_s"),
+        (lambda: xairl.Policy(Falling(), window=3), "feature_names"),
+        (lambda: xairl.Policy(Falling(), feature_names=["a"], window=3, observation=(3, 1)), "observation"),
+    ],
+)
+def test_bad_windows_are_refused_in_one_line(make, says):
+    with pytest.raises(xairl.InputError, match=says) as err:
+        make()
+    assert "\n" not in str(err.value)
+
+
+def test_an_explanation_without_time_is_refused_in_one_line():
+    p = xairl.Policy(torch.nn.Linear(3, 2), feature_names=["a", "b", "c"])
+    e = xairl.explain(p, np.ones((1, 3)), method="exact", background=np.zeros((2, 3)))
+    with pytest.raises(xairl.InputError, match="not of a window"):
+        e.by_signal()
