@@ -32,6 +32,12 @@ def test_cleanrl_style():
     assert "rather than" in out and "global: Over 3 states" in out
 
 
+def test_cleanrl_gru_over_a_window(tmp_path):
+    out = run([str(EX / "cleanrl_gru.py"), "--steps", "300", "--out", str(tmp_path / "gru")])
+    assert "per step: {'t-3'" in out and out.count("[verified]") == 3 and " over the last 4 observations " in out
+    assert (tmp_path / "gru" / "heatmap.png").stat().st_size > 5000
+
+
 def test_atari_cnn_and_its_cli_with_nothing_installed(tmp_path):
     out = run([str(EX / "atari_cnn.py"), "--out", str(tmp_path / "ex")])
     assert "strongest patches: ['patch[" in out and (tmp_path / "ex" / "image.png").stat().st_size > 5000
