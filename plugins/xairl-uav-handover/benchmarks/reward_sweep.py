@@ -18,6 +18,7 @@ from table_one import targets
 
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.config import SimConfig
+from xairl_uav_handover.memory import MemoryDQNController
 from xairl_uav_handover.policy import DQNController, load_checkpoint
 from xairl_uav_handover.table import flights, format_rows, with_intervals
 from xairl_uav_handover.train import TrainConfig, train_checkpoint
@@ -49,18 +50,29 @@ def main():
         default=TrainConfig().demonstrations,
         help="episodes of the RSRQ rule's flights to learn from (0: a plain DQN)",
     )
+    ap.add_argument(
+        "--memory",
+        choices=["off", "on", "both"],
+        default="off",
+        help="on: the DQN with memory (memory.py: the last 1 s and the times); both: each set with and without",
+    )
     args = ap.parse_args()
     folder = Path(args.keep or tempfile.mkdtemp())
     folder.mkdir(parents=True, exist_ok=True)
     cfg = SimConfig()
     res = {c.name: with_intervals(flights(c, cfg, args.flights, args.eval_seeds)) for c in (CHM(), SAMRO())}
+    memories = {"off": [False], "on": [True], "both": [False, True]}[args.memory]
     for weights in args.sets:
         for seed in args.seeds:
-            path = folder / f"w{weights.replace(',', '_')}_seed{seed}.safetensors"
-            tc = TrainConfig(episodes=args.episodes, seed=seed, demonstrations=args.demonstrations)
-            train_checkpoint(tc, config(weights), str(path), progress=False)
-            net = load_checkpoint(path).net
-            res[f"{weights} s{seed}"] = with_intervals(flights(DQNController(net), cfg, args.flights, args.eval_seeds))
+            for memory in memories:
+                name = f"{weights} s{seed}{' mem' if memory else ''}"
+                path = folder / f"w{weights.replace(',', '_')}_seed{seed}{'_mem' if memory else ''}.safetensors"
+                tc = TrainConfig(episodes=args.episodes, seed=seed, demonstrations=args.demonstrations, memory=memory)
+                seconds = train_checkpoint(tc, config(weights), str(path), progress=False)
+                net = load_checkpoint(path).net
+                controller = MemoryDQNController(net) if memory else DQNController(net)
+                res[name] = with_intervals(flights(controller, cfg, args.flights, args.eval_seeds))
+                print(f"{name}: trained in {seconds:.0f} s", flush=True)
     print(f"w_lost,w_rsrq,w_handover,w_pingpong per column; {args.flights} held-out flights x {args.eval_seeds}")
     print(format_rows(res))
     for name in [k for k in res if k not in ("CHM", "SA-MRO")]:

@@ -19,6 +19,11 @@ FEATURES = (
     *(f"rsrp_{k}" for k in range(N_CANDIDATES)),
     *(f"rsrq_{k}" for k in range(N_CANDIDATES)),
 )
+#: the signals of the DQN with memory (memory.py): the snapshot's features, then seconds on the serving cell and
+#: since the last handover, each step of its window
+SIGNALS = (*FEATURES, "time_on_cell", "time_since_handover")
+#: decisions in its window: 1 s at the DQN's 0.2 s decision period (SimConfig.decision_every x flight.dt_s)
+MEMORY_STEPS = 5
 RSRP = slice(5, 5 + N_CANDIDATES)  # the candidates' RSRP columns, serving BS first
 RSRQ = slice(5 + N_CANDIDATES, 5 + 2 * N_CANDIDATES)  # and their RSRQ columns
 BUFFER = FEATURES.index("buffer_queue_size")
@@ -56,10 +61,19 @@ def state_rows(position, queue_bits, serving_id, rsrp, rsrq, observation) -> np.
     ).astype(np.float32)
 
 
+def snapshot(states) -> np.ndarray:
+    """The newest observation's :data:`FEATURES` of memory states (n, 75: memory.py); snapshot states (n, 13) as
+    they are. What the action mask, the rule baselines and the facts hook read."""
+    states = np.asarray(states)
+    if states.shape[-1] == len(FEATURES):
+        return states
+    return states[..., -len(SIGNALS) :][..., : len(FEATURES)]
+
+
 def available_actions(states, observation) -> np.ndarray:
     """Bool (n, 4): stay is always available, a handover only to a measured candidate (an empty slot reads exactly
     at the detection limit; a measured neighbour is strictly above it)."""
-    rsrq = np.asarray(states, dtype=np.float32).reshape(-1, len(FEATURES))[:, RSRQ]
+    rsrq = np.asarray(snapshot(states), dtype=np.float32).reshape(-1, len(FEATURES))[:, RSRQ]
     mask = rsrq > np.float32(observation.detection_rsrq_db)
     mask[:, 0] = True
     return mask

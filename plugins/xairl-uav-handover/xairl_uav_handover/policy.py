@@ -19,14 +19,27 @@ from xairl import InputError, Policy
 
 from .config import SimConfig, without_retired
 from .env import HandoverVecEnv
-from .features import ACTION_ALIASES, ACTIONS, FEATURES, GROUPS, HandoverFacts, available_actions, feature_info
+from .features import (
+    ACTION_ALIASES,
+    ACTIONS,
+    FEATURES,
+    GROUPS,
+    SIGNALS,
+    HandoverFacts,
+    available_actions,
+    feature_info,
+)
+from .features import (
+    MEMORY_STEPS as STEPS,
+)
 
 DEFAULT_CHECKPOINT = Path(__file__).parent / "checkpoints" / "uav-dqn.safetensors"
 
 
 def build_qnet(mean: np.ndarray, std: np.ndarray, hidden=(64, 64)) -> torch.nn.Sequential:
-    """norm (frozen) -> [Linear, ReLU] * len(hidden) -> Linear to one Q-value per action."""
-    f = len(FEATURES)
+    """norm (frozen) -> [Linear, ReLU] * len(hidden) -> Linear to one Q-value per action; as many inputs as
+    ``mean`` has (13 for the snapshot DQN, 75 for the DQN with memory)."""
+    f = len(mean)
     norm = torch.nn.Linear(f, f)
     with torch.no_grad():
         norm.weight.copy_(torch.diag(torch.as_tensor(1.0 / std, dtype=torch.float32)))
@@ -89,7 +102,7 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
                 "diverged); re-train or re-download it."
             )
     hidden = _hidden_widths(path, meta, tensors)
-    f = len(FEATURES)
+    f = STEPS * len(SIGNALS) if memory_of(meta) else len(FEATURES)
     net = build_qnet(np.zeros(f), np.ones(f), hidden)
     try:
         net.load_state_dict(tensors, strict=True)
@@ -105,6 +118,12 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
             f"{path}: its simulator settings are invalid ({str(exc).splitlines()[0]})."
         ) from None
     return Checkpoint(path, net.eval(), meta, config)
+
+
+def memory_of(meta: dict) -> bool:
+    """Whether a checkpoint's network is the DQN with memory (memory.py): its training config says so."""
+    tc = meta.get("train_config")
+    return bool(tc.get("memory")) if isinstance(tc, dict) else False
 
 
 def _hidden_widths(path: Path, meta: dict, tensors: dict) -> tuple[int, ...]:
@@ -148,16 +167,17 @@ def _refuse_q(net: torch.nn.Module, x: np.ndarray, i: int) -> None:
             "that diverged); re-train or re-download it."
         )
     row = x[i].reshape(-1)
+    names = FEATURES if len(row) == len(FEATURES) else xairl.Observation.window(SIGNALS, STEPS).feature_names()
     bad = np.flatnonzero(~np.isfinite(row))
     if len(bad):
         j = int(bad[0])
         raise InputError(
-            f"{where}: {FEATURES[j]} = {row[j]:g} is not a finite number (as float32, the network's "
+            f"{where}: {names[j]} = {row[j]:g} is not a finite number (as float32, the network's "
             "input); fix that state."
         )
     j = int(np.abs(row).argmax())
     raise InputError(
-        f"{where}: its Q-values overflow to NaN or inf (largest input {FEATURES[j]} = {row[j]:g}, far "
+        f"{where}: its Q-values overflow to NaN or inf (largest input {names[j]} = {row[j]:g}, far "
         "beyond any measurement); fix that state."
     )
 
@@ -184,6 +204,10 @@ def background_states(n: int, seed: int = 0, config: SimConfig | None = None) ->
 def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
     """The trained handover DQN as an xairl Policy (the plugin's ``uav-dqn``)."""
     ckpt = checkpoint if isinstance(checkpoint, Checkpoint) else load_checkpoint(checkpoint)
+    if memory_of(ckpt.meta):
+        from .memory import memory_policy  # (memory.py builds on this module)
+
+        return memory_policy(ckpt)
     config = ckpt.sim_config
     from .baselines import CHMConfig
 

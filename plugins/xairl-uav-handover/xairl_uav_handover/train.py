@@ -17,6 +17,7 @@ import time
 from contextlib import contextmanager
 from types import SimpleNamespace
 
+import gymnasium as gym
 import numpy as np
 import torch
 from pydantic import Field, model_validator
@@ -27,6 +28,7 @@ from .baselines import RSRQRule
 from .config import SimConfig
 from .env import HandoverVecEnv
 from .features import available_actions
+from .memory import N_FEATURES, Memory
 from .policy import background_states, build_qnet, greedy, random_available
 
 
@@ -82,10 +84,17 @@ class TrainConfig(xairl.plugin.Options, frozen=True):
         "target must be than the serving cell (3 dB: RSRQ time 7.7-7.9 % but "
         "0.53-0.55x CHM's handovers; 3.5 dB: 8.1-8.4 % at 0.48x)",
     )
+    memory: bool = Field(
+        False,
+        description="the DQN with memory (memory.py, issue 55): its state is the last 1 s (5 decisions) of "
+        "the snapshot's 13 features plus the times on the cell and since the last handover; False: the snapshot DQN",
+    )
     seed: int = 0
 
     @model_validator(mode="after")
     def _exploration(self):
+        if self.memory and self.demonstrations:
+            raise ValueError("demonstrations are for the snapshot DQN; train the DQN with memory without them")
         if self.eps_start is None:
             object.__setattr__(self, "eps_start", 0.2 if self.demonstrations else 1.0)  # (frozen: set once, here)
         return self
@@ -150,7 +159,12 @@ def margin_loss(q: torch.nn.Module, batch, margin: float) -> torch.Tensor:
 
 def _networks(tc: TrainConfig, sim_cfg: SimConfig):
     """Q-network and target network, standardising inputs with statistics of states met in flight."""
-    bg = background_states(2048, seed=tc.seed + 10_000, config=sim_cfg)
+    if tc.memory:
+        from .memory import background
+
+        bg = background(2048, seed=tc.seed + 10_000, config=sim_cfg)
+    else:
+        bg = background_states(2048, seed=tc.seed + 10_000, config=sim_cfg)
     mean, std = bg.mean(axis=0), np.maximum(bg.std(axis=0), 1e-3)
     q, target = build_qnet(mean, std, tc.hidden), build_qnet(mean, std, tc.hidden)
     target.load_state_dict(q.state_dict())
@@ -185,9 +199,11 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
     q, target = _networks(tc, sim_cfg)
     opt = torch.optim.Adam([p for p in q.parameters() if p.requires_grad], lr=tc.lr0)
     env = HandoverVecEnv(sim_cfg, tc.n_flights)
+    memory = Memory() if tc.memory else None
+    space = env.single_observation_space if memory is None else gym.spaces.Box(-np.inf, np.inf, (N_FEATURES,))
     rb = ReplayBuffer(
         max(tc.replay_size // tc.n_flights, 1) * tc.n_flights,
-        env.single_observation_space,
+        space,
         env.single_action_space,
         device="cpu",
         n_envs=tc.n_flights,
@@ -215,12 +231,14 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
         for g in opt.param_groups:
             g["lr"] = learning_rate(tc, ep)
         obs, _ = env.reset(seed=tc.seed * 100_003 + ep)
+        obs = obs if memory is None else memory.start(env)
         ep_ret, ep_ho, t0, ended = np.zeros(tc.n_flights), np.zeros(tc.n_flights), time.time(), False
         while not ended:
             eps = linear_schedule(tc.eps_start, tc.eps_end, tc.eps_fraction * total, step)
             explore = rng.uniform(size=tc.n_flights) < eps
             act = np.where(explore, random_available(rng, obs, sim_cfg), greedy(q, obs, sim_cfg))
             nxt, reward, _, truncated, info = env.step(act)
+            nxt = nxt if memory is None else memory.step(env, info["handover"])
             ended = bool(truncated.all())
             rb.add(obs, nxt, act, reward, truncated, [{}] * tc.n_flights)
             obs, ep_ret, ep_ho, step = nxt, ep_ret + reward, ep_ho + info["handover"], step + 1
@@ -261,6 +279,7 @@ def _demonstrations(tc: TrainConfig, sim_cfg: SimConfig, env: HandoverVecEnv, rb
     buffer ``rb`` (for the TD loss) and their states and actions into the returned :class:`Demonstrations`."""
     if not tc.demonstrations:
         return None
+
     rule, obs_seen, act_seen = RSRQRule(margin_db=tc.demonstrator_margin_db), [], []
     for k in range(tc.demonstrations):
         obs, _ = env.reset(seed=tc.seed * 100_003 + tc.episodes + k)

@@ -1,0 +1,131 @@
+"""The DQN with memory (issue 55): its window is the last 1 s of what the snapshot DQN sees, candidate slots keep
+their cell through the window, the times count as the simulator does, its controller acts on the same states as
+training, and its checkpoint loads as a window policy whose narratives verify."""
+
+import numpy as np
+import pytest
+import torch
+
+import xairl
+from xairl_uav_handover.config import SimConfig
+from xairl_uav_handover.env import HandoverVecEnv
+from xairl_uav_handover.features import FEATURES, MEMORY_STEPS, SIGNALS, snapshot
+from xairl_uav_handover.memory import TIME_CAP_S, Memory, MemoryDQNController, background
+from xairl_uav_handover.policy import build_qnet, greedy, load_checkpoint, save_checkpoint, uav_policy
+
+F = len(SIGNALS)
+
+
+def _sim(seconds=12.0):
+    data = SimConfig().model_dump()
+    data["flight"]["duration_s"] = seconds
+    return SimConfig.model_validate(data)
+
+
+def _fly(actions, n_flights=6, seed=5, decisions=40):
+    """Fly with ``actions(k, env)`` per decision; every decision's memory states, env states, infos and the
+    simulator's reported RSRP/RSRQ of every cell."""
+    env = HandoverVecEnv(_sim(), n_flights)
+    env.reset(seed=seed)
+    memory = Memory()
+    states, obs, infos, rsrp, rsrq = [memory.start(env)], [env.obs.copy()], [], [], []
+    rsrp.append(env.sim.meas_rsrp.copy())
+    rsrq.append(env.sim.meas_rsrq.copy())
+    cands = [env.candidates.copy()]
+    for k in range(decisions):
+        info = env.step(actions(k, env))[4]
+        infos.append(info)
+        states.append(memory.step(env, info["handover"]))
+        obs.append(env.obs.copy())
+        cands.append(env.candidates.copy())
+        rsrp.append(env.sim.meas_rsrp.copy())
+        rsrq.append(env.sim.meas_rsrq.copy())
+    return env, states, obs, infos, rsrp, rsrq, cands
+
+
+def _hand_over_every(n):
+    return lambda k, env: np.full(env.sim.K, 1 if k % n == n - 1 else 0)
+
+
+def test_the_newest_step_is_the_snapshot_and_the_first_window_repeats_it():
+    _, states, obs, *_ = _fly(_hand_over_every(7))
+    for s, o in zip(states, obs):
+        np.testing.assert_array_equal(snapshot(s), o)
+    first = states[0].reshape(-1, MEMORY_STEPS, F)
+    assert (first == first[:, :1]).all()
+
+
+def test_a_slot_keeps_its_cell_through_the_window():
+    env, states, _, _, rsrp, rsrq, cands = _fly(_hand_over_every(9))
+    i = len(states) - 1
+    window = states[i].reshape(-1, MEMORY_STEPS, F)
+    rows = np.arange(env.sim.K)
+    for back in range(MEMORY_STEPS):  # step back: the measurements then of the cells in the slots now
+        then = i - (MEMORY_STEPS - 1 - back)
+        for slot in range(4):
+            cell = cands[i][:, slot]
+            seen = cell >= 0
+            col = FEATURES.index(f"rsrp_{slot}")
+            np.testing.assert_allclose(window[seen, back, col], rsrp[then][rows, cell][seen], rtol=1e-6)
+            col = FEATURES.index(f"rsrq_{slot}")
+            got, want = window[seen, back, col], rsrq[then][rows, cell][seen]
+            limit = env.cfg.observation.detection_rsrq_db  # a cell below detection then reads at the limit
+            np.testing.assert_allclose(got, np.where(want > limit, want, got), rtol=1e-6)
+
+
+def test_the_times_count_decisions_and_reset_at_a_handover():
+    env, states, _, infos, *_ = _fly(_hand_over_every(6))
+    step_s = env.sim.dt * env.decision_every
+    since = np.zeros(env.sim.K)
+    for s, info in zip(states[1:], infos):
+        since = np.where(info["handover"] > 0, 0.0, since + step_s)
+        newest = s.reshape(-1, MEMORY_STEPS, F)[:, -1]
+        np.testing.assert_allclose(newest[:, SIGNALS.index("time_since_handover")], np.minimum(since, TIME_CAP_S))
+    on_cell = newest[:, SIGNALS.index("time_on_cell")]
+    np.testing.assert_allclose(on_cell, np.minimum((env.sim.t - env.sim.entered) * env.sim.dt, TIME_CAP_S))
+    assert any(info["handover"].any() for info in infos)
+
+
+def test_the_controller_acts_on_the_states_training_sees():
+    torch.manual_seed(0)
+    net = build_qnet(np.zeros(MEMORY_STEPS * F), np.full(MEMORY_STEPS * F, 10.0), (16,))
+    controller, cfg = MemoryDQNController(net), _sim()
+    env = HandoverVecEnv(cfg, 6)
+    env.reset(seed=11)
+    controller.reset(env)
+    memory, states, took = Memory(), None, 0
+    for _ in range(40):
+        act = controller(env)
+        states = memory.start(env) if states is None else states
+        np.testing.assert_array_equal(act, greedy(net, states, cfg))
+        info = env.step(act)[4]
+        took += int(info["handover"].sum())
+        states = memory.step(env, info["handover"])
+    assert took > 0  # the comparison crossed handovers
+
+
+def test_a_memory_checkpoint_loads_as_a_window_policy_whose_narratives_verify(tmp_path):
+    torch.manual_seed(1)
+    bg = background(64, seed=2, config=_sim())
+    net = build_qnet(bg.mean(axis=0), np.maximum(bg.std(axis=0), 1e-3), (16, 16))
+    path = tmp_path / "mem.safetensors"
+    save_checkpoint(
+        net, path, {"hidden": [16, 16], "train_config": {"memory": True}, "sim_config": _sim().model_dump()}
+    )
+    ckpt = load_checkpoint(path)
+    policy = uav_policy(ckpt)
+    assert policy.n_features == MEMORY_STEPS * F and policy.feature_names[-1] == "time_since_handover[t]"
+    exp = xairl.explain(policy, bg[:4], background=bg[10:40])
+    assert exp.by_step().feature_names == ("t-4", "t-3", "t-2", "t-1", "t")
+    for i in range(4):
+        n = xairl.narrate(exp, i, policy=policy, template="handover")
+        assert n.verified, [c for c in n.claims if c.status != "verified"]
+
+
+def test_demonstrations_are_refused_for_the_memory_dqn():
+    from pydantic import ValidationError
+
+    from xairl_uav_handover.train import TrainConfig
+
+    with pytest.raises(ValidationError, match="without them"):
+        TrainConfig(memory=True, demonstrations=1)

@@ -1,0 +1,159 @@
+"""The DQN with memory (issue 55): its state is the last second of what the snapshot DQN sees, plus time.
+
+A snapshot DQN decides on one 0.2 s state (:data:`features.FEATURES`). The hindsight bound (oracle.py) shows that 1 s
+of foresight meets the operator targets where a snapshot does not. A policy cannot see the future, but it can see
+the recent past: whether a neighbour's RSRQ is rising or the serving cell's falling.
+
+**The state.** It is a window (:mod:`xairl.windows`) of :data:`STEPS` decisions, oldest first, of :data:`SIGNALS`:
+
+- the 13 features of the snapshot;
+- ``time_on_cell``: seconds since the UAV came onto its serving cell, by handover or by re-establishment after a
+  failure;
+- ``time_since_handover``: seconds since its last handover.
+
+Both times are capped at :data:`TIME_CAP_S`. Flat, it has 5 x 15 = 75 columns, time-major (``layout='stacked'``).
+
+**The candidates' past.** Candidate slot k's RSRP and RSRQ at an earlier step are that step's measurements of the
+cell in slot k *now*. So a slot keeps one cell through the window even when the ranking of neighbours changed. The
+UE reports every detected cell, and :class:`Memory` keeps every cell's reported values.
+
+**The start of a flight.** The window repeats the first observation: there is no past yet.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+import xairl
+
+from .features import (
+    ACTION_ALIASES,
+    ACTIONS,
+    SIGNALS,
+    HandoverFacts,
+    available_actions,
+    feature_info,
+    snapshot,
+    state_rows,
+)
+from .features import MEMORY_STEPS as STEPS
+from .policy import greedy
+
+#: the times are capped here (seconds): a 120 s flight's cells last tens of seconds, and a cap keeps a rare long
+#: stay from stretching the network's input scale
+TIME_CAP_S = 30.0
+N_FEATURES = STEPS * len(SIGNALS)
+
+
+def observation() -> xairl.Observation:
+    """The memory DQN's input as an xairl observation: a stacked window of :data:`SIGNALS`, 0.2 s apart."""
+    return xairl.Observation.window(SIGNALS, STEPS, layout="stacked", step_s=0.2)
+
+
+class Memory:
+    """The last :data:`STEPS` decisions of K flights: every cell's reported RSRP and RSRQ, the position, buffer,
+    serving cell and times. :meth:`start` after ``env.reset``, :meth:`step` after each ``env.step``; both return
+    the memory states (K, 75)."""
+
+    def start(self, env) -> np.ndarray:
+        sim = env.sim
+        self.since_ho = np.zeros(sim.K)
+        now = self._now(env)
+        self.past = [now] * STEPS
+        return self.states(env)
+
+    def step(self, env, handover: np.ndarray) -> np.ndarray:
+        decision_s = env.sim.dt * env.decision_every
+        self.since_ho = np.where(np.asarray(handover) > 0, 0.0, self.since_ho + decision_s)
+        self.past = [*self.past[1:], self._now(env)]
+        return self.states(env)
+
+    def _now(self, env) -> dict:
+        sim = env.sim
+        on_cell = (sim.t - sim.entered) * sim.dt
+        return {
+            "pos": sim.pos.copy(),
+            "q": sim.q.copy(),
+            "rsrp": sim.meas_rsrp.copy(),
+            "rsrq": sim.meas_rsrq.copy(),
+            "times": np.minimum(np.stack([on_cell, self.since_ho], axis=1), TIME_CAP_S),
+        }
+
+    def states(self, env) -> np.ndarray:
+        """(K, 75): for each step, the 13 features of the cells in today's candidate slots, then the two times."""
+        sim, cand = env.sim, env.candidates
+        rows, missing = np.arange(sim.K)[:, None], cand < 0
+        out = []
+        for then in self.past:
+            rsrp = np.where(missing, np.nan, then["rsrp"][rows, np.maximum(cand, 0)])
+            rsrq = np.where(missing, np.nan, then["rsrq"][rows, np.maximum(cand, 0)])
+            snap = state_rows(then["pos"], then["q"], sim.serving, rsrp, rsrq, sim.cfg.observation)
+            out.append(np.concatenate([snap, then["times"].astype(np.float32)], axis=1))
+        return np.concatenate(out, axis=1).astype(np.float32)
+
+
+class MemoryDQNController:
+    """Acts greedily with a memory Q-network (states from :class:`Memory`), one decision per env step."""
+
+    name = "DQN with memory"
+    decision_every = None  # the simulator config's
+
+    def __init__(self, net):
+        self.net = net.eval()
+
+    def reset(self, env) -> None:
+        self.memory, self.states, self.serving = Memory(), None, None
+
+    def __call__(self, env) -> np.ndarray:
+        if self.states is None:
+            self.states = self.memory.start(env)
+        else:  # a handover since the last decision: the serving cell changed where this controller asked for it
+            self.states = self.memory.step(env, (env.sim.serving != self.serving) & (self.asked != self.serving))
+        act = greedy(self.net, self.states, env.cfg)
+        self.serving = env.sim.serving.copy()
+        target = env.candidates[np.arange(env.sim.K), act]
+        self.asked = np.where(target < 0, self.serving, target)
+        return act
+
+
+def background(n: int, seed: int = 0, config=None) -> np.ndarray:
+    """``n`` memory states met in flight: ``n`` simulated UAVs after 10 s under conventional handover, decided every
+    0.2 s (the memory's cadence)."""
+    from .baselines import CHM
+    from .env import HandoverVecEnv
+
+    env = HandoverVecEnv(config, n_flights=n)
+    env.reset(seed=seed)
+    chm, memory = CHM(), Memory()
+    chm.reset(env)
+    states = memory.start(env)
+    for _ in range(int(round(10.0 / (env.sim.dt * env.decision_every)))):
+        info = env.step(chm(env))[4]
+        states = memory.step(env, info["handover"])
+    return states
+
+
+def memory_policy(ckpt) -> xairl.Policy:
+    """The DQN with memory as an xairl Policy (``uav_policy`` of its checkpoint): a window of :data:`SIGNALS`, so
+    its explanations group per signal and per step and its narratives speak of trends; the action mask, the facts
+    hook and the rule comparisons read the newest observation."""
+    from .baselines import CHMConfig
+
+    config = ckpt.sim_config
+    facts = HandoverFacts(config.buffer.q_max_bits, CHMConfig().offset_db, config.observation.detection_rsrq_db)
+    info = {k: v for k, v in feature_info(config.buffer.q_max_bits).items() if v.kind != "group"}
+    info["time_on_cell"] = xairl.FeatureInfo("s", "the time on the serving cell", "just arrived", "long settled")
+    info["time_since_handover"] = xairl.FeatureInfo("s", "the time since the last handover", "recent", "long ago")
+    return xairl.Policy(
+        ckpt.net,
+        observation=observation(),
+        action_names=ACTIONS,
+        features=info,
+        background_sampler=lambda n, seed: background(n, seed, config),
+        name="uav-dqn-memory",
+        action_aliases=ACTION_ALIASES,
+        facts_hook=lambda state, chosen, runner_up, history=None: facts(
+            snapshot(state), chosen, runner_up, None if history is None else snapshot(history)
+        ),
+        action_mask=lambda x: available_actions(x, config.observation),
+    )
