@@ -2,6 +2,8 @@
 their cell through the window, the times count as the simulator does, its controller acts on the same states as
 training, and its checkpoint loads as a window policy whose narratives verify."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import torch
@@ -129,3 +131,28 @@ def test_demonstrations_are_refused_for_the_memory_dqn():
 
     with pytest.raises(ValidationError, match="without them"):
         TrainConfig(memory=True, demonstrations=1)
+
+
+UKM = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "ukm-uav-lte" / "raw"
+
+
+@pytest.mark.skipif(not UKM.is_dir(), reason="../shared/data/ukm-uav-lte is not here")
+def test_a_real_flight_walked_with_memory_holds_the_samples_before_it():
+    from xairl_uav_handover.exports import load_flight
+    from xairl_uav_handover.memory import walk_states
+    from xairl_uav_handover.real_data import walk
+
+    cfg = _sim()
+    w = walk(load_flight(UKM / "100m.csv"), cfg)
+    states = walk_states(w, cfg)
+    np.testing.assert_array_equal(snapshot(states), w.states)  # the newest step is the walk's own state
+    rsrq, checked = FEATURES.index("rsrq_1"), 0
+    for i in range(5, len(w.t), 37):  # a past step: the last sample at or before its time, for the cell now in slot 1
+        j = int(np.searchsorted(w.t, w.t[i] - 0.8 + 1e-9, side="right")) - 1
+        cell = w.candidates[i][1] if len(w.candidates[i]) > 1 else None
+        oldest = states[i].reshape(MEMORY_STEPS, F)[0]
+        if cell in w.measured[j] and w.candidates[i][0] in w.measured[j]:
+            want = max(w.measured[j][cell][1], cfg.observation.detection_rsrq_db)
+            assert oldest[rsrq] == pytest.approx(want, abs=1e-4)
+            checked += 1
+    assert checked >= 5

@@ -12,7 +12,8 @@ import numpy as np
 from .baselines import CHMOnSamples, SAMROOnSamples
 from .evaluate import chm_rate_by_altitude, held_at
 from .features import FEATURES, RSRP, RSRQ
-from .policy import Checkpoint, greedy
+from .memory import walk_states
+from .policy import Checkpoint, greedy, memory_of
 
 BANDS = ((20.0, 60.0), (60.0, 100.0), (100.0, 160.0))
 #: median interval between the real UKM logs' samples (s): CHM replayed on them sees the measurements this often
@@ -128,8 +129,9 @@ def quantile_rows(sim: np.ndarray, real: np.ndarray) -> list[QuantileRow]:
 def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
     from .real_data import agreement
 
-    def dqn(walk):  # the DQN keeps no state: its action at every sample of the walk in one batch
-        actions = dict(zip(walk.t.tolist(), greedy(ckpt.net, walk.states, cfg).tolist()))
+    def dqn(walk):  # the DQN's action at every sample of the walk in one batch (with memory: its windows)
+        states = walk_states(walk, cfg) if memory_of(ckpt.meta) else walk.states
+        actions = dict(zip(walk.t.tolist(), greedy(ckpt.net, states, cfg).tolist()))
         return lambda s, c, t: actions[t]
 
     rows = []

@@ -157,3 +157,30 @@ def memory_policy(ckpt) -> xairl.Policy:
         ),
         action_mask=lambda x: available_actions(x, config.observation),
     )
+
+
+def walk_states(walk, config) -> np.ndarray:
+    """Memory states (n, 75) along a real flight (:func:`real_data.walk`): at each sample, the window's steps 0.2 s
+    apart back from it, each read from the last sample at or before that time (the logs report every 1.28 s in
+    the median, so most of a window holds one or two samples: sample and hold, as a UE's report holds between
+    reports). The candidates' past are the cells in the slots now; the times run on the network's own path."""
+    t, cands = np.asarray(walk.t, float), walk.candidates
+    serving = np.array([c[0] for c in cands])
+    changed = np.flatnonzero(serving[1:] != serving[:-1]) + 1
+    since = t - t[np.concatenate([[0], changed])[np.searchsorted(changed, np.arange(len(t)), side="right")]]
+    since = np.minimum(since, TIME_CAP_S)
+    pad = [np.nan] * (4 - 1)
+    out = np.empty((len(t), STEPS * len(SIGNALS)), dtype=np.float32)
+    for i in range(len(t)):
+        slots = list(cands[i]) + pad[: 4 - len(cands[i])]
+        rows = []
+        for d in range(STEPS - 1, -1, -1):
+            j = max(int(np.searchsorted(t, t[i] - 0.2 * d + 1e-9, side="right")) - 1, 0)
+            cells = walk.measured[j] if slots[0] in walk.measured[j] else walk.measured[i]  # no past of it
+            snap = walk.states[j].copy()
+            snap[5:9] = [cells.get(c, (np.nan, np.nan))[0] for c in slots]
+            snap[9:13] = [cells.get(c, (np.nan, np.nan))[1] for c in slots]
+            fixed = state_rows(snap[:3], snap[3], walk.states[i][4], snap[5:9], snap[9:13], config.observation)[0]
+            rows.append(np.concatenate([fixed, [min(since[j], TIME_CAP_S)] * 2]))
+        out[i] = np.concatenate(rows)
+    return out

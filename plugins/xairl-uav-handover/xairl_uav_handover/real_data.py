@@ -36,6 +36,7 @@ class Walk:
     queue_bits: np.ndarray  # (n,) the modelled uplink buffer
     lost_bits: float
     name: str = ""  # the flight's
+    measured: list | None = None  # per sample: every measured cell's (RSRP, RSRQ), by PCI (the memory's past)
 
     @property
     def serving(self) -> np.ndarray:
@@ -105,9 +106,10 @@ def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
     ids = {p: k for k, p in enumerate(sorted(set(f.pci.tolist())))}
     max_id = n_cells(cfg.layout) - 1  # the simulator's ids: a real flight's cells are ranked into that range
     link = UplinkBuffer(cfg, f.altitude_m, seed, f.name)
-    states, cands, queues = [], [], []
+    states, cands, queues, measured = [], [], [], []
     for i in range(len(f.t)):
         cells = _measured(f, i)
+        measured.append(cells)
         serving = f.pci[i]
         cand = _candidates(cells, serving, cfg)
         pad = [np.nan] * (N_CANDIDATES - len(cand))
@@ -133,7 +135,8 @@ def walk(f: RealFlight, config: SimConfig | None = None, seed: int = 0) -> Walk:
             f"{f.name}: the state at sample {i} has {FEATURES[j]} = {states[i, j]:g} (float32), not a "
             "finite number; fix that measurement."
         )
-    return Walk(f.t, states, cands, np.append(f.pci[1:], f.pci[-1]), np.array(queues), link.lost, f.name)
+    next_serving = np.append(f.pci[1:], f.pci[-1])
+    return Walk(f.t, states, cands, next_serving, np.array(queues), link.lost, f.name, measured)
 
 
 def chm_handovers(f: RealFlight, config=None, sim_config: SimConfig | None = None) -> int:
