@@ -12,6 +12,7 @@ writes the same).
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/reproduce.py [--seeds 0 1 2] [--episodes 40]
      [--flights 200] [--eval-seeds 0] [--states 400] [--real DIR] [--out-dir DIR] [--json OUT]
      [--demonstrations N] [--reward w_lost=2 w_pingpong=80 ...]   trains with these RewardConfig weights
+     [--memory]   trains the DQN with memory (issue 55) instead of the snapshot DQN
 or:  ... reproduce.py --checkpoints A.safetensors B.safetensors ...   measures existing checkpoints
 """
 
@@ -27,7 +28,8 @@ from table_one import print_targets, targets
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.evaluate import importance, ranked
-from xairl_uav_handover.policy import DQNController, dqn_decision_states, load_checkpoint
+from xairl_uav_handover.memory import MemoryDQNController, walk_states
+from xairl_uav_handover.policy import DQNController, dqn_decision_states, load_checkpoint, memory_of
 from xairl_uav_handover.table import flights, format_paper, format_rows, pooled_seeds, with_intervals
 from xairl_uav_handover.train import TrainConfig, train_checkpoint
 
@@ -56,13 +58,23 @@ def _parser() -> argparse.ArgumentParser:
         metavar="KEY=VALUE",
         help="train with these reward weights (RewardConfig) instead of the defaults",
     )
+    ap.add_argument(
+        "--memory",
+        action="store_true",
+        help="train the DQN with memory (memory.py: the last 1 s and the times on the cell and since the handover)",
+    )
     return ap
+
+
+def controller(ckpt):
+    """The controller that flies a checkpoint: the DQN with memory keeps its window."""
+    return MemoryDQNController(ckpt.net) if memory_of(ckpt.meta) else DQNController(ckpt.net)
 
 
 def _seed_figures(ckpt, res: dict, name: str, walks, n_states: int, n: int):
     """One DQN's targets met (Table I's against CHM; on real flights, targets 5 and 6b), its feature rankings by
     mean |contribution| (simulated and real, margin and score) and the buffer's rank in each."""
-    imp = {"simulated": importance(ckpt, dqn_decision_states(ckpt, n_states, 0))}
+    imp = {"simulated": importance(ckpt, dqn_decision_states(ckpt, n_states, 0))}  # (with memory: per signal)
     met = [(label, bool(ok), detail) for label, ok, detail in targets({"CHM": res["CHM"], "DQN": res[name]}, n)]
     if walks:
         imp["real"], target5 = real_figures(ckpt, walks, n_states)
@@ -82,7 +94,7 @@ def main():
     if not paths:
         paths = [str(folder / f"seed{seed}.safetensors") for seed in args.seeds]
         for seed, path in zip(args.seeds, paths):
-            tc = TrainConfig(episodes=args.episodes, seed=seed, demonstrations=args.demonstrations)
+            tc = TrainConfig(episodes=args.episodes, seed=seed, demonstrations=args.demonstrations, memory=args.memory)
             seconds = train_checkpoint(tc, with_reward(args.reward), path, progress=False)
             print(f"seed {seed}: trained in {seconds} s -> {path}")
     ckpts = [load_checkpoint(p) for p in paths]
@@ -101,7 +113,7 @@ def main():
     per_seed, runs = [], []
     for k, (path, ckpt) in enumerate(zip(paths, ckpts)):
         name = f"DQN seed {ckpt.meta.get('seed')}" if not args.checkpoints else f"DQN {k + 1}: {Path(path).stem}"
-        runs.append(flights(DQNController(ckpt.net), ckpt.sim_config, args.flights, args.eval_seeds))
+        runs.append(flights(controller(ckpt), ckpt.sim_config, args.flights, args.eval_seeds))
         res[name] = with_intervals(runs[-1])
         met, ranks, buffer = _seed_figures(ckpt, res, name, walks, args.states, n)
         per_seed.append(
@@ -154,9 +166,10 @@ def real_walks(folder: str, cfg) -> list:
     return [walk(f, cfg) for f in load_folder(folder)[0]]
 
 
-def real_sample(walks: list, n: int) -> np.ndarray:
-    """``n`` of the walks' states, drawn uniformly (seeded), in their order."""
-    states = np.concatenate([w.states for w in walks])
+def real_sample(walks: list, n: int, ckpt=None) -> np.ndarray:
+    """``n`` of the walks' states, drawn uniformly (seeded), in their order (a DQN with memory's: its windows)."""
+    memory = ckpt is not None and memory_of(ckpt.meta)
+    states = np.concatenate([walk_states(w, ckpt.sim_config) if memory else w.states for w in walks])
     return states[np.sort(np.random.default_rng(0).choice(len(states), size=min(n, len(states)), replace=False))]
 
 
@@ -165,7 +178,7 @@ def real_figures(ckpt, walks: list, n_states: int) -> tuple[dict, tuple[str, boo
     from xairl_uav_handover.calibration import agreement_rows
 
     dqn = agreement_rows(walks, ckpt, ckpt.sim_config)[0]
-    return importance(ckpt, real_sample(walks, n_states)), (
+    return importance(ckpt, real_sample(walks, n_states, ckpt)), (
         "5. real: new proposals <= 2 x the network's rate",
         bool(dqn.new_proposals_per_min <= 2 * dqn.network_per_min),
         f"{dqn.new_proposals_per_min:.2f} vs 2 x {dqn.network_per_min:.2f} per minute",

@@ -94,15 +94,15 @@ def _fly(controller, config: SimConfig, seeds: list) -> dict[str, np.ndarray]:
 
 def importance(ckpt, states: np.ndarray, seed: int = 0, groups: dict | None = None) -> dict[str, np.ndarray]:
     """Mean |contribution| per feature (deep_shap) on ``states``: ``margin`` to the margin over the runner-up (the
-    paper's Figure 2 as the cards read it) and ``score`` to the chosen action's score; ``names`` the features, or
-    with ``groups`` ({name: members}) each group summed per state in place of its members."""
+    paper's Figure 2 as the cards read it) and ``score`` to the chosen action's score; ``names`` the features (of
+    the DQN with memory: its signals, each summed over its window), or with ``groups`` ({name: members}) each group summed per state in place of its members."""
     import xairl
 
-    from .policy import background_states, uav_policy
+    from .policy import uav_policy
 
-    exp = xairl.explain(
-        uav_policy(ckpt), states, background=background_states(100, seed=seed + 7, config=ckpt.sim_config)
-    )
+    policy = uav_policy(ckpt)
+    exp = xairl.explain(policy, states, background=policy.background(100, seed=seed + 7))
+    exp = exp.by_signal() if policy.window else exp  # the DQN with memory: each signal over its window
     exp = exp.grouped(groups) if groups else exp
     return {
         "margin": np.abs(exp.margin()).mean(axis=0),

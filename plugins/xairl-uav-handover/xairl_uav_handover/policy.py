@@ -234,13 +234,19 @@ def dqn_decision_states(
     sees). Flights draw their height uniformly, so a few hundred cover the altitude range to its percentiles."""
     env = HandoverVecEnv(ckpt.sim_config, n_flights=n_flights)
     obs, _ = env.reset(seed=2_000_000 + seed)
+    if memory_of(ckpt.meta):  # the DQN with memory decides on its window
+        from .memory import Memory
+
+        memory = Memory()
+        obs = memory.start(env)
     rng = np.random.default_rng(seed)
     seen, truncated = [], np.zeros(n_flights, bool)
     while not truncated.all():
         seen.append(obs)
         act = greedy(ckpt.net, obs, ckpt.sim_config)
         act = np.where(rng.uniform(size=n_flights) < epsilon, random_available(rng, obs, ckpt.sim_config), act)
-        obs, _, _, truncated, _ = env.step(act)
+        obs, _, _, truncated, info = env.step(act)
+        obs = memory.step(env, info["handover"]) if memory_of(ckpt.meta) else obs
     states = np.concatenate(seen)
     return states[np.random.default_rng(seed).choice(len(states), size=min(n, len(states)), replace=False)]
 
