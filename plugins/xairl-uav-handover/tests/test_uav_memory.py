@@ -156,3 +156,18 @@ def test_a_real_flight_walked_with_memory_holds_the_samples_before_it():
             assert oldest[rsrq] == pytest.approx(want, abs=1e-4)
             checked += 1
     assert checked >= 5
+
+
+def test_without_the_past_the_window_holds_its_newest_step_and_the_clocks_count():
+    from xairl_uav_handover.memory import without_past
+
+    _, states, *_ = _fly(_hand_over_every(4))
+    s = np.stack(states[-3:])
+    flat = without_past(s).reshape(len(s), MEMORY_STEPS, F)
+    np.testing.assert_array_equal(flat[:, -1], s.reshape(len(s), MEMORY_STEPS, F)[:, -1])
+    held = [j for j, name in enumerate(SIGNALS) if not name.startswith("time_")]
+    assert (flat[:, :, held] == flat[:, -1:, held]).all()
+    clock = flat[:, :, SIGNALS.index("time_on_cell")]
+    np.testing.assert_allclose(
+        clock, np.maximum(clock[:, -1:] - 0.2 * np.arange(MEMORY_STEPS - 1, -1, -1), 0), atol=1e-6
+    )

@@ -184,3 +184,21 @@ def walk_states(walk, config) -> np.ndarray:
             rows.append(np.concatenate([fixed, [min(since[j], TIME_CAP_S)] * 2]))
         out[i] = np.concatenate(rows)
     return out
+
+
+def without_past(states: np.ndarray, step_s: float = 0.2) -> np.ndarray:
+    """Memory states whose measurements, position and buffer hold the newest step's values through the window, as
+    if nothing had changed over the last second: what the same network decides when it may not look back. The times
+    keep counting (each step ``step_s`` less, not below 0): time on the cell is part of the state, not its past."""
+    w = np.repeat(np.asarray(states).reshape(len(states), STEPS, len(SIGNALS))[:, -1:], STEPS, axis=1)
+    back = step_s * np.arange(STEPS - 1, -1, -1)[None, :, None]
+    times = [SIGNALS.index(t) for t in ("time_on_cell", "time_since_handover")]
+    w[:, :, times] = np.maximum(w[:, :, times] - back, 0.0)
+    return w.reshape(len(states), -1)
+
+
+def on_trends(net, states: np.ndarray, config) -> np.ndarray:
+    """Bool per state: the memory DQN hands over there and would stay without its past (:func:`without_past`): a
+    handover taken on a trend, which a snapshot of the same state would not give."""
+    acts, flat = greedy(net, states, config), greedy(net, without_past(states), config)
+    return (acts > 0) & (flat == 0)
