@@ -162,7 +162,7 @@ def test_without_the_past_the_window_holds_its_newest_step_and_the_clocks_count(
     from xairl_uav_handover.memory import without_past
 
     _, states, *_ = _fly(_hand_over_every(4))
-    s = np.stack(states[-3:])
+    s = states[-1]  # (flights, 75)
     flat = without_past(s).reshape(len(s), MEMORY_STEPS, F)
     np.testing.assert_array_equal(flat[:, -1], s.reshape(len(s), MEMORY_STEPS, F)[:, -1])
     held = [j for j, name in enumerate(SIGNALS) if not name.startswith("time_")]
