@@ -48,8 +48,8 @@ class ExactOptions(Options):
 class ExactCost:
     """What one exact call costs, known before it runs.
 
-    :param evaluations: rows through the network: states x 2^F coalitions x background rows, plus the states' own
-        outputs (one row each), which every method computes.
+    :param evaluations: rows exact runs through the network: states x 2^F coalitions x background rows (every method
+        also runs each state once for its outputs: one row per state on top).
     :param bytes: memory of its batches: the rows of one forward (``rows_per_forward`` x F in the network's dtype),
         their outputs, and the (2^F, actions) value table of one state. The network's own activations come on top
         (a recurrent network's are several times its input).
@@ -107,7 +107,7 @@ class Exact(Attributor):
         rows = self._coalitions_per_forward(f, n_background) * n_background
         out_rows = min(rows, self.options.max_rows)
         memory = rows * f * item + out_rows * a * item + rows * a * 8 + 2**f * (a * 8 + f)
-        return ExactCost(n_states * 2**f * n_background + n_states, memory, rows)
+        return ExactCost(n_states * 2**f * n_background, memory, rows)
 
     def _check_cost(self, policy, n_states, n_background):
         f = policy.n_features
