@@ -81,6 +81,7 @@ def fit(net: torch.nn.Module, seed: int, steps: int) -> float:
     rng = np.random.default_rng(1000 + seed)
     opt = torch.optim.Adam(net.parameters(), lr=3e-3)
     net.train()
+    loss = torch.tensor(float("nan"))  # 0 steps: the network at its random initialisation
     for _ in range(steps):
         x = torch.as_tensor(windows(rng, 256))
         loss = torch.nn.functional.mse_loss(net(x), target(x))
@@ -152,6 +153,8 @@ def main():
             mean, sig = np.mean([r[method][1] for r in runs]), max(r[method][2] for r in runs)
             top, secs = np.mean([r[method][3] for r in runs]), sum(r[method][4] for r in runs)
             print(f"{kind:<8} {method:<21} {worst:>14.3f} {mean:>14.3f} {sig:>10.3f} {100 * top:>7.0f}% {secs:>8.1f}")
+        if args.fit_steps == 0:
+            continue
         mses = ", ".join(f"{r['mse']:.3f}" for r in runs)
         print(f"{kind:<8} fit: final mean squared error {mses} (variance of the target per action 0.35-1.0)")
 
