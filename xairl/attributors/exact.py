@@ -149,9 +149,9 @@ class Exact(Attributor):
                     rows = torch.where(mt[s : s + per], xi, bt).reshape(-1, f)
                     out = self._forward(policy, rows, self.options.max_rows)
                     v[s : s + per] = out.reshape(-1, b, a).mean(dim=1).numpy()
-                    bar.update(n == 1)
+                    bar.update(int(n == 1))
                 values[i] = shapley(v, masks, weights)
-                bar.update(n > 1)
+                bar.update(int(n > 1))
         finally:
             bar.close()
         # the empty coalition is every feature from the background: the base value, the same for every state
