@@ -7,6 +7,7 @@ narratives write it (:func:`value_text`), and a progress bar that is quiet in a 
 from __future__ import annotations
 
 import html
+import sys
 import warnings
 
 import numpy as np
@@ -32,6 +33,15 @@ def progress(iterable=None, **kwargs):
     from tqdm.auto import tqdm
 
     return tqdm(iterable, **kwargs)
+
+
+def show_progress(progress: bool | None) -> bool:
+    """Whether to show a progress bar: ``True`` or ``False`` as given; ``None`` only when stderr is a terminal (as
+    :func:`xairl.stream.explain_to_parquet` does), so logs, pipes and tests stay quiet."""
+    if progress is not None:
+        return progress
+    isatty = getattr(sys.stderr, "isatty", None)
+    return bool(isatty and isatty())
 
 
 def explanation_html(exp, states: int = 5, top: int = 6) -> str:

@@ -51,6 +51,7 @@ class Attributor:
             )
         x = policy.check_states(states)
         bg = policy.background() if background is None else policy.check_states(background, "background")
+        self._check_cost(policy, len(x), len(bg))  # before any forward pass: a refusal costs nothing
         outputs = policy.scores(x)
         bad = ~np.isfinite(outputs).all(axis=1)
         if bad.any():
@@ -106,6 +107,10 @@ class Attributor:
                 f"{self.name} contributions do not add up to the output (gap {gap:.3g}, {what} {scale:.3g}, "
                 f"tolerance {self.tolerance:g} of it): {self.gap_reason}; otherwise {alternatives(policy, self.name)}"
             )
+
+    def _check_cost(self, policy: Policy, n_states: int, n_background: int) -> None:
+        """Refuse, with an :class:`InputError`, work this method cannot do or should not start; nothing has run yet.
+        The default accepts everything."""
 
     def _attribute(self, policy: Policy, x: np.ndarray, bg: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
         """The subclass's method: contributions of ``x`` (n, f) against ``bg`` (m, f), module already in eval mode.

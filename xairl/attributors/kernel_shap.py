@@ -8,7 +8,7 @@ import numpy as np
 import torch
 from pydantic import Field
 
-from ..display import quiet_tqdm
+from ..display import quiet_tqdm, show_progress
 from .base import Attributor, Options
 
 
@@ -20,6 +20,10 @@ class KernelShapOptions(Options):
         Field(False, description="shap's feature selection; False keeps every feature")
     )
     seed: int = Field(0, ge=0, le=2**32 - 1, description="seed of the coalition sampler")
+    progress: bool | None = Field(
+        None,
+        description="show shap's progress bar over the states: True, False, or None = only when stderr is a terminal",
+    )
 
 
 class KernelShap(Attributor):
@@ -40,10 +44,11 @@ class KernelShap(Attributor):
 
         explainer = shap.KernelExplainer(f, bg)
         # shap samples coalitions from numpy's global generator: seed it here and put the caller's state back
+        silent = not show_progress(self.options.progress)
         saved = np.random.get_state()
         np.random.seed(self.options.seed)
         try:
-            sv = explainer.shap_values(x, nsamples=self.options.nsamples, l1_reg=self.options.l1_reg, silent=True)
+            sv = explainer.shap_values(x, nsamples=self.options.nsamples, l1_reg=self.options.l1_reg, silent=silent)
         finally:
             np.random.set_state(saved)
         values = np.stack(sv, axis=-1) if isinstance(sv, list) else np.asarray(sv)

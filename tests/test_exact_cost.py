@@ -1,0 +1,156 @@
+"""exact states its cost before it runs and refuses above max_evaluations; exact and kernel_shap show progress only
+when asked (or on a terminal)."""
+
+import itertools
+
+import numpy as np
+import pytest
+import torch
+
+import xairl
+from xairl.attributors.exact import MAX_EVALUATIONS, Exact
+from xairl.errors import InputError
+
+from .conftest import mlp, run
+
+SIGNALS, STEPS = 4, 4
+NAMES = [f"s{j}_t{t}" for t in range(STEPS) for j in range(SIGNALS)]  # time-major, as observation=(4, 4) flattens
+
+
+class Counting(torch.nn.Module):
+    """The user's module, counting the forward passes and rows it is asked for."""
+
+    def __init__(self, inner: torch.nn.Module):
+        super().__init__()
+        self.inner = inner
+        self.reset()
+
+    def reset(self) -> None:
+        self.calls, self.rows, self.largest = 0, 0, 0
+
+    def forward(self, x):
+        self.calls += 1
+        self.rows += len(x)
+        self.largest = max(self.largest, len(x))
+        return self.inner(x)
+
+
+class GruQ(torch.nn.Module):
+    """A CleanRL-style GRU Q-network over the last 4 observations of 4 signals: (batch, 4, 4) -> (batch, 3)."""
+
+    def __init__(self):
+        super().__init__()
+        torch.manual_seed(0)
+        self.gru = torch.nn.GRU(SIGNALS, 8, batch_first=True)
+        self.head = torch.nn.Linear(8, 3)
+
+    def forward(self, x):
+        return self.head(self.gru(x)[0][:, -1])
+
+
+def counted(inner, f, a=3, **kw):
+    module = Counting(inner.eval())
+    policy = xairl.Policy(module, feature_names=kw.pop("names", [f"f{i}" for i in range(f)]), **kw)
+    module.reset()  # Policy runs the module once to count its outputs
+    assert policy.n_actions == a
+    return module, policy
+
+
+def brute_force_shapley(fn, x, bg):
+    """Average marginal contribution over all orderings of the features (independent of exact's coalition sums)."""
+    f = len(x)
+
+    def v(coalition):
+        rows = bg.copy()
+        rows[:, list(coalition)] = x[list(coalition)]
+        return fn(rows).mean(axis=0)
+
+    orders = list(itertools.permutations(range(f)))
+    phi = np.zeros((f, fn(bg[:1]).shape[1]))
+    for order in orders:
+        for k, j in enumerate(order):
+            phi[j] += v(order[: k + 1]) - v(order[:k])
+    return phi / len(orders)
+
+
+def test_exact_refuses_a_16_feature_gru_before_any_forward_pass():
+    module, policy = counted(GruQ(), 16, names=NAMES, observation=(STEPS, SIGNALS))
+    r = np.random.default_rng(0)
+    x, bg = r.normal(size=(3, 16)), r.normal(size=(100, 16))  # the issue's case: 3 states, 100 background rows
+    with pytest.raises(InputError) as err:
+        xairl.explain(policy, x, background=bg, method="exact")
+    msg = str(err.value)
+    assert "\n" not in msg
+    assert "19,660,800 network evaluations" in msg and "3 states x 2^16 coalitions x 100 background rows" in msg
+    assert f"over max_evaluations={MAX_EVALUATIONS:,}" in msg and "'max_evaluations': 19660800" in msg
+    assert " MB" in msg  # the memory of its batches, stated too
+    assert module.calls == 0
+
+
+def test_exact_over_16_features_refused_before_any_forward_pass():
+    module, policy = counted(mlp([17, 4, 3]), 17)
+    with pytest.raises(InputError, match="17 features.*16"):
+        xairl.explain(policy, np.zeros((1, 17)), background=np.ones((2, 17)), method="exact")
+    assert module.calls == 0
+
+
+@pytest.mark.parametrize("max_rows", [8_192, 20, 3])  # whole table at once; 2 coalitions a batch; a coalition split
+def test_exact_with_the_limit_raised_equals_brute_force_and_costs_what_it_said(max_rows):
+    module, policy = counted(mlp([5, 16, 16, 3], seed=3), 5)
+    r = np.random.default_rng(4)
+    x, bg = r.normal(size=(3, 5)).astype(np.float32), r.normal(size=(7, 5)).astype(np.float32)
+    cost = Exact({"max_rows": max_rows}).cost(policy, 3, 7)
+    assert cost.evaluations == 3 * 2**5 * 7
+    with pytest.raises(InputError, match="max_evaluations"):
+        xairl.explain(policy, x, bg, "exact", {"max_rows": max_rows, "max_evaluations": cost.evaluations - 1})
+    assert module.calls == 0
+    exp = xairl.explain(policy, x, bg, "exact", {"max_rows": max_rows, "max_evaluations": cost.evaluations})
+    assert module.rows == cost.evaluations + 3  # every row it said, and the states' outputs every method runs
+    assert module.largest == min(max(cost.rows_per_forward, 3), max_rows)
+    for i in range(3):
+        ref = brute_force_shapley(policy.scores, x[i], bg)
+        np.testing.assert_allclose(exp.values[i], ref, rtol=0, atol=2e-6)
+    np.testing.assert_allclose(exp.base_values[0], policy.scores(bg).mean(axis=0), rtol=0, atol=1e-6)
+
+
+def test_cost_grows_with_its_parts_and_bounds_the_batches():
+    _, policy = counted(GruQ(), 16, names=NAMES, observation=(STEPS, SIGNALS))
+    small, big = Exact().cost(policy, 1, 100), Exact({"max_rows": 65_536}).cost(policy, 1, 100)
+    assert small.evaluations == big.evaluations == 2**16 * 100
+    assert small.rows_per_forward == 8_100 and big.rows_per_forward == 65_500  # whole coalitions of 100 rows
+    assert 8_100 * 16 * 4 < small.bytes < big.bytes
+    assert Exact().cost(policy, 3, 100).evaluations == 3 * small.evaluations
+    assert "6,553,600 network evaluations" in str(small)
+
+
+def _states(f, n=2, m=6, seed=0):
+    r = np.random.default_rng(seed)
+    return r.normal(size=(n, f)).astype(np.float32), r.normal(size=(m, f)).astype(np.float32)
+
+
+@pytest.mark.parametrize("method", ["exact", "kernel_shap"])
+def test_progress_is_quiet_unless_asked(method, capsys):
+    _, policy = counted(mlp([4, 8, 3]), 4)
+    x, bg = _states(4)
+    xairl.explain(policy, x, background=bg, method=method)  # stderr is captured: not a terminal
+    assert capsys.readouterr().err == ""
+    xairl.explain(policy, x, background=bg, method=method, options={"progress": False})
+    assert capsys.readouterr().err == ""
+    xairl.explain(policy, x, background=bg, method=method, options={"progress": True})
+    err = capsys.readouterr().err
+    assert "100%" in err and "2/2" in err  # a bar over the two states
+    if method == "exact":
+        assert "exact: 100%" in err and "state/s" in err
+
+
+def test_exact_one_state_shows_a_bar_over_its_batches(capsys):
+    _, policy = counted(mlp([6, 8, 3]), 6)
+    x, bg = _states(6, n=1, m=10)
+    xairl.explain(policy, x, background=bg, method="exact", options={"progress": True, "max_rows": 100})
+    err = capsys.readouterr().err
+    assert "7/7" in err and "batch" in err  # 64 coalitions, 10 a batch of 100 rows
+
+
+def test_cli_names_the_limit(capsys):
+    rc, _, err = run(capsys, "explain", "--n", "2", "--method", "exact", "-o", "max_evaluations=10")
+    assert rc == 2 and "max_evaluations=10" in err and "network evaluations" in err and err.count("\n") == 1
