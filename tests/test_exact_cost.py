@@ -154,3 +154,17 @@ def test_exact_one_state_shows_a_bar_over_its_batches(capsys):
 def test_cli_names_the_limit(capsys):
     rc, _, err = run(capsys, "explain", "--n", "2", "--method", "exact", "-o", "max_evaluations=10")
     assert rc == 2 and "max_evaluations=10" in err and "network evaluations" in err and err.count("\n") == 1
+
+
+def test_a_resumed_run_may_change_how_it_is_shown_and_bounded(tmp_path):
+    """progress and max_evaluations say how a run is shown or bounded, not what it computes: resume takes them."""
+    torch.manual_seed(0)
+    policy = xairl.Policy(torch.nn.Linear(4, 2), feature_names=["a", "b", "c", "d"])
+    states, bg = np.random.default_rng(0).normal(size=(6, 4)), np.zeros((3, 4))
+    out = tmp_path / "run"
+    xairl.explain_to_parquet(policy, states, out, bg, method="exact", chunk_size=3, progress=False)
+    (out / "explanations.parquet" / "part-000000000003.parquet").unlink()  # as if interrupted
+    again = {"progress": False, "max_evaluations": 10**6}
+    xairl.explain_to_parquet(policy, states, out, bg, "exact", again, chunk_size=3, resume=True, progress=False)
+    with pytest.raises(xairl.InputError, match="another run"):
+        xairl.explain_to_parquet(policy, states, out, bg, "exact", {"max_rows": 7}, chunk_size=3, resume=True)

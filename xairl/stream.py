@@ -178,6 +178,10 @@ def _rows(exp: Explanation, i: int) -> Explanation:
     )
 
 
+#: options that say how a run is shown or bounded, not what it computes: a resumed run may change them
+NOT_IDENTITY = frozenset({"progress", "max_evaluations"})
+
+
 def run_identity(
     policy: Policy, source, background: np.ndarray, method: str, options: dict, chunk_size: int
 ) -> dict[str, Any]:
@@ -191,7 +195,7 @@ def run_identity(
         **where,
         "chunk_size": chunk_size,
         "method": method,
-        "options": options,
+        "options": {k: v for k, v in options.items() if k not in NOT_IDENTITY},
         "policy": policy.name,
         "policy_hash": model_hash(policy.module),
         "background_sha256": hashlib.sha256(np.ascontiguousarray(background).tobytes()).hexdigest(),

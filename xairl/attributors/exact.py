@@ -122,8 +122,8 @@ class Exact(Attributor):
                 f"exact would run {cost.evaluations:,} network evaluations ({n_states} states x 2^{f} coalitions x "
                 f"{n_background} background rows) with batches of about {_size(cost.bytes)}, over "
                 f"max_evaluations={limit:,}: raise it (options={{'max_evaluations': {cost.evaluations}}}; "
-                f"-o max_evaluations={cost.evaluations} on the command line), explain fewer states against a "
-                "smaller background, or use method='kernel_shap'."
+                f"-o max_evaluations={cost.evaluations} on the command line), explain fewer states (a streamed "
+                "run: a smaller chunk_size) against a smaller background, or use method='kernel_shap'."
             )
 
     def _attribute(self, policy, x, bg):
