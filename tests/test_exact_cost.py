@@ -166,5 +166,23 @@ def test_a_resumed_run_may_change_how_it_is_shown_and_bounded(tmp_path):
     (out / "explanations.parquet" / "part-000000000003.parquet").unlink()  # as if interrupted
     again = {"progress": False, "max_evaluations": 10**6}
     xairl.explain_to_parquet(policy, states, out, bg, "exact", again, chunk_size=3, resume=True, progress=False)
-    with pytest.raises(xairl.InputError, match="another run"):
-        xairl.explain_to_parquet(policy, states, out, bg, "exact", {"max_rows": 7}, chunk_size=3, resume=True)
+    with pytest.raises(xairl.InputError, match="another run"):  # another method is another run
+        xairl.explain_to_parquet(policy, states, out, bg, "kernel_shap", chunk_size=3, resume=True)
+
+
+def test_a_refused_stream_leaves_no_run_and_the_sampler_is_not_called(tmp_path):
+    calls = []
+
+    def sampler(n, seed):
+        calls.append(n)
+        return np.zeros((n, 16))
+
+    policy = xairl.Policy(torch.nn.Linear(16, 2), feature_names=[f"f{i}" for i in range(16)])
+    sampled = xairl.Policy(policy.module, feature_names=policy.feature_names, background_sampler=sampler)
+    with pytest.raises(InputError, match="max_evaluations"):
+        xairl.explain(sampled, np.zeros((30, 16)), method="exact")
+    assert calls == []  # refused before the sampler ran
+    out = tmp_path / "run"
+    with pytest.raises(InputError, match="chunk_size"):
+        xairl.explain_to_parquet(policy, np.zeros((30, 16)), out, np.zeros((300, 16)), "exact", progress=False)
+    assert not (out / "run.json").exists()

@@ -165,7 +165,11 @@ def test_the_window_survives_json(exp):
 @pytest.mark.parametrize(
     "make, says",
     [
-        (lambda: Window(("a",), 1), "2 steps"),
+        (lambda: Window(("a",), 1), "at least 2"),
+        (lambda: Window(("a",), 2.7), "whole number"),
+        (lambda: Window("rsrq", 3), "list of names"),
+        (lambda: Window(("a",), 3, step_s=True), "step_s"),
+        (lambda: xairl.Policy(Falling(), feature_names=list(SIGNALS), window=3, groups={"g": ["rsrq"]}), "groups"),
         (lambda: Window(("a", "a"), 3), "duplicates"),
         (lambda: Window(("a",), 3, layout="time"), "layout"),
         (lambda: Window(("a",), 3, step_s=-1), "step_s"),
@@ -184,3 +188,49 @@ def test_an_explanation_without_time_is_refused_in_one_line():
     e = xairl.explain(p, np.ones((1, 3)), method="exact", background=np.zeros((2, 3)))
     with pytest.raises(xairl.InputError, match="not of a window"):
         e.by_signal()
+
+
+def test_a_trend_word_about_a_score_is_no_trend(exp, tmp_path):
+    """'the margin grew by X' (X a contribution) is no signal's change, with or without a window."""
+    body = "{% for f in reasons[:1] %}The margin of {{ action }} grew by {{ f.contribution|num }} from {{ f.label }}.{% endfor %}"
+    path = tmp_path / "m.yaml"
+    path.write_text(yaml.safe_dump({"name": "m", "kind": "decision", "description": "m", "sentences": [[body]]}))
+    assert xairl.narrate(exp, 0, policy=policy(), template=str(path)).verified
+    flat = xairl.Policy(torch.nn.Linear(3, 2), feature_names=["a", "b", "c"], action_names=["stay", "go"])
+    e = xairl.explain(flat, np.eye(3), method="exact", background=np.zeros((2, 3)))
+    assert all(xairl.narrate(e, i, policy=flat, template=str(path)).verified for i in range(3) if e.decides)
+
+
+def test_the_reader_of_outside_text_reads_a_window_per_signal(exp):
+    """xairl.verify on the narrative as text, from the explanation alone (JSON): the same verdict as narrate."""
+    n = xairl.narrate(exp, 0, policy=policy())
+    again = xairl.verify(n.text, xairl.Explanation.from_json(exp.to_json()), 0, policy())
+    assert again.accurate, [(c.text, c.detail) for c in again.claims if c.status == "contradicted"]
+    wrong = n.text.replace("fell 4 dB", "fell 7 dB")
+    assert not xairl.verify(wrong, exp, 0, policy()).accurate
+
+
+def test_changes_are_said_in_the_units_a_reader_expects(data):
+    x, bg = data
+    info = {"rsrq": xairl.FeatureInfo("dBm", "the serving RSRP"), "load": xairl.FeatureInfo("bit", capacity=10.0)}
+    obs = xairl.Observation.window(SIGNALS, STEPS, step_s=0.2)
+    p = xairl.Policy(Falling(), observation=obs, action_names=["stay", "go"], features=info)
+    y = x.copy()
+    y[0, :, 1] = np.linspace(2.0, 5.0, STEPS)  # the buffer fills by 3 bit of 10: 30 percentage points
+    e = xairl.explain(p, y, method="exact", background=bg)
+    facts = {f.name: f for f in xairl.facts.decision_facts(e, 0, p, k=2).margin_top}
+    assert (facts["rsrq"].change_unit, facts["load"].change_unit) == ("dB", "percentage points")
+    assert facts["load"].change == pytest.approx(30.0)
+    assert xairl.narrate(e, 0, policy=p).verified
+
+
+def test_a_label_has_no_trend(data):
+    x, bg = data
+    info = {"load": xairl.FeatureInfo(categories=("low", "mid", "high", "x", "y", "z"))}
+    p = xairl.Policy(
+        Falling(), observation=xairl.Observation.window(SIGNALS, STEPS), action_names=["s", "g"], features=info
+    )
+    y = np.abs(np.round(x)).clip(0, 5)
+    e = xairl.explain(p, y, method="exact", background=np.abs(np.round(bg)).clip(0, 5))
+    for i in range(len(y)):
+        assert all(f.name != "load" for f in xairl.facts.decision_facts(e, i, p).trends)

@@ -22,7 +22,7 @@ class _Window(BaseModel):
     signals: list[str] = Field(min_length=1)
     steps: Annotated[int, Field(ge=2)]
     layout: Literal["sequence", "stacked"] = "sequence"
-    step_s: Annotated[float, Field(gt=0, allow_inf_nan=False)] | None = None
+    step_s: Annotated[float, Field(gt=0, allow_inf_nan=False, strict=True)] | None = None
 
 
 class _Part(BaseModel):

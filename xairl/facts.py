@@ -14,7 +14,7 @@ from .explanation import Explanation
 from .policy import FeatureInfo, Policy
 from .prompts import format_number
 from .values import fill_and_text, state_value_text, value_level, value_text
-from .windows import Window, trend
+from .windows import Window, said_change, trend
 
 __all__ = [
     "Comparison",
@@ -53,6 +53,8 @@ class FeatureFact:
         its newest); None for other features.
     :param trend: for such a signal: 'rose' or 'fell' when it is said as a trend (its earlier steps carry at least a
         third of its push, and it changed), else ''; ``window`` the span in words ('the last 0.8 s').
+    :param change_unit: the unit of ``change``: the feature's, a dBm level's change in dB, and a quantity with a
+        capacity changes in 'percentage points' of it (``change`` is then in them too: its level is said in % full).
     """
 
     name: str
@@ -71,6 +73,7 @@ class FeatureFact:
     change: float | None = None
     trend: str = ""
     window: str = ""
+    change_unit: str = ""
 
 
 @dataclass(frozen=True)
@@ -253,7 +256,9 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
         label = None if not single or labels is None or labels[i, j] is None else str(labels[i, j])
         lvl, words = value_level(value, u.info, None if q is None or not single else (float(q[0, j]), float(q[2, j])))
         fill, text = fill_and_text(value, u.info, label, u.name in regions)
-        moved = trend(exp.states[i, list(u.columns)], contrib[list(u.columns)]) if u.window else None
+        numeric = u.window is not None and u.info.kind == "numeric"  # a label or an id has no trend
+        moved = trend(exp.states[i, list(u.columns)], contrib[list(u.columns)]) if numeric else None
+        change, change_unit = said_change(moved.change, u.info.unit, u.info.capacity) if moved else (None, "")
         out.append(
             FeatureFact(
                 u.name,
@@ -269,9 +274,10 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
                 u.info.kind,
                 fill,
                 text,
-                None if moved is None else moved.change,
+                change,
                 "" if moved is None else moved.word,
                 "" if moved is None else u.window.span_text(),
+                change_unit,
             )
         )
     return out

@@ -142,6 +142,10 @@ class Policy:
             )
 
         if self.window is not None:
+            if isinstance(self.window, bool) or not isinstance(self.window, (int, np.integer)):
+                raise InputError(
+                    f"window is the number of observations the module takes (k >= 2); got {self.window!r:.40}."
+                )
             if self.observation is not None or self.feature_names is None:
                 raise InputError(
                     "window=k takes the signals' names as feature_names and no observation; for another layout "
@@ -190,6 +194,11 @@ class Policy:
         for g, info in self.features.items():
             if info.kind == "group" and g not in self.groups:
                 raise InputError(f"features['{g}'] has kind 'group' but '{g}' is not in groups; add it to groups.")
+        if window is not None and self.groups:
+            raise InputError(
+                "groups of a window policy are not narrated (its signals are: each over its steps); leave groups "
+                "out and sum your own with Explanation.grouped on exp.by_signal()."
+            )
         members = [f for g, i in self.features.items() if i.kind == "group" for f in self.groups[g]]
         if len(members) != len(set(members)):
             raise InputError("a feature belongs to two groups narrated as one reason (kind='group'); keep them apart.")

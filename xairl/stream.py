@@ -179,7 +179,7 @@ def _rows(exp: Explanation, i: int) -> Explanation:
 
 
 #: options that say how a run is shown or bounded, not what it computes: a resumed run may change them
-NOT_IDENTITY = frozenset({"progress", "max_evaluations"})
+NOT_IDENTITY = frozenset({"progress", "max_evaluations", "max_rows"})
 
 
 def run_identity(
@@ -272,8 +272,11 @@ def start_run(
     from .plugins import get_attributor
 
     out = Path(out)
-    options = get_attributor(method)(options).options.model_dump()
+    attributor = get_attributor(method)(options)
+    options = attributor.options.model_dump()
     bg = policy.background() if background is None else policy.check_states(background, "background")
+    # the largest chunk's cost, before anything is written: a refused run leaves no folder to resume
+    attributor.check_cost(policy, min(chunk_size, count_rows(states, policy)), len(bg))
     identity = run_identity(policy, states, bg, method, options, chunk_size)
     meta = part_meta(policy, method, options, identity)
     done = existing_parts(out, identity, resume, meta["run"], lambda: count_rows(states, policy))

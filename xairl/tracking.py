@@ -310,6 +310,7 @@ _FEATURE_FIELDS = {
     "change": "value_change",
     "trend": "trend",
     "window": "window",
+    "change_unit": "change_unit",
     "mean_abs": "mean_abs",
     "mean": "mean",
     "high_values": "direction_high",

@@ -46,19 +46,29 @@ class Window:
     step_s: float | None = None
 
     def __post_init__(self) -> None:
+        if isinstance(self.signals, str) or not isinstance(self.signals, (list, tuple)):
+            raise InputError(
+                f"a window's signals are a list of names, one per column of one observation; got {self.signals!r:.60}."
+            )
         object.__setattr__(self, "signals", tuple(str(s) for s in self.signals))
+        steps = self.steps
+        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 2:
+            raise InputError(
+                f"a window's steps are a whole number of observations, at least 2; got {steps!r:.40} (a single "
+                "observation is a plain policy: leave window out)."
+            )
+        object.__setattr__(self, "steps", int(steps))
         if self.layout not in LAYOUTS:
             raise InputError(f"window layout '{self.layout}' is unknown; use one of {', '.join(LAYOUTS)}.")
-        if not self.signals or int(self.steps) < 2:
-            raise InputError(
-                f"a window needs at least one signal and 2 steps, got {len(self.signals)} signal(s) and "
-                f"{self.steps} step(s); a single observation is a plain policy (leave window out)."
-            )
+        if not self.signals:
+            raise InputError("a window needs at least one signal: name each column of one observation.")
         if len(set(self.signals)) != len(self.signals):
             raise InputError(f"the window's signals have duplicates ({', '.join(self.signals)}); name each once.")
-        if self.step_s is not None and not (np.isfinite(self.step_s) and self.step_s > 0):
-            raise InputError(f"the window's step_s must be a positive number of seconds, got {self.step_s}.")
-        object.__setattr__(self, "steps", int(self.steps))
+        step = self.step_s
+        if step is not None and (
+            isinstance(step, bool) or not isinstance(step, (int, float, np.number)) or not 0 < step < float("inf")
+        ):
+            raise InputError(f"the window's step_s is the seconds between two observations (> 0); got {step!r:.40}.")
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -86,7 +96,8 @@ class Window:
         """The window's span in words: 'the last 0.8 s' from its oldest to its newest observation (with ``step_s``),
         else 'the last 5 observations'."""
         if self.step_s is not None:
-            return f"the last {(self.steps - 1) * self.step_s:.3g} s"
+            seconds = (self.steps - 1) * self.step_s
+            return f"the last {seconds / 60:.3g} min" if seconds >= 120 else f"the last {seconds:.3g} s"
         return f"the last {self.steps} observations"
 
     def to_dict(self) -> dict:
@@ -119,6 +130,15 @@ def trend(values: np.ndarray, contributions: np.ndarray) -> Trend:
     history = float(size[:-1].sum() / size.sum()) if size.sum() > 0 else 0.0
     said = history >= TREND_SHARE and np.isfinite(change) and change != 0
     return Trend(change, (RISE if change > 0 else FALL) if said else "", history)
+
+
+def said_change(change: float, unit: str, capacity: float | None = None) -> tuple[float, str]:
+    """(size, unit) of a change as narratives say it: a quantity with a capacity in percentage points of it (a
+    buffer '12.5 percentage points' fuller, as its level is said in % full), a level in dBm or dBW in dB (a
+    difference of two levels is a ratio), any other in its own unit."""
+    if capacity:
+        return 100.0 * change / capacity, "percentage points"
+    return change, {"dBm": "dB", "dBW": "dB"}.get(unit, unit)
 
 
 def over_time(contributions: np.ndarray, signals: dict[str, np.ndarray], steps: dict[str, np.ndarray]) -> np.ndarray:

@@ -15,6 +15,8 @@ from ..explanation import Explanation
 from ..options import Options, parse_options
 from ..policy import Policy
 
+#: background states drawn from the policy's sampler when none are given
+DEFAULT_BACKGROUND = 100
 #: the most features exact Shapley values enumerate (2^16 coalitions); here so that refusals can name it
 EXACT_MAX_FEATURES = 16
 
@@ -50,8 +52,14 @@ class Attributor:
                 "xairl.Policy(module, feature_names, action_names)."
             )
         x = policy.check_states(states)
-        bg = policy.background() if background is None else policy.check_states(background, "background")
-        self._check_cost(policy, len(x), len(bg))  # before any forward pass: a refusal costs nothing
+        if background is None:  # before the sampler, which may fly the policy: a refusal costs nothing
+            self.check_cost(policy, len(x), DEFAULT_BACKGROUND)
+        bg = (
+            policy.background(DEFAULT_BACKGROUND)
+            if background is None
+            else policy.check_states(background, "background")
+        )
+        self.check_cost(policy, len(x), len(bg))  # before any forward pass
         outputs = policy.scores(x)
         bad = ~np.isfinite(outputs).all(axis=1)
         if bad.any():
@@ -108,7 +116,7 @@ class Attributor:
                 f"tolerance {self.tolerance:g} of it): {self.gap_reason}; otherwise {alternatives(policy, self.name)}"
             )
 
-    def _check_cost(self, policy: Policy, n_states: int, n_background: int) -> None:
+    def check_cost(self, policy: Policy, n_states: int, n_background: int) -> None:
         """Refuse, with an :class:`InputError`, work this method cannot do or should not start; nothing has run yet.
         The default accepts everything."""
 

@@ -109,7 +109,7 @@ class Exact(Attributor):
         memory = rows * f * item + out_rows * a * item + rows * a * 8 + 2**f * (a * 8 + f)
         return ExactCost(n_states * 2**f * n_background, memory, rows)
 
-    def _check_cost(self, policy, n_states, n_background):
+    def check_cost(self, policy, n_states, n_background):
         f = policy.n_features
         if f > MAX_FEATURES:
             raise InputError(

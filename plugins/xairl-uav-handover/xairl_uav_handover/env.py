@@ -67,6 +67,7 @@ class HandoverVecEnv(gym.vector.VectorEnv):
         self.sim: Simulator | None = None
         self.obs: np.ndarray | None = None  # the latest observation (K, 13)
         self.candidates: np.ndarray | None = None  # the latest candidate BS ids (K, 4)
+        self.info: dict | None = None  # the latest step's info
 
     def reset(self, *, seed: int | None = None, options=None):
         """New flights; every random draw of the episode comes from ``seed``."""
@@ -104,7 +105,8 @@ class HandoverVecEnv(gym.vector.VectorEnv):
         )
         self._observe()
         ended = np.full(sim.K, sim.done)
-        return self.obs, reward, np.zeros(sim.K, dtype=bool), ended, sums | {"candidates": self.candidates}
+        self.info = sums | {"candidates": self.candidates}  # the last step's (for controllers that keep a memory)
+        return self.obs, reward, np.zeros(sim.K, dtype=bool), ended, self.info
 
     def _observe(self) -> None:
         """The simulator's states and candidates; a non-finite state is refused before any policy acts on it."""

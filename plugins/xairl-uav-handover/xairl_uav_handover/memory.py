@@ -102,18 +102,14 @@ class MemoryDQNController:
         self.net = net.eval()
 
     def reset(self, env) -> None:
-        self.memory, self.states, self.serving = Memory(), None, None
+        self.memory, self.states = Memory(), None
 
     def __call__(self, env) -> np.ndarray:
         if self.states is None:
             self.states = self.memory.start(env)
-        else:  # a handover since the last decision: the serving cell changed where this controller asked for it
-            self.states = self.memory.step(env, (env.sim.serving != self.serving) & (self.asked != self.serving))
-        act = greedy(self.net, self.states, env.cfg)
-        self.serving = env.sim.serving.copy()
-        target = env.candidates[np.arange(env.sim.K), act]
-        self.asked = np.where(target < 0, self.serving, target)
-        return act
+        else:  # the step just flown, as training records it
+            self.states = self.memory.step(env, env.info["handover"])
+        return greedy(self.net, self.states, env.cfg)
 
 
 def background(n: int, seed: int = 0, config=None) -> np.ndarray:
@@ -161,27 +157,29 @@ def memory_policy(ckpt) -> xairl.Policy:
 
 def walk_states(walk, config) -> np.ndarray:
     """Memory states (n, 75) along a real flight (:func:`real_data.walk`): at each sample, the window's steps 0.2 s
-    apart back from it, each read from the last sample at or before that time (the logs report every 1.28 s in
-    the median, so most of a window holds one or two samples: sample and hold, as a UE's report holds between
-    reports). The candidates' past are the cells in the slots now; the times run on the network's own path."""
+    apart back from it. Each step's measurements, position and buffer are the last sample's at or before its time
+    (the logs report every 1.28 s in the median, so a window holds one or two samples: sample and hold, as a UE's
+    report holds between reports); a cell that sample did not report is at the detection limit, and the serving
+    cell, if it was not reported then, holds its newest report. Each step's times are counted at its own instant on
+    the network's path (its serving cell changes are its handovers)."""
     t, cands = np.asarray(walk.t, float), walk.candidates
     serving = np.array([c[0] for c in cands])
     changed = np.flatnonzero(serving[1:] != serving[:-1]) + 1
-    since = t - t[np.concatenate([[0], changed])[np.searchsorted(changed, np.arange(len(t)), side="right")]]
-    since = np.minimum(since, TIME_CAP_S)
-    pad = [np.nan] * (4 - 1)
+    began = t[np.concatenate([[0], changed])[np.searchsorted(changed, np.arange(len(t)), side="right")]]
     out = np.empty((len(t), STEPS * len(SIGNALS)), dtype=np.float32)
     for i in range(len(t)):
-        slots = list(cands[i]) + pad[: 4 - len(cands[i])]
+        slots = list(cands[i]) + [None] * (4 - len(cands[i]))
         rows = []
         for d in range(STEPS - 1, -1, -1):
-            j = max(int(np.searchsorted(t, t[i] - 0.2 * d + 1e-9, side="right")) - 1, 0)
-            cells = walk.measured[j] if slots[0] in walk.measured[j] else walk.measured[i]  # no past of it
-            snap = walk.states[j].copy()
-            snap[5:9] = [cells.get(c, (np.nan, np.nan))[0] for c in slots]
-            snap[9:13] = [cells.get(c, (np.nan, np.nan))[1] for c in slots]
-            fixed = state_rows(snap[:3], snap[3], walk.states[i][4], snap[5:9], snap[9:13], config.observation)[0]
-            rows.append(np.concatenate([fixed, [min(since[j], TIME_CAP_S)] * 2]))
+            at = t[i] - 0.2 * d
+            j = max(int(np.searchsorted(t, at + 1e-9, side="right")) - 1, 0)
+            then = {**walk.measured[j]}
+            then.setdefault(slots[0], walk.measured[i][slots[0]])
+            rsrp, rsrq = ([then.get(c, (np.nan, np.nan))[k] for c in slots] for k in (0, 1))
+            snap = walk.states[j]
+            fixed = state_rows(snap[:3], snap[3], walk.states[i][4], rsrp, rsrq, config.observation)[0]
+            since = min(max(at - began[j], 0.0), TIME_CAP_S)
+            rows.append(np.concatenate([fixed, [since, since]]))
         out[i] = np.concatenate(rows)
     return out
 

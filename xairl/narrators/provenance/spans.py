@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
+from dataclasses import replace
 
 from ...tracking import Span
 from ..verify import Claim
@@ -24,6 +25,8 @@ from .lexicon import (
     RUNNER_BEFORE,
     SCORE_FOR_AFTER,
     SCORE_OF_BEFORE,
+    SCORE_SUBJECT,
+    SEGMENT,
     SIGN_AFTER,
     SIGN_BEFORE,
     TREND_BEFORE,
@@ -31,7 +34,7 @@ from .lexicon import (
     VIEW_AFTER,
 )
 from .parts import Part, is_name, literal, parts
-from .truth import Truth, number, view_of
+from .truth import MISSING, Truth, number, view_of
 from .words import WordRules
 
 
@@ -109,13 +112,19 @@ class Sentence(WordRules):
 
     def trend_word(self, p: Part) -> tuple[bool, int]:
         """(a trend word stands right before ``p``, the sign it says: +1 'rose', -1 'fell', 0 'changed' or the
-        trend's own tracked word, which its fact checks)."""
+        trend's own tracked word, which its fact checks). A literal one counts only for a signal of a window (a
+        feature with a change over it), and not when a score is its subject ('the margin grew by 8.8')."""
         prev = [r for r in self.spans if r.end <= p.start]
         if prev and prev[-1].span.fact.quantity == "trend":
             if re.fullmatch(r"\s*(?:by\s*)?", self.text[prev[-1].end : p.start]):
                 return True, 0
+        f = p.span.fact
+        if self.truth.get(Span(0, 0, "", replace(f, quantity="value_change"))) in (None, MISSING):
+            return False, 0
         m = TREND_BEFORE.search(self.before(p, 24))
-        return m is not None, 0 if m is None else 1 if m.group("up") else -1 if m.group("down") else 0
+        if m is None or SCORE_SUBJECT.search(SEGMENT.split(self.text[max(0, p.start - 80) : p.start])[-1]):
+            return False, 0
+        return True, 1 if m.group("up") else -1 if m.group("down") else 0
 
     def trend(self, p: Part) -> Claim | None:
         """A number right after a trend word ('fell 4.1 dB', literal or a trend's own tracked word) is a signal's

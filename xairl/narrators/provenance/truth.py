@@ -81,7 +81,7 @@ def truth(exp: Explanation, index: int | None, policy: Policy | None, domain: Do
             features.setdefault(f.name, {})[view] = f
             for q in (
                 *("value", "value_text", "unit", "contribution", "share", "direction", "rank", "kind", "fill"),
-                *("trend", "window"),
+                *("trend", "window", "change_unit"),
             ):
                 values[(q, f.name, view, None)] = getattr(f, q)
             values[("value_change", f.name, view, None)] = f.change
@@ -148,7 +148,7 @@ def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
     if (
         percent
         and f.quantity in NUMERIC
-        and f.quantity not in ("share", "fill", "value")
+        and f.quantity not in ("share", "fill", "value", "value_change")  # (a fill changes in points)
         and "scale:100" not in span.transform
     ):
         return Claim(

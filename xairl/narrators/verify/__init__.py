@@ -31,14 +31,16 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ...errors import InputError
 from ...explanation import Explanation
+from ...facts import Comparison, DomainFacts
 from ...policy import Policy
 from ...regions import in_regions
+from ...windows import Window, said_change
 from . import binding, checks, clauses, directions, parse, quantities, regions, reread, sums
 from .book import FactBook, add_facts, clean_surface, fact_book
 from .checks import CHECKED, Claim
@@ -226,7 +228,8 @@ def verify(
 
 def inputs(text, explanation: Explanation, index: int | None, caller: str = "verify") -> tuple:
     """(text, explanation, index, note): a str checked (else a one-line error), the index checked (``None``: the
-    global view), the explanation in regions (an image is read as it is narrated), the text normalised and cut at
+    global view), the explanation in regions or per signal (an image or a window is read as it is narrated), the
+    text normalised and cut at
     :data:`MAX_CHARS` (the note says so). What every reader of prose does first."""
     if not isinstance(text, str):
         raise InputError(
@@ -234,9 +237,36 @@ def inputs(text, explanation: Explanation, index: int | None, caller: str = "ver
         )
     index = None if index is None else explanation.check_index(index)
     explanation, text, note = in_regions(explanation), normalise(text), ""
+    if explanation.observation is not None and explanation.observation["kind"] == "window":
+        explanation = _per_signal(explanation)
     if len(text) > MAX_CHARS:
         text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
     return text, explanation, index, note
+
+
+def _per_signal(explanation: Explanation) -> Explanation:
+    """A window read as it is narrated: per signal with its newest value, each signal's change over the window and
+    the window's span kept in ``extras['window']`` (numbers a text may cite: :func:`aids`)."""
+    window = Window.from_dict(explanation.observation["parts"][0]["window"])
+    out = explanation.by_signal()
+    if explanation.states is None:
+        return out
+    cols = np.stack(list(window.signal_columns().values()))  # (signals, steps)
+    changes = explanation.states[:, cols[:, -1]] - explanation.states[:, cols[:, 0]]
+    span = None if window.step_s is None else (window.steps - 1) * window.step_s
+    return replace(out, extras={**out.extras, "window": {"changes": changes, "span_s": span, "steps": window.steps}})
+
+
+def _window_facts(explanation: Explanation, index: int, policy: Policy | None) -> DomainFacts:
+    """Each signal's change over the window as narratives say it (:func:`xairl.windows.said_change`, before its
+    unit) and the window's span."""
+    w, out = explanation.extras["window"], []
+    for j, name in enumerate(explanation.feature_names):
+        info = policy.features.get(name) if policy else None
+        size, unit = said_change(float(w["changes"][index, j]), *((info.unit, info.capacity) if info else ("", None)))
+        out.append(Comparison(f"{name} changed", abs(size), unit))
+    out += [Comparison("window", float(w["span_s"]), "s")] if w["span_s"] else []
+    return DomainFacts(comparisons=(*out, Comparison("window steps", float(w["steps"]), "observations")))
 
 
 def aids(explanation: Explanation, index: int | None, policy: Policy | None = None, facts=None) -> tuple:
@@ -247,6 +277,11 @@ def aids(explanation: Explanation, index: int | None, policy: Policy | None = No
     if facts is not None:
         add_facts(book, facts)
         book.closed = index is None  # a summary made from these facts: a number that is none of them is wrong
+    if index is not None and "window" in (explanation.extras or {}):
+        add_facts(book, _window_facts(explanation, index, policy))
+        for c, name in zip(_window_facts(explanation, index, policy).comparisons, explanation.feature_names):
+            if name in book.features:
+                book.features[name].change = c.value
     vocab = vocabulary(explanation, policy, clean_surface)
 
     def unit_of(f: str) -> str:

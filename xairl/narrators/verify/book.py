@@ -47,6 +47,7 @@ class FeatureFacts:
     quartiles: tuple[float, float, float] | None = None  # the background's 25th, 50th and 75th percentiles
     legend: dict[int, str] = field(default_factory=dict)  # code -> its meaning, from the description's legend
     identifier: bool = False  # an id (kind 'identifier'): its number is its value
+    change: float | None = None  # a window's signal: its newest value minus its oldest (xairl.windows)
 
 
 @dataclass

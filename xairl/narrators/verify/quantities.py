@@ -159,6 +159,8 @@ def feature_number(
             )
         if n.percent and not contrib_cue and e.fill is not None:
             cands.append(("fill (% of capacity)", e.fill))
+        if not contrib_cue and e.change is not None:  # 'fell 4 dB over the last second': its size, or signed
+            cands += [("change over the window", e.change), ("change over the window", abs(e.change))]
         if not value_cue and (cue.pushes or not e.identifier):
             cands += [(f"contribution ({c})", e.contribs[c]) for c in contexts if c in e.contribs]
         unsigned = None  # a value the number states in size only, its sign neither written nor said
