@@ -27,7 +27,8 @@ from table_one import targets
 from xairl_uav_handover import oracle
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.evaluate import run_flights
-from xairl_uav_handover.policy import DQNController, load_checkpoint
+from xairl_uav_handover.memory import MemoryDQNController
+from xairl_uav_handover.policy import DQNController, load_checkpoint, memory_of
 from xairl_uav_handover.report import frontier_figure
 from xairl_uav_handover.table import with_intervals
 
@@ -151,6 +152,12 @@ def main():
         default=0.01,
         help="seconds below the RSRQ threshold one Mbit of uplink shortfall is worth",
     )
+    ap.add_argument(
+        "--checkpoints",
+        nargs="*",
+        default=[],
+        help="more DQNs to place on the frontier (a DQN with memory flies with its window; issue 55)",
+    )
     args = ap.parse_args()
     t_start = time.perf_counter()
     ckpt = load_checkpoint()
@@ -161,7 +168,12 @@ def main():
     data["decision_s"], data["rsrq_threshold_db"] = cfg.flight.dt_s * cfg.decision_every, cfg.handover.rsrq_threshold_db
     data |= sweep(rec, w_hos, args.w_cap)
     data["policies"], res = {}, {}
-    for c in (CHM(), SAMRO(), DQNController(ckpt.net)):
+    more = [(Path(p).stem, load_checkpoint(p)) for p in args.checkpoints]
+    flown = [CHM(), SAMRO(), DQNController(ckpt.net)]
+    for name, other in more:
+        flown.append(MemoryDQNController(other.net) if memory_of(other.meta) else DQNController(other.net))
+        flown[-1].name = f"DQN {name}"
+    for c in flown:
         m, point = place(c, rec, cfg, args.flights, args.seed)
         res[c.name] = with_intervals(m, resamples=200)
         point["bound_handovers_at_rsrq"] = oracle.handovers_at(data["frontier"], point["rsrq_pct"])
