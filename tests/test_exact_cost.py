@@ -1,8 +1,6 @@
 """exact states its cost before it runs and refuses above max_evaluations; exact and kernel_shap show progress only
 when asked (or on a terminal)."""
 
-import itertools
-
 import numpy as np
 import pytest
 import torch
@@ -12,6 +10,7 @@ from xairl.attributors.exact import MAX_EVALUATIONS, Exact
 from xairl.errors import InputError
 
 from .conftest import mlp, run
+from .test_references import brute_force_shapley
 
 SIGNALS, STEPS = 4, 4
 NAMES = [f"s{j}_t{t}" for t in range(STEPS) for j in range(SIGNALS)]  # time-major, as observation=(4, 4) flattens
@@ -54,23 +53,6 @@ def counted(inner, f, a=3, **kw):
     module.reset()  # Policy runs the module once to count its outputs
     assert policy.n_actions == a
     return module, policy
-
-
-def brute_force_shapley(fn, x, bg):
-    """Average marginal contribution over all orderings of the features (independent of exact's coalition sums)."""
-    f = len(x)
-
-    def v(coalition):
-        rows = bg.copy()
-        rows[:, list(coalition)] = x[list(coalition)]
-        return fn(rows).mean(axis=0)
-
-    orders = list(itertools.permutations(range(f)))
-    phi = np.zeros((f, fn(bg[:1]).shape[1]))
-    for order in orders:
-        for k, j in enumerate(order):
-            phi[j] += v(order[: k + 1]) - v(order[:k])
-    return phi / len(orders)
 
 
 def test_exact_refuses_a_16_feature_gru_before_any_forward_pass():
