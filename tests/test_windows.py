@@ -196,9 +196,12 @@ def test_a_trend_word_about_a_score_is_no_trend(exp, tmp_path):
     path = tmp_path / "m.yaml"
     path.write_text(yaml.safe_dump({"name": "m", "kind": "decision", "description": "m", "sentences": [[body]]}))
     assert xairl.narrate(exp, 0, policy=policy(), template=str(path)).verified
+    torch.manual_seed(0)
     flat = xairl.Policy(torch.nn.Linear(3, 2), feature_names=["a", "b", "c"], action_names=["stay", "go"])
-    e = xairl.explain(flat, np.eye(3), method="exact", background=np.zeros((2, 3)))
-    assert all(xairl.narrate(e, i, policy=flat, template=str(path)).verified for i in range(3) if e.decides)
+    e = xairl.explain(flat, np.eye(3) - np.eye(3)[::-1], method="exact", background=np.zeros((2, 3)))
+    said = [xairl.narrate(e, i, policy=flat, template=str(path)) for i in range(3)]
+    said = [n for n in said if n.text]  # (a decision with no reason for it says nothing here)
+    assert said and all(n.verified for n in said), [n.text for n in said]
 
 
 def test_the_reader_of_outside_text_reads_a_window_per_signal(exp):

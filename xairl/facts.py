@@ -14,7 +14,7 @@ from .explanation import Explanation
 from .policy import FeatureInfo, Policy
 from .prompts import format_number
 from .values import fill_and_text, state_value_text, value_level, value_text
-from .windows import Window, said_change, trend
+from .windows import Window, said_change, trend, window_of
 
 __all__ = [
     "Comparison",
@@ -204,7 +204,7 @@ def narration_units(exp: Explanation, policy: Policy | None) -> list[Unit]:
     steps), then every feature outside them."""
     index = {f: j for j, f in enumerate(exp.feature_names)}
     out, taken = [], set()
-    window = _window(exp)
+    window = window_of(exp)
     for s, cols in (window.signal_columns() if window else {}).items():
         out.append(Unit(s, tuple(int(j) for j in cols), _info(policy, s), window))
         taken.update(out[-1].columns)
@@ -215,14 +215,6 @@ def narration_units(exp: Explanation, policy: Policy | None) -> list[Unit]:
             taken.update(cols)
     out += [Unit(f, (j,), _info(policy, f)) for j, f in enumerate(exp.feature_names) if j not in taken]
     return out
-
-
-def _window(exp: Explanation) -> Window | None:
-    """The window of an explanation of a window policy, with its states; None for any other."""
-    obs = exp.observation
-    if obs is None or obs["kind"] != "window" or exp.states is None or len(exp.feature_names) != len(exp.states[0]):
-        return None
-    return Window.from_dict(obs["parts"][0]["window"])
 
 
 def unit_ranks(contrib: np.ndarray, reasons: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -370,7 +362,7 @@ def _direction(contrib: np.ndarray) -> str:
 def global_facts(exp: Explanation, policy: Policy | None = None, k: int = 5, view: str = "margin") -> GlobalFacts:
     """Features ranked by mean |contribution| in ``view`` ('margin' over the runner-up by default, as the plots rank
     them; 'score': the chosen action's), each with the direction it pushed on average and for high and low values."""
-    if _window(exp) is not None:  # a window is summarised per signal, never slot by slot
+    if window_of(exp) is not None:  # a window is summarised per signal, never slot by slot
         exp = exp.by_signal()
     contrib = exp.contributions(view)[0]
     shown = view if exp.decides else "score" if exp.output == "actions" else "output"

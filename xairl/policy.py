@@ -11,9 +11,11 @@ from typing import Any, Literal
 import numpy as np
 import torch
 
-from .errors import InputError, XairlError
+from .errors import InputError
 from .heads import check_kinds, heads
+from .network import PolicyNetwork, module_dtype
 from .observation import Observation, names_preview
+from .windows import slot_features
 
 
 @dataclass(frozen=True)
@@ -65,6 +67,9 @@ FEATURE_KINDS = ("numeric", "categorical", "identifier", "group")
 #: what a policy's outputs are: scores of discrete actions (the highest available one is taken; a runner-up exists),
 #: the dimensions of a continuous action (each explained on its own; nothing is chosen among them), or one value
 OUTPUT_KINDS = ("actions", "continuous", "value")
+
+
+_TORCH = {np.float32: torch.float32, np.float64: torch.float64}
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: two policies are the same object or different ones
@@ -141,23 +146,11 @@ class Policy:
                 f"{', '.join(OUTPUT_KINDS)}, or one of them per output column."
             )
 
-        if self.window is not None:
-            if isinstance(self.window, bool) or not isinstance(self.window, (int, np.integer)):
-                raise InputError(
-                    f"window is the number of observations the module takes (k >= 2); got {self.window!r:.40}."
-                )
-            if self.observation is not None or self.feature_names is None:
-                raise InputError(
-                    "window=k takes the signals' names as feature_names and no observation; for another layout "
-                    "give observation=xairl.Observation.window(signals, k, layout) instead."
-                )
-            normalise("observation", Observation.window(self.feature_names, self.window))
-        normalise("observation", _observation(self.observation, self.feature_names))
+        observation, names = _with_window(self.window, self.observation, self.feature_names)
+        normalise("observation", observation)
+        normalise("feature_names", names)
         window = self.observation.parts[0].window if self.observation.kind == "window" else None
-        if window is not None:
-            if self.feature_names is not None and tuple(map(str, self.feature_names)) == window.signals:
-                normalise("feature_names", None)  # the signals' names: the slots' are generated from them
-            normalise("window", window.steps)
+        normalise("window", window.steps if window else None)
         normalise("name", str(self.name))
         normalise("network", PolicyNetwork(self.module, self.observation, self.name))
         if self.action_names is None:  # count the outputs on one all-zero state
@@ -166,7 +159,7 @@ class Policy:
         names = self.observation.feature_names() if self.feature_names is None else self.feature_names
         normalise("feature_names", tuple(str(f) for f in names))
         normalise("action_names", tuple(str(a) for a in self.action_names))
-        normalise("features", _slot_features(dict(self.features), window))  # copies: the caller's dicts stay theirs
+        normalise("features", slot_features(dict(self.features), window))  # copies: the caller's dicts stay theirs
         normalise("groups", {str(g): tuple(m) for g, m in dict(self.groups).items()})
         normalise("action_aliases", {str(a): tuple(v) for a, v in dict(self.action_aliases).items()})
         for what, names in (("feature_names", self.feature_names), ("action_names", self.action_names)):
@@ -183,25 +176,7 @@ class Policy:
         check_kinds(self, kinds, declared)
         if self.output == "value" and len(self.action_names) != 1:
             raise InputError("a 'value' policy has one output; give one name in action_names (e.g. ['value']).")
-        names = set(self.feature_names) | set(window.signals if window else ())
-        described = {f for f, i in self.features.items() if i.kind != "group"}
-        unknown = sorted(described - names) + sorted({str(f) for g in self.groups.values() for f in g} - names)
-        if unknown:
-            raise InputError(
-                f"metadata names unknown feature(s) {', '.join(unknown[:5])}; use names from "
-                "feature_names (column indices, as xairl.patches gives, go to Explanation.grouped)."
-            )
-        for g, info in self.features.items():
-            if info.kind == "group" and g not in self.groups:
-                raise InputError(f"features['{g}'] has kind 'group' but '{g}' is not in groups; add it to groups.")
-        if window is not None and self.groups:
-            raise InputError(
-                "groups of a window policy are not narrated (its signals are: each over its steps); leave groups "
-                "out and sum your own with Explanation.grouped on exp.by_signal()."
-            )
-        members = [f for g, i in self.features.items() if i.kind == "group" for f in self.groups[g]]
-        if len(members) != len(set(members)):
-            raise InputError("a feature belongs to two groups narrated as one reason (kind='group'); keep them apart.")
+        _check_metadata(self, window)
 
     def __repr__(self) -> str:
         """Counts and the first few names, never thousands: ``Policy('cnn', 12288 features: obs[0,0,0], ... ;
@@ -251,7 +226,7 @@ class Policy:
         """The numpy dtype the network computes in, as its first floating-point parameter: float64 for a float64
         network (its states are explained in float64), float32 otherwise (a float16 network is refused in one line
         when it runs)."""
-        return np.float64 if _module_dtype(self.module) == torch.float64 else np.float32
+        return np.float64 if module_dtype(self.module) == torch.float64 else np.float32
 
     def check_states(self, states, what: str = "states") -> np.ndarray:
         """States in any form the observation takes -> validated (n, n_features) in the network's :attr:`dtype`;
@@ -324,85 +299,47 @@ def model_hash(module) -> str:
     return h.hexdigest()[:16]
 
 
-class PolicyNetwork(torch.nn.Module):
-    """The module as every attributor sees it: flat rows (n, F) -> outputs (n, n_outputs).
+def _check_metadata(policy: Policy, window) -> None:
+    """Features, groups and their kinds name known features (of a window: its signals too), groups narrated as one
+    reason are groups and do not overlap, and a window policy has none."""
+    names = set(policy.feature_names) | set(window.signals if window else ())
+    described = {f for f, i in policy.features.items() if i.kind != "group"}
+    unknown = sorted(described - names) + sorted({str(f) for g in policy.groups.values() for f in g} - names)
+    if unknown:
+        raise InputError(
+            f"metadata names unknown feature(s) {', '.join(unknown[:5])}; use names from "
+            "feature_names (column indices, as xairl.patches gives, go to Explanation.grouped)."
+        )
+    for g, info in policy.features.items():
+        if info.kind == "group" and g not in policy.groups:
+            raise InputError(f"features['{g}'] has kind 'group' but '{g}' is not in groups; add it to groups.")
+    if window is not None and policy.groups:
+        raise InputError(
+            "groups of a window policy are not narrated (its signals are: each over its steps); leave groups "
+            "out and sum your own with Explanation.grouped on exp.by_signal()."
+        )
+    members = [f for g, i in policy.features.items() if i.kind == "group" for f in policy.groups[g]]
+    if len(members) != len(set(members)):
+        raise InputError("a feature belongs to two groups narrated as one reason (kind='group'); keep them apart.")
 
-    It unflattens the rows into what the module takes (a view and a split: linear, so attributions see through
-    it), calls the module, reads a (n,) output as one column, and turns an exception raised inside the user's
-    module into one line that names the module and the input's shape.
-    """
 
-    def __init__(self, module: torch.nn.Module, observation: Observation, policy_name: str):
-        super().__init__()
-        self.module = module
-        self.observation = observation
-        self.policy_name = policy_name
-
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        inp = self.observation.unflatten(x)
-        try:
-            out = self.module(*inp) if isinstance(inp, tuple) else self.module(inp)
-        except XairlError:
-            raise
-        except Exception as exc:  # the user's code: say where, in one line, without its traceback
-            detail = " ".join(str(exc).split())[:300]
-            own = _module_dtype(self.module)
-            if own is not None and own != x.dtype:  # e.g. a float16 network: the dtype, not the shape, is wrong
-                own, given = (str(t).removeprefix("torch.") for t in (own, x.dtype))
-                raise InputError(
-                    f"policy '{self.policy_name}': its module {type(self.module).__name__} computes in "
-                    f"{own} and failed on {given} states ({type(exc).__name__}: {detail[:160]}); xairl "
-                    "explains float32 and float64 networks: convert it with module.float() or "
-                    "module.double()."
-                ) from None
-            shape = (
-                tuple(x.shape[:1]) + tuple(inp.shape[1:])
-                if isinstance(inp, torch.Tensor)
-                else f"{self.observation.describe().replace('(n', f'({len(x)}')}"
-            )
+def _with_window(window, observation, feature_names) -> tuple[Observation, Sequence[str] | None]:
+    """(observation, feature names) of a policy given ``window=k`` or a window observation: the signals' names
+    become slot names (generated, so ``None``); any other observation as :func:`_observation` makes it."""
+    if window is not None:
+        if isinstance(window, bool) or not isinstance(window, (int, np.integer)):
+            raise InputError(f"window is the number of observations the module takes (k >= 2); got {window!r:.40}.")
+        if observation is not None or feature_names is None:
             raise InputError(
-                f"policy '{self.policy_name}': its module {type(self.module).__name__} raised "
-                f"{type(exc).__name__} ({detail}) on input {shape}; check that it takes "
-                f"{self.observation.describe()}."
-            ) from None
-        if not isinstance(out, torch.Tensor):
-            raise InputError(
-                f"policy '{self.policy_name}': its module {type(self.module).__name__} returned a "
-                f"{type(out).__name__}, not a tensor; wrap it so that it returns one (batch, n_outputs) "
-                "tensor (e.g. the logits or Q-values only)."
+                "window=k takes the signals' names as feature_names and no observation; for another layout "
+                "give observation=xairl.Observation.window(signals, k, layout) instead."
             )
-        if out.dim() == 1 and len(out) == len(x):
-            out = out[:, None]
-        if out.dim() != 2 or len(out) != len(x):
-            raise InputError(
-                f"policy '{self.policy_name}': the module returned shape {tuple(out.shape)} for "
-                f"{len(x)} states; it must return (batch, n_outputs)."
-            )
-        return out
-
-
-_TORCH = {np.float32: torch.float32, np.float64: torch.float64}
-
-
-def _module_dtype(module: torch.nn.Module) -> torch.dtype | None:
-    """The dtype of the module's first floating-point parameter or buffer; None when it has none."""
-    for t in (*module.parameters(), *module.buffers()):
-        if t.is_floating_point():
-            return t.dtype
-    return None
-
-
-def _slot_features(features: dict, window) -> dict:
-    """A window's :class:`FeatureInfo`: each signal's, given once, for every slot of it too (a slot's own wins)."""
-    if window is None:
-        return features
-    slots = window.signal_columns()
-    names = window.names()
-    for s in window.signals:
-        if s in features:
-            for j in slots[s]:
-                features.setdefault(names[j], features[s])
-    return features
+        observation = Observation.window(feature_names, window)
+    observation = _observation(observation, feature_names)
+    if observation.kind == "window" and feature_names is not None:
+        if tuple(map(str, feature_names)) == observation.parts[0].window.signals:
+            feature_names = None  # the signals' names: the slots' are generated from them
+    return observation, feature_names
 
 
 def _observation(obs, feature_names) -> Observation:

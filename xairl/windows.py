@@ -132,6 +132,27 @@ def trend(values: np.ndarray, contributions: np.ndarray) -> Trend:
     return Trend(change, (RISE if change > 0 else FALL) if said else "", history)
 
 
+def slot_features(features: dict, window: Window | None) -> dict:
+    """A window's :class:`FeatureInfo`: each signal's, given once, for every slot of it too (a slot's own wins)."""
+    if window is None:
+        return features
+    slots = window.signal_columns()
+    names = window.names()
+    for s in window.signals:
+        if s in features:
+            for j in slots[s]:
+                features.setdefault(names[j], features[s])
+    return features
+
+
+def window_of(exp) -> Window | None:
+    """The window of an explanation of a window policy that keeps its states (not a grouped one); else None."""
+    obs = exp.observation
+    if obs is None or obs["kind"] != "window" or exp.states is None or len(exp.feature_names) != len(exp.states[0]):
+        return None
+    return Window.from_dict(obs["parts"][0]["window"])
+
+
 def said_change(change: float, unit: str, capacity: float | None = None) -> tuple[float, str]:
     """(size, unit) of a change as narratives say it: a quantity with a capacity in percentage points of it (a
     buffer '12.5 percentage points' fuller, as its level is said in % full), a level in dBm or dBW in dB (a

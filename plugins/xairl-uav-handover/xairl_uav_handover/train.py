@@ -190,7 +190,6 @@ def train(tc: TrainConfig, sim_cfg: SimConfig | None = None, progress: bool = Tr
 
 
 def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
-    from stable_baselines3.common.buffers import ReplayBuffer
     from stable_baselines3.common.utils import set_random_seed
 
     sim_cfg = sim_cfg or SimConfig()
@@ -200,15 +199,7 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
     opt = torch.optim.Adam([p for p in q.parameters() if p.requires_grad], lr=tc.lr0)
     env = HandoverVecEnv(sim_cfg, tc.n_flights)
     memory = Memory() if tc.memory else None
-    space = env.single_observation_space if memory is None else gym.spaces.Box(-np.inf, np.inf, (N_FEATURES,))
-    rb = ReplayBuffer(
-        max(tc.replay_size // tc.n_flights, 1) * tc.n_flights,
-        space,
-        env.single_action_space,
-        device="cpu",
-        n_envs=tc.n_flights,
-        handle_timeout_termination=False,
-    )
+    rb = _replay_buffer(tc, env)
     total = tc.episodes * int(np.ceil(sim_cfg.flight.n_steps / env.decision_every))
     demos = _demonstrations(tc, sim_cfg, env, rb)
     step = updates = 0
@@ -259,6 +250,21 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
         bar.set_postfix(ho=history[-1]["median_handovers"], ret=round(history[-1]["mean_return"], 1))
     bar.close()
     return q.eval(), history
+
+
+def _replay_buffer(tc: TrainConfig, env: HandoverVecEnv):
+    """SB3's replay buffer, one row per flight and decision, of the snapshot's states or the memory's windows."""
+    from stable_baselines3.common.buffers import ReplayBuffer
+
+    space = gym.spaces.Box(-np.inf, np.inf, (N_FEATURES,)) if tc.memory else env.single_observation_space
+    return ReplayBuffer(
+        max(tc.replay_size // tc.n_flights, 1) * tc.n_flights,
+        space,
+        env.single_action_space,
+        device="cpu",
+        n_envs=tc.n_flights,
+        handle_timeout_termination=False,
+    )
 
 
 class Demonstrations:

@@ -31,22 +31,22 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from ...errors import InputError
 from ...explanation import Explanation
-from ...facts import Comparison, DomainFacts
 from ...policy import Policy
 from ...regions import in_regions
-from ...windows import Window, said_change
+from ...windows import window_of
 from . import binding, checks, clauses, directions, parse, quantities, regions, reread, sums
 from .book import FactBook, add_facts, clean_surface, fact_book
 from .checks import CHECKED, Claim
 from .names import Mention, find_mentions, named_features
 from .numbers import NUMBER_RE, find_numbers, matches, normalise, unit_in_name
 from .vocabulary import split_words, vocabulary
+from .window import add_window_facts, per_signal
 
 MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
 MAX_CHARS = 200_000  # longer texts are cut here (and the cut reported)
@@ -237,36 +237,11 @@ def inputs(text, explanation: Explanation, index: int | None, caller: str = "ver
         )
     index = None if index is None else explanation.check_index(index)
     explanation, text, note = in_regions(explanation), normalise(text), ""
-    if explanation.observation is not None and explanation.observation["kind"] == "window":
-        explanation = _per_signal(explanation)
+    if window_of(explanation) is not None:
+        explanation = per_signal(explanation)
     if len(text) > MAX_CHARS:
         text, note = text[:MAX_CHARS], f"text cut at {MAX_CHARS} characters"
     return text, explanation, index, note
-
-
-def _per_signal(explanation: Explanation) -> Explanation:
-    """A window read as it is narrated: per signal with its newest value, each signal's change over the window and
-    the window's span kept in ``extras['window']`` (numbers a text may cite: :func:`aids`)."""
-    window = Window.from_dict(explanation.observation["parts"][0]["window"])
-    out = explanation.by_signal()
-    if explanation.states is None:
-        return out
-    cols = np.stack(list(window.signal_columns().values()))  # (signals, steps)
-    changes = explanation.states[:, cols[:, -1]] - explanation.states[:, cols[:, 0]]
-    span = None if window.step_s is None else (window.steps - 1) * window.step_s
-    return replace(out, extras={**out.extras, "window": {"changes": changes, "span_s": span, "steps": window.steps}})
-
-
-def _window_facts(explanation: Explanation, index: int, policy: Policy | None) -> DomainFacts:
-    """Each signal's change over the window as narratives say it (:func:`xairl.windows.said_change`, before its
-    unit) and the window's span."""
-    w, out = explanation.extras["window"], []
-    for j, name in enumerate(explanation.feature_names):
-        info = policy.features.get(name) if policy else None
-        size, unit = said_change(float(w["changes"][index, j]), *((info.unit, info.capacity) if info else ("", None)))
-        out.append(Comparison(f"{name} changed", abs(size), unit))
-    out += [Comparison("window", float(w["span_s"]), "s")] if w["span_s"] else []
-    return DomainFacts(comparisons=(*out, Comparison("window steps", float(w["steps"]), "observations")))
 
 
 def aids(explanation: Explanation, index: int | None, policy: Policy | None = None, facts=None) -> tuple:
@@ -278,10 +253,7 @@ def aids(explanation: Explanation, index: int | None, policy: Policy | None = No
         add_facts(book, facts)
         book.closed = index is None  # a summary made from these facts: a number that is none of them is wrong
     if index is not None and "window" in (explanation.extras or {}):
-        add_facts(book, _window_facts(explanation, index, policy))
-        for c, name in zip(_window_facts(explanation, index, policy).comparisons, explanation.feature_names):
-            if name in book.features:
-                book.features[name].change = c.value
+        add_window_facts(book, explanation, index, policy)
     vocab = vocabulary(explanation, policy, clean_surface)
 
     def unit_of(f: str) -> str:

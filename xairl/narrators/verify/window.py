@@ -1,0 +1,46 @@
+"""A window of observations (:mod:`xairl.windows`) read as it is narrated: per signal, with each signal's newest
+value, its change over the window and the window's span among the numbers a text may cite."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ...explanation import Explanation
+from ...facts import Comparison, DomainFacts
+from ...policy import Policy
+from ...windows import said_change, window_of
+from .book import FactBook, add_facts
+
+
+def per_signal(explanation: Explanation) -> Explanation:
+    """A window read as it is narrated: per signal with its newest value, each signal's change over the window and
+    the window's span kept in ``extras['window']`` (numbers a text may cite: :func:`aids`)."""
+    window = window_of(explanation)
+    out = explanation.by_signal()
+    cols = np.stack(list(window.signal_columns().values()))  # (signals, steps)
+    changes = explanation.states[:, cols[:, -1]] - explanation.states[:, cols[:, 0]]
+    span = None if window.step_s is None else (window.steps - 1) * window.step_s
+    return replace(out, extras={**out.extras, "window": {"changes": changes, "span_s": span, "steps": window.steps}})
+
+
+def _window_facts(explanation: Explanation, index: int, policy: Policy | None) -> DomainFacts:
+    """Each signal's change over the window as narratives say it (:func:`xairl.windows.said_change`, before its
+    unit) and the window's span."""
+    w, out = explanation.extras["window"], []
+    for j, name in enumerate(explanation.feature_names):
+        info = policy.features.get(name) if policy else None
+        size, unit = said_change(float(w["changes"][index, j]), *((info.unit, info.capacity) if info else ("", None)))
+        out.append(Comparison(f"{name} changed", abs(size), unit))
+    out += [Comparison("window", float(w["span_s"]), "s")] if w["span_s"] else []
+    return DomainFacts(comparisons=(*out, Comparison("window steps", float(w["steps"]), "observations")))
+
+
+def add_window_facts(book: FactBook, explanation: Explanation, index: int, policy: Policy | None) -> None:
+    """The changes and the span as citable numbers, and each signal's change as one of its facts."""
+    facts = _window_facts(explanation, index, policy)
+    add_facts(book, facts)
+    for c, name in zip(facts.comparisons, explanation.feature_names):
+        if name in book.features:
+            book.features[name].change = c.value
