@@ -237,3 +237,15 @@ def test_a_label_has_no_trend(data):
     e = xairl.explain(p, y, method="exact", background=np.abs(np.round(bg)).clip(0, 5))
     for i in range(len(y)):
         assert all(f.name != "load" for f in xairl.facts.decision_facts(e, i, p).trends)
+
+
+def test_a_report_of_a_window_shows_signals_over_time(exp, data, tmp_path):
+    from xairl.plugin import ReportContent, ReportRequest
+    from xairl.report import write_report
+
+    x, bg = data
+    req = ReportRequest(out=tmp_path, method="exact", n_narrated=1, progress=False, robustness=False)
+    content = ReportContent(title="w", policy=policy(), background=bg, datasets=[("sim", x)])
+    html = write_report(req, content, explained={"sim": exp}).read_text()
+    assert "Signals over the window (sim states)" in html and (tmp_path / "window_3.png").stat().st_size > 5000
+    assert plots.readable(exp).feature_names == SIGNALS  # the beeswarm and waterfall per signal

@@ -26,6 +26,7 @@ from .explanation import Explanation
 from .facts import state_value_text
 from .files import save_figure
 from .regions import in_regions
+from .windows import window_of
 
 #: more features than this are plotted in groups (image patches, dict keys) or only the strongest are shown
 MAX_SHOWN = 40
@@ -113,8 +114,10 @@ def view_label(exp: Explanation, view: str = "margin") -> str:
 
 
 def readable(exp: Explanation) -> Explanation:
-    """An explanation a beeswarm can show: images in the regions their narratives name (:func:`xairl.in_regions`),
-    dicts by key."""
+    """An explanation a beeswarm can show: a window per signal (as its narratives name them), images in the regions
+    their narratives name (:func:`xairl.in_regions`), dicts by key."""
+    if window_of(exp) is not None:
+        return exp.by_signal()
     if exp.values.shape[1] <= MAX_SHOWN or exp.observation is None:
         return exp
     if exp.image_shape is not None:

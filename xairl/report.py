@@ -25,6 +25,7 @@ from .files import atomic_write, write_text
 from .options import Options, parse_options
 from .policy import Policy
 from .regions import in_regions
+from .windows import window_of
 
 #: an image's report lists this many regions by importance (its cards list every region, sorted)
 TOP_REGIONS = 20
@@ -192,6 +193,13 @@ def _figures(
                     "lowers it; summed over channels)"
                 ),
                 plots.save(plots.image(ref, pick), out / "image.png"),
+            )
+        )
+    for label, e in [(lb, x) for lb, x in exps if window_of(x) is not None]:  # which signals, which moments
+        figures.append(
+            (
+                f"Signals over the window ({label} states): mean |{target}| per signal and time step",
+                plots.save(plots.window_heatmap(e), out / f"window_{len(figures)}.png"),
             )
         )
     if groups:

@@ -171,3 +171,41 @@ def test_without_the_past_the_window_holds_its_newest_step_and_the_clocks_count(
     np.testing.assert_allclose(
         clock, np.maximum(clock[:, -1:] - 0.2 * np.arange(MEMORY_STEPS - 1, -1, -1), 0), atol=1e-6
     )
+
+
+TIME_SENTENCE = (
+    "{% for f in margin_top if f.name == 'time_on_cell' %}While on BS {{ ID }}, the UAV had been on its cell for "
+    "{{ f.value|round(ROUND) }} s.{% endfor %}"
+)
+
+
+@pytest.mark.parametrize(
+    "cell, rounding, verified",
+    [
+        ("extras.serving_bs", "0", True),
+        ("extras.serving_bs", "1", True),
+        ("extras.serving_bs + 1", "0", False),
+        ("99", "0", False),
+    ],
+)
+def test_ids_and_coarser_roundings_of_time_are_read_right(tmp_path, cell, rounding, verified):
+    """The two failures of the first attempt at time on the cell: a wrong BS id accepted, a coarser rounding of a
+    time rejected."""
+    import yaml
+
+    torch.manual_seed(1)
+    bg = background(64, seed=2, config=_sim())
+    net = build_qnet(bg.mean(axis=0), np.maximum(bg.std(axis=0), 1e-3), (16, 16))
+    save_checkpoint(
+        net,
+        tmp_path / "m.safetensors",
+        {"hidden": [16, 16], "train_config": {"memory": True}, "sim_config": _sim().model_dump()},
+    )
+    policy = uav_policy(load_checkpoint(tmp_path / "m.safetensors"))
+    exp = xairl.explain(policy, bg[:3], background=bg[10:40])
+    body = TIME_SENTENCE.replace("ID", cell).replace("ROUND", rounding)
+    path = tmp_path / "t.yaml"
+    path.write_text(yaml.safe_dump({"name": "t", "kind": "decision", "description": "t", "sentences": [[body]]}))
+    said = [xairl.narrate(exp, i, policy=policy, template=str(path)) for i in range(3)]
+    said = [n for n in said if n.text]
+    assert said and all(n.verified == verified for n in said), [(n.text, n.verified) for n in said]

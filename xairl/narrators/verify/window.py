@@ -31,6 +31,8 @@ def _window_facts(explanation: Explanation, index: int, policy: Policy | None) -
     w, out = explanation.extras["window"], []
     for j, name in enumerate(explanation.feature_names):
         info = policy.features.get(name) if policy else None
+        if info is not None and info.kind != "numeric":  # a label or an id has no change to cite
+            continue
         size, unit = said_change(float(w["changes"][index, j]), *((info.unit, info.capacity) if info else ("", None)))
         out.append(Comparison(f"{name} changed", abs(size), unit))
     out += [Comparison("window", float(w["span_s"]), "s")] if w["span_s"] else []
@@ -41,6 +43,7 @@ def add_window_facts(book: FactBook, explanation: Explanation, index: int, polic
     """The changes and the span as citable numbers, and each signal's change as one of its facts."""
     facts = _window_facts(explanation, index, policy)
     add_facts(book, facts)
-    for c, name in zip(facts.comparisons, explanation.feature_names):
-        if name in book.features:
+    for c in facts.comparisons:
+        name = c.text.removesuffix(" changed")
+        if name in book.features and c.text.endswith(" changed"):
             book.features[name].change = c.value
