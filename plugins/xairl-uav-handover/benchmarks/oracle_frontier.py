@@ -27,8 +27,8 @@ from table_one import targets
 from xairl_uav_handover import oracle
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.evaluate import run_flights
-from xairl_uav_handover.memory import MemoryDQNController
-from xairl_uav_handover.policy import DQNController, load_checkpoint, memory_of
+from xairl_uav_handover.memory import controller
+from xairl_uav_handover.policy import DQNController, load_checkpoint
 from xairl_uav_handover.report import frontier_figure
 from xairl_uav_handover.table import with_intervals
 
@@ -171,7 +171,7 @@ def main():
     more = [(Path(p).stem, load_checkpoint(p)) for p in args.checkpoints]
     flown = [CHM(), SAMRO(), DQNController(ckpt.net)]
     for name, other in more:
-        flown.append(MemoryDQNController(other.net) if memory_of(other.meta) else DQNController(other.net))
+        flown.append(controller(other))
         flown[-1].name = f"DQN {name}"
     for c in flown:
         m, point = place(c, rec, cfg, args.flights, args.seed)

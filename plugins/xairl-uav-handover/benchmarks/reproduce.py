@@ -28,8 +28,8 @@ from table_one import print_targets, targets
 from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.evaluate import importance, ranked
-from xairl_uav_handover.memory import MemoryDQNController, walk_states
-from xairl_uav_handover.policy import DQNController, dqn_decision_states, load_checkpoint, memory_of
+from xairl_uav_handover.memory import controller, walk_states
+from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint, memory_of
 from xairl_uav_handover.table import flights, format_paper, format_rows, pooled_seeds, with_intervals
 from xairl_uav_handover.train import TrainConfig, train_checkpoint
 
@@ -64,11 +64,6 @@ def _parser() -> argparse.ArgumentParser:
         help="train the DQN with memory (memory.py: the last 1 s and the times on the cell and since the handover)",
     )
     return ap
-
-
-def controller(ckpt):
-    """The controller that flies a checkpoint: the DQN with memory keeps its window."""
-    return MemoryDQNController(ckpt.net) if memory_of(ckpt.meta) else DQNController(ckpt.net)
 
 
 def _seed_figures(ckpt, res: dict, name: str, walks, n_states: int, n: int):

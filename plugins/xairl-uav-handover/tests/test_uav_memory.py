@@ -82,8 +82,8 @@ def test_the_times_count_decisions_and_reset_at_a_handover():
     for s, info in zip(states[1:], infos):
         since = np.where(info["handover"] > 0, 0.0, since + step_s)
         newest = s.reshape(-1, MEMORY_STEPS, F)[:, -1]
-        np.testing.assert_allclose(newest[:, SIGNALS.index("time_since_handover")], np.minimum(since, TIME_CAP_S))
-    on_cell = newest[:, SIGNALS.index("time_on_cell")]
+        np.testing.assert_allclose(newest[:, SIGNALS.index("since_handover_s")], np.minimum(since, TIME_CAP_S))
+    on_cell = newest[:, SIGNALS.index("on_cell_s")]
     np.testing.assert_allclose(on_cell, np.minimum((env.sim.t - env.sim.entered) * env.sim.dt, TIME_CAP_S))
     assert any(info["handover"].any() for info in infos)
 
@@ -116,7 +116,7 @@ def test_a_memory_checkpoint_loads_as_a_window_policy_whose_narratives_verify(tm
     )
     ckpt = load_checkpoint(path)
     policy = uav_policy(ckpt)
-    assert policy.n_features == MEMORY_STEPS * F and policy.feature_names[-1] == "time_since_handover[t]"
+    assert policy.n_features == MEMORY_STEPS * F and policy.feature_names[-1] == "since_handover_s[t]"
     exp = xairl.explain(policy, bg[:4], background=bg[10:40])
     assert exp.by_step().feature_names == ("t-4", "t-3", "t-2", "t-1", "t")
     for i in range(4):
@@ -165,16 +165,16 @@ def test_without_the_past_the_window_holds_its_newest_step_and_the_clocks_count(
     s = states[-1]  # (flights, 75)
     flat = without_past(s).reshape(len(s), MEMORY_STEPS, F)
     np.testing.assert_array_equal(flat[:, -1], s.reshape(len(s), MEMORY_STEPS, F)[:, -1])
-    held = [j for j, name in enumerate(SIGNALS) if not name.startswith("time_")]
+    held = [j for j, name in enumerate(SIGNALS) if name not in ("on_cell_s", "since_handover_s")]
     assert (flat[:, :, held] == flat[:, -1:, held]).all()
-    clock = flat[:, :, SIGNALS.index("time_on_cell")]
+    clock = flat[:, :, SIGNALS.index("on_cell_s")]
     np.testing.assert_allclose(
         clock, np.maximum(clock[:, -1:] - 0.2 * np.arange(MEMORY_STEPS - 1, -1, -1), 0), atol=1e-6
     )
 
 
 TIME_SENTENCE = (
-    "{% for f in margin_top if f.name == 'time_on_cell' %}While on BS {{ ID }}, the UAV had been on its cell for "
+    "{% for f in margin_top if f.name == 'on_cell_s' %}While on BS {{ ID }}, the UAV had been on its cell for "
     "{{ f.value|round(ROUND) }} s.{% endfor %}"
 )
 
@@ -209,3 +209,23 @@ def test_ids_and_coarser_roundings_of_time_are_read_right(tmp_path, cell, roundi
     said = [xairl.narrate(exp, i, policy=policy, template=str(path)) for i in range(3)]
     said = [n for n in said if n.text]
     assert said and all(n.verified == verified for n in said), [(n.text, n.verified) for n in said]
+
+
+def test_a_flight_of_the_memory_dqn_at_a_glance_is_verified(tmp_path):
+    from xairl_uav_handover.flight import narrate_flight, simulated_flight, timeline_figure
+
+    torch.manual_seed(2)
+    bg = background(64, seed=2, config=_sim())
+    net = build_qnet(bg.mean(axis=0), np.maximum(bg.std(axis=0), 1e-3), (16,))
+    path = tmp_path / "m.safetensors"
+    save_checkpoint(
+        net, path, {"hidden": [16], "train_config": {"memory": True}, "sim_config": _sim(20.0).model_dump()}
+    )
+    ckpt = load_checkpoint(path)
+    policy = uav_policy(ckpt)
+    tl = simulated_flight(ckpt, seed=0)
+    assert tl.states.shape[1] == MEMORY_STEPS * F
+    exp = xairl.explain(policy, tl.states, background=bg[:30])
+    text, check = narrate_flight(tl, exp, policy)
+    assert check.ok, (text, [c for s in check.sentences for c in s.claims if c.status == "contradicted"])
+    assert timeline_figure(tl, exp, policy, tmp_path / "f.png").stat().st_size > 5000

@@ -21,7 +21,7 @@ FEATURES = (
 )
 #: the signals of the DQN with memory (memory.py): the snapshot's features, then seconds on the serving cell and
 #: since the last handover, each step of its window
-SIGNALS = (*FEATURES, "time_on_cell", "time_since_handover")
+SIGNALS = (*FEATURES, "on_cell_s", "since_handover_s")
 #: decisions in its window: 1 s at the DQN's 0.2 s decision period (SimConfig.decision_every x flight.dt_s)
 MEMORY_STEPS = 5
 RSRP = slice(5, 5 + N_CANDIDATES)  # the candidates' RSRP columns, serving BS first

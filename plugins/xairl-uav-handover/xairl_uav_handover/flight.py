@@ -23,8 +23,9 @@ import numpy as np
 import xairl
 from xairl import Explanation, Policy, verify
 
-from .features import BUFFER, RSRP
-from .policy import Checkpoint, greedy
+from .features import BUFFER, RSRP, snapshot
+from .memory import Memory, walk_states
+from .policy import Checkpoint, greedy, memory_of
 
 HISTORY = 10  # earlier states a decision's facts may look back on
 
@@ -63,12 +64,15 @@ def simulated_flight(ckpt: Checkpoint, seed: int = 0) -> FlightTimeline:
     cfg = ckpt.sim_config
     env = HandoverVecEnv(cfg, 1)
     obs, _ = env.reset(seed=HELD_OUT_SEED + seed)
+    memory = Memory() if memory_of(ckpt.meta) else None  # the DQN with memory decides on its window
+    obs = obs if memory is None else memory.start(env)
     states, handed, ended = [], [], False
     while not ended:
         states.append(obs[0])
         action = greedy(ckpt.net, obs, cfg)
         handed.append(bool(action[0] != 0))
-        obs, _, _, truncated, _ = env.step(action)
+        obs, _, _, truncated, info = env.step(action)
+        obs = obs if memory is None else memory.step(env, info["handover"])
         ended = bool(truncated.all())
     step_s = cfg.flight.dt_s * env.decision_every
     chm_env, chm = HandoverVecEnv(cfg, 1, decision_every=1), CHM()
@@ -98,11 +102,12 @@ def real_flight(flight, ckpt: Checkpoint, seed: int = 0) -> FlightTimeline:
     from .real_data import walk
 
     w = walk(flight, ckpt.sim_config, seed=seed)
-    dqn = greedy(ckpt.net, w.states, ckpt.sim_config) != 0
+    states = walk_states(w, ckpt.sim_config) if memory_of(ckpt.meta) else w.states  # the DQN's own states
+    dqn = greedy(ckpt.net, states, ckpt.sim_config) != 0
     chm = CHMOnSamples(flight.cells)
     chm_times = [float(t) for s, c, t in zip(w.states, w.candidates, w.t) if chm(s, c, float(t)) != 0]
     live = flight.t[1:][np.diff(flight.pci) != 0]
-    return FlightTimeline(flight.name, np.asarray(w.t, float), w.states, dqn, np.array(chm_times), live, False)
+    return FlightTimeline(flight.name, np.asarray(w.t, float), states, dqn, np.array(chm_times), live, False)
 
 
 def _first_reasons(tl: FlightTimeline, exp: Explanation, policy: Policy) -> list[tuple[int, str | None]]:
@@ -174,12 +179,13 @@ def timeline_figure(tl: FlightTimeline, exp: Explanation, policy: Policy, path: 
     keep = [j for j, u in enumerate(us) if u.info.kind != "identifier"]
     top = sorted(keep, key=lambda j: -np.abs(contrib[:, j]).mean())[:3]
     fig, ax = plt.subplots(4, 1, figsize=(9, 8), sharex=True, gridspec_kw={"height_ratios": [3, 1.5, 1, 2.5]})
-    rsrp = tl.states[:, RSRP]
+    now = snapshot(tl.states)  # (the newest step of a memory DQN's window)
+    rsrp = now[:, RSRP]
     ax[0].plot(tl.t, rsrp[:, 0], lw=1, label="serving RSRP")
     ax[0].plot(tl.t, rsrp[:, 1], lw=1, label="strongest neighbour RSRP")
     ax[0].set_ylabel("dBm")
     ax[0].legend(fontsize=8, loc="lower left")
-    ax[1].plot(tl.t, 100 * tl.states[:, BUFFER] / q_max, color="tab:purple", lw=1)
+    ax[1].plot(tl.t, 100 * now[:, BUFFER] / q_max, color="tab:purple", lw=1)
     ax[1].set_ylabel("buffer %")
     ax[1].set_ylim(-5, 105)
     rows = [("DQN", tl.t[tl.dqn_handover], "tab:red"), ("CHM", tl.chm_times, "tab:gray")]

@@ -7,9 +7,9 @@ the recent past: whether a neighbour's RSRQ is rising or the serving cell's fall
 **The state.** It is a window (:mod:`xairl.windows`) of :data:`STEPS` decisions, oldest first, of :data:`SIGNALS`:
 
 - the 13 features of the snapshot;
-- ``time_on_cell``: seconds since the UAV came onto its serving cell, by handover or by re-establishment after a
+- ``on_cell_s``: seconds since the UAV came onto its serving cell, by handover or by re-establishment after a
   failure;
-- ``time_since_handover``: seconds since its last handover.
+- ``since_handover_s``: seconds since its last handover.
 
 Both times are capped at :data:`TIME_CAP_S`. Flat, it has 5 x 15 = 75 columns, time-major (``layout='stacked'``).
 
@@ -37,7 +37,7 @@ from .features import (
     state_rows,
 )
 from .features import MEMORY_STEPS as STEPS
-from .policy import greedy
+from .policy import DQNController, greedy, memory_of
 
 #: the times are capped here (seconds): a 120 s flight's cells last tens of seconds, and a cap keeps a rare long
 #: stay from stretching the network's input scale
@@ -95,7 +95,7 @@ class Memory:
 class MemoryDQNController:
     """Acts greedily with a memory Q-network (states from :class:`Memory`), one decision per env step."""
 
-    name = "DQN with memory"
+    name = "DQN"  # (Table I's column: the DQN, whichever state it sees)
     decision_every = None  # the simulator config's
 
     def __init__(self, net):
@@ -110,6 +110,11 @@ class MemoryDQNController:
         else:  # the step just flown, as training records it
             self.states = self.memory.step(env, env.info["handover"])
         return greedy(self.net, self.states, env.cfg)
+
+
+def controller(ckpt):
+    """The controller that flies a checkpoint: the DQN with memory keeps its window, the snapshot DQN needs none."""
+    return MemoryDQNController(ckpt.net) if memory_of(ckpt.meta) else DQNController(ckpt.net)
 
 
 def background(n: int, seed: int = 0, config=None) -> np.ndarray:
@@ -138,8 +143,9 @@ def memory_policy(ckpt) -> xairl.Policy:
     config = ckpt.sim_config
     facts = HandoverFacts(config.buffer.q_max_bits, CHMConfig().offset_db, config.observation.detection_rsrq_db)
     info = {k: v for k, v in feature_info(config.buffer.q_max_bits).items() if v.kind != "group"}
-    info["time_on_cell"] = xairl.FeatureInfo("s", "the time on the serving cell", "just arrived", "long settled")
-    info["time_since_handover"] = xairl.FeatureInfo("s", "the time since the last handover", "recent", "long ago")
+    # (described without the word 'time': '14 times' in a flight's summary would name them)
+    info["on_cell_s"] = xairl.FeatureInfo("s", "how long the UAV had been on its serving cell", "briefly", "long")
+    info["since_handover_s"] = xairl.FeatureInfo("s", "how long since the last handover", "recently", "long ago")
     return xairl.Policy(
         ckpt.net,
         observation=observation(),
@@ -190,7 +196,7 @@ def without_past(states: np.ndarray, step_s: float = 0.2) -> np.ndarray:
     keep counting (each step ``step_s`` less, not below 0): time on the cell is part of the state, not its past."""
     w = np.repeat(np.asarray(states).reshape(len(states), STEPS, len(SIGNALS))[:, -1:], STEPS, axis=1)
     back = step_s * np.arange(STEPS - 1, -1, -1)[None, :, None]
-    times = [SIGNALS.index(t) for t in ("time_on_cell", "time_since_handover")]
+    times = [SIGNALS.index(t) for t in ("on_cell_s", "since_handover_s")]
     w[:, :, times] = np.maximum(w[:, :, times] - back, 0.0)
     return w.reshape(len(states), -1)
 

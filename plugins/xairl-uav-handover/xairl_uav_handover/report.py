@@ -20,15 +20,9 @@ from xairl import Explanation, InputError
 from .baselines import CHM, SAMRO, SAMROConfig
 from .calibration import agreement_rows, band_rows, outside, quantile_rows
 from .evaluate import PAPER, chm_rate_by_altitude
-from .features import GROUPS
-from .policy import (
-    Checkpoint,
-    DQNController,
-    background_states,
-    dqn_decision_states,
-    load_checkpoint,
-    uav_policy,
-)
+from .features import GROUPS, snapshot
+from .memory import controller, walk_states
+from .policy import Checkpoint, dqn_decision_states, load_checkpoint, memory_of, uav_policy
 
 
 class UAVReportOptions(xairl.plugin.Options):
@@ -47,6 +41,11 @@ class UAVReportOptions(xairl.plugin.Options):
         ge=0,
         le=20,
         description="simulated flights shown at a glance (timeline and summary; with real data, its first flight too)",
+    )
+    checkpoint: str | None = Field(
+        None,
+        description="a DQN checkpoint to report on (default: the committed one); one trained with memory "
+        "(issue 55) is explained per signal and time step",
     )
     frontier: str | None = Field(
         None,
@@ -68,12 +67,13 @@ class UAVReport(xairl.plugin.Report):
     def build(self, req: xairl.plugin.ReportRequest) -> xairl.plugin.ReportContent:
         real, real_setting = real_source(self.options.real)
         loaded = _load_real(real) if real is not None else None  # a bad file is named before Table I's minutes
-        ckpt = load_checkpoint()
+        ckpt = load_checkpoint(self.options.checkpoint)
         cfg = ckpt.sim_config
+        policy = uav_policy(ckpt)
         content = xairl.plugin.ReportContent(
             title="xairl report: UAV handover DQN (Meer et al.), calibrated reproduction",
-            policy=uav_policy(ckpt),
-            background=background_states(100, seed=req.seed + 7, config=cfg),
+            policy=policy,
+            background=policy.background(100, seed=req.seed + 7),
             datasets=[("simulated", dqn_decision_states(ckpt, req.n_states, seed=req.seed + 1))],
             tables=[self._table_one(ckpt, req.seed)],
             settings={
@@ -123,7 +123,7 @@ class UAVReport(xairl.plugin.Report):
 
         n, cfg = self.options.flights, ckpt.sim_config
         sa_mro = SAMRO(SAMROConfig(warmup_flights=n))  # the network adapts on as many flights as the table has
-        res = {c.name: with_intervals(flights(c, cfg, n, [seed])) for c in (CHM(), sa_mro, DQNController(ckpt.net))}
+        res = {c.name: with_intervals(flights(c, cfg, n, [seed])) for c in (CHM(), sa_mro, controller(ckpt))}
         paper = ", ".join(f"{name} {ho} handovers and {pp} % ping-pongs" for name, (ho, pp) in PAPER.items())
         return (
             f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s (SA-MRO's offsets adapted on "
@@ -151,10 +151,14 @@ class UAVReport(xairl.plugin.Report):
             for f in xairl.plugin.progress(flights, desc="real flights", disable=not req.progress)
         ]
         chm_real = [chm_handovers(f, sim_config=cfg) for f in flights]
-        states = np.concatenate([w.states for w in walks])
+        states = np.concatenate([w.states for w in walks])  # the snapshot: the calibration compares the simulator
+        if memory_of(ckpt.meta):  # the DQN's own states on the real flights: its windows
+            seen = np.concatenate([walk_states(w, ckpt.sim_config) for w in walks])
+        else:
+            seen = states
         pick = np.random.default_rng(req.seed).choice(len(states), size=min(req.n_states, len(states)), replace=False)
-        content.datasets.append(("real", states[np.sort(pick)]))
-        sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=256)
+        content.datasets.append(("real", seen[np.sort(pick)]))
+        sim_ref = snapshot(dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=256))
         queue = np.concatenate([w.queue_bits for w in walks])
         where = f"{len(flights)} real flights from {real}" + (f" ({len(bad)} skipped)" if bad else "")
         content.tables += [
@@ -262,6 +266,7 @@ def findings(exps: dict[str, Explanation]) -> list[str]:
     the chosen action's score), and why where they do not."""
     out = []
     for label, exp in exps.items():
+        exp = exp.by_signal() if exp.observation and exp.observation["kind"] == "window" else exp  # (with memory)
         grouped = exp.grouped({"position": GROUPS["position"]})
         imp = np.abs(grouped.margin()).mean(axis=0)
         order = [grouped.feature_names[j] for j in np.argsort(-imp)]
