@@ -40,6 +40,8 @@ class GRUQ(torch.nn.Module):
 q = GRUQ()
 opt = torch.optim.Adam(q.parameters(), lr=1e-3)
 env = gym.make("CartPole-v1")
+env.reset(seed=0)  # every later episode follows from this seed
+env.action_space.seed(0)
 
 
 def start():
@@ -83,4 +85,5 @@ plots.save(plots.window_heatmap(exp), out / "heatmap.png")
 for i in range(len(states)):
     n = xairl.narrate(exp, i, policy=policy)
     print(f"[{'verified' if n.verified else 'NOT verified'}] {n.text}")
+    print("  said as trends:", [f.name for f in xairl.facts.decision_facts(exp, i, policy).trends])
 print("global:", xairl.narrate(exp, None, policy=policy).text)
