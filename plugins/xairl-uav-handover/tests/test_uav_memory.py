@@ -229,3 +229,17 @@ def test_a_flight_of_the_memory_dqn_at_a_glance_is_verified(tmp_path):
     text, check = narrate_flight(tl, exp, policy)
     assert check.ok, (text, [c for s in check.sentences for c in s.claims if c.status == "contradicted"])
     assert timeline_figure(tl, exp, policy, tmp_path / "f.png").stat().st_size > 5000
+
+
+def test_the_serving_bs_is_bound_by_its_words_and_another_bs_is_not():
+    """'on BS 20' and 'from BS 20' name the serving BS (a wrong id is contradicted); 'to BS 7' names another cell,
+    whose id is no fact here (not contradicted)."""
+    from xairl_uav_handover.policy import background_states
+
+    ckpt = load_checkpoint()
+    policy = uav_policy(ckpt)
+    bg = background_states(24, 1, ckpt.sim_config)
+    exp = xairl.explain(policy, bg[:1], background=bg[4:])
+    bs = int(exp.states[0][4])
+    assert xairl.verify(f"The DQN handed the UAV over from BS {bs} to BS {bs + 7}.", exp, 0, policy).accurate
+    assert not xairl.verify(f"While on BS {bs + 1}, the DQN decided.", exp, 0, policy).accurate

@@ -140,7 +140,9 @@ def feature_info(q_max_bits: float = 2e6) -> dict[str, FeatureInfo]:
             ("the uplink buffer queue", "buffer queue"),
             capacity=q_max_bits,
         ),
-        "serving_bs": FeatureInfo("", "the serving BS's id", aliases=("BS", "serving BS"), kind="identifier"),
+        "serving_bs": FeatureInfo(
+            "", "the serving BS's id", aliases=("serving BS", "on BS", "from BS"), kind="identifier"
+        ),
         **{f"rsrp_{k}": _signal("RSRP", k, "dBm", "weak signal", "strong signal", RSRP_LEVELS) for k in range(4)},
         **{f"rsrq_{k}": _signal("RSRQ", k, "dB", "poor quality", "good quality", RSRQ_LEVELS) for k in range(4)},
     }
