@@ -128,18 +128,24 @@ MUTANTS = {  # a template that misstates a trend -> the claim that must be contr
 }
 
 
-@pytest.mark.parametrize("mutant", [*MUTANTS, "right"])
+RIGHT = {  # correct ways to say the same trend: each must verify
+    "right": "{{ f.label|cap }} {{ f.trend }} by {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}.",
+    "went down": "{{ f.label|cap }} went down by {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}.",
+    "decreased": "{{ f.label|cap }} decreased by about {{ f.change|abs|num }} {{ f.unit }}.",
+    "changed": "{{ f.label|cap }} changed by {{ f.change|num }} {{ f.unit }} over {{ f.window }}.",
+}
+
+
+@pytest.mark.parametrize("mutant", [*MUTANTS, *RIGHT])
 def test_a_misstated_trend_is_contradicted(exp, tmp_path, mutant):
-    body = MUTANTS.get(
-        mutant, "{{ f.label|cap }} {{ f.trend }} by {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}."
-    )
+    body = MUTANTS.get(mutant) or RIGHT[mutant]
     path = tmp_path / "trend.yaml"
     sentence = "{% for f in trends %}" + body + "{% endfor %}"
     path.write_text(
         yaml.safe_dump({"name": "trend", "kind": "decision", "description": "t", "sentences": [[sentence]]})
     )
     n = xairl.narrate(exp, 0, policy=policy(), template=str(path))
-    assert n.verified == (mutant == "right"), (n.text, [c for c in n.claims if c.status == "contradicted"])
+    assert n.verified == (mutant in RIGHT), (n.text, [c for c in n.claims if c.status == "contradicted"])
 
 
 def test_frame_stack_groups_per_region_and_frame():
@@ -249,3 +255,17 @@ def test_a_report_of_a_window_shows_signals_over_time(exp, data, tmp_path):
     html = write_report(req, content, explained={"sim": exp}).read_text()
     assert "Signals over the window (sim states)" in html and (tmp_path / "window_3.png").stat().st_size > 5000
     assert plots.readable(exp).feature_names == SIGNALS  # the beeswarm and waterfall per signal
+
+
+def test_a_signal_named_like_a_score_keeps_its_trend(data, tmp_path):
+    """'the gap to the lead vehicle fell by 4 m': a signal's own change, though 'gap' names a score elsewhere."""
+    x, bg = data
+    info = {"rsrq": xairl.FeatureInfo("m", "the gap to the lead vehicle")}
+    obs = xairl.Observation.window(SIGNALS, STEPS)
+    p = xairl.Policy(Falling(), observation=obs, action_names=["s", "g"], features=info)
+    e = xairl.explain(p, x, method="exact", background=bg)
+    body = "{% for f in trends %}{{ f.label|cap }} {{ f.trend }} by {{ f.change|abs|num }} {{ f.unit }}.{% endfor %}"
+    path = tmp_path / "g.yaml"
+    path.write_text(yaml.safe_dump({"name": "g", "kind": "decision", "description": "g", "sentences": [[body]]}))
+    n = xairl.narrate(e, 0, policy=p, template=str(path))
+    assert n.text == "The gap to the lead vehicle fell by 4 m." and n.verified, n.claims

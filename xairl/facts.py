@@ -23,6 +23,7 @@ __all__ = [
     "FeatureFact",
     "GlobalFacts",
     "decision_facts",
+    "domain_facts",
     "format_number",
     "global_facts",
     "narration_units",
@@ -294,7 +295,7 @@ def decision_facts(
             "(Explanation.output_slice(j))."
         )
     c, r = int(exp.chosen[index]), int(exp.runner_up[index])
-    domain = _domain_facts(policy, np.asarray(exp.states[index]), c, r, history)
+    domain = domain_facts(policy, np.asarray(exp.states[index]), c, r, history)
     chosen = _feature_facts(exp, index, exp.for_chosen()[index], policy)
     deciding = exp.output == "actions" and r != c
     margin = _feature_facts(exp, index, exp.margin()[index], policy) if deciding else []
@@ -330,7 +331,7 @@ def _takes_history(hook) -> bool:
     return "history" in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
 
 
-def _domain_facts(
+def domain_facts(
     policy: Policy | None, state: np.ndarray, chosen: int, runner_up: int, history: np.ndarray | None = None
 ) -> DomainFacts:
     """The policy plugin's ``facts_hook`` output, checked for its type; ``history`` goes to hooks that take it. An

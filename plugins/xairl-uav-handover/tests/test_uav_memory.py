@@ -122,6 +122,8 @@ def test_a_memory_checkpoint_loads_as_a_window_policy_whose_narratives_verify(tm
     for i in range(4):
         n = xairl.narrate(exp, i, policy=policy, template="handover")
         assert n.verified, [c for c in n.claims if c.status != "verified"]
+        again = xairl.verify(n.text, exp, i, policy)  # read as outside text: the plugin's facts from the window
+        assert again.accurate, [(c.text, c.detail) for c in again.claims if c.status == "contradicted"]
 
 
 def test_demonstrations_are_refused_for_the_memory_dqn():

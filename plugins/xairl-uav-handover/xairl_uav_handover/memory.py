@@ -209,5 +209,5 @@ def without_past(states: np.ndarray, step_s: float = 0.2) -> np.ndarray:
 def on_trends(net, states: np.ndarray, config) -> np.ndarray:
     """Bool per state: the memory DQN hands over there and would stay without its past (:func:`without_past`): a
     handover taken on a trend, which a snapshot of the same state would not give."""
-    acts, flat = greedy(net, states, config), greedy(net, without_past(states), config)
+    acts, flat = greedy(net, states, config), greedy(net, without_past(states, decision_s(config)), config)
     return (acts > 0) & (flat == 0)

@@ -162,11 +162,13 @@ NEGATED = re.compile(r"(?:\b(?:not|never|no longer|neither|nor)|n't)\b\W*(?:\w+\
 #: a trend word right before a number: the number is a signal's change over its window (:mod:`xairl.windows`), and
 #: an 'up' or 'down' word says its sign ('changed', 'moved' say none)
 TREND_BEFORE = re.compile(
-    r"\b(?:(?P<up>rose|risen|rising|climbed|climbing|increased|increasing|grew|growing|gained|jumped|went up|up)|"
-    r"(?P<down>fell|fallen|falling|dropped|dropping|decreased|decreasing|declined|declining|sank|dipped|went down|"
-    r"down)|changed|moved)(?:\s+by)?(?:\s+(?:about|around|roughly|some|nearly|almost|just))?\W*$",
+    r"\b(?:(?P<up>rose|risen|rising|climbed|climbing|increased|increasing|grew|growing|gained|jumped|went up)|"
+    r"(?P<down>fell|fallen|falling|dropped|dropping|decreased|decreasing|declined|declining|sank|dipped|went down)|"
+    r"changed|moved)(?:\s+by)?(?:\s+(?:about|around|roughly|some|nearly|almost|just))?\W*$",
     re.IGNORECASE,
 )
+#: what may stand between a direction word and a change it is said of ('went down by about 2 dB')
+CHANGE_NEXT = re.compile(r"\W*(?:by\W*)?(?:(?:about|around|roughly|some|nearly|almost|just)\W*)?", re.IGNORECASE)
 #: a score as the subject of a trend word ('the margin grew by 8.8'): the number is no signal's change
 SCORE_SUBJECT = re.compile(r"\b(?:margin|score|lead|q[- ]?values?|gap|estimate|probability|logit)s?\b", re.I)
 #: the quantities a trend word may stand before: a signal's change (a trend's own word, tracked, likewise)

@@ -122,8 +122,9 @@ class Sentence(WordRules):
         if self.truth.get(Span(0, 0, "", replace(f, quantity="value_change"))) in (None, MISSING):
             return False, 0
         m = TREND_BEFORE.search(self.before(p, 24))
-        if m is None or SCORE_SUBJECT.search(SEGMENT.split(self.text[max(0, p.start - 80) : p.start])[-1]):
-            return False, 0
+        before = SEGMENT.split(self.text[max(0, p.start - 80) : p.start])[-1]
+        if m is None or (f.quantity != "value_change" and SCORE_SUBJECT.search(before)):
+            return False, 0  # (a signal's own change is one whatever its label: 'the gap to the lead fell 10 m')
         return True, 1 if m.group("up") else -1 if m.group("down") else 0
 
     def trend(self, p: Part) -> Claim | None:

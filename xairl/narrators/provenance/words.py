@@ -10,6 +10,7 @@ import numpy as np
 from ..verify import Claim
 from ..verify.checks import DIRECTION_RE
 from .lexicon import (
+    CHANGE_NEXT,
     CHOSEN_SIDE,
     EXTRA_DIRECTIONS,
     LESS,
@@ -49,7 +50,14 @@ class WordRules:
                 if target is not None:
                     polarity = -1 if prev.span.fact.role == "runner_up" else 1
                     out.append(self._judge(side.group(0), polarity, target, prev))
+            nxt = next((q for q in self.spans if q.start >= p.end), None)
             for m, polarity in found:
+                if (
+                    nxt is not None
+                    and nxt.span.fact.quantity == "value_change"
+                    and CHANGE_NEXT.fullmatch(words[m.end() :])
+                ):
+                    continue  # 'went down by 2.0 dB': a signal's change over its window (its trend rule), no push
                 action = self._action_after(p, m.end())
                 if action is None and SIDE.fullmatch(m.group(0)) and not CHOSEN_SIDE.match(words, m.end()):
                     continue  # 'favoured a handover to BS 2': a side the words name without a tracked action

@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 
 from ...explanation import Explanation
-from ...facts import Comparison, DomainFacts
+from ...facts import Comparison, DomainFacts, domain_facts
 from ...policy import Policy
 from ...windows import said_change, window_of
 from .book import FactBook, add_facts
@@ -22,7 +22,8 @@ def per_signal(explanation: Explanation) -> Explanation:
     cols = np.stack(list(window.signal_columns().values()))  # (signals, steps)
     changes = explanation.states[:, cols[:, -1]] - explanation.states[:, cols[:, 0]]
     span = None if window.step_s is None else (window.steps - 1) * window.step_s
-    return replace(out, extras={**out.extras, "window": {"changes": changes, "span_s": span, "steps": window.steps}})
+    kept = {"changes": changes, "span_s": span, "steps": window.steps, "states": explanation.states}
+    return replace(out, extras={**out.extras, "window": kept})
 
 
 def _window_facts(explanation: Explanation, index: int, policy: Policy | None) -> DomainFacts:
@@ -40,9 +41,13 @@ def _window_facts(explanation: Explanation, index: int, policy: Policy | None) -
 
 
 def add_window_facts(book: FactBook, explanation: Explanation, index: int, policy: Policy | None) -> None:
-    """The changes and the span as citable numbers, and each signal's change as one of its facts."""
+    """The changes and the span as citable numbers, each signal's change as one of its facts, and the policy's own
+    facts (its hook sees the whole window, which the per-signal explanation no longer holds)."""
     facts = _window_facts(explanation, index, policy)
     add_facts(book, facts)
+    if policy is not None and policy.facts_hook is not None:  # the plugin's facts, from the whole window
+        chosen, runner_up = int(explanation.chosen[index]), int(explanation.runner_up[index])
+        add_facts(book, domain_facts(policy, explanation.extras["window"]["states"][index], chosen, runner_up))
     for c in facts.comparisons:
         name = c.text.removesuffix(" changed")
         if name in book.features and c.text.endswith(" changed"):
