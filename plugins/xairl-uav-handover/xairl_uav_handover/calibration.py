@@ -115,15 +115,16 @@ def band_rows(
 
 
 def outside(real: np.ndarray, sim: np.ndarray) -> np.ndarray:
-    """(n, 13): where a real state's feature lies outside the simulated 0.5-99.5 percentile range."""
+    """(n, features): where a real state's feature lies outside the simulated 0.5-99.5 percentile range."""
     lo, hi = np.percentile(sim, [0.5, 99.5], axis=0)
     return (real < lo) | (real > hi)
 
 
-def quantile_rows(sim: np.ndarray, real: np.ndarray) -> list[QuantileRow]:
+def quantile_rows(sim: np.ndarray, real: np.ndarray, names=FEATURES) -> list[QuantileRow]:
+    """One row per feature (``names``, the columns of ``sim`` and ``real``)."""
     ps, pr = np.percentile(sim, [5, 50, 95], axis=0), np.percentile(real, [5, 50, 95], axis=0)
     out = 100 * outside(real, sim).mean(axis=0)
-    return [QuantileRow(f, *ps[:, j], *pr[:, j], out[j]) for j, f in enumerate(FEATURES)]
+    return [QuantileRow(f, *ps[:, j], *pr[:, j], out[j]) for j, f in enumerate(names)]
 
 
 def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:

@@ -20,7 +20,7 @@ from xairl import Explanation, InputError
 from .baselines import CHM, SAMRO, SAMROConfig
 from .calibration import agreement_rows, band_rows, outside, quantile_rows
 from .evaluate import PAPER, chm_rate_by_altitude
-from .features import GROUPS, snapshot
+from .features import FEATURES, GROUPS, SIGNALS
 from .memory import controller, walk_states
 from .policy import Checkpoint, dqn_decision_states, load_checkpoint, memory_of, uav_policy
 
@@ -151,14 +151,19 @@ class UAVReport(xairl.plugin.Report):
             for f in xairl.plugin.progress(flights, desc="real flights", disable=not req.progress)
         ]
         chm_real = [chm_handovers(f, sim_config=cfg) for f in flights]
-        states = np.concatenate([w.states for w in walks])  # the snapshot: the calibration compares the simulator
+        states = np.concatenate([w.states for w in walks])  # the walks' snapshot states
         if memory_of(ckpt.meta):  # the DQN's own states on the real flights: its windows
             seen = np.concatenate([walk_states(w, ckpt.sim_config) for w in walks])
         else:
             seen = states
         pick = np.random.default_rng(req.seed).choice(len(states), size=min(req.n_states, len(states)), replace=False)
         content.datasets.append(("real", seen[np.sort(pick)]))
-        sim_ref = snapshot(dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=256))
+        if memory_of(ckpt.meta):  # the newest step, times included, against the greedy DQN's own states: a time
+            # on the cell grows as the DQN stays, so only its own decisions compare like with like
+            names, states = SIGNALS, seen[:, -len(SIGNALS) :]
+            sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, n_flights=256)[:, -len(SIGNALS) :]
+        else:  # the mix of exploration and greedy steps that training sees
+            names, sim_ref = FEATURES, dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=256)
         queue = np.concatenate([w.queue_bits for w in walks])
         where = f"{len(flights)} real flights from {real}" + (f" ({len(bad)} skipped)" if bad else "")
         content.tables += [
@@ -170,7 +175,7 @@ class UAVReport(xairl.plugin.Report):
                 f"Real states in the training distribution: buffer full in {100 * np.mean(queue >= cfg.buffer.q_max_bits):.1f} "
                 f"% of real states, non-empty in {100 * np.mean(queue > 0):.1f} %; any feature outside the simulated "
                 f"0.5-99.5 % range in {100 * outside(states, sim_ref).any(axis=1).mean():.1f} % of real states",
-                _table(quantile_rows(sim_ref, states)),
+                _table(quantile_rows(sim_ref, states, names)),
             ),
             (
                 f"Open-loop agreement with the live network's decisions ({where})",
