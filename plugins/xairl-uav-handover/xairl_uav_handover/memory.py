@@ -173,6 +173,13 @@ def walk_states(walk, config) -> np.ndarray:
     report holds between reports); a cell that sample did not report is at the detection limit, and the serving
     cell, if it was not reported then, holds its newest report. Each step's times are counted at its own instant on
     the network's path (its serving cell changes are its handovers)."""
+    key = (decision_s(config), config.observation.model_dump_json())
+    if key not in walk.windows:  # (the report and the benchmarks ask for a walk's windows more than once)
+        walk.windows[key] = _walk_states(walk, config)
+    return walk.windows[key]
+
+
+def _walk_states(walk, config) -> np.ndarray:
     t, cands, step = np.asarray(walk.t, float), walk.candidates, decision_s(config)
     serving = np.array([c[0] for c in cands])
     changed = np.flatnonzero(serving[1:] != serving[:-1]) + 1

@@ -9,7 +9,7 @@ time step between samples.
 from __future__ import annotations
 
 import zlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -37,6 +37,7 @@ class Walk:
     lost_bits: float
     name: str = ""  # the flight's
     measured: list | None = None  # per sample: every measured cell's (RSRP, RSRQ), by PCI (the memory's past)
+    windows: dict = field(default_factory=dict, repr=False)  # memory.walk_states, built once per setting
 
     @property
     def serving(self) -> np.ndarray:

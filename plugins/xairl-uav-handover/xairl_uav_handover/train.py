@@ -238,18 +238,21 @@ def _train(tc: TrainConfig, sim_cfg: SimConfig | None, progress: bool):
                 continue
             for _ in range(tc.updates_per_decision):
                 update()
-        history.append(
-            {
-                "episode": ep,
-                "epsilon": round(eps, 4),
-                "mean_return": float(ep_ret.mean()),
-                "median_handovers": float(np.median(ep_ho)),
-                "seconds": round(time.time() - t0, 2),
-            }
-        )
+        history.append(_record(ep, eps, ep_ret, ep_ho, t0))
         bar.set_postfix(ho=history[-1]["median_handovers"], ret=round(history[-1]["mean_return"], 1))
     bar.close()
     return q.eval(), history
+
+
+def _record(ep: int, eps: float, ep_ret: np.ndarray, ep_ho: np.ndarray, t0: float) -> dict:
+    """One episode's line of the training history."""
+    return {
+        "episode": ep,
+        "epsilon": round(eps, 4),
+        "mean_return": float(ep_ret.mean()),
+        "median_handovers": float(np.median(ep_ho)),
+        "seconds": round(time.time() - t0, 2),
+    }
 
 
 def _replay_buffer(tc: TrainConfig, env: HandoverVecEnv):
