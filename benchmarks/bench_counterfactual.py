@@ -1,0 +1,357 @@
+"""xairl's counterfactual search against DiCE's model-agnostic methods (issue 56).
+
+The same states of two policies: the UAV handover DQN (the plugin's committed checkpoint; states at which it decided
+on held-out flights, its background the simulated states its sampler draws) and the toy policy
+(``xairl.toy.toy_policy()``). For each state the question is the same: which change of the state makes the policy
+choose its runner-up (the second-best available action) instead of the action it took?
+
+DiCE (``dice-ml``) explains classifiers, so each policy is wrapped as a classifier of the chosen action: its
+``predict_proba`` is a softmax of the policy's scores with unavailable actions at probability 0, so that its argmax
+is exactly the action the policy takes; the label DiCE flips is "the chosen action", ``desired_class`` the runner-up's
+index (DiCE's multiclass validity: the argmax of the probabilities is the desired class). Both searches get the same
+ranges: each feature between the background's 1st and 99th percentiles, narrowed by the bounds a ``FeatureInfo``
+declares, and the features xairl holds fixed (immutables, identifiers) left out of DiCE's ``features_to_vary``. DiCE
+has no limit on the number of features changed (xairl's ``max_changes=2``): its counts are reported as they come.
+One counterfactual is asked of each (``total_CFs=1``, ``n=1``).
+
+Every returned counterfactual is re-run through the policy here (validity: the policy's action on it is the
+runner-up). Per policy and method it prints: states with an answer, validity, features changed (mean and share <= 2),
+the distance (sum over features of |quantile after - quantile before| in the background's empirical distribution)
+and the scaled distance (sum of |delta| / interquartile range), both xairl's ``Counterfactual.distance`` definitions,
+and the seconds per state (wall clock, one process). A second table compares each DiCE method with xairl on the
+states where both returned a valid counterfactual.
+
+    .venv/bin/python benchmarks/bench_counterfactual.py [--states 200] [--quick] [--policy uav toy] [--methods ...]
+
+dice-ml is an optional extra (``pip install xairl[bench]``); without it the benchmark says so and exits 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import os
+import random
+import signal
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+import xairl
+
+DICE_METHODS = ("random", "genetic", "kdtree")
+SEED = 0
+
+
+@dataclass(frozen=True)
+class Case:
+    """One policy's benchmark: the states searched, the background, the ranges and the targets."""
+
+    name: str
+    policy: xairl.Policy
+    states: np.ndarray  # (n, n_features) float64
+    background: np.ndarray
+    low: np.ndarray  # per feature, the range both searches may use
+    high: np.ndarray
+    fixed: tuple[str, ...]  # features no search may change
+    chosen: np.ndarray  # the action the policy took in each state
+    target: np.ndarray  # its runner-up: the action each search must reach
+
+
+class ChosenActionClassifier:
+    """The policy as a scikit-learn-like classifier of the action it takes (for DiCE's 'sklearn' backend)."""
+
+    def __init__(self, policy: xairl.Policy):
+        self.policy = policy
+        self.classes_ = np.arange(policy.n_actions)
+
+    def predict_proba(self, frame) -> np.ndarray:
+        x = np.asarray(frame, dtype=np.float64)
+        scores = np.where(self.policy.available(x), self.policy.scores(x), -np.inf)
+        scores = scores - scores.max(axis=1, keepdims=True)
+        e = np.exp(scores)
+        return e / e.sum(axis=1, keepdims=True)
+
+    def predict(self, frame) -> np.ndarray:
+        return self.predict_proba(frame).argmax(axis=1)
+
+
+def runner_up(policy: xairl.Policy, states: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(chosen, runner-up, has one): the best and second-best available actions; one forward pass."""
+    scores = np.where(policy.available(states), policy.scores(states), -np.inf)
+    ranked = np.argsort(-scores, axis=1, kind="stable")
+    has = np.isfinite(scores[np.arange(len(states)), ranked[:, 1]]) if scores.shape[1] > 1 else np.zeros(len(states))
+    return ranked[:, 0], ranked[:, 1], has.astype(bool)
+
+
+def ranges(policy: xairl.Policy, background: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
+    """Per-feature (low, high) and the fixed features: the background's 1st-99th percentiles within the declared
+    bounds; fixed are the declared immutables and the identifiers."""
+    low, high = np.percentile(background, [1, 99], axis=0)
+    fixed = []
+    for j, name in enumerate(policy.feature_names):
+        info = policy.features.get(name)
+        if info is None:
+            continue
+        bounds = getattr(info, "bounds", None)
+        if bounds is not None:
+            low[j], high[j] = max(low[j], bounds[0]), min(high[j], bounds[1])
+        if getattr(info, "immutable", False) or info.kind == "identifier":
+            fixed.append(name)
+    return low, high, tuple(fixed)
+
+
+def make_case(name: str, policy: xairl.Policy, states: np.ndarray, background: np.ndarray) -> Case:
+    states, background = np.asarray(states, np.float64), np.asarray(background, np.float64)
+    chosen, target, has = runner_up(policy, states)
+    low, high, fixed = ranges(policy, background)
+    keep = has  # a state with one available action has no runner-up to reach
+    return Case(name, policy, states[keep], background, low, high, fixed, chosen[keep], target[keep])
+
+
+def uav_case(n: int) -> Case:
+    from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint, uav_policy
+
+    ckpt = load_checkpoint()
+    policy = uav_policy(ckpt)
+    return make_case("uav-dqn", policy, dqn_decision_states(ckpt, n, seed=SEED), policy.background(1000, seed=SEED))
+
+
+def toy_case(n: int) -> Case:
+    from xairl.toy import toy_background, toy_policy
+
+    return make_case("toy", toy_policy(), toy_background(n, seed=SEED + 1), toy_background(1000, seed=SEED))
+
+
+@dataclass
+class Answers:
+    """What one method returned: per state a counterfactual state or None, the seconds it took in all, and how many
+    states ran out of time."""
+
+    method: str
+    states: list[np.ndarray | None]
+    seconds: float
+    timed_out: int = 0
+
+
+class OutOfTime(Exception):
+    pass
+
+
+def _alarm(signum, frame):
+    raise OutOfTime
+
+
+def dice_answers(case: Case, method: str, limit: float = 10.0, cache: str | None = None) -> Answers:
+    """DiCE's first counterfactual per state (one query per call: each state has its own desired class), each query
+    stopped after ``limit`` seconds (DiCE's genetic search draws random states until enough of them have the
+    desired class, without a limit); with ``cache``, answers are kept in that folder and reused for the same states."""
+    path = cache and os.path.join(cache, f"{case.name}-{method}-{len(case.states)}-{limit:g}.npz")
+    if path and os.path.exists(path):
+        saved = np.load(path)
+        if np.array_equal(saved["query"], case.states):
+            rows = [None if np.isnan(r).all() else r for r in saved["found"]]
+            return Answers(f"dice-{method}", rows, float(saved["seconds"]), int(saved["timed_out"]))
+    answers = _run_dice(case, method, limit)
+    if path:
+        os.makedirs(cache, exist_ok=True)
+        found = np.array([np.full(case.states.shape[1], np.nan) if a is None else a for a in answers.states])
+        np.savez(path, query=case.states, found=found, seconds=answers.seconds, timed_out=answers.timed_out)
+    return answers
+
+
+def _run_dice(case: Case, method: str, limit: float) -> Answers:
+    import dice_ml
+    import pandas as pd
+
+    # columns renamed: DiCE's k-d tree writes a column 'distance' of its own over the toy's feature 'distance'
+    names = [f"f{j}" for j in range(case.states.shape[1])]
+    fixed = {f"f{case.policy.feature_names.index(f)}" for f in case.fixed}
+    frame = pd.DataFrame(case.background, columns=names)
+    frame["action"] = ChosenActionClassifier(case.policy).predict(case.background)
+    data = dice_ml.Data(dataframe=frame, continuous_features=names, outcome_name="action")
+    model = dice_ml.Model(model=ChosenActionClassifier(case.policy), backend="sklearn", model_type="classifier")
+    explainer = dice_ml.Dice(data, model, method=method)
+    vary = [f for f in names if f not in fixed]
+    permitted = {f: [float(case.low[j]), float(case.high[j])] for j, f in enumerate(names) if f in vary}
+    random.seed(SEED)
+    np.random.seed(SEED)
+    extra = {"random_seed": SEED} if method == "random" else {}
+    found: list[np.ndarray | None] = []
+    timed_out, start = 0, time.perf_counter()
+    previous = signal.signal(signal.SIGALRM, _alarm)
+    try:
+        for i in range(len(case.states)):
+            query = pd.DataFrame(case.states[i : i + 1], columns=names)
+            signal.setitimer(signal.ITIMER_REAL, limit)
+            try:
+                found.append(_one_dice(explainer, query, int(case.target[i]), vary, permitted, extra))
+            except OutOfTime:
+                found.append(None)
+                timed_out += 1
+            finally:
+                signal.setitimer(signal.ITIMER_REAL, 0)
+    finally:
+        signal.signal(signal.SIGALRM, previous)
+    return Answers(f"dice-{method}", found, time.perf_counter() - start, timed_out)
+
+
+def _one_dice(explainer, query, target: int, vary, permitted, extra) -> np.ndarray | None:
+    """One DiCE query; None when it returns nothing (DiCE raises when no counterfactual is found)."""
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            out = explainer.generate_counterfactuals(
+                query, total_CFs=1, desired_class=target, features_to_vary=vary, permitted_range=permitted, **extra
+            )
+    except OutOfTime:
+        raise
+    except Exception as err:  # noqa: BLE001 (DiCE's 'no counterfactual found' is an exception of its own)
+        if "no counterfactuals found" not in str(err).lower():
+            print(f"  dice: {type(err).__name__}: {str(err)[:120]}")
+        return None
+    ex = out.cf_examples_list[0]
+    cfs = ex.final_cfs_df_sparse if ex.final_cfs_df_sparse is not None else ex.final_cfs_df
+    if cfs is None or len(cfs) == 0:
+        return None
+    return cfs[list(query.columns)].to_numpy(np.float64)[0]
+
+
+def xairl_answers(case: Case) -> Answers:
+    """xairl's best counterfactual per state, all states in one call (the search batches its forward passes)."""
+    start = time.perf_counter()
+    answers = xairl.counterfactual(case.policy, case.states, index=None, max_changes=2, background=case.background)
+    seconds = time.perf_counter() - start
+    found = [None if a.best is None else np.asarray(a.best.state, np.float64) for a in answers]
+    return Answers("xairl", found, seconds)
+
+
+@dataclass
+class Scores:
+    """Per state of one method: answered, valid (re-run: the policy takes the target), features changed, distances."""
+
+    answered: np.ndarray
+    valid: np.ndarray
+    changed: np.ndarray
+    distance: np.ndarray
+    scaled: np.ndarray
+
+
+def quantiles(background: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Positions 0..1 of ``x`` (n, features) in the background's empirical distribution, feature by feature (the
+    mid-rank: ties count half)."""
+    sorted_bg = np.sort(background, axis=0)
+    cols = [
+        np.searchsorted(sorted_bg[:, j], x[:, j], "left") + np.searchsorted(sorted_bg[:, j], x[:, j], "right")
+        for j in range(x.shape[1])
+    ]
+    return np.stack(cols, axis=1) / (2.0 * len(background))
+
+
+def iqr(background: np.ndarray) -> np.ndarray:
+    q1, q3 = np.percentile(background, [25, 75], axis=0)
+    return np.where(q3 > q1, q3 - q1, 1.0)  # a feature without spread: its own units
+
+
+def score(case: Case, answers: Answers) -> Scores:
+    """Re-run the policy on every answer (one batch) and measure it against its state."""
+    answered = np.array([a is not None for a in answers.states])
+    cf = np.array([a if a is not None else s for a, s in zip(answers.states, case.states)])
+    valid = answered & (case.policy.act(cf) == case.target)
+    delta = np.abs(cf - case.states)
+    tol = 1e-6 * (case.high - case.low) + 1e-12
+    moved = delta > tol
+    dq = np.abs(quantiles(case.background, cf) - quantiles(case.background, case.states))
+    return Scores(
+        answered,
+        valid,
+        moved.sum(axis=1),
+        np.where(moved, dq, 0.0).sum(axis=1),
+        np.where(moved, delta / iqr(case.background), 0.0).sum(axis=1),
+    )
+
+
+HEAD = f"{'policy':<9}{'method':<15}{'states':>7}{'answered':>10}{'valid':>8}{'changed':>9}{'<=2':>7}"
+HEAD += f"{'distance':>10}{'scaled':>8}{'s/state':>9}{'timeouts':>10}"
+
+
+def row(case: Case, answers: Answers, s: Scores) -> str:
+    n, a = len(case.states), s.answered
+    mean = (lambda v: float(v[a].mean())) if a.any() else (lambda v: float("nan"))
+    validity = float(s.valid[a].mean()) if a.any() else float("nan")
+    return (
+        f"{case.name:<9}{answers.method:<15}{n:>7}{a.mean():>10.0%}{validity:>8.1%}{mean(s.changed):>9.2f}"
+        f"{(mean(s.changed <= 2)):>7.0%}{mean(s.distance):>10.3f}{mean(s.scaled):>8.2f}{answers.seconds / n:>9.3f}"
+        f"{answers.timed_out:>10}"
+    )
+
+
+def paired(case: Case, ours: Scores, theirs: Scores, method: str) -> str:
+    """xairl and one DiCE method on the states where both returned a valid counterfactual."""
+    both = ours.valid & theirs.valid
+    if not both.any():
+        return f"{case.name:<9}{method:<15} no state where both are valid"
+    c = f"{ours.changed[both].mean():.2f} vs {theirs.changed[both].mean():.2f}"
+    d = f"{ours.distance[both].mean():.3f} vs {theirs.distance[both].mean():.3f}"
+    sc = f"{ours.scaled[both].mean():.2f} vs {theirs.scaled[both].mean():.2f}"
+    fewer = float((ours.changed[both] < theirs.changed[both]).mean())
+    nearer = float((ours.distance[both] < theirs.distance[both]).mean())
+    return (
+        f"{case.name:<9}{method:<15}{int(both.sum()):>6}  changed {c} (xairl fewer {fewer:.0%}), distance {d} "
+        f"(xairl nearer {nearer:.0%}), scaled {sc}"
+    )
+
+
+def run(case: Case, methods: tuple[str, ...], with_xairl: bool, limit: float, cache: str | None) -> None:
+    print(f"{case.name}: {len(case.states)} states with a runner-up; fixed: {', '.join(case.fixed) or 'none'}")
+    results = []
+    if with_xairl:
+        ours = xairl_answers(case)
+        results.append((ours, score(case, ours)))
+    for method in methods:
+        answers = dice_answers(case, method, limit, cache)
+        results.append((answers, score(case, answers)))
+    print(HEAD)
+    for answers, s in results:
+        print(row(case, answers, s))
+    if with_xairl:
+        print("paired, on states where both are valid (xairl vs DiCE):")
+        for answers, s in results[1:]:
+            print(paired(case, results[0][1], s, answers.method))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--states", type=int, default=200, help="states per policy (default 200)")
+    ap.add_argument("--quick", action="store_true", help="a smoke run: 10 states per policy")
+    ap.add_argument("--policy", nargs="+", choices=("uav", "toy"), default=["uav", "toy"])
+    ap.add_argument("--methods", nargs="+", choices=DICE_METHODS, default=list(DICE_METHODS))
+    ap.add_argument("--limit", type=float, default=10.0, help="seconds a DiCE query may take (default 10)")
+    ap.add_argument("--cache", help="a folder to keep DiCE's answers in and reuse them for the same states")
+    args = ap.parse_args(argv)
+    os.environ.setdefault("TQDM_DISABLE", "1")  # DiCE's progress bar, one per query (read when tqdm is imported)
+    try:
+        import dice_ml  # noqa: F401
+    except ImportError:
+        print("bench_counterfactual: dice-ml is not installed; pip install xairl[bench] to compare with DiCE.")
+        return 0
+    n = 10 if args.quick else args.states
+    with_xairl = hasattr(xairl, "counterfactual")
+    if not with_xairl:
+        print("xairl.counterfactual is not on this branch: DiCE alone.")
+    for name in args.policy:
+        if name == "uav":
+            try:
+                case = uav_case(n)
+            except ImportError:
+                print("uav: the xairl-uav-handover plugin is not installed; skipped.")
+                continue
+        else:
+            case = toy_case(n)
+        run(case, tuple(args.methods), with_xairl, args.limit, args.cache)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,47 @@
+"""The DiCE benchmark's own parts (benchmarks/bench_counterfactual.py): the classifier DiCE sees takes exactly the
+policy's actions, the scoring re-runs the policy (an answer that does not flip is counted invalid), and a quick run on
+the toy policy (only with dice-ml installed: the `bench` extra)."""
+
+import numpy as np
+import pytest
+
+from benchmarks import bench_counterfactual as bench
+
+
+@pytest.fixture(scope="module")
+def case():
+    return bench.toy_case(12)
+
+
+def test_the_classifier_takes_the_policy_s_action(case):
+    clf = bench.ChosenActionClassifier(case.policy)
+    x = np.concatenate([case.states, case.background[:50]])
+    np.testing.assert_array_equal(clf.predict(x), case.policy.act(x))
+    np.testing.assert_allclose(clf.predict_proba(x).sum(axis=1), 1.0)
+    assert (case.target != case.chosen).all()
+
+
+def test_scoring_reruns_the_policy(case):
+    """A brute-force flip (walk one feature until the target action wins) is valid; the state itself, given back as
+    its own counterfactual, is answered but invalid; no answer is not counted."""
+    found = []
+    for s, t in zip(case.states, case.target):
+        steps = s + np.linspace(-6, 6, 241)[:, None] * np.eye(len(s))[:, None, :]  # (features, steps, features)
+        hits = steps.reshape(-1, len(s))[case.policy.act(steps.reshape(-1, len(s))) == t]
+        found.append(hits[np.abs(hits - s).sum(axis=1).argmin()] if len(hits) else None)
+    walked = bench.score(case, bench.Answers("walk", found, 1.0))
+    assert walked.answered.sum() >= 6 and walked.valid[walked.answered].all()
+    assert (walked.changed[walked.answered] == 1).all()
+    same = bench.score(case, bench.Answers("same", list(case.states), 1.0))
+    assert same.answered.all() and not same.valid.any() and (same.changed == 0).all() and (same.distance == 0).all()
+
+
+@pytest.mark.slow
+def test_quick_run_against_dice(case, capsys):
+    pytest.importorskip("dice_ml")
+    small = bench.make_case("toy", case.policy, case.states[:4], case.background)
+    answers = bench.dice_answers(small, "genetic")
+    s = bench.score(small, answers)
+    assert s.answered.any()
+    assert bench.main(["--quick", "--policy", "toy", "--methods", "genetic"]) == 0
+    assert "dice-genetic" in capsys.readouterr().out
