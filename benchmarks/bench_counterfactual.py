@@ -9,17 +9,22 @@ DiCE (``dice-ml``) explains classifiers, so each policy is wrapped as a classifi
 ``predict_proba`` is a softmax of the policy's scores with unavailable actions at probability 0, so that its argmax
 is exactly the action the policy takes; the label DiCE flips is "the chosen action", ``desired_class`` the runner-up's
 index (DiCE's multiclass validity: the argmax of the probabilities is the desired class). Both searches get the same
-ranges: each feature between the background's 1st and 99th percentiles, narrowed by the bounds a ``FeatureInfo``
-declares, and the features xairl holds fixed (immutables, identifiers) left out of DiCE's ``features_to_vary``. DiCE
-has no limit on the number of features changed (xairl's ``max_changes=2``): its counts are reported as they come.
-One counterfactual is asked of each (``total_CFs=1``, ``n=1``).
+room, xairl's own (:mod:`xairl.counterfactuals.bounds`): each feature within its declared ``FeatureInfo.bounds``,
+else the background's 1st-99th percentile widened to the state's value (DiCE's ``permitted_range``, per state), and
+the features xairl never changes (immutables, identifiers, categoricals) left out of DiCE's ``features_to_vary``.
+What neither range can say, the UAV's coupling of each RSRQ to the RSRPs (the policy's ``feasible``), xairl's search
+enforces and DiCE cannot be told: it is reported. DiCE has no limit on the number of features changed (xairl's
+``max_changes=2``): its counts are as they come. One counterfactual is asked of each (``total_CFs=1``, ``n=1``), with
+DiCE's other settings at their defaults; a DiCE query is stopped after ``--limit`` seconds (its genetic method draws
+random states until enough have the desired class, with no limit of its own).
 
-Every returned counterfactual is re-run through the policy here (validity: the policy's action on it is the
-runner-up). Per policy and method it prints: states with an answer, validity, features changed (mean and share <= 2),
-the distance (sum over features of |quantile after - quantile before| in the background's empirical distribution)
-and the scaled distance (sum of |delta| / interquartile range), both xairl's ``Counterfactual.distance`` definitions,
-and the seconds per state (wall clock, one process). A second table compares each DiCE method with xairl on the
-states where both returned a valid counterfactual.
+Every returned counterfactual is re-run through the policy here. Per policy and method it prints: the share of states
+answered; among the answers, valid (the policy, re-run, takes the runner-up), feasible, features changed (mean and
+share <= 2), the distance (sum over the changed features of |quantile after - quantile before| in the background)
+and the scaled one (sum of |delta| / interquartile range), xairl's ``Counterfactual.distance`` and
+``distance_scaled`` measured by xairl's own units; seconds per state (wall clock, one process, all states of the
+policy); queries out of time; and "usable", the share of all states with a valid, feasible answer of at most two
+changes. A second table compares each DiCE method with xairl on the states where both returned a valid answer.
 
     .venv/bin/python benchmarks/bench_counterfactual.py [--states 200] [--quick] [--policy uav toy] [--methods ...]
 
@@ -53,7 +58,9 @@ class Case:
     policy: xairl.Policy
     states: np.ndarray  # (n, n_features) float64
     background: np.ndarray
-    low: np.ndarray  # per feature, the range both searches may use
+    units: object  # xairl's units of change (xairl.counterfactuals.bounds.Units): the features a search may change
+    columns: np.ndarray  # the flat column of each unit
+    low: np.ndarray  # (n, units): where each unit of each state may move, the same for both searches
     high: np.ndarray
     fixed: tuple[str, ...]  # features no search may change
     chosen: np.ndarray  # the action the policy took in each state
@@ -86,29 +93,22 @@ def runner_up(policy: xairl.Policy, states: np.ndarray) -> tuple[np.ndarray, np.
     return ranked[:, 0], ranked[:, 1], has.astype(bool)
 
 
-def ranges(policy: xairl.Policy, background: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
-    """Per-feature (low, high) and the fixed features: the background's 1st-99th percentiles within the declared
-    bounds; fixed are the declared immutables and the identifiers."""
-    low, high = np.percentile(background, [1, 99], axis=0)
-    fixed = []
-    for j, name in enumerate(policy.feature_names):
-        info = policy.features.get(name)
-        if info is None:
-            continue
-        bounds = getattr(info, "bounds", None)
-        if bounds is not None:
-            low[j], high[j] = max(low[j], bounds[0]), min(high[j], bounds[1])
-        if getattr(info, "immutable", False) or info.kind == "identifier":
-            fixed.append(name)
-    return low, high, tuple(fixed)
-
-
 def make_case(name: str, policy: xairl.Policy, states: np.ndarray, background: np.ndarray) -> Case:
+    """The states that have a runner-up, with xairl's own ranges (:mod:`xairl.counterfactuals.bounds`: declared
+    bounds, else the background's 1st-99th percentile widened to the state's value; immutables, identifiers and
+    categoricals fixed), so that DiCE gets exactly the room xairl's search has."""
+    from xairl.counterfactuals.bounds import units as units_of
+
     states, background = np.asarray(states, np.float64), np.asarray(background, np.float64)
-    chosen, target, has = runner_up(policy, states)
-    low, high, fixed = ranges(policy, background)
-    keep = has  # a state with one available action has no runner-up to reach
-    return Case(name, policy, states[keep], background, low, high, fixed, chosen[keep], target[keep])
+    chosen, target, keep = runner_up(policy, states)  # a state with one available action has no runner-up
+    states, chosen, target = states[keep], chosen[keep], target[keep]
+    units = units_of(policy, background, None)
+    if any(len(c) != 1 for c in units.columns):
+        raise ValueError("the benchmark wraps flat policies only (a unit is one column)")
+    columns = np.array([c[0] for c in units.columns], dtype=int)
+    low, high = units.ranges(units.values(states))
+    fixed = tuple(f for j, f in enumerate(policy.feature_names) if j not in set(columns.tolist()))
+    return Case(name, policy, states, background, units, columns, low, high, fixed, chosen, target)
 
 
 def uav_case(n: int) -> Case:
@@ -147,18 +147,29 @@ def _alarm(signum, frame):
 def dice_answers(case: Case, method: str, limit: float = 10.0, cache: str | None = None) -> Answers:
     """DiCE's first counterfactual per state (one query per call: each state has its own desired class), each query
     stopped after ``limit`` seconds (DiCE's genetic search draws random states until enough of them have the
-    desired class, without a limit); with ``cache``, answers are kept in that folder and reused for the same states."""
+    desired class, without a limit); with ``cache``, answers are kept in that folder and reused for the same states,
+    ranges and targets."""
     path = cache and os.path.join(cache, f"{case.name}-{method}-{len(case.states)}-{limit:g}.npz")
     if path and os.path.exists(path):
         saved = np.load(path)
-        if np.array_equal(saved["query"], case.states):
+        if all(np.array_equal(saved[k], getattr(case, k)) for k in ("states", "low", "high", "columns", "target")):
             rows = [None if np.isnan(r).all() else r for r in saved["found"]]
             return Answers(f"dice-{method}", rows, float(saved["seconds"]), int(saved["timed_out"]))
     answers = _run_dice(case, method, limit)
     if path:
         os.makedirs(cache, exist_ok=True)
         found = np.array([np.full(case.states.shape[1], np.nan) if a is None else a for a in answers.states])
-        np.savez(path, query=case.states, found=found, seconds=answers.seconds, timed_out=answers.timed_out)
+        np.savez(
+            path,
+            states=case.states,
+            low=case.low,
+            high=case.high,
+            columns=case.columns,
+            target=case.target,
+            found=found,
+            seconds=answers.seconds,
+            timed_out=answers.timed_out,
+        )
     return answers
 
 
@@ -168,14 +179,12 @@ def _run_dice(case: Case, method: str, limit: float) -> Answers:
 
     # columns renamed: DiCE's k-d tree writes a column 'distance' of its own over the toy's feature 'distance'
     names = [f"f{j}" for j in range(case.states.shape[1])]
-    fixed = {f"f{case.policy.feature_names.index(f)}" for f in case.fixed}
     frame = pd.DataFrame(case.background, columns=names)
     frame["action"] = ChosenActionClassifier(case.policy).predict(case.background)
     data = dice_ml.Data(dataframe=frame, continuous_features=names, outcome_name="action")
     model = dice_ml.Model(model=ChosenActionClassifier(case.policy), backend="sklearn", model_type="classifier")
     explainer = dice_ml.Dice(data, model, method=method)
-    vary = [f for f in names if f not in fixed]
-    permitted = {f: [float(case.low[j]), float(case.high[j])] for j, f in enumerate(names) if f in vary}
+    vary = [names[c] for c in case.columns]
     random.seed(SEED)
     np.random.seed(SEED)
     extra = {"random_seed": SEED} if method == "random" else {}
@@ -187,6 +196,7 @@ def _run_dice(case: Case, method: str, limit: float) -> Answers:
             query = pd.DataFrame(case.states[i : i + 1], columns=names)
             signal.setitimer(signal.ITIMER_REAL, limit)
             try:
+                permitted = {f: [float(case.low[i, u]), float(case.high[i, u])] for u, f in enumerate(vary)}
                 found.append(_one_dice(explainer, query, int(case.target[i]), vary, permitted, extra))
             except OutOfTime:
                 found.append(None)
@@ -229,51 +239,42 @@ def xairl_answers(case: Case) -> Answers:
 
 @dataclass
 class Scores:
-    """Per state of one method: answered, valid (re-run: the policy takes the target), features changed, distances."""
+    """Per state of one method: answered, valid (re-run: the policy takes the target), feasible (the policy's
+    ``feasible`` accepts it: the UAV's RSRQ within what its RSRP allows), features changed, distances."""
 
     answered: np.ndarray
     valid: np.ndarray
+    feasible: np.ndarray
     changed: np.ndarray
     distance: np.ndarray
     scaled: np.ndarray
 
 
-def quantiles(background: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Positions 0..1 of ``x`` (n, features) in the background's empirical distribution, feature by feature (the
-    mid-rank: ties count half)."""
-    sorted_bg = np.sort(background, axis=0)
-    cols = [
-        np.searchsorted(sorted_bg[:, j], x[:, j], "left") + np.searchsorted(sorted_bg[:, j], x[:, j], "right")
-        for j in range(x.shape[1])
-    ]
-    return np.stack(cols, axis=1) / (2.0 * len(background))
-
-
-def iqr(background: np.ndarray) -> np.ndarray:
-    q1, q3 = np.percentile(background, [25, 75], axis=0)
-    return np.where(q3 > q1, q3 - q1, 1.0)  # a feature without spread: its own units
-
-
 def score(case: Case, answers: Answers) -> Scores:
-    """Re-run the policy on every answer (one batch) and measure it against its state."""
+    """Re-run the policy on every answer (one batch) and measure it against its state with xairl's own measures
+    (the units' background quantiles and interquartile ranges)."""
     answered = np.array([a is not None for a in answers.states])
     cf = np.array([a if a is not None else s for a, s in zip(answers.states, case.states)])
     valid = answered & (case.policy.act(cf) == case.target)
-    delta = np.abs(cf - case.states)
-    tol = 1e-6 * (case.high - case.low) + 1e-12
-    moved = delta > tol
-    dq = np.abs(quantiles(case.background, cf) - quantiles(case.background, case.states))
+    feasible = np.ones(len(cf), bool) if case.policy.feasible is None else np.asarray(case.policy.feasible(cf), bool)
+    moved = np.abs(cf - case.states) > 1e-9 * (1 + np.abs(case.states))  # any column, fixed ones included
+    u = case.units
+    before, after = u.values(case.states), u.values(cf)
+    units = np.broadcast_to(np.arange(u.n), before.shape)
+    dq = np.abs(u.quantile(after, units) - u.quantile(before, units))
+    on = moved[:, case.columns]
     return Scores(
         answered,
         valid,
+        answered & feasible,
         moved.sum(axis=1),
-        np.where(moved, dq, 0.0).sum(axis=1),
-        np.where(moved, delta / iqr(case.background), 0.0).sum(axis=1),
+        np.where(on, dq, 0.0).sum(axis=1),
+        np.where(on, np.abs(after - before) / u.scale(), 0.0).sum(axis=1),
     )
 
 
-HEAD = f"{'policy':<9}{'method':<15}{'states':>7}{'answered':>10}{'valid':>8}{'changed':>9}{'<=2':>7}"
-HEAD += f"{'distance':>10}{'scaled':>8}{'s/state':>9}{'timeouts':>10}"
+HEAD = f"{'policy':<9}{'method':<15}{'states':>7}{'answered':>10}{'valid':>8}{'feasible':>10}{'changed':>9}{'<=2':>7}"
+HEAD += f"{'distance':>10}{'scaled':>8}{'s/state':>9}{'timeouts':>10}{'usable':>8}"
 
 
 def row(case: Case, answers: Answers, s: Scores) -> str:
@@ -281,9 +282,9 @@ def row(case: Case, answers: Answers, s: Scores) -> str:
     mean = (lambda v: float(v[a].mean())) if a.any() else (lambda v: float("nan"))
     validity = float(s.valid[a].mean()) if a.any() else float("nan")
     return (
-        f"{case.name:<9}{answers.method:<15}{n:>7}{a.mean():>10.0%}{validity:>8.1%}{mean(s.changed):>9.2f}"
+        f"{case.name:<9}{answers.method:<15}{n:>7}{a.mean():>10.0%}{validity:>8.1%}{mean(s.feasible):>10.1%}{mean(s.changed):>9.2f}"
         f"{(mean(s.changed <= 2)):>7.0%}{mean(s.distance):>10.3f}{mean(s.scaled):>8.2f}{answers.seconds / n:>9.3f}"
-        f"{answers.timed_out:>10}"
+        f"{answers.timed_out:>10}{(s.valid & s.feasible & (s.changed <= 2)).mean():>8.0%}"
     )
 
 

@@ -5,6 +5,7 @@ the toy policy (only with dice-ml installed: the `bench` extra)."""
 import numpy as np
 import pytest
 
+import xairl
 from benchmarks import bench_counterfactual as bench
 
 
@@ -34,6 +35,19 @@ def test_scoring_reruns_the_policy(case):
     assert (walked.changed[walked.answered] == 1).all()
     same = bench.score(case, bench.Answers("same", list(case.states), 1.0))
     assert same.answered.all() and not same.valid.any() and (same.changed == 0).all() and (same.distance == 0).all()
+
+
+def test_the_measures_are_xairl_s_own(case):
+    """Measured here, xairl's own answers have exactly the distances, changes and action xairl reports."""
+    results = xairl.counterfactual(case.policy, case.states, index=None, background=case.background)
+    found = [None if r.best is None else np.asarray(r.best.state, np.float64) for r in results]
+    s = bench.score(case, bench.Answers("xairl", found, 1.0))
+    assert s.answered.sum() >= 10 and s.valid[s.answered].all()
+    for k, r in enumerate(results):
+        if r.best is not None:
+            assert s.changed[k] == len(r.best.changes)
+            np.testing.assert_allclose([s.distance[k], s.scaled[k]], [r.best.distance, r.best.distance_scaled])
+            assert r.best.action == case.policy.action_names[case.target[k]]
 
 
 @pytest.mark.slow
