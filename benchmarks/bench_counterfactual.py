@@ -140,7 +140,11 @@ class OutOfTime(Exception):
     pass
 
 
+_FIRED: list[bool] = [False]  # the alarm's own flag: the policy may wrap the exception raised inside its forward pass
+
+
 def _alarm(signum, frame):
+    _FIRED[0] = True
     raise OutOfTime
 
 
@@ -194,15 +198,17 @@ def _run_dice(case: Case, method: str, limit: float) -> Answers:
     try:
         for i in range(len(case.states)):
             query = pd.DataFrame(case.states[i : i + 1], columns=names)
+            permitted = {f: [float(case.low[i, u]), float(case.high[i, u])] for u, f in enumerate(vary)}
+            _FIRED[0] = False
             signal.setitimer(signal.ITIMER_REAL, limit)
             try:
-                permitted = {f: [float(case.low[i, u]), float(case.high[i, u])] for u, f in enumerate(vary)}
                 found.append(_one_dice(explainer, query, int(case.target[i]), vary, permitted, extra))
             except OutOfTime:
                 found.append(None)
-                timed_out += 1
             finally:
                 signal.setitimer(signal.ITIMER_REAL, 0)
+            if _FIRED[0]:
+                found[-1], timed_out = None, timed_out + 1
     finally:
         signal.signal(signal.SIGALRM, previous)
     return Answers(f"dice-{method}", found, time.perf_counter() - start, timed_out)
@@ -218,7 +224,7 @@ def _one_dice(explainer, query, target: int, vary, permitted, extra) -> np.ndarr
     except OutOfTime:
         raise
     except Exception as err:  # noqa: BLE001 (DiCE's 'no counterfactual found' is an exception of its own)
-        if "no counterfactuals found" not in str(err).lower():
+        if "no counterfactuals found" not in str(err).lower() and not _FIRED[0]:
             print(f"  dice: {type(err).__name__}: {str(err)[:120]}")
         return None
     ex = out.cf_examples_list[0]
