@@ -227,6 +227,12 @@ def test_values_are_written_away_from_the_line(linear):
     rounded = replace(fact, changes=(replace(c, after_text=f"{round(c.after_fill):.0f} % full"),))
     text, status, _ = said(exp, 0, p, rounded)
     assert "below 20 % full" in text and status == "contradicted"
+    across = replace(fact, changes=(at(p, c, 41.0),))  # docs/customising-prompts.md's example of the rule
+    text, status, _ = said(exp, 0, p, across, alone=True)
+    assert text == (
+        "Had the queue been below 20.5 % full (it was 80 % full), the policy would have chosen go (margin 0.01)."
+    )
+    assert status == "contradicted"
 
 
 def test_corpus_on_the_linear_policy(linear):
