@@ -316,3 +316,35 @@ def test_narrate_with_a_counterfactual(linear):
         xairl.narrate(exp, 0, counterfactual=True, robustness=False)
     with pytest.raises(InputError, match="of state 0, not 1"):
         xairl.narrate(exp, 1, policy=p, counterfactual=none, robustness=False)
+
+
+def test_the_action_mask_is_honoured(linear):
+    """go is unavailable below -130 dBm: 'below -135 dBm, go' holds for the bare network, not for the policy."""
+    p, states, exp, _ = linear
+    masked = replace(p, action_mask=lambda x: np.stack([np.ones(len(x), bool), x[:, 1] >= -130], axis=1))
+    assert counterfactual_fact(exp, 0, masked, answer(p, states, 0, {1: -135.0})) is None  # refused, not said
+    fact = counterfactual_fact(exp, 0, p, answer(p, states, 0, {1: -135.0}))
+    assert said(exp, 0, p, fact, alone=True)[1] == "verified"
+    text, status, _ = said(exp, 0, masked, fact, alone=True)
+    assert "below -135 dBm (it was -90 dBm), the policy would have chosen go" in text and status == "contradicted"
+
+
+def test_a_category_is_said_by_its_label():
+    """weather is a category: 'Had the weather been storm (it was calm)'; 'windy' does not flip it."""
+    lin = torch.nn.Linear(2, 2)
+    with torch.no_grad():
+        lin.weight.copy_(torch.tensor([[0.05, 0.0], [0.0, 2.0]]))
+        lin.bias.zero_()
+    info = {"load": FeatureInfo("kbit", "the queue"), "weather": FeatureInfo(description="the weather", categories=("calm", "windy", "storm"))}  # fmt: skip
+    p = Policy(lin, ["load", "weather"], ["stay", "go"], features=info)
+    states = np.array([[60.0, 0.0], [20.0, 1.0]], dtype=np.float32)
+    exp = xairl.explain(p, states, background=np.array([[0, 0], [100, 2], [50, 1]], dtype=np.float32), method="exact")
+    fact = counterfactual_fact(exp, 0, p, answer(p, states, 0, {1: 2.0}))
+    text, status, _ = said(exp, 0, p, fact, alone=True)
+    assert (text, status) == (
+        "Had the weather been storm (it was calm), the policy would have chosen go (margin 1).",
+        "verified",
+    )
+    c = fact.changes[0]
+    for wrong in (replace(c, after=1.0, after_text="windy"), replace(c, value_text="windy")):
+        assert said(exp, 0, p, replace(fact, changes=(wrong,)), alone=True)[1] == "contradicted"

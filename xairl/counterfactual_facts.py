@@ -136,6 +136,9 @@ def counterfactual_fact(
         raise InputError(f"the counterfactuals given are of state {found.index}, not {index}; search state {index}.")
     if not found.reachable:
         return _unreachable(found, max_changes, found.reason)
+    unknown = {c.feature for cf in found.found for c in cf.changes} - set(policy.feature_names)
+    if unknown:  # (an image's regions: their change is every pixel of them shifted, which no sentence states yet)
+        raise InputError(f"counterfactual words name the policy's features; {sorted(unknown)[0]!r} is none of them.")
     state = np.asarray(exp.states[index], dtype=float)
     said = [(cf, _said(policy, state, cf.changes, extra)) for cf in found.found for extra in _NUDGES]
     rows = np.repeat(state[None], len(said), axis=0)

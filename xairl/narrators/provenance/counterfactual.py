@@ -48,14 +48,15 @@ def _said(text: str) -> str:
     return " ".join(text.lower().split()).strip(" .,;:'\"")
 
 
-def _feature(policy, text: str) -> int | None:
-    """The feature a text names: its name, description or an alias (None when it names none)."""
-    said = _said(text)
+def _feature(policy, text: str, meant: str | None = None) -> int | None:
+    """The feature a text names: its name, description or an alias (None when it names none); of several that share
+    the words, the one the span was printed from (``meant``)."""
+    said, named = _said(text), []
     for j, f in enumerate(policy.feature_names):
         info = policy.features.get(f) or FeatureInfo()
         if said in {_said(w) for w in (f, info.description, *info.aliases) if w}:
-            return j
-    return None
+            named.append(j)
+    return next((j for j in named if policy.feature_names[j] == meant), named[0] if named else None)
 
 
 def _action(policy, text: str) -> int | None:
@@ -120,7 +121,7 @@ def _change(s, parts: dict[str, list[Part]], policy, state: np.ndarray, stated: 
     """One change's claims (its feature, direction, 'it was' value); (column, stated value, its spans) goes into
     ``stated`` (column or value None when the words do not say them)."""
     claims, names = [], parts.get("name", []) + parts.get("label", [])
-    cols = [_feature(policy, p.span.text) for p in names]
+    cols = [_feature(policy, p.span.text, p.span.fact.feature) for p in names]
     for p, j in zip(names, cols):
         ok = j is not None and j == cols[0]
         claims.append(_claim(p, "feature", "verified" if ok else "contradicted", "a feature of the policy"))
