@@ -348,3 +348,12 @@ def test_a_category_is_said_by_its_label():
     c = fact.changes[0]
     for wrong in (replace(c, after=1.0, after_text="windy"), replace(c, value_text="windy")):
         assert said(exp, 0, p, replace(fact, changes=(wrong,)), alone=True)[1] == "contradicted"
+
+
+def test_a_batch_answer_gives_each_decision_its_own(linear):
+    p, states, exp, _ = linear
+    batch = (answer(p, states, 0, {0: 39.0}), answer(p, states, 1, {0: 20.0}))
+    n = xairl.narrate(exp, 1, policy=p, counterfactual=batch, robustness=False)
+    assert n.sentences[-1][1] == "verified" and "(it was 60 % full)" in n.sentences[-1][0]
+    with pytest.raises(InputError, match="no answer for state 2"):
+        xairl.narrate(exp, 2, policy=p, counterfactual=batch, robustness=False)

@@ -107,7 +107,7 @@ def _written(before: float, after: float, info: FeatureInfo, extra: int) -> tupl
         return float(code), None, info.categories[code]
     down = after < before
     if info.capacity is not None:
-        fill = _outward(100.0 * after / info.capacity, down, extra)
+        fill = float(np.clip(_outward(100.0 * after / info.capacity, down, extra), 0.0, 100.0))  # (never -0.1 % full)
         raw = fill * info.capacity / 100.0
         return raw, fill, fill_and_text(raw, info, None)[1]
     raw = _outward(after, down, extra)
@@ -175,9 +175,12 @@ def said_counterfactual(
 ) -> CounterfactualFact | None:
     """The counterfactual fact of decision ``index``: ``ask`` is True (run the search,
     :func:`xairl.counterfactuals.search.counterfactual`, guided by ``exp``) or the search's answer
-    (:class:`~xairl.counterfactuals.Counterfactuals`) for that state."""
+    (:class:`~xairl.counterfactuals.Counterfactuals`) for that state, or the search's answers for several states
+    (``index=None``), among which that state's is taken."""
     if policy is None:
         raise InputError("counterfactual=True needs the policy (policy=...): the search and its check run it.")
+    if isinstance(ask, (tuple, list)) and all(isinstance(a, Counterfactuals) for a in ask):
+        ask = next((a for a in ask if a.index == index), None) or _refuse(index)  # a batch answer (index=None)
     if not isinstance(ask, Counterfactuals):
         from .counterfactuals.search import counterfactual
 
@@ -185,6 +188,10 @@ def said_counterfactual(
             policy, exp.states, index=index, background=background, explanation=exp, max_changes=max_changes
         )
     return counterfactual_fact(exp, index, policy, ask, max_changes)
+
+
+def _refuse(index: int):
+    raise InputError(f"the counterfactuals given have no answer for state {index}; search it (counterfactual=True).")
 
 
 def _label(info: FeatureInfo, value: float) -> str | None:
