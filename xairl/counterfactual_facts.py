@@ -29,6 +29,9 @@ __all__ = ["ChangeFact", "CounterfactualFact", "action_words", "counterfactual_f
 
 #: extra rounding steps tried, away from the line, when the value as written does not flip the decision
 _NUDGES = (0, 1, 3)
+#: a flip by less than this share of the scores' size is noise: a float32 network's scores differ in their last bits
+#: between batch shapes, so the check's re-run (one row) could read it either way; the next nudge is said instead
+NOISE = 1e-5
 
 
 @dataclass(frozen=True)
@@ -149,9 +152,9 @@ def counterfactual_fact(
     for n, (cf, changes) in enumerate(said):
         a = policy.action_names.index(cf.action)
         others = np.delete(free[n], a)
-        if free[n].argmax() == a and cf.action != found.chosen and np.isfinite(others).any():
+        margin = float(scores[n, a] - others.max()) if np.isfinite(others).any() else -np.inf
+        if free[n].argmax() == a and cf.action != found.chosen and margin > NOISE * max(1.0, np.abs(scores[n]).max()):
             words = action_words(policy, cf.action)
-            margin = float(scores[n, a] - others.max())
             return CounterfactualFact(True, changes, cf.action, words, margin, found.chosen, found.target, max_changes)
     return None
 
