@@ -144,6 +144,9 @@ def counterfactual_fact(
         raise InputError(f"counterfactual words name the policy's features; {sorted(unknown)[0]!r} is none of them.")
     state = np.asarray(exp.states[index], dtype=float)
     said = [(cf, _said(policy, state, cf.changes, extra)) for cf in found.found for extra in _NUDGES]
+    said = [(cf, changes) for cf, changes in said if changes]
+    if not said:
+        return None
     rows = np.repeat(state[None], len(said), axis=0)
     for n, (_, changes) in enumerate(said):
         rows[n, [policy.feature_names.index(c.name) for c in changes]] = [c.after for c in changes]
@@ -167,7 +170,10 @@ def _said(policy: Policy, state: np.ndarray, changes, extra: int) -> tuple[Chang
         before = float(state[j])
         raw, fill, text = _written(before, float(c.after), info, extra)
         was, was_text = fill_and_text(before, info, _label(info, before))
-        direction = "" if info.categories else "below" if raw < before else "above"
+        if _shown(raw, info) == _shown(before, info) or _shown(float(c.after), info) == _shown(before, info):
+            continue  # a change below the digits written ('10 % full (it was 10 % full)'): left out, and not re-run
+        # no direction word for a category, nor at a capacity's end ('been 100 % full', not 'above 100 % full')
+        direction = "" if info.categories or fill in (0.0, 100.0) else "below" if raw < before else "above"
         label = info.description or c.feature
         out.append(ChangeFact(c.feature, label, info.unit, before, was_text, raw, text, direction, was, fill))
     return tuple(out)
@@ -191,6 +197,13 @@ def said_counterfactual(
             policy, exp.states, index=index, background=background, explanation=exp, max_changes=max_changes
         )
     return counterfactual_fact(exp, index, policy, ask, max_changes)
+
+
+def _shown(value: float, info: FeatureInfo) -> float:
+    """A value as its text shows it: a category's code, else the number written (a fill in % of a capacity)."""
+    if info.categories:
+        return float(round(value))
+    return float(format_number(100.0 * value / info.capacity if info.capacity is not None else value))
 
 
 def _refuse(index: int):
