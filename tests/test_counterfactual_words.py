@@ -360,8 +360,8 @@ def test_a_batch_answer_gives_each_decision_its_own(linear):
 
 
 def test_a_capacity_end_has_no_direction_word_and_no_change_is_not_said(linear):
-    """A queue filled to its capacity is 'been 100 % full', never 'above 100 % full'; a change that the words do not
-    show ('10 % full (it was 10 % full)') is left out of the sentence and of the re-run."""
+    """A queue filled to its capacity is 'been 100 % full', never 'above 100 % full'; a change the digits written do
+    not show ('10 % full (it was 10 % full)') is left out of the sentence and of the re-run."""
     p, states, exp, _ = linear
     fact = counterfactual_fact(exp, 4, p, answer(p, states, 4, {0: CAP}))
     assert said(exp, 4, p, fact, alone=True)[:2] == (
@@ -369,6 +369,6 @@ def test_a_capacity_end_has_no_direction_word_and_no_change_is_not_said(linear):
         "verified",
     )
     assert fact.changes[0].direction == "" and fact.changes[0].after_text == "100 % full"
-    fact = counterfactual_fact(exp, 4, p, answer(p, states, 4, {0: 20.000001, 1: -60.0}))
+    fact = counterfactual_fact(exp, 4, p, answer(p, states, 4, {0: 20.0, 1: -60.0}))
     assert [c.name for c in fact.changes] == ["signal"] and fact.changes[0].after_text == "-60 dBm"
     assert said(exp, 4, p, fact, alone=True)[1] == "verified"

@@ -170,8 +170,8 @@ def _said(policy: Policy, state: np.ndarray, changes, extra: int) -> tuple[Chang
         before = float(state[j])
         raw, fill, text = _written(before, float(c.after), info, extra)
         was, was_text = fill_and_text(before, info, _label(info, before))
-        if _shown(raw, info) == _shown(before, info) or _shown(float(c.after), info) == _shown(before, info):
-            continue  # a change below the digits written ('10 % full (it was 10 % full)'): left out, and not re-run
+        if _shown(raw, info) == _shown(before, info):
+            continue  # no change in the digits written ('0 % full (it was 0 % full)'): left out, and not re-run
         # no direction word for a category, nor at a capacity's end ('been 100 % full', not 'above 100 % full')
         direction = "" if info.categories or fill in (0.0, 100.0) else "below" if raw < before else "above"
         label = info.description or c.feature
