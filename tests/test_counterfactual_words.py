@@ -372,3 +372,17 @@ def test_a_capacity_end_has_no_direction_word_and_no_change_is_not_said(linear):
     fact = counterfactual_fact(exp, 4, p, answer(p, states, 4, {0: 20.0, 1: -60.0}))
     assert [c.name for c in fact.changes] == ["signal"] and fact.changes[0].after_text == "-60 dBm"
     assert said(exp, 4, p, fact, alone=True)[1] == "verified"
+
+
+def test_the_words_name_the_action_the_policy_takes_as_written():
+    """A search's answer whose action is not the one the policy takes with the values as written (a line that bends
+    toward a third action) is said with the action the policy does take there."""
+    p = toy_policy()
+    states = p.background(6, seed=5)
+    exp = xairl.explain(p, states, background=p.background(32), method="exact")
+    i, (j, _, after) = next((i, h) for i, h in enumerate(one_change(p, states, {0: (-3.0, 3.0)})) if h is not None)
+    right = answer(p, states, i, {j: after})
+    third = next(a for a in p.action_names if a not in (right.chosen, right.found[0].action))
+    wrong = replace(right, found=(replace(right.found[0], action=third),))
+    fact = counterfactual_fact(exp, i, p, wrong)
+    assert fact.action == right.found[0].action != third and said(exp, i, p, fact, alone=True)[1] == "verified"

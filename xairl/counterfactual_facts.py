@@ -5,8 +5,9 @@ How it is built from a search's answer (:class:`xairl.counterfactuals.Counterfac
 written as the narratives write values (:func:`xairl.values.value_text`: a buffer in % of its capacity, dBm, a
 category's label), and rounded *away from the line*, to the digits it is written with: 'below 37.6' for a line at
 37.64, never 'below 37.7', which rounds back across it. The state with the values as written is then run through the
-policy (all candidates in one batch, its action mask honoured); the first one that still takes the new action is the
-fact, with the action and the margin of that re-run. What a template prints is therefore exactly what the verifier
+policy (all candidates in one batch, its action mask honoured); the first one that still takes the search's action is
+the fact (else the first that takes any other action than the one taken: the words name what the policy does there),
+with the action and the margin of that re-run. What a template prints is therefore exactly what the verifier
 re-runs (:mod:`xairl.narrators.provenance.counterfactual`). None of the candidates flipping as written (a line that
 bends within one rounding step) leaves the fact out: no sentence rather than a wrong one.
 """
@@ -131,8 +132,9 @@ def counterfactual_fact(
     exp: Explanation, index: int, policy: Policy, found: Counterfactuals, max_changes: int = 2
 ) -> CounterfactualFact | None:
     """The fact of ``found`` (the search's answer for state ``index``): its counterfactuals written as a narrative
-    writes them, re-run through ``policy`` in one batch; the first that flips as written (module doc). None when
-    none does."""
+    writes them, re-run through ``policy`` in one batch; the first that flips as written to the search's action,
+    else the first that flips to another action than the chosen one (its words name the action taken), else None
+    (module doc)."""
     if policy.output != "actions" or exp.states is None or exp.states.shape[1] != policy.n_features:
         raise InputError("counterfactual words are for discrete actions on flat states; use xairl.counterfactual().")
     if found.index != index:
@@ -152,13 +154,16 @@ def counterfactual_fact(
         rows[n, [policy.feature_names.index(c.name) for c in changes]] = [c.after for c in changes]
     scores = policy.scores(rows)
     free = np.where(policy.available(rows), scores, -np.inf)
-    for n, (cf, changes) in enumerate(said):
-        a = policy.action_names.index(cf.action)
+    chosen = policy.action_names.index(found.chosen)
+    # the search's own action as written first; else another action than the chosen one, which the words then name
+    for n in sorted(range(len(said)), key=lambda n: free[n].argmax() != policy.action_names.index(said[n][0].action)):
+        a = int(free[n].argmax())
         others = np.delete(free[n], a)
         margin = float(scores[n, a] - others.max()) if np.isfinite(others).any() else -np.inf
-        if free[n].argmax() == a and cf.action != found.chosen and margin > NOISE * max(1.0, np.abs(scores[n]).max()):
-            words = action_words(policy, cf.action)
-            return CounterfactualFact(True, changes, cf.action, words, margin, found.chosen, found.target, max_changes)
+        if a != chosen and margin > NOISE * max(1.0, np.abs(scores[n]).max()):
+            act = policy.action_names[a]
+            words = action_words(policy, act)
+            return CounterfactualFact(True, said[n][1], act, words, margin, found.chosen, found.target, max_changes)
     return None
 
 
