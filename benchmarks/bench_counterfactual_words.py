@@ -48,6 +48,7 @@ def main() -> None:
     ap.add_argument("--template", default="explain_action")
     ap.add_argument("--states", type=int, default=1000)
     ap.add_argument("--max-changes", type=int, default=2)
+    ap.add_argument("--narrate", type=int, default=50, help="whole narratives, narrate(counterfactual=True)")
     a = ap.parse_args()
     policy = xairl.get_policy(a.policy)
     bg, states = policy.background(200), policy.background(a.states, seed=3)
