@@ -4,5 +4,6 @@ the policy on every result before it is returned or said.
 """
 
 from .result import Change, Counterfactual, Counterfactuals, Threshold
+from .search import counterfactual
 
-__all__ = ["Change", "Counterfactual", "Counterfactuals", "Threshold"]
+__all__ = ["Change", "Counterfactual", "Counterfactuals", "Threshold", "counterfactual"]
