@@ -8,14 +8,15 @@ output's distance past it. Unavailable actions (the policy's action mask, evalua
 
 :func:`pushes` ranks the features by how much they push the margin the change must overturn (the chosen action's
 score minus the target's, or the output itself), from an explanation of the states (a given one, or
-:func:`xairl.explain` with its default method); an image's regions sum their pixels' contributions.
+:func:`xairl.explain` with its default method, or integrated gradients for a module deep_shap cannot walk); an
+image's regions sum their pixels' contributions.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, UnsupportedModelError
 from ..explanation import Explanation
 from ..policy import Policy
 from .bounds import Units
@@ -25,7 +26,7 @@ from .result import Threshold
 EXPLAIN_BACKGROUND = 100
 #: how far past the line (relative to the scores' size) the search keeps: a re-run in another batch, whose float32
 #: sums may round differently, still decides the same
-TOLERANCE = 1e-5
+TOLERANCE = 1e-4
 
 
 class Goal:
@@ -117,7 +118,10 @@ def pushes(policy: Policy, goal: Goal, units: Units, x: np.ndarray, rows: np.nda
     if explanation is None:
         from ..attributors import explain
 
-        exp = explain(policy, x[rows], bg[:EXPLAIN_BACKGROUND])
+        try:
+            exp = explain(policy, x[rows], bg[:EXPLAIN_BACKGROUND])
+        except UnsupportedModelError:  # a module deep_shap cannot walk: gradients along a path take any module
+            exp = explain(policy, x[rows], bg[:EXPLAIN_BACKGROUND], method="integrated_gradients")
     elif not isinstance(explanation, Explanation):
         raise InputError(f"explanation is an xairl.Explanation of the states, not {type(explanation).__name__}.")
     elif len(explanation) in (len(x), len(rows)):

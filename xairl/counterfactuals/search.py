@@ -16,8 +16,9 @@ For each decision:
    one batched pass; the flipping value nearest the state (in background quantiles) is kept and the crossing between
    it and its non-flipping neighbour refined by bisection, batched across units and states, so that the value
    returned is just past the line.
-4. **Pairs**, among the top 6 units, only for states no single change flips (or for all when ``n > 1``): a 12x12
-   grid per pair, the nearest flipping cell, then bisection along the line from the state to it.
+4. **Pairs**, among the top 9 units (4 for an image), only for states no single change flips (or for all when ``n > 1``): a 13x13
+   grid per pair over both ranges, zoomed in three times around the nearest flipping cell (a 13x13 grid over the
+   cells beside it), then bisection along the line from the state to it.
 5. **Checked.** The candidates, ranked by distance in quantiles (ties by the scaled distance), one per set of
    features, are run through the policy once more; one that does not flip (or is infeasible, or out of range) is
    dropped. What is returned is exactly what was run.
@@ -37,7 +38,9 @@ from . import bounds
 from .goals import Goal, pushes
 from .result import Change, Counterfactual, Counterfactuals
 
-GRID, GRID2, TOP_SINGLE, TOP_PAIR, STEPS = 32, 12, 16, 9, 24
+GRID, GRID2, TOP_SINGLE, TOP_PAIR, STEPS, ZOOMS = 32, 13, 16, 9, 24, 3
+#: a state of more flat columns than this (an image) pairs only its top 4 units: each pair costs 676 forward passes
+WIDE, TOP_PAIR_WIDE = 1024, 4
 _BACKGROUND = 200  # states drawn from the policy's sampler when no background is given
 
 
@@ -176,29 +179,41 @@ class _Search:
         return good
 
     def pairs(self, who: np.ndarray) -> None:
-        """Two units each, among the top ones: a 2-D grid, the nearest flipping cell, bisection towards it."""
-        k = min(TOP_PAIR, self.units.n)
+        """Two units each, among the top ones: a 2-D grid over both ranges, zoomed in around the nearest flipping
+        cell, then bisection along the line from the state to it."""
+        k = min(TOP_PAIR if self.xs.shape[1] <= WIDE else TOP_PAIR_WIDE, self.units.n)
         if not len(who) or k < 2:
             return
         combos = np.array(list(combinations(range(k), 2)))
-        pu = self.order[who, :k][:, combos]  # (m, C, 2)
-        lo, hi, own = (a[who[:, None, None], pu] for a in (self.low, self.high, self.own))
-        lin = np.linspace(0.0, 1.0, GRID2)
-        ga = lo[..., 0, None] + (hi - lo)[..., 0, None] * lin  # (m, C, G)
-        gb = lo[..., 1, None] + (hi - lo)[..., 1, None] * lin
-        shape = (*pu.shape[:2], GRID2, GRID2)
-        values = np.stack([np.broadcast_to(ga[..., :, None], shape), np.broadcast_to(gb[..., None, :], shape)], -1)
-        units = np.broadcast_to(pu[:, :, None, None, :], values.shape)
-        w = np.broadcast_to(who[:, None, None, None], shape)
-        delta = values - own[:, :, None, None, :]
-        good = self.gaps(w.ravel(), units.reshape(-1, 2), delta.reshape(-1, 2)).reshape(shape) > 0
-        key = np.where(good, self._distance(units, values, w), np.inf).reshape(*shape[:2], -1)
-        cell = key.argmin(axis=-1)
-        i, c = np.nonzero(np.isfinite(key.min(axis=-1)))
-        target = values.reshape(*shape[:2], -1, 2)[i, c, cell[i, c]]  # (P, 2)
-        done = self._ray(who[i], pu[i, c], own[i, c], target)
-        for s, us, vs in zip(who[i], pu[i, c], done):
+        units = self.order[who, :k][:, combos].reshape(-1, 2)  # (P, 2): every pair of every state
+        w = np.repeat(who, len(combos))
+        lo, hi, own = (a[w[:, None], units] for a in (self.low, self.high, self.own))
+        best, has = self._grid2(w, units, own, lo, hi, np.full(len(w), False), np.zeros((len(w), 2)))
+        for _ in range(ZOOMS):
+            step = (hi - lo) / (GRID2 - 1)
+            lo, hi = np.maximum(lo, best - step), np.minimum(hi, best + step)
+            best, has = self._grid2(w, units, own, lo, hi, has, best)
+        done = self._ray(w[has], units[has], own[has], best[has])
+        for s, us, vs in zip(w[has], units[has], done):
             self.candidates[s][tuple(int(u) for u in us)] = tuple(float(v) for v in vs)
+
+    def _grid2(self, w, units, own, lo, hi, had, best) -> tuple[np.ndarray, np.ndarray]:
+        """The nearest flipping point of a GRID2 x GRID2 grid over each box [lo, hi] (P, 2) and whether there is one
+        (where none is, ``best`` and ``had`` as they were)."""
+        lin = np.linspace(0.0, 1.0, GRID2)
+        axes = lo[:, :, None] + (hi - lo)[:, :, None] * lin  # (P, 2, G)
+        shape = (len(w), GRID2, GRID2)
+        values = np.stack(
+            [np.broadcast_to(axes[:, 0, :, None], shape), np.broadcast_to(axes[:, 1, None, :], shape)], -1
+        )
+        us = np.broadcast_to(units[:, None, None, :], values.shape)
+        ws = np.broadcast_to(w[:, None, None], shape)
+        good = self.gaps(ws.ravel(), us.reshape(-1, 2), (values - own[:, None, None, :]).reshape(-1, 2)) > 0
+        key = np.where(good.reshape(shape), self._distance(us, values, ws), np.inf).reshape(len(w), -1)
+        cell = key.argmin(axis=-1)
+        has = np.isfinite(key[np.arange(len(w)), cell])
+        found = values.reshape(len(w), -1, 2)[np.arange(len(w)), cell]
+        return np.where(has[:, None], found, best), has | had
 
     def _ray(self, who, unit, start, end) -> np.ndarray:
         """Points just past the line on the segments from ``start`` (no flip) to ``end`` (a flip), (N, k)."""
