@@ -74,7 +74,7 @@ def counterfactual(
         raise InputError(f"n is how many counterfactuals to return per decision, a whole number >= 1; got {n!r:.40}.")
     bg = policy.background(_BACKGROUND) if background is None else policy.check_states(background, "background")
     units, goal = bounds.units(policy, bg, features), Goal(policy, x[rows], target)
-    found = _Search(policy, x[rows], bg, units, goal)
+    found = _Search(policy, x[rows], units, goal)
     found.rank(pushes(policy, goal, units, x, rows, bg, explanation))
     found.run(max_changes, int(n))
     out = tuple(found.result(k, int(r), max_changes) for k, r in enumerate(rows))
@@ -84,7 +84,7 @@ def counterfactual(
 class _Search:
     """The candidates of each state, searched in batches across units and states."""
 
-    def __init__(self, policy: Policy, xs: np.ndarray, bg: np.ndarray, units: bounds.Units, goal: Goal) -> None:
+    def __init__(self, policy: Policy, xs: np.ndarray, units: bounds.Units, goal: Goal) -> None:
         self.policy, self.xs, self.units, self.goal = policy, xs, units, goal
         self.own = units.values(xs)
         self.low, self.high = units.ranges(self.own)
@@ -100,22 +100,20 @@ class _Search:
         self.push = push
         self.order = np.argsort(-push, axis=1, kind="stable")
 
-    def gaps(self, who: np.ndarray, unit: np.ndarray, delta: np.ndarray, out_scores: bool = False):
+    def gaps(self, who: np.ndarray, unit: np.ndarray, delta: np.ndarray) -> np.ndarray:
         """The gap of each state ``xs[who]`` with units ``unit`` (N, k) shifted by ``delta`` (N, k), in batches."""
         f = self.xs.shape[1]
         step = max(64, 2**21 // f)
-        gap, keep = np.empty(len(who)), []
+        gap = np.empty(len(who))
         for s in range(0, len(who), step):
             sl = slice(s, s + step)
             x = self.xs[who[sl]].astype(np.float64)
             for k in range(unit.shape[1]):
                 self.units.shift(x, unit[sl, k], delta[sl, k])
-            g, scores = self._gap(x.astype(self.policy.dtype), who[sl])
-            gap[sl] = g
-            keep.append(scores)
+            gap[sl] = self._gap(x.astype(self.policy.dtype), who[sl])[0]
         np.add.at(self.evals, who, 1)
         gap -= self.goal.tol[who]  # the search keeps clear of the line by more than float32's rounding
-        return (gap, np.concatenate(keep) if keep else np.empty((0, self.policy.n_actions))) if out_scores else gap
+        return gap
 
     def _gap(self, x: np.ndarray, who: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         p = self.policy
