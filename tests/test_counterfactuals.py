@@ -259,3 +259,24 @@ def test_the_uav_dqn_never_changes_what_it_declares_immutable():
     lifted[:, 10] = ceiling + policy.feasible.tolerance + 0.1
     measured = bg[:, 10] > -24
     assert measured.any() and not policy.feasible(lifted[measured]).any()
+
+
+def test_a_given_explanation_ranks_the_search_and_a_window_is_searched_slot_by_slot():
+    policy, x, bg = flat_policy(), normal(6, seed=9), normal(200)
+    exp = xairl.explain(policy, x, bg[:50], method="integrated_gradients")
+    results = xairl.counterfactual(policy, x, index=None, background=bg, explanation=exp)
+    assert all(r.reachable for r in results)
+    assert_valid(policy, results, x)
+    alone = xairl.counterfactual(policy, x, index=2, background=bg, explanation=exp[2])
+    # one state's explanation, or the batch's: the same search (the same value up to float32 sums in another batch)
+    assert [c.feature for c in alone.best.changes] == [c.feature for c in results[2].best.changes]
+    assert alone.best.changes[0].after == pytest.approx(results[2].best.changes[0].after, rel=1e-5)
+    with pytest.raises(InputError, match="explain the same states"):
+        xairl.counterfactual(policy, x, index=2, background=bg, explanation=exp[:4])
+    net = torch.nn.Sequential(torch.nn.Flatten(), mlp([6, 16, 2], seed=4))  # over (n, 3 steps, 2 signals)
+    window = xairl.Policy(net, feature_names=["speed", "gap"], window=3)
+    w, wbg = normal(8, 6, seed=10), normal(100, 6)
+    found = xairl.counterfactual(window, w, index=None, background=wbg, target="any")
+    assert any(r.reachable for r in found)
+    assert_valid(window, found, w)
+    assert {c.feature for r in found for cf in r.found for c in cf.changes} <= set(window.feature_names)
