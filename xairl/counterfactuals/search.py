@@ -14,14 +14,16 @@ For each decision:
    :func:`xairl.explain` with its default method, once for all the states).
 3. **Single changes.** For the top units, a grid of 32 values across each one's range is run through the policy in
    one batched pass; the flipping value nearest the state (in background quantiles) is kept and the crossing between
-   it and its non-flipping neighbour refined by bisection, batched across units and states, so that the value
-   returned is just past the line.
-4. **Pairs**, among the top 9 units (4 for an image), only for states no single change flips (or for all when ``n > 1``): a 13x13
-   grid per pair over both ranges, zoomed in three times around the nearest flipping cell (a 13x13 grid over the
-   cells beside it), then bisection along the line from the state to it.
+   it and its non-flipping neighbour refined by bisection (24 halvings), batched across units and states, so that
+   the value returned is just past the line: by a gap of 1e-4 x (1 + |the chosen score|) (or of the threshold), so
+   that a re-run in another batch, whose float32 sums may round differently, decides the same.
+4. **Pairs**, among the top 9 units (4 for an image), only for states no single change flips (or for all when
+   ``n > 1``): a 13x13 grid per pair over both ranges, zoomed in three times around the nearest flipping cell (a
+   13x13 grid over the cells beside it), then bisection along the line from the state to it. A pair no nearer than
+   one of its features changed alone is dropped (a single change with a needless second one).
 5. **Checked.** The candidates, ranked by distance in quantiles (ties by the scaled distance), one per set of
-   features, are run through the policy once more; one that does not flip (or is infeasible, or out of range) is
-   dropped. What is returned is exactly what was run.
+   features, are run through the policy once more, all in one batch; one that does not flip (or is infeasible, or
+   out of range) is dropped. What is returned is exactly what was run.
 
 Windows (a memory policy's slots) are searched as flat features, each slot on its own. ``max_changes`` is 1 or 2.
 """
