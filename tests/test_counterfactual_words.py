@@ -386,3 +386,17 @@ def test_the_words_name_the_action_the_policy_takes_as_written():
     wrong = replace(right, found=(replace(right.found[0], action=third),))
     fact = counterfactual_fact(exp, i, p, wrong)
     assert fact.action == right.found[0].action != third and said(exp, i, p, fact, alone=True)[1] == "verified"
+
+
+def test_narrate_searches_when_asked(linear):
+    """counterfactual=True runs the search (xairl.counterfactual) and says its answer; every said one verified."""
+    p, states, exp, bg = linear
+    for i in range(len(states)):
+        n = xairl.narrate(exp, i, policy=p, background=bg, counterfactual=True, robustness=False)
+        assert n.verified and n.sentences[-1][1] == "verified", n.text
+    toy = toy_policy()
+    bg, states = toy.background(64), toy.background(8, seed=2)
+    exp = xairl.explain(toy, states, background=bg)
+    for i in range(len(states)):
+        n = xairl.narrate(exp, i, policy=toy, background=bg, counterfactual=True, robustness=False)
+        assert n.verified and n.sentences[-1][1] == "verified" and n.sentences[-1][0].startswith("Had "), n.text
