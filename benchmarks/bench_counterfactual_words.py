@@ -79,6 +79,14 @@ def main() -> None:
     print(
         f"  search {1000 * t_search / a.states:.1f} ms per decision; fact, words and check {1000 * t_words / a.states:.1f} ms"
     )
+    told, t0, m = collections.Counter(), time.perf_counter(), min(a.narrate, a.states)
+    for i in range(m):
+        n = xairl.narrate(
+            exp, i, template=a.template, policy=policy, background=bg, counterfactual=True, robustness=False
+        )
+        told[f"verified {n.verified}, its last sentence {n.sentences[-1][1]}"] += 1
+    each = (time.perf_counter() - t0) / max(1, m)
+    print(f"  {m} whole narratives, counterfactual=True: {dict(told)}; {each:.2f} s each (robustness=False)")
 
 
 if __name__ == "__main__":
