@@ -3,6 +3,7 @@ signal and per step exactly, drawn as a signal x time heat map, and narrated wit
 word and window are tracked facts, so a template that misstates them is contradicted."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -160,6 +161,39 @@ def test_frame_stack_groups_per_region_and_frame():
     assert regions.feature_names[0] == "patch A1" and len(regions.feature_names) == side * side
     for g in (steps, regions):
         np.testing.assert_allclose(g.values.sum(axis=1), e.values.sum(axis=1), atol=1e-9)
+
+
+def test_a_frame_stacked_cnn_is_narrated_in_trends_over_its_frames():
+    """Done-when 3's frame stack: SB3's NatureCNN over 4x84x84 frames, grouped per region and per frame (exact), drawn
+    as a heat map, and narrated per region over the frames with trend sentences that both readers verify; a region's
+    change is its mean pixel value's, newest frame minus oldest."""
+    from gymnasium import spaces
+    from stable_baselines3.common.torch_layers import NatureCNN
+
+    torch.manual_seed(0)
+    cnn = torch.nn.Sequential(
+        NatureCNN(spaces.Box(0, 255, (4, 84, 84), np.uint8), features_dim=64), torch.nn.Linear(64, 3)
+    )
+    p = xairl.Policy(cnn, observation=xairl.Observation.array((4, 84, 84), channels="frames"))
+    rng = np.random.default_rng(2)
+    frames = rng.uniform(0, 255, (6, 4, 84, 84)).astype(np.float32)
+    frames[:, :, :42] += np.linspace(-60, 60, 4)[None, :, None, None]  # the top half brightens frame by frame
+    e = xairl.explain(p, frames[:2], background=frames[2:])
+    regions = xairl.in_regions(e)
+    for g in (e.by_signal(), e.by_step(), regions.by_signal(), regions.by_step()):
+        np.testing.assert_allclose(g.values.sum(axis=1), e.values.sum(axis=1), rtol=1e-6, atol=1e-4)
+    assert regions.feature_names[0] == "patch A1 of frame 0" and e.by_step().feature_names[-1] == "frame 3"
+    patch = [f for f in regions.feature_names if f.endswith(" of frame 0")]
+    j = regions.feature_names.index(patch[0])
+    size = xairl.region_names.region_size(84, 84)
+    np.testing.assert_allclose(regions.states[0, j], frames[0, 0, :size, :size].mean(), rtol=1e-5)
+    plots.window_heatmap(e, 0)
+    said = 0
+    for i in range(2):
+        n = xairl.narrate(e, i, policy=p, robustness=False)
+        assert n.verified and xairl.verify(n.text, e, i, p).status == "verified", n.text
+        said += len(re.findall(r"(?:rose|fell) [\d.]+ over the last 4 frames", n.text))
+    assert said >= 2
 
 
 def test_the_window_survives_json(exp):

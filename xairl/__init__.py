@@ -24,6 +24,11 @@ _LAZY = {
     # attribution, in memory or streamed chunk by chunk to a resumable Parquet dataset
     "explain": "xairl.attributors",
     "explain_chunks": "xairl.stream",
+    # counterfactuals: what would have had to differ for another decision, each checked by running the policy
+    "counterfactual": "xairl.counterfactuals.search",
+    "Counterfactual": "xairl.counterfactuals.result",
+    "Counterfactuals": "xairl.counterfactuals.result",
+    "Threshold": "xairl.counterfactuals.result",
     "explain_to_parquet": "xairl.stream",
     "read_parquet": "xairl.stream",
     # narration and verification

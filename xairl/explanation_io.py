@@ -23,6 +23,7 @@ class _Window(BaseModel):
     steps: Annotated[int, Field(ge=2)]
     layout: Literal["sequence", "stacked"] = "sequence"
     step_s: Annotated[float, Field(gt=0, allow_inf_nan=False, strict=True)] | None = None
+    frames: bool = False  # a frame stack's regions over its frames (xairl.regions.in_regions)
 
 
 class _Part(BaseModel):
@@ -71,6 +72,8 @@ def check_observation(observation: Any, n_features: int) -> dict:
     for p in out["parts"]:
         if p["window"] is None:
             del p["window"]
+        elif not p["window"]["frames"]:
+            del p["window"]["frames"]
     return out
 
 

@@ -36,6 +36,11 @@ class FeatureInfo:
         percentage of it and its level words come from it (below 25 % low, above 75 % high, unless ``thresholds``).
     :param thresholds: (low below, high above) in the feature's unit, e.g. RSRP (-100, -80) dBm: level words come
         from them instead of the background's quartiles.
+    :param bounds: (low, high) the values the feature can take in the world (finite, or -inf/inf for no limit):
+        a counterfactual (:func:`xairl.counterfactual`) moves it only within them, instead of within the background's
+        1st to 99th percentile.
+    :param immutable: a counterfactual never changes it (a position, a cell's id). Identifiers and categoricals
+        never change either way.
     """
 
     unit: str = ""
@@ -47,6 +52,8 @@ class FeatureInfo:
     kind: Literal["numeric", "categorical", "identifier", "group"] = "numeric"
     capacity: float | None = None
     thresholds: tuple[float, float] | None = None
+    bounds: tuple[float, float] | None = None
+    immutable: bool = False
 
     def __post_init__(self) -> None:
         if self.kind not in FEATURE_KINDS:
@@ -59,6 +66,23 @@ class FeatureInfo:
             raise InputError(
                 f"FeatureInfo thresholds must be (low below, high above) with low <= high, got {self.thresholds}."
             )
+        if self.bounds is not None:
+            b = np.asarray(self.bounds, dtype=float) if _numbers(self.bounds) else np.array([np.nan])
+            if b.shape != (2,) or np.isnan(b).any() or b[0] > b[1]:
+                raise InputError(
+                    f"FeatureInfo bounds must be (low, high) numbers (or -inf/inf) with low <= high, got "
+                    f"{self.bounds!r:.60}."
+                )
+            object.__setattr__(self, "bounds", (float(b[0]), float(b[1])))
+        if not isinstance(self.immutable, (bool, np.bool_)):
+            raise InputError(f"FeatureInfo immutable is True or False, got {self.immutable!r:.40}.")
+
+
+def _numbers(value) -> bool:
+    """Whether ``value`` is a sequence of real numbers (no bools, strings or None)."""
+    return isinstance(value, (tuple, list, np.ndarray)) and all(
+        isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool) for v in value
+    )
 
 
 FEATURE_KINDS = ("numeric", "categorical", "identifier", "group")
@@ -111,6 +135,8 @@ class Policy:
         features are their slots, ``signal[t-3]`` ... ``signal[t]``; ``features`` may describe a signal once. The
         same as ``observation=xairl.Observation.window(signals, window)``, which also takes a flat layout and the
         seconds between observations (:mod:`xairl.windows`).
+    :param feasible: optional ``f(states (n, n_features)) -> bool (n,)``, True for the states the world allows
+        (coupled constraints, such as an RSRQ its RSRP makes possible): a counterfactual it rejects is never returned.
     """
 
     module: torch.nn.Module
@@ -126,6 +152,7 @@ class Policy:
     observation: Any = None
     output: Literal["actions", "continuous", "value"] | Sequence[str] | None = None
     window: int | None = None
+    feasible: Callable[[np.ndarray], np.ndarray] | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.module, torch.nn.Module):
@@ -174,6 +201,8 @@ class Policy:
                 f"{self.observation.n_features} columns {self.observation.describe()}; name each column."
             )
         check_kinds(self, kinds, declared)
+        if self.feasible is not None and not callable(self.feasible):
+            raise InputError(f"feasible must be a function of flat states (n, {self.n_features}) -> bool (n,).")
         if self.output == "value" and len(self.action_names) != 1:
             raise InputError("a 'value' policy has one output; give one name in action_names (e.g. ['value']).")
         _check_metadata(self, window)

@@ -8,6 +8,11 @@ sum of its pixels' and whose value is their mean. The pixels each region covers 
 columns 40 to 47 of channel 2') are in the regioned explanation's ``extras["regions"]``, for tables and hover texts.
 Narration and :func:`xairl.verify` both read an image explanation through :func:`in_regions`, so a narrative's region
 names are the verifier's vocabulary (which also takes a region's extent as its name).
+
+A frame stack's regions are a window over its frames (:class:`xairl.windows.Window` with ``frames=True``): each
+region a signal ('patch F6') whose slots are its patch in each frame ('patch F6 of frame 2'), so its narrative says
+how a region changed over the stack ('the mean pixel value of patch F6 rose 40 over the last 4 frames') as any
+window's trends are said.
 """
 
 from __future__ import annotations
@@ -18,7 +23,8 @@ from dataclasses import replace
 import numpy as np
 
 from .explanation import Explanation
-from .observation import Observation
+from .observation import Observation, Part
+from .windows import Window
 
 #: id of an explanation -> (a weak reference to it, its regioned copy): narrating, verifying and reporting a
 #: decision each ask for the same regions (kept while the explanation lives)
@@ -62,9 +68,27 @@ def _in_regions(exp: Explanation) -> Explanation:
             axis=1,
         )
     extents = observation.region_extents()
+    extents = {f: extents[f] for f in out.feature_names if f in extents}
+    window = _frame_window(observation, out.feature_names)
+    if window is not None:  # a region over the frames: the pixels of its first frame's patch, in every frame
+        first = window.names()[: len(window.signals)]
+        extents |= {s: extents[f].replace(" of frame 0", " in every frame") for s, f in zip(window.signals, first)}
     return replace(
         out,
         states=states,
         background_quantiles=quartiles,
-        extras={**exp.extras, "regions": {f: extents[f] for f in out.feature_names if f in extents}},
+        observation=None
+        if window is None
+        else Observation("window", (Part("obs", window.shape, window=window),)).to_dict(),
+        extras={**exp.extras, "regions": extents},
     )
+
+
+def _frame_window(observation: Observation, names: tuple[str, ...]) -> Window | None:
+    """A frame stack's regions over its frames, when ``names`` (the regioned features) are its slots."""
+    groups = observation.time_groups()
+    if groups is None or observation.kind != "array":
+        return None
+    regions, frames = groups
+    window = Window(tuple(regions), len(frames), frames=True)
+    return window if window.names() == list(names) else None

@@ -38,12 +38,15 @@ class Window:
     :param layout: one of :data:`LAYOUTS`.
     :param step_s: seconds between two observations, when they are evenly spaced in time: trends are then said
         'over the last 0.8 s' instead of 'over the last 5 observations'.
+    :param frames: the regions of a frame stack over its frames (:func:`xairl.regions.in_regions`): steps are named
+        'frame 0' ... (oldest first), slots 'patch F6 of frame 2', and the span 'the last 4 frames'.
     """
 
     signals: tuple[str, ...]
     steps: int
     layout: str = "sequence"
     step_s: float | None = None
+    frames: bool = False
 
     def __post_init__(self) -> None:
         if isinstance(self.signals, str) or not isinstance(self.signals, (list, tuple)):
@@ -75,12 +78,16 @@ class Window:
         return self.steps, len(self.signals)
 
     def step_names(self) -> list[str]:
-        """``t-3, t-2, t-1, t`` for 4 steps: the oldest first."""
+        """``t-3, t-2, t-1, t`` for 4 steps (a frame stack's ``frame 0`` ... ``frame 3``): the oldest first."""
+        if self.frames:
+            return [f"frame {k}" for k in range(self.steps)]
         return [f"t-{d}" if d else "t" for d in range(self.steps - 1, -1, -1)]
 
     def names(self) -> list[str]:
-        """Every slot's feature name, time-major: ``signal[t-3]`` ... ``signal[t]``."""
-        return [f"{s}[{step}]" for step in self.step_names() for s in self.signals]
+        """Every slot's feature name, time-major: ``signal[t-3]`` ... ``signal[t]`` (a frame stack's ``patch A1 of
+        frame 0`` ...)."""
+        slot = "{s} of {step}" if self.frames else "{s}[{step}]"
+        return [slot.format(s=s, step=step) for step in self.step_names() for s in self.signals]
 
     def signal_columns(self, offset: int = 0) -> dict[str, np.ndarray]:
         """Each signal's columns, oldest step first (for :meth:`Explanation.grouped`)."""
@@ -98,14 +105,17 @@ class Window:
         if self.step_s is not None:
             seconds = (self.steps - 1) * self.step_s
             return f"the last {seconds / 60:.3g} min" if seconds >= 120 else f"the last {seconds:.3g} s"
-        return f"the last {self.steps} observations"
+        return f"the last {self.steps} {'frames' if self.frames else 'observations'}"
 
     def to_dict(self) -> dict:
-        return {"signals": list(self.signals), "steps": self.steps, "layout": self.layout, "step_s": self.step_s}
+        out = {"signals": list(self.signals), "steps": self.steps, "layout": self.layout, "step_s": self.step_s}
+        return out | ({"frames": True} if self.frames else {})
 
     @classmethod
     def from_dict(cls, d) -> Window:
-        return cls(tuple(d["signals"]), int(d["steps"]), d.get("layout", "sequence"), d.get("step_s"))
+        return cls(
+            tuple(d["signals"]), int(d["steps"]), d.get("layout", "sequence"), d.get("step_s"), bool(d.get("frames"))
+        )
 
 
 @dataclass(frozen=True)

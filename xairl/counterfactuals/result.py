@@ -26,7 +26,9 @@ class Threshold:
 
     def __post_init__(self) -> None:
         if (self.above is None) == (self.below is None):
-            raise InputError("a Threshold takes exactly one of above=... or below=..., e.g. Threshold('steer', above=0).")
+            raise InputError(
+                "a Threshold takes exactly one of above=... or below=..., e.g. Threshold('steer', above=0)."
+            )
         bound = self.above if self.above is not None else self.below
         if isinstance(bound, bool) or not isinstance(bound, (int, float, np.number)) or not np.isfinite(bound):
             raise InputError(f"a Threshold's bound is a finite number; got {bound!r:.40}.")

@@ -114,23 +114,30 @@ _WHO = ("the serving BS", "the strongest neighbour", "the second strongest neigh
 #: (LTE's usual "excellent" band) strong; RSRQ below the violation threshold (-16 dB) poor, above -10 dB good
 RSRP_LEVELS = (-100.0, -80.0)
 RSRQ_LEVELS = (-16.0, -10.0)
+#: what a UE can report (TS 36.133 sec. 9.1.4 and 9.1.7, the reporting ranges): RSRP -140..-44 dBm, RSRQ -19.5..-3 dB;
+#: a counterfactual moves a signal only within them
+RSRP_RANGE = (-140.0, -44.0)
+RSRQ_RANGE = (-19.5, -3.0)
 
 
-def _signal(kind: str, k: int, unit: str, low: str, high: str, levels) -> FeatureInfo:
+def _signal(kind: str, k: int, unit: str, low: str, high: str, levels, bounds) -> FeatureInfo:
     aliases = (
         (f"{kind} of candidate {k}", f"candidate {k}'s {kind}")
         if k
         else (f"serving {kind}", f"the serving cell's {kind}", f"serving cell {kind}")
     )
-    return FeatureInfo(unit, f"{_WHO[k]}'s {kind}", low, high, aliases, thresholds=levels)
+    return FeatureInfo(unit, f"{_WHO[k]}'s {kind}", low, high, aliases, thresholds=levels, bounds=bounds)
 
 
 def feature_info(q_max_bits: float = 2e6) -> dict[str, FeatureInfo]:
-    """What each feature means to an operator; the buffer's capacity is the simulator's ``q_max_bits``."""
+    """What each feature means to an operator; the buffer's capacity is the simulator's ``q_max_bits``. For
+    counterfactuals: the position and the serving cell's id never change (immutable: the question is what the radio
+    or the buffer would have had to be, where the UAV was), the signals stay within their reporting ranges and the
+    buffer within [0, capacity]."""
     return {
-        "x": FeatureInfo("m", "the UAV's east position", "west", "east"),
-        "y": FeatureInfo("m", "the UAV's north position", "south", "north"),
-        "z": FeatureInfo("m", "the UAV's altitude", "low altitude", "high altitude"),
+        "x": FeatureInfo("m", "the UAV's east position", "west", "east", immutable=True),
+        "y": FeatureInfo("m", "the UAV's north position", "south", "north", immutable=True),
+        "z": FeatureInfo("m", "the UAV's altitude", "low altitude", "high altitude", immutable=True),
         "position": FeatureInfo("", "the UAV's position", kind="group", aliases=("position (x, y, z)",)),
         "buffer_queue_size": FeatureInfo(
             "bit",
@@ -139,16 +146,62 @@ def feature_info(q_max_bits: float = 2e6) -> dict[str, FeatureInfo]:
             "heavily loaded",
             ("the uplink buffer queue", "buffer queue"),
             capacity=q_max_bits,
+            bounds=(0.0, float(q_max_bits)),
         ),
         "serving_bs": FeatureInfo(
-            "", "the serving BS's id", aliases=("serving BS", "on BS", "from BS"), kind="identifier"
+            "", "the serving BS's id", aliases=("serving BS", "on BS", "from BS"), kind="identifier", immutable=True
         ),
-        **{f"rsrp_{k}": _signal("RSRP", k, "dBm", "weak signal", "strong signal", RSRP_LEVELS) for k in range(4)},
-        **{f"rsrq_{k}": _signal("RSRQ", k, "dB", "poor quality", "good quality", RSRQ_LEVELS) for k in range(4)},
+        **{
+            f"rsrp_{k}": _signal("RSRP", k, "dBm", "weak signal", "strong signal", RSRP_LEVELS, RSRP_RANGE)
+            for k in range(4)
+        },
+        **{
+            f"rsrq_{k}": _signal("RSRQ", k, "dB", "poor quality", "good quality", RSRQ_LEVELS, RSRQ_RANGE)
+            for k in range(4)
+        },
     }
 
 
 FEATURE_INFO = feature_info()
+
+
+class RsrqFeasible:
+    """The policy's ``feasible``: whether each candidate's RSRQ is one its RSRP, and the other cells' RSRP, allow.
+
+    Derived from the simulator's own formula (``Simulator._measure``): RSRQ_k = P_k / (12 RSSI_k) with RSSI_k per
+    resource element over cell k's reference-signal symbols = P_k a_k + sum_j P_j b_j + N, where P is the RSRP in mW,
+    a_k = 1/3 + 2/3 load_k >= 1/3 (cell k's own reference signals, 4 of 12 elements, and its data at its load), b_j >=
+    16/168 (every other cell's reference-signal share of a subframe, at load 0) and N the UE's noise per element
+    (-174 dBm/Hz + 10 log10(15 kHz) + its noise figure). Every RSSI is therefore at least
+    P_k/3 + (16/168) sum_{j != k} P_j + N over the measured candidates, and
+
+        RSRQ_k <= -10 log10(12 (1/3 + (16/168) sum_{j != k} P_j / P_k + N / P_k))
+
+    (-6.0 dB for a lone, strong cell). A state is feasible when every measured candidate's RSRQ is at most that plus
+    ``tolerance_db`` (the reported values carry the UE's measurement errors after the layer-3 filter: with the
+    default errors, 1.5 dB RSRQ and 1.2 dB RSRP, filtered at k=4, about 1 dB together; 3 dB is three of them) and an
+    empty slot (RSRQ at or below the detection limit) is anything. Simulated states keep at least 0.9 dB below it.
+    """
+
+    def __init__(self, noise_figure_db: float = 9.0, detection_rsrq_db: float = -24.0, tolerance_db: float = 3.0):
+        self.noise_mw = 10 ** ((-174 + 10 * np.log10(15e3) + noise_figure_db) / 10)
+        self.detection, self.tolerance = detection_rsrq_db, tolerance_db
+
+    def ceiling(self, rsrp: np.ndarray, measured: np.ndarray) -> np.ndarray:
+        """(n, 4) the highest RSRQ (dB) each candidate's RSRP allows beside the other measured candidates'."""
+        p = 10 ** (np.asarray(rsrp, dtype=np.float64) / 10)
+        others = np.where(measured, p, 0.0).sum(axis=1, keepdims=True) - np.where(measured, p, 0.0)
+        return -10 * np.log10(12 * (1 / 3 + (16 / 168) * others / p + self.noise_mw / p))
+
+    def __call__(self, states) -> np.ndarray:
+        x = np.asarray(states, dtype=np.float64)
+        rows = x.reshape(len(x), -1, len(SIGNALS))[..., : len(FEATURES)] if x.shape[1] != len(FEATURES) else x[:, None]
+        rsrp, rsrq = rows[..., RSRP].reshape(-1, N_CANDIDATES), rows[..., RSRQ].reshape(-1, N_CANDIDATES)
+        measured = rsrq > self.detection
+        ok = ~measured | (rsrq <= self.ceiling(rsrp, measured) + self.tolerance)
+        return ok.all(axis=1).reshape(len(x), -1).all(axis=1)
+
+
 ACTION_ALIASES = {
     "stay": ("keep the serving BS", "staying"),
     **{

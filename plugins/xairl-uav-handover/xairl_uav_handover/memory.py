@@ -31,6 +31,7 @@ from .features import (
     ACTIONS,
     SIGNALS,
     HandoverFacts,
+    RsrqFeasible,
     available_actions,
     feature_info,
     snapshot,
@@ -163,6 +164,7 @@ def memory_policy(ckpt) -> xairl.Policy:
             snapshot(state), chosen, runner_up, None if history is None else snapshot(history)
         ),
         action_mask=lambda x: available_actions(x, config.observation),
+        feasible=RsrqFeasible(config.radio.ue_noise_figure_db, config.observation.detection_rsrq_db),
     )
 
 

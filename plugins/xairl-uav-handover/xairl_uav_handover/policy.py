@@ -26,6 +26,7 @@ from .features import (
     GROUPS,
     SIGNALS,
     HandoverFacts,
+    RsrqFeasible,
     available_actions,
     feature_info,
 )
@@ -223,6 +224,7 @@ def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
         action_aliases=ACTION_ALIASES,
         facts_hook=facts,
         action_mask=lambda x: available_actions(x, config.observation),
+        feasible=RsrqFeasible(config.radio.ue_noise_figure_db, config.observation.detection_rsrq_db),
     )
 
 

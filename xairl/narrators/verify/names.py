@@ -52,20 +52,24 @@ def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
     taken = bytearray(len(text))
     found: list[Mention] = []
     folded = text.lower().replace("ı", "i").replace("ſ", "s")  # the two letters a case-blind 'i' and 's' match
+    # a region by its extent or its grid reference, first: 'patch F6 of frame 2' is one name, not 'patch F6' and more
+    # ('patch F6 of frame 7', of no frame, is no mention of 'patch F6' either: left unmasked for unknown_regions)
+    unknown = bytearray(len(text))
+    for m in REGION_RE.finditer(text) if vocab.regions else ():
+        keys = vocab.regions.get(region_key(m.group(0)))
+        span = taken if keys else unknown
+        if not any(taken[m.start() : m.end()]):
+            found += [Mention(m.start(), m.end(), "feature", keys)] if keys else []
+            span[m.start() : m.end()] = b"\1" * (m.end() - m.start())
     for pattern, kind, keys, label, form, needle in vocab.entries:
         if needle not in folded:
             continue  # the regex cannot match: much cheaper to know than to run it
         for m in pattern.finditer(text):
             if kind == "label" and _IDIOM.search(text, max(0, m.start() - 16), m.start()):
                 continue  # 'on its own' is no housing label
-            if not any(taken[m.start() : m.end()]):
+            if not any(taken[m.start() : m.end()]) and not any(unknown[m.start() : m.end()]):
                 found.append(Mention(m.start(), m.end(), kind, keys, label, form))
                 taken[m.start() : m.end()] = b"\1" * (m.end() - m.start())
-    for m in REGION_RE.finditer(text) if vocab.regions else ():  # a region by its extent, or its grid ref alone
-        keys = vocab.regions.get(region_key(m.group(0)))
-        if keys and not any(taken[m.start() : m.end()]):
-            found.append(Mention(m.start(), m.end(), "feature", keys))
-            taken[m.start() : m.end()] = b"\1" * (m.end() - m.start())
     features = [m for m in found if m.kind == "feature"]
     for f, labels in vocab.short_labels.items():  # 'Y', 'Ex', 'other': only right next to their feature
         near = [m for m in features if f in m.keys]

@@ -172,9 +172,11 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
 
 
 def _regions(exp: Explanation) -> dict[str, str]:
-    """The explanation's image regions (name -> extent, as :func:`xairl.in_regions` keeps them); none for pixels."""
+    """The explanation's image regions (name -> extent, as :func:`xairl.in_regions` keeps them), a frame stack's
+    regions over its frames and each frame's patch of them (:func:`.window.per_signal`); none for pixels."""
     extents = (exp.extras or {}).get("regions")
-    return {f: str(extents[f]) for f in exp.feature_names if f in extents} if isinstance(extents, Mapping) else {}
+    names = [*exp.feature_names, *((exp.extras or {}).get("window") or {}).get("slots", {}).get("names", ())]
+    return {f: str(extents[f]) for f in names if f in extents} if isinstance(extents, Mapping) else {}
 
 
 def region_key(phrase: str) -> str:
@@ -202,7 +204,7 @@ def _region_aliases(exp: Explanation) -> dict[str, tuple[str, ...]]:
                 if (m := REGION_RE.search(alias)) and m.group(0) != alias.removeprefix("the "):  # ' of KEY' left out
                     out.setdefault(region_key(m.group(0)), set()).add(f)
         ref = f.split(" of ", 1)[0]
-        if ref != f:
+        if ref != f and ref not in exp.feature_names:  # (a region over frames is named by its reference alone)
             out.setdefault(region_key(ref), set()).add(f)
     return {k: tuple(sorted(v)) for k, v in out.items()}
 

@@ -11,7 +11,7 @@ from ...explanation import Explanation
 from ...facts import Comparison, DomainFacts, domain_facts
 from ...policy import Policy
 from ...windows import said_change, window_of
-from .book import FactBook, add_facts
+from .book import FactBook, FeatureFacts, add_facts
 
 
 def per_signal(explanation: Explanation) -> Explanation:
@@ -23,6 +23,8 @@ def per_signal(explanation: Explanation) -> Explanation:
     changes = explanation.states[:, cols[:, -1]] - explanation.states[:, cols[:, 0]]
     span = None if window.step_s is None else (window.steps - 1) * window.step_s
     kept = {"changes": changes, "span_s": span, "steps": window.steps, "states": explanation.states}
+    if window.frames:  # a frame stack: each frame's patch stays citable by its own name ('patch F6 of frame 2')
+        kept["slots"] = {"names": explanation.feature_names, "values": explanation.values}
     return replace(out, extras={**out.extras, "window": kept})
 
 
@@ -48,7 +50,23 @@ def add_window_facts(book: FactBook, explanation: Explanation, index: int, polic
     if policy is not None and policy.facts_hook is not None:  # the plugin's facts, from the whole window
         chosen, runner_up = int(explanation.chosen[index]), int(explanation.runner_up[index])
         add_facts(book, domain_facts(policy, explanation.extras["window"]["states"][index], chosen, runner_up))
+    _add_slots(book, explanation, index)
     for c in facts.comparisons:
         name = c.text.removesuffix(" changed")
         if name in book.features and c.text.endswith(" changed"):
             book.features[name].change = c.value
+
+
+def _add_slots(book: FactBook, explanation: Explanation, index: int) -> None:
+    """A frame stack's patches frame by frame, as facts of their own: their mean pixel value and their push to the
+    chosen action and to the margin (ranks are said of the regions over the frames, as narrated)."""
+    w = explanation.extras["window"]
+    if "slots" not in w:
+        return
+    chosen, runner_up = int(explanation.chosen[index]), int(explanation.runner_up[index])
+    values, deciding = w["slots"]["values"][index], explanation.output == "actions" and runner_up != chosen
+    for j, name in enumerate(w["slots"]["names"]):
+        contribs = {"chosen": float(values[j, chosen])}
+        if deciding:
+            contribs["margin"] = float(values[j, chosen] - values[j, runner_up])
+        book.features[name] = FeatureFacts(value=float(w["states"][index, j]), contribs=contribs)

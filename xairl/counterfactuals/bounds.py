@@ -1,0 +1,137 @@
+"""What a counterfactual may change, how far, and how far a change is.
+
+A *unit* of change is what one change moves: a flat feature (a dict observation's columns by their names, a window's
+slots as flat features), or, for an image, a region of it (the patches of :meth:`xairl.Observation.regions`, named
+as narration names them). A region's change shifts all its pixels by one amount; its value is their mean.
+
+Never changed: a feature declared ``FeatureInfo(immutable=True)``, an identifier (``kind='identifier'``: a cell's id
+means nothing as a quantity) and a categorical (its codes have no order; the one-hot columns of a categorical input
+as well). Searching among a categorical's codes is not supported: it is left out.
+
+Each unit moves within a range: its declared ``FeatureInfo.bounds`` where they are finite, else the background's 1st
+to 99th percentile of the unit's value, widened to include the state's own value (a state may lie outside its data).
+
+A change's size is measured two ways: in background quantiles (the unit's empirical distribution function over the
+background, interpolated between the sorted values: 0..1, comparable across units), and in the unit's own units
+divided by its interquartile range (its 1st-99th percentile span where the quartiles coincide, else 1).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from ..policy import Policy
+
+
+@dataclass(frozen=True)
+class Units:
+    """The units a search may change, with what it needs of the background.
+
+    :param names: one per unit; ``columns`` the flat columns each covers; ``labels`` its unit of measure.
+    :param declared: (U, 2) declared bounds (-inf/inf where none).
+    :param sorted_bg: (B, U) the background's value of each unit, sorted per unit.
+    """
+
+    names: tuple[str, ...]
+    columns: tuple[np.ndarray, ...]
+    labels: tuple[str, ...]
+    declared: np.ndarray
+    sorted_bg: np.ndarray
+
+    @property
+    def n(self) -> int:
+        return len(self.names)
+
+    def values(self, x: np.ndarray) -> np.ndarray:
+        """(n, U) the value of each unit in flat states ``x`` (a region's: its pixels' mean)."""
+        return np.stack([x[:, c].astype(np.float64).mean(axis=1) for c in self.columns], axis=1).reshape(len(x), -1)
+
+    def ranges(self, own: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(low, high), each (n, U): where each unit of each state may move (declared bounds, else the background's
+        1st-99th percentile widened to the state's own value ``own`` (n, U))."""
+        p1, p99 = np.percentile(self.sorted_bg, [1, 99], axis=0)
+        low, high = np.minimum(p1, own), np.maximum(p99, own)
+        low = np.where(np.isfinite(self.declared[:, 0]), self.declared[:, 0], low)
+        high = np.where(np.isfinite(self.declared[:, 1]), self.declared[:, 1], high)
+        return low, np.maximum(high, low)
+
+    def scale(self) -> np.ndarray:
+        """(U,) the interquartile range of each unit (its 1st-99th percentile span where that is 0, else 1)."""
+        p1, q1, q3, p99 = np.percentile(self.sorted_bg, [1, 25, 75, 99], axis=0)
+        return np.where(q3 > q1, q3 - q1, np.where(p99 > p1, p99 - p1, 1.0))
+
+    def quantile(self, values: np.ndarray, unit: np.ndarray) -> np.ndarray:
+        """Background quantile (0..1) of ``values`` of units ``unit`` (same shape)."""
+        values, unit = np.broadcast_arrays(np.asarray(values, dtype=np.float64), np.asarray(unit))
+        out = np.empty(values.shape)
+        b = len(self.sorted_bg)
+        levels = (np.arange(b) + 0.5) / b
+        for u in np.unique(unit):
+            at = unit == u
+            out[at] = np.interp(values[at], self.sorted_bg[:, u], levels)
+        return out
+
+    def shift(self, x: np.ndarray, unit: np.ndarray, delta: np.ndarray) -> None:
+        """Shift in place unit ``unit[r]`` of row ``x[r]`` by ``delta[r]`` (every column of a region alike)."""
+        for u in np.unique(unit):
+            rows = np.flatnonzero(unit == u)
+            x[np.ix_(rows, self.columns[u])] += delta[rows, None]
+
+
+def units(policy: Policy, background: np.ndarray, features: Sequence[str] | str | None) -> Units:
+    """The units of ``policy`` a counterfactual may change (``features``: only these, by name; a group's name stands
+    for its members), with the background's values of each."""
+    every = _every_unit(policy)
+    fixed = _immutable(policy, every)
+    names = [name for name in every if name not in fixed]
+    if features is not None:
+        asked = [features] if isinstance(features, str) else [str(f) for f in features]
+        wanted = [m for f in asked for m in (policy.groups.get(f) or (f,))]
+        unknown = [f for f in wanted if f not in every]
+        if unknown:
+            raise InputError(
+                f"features {', '.join(unknown[:3])} are not units a counterfactual changes; use names such as "
+                f"{', '.join(names[:5])}."
+            )
+        frozen = [f for f in wanted if f in fixed]
+        if frozen:
+            raise InputError(
+                f"feature {frozen[0]} never changes in a counterfactual (immutable, an identifier or a category); "
+                "leave it out of features."
+            )
+        names = [n for n in names if n in set(wanted)]
+    columns = tuple(np.asarray(every[n]) for n in names)
+    info = [policy.features.get(n) for n in names]
+    declared = np.array([i.bounds if i is not None and i.bounds else (-np.inf, np.inf) for i in info], dtype=float)
+    out = Units(tuple(names), columns, tuple(i.unit if i else "" for i in info), declared.reshape(-1, 2), np.empty(0))
+    bg = np.sort(out.values(np.asarray(background)), axis=0)
+    return Units(out.names, out.columns, out.labels, out.declared, bg)
+
+
+def _every_unit(policy: Policy) -> dict[str, np.ndarray]:
+    """Every unit's name -> its flat columns: an image's regions, then each column no region covers."""
+    regions = policy.observation.regions()
+    covered = np.zeros(policy.n_features, dtype=bool)
+    for cols in regions.values():
+        covered[cols] = True
+    out = {name: np.asarray(cols) for name, cols in regions.items()}
+    out.update({f: np.array([j]) for j, f in enumerate(policy.feature_names) if not covered[j]})
+    return out
+
+
+def _immutable(policy: Policy, every: dict[str, np.ndarray]) -> set[str]:
+    """Units never changed: declared immutable, identifiers, categoricals, and a categorical input's columns."""
+    fixed = {n for n in every if (i := policy.features.get(n)) is not None and (i.immutable or i.kind in _FIXED_KINDS)}
+    start, onehot = 0, set()
+    for part in policy.observation.parts:
+        if part.categories:
+            onehot.update(range(start, start + part.size))
+        start += part.size
+    return fixed | {n for n, cols in every.items() if onehot.intersection(cols.tolist())}
+
+
+_FIXED_KINDS = ("identifier", "categorical")
