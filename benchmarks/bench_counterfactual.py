@@ -1,8 +1,8 @@
 """xairl's counterfactual search against DiCE's model-agnostic methods (issue 56).
 
-The same states of two policies: the UAV handover DQN (the plugin's committed checkpoint; states at which it decided
-on held-out flights, its background the simulated states its sampler draws) and the toy policy
-(``xairl.toy.toy_policy()``). For each state the question is the same: which change of the state makes the policy
+The same states of two policies: the UAV handover DQN (``uav-dqn``, the plugin's committed checkpoint, through its
+entry point; the states and the background 1,000 others drawn by its sampler: simulated UAVs 10 s into a flight) and
+the toy policy (``xairl.toy.toy_policy()``, standard-normal states). For each state the question is the same: which change of the state makes the policy
 choose its runner-up (the second-best available action) instead of the action it took?
 
 DiCE (``dice-ml``) explains classifiers, so each policy is wrapped as a classifier of the chosen action: its
@@ -112,11 +112,8 @@ def make_case(name: str, policy: xairl.Policy, states: np.ndarray, background: n
 
 
 def uav_case(n: int) -> Case:
-    from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint, uav_policy
-
-    ckpt = load_checkpoint()
-    policy = uav_policy(ckpt)
-    return make_case("uav-dqn", policy, dqn_decision_states(ckpt, n, seed=SEED), policy.background(1000, seed=SEED))
+    policy = xairl.get_policy("uav-dqn")  # through the plugin's entry point (the core's benchmarks import no plugin)
+    return make_case("uav-dqn", policy, policy.background(n, seed=SEED + 1), policy.background(1000, seed=SEED))
 
 
 def toy_case(n: int) -> Case:
@@ -351,7 +348,7 @@ def main(argv: list[str] | None = None) -> int:
         if name == "uav":
             try:
                 case = uav_case(n)
-            except ImportError:
+            except xairl.InputError:
                 print("uav: the xairl-uav-handover plugin is not installed; skipped.")
                 continue
         else:
