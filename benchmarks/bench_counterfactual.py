@@ -37,12 +37,15 @@ import argparse
 import contextlib
 import io
 import os
+import platform
 import random
 import signal
 import time
 from dataclasses import dataclass
+from importlib.metadata import version
 
 import numpy as np
+import torch
 
 import xairl
 
@@ -307,22 +310,19 @@ def paired(case: Case, ours: Scores, theirs: Scores, method: str) -> str:
     )
 
 
-def run(case: Case, methods: tuple[str, ...], with_xairl: bool, limit: float, cache: str | None) -> None:
+def run(case: Case, methods: tuple[str, ...], limit: float, cache: str | None) -> None:
     print(f"{case.name}: {len(case.states)} states with a runner-up; fixed: {', '.join(case.fixed) or 'none'}")
-    results = []
-    if with_xairl:
-        ours = xairl_answers(case)
-        results.append((ours, score(case, ours)))
+    ours = xairl_answers(case)
+    results = [(ours, score(case, ours))]
     for method in methods:
         answers = dice_answers(case, method, limit, cache)
         results.append((answers, score(case, answers)))
     print(HEAD)
     for answers, s in results:
         print(row(case, answers, s))
-    if with_xairl:
-        print("paired, on states where both are valid (xairl vs DiCE):")
-        for answers, s in results[1:]:
-            print(paired(case, results[0][1], s, answers.method))
+    print("paired, on states where both are valid (xairl vs DiCE):")
+    for answers, s in results[1:]:
+        print(paired(case, results[0][1], s, answers.method))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -341,9 +341,10 @@ def main(argv: list[str] | None = None) -> int:
         print("bench_counterfactual: dice-ml is not installed; pip install xairl[bench] to compare with DiCE.")
         return 0
     n = 10 if args.quick else args.states
-    with_xairl = hasattr(xairl, "counterfactual")
-    if not with_xairl:
-        print("xairl.counterfactual is not on this branch: DiCE alone.")
+    print(
+        f"machine: {platform.machine()}, {os.cpu_count()} cores (load {os.getloadavg()[0]:.1f}), torch "
+        f"{torch.get_num_threads()} thread(s); dice-ml {version('dice-ml')}; DiCE limit {args.limit:g} s per query"
+    )
     for name in args.policy:
         if name == "uav":
             try:
@@ -353,7 +354,7 @@ def main(argv: list[str] | None = None) -> int:
                 continue
         else:
             case = toy_case(n)
-        run(case, tuple(args.methods), with_xairl, args.limit, args.cache)
+        run(case, tuple(args.methods), args.limit, args.cache)
     return 0
 
 
