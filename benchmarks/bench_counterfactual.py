@@ -24,7 +24,8 @@ share <= 2), the distance (sum over the changed features of |quantile after - qu
 and the scaled one (sum of |delta| / interquartile range), xairl's ``Counterfactual.distance`` and
 ``distance_scaled`` measured by xairl's own units; seconds per state (wall clock, one process, all states of the
 policy); queries out of time; and "usable", the share of all states with a valid, feasible answer of at most two
-changes. A second table compares each DiCE method with xairl on the states where both returned a valid answer.
+changes. A second table compares each DiCE method with xairl on the states where both returned a valid answer, and counts xairl's misses: states where DiCE's answer is one xairl could
+have given (valid, feasible, at most two changes) and xairl found none.
 
     .venv/bin/python benchmarks/bench_counterfactual.py [--states 200] [--quick] [--policy uav toy] [--methods ...]
 
@@ -297,8 +298,10 @@ def row(case: Case, answers: Answers, s: Scores) -> str:
 def paired(case: Case, ours: Scores, theirs: Scores, method: str) -> str:
     """xairl and one DiCE method on the states where both returned a valid counterfactual."""
     both = ours.valid & theirs.valid
+    # a search miss of xairl's: DiCE's answer is one xairl could have given (valid, feasible, <= 2 changes)
+    missed = int((theirs.valid & theirs.feasible & (theirs.changed <= 2) & ~ours.answered).sum())
     if not both.any():
-        return f"{case.name:<9}{method:<15} no state where both are valid"
+        return f"{case.name:<9}{method:<15} no state where both are valid; xairl missed {missed}"
     c = f"{ours.changed[both].mean():.2f} vs {theirs.changed[both].mean():.2f}"
     d = f"{ours.distance[both].mean():.3f} vs {theirs.distance[both].mean():.3f}"
     sc = f"{ours.scaled[both].mean():.2f} vs {theirs.scaled[both].mean():.2f}"
@@ -306,7 +309,7 @@ def paired(case: Case, ours: Scores, theirs: Scores, method: str) -> str:
     nearer = float((ours.distance[both] < theirs.distance[both]).mean())
     return (
         f"{case.name:<9}{method:<15}{int(both.sum()):>6}  changed {c} (xairl fewer {fewer:.0%}), distance {d} "
-        f"(xairl nearer {nearer:.0%}), scaled {sc}"
+        f"(xairl nearer {nearer:.0%}), scaled {sc}; xairl missed {missed}"
     )
 
 
