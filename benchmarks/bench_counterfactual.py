@@ -24,10 +24,16 @@ share <= 2), the distance (sum over the changed features of |quantile after - qu
 and the scaled one (sum of |delta| / interquartile range), xairl's ``Counterfactual.distance`` and
 ``distance_scaled`` measured by xairl's own units; seconds per state (wall clock, one process, all states of the
 policy); queries out of time; and "usable", the share of all states with a valid, feasible answer of at most two
-changes. A second table compares each DiCE method with xairl on the states where both returned a valid answer, and counts xairl's misses: states where DiCE's answer is one xairl could
-have given (valid, feasible, at most two changes) and xairl found none.
+changes. A second table compares each DiCE method with xairl on the states where both returned a valid answer, and
+counts xairl's misses: states where DiCE's answer is one xairl could have given (valid, feasible, at most two
+changes) and xairl found none.
 
     .venv/bin/python benchmarks/bench_counterfactual.py [--states 200] [--quick] [--policy uav toy] [--methods ...]
+        [--limit 10] [--cache DIR]
+
+200 states of each take about 25 minutes on 2 cores, most of it DiCE's k-d tree on the toy policy (its default
+post-hoc sparsity walks each feature back in steps of the data's decimal precision, up to 10,000 single-row forward
+passes).
 
 dice-ml is an optional extra (``pip install xairl[bench]``); without it the benchmark says so and exits 0.
 """
