@@ -50,6 +50,11 @@ def line():
         (HAD + "the policy would have chosen go.", "verified"),
         (HAD + "the policy would not have chosen go.", "contradicted"),
         (HAD + "the policy would have chosen {{ cf.target }}.", "contradicted"),
+        (HAD + "the policy would have not chosen go.", "contradicted"),
+        (HAD + "the policy would still have chosen {{ cf.chosen }}.", "contradicted"),
+        (HAD + "the policy would have chosen go rather than stay.", "verified"),
+        (HAD + "the policy would have chosen stay rather than go.", "contradicted"),
+        (HAD + "the policy would have done otherwise.", "unchecked"),  # (no action named: not verified)
         # numbers the template wrote itself are read like the tracked ones
         ("Had the queue been below 30 % full (it was {{ c.value_text }}), " + THEN, "contradicted"),
         ("Had the queue been below 30 % full, the policy would have chosen {{ cf.action }}.", "contradicted"),
@@ -91,7 +96,8 @@ def test_a_search_miss_is_no_proof(line):
     head = "{% if counterfactual and not counterfactual.reachable %}{% set cf = counterfactual %}"
     _, status, v = said(exp, 0, p, fact, sentence=body, head=head)
     claims = [c for c in v.claims if c.rule == "tracked.counterfactual"]
-    assert status == "unchecked" and claims and all("no proof" in c.detail for c in claims)
+    assert status == "unchecked" and any("no proof" in c.detail for c in claims)
+    assert not any(c.status == "verified" for c in claims)
 
 
 def test_the_change_as_written_keeps_the_state_feasible(line):

@@ -48,10 +48,10 @@ RULE = "tracked.counterfactual"
 _BELOW = r"below|under|less than|lower than|smaller than|at most|beneath"
 _ABOVE = r"above|over|more than|higher than|greater than|larger than|at least|exceed\w*"
 #: the forms that make a sentence counterfactual
-FORM = re.compile(r"\bhad\b.+?\bbeen\b|\bif\b.+?\bwere\b|\bwould(?:\s+not|n't)?\s+have\b", re.I | re.S)
+FORM = re.compile(r"\bhad\b.+?\bbeen\b|\bif\b.+?\bwere\b|\bwould\b(?:\s+\w+|n't){0,2}\s+have\b", re.I | re.S)
 _HYPO = re.compile(rf"\b(?:been|were|at|to)\s+(?:(?P<dir>{_BELOW}|{_ABOVE})\s+)?$", re.I)
 _ACTUAL = re.compile(rf"\b(?:was|is|are|were|now|currently|at)\s+(?:(?P<dir>{_BELOW}|{_ABOVE})\s+)?$", re.I)
-_WOULD = re.compile(r"\bwould(?P<neg>\s+not|n't)?\s+have\b", re.I)
+_WOULD = re.compile(r"\bwould(?P<neg>\s+not|n't|\s+never)?(?:\s+(?:still|also|then|instead|rather))?\s+have\b", re.I)
 _CHOSE = re.compile(r"\b(?:chose|chooses|took|takes|picked|selected|preferred)\b", re.I)
 _VALUES = ("after_text", "after", "after_fill", "value_text", "value", "fill")
 _ACTIONS = ("action", "action_words", "chosen", "target")
@@ -179,10 +179,13 @@ def check_counterfactual(s, cf: list[Part], truth: Truth) -> list[Claim]:
         for v in vals
         if not v.slot
     ]
-    hypo = [v for v in vals if v.slot == "hypo"]
-    claims += _rerun(s, cf, hypo, policy, state, truth, counterfactual)
-    if counterfactual and not hypo:  # its change unread ('been storm' written by hand): its facts do not verify it
-        unread = "the change it states was not read (no value after 'had ... been', 'if ... were', 'with ... at')"
+    hypo, acts = [v for v in vals if v.slot == "hypo"], _said_actions(s, cf, policy)
+    claims += _rerun(cf, hypo, acts, policy, state, truth, counterfactual)
+    # its change or its new action unread ('been storm', 'would have kept the UAV' written by hand): its other claims,
+    # true as they may be, do not verify what it says
+    if counterfactual and (not hypo or any(slot == "unread" for *_, slot in acts)):
+        unread = "what it says would have been, or been done, was not read: " + ("no value after 'had ... been', "
+                 "'if ... were', 'with ... at'" if not hypo else "no action named after 'would have'")  # fmt: skip
         claims = [replace(c, status="unchecked", detail=unread) if c.status == "verified" else c for c in claims]
     return claims
 
@@ -207,40 +210,48 @@ def _actual(s, v: _Value, policy, state: np.ndarray) -> Claim:
     return _claim(v.part, "number", "verified" if ok else "contradicted", what, v.text)
 
 
+def _first_action(policy, words: list[str]) -> tuple[str, int] | None:
+    """(its words, the action) of the first action ``words`` name, by its name or an alias, longest first."""
+    for k in range(len(words)):
+        for e in range(len(words), k, -1):
+            a = action_index(policy, " ".join(words[k:e]))
+            if a is not None:
+                return " ".join(words[k:e]), a
+    return None
+
+
 def _said_actions(s, cf: list[Part], policy) -> list[tuple[Part | None, str, int | None, str]]:
-    """(its span or None, its text, the action it names, its slot: 'would', 'not', 'chose' or '') per action the
-    sentence names: the words after each 'would (not) have', and every tracked action of the fact."""
+    """(its span or None, its text, the action it names, its slot) per action the sentence names: the first one
+    after each 'would (not) have' (slot 'would' or 'not'; 'unread' when those words name none), and every tracked
+    action of the fact elsewhere ('chose' after 'chose', 'took'; '' when said as neither)."""
     out, covered = [], []
     for m in _WOULD.finditer(s.text):
         end = re.search(r"[(),.;]|$", s.text[m.end() :]).start() + m.end()
-        words = s.text[m.end() : end].split()
-        hit = next(
-            (
-                (k, " ".join(words[k:]))
-                for k in range(len(words))
-                if action_index(policy, " ".join(words[k:])) is not None
-            ),
-            None,
-        )
-        if hit is None:
-            continue
-        at = m.end() + s.text[m.end() : end].rfind(hit[1])
-        part = next((p for p in cf if p.start <= at < p.end), None)
-        out.append((part, hit[1], action_index(policy, hit[1]), "not" if m["neg"] else "would"))
         covered.append((m.end(), end))
+        hit = _first_action(policy, s.text[m.end() : end].split())
+        if hit is None:  # (a tracked action of the fact there that names no action, 'any other action': wrong)
+            named = next((p for p in cf if m.end() <= p.start < end and p.span.fact.quantity[3:] in _ACTIONS), None)
+            text = named.span.text if named else s.text[m.end() : end].strip()
+            out.append((named, text, None, "would" if named else "unread"))
+            continue
+        at = m.end() + s.text[m.end() : end].find(hit[0])
+        part = next((p for p in cf if p.start <= at < p.end), None)
+        negated = m["neg"] or re.search(r"\b(?:not|never)\b", s.text[m.end() : at], re.I)  # ('would have not')
+        out.append((part, hit[0], hit[1], "not" if negated else "would"))
     for p in cf:
         if p.span.fact.quantity[3:] in _ACTIONS and not any(a <= p.start < b for a, b in covered):
             clause = s.text[: p.start].split(",")[-1]
-            slot = "would" if _WOULD.search(clause) else "chose" if _CHOSE.search(clause) else ""
+            slot = "chose" if _CHOSE.search(clause) else ""
             out.append((p, p.span.text, action_index(policy, p.span.text), slot))
     return out
 
 
-def _rerun(s, cf, hypo: list[_Value], policy, state: np.ndarray, truth: Truth, counterfactual: bool) -> list[Claim]:
+def _rerun(
+    cf, hypo: list[_Value], acts: list, policy, state: np.ndarray, truth: Truth, counterfactual: bool
+) -> list[Claim]:
     """The stated change run through the policy: the hypothetical values (they change the decision, within the
     world's constraints), the actions named (the one taken there) and the margin (module doc)."""
     chosen = policy.action_names.index(truth.actions["chosen"])
-    acts = _said_actions(s, cf, policy)
     margins = [p for p in cf if p.span.fact.quantity == "cf_margin"]
     claims = _taken(acts, chosen, truth.actions["chosen"])
     acts = [a for a in acts if a[3] in ("would", "not")]
@@ -290,9 +301,9 @@ def _taken(acts: list[tuple], chosen: int, name: str) -> list[Claim]:
         if slot == "chose"
     ]
     return claims + [
-        _claim(p, "action", "unchecked", "not said as the action taken nor the one it would take", t)
+        _claim(p, "action", "unchecked", "no action it names is said as taken or as the one it would take", t)
         for p, t, a, slot in acts
-        if not slot
+        if slot in ("", "unread")
     ]
 
 
