@@ -82,7 +82,8 @@ class Counterfactuals:
     :param chosen: the action the policy took (for a :class:`Threshold`: the output's name).
     :param target: what was asked, in words: the runner-up's name, a named action, 'any other action', or
         'steer above 0.5'.
-    :param found: empty when no change of at most ``max_changes`` features within the bounds flips the decision.
+    :param found: empty when the search found no change of at most ``max_changes`` features within the bounds that flips
+        the decision (a grid search: a miss is no proof that none exists).
     :param reason: why none was found, in one line ('' when some were).
     :param evaluations: states run through the policy by the search.
     """
