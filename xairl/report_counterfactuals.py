@@ -9,7 +9,8 @@ the report's own explanation of them; each answer travels in its card's evidence
 The run: for the first :data:`RUN` decisions, every feature that may change is tried alone (``max_changes=1``,
 ``target='any'``: any other action; one batched search keeps each feature's nearest flipping value). Per feature
 and per chosen action: how many decisions a change of that feature alone flips, and the median change needed, in
-the feature's unit (a feature with a capacity in percentage points of it) and in background quantiles. The rows
+the feature's unit (a feature with a capacity in % of it) and in percentiles of the background (its quantile
+times 100). The rows
 'some single feature' and 'no single feature' add up to the decisions of each action.
 
 Shown for discrete actions of flat, dict or window observations; an image's regions are not searched here (a
@@ -69,7 +70,7 @@ def attach(pairs: list, found: dict[int, Counterfactuals], policy: Policy) -> No
 
 def flip_rows(policy: Policy, exp: Explanation, background, limit: int = RUN) -> tuple[str, list[str], list[list], str]:
     """(title, header, rows, sentence) of the run's table: per feature, per chosen action, the decisions a change of
-    that feature alone flips (count and share), and the median change needed; then the rows 'some single feature',
+    that feature alone flips (share and count) and the median change needed; then the rows 'some single feature',
     'no single feature' and 'decisions'. ``sentence`` says the most frequent one in words."""
     from .counterfactuals import counterfactual
     from .counterfactuals.bounds import units
@@ -85,57 +86,59 @@ def flip_rows(policy: Policy, exp: Explanation, background, limit: int = RUN) ->
     actions = [a for a in exp.action_names if total[a]]
     some = Counter(r.chosen for r in found if any(len(cf.changes) == 1 for cf in r.found))
 
-    def share(count: int, action: str) -> str:
-        return f"{100 * count / total[action]:.0f} % ({count})"
+    def cells(f: str | None, count: int, a: str) -> list[str]:
+        one = stats[f].get(a) if f else None
+        size = f"{_size(policy, f, one['median_delta'])} ({_points(one['median_quantiles'])})" if one else ""
+        return [f"{100 * count / total[a]:.0f} % ({count})", size]
+
+    def row(label: str, counts: dict, f: str | None = None) -> list:
+        return [label, *[c for a in actions for c in cells(f, counts.get(a, 0), a)]]
 
     rows = [
-        [f, *[share(stats[f]["by_action"].get(a, 0), a) for a in actions], _size(policy, f, stats[f]["median_delta"]),
-         _points(stats[f]["median_quantiles"])]
-        for f in sorted(names, key=lambda f: -stats[f]["flips"])
-    ]  # fmt: skip
-    rows.append(["some single feature", *[share(some[a], a) for a in actions], "", ""])
-    rows.append(["no single feature", *[share(total[a] - some[a], a) for a in actions], "", ""])
-    rows.append(["decisions", *[str(total[a]) for a in actions], "", ""])
+        row(f, {a: s["flips"] for a, s in stats[f].items()}, f) for f in sorted(names, key=lambda f: -_flips(stats[f]))
+    ]
+    rows.append(row("some single feature", some))
+    rows.append(row("no single feature", {a: total[a] - some[a] for a in actions}))
+    rows.append(["decisions", *[c for a in actions for c in (str(total[a]), "")]])
     header = [
         "feature changed alone",
-        *[f"flips it: {a}" for a in actions],
-        "median change",
-        "median change (quantiles)",
+        *[h for a in actions for h in (f"{a}: flipped", f"{a}: median change (in percentiles)")],
     ]
     title = (
         f"Distance to another action: how often a change of one feature alone flips the decision ({k} decisions; "
         "each feature tried alone within its bounds, to any other action, every flip re-run through the policy; "
-        "share of the decisions of each chosen action)"
+        "share of the decisions of each chosen action, and the median change of those it flips)"
     )
-    return title, header, rows, _sentence(policy, stats, total, actions)
+    return title, header, rows, _sentence(policy, stats, total)
+
+
+def _flips(per_action: dict) -> int:
+    return sum(s["flips"] for s in per_action.values())
 
 
 def _size(policy: Policy, feature: str, delta: float) -> str:
-    """A median change in the feature's unit: a feature with a capacity in percentage points of it."""
+    """A median change in the feature's unit: a feature with a capacity in % of it."""
     if not np.isfinite(delta):
         return ""
     info = policy.features.get(feature)
     if info is not None and info.capacity:
-        return f"{format_number(100 * delta / info.capacity, signed=True)} percentage points of capacity"
+        return f"{format_number(100 * delta / info.capacity, signed=True)} % of capacity"
     return f"{format_number(delta, signed=True)} {info.unit if info is not None else ''}".strip()
 
 
 def _points(q: float) -> str:
-    return f"{format_number(100 * q, signed=True)} pp" if np.isfinite(q) else ""
+    return f"{format_number(100 * q, signed=True)} percentiles" if np.isfinite(q) else ""
 
 
-def _sentence(policy: Policy, stats: dict, total: Counter, actions: list[str]) -> str:
-    """The most frequent single flip, in words: 'A change of buffer_queue_size alone would flip 34 % of the stay
-    decisions (median -41 percentage points of capacity).'"""
-    best = max(
-        ((f, a) for f in stats for a in actions), key=lambda t: stats[t[0]]["by_action"].get(t[1], 0), default=None
-    )
-    if best is None or not stats[best[0]]["by_action"].get(best[1], 0):
+def _sentence(policy: Policy, stats: dict, total: Counter) -> str:
+    """The most frequent single flip, in words: 'A change of rsrp_0 alone would flip 53 % of the stay decisions
+    (median change -9.57 dBm, -37.1 percentiles of the background).'"""
+    share = {(f, a): s["flips"] / total[a] for f in stats for a, s in stats[f].items()}
+    if not share:
         return "No decision is flipped by a change of one feature alone within the bounds."
-    f, a = best
-    pct = 100 * stats[f]["by_action"][a] / total[a]
+    f, a = max(share, key=lambda fa: (stats[fa[0]][fa[1]]["flips"], share[fa]))  # the most decisions
+    one = stats[f][a]
     return (
-        f"A change of {f} alone would flip {pct:.0f} % of the {a} decisions (median change "
-        f"{_size(policy, f, stats[f]['median_delta'])}, {_points(stats[f]['median_quantiles'])} in background quantiles; "
-        "over all decisions that it flips)."
+        f"A change of {f} alone would flip {100 * share[f, a]:.0f} % of the {a} decisions (median change "
+        f"{_size(policy, f, one['median_delta'])}, {_points(one['median_quantiles'])} of the background)."
     )

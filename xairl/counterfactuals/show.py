@@ -4,7 +4,8 @@ store and back to the review page), and :func:`single_flips`, the run's view: pe
 that feature alone flips the decisions and how large it is.
 
 Values are written by ``text(feature, value)`` when the caller gives one (the report and the CLI give the narratives'
-own writer: '100 % full', '-85.3 dBm'), else as the narratives write numbers, with the feature's unit.
+own writer: '100 % full', '-85.3 dBm'), else as the narratives write numbers, with the feature's unit. It reads
+:class:`xairl.Counterfactuals` without importing them (their notebook card calls :func:`summary`).
 """
 
 from __future__ import annotations
@@ -13,10 +14,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from .result import Counterfactuals
 
-
-def summary(cfs: Counterfactuals, text: Callable[[str, float], str] | None = None, n: int = 3) -> dict:
+def summary(cfs, text: Callable[[str, float], str] | None = None, n: int = 3) -> dict:
     """A decision's answer as plain data: ``chosen``, ``target``, ``reason`` ('' when some were found) and ``found``,
     its first ``n`` counterfactuals, each with its ``changes`` (feature, before, after, their texts, unit, background
     quantiles), the ``action`` the policy then takes, its ``margin`` and its ``distance`` (in quantiles)."""
@@ -48,29 +47,31 @@ def summary(cfs: Counterfactuals, text: Callable[[str, float], str] | None = Non
     return {"index": cfs.index, "chosen": cfs.chosen, "target": cfs.target, "reason": cfs.reason, "found": found}
 
 
-def single_flips(results: Sequence[Counterfactuals], features: Sequence[str]) -> dict[str, dict]:
-    """Per feature of ``features``: over the decisions ``results`` (searched with ``max_changes=1`` and ``n`` at least
-    the number of features, so that every feature's single change is kept), how many flipped by a change of it alone
-    (``flips``, and ``by_action``: counted per chosen action) and the median change needed (``median_delta`` in its
-    own unit, ``median_quantiles``: the signed change of its background quantile)."""
-    out = {}
+def single_flips(results: Sequence, features: Sequence[str]) -> dict[str, dict[str, dict]]:
+    """Per feature of ``features``, per chosen action: over the decisions ``results`` (searched with
+    ``max_changes=1`` and ``n`` at least the number of features, so that every feature's single change is kept), how
+    many a change of that feature alone flips (``flips``) and the median change needed (``median_delta`` in the
+    feature's own unit, ``median_quantiles`` the signed change of its background quantile; NaN when none)."""
+    out: dict[str, dict[str, dict]] = {}
     for f in features:
-        deltas, quants, by_action = [], [], {}
+        seen: dict[str, list] = {}
         for r in results:
             change = next(
                 (cf.changes[0] for cf in r.found if len(cf.changes) == 1 and cf.changes[0].feature == f), None
             )
-            if change is None:
-                continue
-            deltas.append(change.delta)
-            quants.append(change.quantiles[1] - change.quantiles[0])
-            by_action[r.chosen] = by_action.get(r.chosen, 0) + 1
+            if change is not None:
+                seen.setdefault(r.chosen, []).append((change.delta, change.quantiles[1] - change.quantiles[0]))
         out[f] = {
-            "flips": len(deltas),
-            "by_action": by_action,
-            "median_delta": float(np.median(deltas)) if deltas else float("nan"),
-            "median_quantiles": float(np.nanmedian(quants))
-            if deltas and not np.all(np.isnan(quants))
-            else float("nan"),
+            action: {
+                "flips": len(pairs),
+                "median_delta": float(np.median([d for d, _ in pairs])),
+                "median_quantiles": _median([q for _, q in pairs]),
+            }
+            for action, pairs in seen.items()
         }
     return out
+
+
+def _median(values: list[float]) -> float:
+    known = [v for v in values if np.isfinite(v)]
+    return float(np.median(known)) if known else float("nan")
