@@ -1,7 +1,8 @@
 """Counterfactuals (issue 56): validity, reach and time per decision of :func:`xairl.counterfactual`.
 
-On the reference plugin's trained DQN (``uav-dqn``, its committed checkpoint): ``--n`` decisions sampled from
-held-out flights the DQN flies itself (``dqn_decision_states``), the background 200 simulated states; the targets the
+On the reference plugin's trained DQN (``uav-dqn``, its committed checkpoint, through the plugin's entry point):
+``--n`` decisions of the plugin's sampler (simulated UAVs 10 s into a flight, seed 1; the background 200 of seed 0);
+the targets the
 runner-up (the default) and any other action. On each policy kind: a flat MLP, a dict observation, image regions of a
 small CNN, a continuous action with a Threshold, a value with a Threshold (seeded networks, standard-normal states).
 
@@ -80,11 +81,8 @@ def row(name, policy, states, bg, target=None, single=20, **kwargs):
 
 
 def uav_rows(n, single):
-    from xairl_uav_handover.policy import background_states, dqn_decision_states, load_checkpoint, uav_policy
-
-    ckpt = load_checkpoint()
-    policy = uav_policy(ckpt)
-    states, bg = dqn_decision_states(ckpt, n, seed=1), background_states(200, 0, ckpt.sim_config)
+    policy = xairl.get_policy("uav-dqn")  # through the plugin's entry point, as a user reaches it
+    states, bg = policy.background(n, seed=1), policy.background(200, seed=0)
     yield row("uav-dqn, runner-up", policy, states, bg, single=single)
     yield row("uav-dqn, any other action", policy, states, bg, "any", single=single)
 

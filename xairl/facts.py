@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .counterfactual_facts import CounterfactualFact
 from .errors import InputError, PluginError
 from .explanation import Explanation
 from .policy import FeatureInfo, Policy
@@ -131,6 +132,7 @@ class DecisionFacts:
     :param output: the policy's output kind. For 'value' and 'continuous' (one dimension at a time) nothing is
         chosen: ``action`` names the output, ``score`` is its value, ``runner_up`` is ``action`` again and
         ``margin_top`` is empty.
+    :param counterfactual: what would have changed the decision (:mod:`xairl.counterfactual_facts`), when asked.
     """
 
     index: int
@@ -152,6 +154,7 @@ class DecisionFacts:
     base_margin: float = 0.0
     identifiers: tuple[FeatureFact, ...] = ()
     trends: tuple[FeatureFact, ...] = ()
+    counterfactual: CounterfactualFact | None = None
 
     def context(self) -> dict[str, Any]:
         """Variables a decision template sees: every field (feature facts as dicts) and ``k``."""

@@ -46,6 +46,7 @@ DECISION_VARS = {
     "base_margin",
     "identifiers",
     "trends",
+    "counterfactual",
 }
 GLOBAL_VARS = {"n_states", "method", "ranking", "view", "target", "k"}
 

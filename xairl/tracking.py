@@ -355,8 +355,21 @@ def track_decision(context: Mapping) -> dict:
             for d in c["comparisons"]
         ],
         "extras": {k: tracked(v, Fact("extra", feature=str(k))) for k, v in c["extras"].items()},
+        "counterfactual": track_counterfactual(c.get("counterfactual")),
     }
     return c | out
+
+
+def track_counterfactual(cf: Mapping | None) -> dict | None:
+    """A counterfactual fact (:class:`xairl.counterfactual_facts.CounterfactualFact` as a dict), tracked: each
+    change's fields as 'cf_<field>' of its feature, with role 'change:<n>' (which change), the rest as 'cf_<field>'."""
+    if cf is None:
+        return None
+    changes = [
+        {k: tracked(v, Fact(f"cf_{k}", str(d["name"]), role=f"change:{n}")) for k, v in d.items()}
+        for n, d in enumerate(cf["changes"])
+    ]
+    return {k: tracked(v, Fact(f"cf_{k}")) for k, v in cf.items() if k != "changes"} | {"changes": changes}
 
 
 def track_global(context: Mapping) -> dict:

@@ -27,6 +27,7 @@ def narrate(
     store=None,
     robustness: bool = True,
     history=None,
+    counterfactual=False,
 ) -> Narrative:
     """Words for decision ``index`` (``None``: a global summary over all states), checked against the numbers.
 
@@ -50,6 +51,7 @@ def narrate(
         k=k,
         robustness=robustness,
         history=history,
+        counterfactual=counterfactual,
     )
     if store is not None:
         store.record(narrative, policy=policy)  # with its evidence: the numbers of what it says

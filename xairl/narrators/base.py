@@ -14,6 +14,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ..counterfactual_facts import said_counterfactual
 from ..errors import InputError
 from ..evidence import CARD_STYLE, card_html, evidence
 from ..explanation import Explanation
@@ -134,6 +135,7 @@ class Narrator:
         k: int = 3,
         robustness: bool = True,
         history=None,
+        counterfactual=False,
     ) -> Narrative:
         """Words for decision ``index`` (``None``: a global summary over all states), verified, with confidence.
 
@@ -144,6 +146,10 @@ class Narrator:
         :param robustness: measure agreement and stability (three extra explanations of the state).
         :param history: the states before ``index`` in the same episode (oldest first), for a policy whose
             ``facts_hook`` states facts over time ("the neighbour has been stronger for 3 decisions").
+        :param counterfactual: True: search what would have changed the decision (it needs ``policy``; the search
+            is guided by ``explanation`` and bounded by ``background``) and give the template its fact, or the
+            search's answer for this state (:class:`xairl.Counterfactuals`); its sentence is checked by running the
+            policy on it. Discrete actions only.
         """
         index = None if index is None else explanation.check_index(index)
         tpl = _template(explanation, index, template, prompt_dirs)
@@ -155,7 +161,10 @@ class Narrator:
             if index is not None and explanation.output == "continuous"
             else [narrated]
         )
-        words = [self._words(view, index, tpl, policy, k, history) for view in views]
+        said = None
+        if counterfactual is not False and counterfactual is not None and index is not None:
+            said = said_counterfactual(explanation, index, policy, counterfactual, background)
+        words = [self._words(view, index, tpl, policy, k, history, said) for view in views]
         scores, comps = zip(
             *(
                 confidence(explanation, index, c.ok, policy, background, robustness, output=j, coverage=c.coverage)
@@ -183,13 +192,15 @@ class Narrator:
         )
         return replace(told, evidence=evidence(narrated, told))
 
-    def _words(self, explanation: Explanation, index: int | None, tpl, policy: Policy | None, k: int, history=None):
+    def _words(
+        self, explanation: Explanation, index: int | None, tpl, policy: Policy | None, k: int, history=None, said=None
+    ):
         """(text, verification, source, rejected text) for one explanation: the subclass's words, verified, or the
         template's first phrasings when they fail."""
         facts = (
             global_facts(explanation, policy, k=max(k, 3))
             if index is None
-            else decision_facts(explanation, index, policy, k, history)
+            else replace(decision_facts(explanation, index, policy, k, history), counterfactual=said)
         )
         context = facts.context()
         variants = tpl.render_variants(track_global(context) if index is None else track_decision(context))

@@ -3,6 +3,7 @@ plausible values of every variable a decision or global template may use."""
 
 from __future__ import annotations
 
+from ..counterfactual_facts import ChangeFact, CounterfactualFact
 from ..facts import Comparison, DecisionFacts, FeatureFact, GlobalFacts
 
 
@@ -61,4 +62,14 @@ def sample_context(kind: str) -> dict:
         concession=against,
         base_margin=0.1,
         identifiers=(ident,),
+        counterfactual=CounterfactualFact(
+            True,
+            (ChangeFact("f1", "feature 1", "m", 1.0, "1.00 m", 0.5, "0.50 m", "below"),),
+            "b",
+            "b",
+            0.2,
+            "a",
+            "",
+            2,
+        ),
     ).context() | {"extras": _SampleExtras()}

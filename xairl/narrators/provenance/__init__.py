@@ -34,6 +34,7 @@ from ...tracking import Span
 from ..verify import Claim, SentenceCheck, Verification, reader, sentences
 from ..verify.checks import DIRECTION_RE
 from ..verify.numbers import normalise
+from .counterfactual import check_counterfactual, is_counterfactual
 from .lexicon import NUMERIC, SAID_OF_FEATURE, SUPERLATIVE
 from .parts import Part, literal
 from .spans import Sentence
@@ -55,6 +56,8 @@ RULES = {
     "tracked.level": "a level word ('low', 'normal', 'high') against the level of the feature it is said of",
     "tracked.untracked": "a number the template wrote itself that the reader cannot bind and that is no fact of the decision",
     "tracked.comparison": "'A mattered more than B' against the sizes of their contributions",
+    "tracked.counterfactual": "a counterfactual ('had X been below v, it would have chosen B') re-run: the policy on "
+    "the stated values takes another action than it did, the stated one, by the stated margin",
 }
 
 
@@ -73,8 +76,10 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, read, smu
     rules of this module, and its untracked numbers and identifiers by the reader (``read``: sentence -> claims;
     every claim it makes of the untracked words when ``smuggled``: a name that carried claims was left untracked)."""
     s = Sentence(sentence, spans, truth)
-    claims = []
+    claims = check_counterfactual(s, [p for p in s.spans if is_counterfactual(p)], truth)
     for p in s.spans:
+        if is_counterfactual(p):
+            continue
         claims.append(check_fact(p.span, truth, sentence[p.end : p.end + 9]))
         q = p.span.fact.quantity
         extra = []

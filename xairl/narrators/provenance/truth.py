@@ -27,6 +27,8 @@ class Truth:
     features: dict  # name -> {view: FeatureFact or ranking dict}
     actions: dict  # role -> name
     output: str
+    policy: Policy | None = None  # a counterfactual sentence is checked by running it (provenance.counterfactual)
+    state: np.ndarray | None = None  # the decision's state, flat, when it is the policy's input
 
     def get(self, span: Span):
         f = span.fact
@@ -92,7 +94,8 @@ def truth(exp: Explanation, index: int | None, policy: Policy | None, domain: Do
         values[("comparison_value", c.text, None, None)] = c.value
     for k, v in (domain.extras if domain else {}).items():
         values[("extra", str(k), None, None)] = v
-    return Truth(values, features, actions, exp.output)
+    flat = exp.states is not None and policy is not None and exp.states.shape[1] == policy.n_features
+    return Truth(values, features, actions, exp.output, policy, np.asarray(exp.states[index]) if flat else None)
 
 
 def number(text: str) -> float | None:

@@ -1,0 +1,220 @@
+"""A counterfactual as a fact a template can say (issue 56): 'Had the uplink buffer been below 38 % full (it was
+100 % full), the DQN would have chosen to hand over to candidate 2 (margin 4.2).'
+
+How it is built from a search's answer (:class:`xairl.counterfactuals.Counterfactuals`): each change's value is
+written as the narratives write values (:func:`xairl.values.value_text`: a buffer in % of its capacity, dBm, a
+category's label), and rounded *away from the line*, to the digits it is written with: 'below 37.6' for a line at
+37.64, never 'below 37.7', which rounds back across it. The state with the values as written is then run through the
+policy (all candidates in one batch, its action mask honoured); the first one that still takes the search's action is
+the fact (else the first that takes any other action than the one taken: the words name what the policy does there),
+with the action and the margin of that re-run. What a template prints is therefore exactly what the verifier
+re-runs (:mod:`xairl.narrators.provenance.counterfactual`). None of the candidates flipping as written (a line that
+bends within one rounding step) leaves the fact out: no sentence rather than a wrong one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .counterfactuals import Counterfactuals
+from .errors import InputError
+from .explanation import Explanation
+from .policy import FeatureInfo, Policy
+from .prompts import format_number
+from .values import fill_and_text
+
+__all__ = ["ChangeFact", "CounterfactualFact", "action_words", "counterfactual_fact", "said_counterfactual"]
+
+#: extra rounding steps tried, away from the line, when the value as written does not flip the decision
+_NUDGES = (0, 1, 3)
+#: a flip by less than this share of the scores' size is noise: a float32 network's scores differ in their last bits
+#: between batch shapes, so the check's re-run (one row) could read it either way; the next nudge is said instead
+NOISE = 1e-5
+
+
+@dataclass(frozen=True)
+class ChangeFact:
+    """One feature's change, as a narrative says it.
+
+    :param name: the feature's name; ``label`` its description (or the name); ``unit`` its unit.
+    :param value: its value in the state; ``value_text`` as narratives write it ('100 % full', '-85.3 dBm').
+    :param after: the value it would need, as written (rounded away from the line), in the feature's own unit;
+        ``after_text`` written like ``value_text`` ('37.6 % full'). Print ``after_text``: for a feature with a capacity
+        ``after`` is in its unit (bits), and ``|num`` may round it back across the line.
+    :param direction: 'below' (the value would have to be lower) or 'above'; '' for a category ('been <label>').
+    :param fill: for a feature with a capacity, ``value`` and ``after`` in % of it (``after_fill``); else None.
+    """
+
+    name: str
+    label: str
+    unit: str
+    value: float
+    value_text: str
+    after: float
+    after_text: str
+    direction: str
+    fill: float | None = None
+    after_fill: float | None = None
+
+
+@dataclass(frozen=True)
+class CounterfactualFact:
+    """What would have changed a decision, or that nothing within the bounds would have.
+
+    :param reachable: False when no change of at most ``max_changes`` features within the bounds flips it
+        (``changes`` is then empty, ``reason`` says why).
+    :param changes: the changes, all together, largest push first.
+    :param action: the action the policy takes with the changes as written; ``action_words`` the same as a text
+        says it (its first alias, e.g. 'hand over to candidate 2', else its name); '' when unreachable.
+    :param margin: that action's score minus the best other available action's, with the changes as written.
+    :param chosen: the action taken in the state; ``target`` what was asked ('the runner-up', a named action).
+    """
+
+    reachable: bool
+    changes: tuple[ChangeFact, ...]
+    action: str
+    action_words: str
+    margin: float
+    chosen: str
+    target: str
+    max_changes: int
+    reason: str = ""
+
+
+def _step(x: float) -> float:
+    """The last digit :func:`xairl.prompts.format_number` writes of ``x`` (0 decimals from 100, 1 from 10, else 2,
+    3 significant digits below 0.01)."""
+    a = abs(x)
+    if a >= 100:
+        return 1.0
+    if a >= 10:
+        return 0.1
+    if a >= 0.01 or a == 0:
+        return 0.01
+    return 10.0 ** (math.floor(math.log10(a)) - 2)
+
+
+def _outward(x: float, down: bool, extra: int = 0) -> float:
+    """``x`` rounded to the digits it is written with, away from the line (down for 'below'), ``extra`` steps more."""
+    s = _step(x)
+    n = math.floor(x / s + 1e-9) - extra if down else math.ceil(x / s - 1e-9) + extra
+    return float(format_number(n * s))
+
+
+def _written(before: float, after: float, info: FeatureInfo, extra: int) -> tuple[float, float | None, str]:
+    """(the value as written in the feature's unit, its fill or None, its text) for a change to ``after``."""
+    if info.categories:
+        code = int(np.clip(round(after), 0, len(info.categories) - 1))
+        return float(code), None, info.categories[code]
+    down = after < before
+    if info.capacity is not None:
+        fill = float(np.clip(_outward(100.0 * after / info.capacity, down, extra), 0.0, 100.0))  # (never -0.1 % full)
+        raw = fill * info.capacity / 100.0
+        return raw, fill, fill_and_text(raw, info, None)[1]
+    raw = _outward(after, down, extra)
+    return raw, None, fill_and_text(raw, info, None)[1]
+
+
+def action_words(policy: Policy, action: str) -> str:
+    """An action as a text says it: its first alias that names no other action, else its name."""
+    taken = [a for n, al in policy.action_aliases.items() if n != action for a in al]
+    return next((a for a in policy.action_aliases.get(action, ()) if a not in taken), action)
+
+
+def _unreachable(found: Counterfactuals, max_changes: int, reason: str = "") -> CounterfactualFact:
+    return CounterfactualFact(False, (), "", "", float("nan"), found.chosen, found.target, max_changes, reason)
+
+
+def counterfactual_fact(
+    exp: Explanation, index: int, policy: Policy, found: Counterfactuals, max_changes: int = 2
+) -> CounterfactualFact | None:
+    """The fact of ``found`` (the search's answer for state ``index``): its counterfactuals written as a narrative
+    writes them, re-run through ``policy`` in one batch; the first that flips as written to the search's action,
+    else the first that flips to another action than the chosen one (its words name the action taken), else None
+    (module doc)."""
+    if policy.output != "actions" or exp.states is None or exp.states.shape[1] != policy.n_features:
+        raise InputError("counterfactual words are for discrete actions on flat states; use xairl.counterfactual().")
+    if found.index != index:
+        raise InputError(f"the counterfactuals given are of state {found.index}, not {index}; search state {index}.")
+    if not found.reachable:
+        return _unreachable(found, max_changes, found.reason)
+    unknown = {c.feature for cf in found.found for c in cf.changes} - set(policy.feature_names)
+    if unknown:  # (an image's regions: their change is every pixel of them shifted, which no sentence states yet)
+        raise InputError(f"counterfactual words name the policy's features; {sorted(unknown)[0]!r} is none of them.")
+    state = np.asarray(exp.states[index], dtype=float)
+    said = [(cf, _said(policy, state, cf.changes, extra)) for cf in found.found for extra in _NUDGES]
+    said = [(cf, changes) for cf, changes in said if changes]
+    if not said:
+        return None
+    rows = np.repeat(state[None], len(said), axis=0)
+    for n, (_, changes) in enumerate(said):
+        rows[n, [policy.feature_names.index(c.name) for c in changes]] = [c.after for c in changes]
+    scores = policy.scores(rows)
+    free = np.where(policy.available(rows), scores, -np.inf)
+    chosen = policy.action_names.index(found.chosen)
+    # the search's own action as written first; else another action than the chosen one, which the words then name
+    for n in sorted(range(len(said)), key=lambda n: free[n].argmax() != policy.action_names.index(said[n][0].action)):
+        a = int(free[n].argmax())
+        others = np.delete(free[n], a)
+        margin = float(scores[n, a] - others.max()) if np.isfinite(others).any() else -np.inf
+        if a != chosen and margin > NOISE * max(1.0, np.abs(scores[n]).max()):
+            act = policy.action_names[a]
+            words = action_words(policy, act)
+            return CounterfactualFact(True, said[n][1], act, words, margin, found.chosen, found.target, max_changes)
+    return None
+
+
+def _said(policy: Policy, state: np.ndarray, changes, extra: int) -> tuple[ChangeFact, ...]:
+    """The changes as written, ``extra`` rounding steps further from the line."""
+    out = []
+    for c in changes:
+        j, info = policy.feature_names.index(c.feature), policy.features.get(c.feature) or FeatureInfo()
+        before = float(state[j])
+        raw, fill, text = _written(before, float(c.after), info, extra)
+        was, was_text = fill_and_text(before, info, _label(info, before))
+        if _shown(raw, info) == _shown(before, info):
+            continue  # no change in the digits written ('0 % full (it was 0 % full)'): left out, and not re-run
+        # no direction word for a category, nor at a capacity's end ('been 100 % full', not 'above 100 % full')
+        direction = "" if info.categories or fill in (0.0, 100.0) else "below" if raw < before else "above"
+        label = info.description or c.feature
+        out.append(ChangeFact(c.feature, label, info.unit, before, was_text, raw, text, direction, was, fill))
+    return tuple(out)
+
+
+def said_counterfactual(
+    exp: Explanation, index: int, policy: Policy | None, ask, background=None, max_changes: int = 2
+) -> CounterfactualFact | None:
+    """The counterfactual fact of decision ``index``: ``ask`` is True (run the search,
+    :func:`xairl.counterfactuals.search.counterfactual`, guided by ``exp``) or the search's answer
+    (:class:`~xairl.counterfactuals.Counterfactuals`) for that state, or the search's answers for several states
+    (``index=None``), among which that state's is taken."""
+    if policy is None:
+        raise InputError("counterfactual=True needs the policy (policy=...): the search and its check run it.")
+    if isinstance(ask, (tuple, list)) and all(isinstance(a, Counterfactuals) for a in ask):
+        ask = next((a for a in ask if a.index == index), None) or _refuse(index)  # a batch answer (index=None)
+    if not isinstance(ask, Counterfactuals):
+        from .counterfactuals.search import counterfactual
+
+        ask = counterfactual(
+            policy, exp.states, index=index, background=background, explanation=exp, max_changes=max_changes
+        )
+    return counterfactual_fact(exp, index, policy, ask, max_changes)
+
+
+def _shown(value: float, info: FeatureInfo) -> float:
+    """A value as its text shows it: a category's code, else the number written (a fill in % of a capacity)."""
+    if info.categories:
+        return float(round(value))
+    return float(format_number(100.0 * value / info.capacity if info.capacity is not None else value))
+
+
+def _refuse(index: int):
+    raise InputError(f"the counterfactuals given have no answer for state {index}; search it (counterfactual=True).")
+
+
+def _label(info: FeatureInfo, value: float) -> str | None:
+    code = int(round(value))
+    return info.categories[code] if info.categories and 0 <= code < len(info.categories) else None
