@@ -95,6 +95,8 @@ def test_report_cards_and_the_single_flip_table(tmp_path):
     path = write_report(req, ReportContent(title="t", policy=policy, background=bg, datasets=[("s", states)]))
     text = path.read_text()
     assert text.count("What would have changed it") == 3 and "Distance to another action" in text
+    # each card's narrative says it too, as its last sentence, marked as the verifier found it
+    assert text.count("the policy would have chosen") + text.count("No change of at most 2 features") == 3
     exp = xairl.explain(policy, states, background=bg)
     _, header, rows, sentence = flip_rows(policy, exp, bg)
     shares = {r[0]: r[1::2] for r in rows}  # per chosen action: 'share % (count)', then the median change
@@ -127,3 +129,16 @@ def test_review_page_shows_the_counterfactual_beside_the_narrative(tmp_path):
     html = page(store, "t")
     assert "What would have changed it" in html and found[i].best.action in html
     assert found[i].best.changes[0].feature in html.split("What would have changed it")[1]
+
+
+def test_a_narratives_counterfactual_sentence_shows_in_its_card():
+    policy = toy_policy()
+    bg = policy.background(50)
+    states = policy.background(6, seed=5)
+    exp = xairl.explain(policy, states, background=bg)
+    found = xairl.counterfactual(policy, states, index=None, background=bg, explanation=exp)
+    i = next(k for k, r in enumerate(found) if r.reachable)
+    n = xairl.narrate(exp, i, policy=policy, background=bg, robustness=False, counterfactual=found[i])
+    last, status = n.sentences[-1]
+    assert last.startswith("Had ") and found[i].best.action in last and status == "verified"
+    assert f"<span class='s verified' title='verified'>{last.split(' (')[0]}" in n._repr_html_()

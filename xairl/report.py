@@ -317,6 +317,7 @@ def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, sh
             options=req.narrator_options,
             prompt_dirs=req.prompt_dirs,
             robustness=req.robustness,
+            **({"counterfactual": found[i]} if i in found else {}),  # its sentence, checked by a re-run
         )
         for i in progress(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)
     ]

@@ -3,8 +3,10 @@ run a table of how near its decisions lie to another action, feature by feature.
 
 The cards: the narrated decisions are searched in one batch (:func:`xairl.counterfactual`: the smallest change of
 at most two features that makes the policy choose its runner-up, every result re-run through the policy), guided by
-the report's own explanation of them; each answer travels in its card's evidence (``evidence['counterfactual']``,
-:func:`xairl.counterfactuals.show.summary`), so the review page shows it as the report does.
+the report's own explanation of them; each answer is given to the narrator (its template's last sentence, 'Had ...
+been ..., the policy would have chosen ...', checked by re-running the policy on the values as written) and travels
+in its card's evidence (``evidence['counterfactual']``, :func:`xairl.counterfactuals.show.summary`), so the review
+page shows it as the report does.
 
 The run: for the first :data:`RUN` decisions, every feature that may change is tried alone (``max_changes=1``,
 ``target='any'``: any other action; one batched search keeps each feature's nearest flipping value). Per feature
@@ -21,6 +23,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
@@ -57,7 +60,7 @@ def decisions(policy: Policy, exp: Explanation, idx: list[int], background) -> d
     if not idx:
         return {}
     found = counterfactual(policy, exp.states[idx], index=None, background=background, explanation=exp[idx])
-    return dict(zip(idx, found))
+    return {i: replace(r, index=i) for i, r in zip(idx, found)}  # numbered as the states of ``exp``
 
 
 def attach(pairs: list, found: dict[int, Counterfactuals], policy: Policy) -> None:

@@ -58,6 +58,14 @@ def search(args, policy, exp, background):
     )
 
 
+def said(found, i: int, max_changes: int) -> dict:
+    """narrate's ``counterfactual`` argument for decision ``i``: its answer, for the template's sentence. An answer
+    of none found with ``--max-changes 1`` is not given (the sentence would say 'at most 2 features')."""
+    if found is None or (not found[i].reachable and max_changes != 2):
+        return {}
+    return {"counterfactual": found[i]}
+
+
 def summaries(found, policy) -> list[dict] | None:
     """Each decision's answer as plain data (:func:`xairl.counterfactuals.show.summary`), its values written as
     the narratives write them."""

@@ -12,7 +12,7 @@ import re
 from .. import plugins
 from ..errors import InputError
 from .args import MARKS, count, make_dir, narration_arguments, new_file, out_dir, parse_options, report_request
-from .counterfactual import block, counterfactual_arguments, search, summaries
+from .counterfactual import block, counterfactual_arguments, said, search, summaries
 
 #: above this many states, ``--out DIR`` without a --format streams them into DIR/explanations.parquet (200,000 toy
 #: states as one JSON-lines file: 207 MB built in memory, 1.18 GB peak RSS, written at the end with no progress bar;
@@ -50,9 +50,10 @@ def cmd_explain(args) -> int:
     exp = explain(policy, states, background=bg, method=args.method, options=options.model_dump())
     if args.out:
         return _write_report(args, exp, policy, bg)
-    found = summaries(search(args, policy, exp, bg), policy)  # --counterfactual: each decision's, in one batch
+    raw = search(args, policy, exp, bg)  # --counterfactual: each decision's, in one batch
+    found = summaries(raw, policy)
     if args.narrate:
-        return _print_narratives(args, exp, policy, bg, found)
+        return _print_narratives(args, exp, policy, bg, raw)
     if args.format == "jsonl":
         for i, rec in enumerate(exp.records()):
             print(
@@ -204,7 +205,7 @@ def _stream(args, policy, states, bg, options: dict) -> int:
     return 0
 
 
-def _print_narratives(args, exp, policy, bg, found=None) -> int:
+def _print_narratives(args, exp, policy, bg, raw=None) -> int:
     from ..feedback import FeedbackStore
     from ..narrators import narrate
 
@@ -212,6 +213,7 @@ def _print_narratives(args, exp, policy, bg, found=None) -> int:
     options = parse_options(args.narrator_option)
     if args.examples_from_feedback and store is not None:
         options.setdefault("examples", store.examples())
+    found = summaries(raw, policy)
     for i in range(len(exp.values)):
         n = narrate(
             exp,
@@ -223,6 +225,7 @@ def _print_narratives(args, exp, policy, bg, found=None) -> int:
             robustness=not args.no_robustness,
             options=options,
             prompt_dirs=args.prompts,
+            **said(raw, i, args.max_changes),  # the template's counterfactual sentence, checked by a re-run
         )
         if found is not None and n.evidence is not None:  # the review page shows it beside the narrative
             n.evidence["counterfactual"] = found[i]
