@@ -142,3 +142,19 @@ def test_a_narratives_counterfactual_sentence_shows_in_its_card():
     last, status = n.sentences[-1]
     assert last.startswith("Had ") and found[i].best.action in last and status == "verified"
     assert f"<span class='s verified' title='verified'>{last.split(' (')[0]}" in n._repr_html_()
+
+
+def test_the_single_flip_table_of_a_window_policy_takes_its_background_as_windows():
+    import torch
+
+    from .conftest import mlp
+
+    policy = xairl.Policy(
+        torch.nn.Sequential(torch.nn.Flatten(), mlp([12, 16, 3])), feature_names=list("abc"), window=4
+    )
+    rng = np.random.default_rng(0)
+    states, bg = rng.normal(size=(20, 4, 3)).astype(np.float32), rng.normal(size=(60, 4, 3)).astype(np.float32)
+    exp = xairl.explain(policy, states, background=bg)
+    _, _, rows, _ = flip_rows(policy, exp, bg)
+    assert {r[0] for r in rows[:-3]} == {f"{s}[t-{k}]" if k else f"{s}[t]" for s in "abc" for k in range(4)}
+    assert sum(int(c) for c in rows[-1][1::2]) == 20

@@ -79,7 +79,7 @@ def flip_rows(policy: Policy, exp: Explanation, background, limit: int = RUN) ->
     from .counterfactuals.bounds import units
 
     k = min(len(exp), limit)
-    names = list(units(policy, background, None).names)
+    names = list(units(policy, policy.check_states(background, "background"), None).names)  # any form it takes
     found = counterfactual(
         policy, exp.states[:k], index=None, target="any", max_changes=1, n=max(len(names), 1),
         background=background, explanation=exp[:k],
