@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .counterfactuals import Counterfactuals
-from .counterfactuals.goals import _action_index  # (the one resolver of an action's name or alias: the search's)
+from .counterfactuals.goals import action_index as resolve  # (the one resolver of an action's name or alias)
+from .counterfactuals.goals import lead
 from .errors import InputError
 from .explanation import Explanation
 from .policy import FeatureInfo, Policy
@@ -125,15 +126,9 @@ def _written(before: float, after: float, info: FeatureInfo, extra: int) -> tupl
 def action_index(policy: Policy, text: str) -> int | None:
     """The action ``text`` names (its name, or an alias no other action has), else None: the search's resolver."""
     try:
-        return _action_index(policy, text.strip())
+        return resolve(policy, text.strip())
     except InputError:
         return None
-
-
-def lead(scores: np.ndarray, available: np.ndarray, a: int) -> float:
-    """Action ``a``'s score minus the best other available action's (-inf where none other is available)."""
-    others = np.delete(np.where(available, scores, -np.inf), a)
-    return float(scores[a] - others.max()) if np.isfinite(others).any() else -np.inf
 
 
 _PAST_SLOT = re.compile(r"^(?P<signal>.+)\[t-(?P<k>\d+)\]$")

@@ -37,7 +37,7 @@ import numpy as np
 from ..errors import InputError
 from ..policy import Policy
 from . import bounds
-from .goals import Goal, pushes
+from .goals import Goal, lead, pushes
 from .result import Change, Counterfactual, Counterfactuals
 
 GRID, GRID2, TOP_SINGLE, TOP_PAIR, STEPS, ZOOMS = 64, 13, 16, 9, 24, 3
@@ -293,11 +293,9 @@ class _Search:
         dist, scaled = self._sizes(s, units, after[list(units)])
         if policy.output == "actions":
             a = int(np.argmax(np.where(avail[r], scores, -np.inf)))
-            others = np.delete(np.where(avail[r], scores, -np.inf), a)
-            best = (
-                others.max() if len(others) and np.isfinite(others.max()) else np.delete(scores, a).max(initial=-np.inf)
-            )
-            action, output, margin = policy.action_names[a], float(scores[a]), float(scores[a] - best)
+            margin = lead(scores, avail[r], a)  # (the only available action: its lead over the unavailable ones)
+            margin = margin if np.isfinite(margin) else lead(scores, np.ones_like(avail[r]), a)
+            action, output = policy.action_names[a], float(scores[a])
         else:
             j = self.goal.j
             action, output, margin = policy.action_names[j], float(scores[j]), float(gap)
