@@ -47,7 +47,7 @@ REAL := ../shared/data/ukm-uav-lte/raw
 demo: setup-demo
 	@# the main job: Table I, SHAP on simulated and real flights, narrated decisions
 	$(VENV)/bin/xairl report --plugin uav-handover --narrate --out out/report -o real=$(if $(wildcard $(REAL)),$(REAL),ukm)
-	$(VENV)/bin/xairl explain --policy uav-dqn --n 2 --narrate --template handover --no-record
+	$(VENV)/bin/xairl explain --policy uav-dqn --n 2 --narrate --template handover --no-record --counterfactual
 	@echo "the report: $(CURDIR)/out/report/report.html"
 
 # two workers, one torch thread each: the suite's files shared over two cores (one thread per worker, as two

@@ -89,18 +89,24 @@ def template(name: str):
     return prompts.load(name)
 
 
-def said(exp, i, policy, fact, name="explain_action", check_policy="same", alone=False):
+#: the head of a sentence of one's own ('{{ c.label }}' and the rest): the fact as ``cf``, its first change as ``c``
+OWN = "{% if counterfactual %}{% set cf = counterfactual %}{% set c = cf.changes[0] %}"
+#: the built-in sentence of one change
+HAD = "Had {{ c.label }} been {{ c.direction ~ ' ' if c.direction }}{{ c.after_text }} (it was {{ c.value_text }}), "
+
+
+def said(exp, i, policy, fact, name="explain_action", check_policy="same", alone=False, sentence=None, head=OWN):
     """(text, status of its counterfactual sentence, verification) of template ``name`` rendered with ``fact``;
-    ``alone``: its last sentence only (the counterfactual's), rendered and checked on its own."""
+    ``alone``: its last sentence only (the counterfactual's), rendered and checked on its own; ``sentence``: that
+    sentence replaced by this one (after ``head``), rendered and checked alone."""
     tpl = template(name)
-    if alone:
-        tpl = replace(
-            tpl, spec=tpl.spec.model_copy(update={"sentences": tpl.spec.sentences[-1:]}), lines=tpl.lines[-1:]
-        )
+    if alone or sentence is not None:
+        own = [[head + sentence + "{% endif %}"]] if sentence is not None else tpl.spec.sentences[-1:]
+        tpl = replace(tpl, spec=tpl.spec.model_copy(update={"sentences": own}), lines=tpl.lines[-1:])
     facts = replace(decision_facts(exp, i, policy, 3), counterfactual=fact)
     text = first_phrasings(tpl.render_variants(track_decision(facts.context())))
     v = verify(text, exp, i, policy if check_policy == "same" else check_policy, provenance=text.spans)
-    last = [s for s in v.sentences if s.text.startswith(("Had ", "No change"))]
+    last = v.sentences if sentence is not None else [s for s in v.sentences if s.text.startswith("Had ")]
     assert len(last) == 1, text
     return text, last[0].status, v
 
@@ -166,6 +172,35 @@ def mutants(policy: Policy, state: np.ndarray, fact, line: tuple[float, float] |
         yield kind, m
 
 
+def text_mutants(policy: Policy, fact, line: tuple[float, float] | None):
+    """(kind, sentence of one's own) that must be contradicted: the template's *words* mutated, with the fact right:
+    its values swapped, a wrong threshold written as a literal number, the action taken said as the new one, the
+    claim negated, the threshold said as a fact of the state."""
+    c, then = fact.changes[0], "the policy would have chosen {{ cf.action }} (margin {{ cf.margin|num }})."
+    word = c.direction + " " if c.direction else ""
+    out = [
+        (
+            "swapped roles",
+            f"Had {{{{ c.label }}}} been {word}{{{{ c.value_text }}}} (it was {{{{ c.after_text }}}}), {then}",
+        ),
+        ("the action taken as the new one", HAD + "the policy would have chosen {{ cf.chosen }}."),
+        ("negated", HAD + "the policy would not have chosen {{ cf.action }}."),
+        (
+            "said as a fact of the state",
+            "{{ c.label|cap }} was {{ c.after_text }}, so the policy chose {{ cf.action }}.",
+        ),
+    ]
+    if line is not None and not (policy.features.get(c.name) or FeatureInfo()).categories:
+        wrong = at(policy, c, line[0] + 0.5 * (c.value - line[0])).after_text
+        out.append(
+            (
+                "literal threshold",
+                f"Had {{{{ c.label }}}} been {word}{wrong} (it was {{{{ c.value_text }}}}), {then}",
+            )
+        )
+    return out
+
+
 def corpus(policy, exp, states, facts, lines, template="explain_action"):
     """Every correct rendering verified, every mutation contradicted: (correct, Counter of mutations by kind,
     Counter of those the re-run itself contradicted: the stated values or action, not a word or 'it was')."""
@@ -179,6 +214,11 @@ def corpus(policy, exp, states, facts, lines, template="explain_action"):
             assert status == "contradicted", (kind, text)
             counts[kind] += 1
             rerun[kind] += any(c.status == "contradicted" and "re-run" in c.detail for c in v.claims)
+        for kind, body in text_mutants(policy, fact, lines.get(i)) if len(fact.changes) == 1 else ():
+            text, status, v = said(exp, i, policy, fact, template, sentence=body)
+            assert status == "contradicted", (kind, text)
+            counts[f"text: {kind}"] += 1
+            rerun[f"text: {kind}"] += any(c.status == "contradicted" and "re-run" in c.detail for c in v.claims)
     return n_ok, counts, rerun
 
 
@@ -186,5 +226,6 @@ def caught_by_the_rerun(name: str, n_ok: int, counts, rerun) -> None:
     """A threshold on the wrong side, another action, a change left out: the re-run itself contradicts them."""
     print(f"{name}: {n_ok} verified; {sum(counts.values())} mutations contradicted, {sum(rerun.values())} of them "
           f"by the re-run; by kind (contradicted, by the re-run): {({k: (v, rerun[k]) for k, v in counts.items()})}")  # fmt: skip
-    for kind in ("threshold by a margin", "threshold just across", "wrong action", "a change left out"):
+    every = ("threshold by a margin", "threshold just across", "wrong action", "a change left out")
+    for kind in (*every, "text: swapped roles", "text: literal threshold", "text: the action taken as the new one"):
         assert rerun[kind] == counts[kind], kind

@@ -8,25 +8,43 @@ category's label), and rounded *away from the line*, to the digits it is written
 policy (all candidates in one batch, its action mask honoured); the first one that still takes the search's action is
 the fact (else the first that takes any other action than the one taken: the words name what the policy does there),
 with the action and the margin of that re-run. What a template prints is therefore exactly what the verifier
-re-runs (:mod:`xairl.narrators.provenance.counterfactual`). None of the candidates flipping as written (a line that
+re-runs (:mod:`xairl.narrators.provenance.counterfactual`). A candidate must also keep the state one the world
+allows as written (:func:`broken`: the policy's ``feasible``, the declared bounds, no immutable feature changed):
+rounding away from the line may step off the searched point. None of the candidates flipping as written (a line that
 bends within one rounding step) leaves the fact out: no sentence rather than a wrong one.
+
+A window policy's past slot (``speed[t-2]``) is named as that slot, 'the speed 2 steps ago' (:func:`feature_words`),
+never by its signal's words alone, which name the current value.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from .counterfactuals import Counterfactuals
+from .counterfactuals.goals import action_index as resolve  # (the one resolver of an action's name or alias)
+from .counterfactuals.goals import lead
 from .errors import InputError
 from .explanation import Explanation
 from .policy import FeatureInfo, Policy
-from .prompts import format_number
+from .prompts import format_number, written_step
 from .values import fill_and_text
 
-__all__ = ["ChangeFact", "CounterfactualFact", "action_words", "counterfactual_fact", "said_counterfactual"]
+__all__ = [
+    "ChangeFact",
+    "CounterfactualFact",
+    "action_index",
+    "action_words",
+    "broken",
+    "counterfactual_fact",
+    "feature_words",
+    "lead",
+    "said_counterfactual",
+]
 
 #: extra rounding steps tried, away from the line, when the value as written does not flip the decision
 _NUDGES = (0, 1, 3)
@@ -84,22 +102,9 @@ class CounterfactualFact:
     reason: str = ""
 
 
-def _step(x: float) -> float:
-    """The last digit :func:`xairl.prompts.format_number` writes of ``x`` (0 decimals from 100, 1 from 10, else 2,
-    3 significant digits below 0.01)."""
-    a = abs(x)
-    if a >= 100:
-        return 1.0
-    if a >= 10:
-        return 0.1
-    if a >= 0.01 or a == 0:
-        return 0.01
-    return 10.0 ** (math.floor(math.log10(a)) - 2)
-
-
 def _outward(x: float, down: bool, extra: int = 0) -> float:
     """``x`` rounded to the digits it is written with, away from the line (down for 'below'), ``extra`` steps more."""
-    s = _step(x)
+    s = written_step(x)
     n = math.floor(x / s + 1e-9) - extra if down else math.ceil(x / s - 1e-9) + extra
     return float(format_number(n * s))
 
@@ -116,6 +121,47 @@ def _written(before: float, after: float, info: FeatureInfo, extra: int) -> tupl
         return raw, fill, fill_and_text(raw, info, None)[1]
     raw = _outward(after, down, extra)
     return raw, None, fill_and_text(raw, info, None)[1]
+
+
+def action_index(policy: Policy, text: str) -> int | None:
+    """The action ``text`` names (its name, or an alias no other action has), else None: the search's resolver."""
+    try:
+        return resolve(policy, text.strip())
+    except InputError:
+        return None
+
+
+_PAST_SLOT = re.compile(r"^(?P<signal>.+)\[t-(?P<k>\d+)\]$")
+
+
+def feature_words(policy: Policy, name: str) -> str:
+    """How a counterfactual names a feature: its description, else its name; a window's past slot
+    (``speed[t-2]``) as its signal's words that many steps ago ('the speed 2 steps ago')."""
+    info = policy.features.get(name) or FeatureInfo()
+    slot = _PAST_SLOT.match(name) if policy.observation.kind == "window" else None
+    if slot is None:
+        return info.description or name
+    k = int(slot["k"])
+    return f"{info.description or slot['signal']} {k} step{'s' if k > 1 else ''} ago"
+
+
+def broken(policy: Policy, states: np.ndarray, changed: list[list[int]]) -> list[str]:
+    """Per changed state (``states`` (n, F), row r with columns ``changed[r]`` changed): '' when the world allows
+    it, else which constraint it breaks (an immutable feature changed, a declared bound crossed, the policy's
+    ``feasible`` false), in words."""
+    ok = np.ones(len(states), bool) if policy.feasible is None else np.asarray(policy.feasible(states), bool)
+    out = []
+    for r, cols in enumerate(changed):
+        why = "" if ok[r] else f"policy '{policy.name}' calls that state infeasible (its feasible() is False)"
+        for j in cols:
+            f = policy.feature_names[j]
+            info, v = policy.features.get(f) or FeatureInfo(), float(states[r, j])
+            if info.immutable or info.kind == "identifier":
+                why = f"{f} is declared immutable: no counterfactual changes it"
+            elif info.bounds is not None and not info.bounds[0] <= v <= info.bounds[1]:
+                why = f"{f} = {v:.6g} is outside its declared bounds {info.bounds}"
+        out.append(why)
+    return out
 
 
 def action_words(policy: Policy, action: str) -> str:
@@ -152,15 +198,15 @@ def counterfactual_fact(
     rows = np.repeat(state[None], len(said), axis=0)
     for n, (_, changes) in enumerate(said):
         rows[n, [policy.feature_names.index(c.name) for c in changes]] = [c.after for c in changes]
-    scores = policy.scores(rows)
-    free = np.where(policy.available(rows), scores, -np.inf)
+    scores, avail = policy.scores(rows), policy.available(rows)
+    free = np.where(avail, scores, -np.inf)
     chosen = policy.action_names.index(found.chosen)
+    breaks = broken(policy, rows, [[policy.feature_names.index(c.name) for c in changes] for _, changes in said])
     # the search's own action as written first; else another action than the chosen one, which the words then name
     for n in sorted(range(len(said)), key=lambda n: free[n].argmax() != policy.action_names.index(said[n][0].action)):
         a = int(free[n].argmax())
-        others = np.delete(free[n], a)
-        margin = float(scores[n, a] - others.max()) if np.isfinite(others).any() else -np.inf
-        if a != chosen and margin > NOISE * max(1.0, np.abs(scores[n]).max()):
+        margin = lead(scores[n], avail[n], a)
+        if a != chosen and not breaks[n] and margin > NOISE * max(1.0, np.abs(scores[n]).max()):
             act = policy.action_names[a]
             words = action_words(policy, act)
             return CounterfactualFact(True, said[n][1], act, words, margin, found.chosen, found.target, max_changes)
@@ -179,23 +225,37 @@ def _said(policy: Policy, state: np.ndarray, changes, extra: int) -> tuple[Chang
             continue  # no change in the digits written ('0 % full (it was 0 % full)'): left out, and not re-run
         # no direction word for a category, nor at a capacity's end ('been 100 % full', not 'above 100 % full')
         direction = "" if info.categories or fill in (0.0, 100.0) else "below" if raw < before else "above"
-        label = info.description or c.feature
+        label = feature_words(policy, c.feature)
         out.append(ChangeFact(c.feature, label, info.unit, before, was_text, raw, text, direction, was, fill))
     return tuple(out)
 
 
 def said_counterfactual(
-    exp: Explanation, index: int, policy: Policy | None, ask, background=None, max_changes: int = 2
+    exp: Explanation, index: int | None, policy: Policy | None, ask, background=None, max_changes: int = 2
 ) -> CounterfactualFact | None:
-    """The counterfactual fact of decision ``index``: ``ask`` is True (run the search,
-    :func:`xairl.counterfactuals.search.counterfactual`, guided by ``exp``) or the search's answer
-    (:class:`~xairl.counterfactuals.Counterfactuals`) for that state, or the search's answers for several states
-    (``index=None``), among which that state's is taken."""
+    """The counterfactual fact of decision ``index``, or None when not asked: ``ask`` is False (or None), True (run
+    the search, :func:`xairl.counterfactuals.search.counterfactual`, guided by ``exp``), the search's answer
+    (:class:`~xairl.counterfactuals.Counterfactuals`) for that state, or its answers for several states (a tuple,
+    ``index=None``), among which that state's is taken. Anything else is refused in one line."""
+    many = isinstance(ask, (tuple, list)) and ask and all(isinstance(a, Counterfactuals) for a in ask)
+    if ask is None or ask is False:
+        return None
+    if ask is not True and not many and not isinstance(ask, Counterfactuals):
+        raise InputError(
+            f"counterfactual is True (search), False, or xairl.counterfactual()'s answer; got {ask!r:.40}."
+        )
+    if index is None:
+        raise InputError("a counterfactual is of one decision: give narrate a state index, not index=None.")
     if policy is None:
         raise InputError("counterfactual=True needs the policy (policy=...): the search and its check run it.")
-    if isinstance(ask, (tuple, list)) and all(isinstance(a, Counterfactuals) for a in ask):
+    if policy.output != "actions":
+        raise InputError(
+            f"counterfactual words are for discrete actions; policy '{policy.name}' outputs {policy.output}: narrate "
+            "without counterfactual=, and call xairl.counterfactual(..., target=xairl.Threshold(...)) for it."
+        )
+    if many:
         ask = next((a for a in ask if a.index == index), None) or _refuse(index)  # a batch answer (index=None)
-    if not isinstance(ask, Counterfactuals):
+    if ask is True:
         from .counterfactuals.search import counterfactual
 
         ask = counterfactual(

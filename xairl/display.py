@@ -1,7 +1,8 @@
 """What a notebook shows of an explanation: an HTML table of its first decisions and their largest contributions,
 in the margin view (the narratives' view), the view named. A Narrative shows its evidence card
-(:func:`xairl.evidence.card_html`). Also what figures and tables share with the narratives: a feature's value as the
-narratives write it (:func:`value_text`), and a progress bar that is quiet in a notebook (:func:`progress`).
+(:func:`xairl.evidence.card_html`); a decision's counterfactuals their own small card (:func:`counterfactual_html`,
+also inside a decision card), or lines on a terminal (:func:`counterfactual_text`). Also a progress bar that is quiet
+in a notebook (:func:`progress`).
 """
 
 from __future__ import annotations
@@ -66,3 +67,52 @@ def explanation_html(exp, states: int = 5, top: int = 6) -> str:
         f"<div class=xairl-explanation><p><code>{html.escape(repr(exp))}</code></p><table><tr><th>state</th>"
         f"<th>decision</th><th>largest contributions to {target}</th></tr>{''.join(rows)}</table>{more}</div>"
     )
+
+
+def counterfactual_text(cf: dict) -> list[str]:
+    """A decision's counterfactuals (the plain dict of :func:`xairl.counterfactuals.show.summary`) as terminal lines:
+    one per counterfactual, 'rsrp_1 -83.2 dBm -> -71.5 dBm: handover_to_candidate_1 (margin 0.0052)', or the one line
+    'unreachable within the bounds: <why>'."""
+    if not cf.get("found"):
+        return [f"unreachable within the bounds: {cf.get('reason') or 'no change found'}"]
+    return [
+        f"{_changes(one, ' -> ')}: {one['action']} (margin {one['margin']:.3g}, distance {one['distance']:.2f})"
+        for one in cf["found"]
+    ]
+
+
+def _changes(one: dict, arrow: str, escape=lambda s: s) -> str:
+    return " and ".join(
+        f"{escape(c['feature'])} {escape(c['before_text'])}{arrow}{escape(c['after_text'])}" for c in one["changes"]
+    )
+
+
+#: the counterfactual card's look (beside a decision card's, or alone in a notebook)
+CF_STYLE = (
+    ".xairl-cf{margin:.5em 0;font-size:90%}.xairl-cf table{border-collapse:collapse}"
+    ".xairl-cf td,.xairl-cf th{border:1px solid #ddd;padding:1px 6px}"
+)
+
+
+def counterfactual_html(cf: dict) -> str:
+    """'What would have changed it': a decision's counterfactuals (the dict of
+    :func:`xairl.counterfactuals.show.summary`) as a small HTML card: each one's changes, the action the policy then
+    takes and its margin, or why none is reachable within the bounds."""
+    e = html.escape
+    head = (
+        f"<b>What would have changed it</b> <span class=meta>(chose {e(cf['chosen'])}; asked: {e(cf['target'])}; each "
+        "re-run through the policy)</span>"
+    )
+    if not cf.get("found"):
+        body = f"<p class=cf-none>None found: {e(cf.get('reason') or 'no change found')}.</p>"
+    else:
+        rows = "".join(
+            f"<tr><td>{_changes(one, ' &rarr; ', e)}</td><td>{e(one['action'])}</td><td>{one['margin']:.3g}</td>"
+            f"<td>{one['distance']:.2f}</td></tr>"
+            for one in cf["found"]
+        )
+        body = (
+            "<table><tr><th>change</th><th>then the policy chooses</th><th>margin</th>"
+            f"<th>distance (quantiles)</th></tr>{rows}</table>"
+        )
+    return f"<div class=xairl-cf>{head}{body}</div>"

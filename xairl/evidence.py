@@ -2,8 +2,9 @@
 
 An operator checks a narrative against the state and the numbers: :func:`evidence` collects them (the decision,
 every feature's value and contributions to the margin over the runner-up and to the chosen score, each sentence's
-verification status, the confidence components) as plain JSON-ready data; the feedback store keeps it with the
-narrative, and :func:`card_html` draws the same card in the HTML report and on the review page.
+verification status, the confidence components; a decision's counterfactuals where they were searched, under
+``'counterfactual'``) as plain JSON-ready data; the feedback store keeps it with the narrative, and :func:`card_html`
+draws the same card in the HTML report and on the review page.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from .display import CF_STYLE, counterfactual_html
 from .explanation import Explanation
 
 #: how many contributions the card's waterfall shows (the rest as one bar)
@@ -146,6 +148,8 @@ def card_html(narrative_text: str, ev: dict, meta: str = "", controls: str = "")
     parts = [f"<p class=narrative>{text}</p>"]
     if meta:
         parts.append(f"<p class=meta>{meta}</p>")
+    if ev.get("counterfactual"):  # what would have changed it (xairl.counterfactuals.show.summary)
+        parts.append(counterfactual_html(ev["counterfactual"]))
     side = [f"<table class=comp><tr><th>confidence</th><th>{ev.get('confidence', 0):.2f}</th></tr>{comps}</table>"]
     if "features" in ev:
         state = "".join(
@@ -171,5 +175,5 @@ CARD_STYLE = (
     "white-space:nowrap}.wf-track{position:relative;flex:1;height:1em;background:#f4f4f4}.wf-bar{position:"
     "absolute;top:0;height:100%}.wf-bar.up{background:#d62728}.wf-bar.down{background:#1f77b4}"
     ".wf-val{width:5em;text-align:right}.wf-head{font-weight:bold;margin-bottom:.2em}"
-    ".meta{color:#555;font-size:90%}"
+    ".meta{color:#555;font-size:90%}" + CF_STYLE
 )

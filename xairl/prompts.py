@@ -9,6 +9,7 @@ Lookup of ``NAME``: explicit folders (``--prompts DIR``) > ``$XAIRL_USER_PATH/pr
 
 from __future__ import annotations
 
+import decimal
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -90,6 +91,12 @@ def format_number(x: float, signed: bool = False) -> str:
     if s.startswith("-") and float(s) == 0:
         s = s[1:]
     return ("+" + s) if signed and not s.startswith("-") else s
+
+
+def written_step(x: float) -> float:
+    """The place of the last digit :func:`format_number` writes of ``x`` (1 for '120', 0.1 for '37.6', 1e-05 for
+    '0.00123'): a value rounded to it is written exactly."""
+    return 10.0 ** decimal.Decimal(format_number(x)).as_tuple().exponent
 
 
 def _num(x, signed: bool = False) -> str:

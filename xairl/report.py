@@ -18,6 +18,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from . import report_counterfactuals as cfs
 from .evidence import CARD_STYLE, card_html, evidence
 from .explanation import Explanation
 from .explanation_io import StateRecord
@@ -59,6 +60,7 @@ class ReportRequest:
     robustness: bool = True
     progress: bool = True
     records: bool = True  # write explanations.jsonl (False when the explanations are already written as Parquet)
+    counterfactuals: bool = True  # cards: 'What would have changed it'; the run: each feature's single flips
 
 
 @dataclass
@@ -275,6 +277,10 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
         else []
     )
     notes = (content.commentary({label: e for label, e in exps}) if content.commentary else []) + content.notes
+    if req.counterfactuals and cfs.shown(content.policy, ref):  # the run's distance to another action, by feature
+        title, header, rows, sentence = cfs.flip_rows(content.policy, ref, content.background)
+        tables.append((title, table_html(header, rows)))
+        notes.append(sentence)
     narratives = _narratives(req, content, ref, regioned[0][1], pick) if req.narrate else []
     settings = {
         "method": req.method,
@@ -298,6 +304,8 @@ def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, sh
     from .narrators import narrate
 
     idx = [pick] + [i for i in range(len(ref.values)) if i != pick][: max(req.n_narrated - 1, 0)]
+    on = req.counterfactuals and cfs.shown(content.policy, ref)
+    found = cfs.decisions(content.policy, ref, idx, content.background) if on else {}
     out = [
         narrate(
             ref,
@@ -309,11 +317,13 @@ def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, sh
             options=req.narrator_options,
             prompt_dirs=req.prompt_dirs,
             robustness=req.robustness,
+            **({"counterfactual": found[i]} if i in found else {}),  # its sentence, checked by a re-run
         )
         for i in progress(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)
     ]
     out.append(narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs))
     pairs = [(n, n.evidence if n.evidence is not None else evidence(shown, n)) for n in out]  # of its regions
+    cfs.attach(pairs, found, content.policy)
     if content.policy.groups:
         grouped = ref.grouped(dict(content.policy.groups))
         n = narrate(grouped, None, policy=content.policy, prompt_dirs=req.prompt_dirs)

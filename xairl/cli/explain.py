@@ -12,6 +12,7 @@ import re
 from .. import plugins
 from ..errors import InputError
 from .args import MARKS, count, make_dir, narration_arguments, new_file, out_dir, parse_options, report_request
+from .counterfactual import block, counterfactual_arguments, said, search, summaries
 
 #: above this many states, ``--out DIR`` without a --format streams them into DIR/explanations.parquet (200,000 toy
 #: states as one JSON-lines file: 207 MB built in memory, 1.18 GB peak RSS, written at the end with no progress bar;
@@ -49,13 +50,17 @@ def cmd_explain(args) -> int:
     exp = explain(policy, states, background=bg, method=args.method, options=options.model_dump())
     if args.out:
         return _write_report(args, exp, policy, bg)
+    raw = search(args, policy, exp, bg)  # --counterfactual: each decision's, in one batch
+    found = summaries(raw, policy)
     if args.narrate:
-        return _print_narratives(args, exp, policy, bg)
+        return _print_narratives(args, exp, policy, bg, raw)
     if args.format == "jsonl":
-        for rec in exp.records():
-            print(rec.model_dump_json())
+        for i, rec in enumerate(exp.records()):
+            print(
+                rec.model_dump_json() if found is None else json.dumps({**rec.model_dump(), "counterfactual": found[i]})
+            )
         return 0
-    return _print_table(exp, args.top, args.view)
+    return _print_table(exp, args.top, args.view, found)
 
 
 def _choose_format(args, policy):
@@ -90,7 +95,7 @@ def _choose_format(args, policy):
     return states
 
 
-def _print_table(exp, top: int, view: str) -> int:
+def _print_table(exp, top: int, view: str, found=None) -> int:
     """Each state's strongest contributions, labelled with what they add up to: the margin over the runner-up
     (why this action and not the next best; the narratives' view) or the chosen action's score."""
     import numpy as np
@@ -122,6 +127,8 @@ def _print_table(exp, top: int, view: str) -> int:
                 print(
                     f"    base {exp.base_values[i, a]:.4f}, additivity gap {exp.additivity_gap[i, a]:.2e} ({exp.method})"
                 )
+        if found is not None:
+            print(block(found[i]))
     return 0
 
 
@@ -198,7 +205,7 @@ def _stream(args, policy, states, bg, options: dict) -> int:
     return 0
 
 
-def _print_narratives(args, exp, policy, bg) -> int:
+def _print_narratives(args, exp, policy, bg, raw=None) -> int:
     from ..feedback import FeedbackStore
     from ..narrators import narrate
 
@@ -206,6 +213,7 @@ def _print_narratives(args, exp, policy, bg) -> int:
     options = parse_options(args.narrator_option)
     if args.examples_from_feedback and store is not None:
         options.setdefault("examples", store.examples())
+    found = summaries(raw, policy)
     for i in range(len(exp.values)):
         n = narrate(
             exp,
@@ -217,8 +225,12 @@ def _print_narratives(args, exp, policy, bg) -> int:
             robustness=not args.no_robustness,
             options=options,
             prompt_dirs=args.prompts,
-            store=store,
+            **said(raw, i, args.max_changes),  # the template's counterfactual sentence, checked by a re-run
         )
+        if found is not None and n.evidence is not None:  # the review page shows it beside the narrative
+            n.evidence["counterfactual"] = found[i]
+        if store is not None:
+            store.record(n, policy=policy)
         if args.format == "jsonl":
             print(
                 json.dumps(
@@ -231,6 +243,7 @@ def _print_narratives(args, exp, policy, bg) -> int:
                         "source": n.source,
                         "template": n.template,
                         "sentences": [{"text": t, "status": st} for t, st in n.sentences],
+                        **({"counterfactual": found[i]} if found is not None else {}),
                     }
                 )
             )
@@ -239,6 +252,8 @@ def _print_narratives(args, exp, policy, bg) -> int:
         parts = ", ".join(f"{k} {v:.2f}" for k, v in n.components.items() if v is not None)
         print(f"state {i} [{mark}, confidence {n.confidence:.2f}: {parts}; {n.source}]")
         print(marked_rows(n.text, n.sentences))
+        if found is not None:
+            print(block(found[i]))
     return 0
 
 
@@ -364,6 +379,7 @@ def explain_parser(p: argparse.ArgumentParser) -> None:
         "show the margin beside the score)",
     )
     narration_arguments(p)
+    counterfactual_arguments(p)
     p.add_argument(
         "--feedback-db", type=new_file, default=None, help="SQLite store of shown narratives (default: in the user dir)"
     )

@@ -2,7 +2,8 @@
 
 A *unit* of change is what one change moves: a flat feature (a dict observation's columns by their names, a window's
 slots as flat features), or, for an image, a region of it (the patches of :meth:`xairl.Observation.regions`, named
-as narration names them). A region's change shifts all its pixels by one amount; its value is their mean.
+as narration names them). A region's change shifts all its pixels by one amount, each kept within the pixel range
+the background holds for that region (a pixel already outside it is not moved further out); its value is their mean.
 
 Never changed: a feature declared ``FeatureInfo(immutable=True)``, an identifier (``kind='identifier'``: a cell's id
 means nothing as a quantity) and a categorical (its codes have no order; the one-hot columns of a categorical input
@@ -34,6 +35,8 @@ class Units:
     :param names: one per unit; ``columns`` the flat columns each covers; ``labels`` its unit of measure.
     :param declared: (U, 2) declared bounds (-inf/inf where none).
     :param sorted_bg: (B, U) the background's value of each unit, sorted per unit.
+    :param pixels: (U, 2) the lowest and highest value of any column of each unit in the background (a region's
+        pixels are shifted within it).
     """
 
     names: tuple[str, ...]
@@ -41,6 +44,7 @@ class Units:
     labels: tuple[str, ...]
     declared: np.ndarray
     sorted_bg: np.ndarray
+    pixels: np.ndarray
 
     @property
     def n(self) -> int:
@@ -79,7 +83,18 @@ class Units:
         """Shift in place unit ``unit[r]`` of row ``x[r]`` by ``delta[r]`` (every column of a region alike)."""
         for u in np.unique(unit):
             rows = np.flatnonzero(unit == u)
-            x[np.ix_(rows, self.columns[u])] += delta[rows, None]
+            self.move(x, rows, u, delta[rows])
+
+    def move(self, x: np.ndarray, rows, u: int, delta) -> None:
+        """Shift in place unit ``u`` of rows ``rows`` of ``x`` by ``delta`` (one per row): a single column as it is;
+        a region's pixels each kept within :attr:`pixels` (or where it already was, beyond them)."""
+        at = np.ix_(np.atleast_1d(rows), self.columns[u])
+        old = x[at]
+        new = old + np.reshape(delta, (-1, 1))
+        if len(self.columns[u]) > 1:
+            lo, hi = self.pixels[u]
+            new = np.clip(new, np.minimum(lo, old), np.maximum(hi, old))
+        x[at] = new
 
 
 def units(policy: Policy, background: np.ndarray, features: Sequence[str] | str | None) -> Units:
@@ -90,6 +105,8 @@ def units(policy: Policy, background: np.ndarray, features: Sequence[str] | str 
     names = [name for name in every if name not in fixed]
     if features is not None:
         asked = [features] if isinstance(features, str) else [str(f) for f in features]
+        if not asked:
+            raise InputError("features is empty: name at least one feature that may change, or leave it out (None).")
         wanted = [m for f in asked for m in (policy.groups.get(f) or (f,))]
         unknown = [f for f in wanted if f not in every]
         if unknown:
@@ -107,9 +124,18 @@ def units(policy: Policy, background: np.ndarray, features: Sequence[str] | str 
     columns = tuple(np.asarray(every[n]) for n in names)
     info = [policy.features.get(n) for n in names]
     declared = np.array([i.bounds if i is not None and i.bounds else (-np.inf, np.inf) for i in info], dtype=float)
-    out = Units(tuple(names), columns, tuple(i.unit if i else "" for i in info), declared.reshape(-1, 2), np.empty(0))
-    bg = np.sort(out.values(np.asarray(background)), axis=0)
-    return Units(out.names, out.columns, out.labels, out.declared, bg)
+    background = np.asarray(background)
+    if len(background) < 2:
+        raise InputError(
+            f"a counterfactual search needs at least 2 background states (ranges and quantiles), got {len(background)}; "
+            "give more typical states."
+        )
+    pixels = np.array([(background[:, c].min(), background[:, c].max()) for c in columns], dtype=float).reshape(-1, 2)
+    out = Units(
+        tuple(names), columns, tuple(i.unit if i else "" for i in info), declared.reshape(-1, 2), np.empty(0), pixels
+    )
+    bg = np.sort(out.values(background), axis=0)
+    return Units(out.names, out.columns, out.labels, out.declared, bg, pixels)
 
 
 def _every_unit(policy: Policy) -> dict[str, np.ndarray]:

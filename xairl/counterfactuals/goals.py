@@ -54,7 +54,7 @@ class Goal:
         elif isinstance(target, str) and target == "any" and "any" not in names:
             self.target = np.full(m, -1)
         else:
-            t = _action_index(policy, target)
+            t = action_index(policy, target)
             self.target = np.full(m, t)
             self.skip = [f"it already chooses {names[t]}" if c == t else "" for c in self.chosen]
         self.compare = np.where(self.target >= 0, self.target, np.maximum(runner, 0))
@@ -68,7 +68,7 @@ class Goal:
                 f"policy '{policy.name}' outputs {policy.output}: give target=xairl.Threshold("
                 f"'{policy.action_names[0]}', above=...) (or below=...) to say what counts as another decision."
             )
-        j = _action_index(policy, target.output)
+        j = action_index(policy, target.output)
         self.j, self.above = j, target.above is not None
         self.bound = float(target.above if self.above else target.below)
         word = f"{policy.action_names[j]} {'above' if self.above else 'below'} {self.bound:g}"
@@ -97,7 +97,7 @@ class Goal:
         return np.nan_to_num(g, nan=-np.inf)
 
 
-def _action_index(policy: Policy, name) -> int:
+def action_index(policy: Policy, name) -> int:
     """The output column named (or numbered) ``name``; a one-line error naming the known ones."""
     names = policy.action_names
     if isinstance(name, (int, np.integer)) and not isinstance(name, bool) and -len(names) <= name < len(names):
@@ -111,6 +111,13 @@ def _action_index(policy: Policy, name) -> int:
     what = "action" if policy.output == "actions" else "output"
     extra = ', or "any"' if policy.output == "actions" else ""
     raise InputError(f"{what} {name!r:.40} is unknown; use one of {', '.join(names[:6])}{extra}.")
+
+
+def lead(scores: np.ndarray, available: np.ndarray, a: int) -> float:
+    """Action ``a``'s score minus the best other available action's (-inf where none other is available): how far a
+    decision for ``a`` is past the line, the margin a counterfactual reports and its sentence says."""
+    others = np.delete(np.where(available, scores, -np.inf), a)
+    return float(scores[a] - others.max()) if np.isfinite(others).any() else -np.inf
 
 
 def pushes(policy: Policy, goal: Goal, units: Units, x: np.ndarray, rows: np.ndarray, bg, explanation) -> np.ndarray:

@@ -50,6 +50,9 @@ class Change:
     def delta(self) -> float:
         return self.after - self.before
 
+    def __repr__(self) -> str:
+        return f"{self.feature} {self.before:.4g} -> {self.after:.4g}{' ' + self.unit if self.unit else ''}"
+
 
 @dataclass(frozen=True)
 class Counterfactual:
@@ -73,6 +76,11 @@ class Counterfactual:
     distance: float
     distance_scaled: float
 
+    def __repr__(self) -> str:
+        """One line (the changed state is left out)."""
+        changes = " and ".join(repr(c) for c in self.changes)
+        return f"Counterfactual({changes}: {self.action}, margin {self.margin:.3g}, distance {self.distance:.3g})"
+
 
 @dataclass(frozen=True)
 class Counterfactuals:
@@ -82,7 +90,8 @@ class Counterfactuals:
     :param chosen: the action the policy took (for a :class:`Threshold`: the output's name).
     :param target: what was asked, in words: the runner-up's name, a named action, 'any other action', or
         'steer above 0.5'.
-    :param found: empty when no change of at most ``max_changes`` features within the bounds flips the decision.
+    :param found: empty when the search found no change of at most ``max_changes`` features within the bounds that flips
+        the decision (a grid search: a miss is no proof that none exists).
     :param reason: why none was found, in one line ('' when some were).
     :param evaluations: states run through the policy by the search.
     """
@@ -101,3 +110,18 @@ class Counterfactuals:
     @property
     def best(self) -> Counterfactual | None:
         return self.found[0] if self.found else None
+
+    def __repr__(self) -> str:
+        """One line: the decision, then the best counterfactual (and how many more), or why there is none."""
+        head = f"Counterfactuals(state {self.index}: chose {self.chosen}, asked {self.target}"
+        if not self.found:
+            return f"{head}; unreachable: {self.reason})"
+        more = f"; {len(self.found) - 1} more" if len(self.found) > 1 else ""
+        return f"{head}; best {self.found[0]!r}{more})"
+
+    def _repr_html_(self) -> str:
+        """Jupyter's view: the card of the report's decisions ('What would have changed it')."""
+        from ..display import CF_STYLE, counterfactual_html
+        from .show import summary
+
+        return f"<style>{CF_STYLE}</style>" + counterfactual_html(summary(self))

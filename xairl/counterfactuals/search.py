@@ -12,7 +12,7 @@ For each decision:
 2. **Which units first.** The units that may change (:mod:`xairl.counterfactuals.bounds`) are ranked by the size of
    their contribution to the margin the change must overturn (``explanation`` if given, else
    :func:`xairl.explain` with its default method, once for all the states).
-3. **Single changes.** For the top units, a grid of 32 values across each one's range is run through the policy in
+3. **Single changes.** For the top units, a grid of 64 values (32 for an image) across each one's range is run through the policy in
    one batched pass; the flipping value nearest the state (in background quantiles) is kept and the crossing between
    it and its non-flipping neighbour refined by bisection (24 halvings), batched across units and states, so that
    the value returned is just past the line: by a gap of 1e-4 x (1 + |the chosen score|) (or of the threshold), so
@@ -37,12 +37,16 @@ import numpy as np
 from ..errors import InputError
 from ..policy import Policy
 from . import bounds
-from .goals import Goal, pushes
+from .goals import Goal, lead, pushes
 from .result import Change, Counterfactual, Counterfactuals
 
-GRID, GRID2, TOP_SINGLE, TOP_PAIR, STEPS, ZOOMS = 32, 13, 16, 9, 24, 3
-#: a state of more flat columns than this (an image) pairs only its top 4 units: each pair costs 676 forward passes
-WIDE, TOP_PAIR_WIDE = 1024, 4
+GRID, GRID2, TOP_SINGLE, TOP_PAIR, STEPS, ZOOMS = 64, 13, 16, 9, 24, 3
+#: the first grid over a pair of a narrow state (41 x 41: a 13 x 13 one missed a flip of one UAV decision in seven
+#: that a brute force found, issue 56's review); the zooms use GRID2
+COARSE = 41
+#: a state of more flat columns than this (an image) pairs only its top 4 units on GRID2 grids (each pair costs 676
+#: forward passes of the network over the whole image) and searches single changes on a grid of GRID_WIDE
+WIDE, TOP_PAIR_WIDE, GRID_WIDE = 1024, 4, 32
 _BACKGROUND = 200  # states drawn from the policy's sampler when no background is given
 
 
@@ -70,7 +74,7 @@ def counterfactual(
     """
     x = policy.check_states(states)
     rows = _rows(index, len(x))
-    if isinstance(max_changes, bool) or max_changes not in (1, 2):
+    if isinstance(max_changes, bool) or not isinstance(max_changes, (int, np.integer)) or max_changes not in (1, 2):
         raise InputError(f"max_changes is 1 or 2 (changes of more features are not searched); got {max_changes!r:.40}.")
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise InputError(f"n is how many counterfactuals to return per decision, a whole number >= 1; got {n!r:.40}.")
@@ -149,10 +153,10 @@ class _Search:
         who = np.flatnonzero(self.active)
         if not len(who):
             return
-        k = min(TOP_SINGLE, self.units.n)
+        k, size = min(TOP_SINGLE, self.units.n), GRID if self.xs.shape[1] <= WIDE else GRID_WIDE
         top = self.order[who, :k]
         lo, hi, own = (a[who[:, None], top] for a in (self.low, self.high, self.own))
-        grid = lo[..., None] + (hi - lo)[..., None] * np.linspace(0.0, 1.0, GRID)  # (m, k, G)
+        grid = lo[..., None] + (hi - lo)[..., None] * np.linspace(0.0, 1.0, size)  # (m, k, G)
         w = np.broadcast_to(who[:, None, None], grid.shape)
         u = np.broadcast_to(top[..., None], grid.shape)
         good = self.gaps(w.ravel(), u.reshape(-1, 1), (grid - own[..., None]).reshape(-1, 1)).reshape(grid.shape) > 0
@@ -161,7 +165,7 @@ class _Search:
         has = np.isfinite(key.min(axis=-1))
         at = np.take_along_axis(grid, g[..., None], -1)[..., 0]
         up = at > own  # the grid's neighbour on the state's side of the flip never flips (it is nearer)
-        side = np.take_along_axis(grid, np.clip(g + np.where(up, -1, 1), 0, GRID - 1)[..., None], -1)[..., 0]
+        side = np.take_along_axis(grid, np.clip(g + np.where(up, -1, 1), 0, size - 1)[..., None], -1)[..., 0]
         inner = np.where(up, np.where(side > own, side, own), np.where(side < own, side, own))
         i, j = np.nonzero(has)
         done = self._bisect(who[i], top[i, j][:, None], own[i, j][:, None], inner[i, j][:, None], at[i, j][:, None])
@@ -181,15 +185,19 @@ class _Search:
     def pairs(self, who: np.ndarray) -> None:
         """Two units each, among the top ones: a 2-D grid over both ranges, zoomed in around the nearest flipping
         cell, then bisection along the line from the state to it."""
-        k = min(TOP_PAIR if self.xs.shape[1] <= WIDE else TOP_PAIR_WIDE, self.units.n)
+        wide = self.xs.shape[1] > WIDE
+        k = min(TOP_PAIR_WIDE if wide else TOP_PAIR, self.units.n)
         if not len(who) or k < 2:
             return
         combos = np.array(list(combinations(range(k), 2)))
         units = self.order[who, :k][:, combos].reshape(-1, 2)  # (P, 2): every pair of every state
         w = np.repeat(who, len(combos))
         lo, hi, own = (a[w[:, None], units] for a in (self.low, self.high, self.own))
-        best, has = self._grid2(w, units, own, lo, hi, np.full(len(w), False), np.zeros((len(w), 2)))
-        for _ in range(ZOOMS):
+        size = GRID2 if wide else COARSE
+        best, has = self._grid2(w, units, own, lo, hi, np.full(len(w), False), np.zeros((len(w), 2)), size)
+        for _ in range(
+            ZOOMS
+        ):  # (each zoom's box: a GRID2 grid's cells either side of the best, however fine the first)
             step = (hi - lo) / (GRID2 - 1)
             lo, hi = np.maximum(lo, best - step), np.minimum(hi, best + step)
             best, has = self._grid2(w, units, own, lo, hi, has, best)
@@ -197,12 +205,12 @@ class _Search:
         for s, us, vs in zip(w[has], units[has], done):
             self.candidates[s][tuple(int(u) for u in us)] = tuple(float(v) for v in vs)
 
-    def _grid2(self, w, units, own, lo, hi, had, best) -> tuple[np.ndarray, np.ndarray]:
-        """The nearest flipping point of a GRID2 x GRID2 grid over each box [lo, hi] (P, 2) and whether there is one
-        (where none is, ``best`` and ``had`` as they were)."""
-        lin = np.linspace(0.0, 1.0, GRID2)
+    def _grid2(self, w, units, own, lo, hi, had, best, size=GRID2) -> tuple[np.ndarray, np.ndarray]:
+        """The nearest flipping point of a ``size`` x ``size`` grid over each box [lo, hi] (P, 2) and whether there is
+        one (where none is, ``best`` and ``had`` as they were)."""
+        lin = np.linspace(0.0, 1.0, size)
         axes = lo[:, :, None] + (hi - lo)[:, :, None] * lin  # (P, 2, G)
-        shape = (len(w), GRID2, GRID2)
+        shape = (len(w), size, size)
         values = np.stack(
             [np.broadcast_to(axes[:, 0, :, None], shape), np.broadcast_to(axes[:, 1, None, :], shape)], -1
         )
@@ -256,7 +264,7 @@ class _Search:
         dtype (a single column is set, not shifted, so that rounding cannot carry it past its bound)."""
         cols = self.units.columns[u]
         if len(cols) > 1:
-            x[r, cols] += value - self.own[s, u]
+            self.units.move(x, r, u, value - self.own[s, u])
             return
         v = self.policy.dtype(value)
         lo, hi = self.low[s, u], self.high[s, u]
@@ -285,11 +293,9 @@ class _Search:
         dist, scaled = self._sizes(s, units, after[list(units)])
         if policy.output == "actions":
             a = int(np.argmax(np.where(avail[r], scores, -np.inf)))
-            others = np.delete(np.where(avail[r], scores, -np.inf), a)
-            best = (
-                others.max() if len(others) and np.isfinite(others.max()) else np.delete(scores, a).max(initial=-np.inf)
-            )
-            action, output, margin = policy.action_names[a], float(scores[a]), float(scores[a] - best)
+            margin = lead(scores, avail[r], a)  # (the only available action: its lead over the unavailable ones)
+            margin = margin if np.isfinite(margin) else lead(scores, np.ones_like(avail[r]), a)
+            action, output = policy.action_names[a], float(scores[a])
         else:
             j = self.goal.j
             action, output, margin = policy.action_names[j], float(scores[j]), float(gap)
@@ -305,8 +311,8 @@ class _Search:
             reason = goal.skip[s] or (
                 "no feature may change: every one is immutable, an identifier or a category"
                 if not self.units.n
-                else f"no change of at most {max_changes} feature{'s' if max_changes > 1 else ''} within the bounds "
-                f"makes {goal.verb[s]}"
+                else f"the search found no change of at most {max_changes} feature{'s' if max_changes > 1 else ''} "
+                f"within the bounds that makes {goal.verb[s]} (a grid search: a miss is no proof that none exists)"
             )
         return Counterfactuals(index, names[goal.chosen[s]], goal.words[s], found, reason, int(self.evals[s]))
 

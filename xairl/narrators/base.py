@@ -149,7 +149,7 @@ class Narrator:
         :param counterfactual: True: search what would have changed the decision (it needs ``policy``; the search
             is guided by ``explanation`` and bounded by ``background``) and give the template its fact, or the
             search's answer for this state (:class:`xairl.Counterfactuals`); its sentence is checked by running the
-            policy on it. Discrete actions only.
+            policy on it. Discrete actions only, one decision (not ``index=None``); anything else is refused.
         """
         index = None if index is None else explanation.check_index(index)
         tpl = _template(explanation, index, template, prompt_dirs)
@@ -161,9 +161,7 @@ class Narrator:
             if index is not None and explanation.output == "continuous"
             else [narrated]
         )
-        said = None
-        if counterfactual is not False and counterfactual is not None and index is not None:
-            said = said_counterfactual(explanation, index, policy, counterfactual, background)
+        said = said_counterfactual(explanation, index, policy, counterfactual, background)
         words = [self._words(view, index, tpl, policy, k, history, said) for view in views]
         scores, comps = zip(
             *(
@@ -171,26 +169,30 @@ class Narrator:
                 for j, c in _checks(words)
             )
         )
+        worst = int(np.argmin(scores))  # a continuous action is as trustworthy as its least trustworthy dimension
+        told = self._told(words, scores[worst], comps[worst], tpl.name, index, explanation.method)
+        return replace(told, evidence=evidence(narrated, told))
+
+    def _told(self, words: list[tuple], score: float, components: dict, template: str, index, method) -> Narrative:
+        """The narrative of the words of every view (a continuous action's dimensions, joined), with its confidence."""
         reworded = [sum(counts) for counts in zip(*(getattr(w[0], "reworded", (0, 0, 0)) or (0, 0, 0) for w in words))]
         sources = [source for _, _, source, _, _ in words]
-        worst = int(np.argmin(scores))  # a continuous action is as trustworthy as its least trustworthy dimension
         text = joined([(w[0], w[0].spans) for w in words], [" "] * (len(words) - 1))
-        told = Narrative(
+        return Narrative(
             text=text,
             claims=tuple(c for _, check, _, _, _ in words for c in check.claims),
             provenance=text.spans,
             verified=all(check.ok for _, check, _, _, _ in words),
-            confidence=scores[worst],
-            components=comps[worst],
+            confidence=score,
+            components=components,
             source=next((s for s in sources if s != self.name), self.name),
-            template=tpl.name,
+            template=template,
             index=index,
             rejected=" ".join(bad for _, _, _, bad, _ in words if bad) or None,
-            extras={"method": explanation.method, "tries": max(w[4] for w in words)}
+            extras={"method": method, "tries": max(w[4] for w in words)}
             | ({"reworded": tuple(reworded)} if reworded[2] else {}),
             sentences=tuple((s.text, s.status) for _, check, _, _, _ in words for s in check.sentences),
         )
-        return replace(told, evidence=evidence(narrated, told))
 
     def _words(
         self, explanation: Explanation, index: int | None, tpl, policy: Policy | None, k: int, history=None, said=None

@@ -114,10 +114,13 @@ _WHO = ("the serving BS", "the strongest neighbour", "the second strongest neigh
 #: (LTE's usual "excellent" band) strong; RSRQ below the violation threshold (-16 dB) poor, above -10 dB good
 RSRP_LEVELS = (-100.0, -80.0)
 RSRQ_LEVELS = (-16.0, -10.0)
-#: what a UE can report (TS 36.133 sec. 9.1.4 and 9.1.7, the reporting ranges): RSRP -140..-44 dBm, RSRQ -19.5..-3 dB;
-#: a counterfactual moves a signal only within them
+#: where a counterfactual may move a signal: RSRP within TS 36.133's reporting range (sec. 9.1.4, -140..-44 dBm);
+#: RSRQ down to the extended reporting range's floor (TS 36.133 sec. 9.1.7, -34 dB, as exports.PLAUSIBLE cites: the
+#: simulator measures the serving cell that low and its neighbours down to the -24 dB detection limit, so -19.5, the
+#: basic range's floor, left states the simulator produces outside their own bounds) and up to -3 dB (what one
+#: cell's RSRQ reaches with no load; RsrqFeasible bounds it by the RSRP as well)
 RSRP_RANGE = (-140.0, -44.0)
-RSRQ_RANGE = (-19.5, -3.0)
+RSRQ_RANGE = (-34.0, -3.0)
 
 
 def _signal(kind: str, k: int, unit: str, low: str, high: str, levels, bounds) -> FeatureInfo:

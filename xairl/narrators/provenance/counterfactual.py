@@ -1,71 +1,112 @@
-"""The check of a counterfactual sentence (issue 56) by running the policy on what it states.
+"""The check of a counterfactual sentence (issue 56) by reading its structure and running the policy on what it states.
 
 'Had the uplink buffer been below 37.6 % full (it was 100 % full), the DQN would have chosen to hand over to
-candidate 2 (margin 4.2)' is read from its tracked spans (:func:`xairl.tracking.track_counterfactual`: each span
-knows which change of the fact it printed, but its *text* is what is checked): the feature each change names (its
-name, description or an alias), the value it states (a fill in % of the capacity turned back into the feature's
-unit, a category's label into its code), the direction word ('below', 'above': tracked, or the template's own word
-right before the value) and the 'it was' value. The state of the decision with every stated feature set to its
-stated value, the others as they were, is run through the policy (its action mask honoured), and:
+candidate 2 (margin 4.2)' is read from its *words*, not from what each tracked span was printed from (a template may
+print a fact anywhere): every value in it (a tracked value of the counterfactual fact, or a number the template wrote
+itself) takes the slot the words before it give it:
 
-- the stated action must be the one the policy takes there, and not the one it took (else the action and the stated
-  values are contradicted: a threshold on the wrong side of the line, a wrong feature, a wrong action);
-- the stated margin must be that action's score minus the best other available one's, as written;
-- a direction word must point from the state's value to the stated one, and 'it was' must be the state's value.
+- the *hypothetical* value, the one the sentence puts under the counterfactual: 'had X been [below] V', 'if X were
+  V', 'with X at V' (also '... to V');
+- the *actual* one: 'it was V', 'X was/is V'.
 
-Without the policy, or without the state as its input (an image narrated in regions), nothing of it is checked:
-its claims are 'unchecked', never 'verified'. The 'nothing within the bounds' sentence states the search's answer,
-which a single re-run cannot check: unchecked too.
+A sentence with no counterfactual form ('had ... been', 'if ... were', 'would have') states facts of the state: every
+value in it is read as actual ('The queue was 19.9 % full' while the state says 80 % is contradicted). Each value is
+of the feature named last before it: a feature's name, description or alias, or a window's past slot by its own
+words ('the speed 2 steps ago'); words that name several features name none.
+
+The state with every hypothetical value set, the others as they were, is run through the policy (its action mask
+honoured), after the constraints of the world (:func:`xairl.counterfactual_facts.broken`: no immutable feature
+changed, the declared bounds, the policy's ``feasible``), and:
+
+- the hypothetical values are verified when that state is allowed and the policy decides otherwise there;
+- the action after 'would have' (tracked from any field, or written: a name or an alias) must be the one it takes
+  there, and not the one it took; 'would not have' is contradicted when the action named is the one it takes there,
+  else unchecked (never verified); an action after 'chose' is the one it took;
+- the stated margin is that action's score minus the best other available one's, as written;
+- a direction word points from the state's value to the hypothetical one, and an actual value is the state's.
+
+Without the policy, or without the state as its input (an image narrated in regions), nothing of it is checked: its
+claims are 'unchecked', never 'verified'. A sentence that nothing within the bounds would have changed the decision
+states a search's miss, which is no proof (the search tries a grid of changes): unchecked.
 """
 
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...counterfactual_facts import NOISE
+from ...counterfactual_facts import NOISE, action_index, broken, feature_words, lead
 from ...policy import FeatureInfo
 from ..verify import Claim
+from .lexicon import NUMBER
 from .parts import Part
 from .truth import Truth, close, number
 
 RULE = "tracked.counterfactual"
-_BELOW = re.compile(r"\b(?:below|under|less than|lower than|smaller than|at most|beneath)\s*$", re.I)
-_ABOVE = re.compile(r"\b(?:above|over|more than|higher than|greater than|larger than|at least|exceed\w*)\s*$", re.I)
-_STATED = ("after_text", "after", "after_fill")  # the value it would need
-_WAS = ("value_text", "value", "fill")  # the value it had
+_BELOW = r"below|under|less than|lower than|smaller than|at most|beneath"
+_ABOVE = r"above|over|more than|higher than|greater than|larger than|at least|exceed\w*"
+#: the forms that make a sentence counterfactual
+FORM = re.compile(r"\bhad\b.+?\bbeen\b|\bif\b.+?\bwere\b|\bwould\b(?:\s+\w+|n't){0,2}\s+have\b", re.I | re.S)
+_HYPO = re.compile(rf"\b(?:been|were|at|to)\s+(?:(?P<dir>{_BELOW}|{_ABOVE})\s+)?$", re.I)
+_ACTUAL = re.compile(rf"\b(?:was|is|are|were|now|currently|at)\s+(?:(?P<dir>{_BELOW}|{_ABOVE})\s+)?$", re.I)
+_WOULD = re.compile(r"\bwould(?P<neg>\s+not|n't|\s+never)?(?:\s+(?:still|also|then|instead|rather))?\s+have\b", re.I)
+_CHOSE = re.compile(r"\b(?:chose|chooses|took|takes|picked|selected|preferred)\b", re.I)
+_VALUES = ("after_text", "after", "after_fill", "value_text", "value", "fill")
+_ACTIONS = ("action", "action_words", "chosen", "target")
+_MISS = "a search's miss is no proof (it tries a grid of changes): no re-run can check that nothing would flip it"
 
 
 def is_counterfactual(p: Part) -> bool:
     return p.span is not None and p.span.fact.quantity.startswith("cf_")
 
 
-def _claim(p: Part, kind: str, status: str, detail: str) -> Claim:
-    return Claim(kind, p.span.text, status, detail, RULE, span=p.span)
+@dataclass
+class _Value:
+    """A value the sentence states: where, its text, its tracked span (None for a number the template wrote)."""
+
+    start: int
+    end: int
+    text: str
+    part: Part | None
+    slot: str = ""  # 'hypo', 'actual' or '' (not said as either)
+    sign: int = 0  # -1 'below', +1 'above', 0 none
+    dir_at: int = -1  # where its direction word starts
+    col: int | None = None
+    x: float | None = None
+
+
+def _claim(p: Part | None, kind: str, status: str, detail: str, text: str = "") -> Claim:
+    return Claim(kind, p.span.text if p is not None else text, status, detail, RULE, span=p.span if p else None)
 
 
 def _said(text: str) -> str:
     return " ".join(text.lower().split()).strip(" .,;:'\"")
 
 
-def _feature(policy, text: str, meant: str | None = None) -> int | None:
-    """The feature a text names: its name, description or an alias (None when it names none); of several that share
-    the words, the one the span was printed from (``meant``)."""
-    said, named = _said(text), []
+def _forms(policy) -> dict[str, set[int]]:
+    """Every feature's words (lower case) -> the columns they name: its name, and its description and aliases,
+    or for a window's past slot its own words ('the speed 2 steps ago'), which the signal's words do not name."""
+    out: dict[str, set[int]] = {}
     for j, f in enumerate(policy.feature_names):
         info = policy.features.get(f) or FeatureInfo()
-        if said in {_said(w) for w in (f, info.description, *info.aliases) if w}:
-            named.append(j)
-    return next((j for j in named if policy.feature_names[j] == meant), named[0] if named else None)
+        words = feature_words(policy, f)
+        own = (f, words) if words.endswith(" ago") else (f, info.description, *info.aliases)
+        for w in own:
+            if w and _said(w):
+                out.setdefault(_said(w), set()).add(j)
+    return out
 
 
-def _action(policy, text: str) -> int | None:
-    """The action a text names: its name, or an alias no other action has."""
-    said = _said(text)
-    named = [k for k, a in enumerate(policy.action_names) if _said(a) == said]
-    aliased = [k for k, a in enumerate(policy.action_names) if said in map(_said, policy.action_aliases.get(a, ()))]
-    return named[0] if named else aliased[0] if len(aliased) == 1 else None
+def _named(forms: dict[str, set[int]], text: str) -> tuple[int, int | None]:
+    """(where, column) of the feature ``text`` names last (None for words that name several); (-1, None) if none."""
+    low, best = text.lower(), (-1, 0, None)
+    for form, cols in forms.items():
+        for m in re.finditer(rf"(?<!\w){re.escape(form)}(?!\w)", low):
+            if (m.end(), len(form)) > best[:2]:
+                best = (m.end(), len(form), next(iter(cols)) if len(cols) == 1 else None)
+    return best[0], best[2]
 
 
 def _percent(text: str, quantity: str, after: str) -> bool:
@@ -84,96 +125,191 @@ def _value(text: str, info: FeatureInfo, quantity: str, after: str) -> float | N
     return x * info.capacity / 100.0
 
 
+def _values(s, cf: list[Part], policy, counterfactual: bool) -> list[_Value]:
+    """Every value the sentence states (tracked, or numbers written in its words), each with its slot, direction,
+    feature and value in the feature's unit."""
+    vals = [_Value(p.start, p.end, p.span.text, p) for p in cf if p.span.fact.quantity[3:] in _VALUES]
+    for p in (q for q in s.parts if q.span is None):
+        vals += [
+            _Value(p.start + m.start(), p.start + m.end(), m.group(), None)
+            for m in NUMBER.finditer(s.text[p.start : p.end])
+        ]
+    vals.sort(key=lambda v: v.start)
+    forms, prev = _forms(policy), 0
+    for v in vals:
+        before = s.text[prev : v.start]
+        hypo, actual = _HYPO.search(before), _ACTUAL.search(before)
+        m = (hypo if hypo else actual) if counterfactual else (actual or hypo)
+        # no counterfactual form: every value is said of the state (a number written there only after 'was', 'at')
+        v.slot = ("hypo" if counterfactual and m is hypo else "actual") if m else ""
+        v.slot = v.slot or ("actual" if not counterfactual and v.part is not None else "")
+        if m and m["dir"]:
+            v.sign, v.dir_at = (-1 if re.fullmatch(_BELOW, m["dir"], re.I) else 1), prev + m.start("dir")
+        prev = v.end
+        where, v.col = _named(forms, s.text[: v.start])
+        if v.col is not None:
+            info = policy.features.get(policy.feature_names[v.col]) or FeatureInfo()
+            quantity = v.part.span.fact.quantity if v.part else ""
+            v.x = _value(v.text, info, quantity, s.text[v.end : v.end + 3])
+    return [v for v in vals if v.part is not None or v.slot]  # (a number the words give no slot: the reader's)
+
+
 def check_counterfactual(s, cf: list[Part], truth: Truth) -> list[Claim]:
-    """The claims of the counterfactual spans ``cf`` of sentence ``s`` (a :class:`.spans.Sentence`), checked by
-    running the policy on the state they state (module doc)."""
+    """The claims of the counterfactual spans ``cf`` of sentence ``s`` (a :class:`.spans.Sentence`), and of the
+    values its words state, checked by running the policy on the state it states (module doc)."""
     if not cf:
         return []
     policy, state = truth.policy, truth.state
     if policy is None or state is None or truth.output != "actions":
         return [_claim(p, "number", "unchecked", "no policy and state to re-run the stated change") for p in cf]
-    changes: dict[int, dict[str, list[Part]]] = {}
-    rest = []
+    counterfactual = bool(FORM.search(s.text))
+    vals = _values(s, cf, policy, counterfactual)
+    forms = _forms(policy)
+    claims = []
     for p in cf:
-        role = p.span.fact.role or ""
-        if role.startswith("change:"):
-            changes.setdefault(int(role[7:]), {}).setdefault(p.span.fact.quantity[3:], []).append(p)
-        else:
-            rest.append(p)
-    claims, stated = [], []
-    for parts in changes.values():
-        claims += _change(s, parts, policy, state, stated)
-    return claims + _rerun(rest, policy, state, stated, truth)
-
-
-def _was(s, p: Part, q: str, info: FeatureInfo, before: float) -> Claim:
-    """'it was ...': the state's value, as written."""
-    printed, percent = number(p.span.text), _percent(p.span.text, q, s.after(p, 3))
-    if info.categories:
-        ok = _value(p.span.text, info, q, "") == before
-    elif printed is not None and info.capacity is not None and percent:
-        ok = close(printed, 100 * before / info.capacity, p.span.text)
-    else:
-        ok = printed is not None and close(printed, before, p.span.text)
-    return _claim(p, "number", "verified" if ok else "contradicted", f"it was {before:.4g}")
-
-
-def _change(s, parts: dict[str, list[Part]], policy, state: np.ndarray, stated: list) -> list[Claim]:
-    """One change's claims (its feature, direction, 'it was' value); (column, stated value, its spans) goes into
-    ``stated`` (column or value None when the words do not say them)."""
-    claims, names = [], parts.get("name", []) + parts.get("label", [])
-    cols = [_feature(policy, p.span.text, p.span.fact.feature) for p in names]
-    for p, j in zip(names, cols):
-        ok = j is not None and j == cols[0]
-        claims.append(_claim(p, "feature", "verified" if ok else "contradicted", "a feature of the policy"))
-    j = cols[0] if names else _feature(policy, next(iter(parts.values()))[0].span.fact.feature or "")
-    values = [(q, p) for q in _STATED for p in parts.get(q, [])]
-    if j is None:
-        stated.append((None, None, [p for _, p in values]))
-        return claims
-    info, before = policy.features.get(policy.feature_names[j]) or FeatureInfo(), float(state[j])
-    claims += [_was(s, p, q, info, before) for q in _WAS for p in parts.get(q, [])]
-    after = {_value(p.span.text, info, q, s.after(p, 3)) for q, p in values}
-    value = after.pop() if len(after) == 1 else None  # (two spans stating two values: no value)
-    stated.append((j, value, [p for _, p in values]))
-    if values and value is not None:
-        word = parts["direction"][0] if parts.get("direction") else values[0][1]
-        sign = -1 if _BELOW.search(word.span.text if parts.get("direction") else s.before(word, 24)) else 0
-        sign = sign or (1 if _ABOVE.search(word.span.text if parts.get("direction") else s.before(word, 24)) else 0)
-        if sign:
-            ok = (value - before) * sign > 0
-            claims.append(_claim(word, "direction", "verified" if ok else "contradicted", f"from {before:.4g}"))
+        q = p.span.fact.quantity[3:]
+        if q in ("label", "name"):
+            ok = len(forms.get(_said(p.span.text), ())) == 1
+            claims.append(_claim(p, "feature", "verified" if ok else "contradicted", "a feature of the policy"))
+        elif q in ("max_changes", "reason", "reachable"):
+            claims.append(_claim(p, "number", "unchecked", _MISS))
+    claims += [_actual(s, v, policy, state) for v in vals if v.slot == "actual"]
+    claims += [
+        _claim(v.part, "number", "unchecked", "not said as the value it had nor the one it would need")
+        for v in vals
+        if not v.slot
+    ]
+    hypo, acts = [v for v in vals if v.slot == "hypo"], _said_actions(s, cf, policy)
+    claims += _rerun(cf, hypo, acts, policy, state, truth, counterfactual)
+    # its change or its new action unread ('been storm', 'would have kept the UAV' written by hand): its other claims,
+    # true as they may be, do not verify what it says
+    if counterfactual and (not hypo or any(slot == "unread" for *_, slot in acts)):
+        unread = "what it says would have been, or been done, was not read: " + ("no value after 'had ... been', "
+                 "'if ... were', 'with ... at'" if not hypo else "no action named after 'would have'")  # fmt: skip
+        claims = [replace(c, status="unchecked", detail=unread) if c.status == "verified" else c for c in claims]
     return claims
 
 
-def _rerun(rest: list[Part], policy, state: np.ndarray, stated: list, truth: Truth) -> list[Claim]:
-    """The stated change run through the policy: the stated values (they change the decision), the action (the one
-    taken there) and the margin (its score minus the best other available one's)."""
-    acts = [p for p in rest if p.span.fact.quantity in ("cf_action", "cf_action_words")]
-    margins = [p for p in rest if p.span.fact.quantity == "cf_margin"]
-    others = [p for p in rest if p not in acts and p not in margins]
-    claims = [_claim(p, "number", "unchecked", "the search's answer: one re-run cannot check it") for p in others]
-    values = [p for _, _, spans in stated for p in spans]
-    if not stated or any(j is None or v is None for j, v, _ in stated):
-        why = "no change stated" if not stated else "a stated change names no feature or no value"
-        status = "unchecked" if not stated else "contradicted"
-        return claims + [_claim(p, "action", status, why) for p in acts + margins + values]
+def _actual(s, v: _Value, policy, state: np.ndarray) -> Claim:
+    """A value said of the state ('it was ...', 'the queue was ...'): the state's value, as written."""
+    if v.col is None or v.x is None:
+        return _claim(v.part, "number", "contradicted", "a value of no feature the sentence names", v.text)
+    before = float(state[v.col])
+    info = policy.features.get(policy.feature_names[v.col]) or FeatureInfo()
+    if v.sign:
+        ok = (before - v.x) * v.sign > 0
+    elif info.categories:
+        ok = v.x == before
+    elif info.capacity is not None and _percent(
+        v.text, v.part.span.fact.quantity if v.part else "", s.text[v.end : v.end + 3]
+    ):
+        ok = close(100 * v.x / info.capacity, 100 * before / info.capacity, v.text)
+    else:
+        ok = close(v.x, before, v.text)
+    what = f"{policy.feature_names[v.col]} was {before:.4g}"
+    return _claim(v.part, "number", "verified" if ok else "contradicted", what, v.text)
+
+
+def _first_action(policy, words: list[str]) -> tuple[str, int] | None:
+    """(its words, the action) of the first action ``words`` name, by its name or an alias, longest first."""
+    for k in range(len(words)):
+        for e in range(len(words), k, -1):
+            a = action_index(policy, " ".join(words[k:e]))
+            if a is not None:
+                return " ".join(words[k:e]), a
+    return None
+
+
+def _said_actions(s, cf: list[Part], policy) -> list[tuple[Part | None, str, int | None, str]]:
+    """(its span or None, its text, the action it names, its slot) per action the sentence names: the first one
+    after each 'would (not) have' (slot 'would' or 'not'; 'unread' when those words name none), and every tracked
+    action of the fact elsewhere ('chose' after 'chose', 'took'; '' when said as neither)."""
+    out, covered = [], []
+    for m in _WOULD.finditer(s.text):
+        end = re.search(r"[(),.;]|$", s.text[m.end() :]).start() + m.end()
+        covered.append((m.end(), end))
+        hit = _first_action(policy, s.text[m.end() : end].split())
+        if hit is None:  # (a tracked action of the fact there that names no action, 'any other action': wrong)
+            named = next((p for p in cf if m.end() <= p.start < end and p.span.fact.quantity[3:] in _ACTIONS), None)
+            text = named.span.text if named else s.text[m.end() : end].strip()
+            out.append((named, text, None, "would" if named else "unread"))
+            continue
+        at = m.end() + s.text[m.end() : end].find(hit[0])
+        part = next((p for p in cf if p.start <= at < p.end), None)
+        negated = m["neg"] or re.search(r"\b(?:not|never)\b", s.text[m.end() : at], re.I)  # ('would have not')
+        out.append((part, hit[0], hit[1], "not" if negated else "would"))
+    for p in cf:
+        if p.span.fact.quantity[3:] in _ACTIONS and not any(a <= p.start < b for a, b in covered):
+            clause = s.text[: p.start].split(",")[-1]
+            slot = "chose" if _CHOSE.search(clause) else ""
+            out.append((p, p.span.text, action_index(policy, p.span.text), slot))
+    return out
+
+
+def _rerun(
+    cf, hypo: list[_Value], acts: list, policy, state: np.ndarray, truth: Truth, counterfactual: bool
+) -> list[Claim]:
+    """The stated change run through the policy: the hypothetical values (they change the decision, within the
+    world's constraints), the actions named (the one taken there) and the margin (module doc)."""
+    chosen = policy.action_names.index(truth.actions["chosen"])
+    margins = [p for p in cf if p.span.fact.quantity == "cf_margin"]
+    claims = _taken(acts, chosen, truth.actions["chosen"])
+    acts = [a for a in acts if a[3] in ("would", "not")]
+    stated = {}
+    for v in hypo:
+        stated.setdefault(v.col, set()).add(v.x)
+    if not counterfactual or not hypo or None in stated or any(None in xs or len(xs) > 1 for xs in stated.values()):
+        why = "no change stated" if not hypo else "a stated change names no feature, or not one value"
+        status = "unchecked" if not hypo else "contradicted"
+        claims += [_claim(p, "action", status, why, t) for p, t, _, _ in acts]
+        claims += [_claim(p, "number", status, why) for p in margins]
+        return claims + [_claim(v.part, "number", status, why, v.text) for v in hypo]
     x = np.array(state, dtype=float)
-    x[[j for j, _, _ in stated]] = [v for _, v, _ in stated]
-    scores = policy.scores(x[None])[0]
-    free = np.where(policy.available(x[None])[0], scores, -np.inf)
-    taken, chosen = int(free.argmax()), policy.action_names.index(truth.actions["chosen"])
-    said = [_action(policy, p.span.text) for p in acts]
-    target = said[0] if said and said[0] is not None else taken
-    how = ", ".join(f"{policy.feature_names[j]} = {v:.6g}" for j, v, _ in stated)
-    how = f"re-run with {how}: the policy takes {policy.action_names[taken]}"
-    for p in values:
-        ok = taken != chosen
-        claims.append(_claim(p, "number", "verified" if ok else "contradicted", how + ("" if ok else ", as it did")))
-    for p, a in zip(acts, said):
-        claims.append(_claim(p, "action", "verified" if a == taken != chosen else "contradicted", how))
-    others_best = np.delete(free, target).max() if len(free) > 1 else -np.inf
-    margin = float(scores[target] - others_best)
+    x[list(stated)] = [xs.pop() for xs in stated.values()]
+    scores, avail = policy.scores(x[None])[0], policy.available(x[None])[0]
+    taken = int(np.where(avail, scores, -np.inf).argmax())
+    why = broken(policy, x[None], [list(stated)])[0]
+    how = ", ".join(f"{policy.feature_names[j]} = {x[j]:.6g}" for j in stated)
+    how = f"re-run with {how}: " + (why if why else f"the policy takes {policy.action_names[taken]}")
+    for v in hypo:
+        ok = taken != chosen and not why
+        detail = how + ("" if ok or why else ", as it did")
+        claims.append(_claim(v.part, "number", "verified" if ok else "contradicted", detail, v.text))
+        if v.sign:
+            ok = (v.x - float(state[v.col])) * v.sign > 0
+            p = next((q for q in cf if q.start <= v.dir_at < q.end), v.part)
+            claims.append(
+                _claim(p, "direction", "verified" if ok else "contradicted", f"from {state[v.col]:.4g}", v.text)
+            )
+    for p, t, a, slot in acts:
+        if slot == "not":
+            status = "contradicted" if a == taken and not why else "unchecked"
+            claims.append(_claim(p, "action", status, how + "; 'would not have' is never verified", t))
+        else:
+            claims.append(
+                _claim(p, "action", "verified" if a == taken != chosen and not why else "contradicted", how, t)
+            )
+    said = next((a for _, _, a, slot in acts if slot == "would" and a is not None), taken)
+    return claims + _margins(margins, scores, lead(scores, avail, said), how)
+
+
+def _taken(acts: list[tuple], chosen: int, name: str) -> list[Claim]:
+    """The claims of the actions said as the one taken ('it chose stay'), and of those said as neither."""
+    claims = [
+        _claim(p, "action", "verified" if a == chosen else "contradicted", f"it chose {name}", t)
+        for p, t, a, slot in acts
+        if slot == "chose"
+    ]
+    return claims + [
+        _claim(p, "action", "unchecked", "no action it names is said as taken or as the one it would take", t)
+        for p, t, a, slot in acts
+        if slot in ("", "unread")
+    ]
+
+
+def _margins(margins: list[Part], scores: np.ndarray, margin: float, how: str) -> list[Claim]:
+    """The stated margins: the re-run's, as written (or within a float32 network's last bits of it)."""
+    claims = []
     for p in margins:
         printed, noise = number(p.span.text), NOISE * max(1.0, float(np.abs(scores).max()))
         ok = printed is not None and np.isfinite(margin)

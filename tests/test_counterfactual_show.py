@@ -1,0 +1,160 @@
+"""Where counterfactuals show (issue 56): the notebook card and repr, the CLI's lines (and its one-line errors), the
+report's cards and its per-feature single-flip table, and the review page, each checked against the search's own
+answer and a re-run of the policy."""
+
+import json
+
+import numpy as np
+import pytest
+
+import xairl
+from xairl.counterfactuals.show import summary
+from xairl.feedback import FeedbackStore
+from xairl.report import ReportContent, ReportRequest, write_report
+from xairl.report_counterfactuals import flip_rows
+from xairl.review import page
+from xairl.toy import toy_policy
+
+from .conftest import one_line_error, run
+
+
+@pytest.fixture(scope="module")
+def uav():
+    from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint, uav_policy
+
+    ckpt = load_checkpoint(None)
+    policy = uav_policy(ckpt)
+    return policy, dqn_decision_states(ckpt, 12, seed=1), policy.background(100, seed=7)
+
+
+def test_notebook_card_names_the_change_and_the_new_action(uav):
+    policy, states, bg = uav
+    found = xairl.counterfactual(policy, states, index=None, background=bg)
+    hit = next(r for r in found if r.reachable)
+    cf = hit.best
+    again = policy.action_names[policy.act(cf.state[None])[0]]
+    assert again == cf.action != hit.chosen  # what the card states is what the policy does
+    card = hit._repr_html_()
+    assert "What would have changed it" in card and cf.action in card
+    for c in cf.changes:
+        assert c.feature in card
+    line = repr(hit)
+    assert "\n" not in line and len(line) < 400 and cf.changes[0].feature in line and cf.action in line
+    miss = next((r for r in found if not r.reachable), None)
+    if miss is not None:
+        assert "None found" in miss._repr_html_() and miss.reason in repr(miss)
+
+
+def test_summary_writes_values_as_the_narratives_do(uav):
+    from xairl.report_counterfactuals import writer
+
+    policy, states, bg = uav
+    found = xairl.counterfactual(policy, states, index=None, background=bg, features=["rsrp_0"], target="any")
+    hit = next(r for r in found if r.reachable)
+    d = summary(hit, writer(policy))
+    change = d["found"][0]["changes"][0]
+    assert (
+        change["feature"] == "rsrp_0"
+        and change["before_text"].endswith(" dBm")
+        and change["after_text"].endswith(" dBm")
+    )
+    assert writer(policy)("buffer_queue_size", 7.6e6) == "50 % full"
+    assert json.loads(json.dumps(d)) == d  # travels in the evidence as JSON
+
+
+def test_cli_prints_each_decisions_counterfactual(capsys):
+    rc, out, err = run(capsys, "explain", "--n", "3", "--counterfactual", "--max-changes", "1")
+    assert rc == 0, err
+    assert out.count("what would have changed it") == 3
+    policy = toy_policy()
+    states = policy.background(3, seed=1)  # the CLI's sampled states (--seed 0: seed + 1)
+    ref = xairl.counterfactual(policy, states, index=None, max_changes=1, background=policy.background(100, seed=0))
+    for r in ref:
+        if r.reachable:
+            assert f"{r.best.changes[0].feature} " in out and f": {r.best.action} (margin" in out
+        else:
+            assert "unreachable within the bounds" in out
+    rc, out, err = run(capsys, "explain", "--n", "2", "--counterfactual-target", "any", "--format", "jsonl")
+    assert rc == 0 and all(
+        json.loads(line)["counterfactual"]["target"] == "any other action" for line in out.splitlines()
+    )
+
+
+def test_cli_bad_target_or_max_changes_is_one_line(capsys):
+    rc, _, err = run(capsys, "explain", "--n", "2", "--counterfactual-target", "fly")
+    one_line_error(rc, err, "fly", "any")
+    rc, _, err = run(capsys, "explain", "--n", "2", "--counterfactual", "--max-changes", "3")
+    one_line_error(rc, err, "--max-changes")
+
+
+def test_report_cards_and_the_single_flip_table(tmp_path):
+    policy = toy_policy()
+    bg = policy.background(60)
+    states = policy.background(40, seed=3)
+    req = ReportRequest(out=tmp_path, n_narrated=3, robustness=False, progress=False, records=False)
+    path = write_report(req, ReportContent(title="t", policy=policy, background=bg, datasets=[("s", states)]))
+    text = path.read_text()
+    assert text.count("What would have changed it") == 3 and "Distance to another action" in text
+    # each card's narrative says it too, as its last sentence, marked as the verifier found it
+    assert text.count("the policy would have chosen") + text.count("No change of at most 2 features") == 3
+    exp = xairl.explain(policy, states, background=bg)
+    _, header, rows, sentence = flip_rows(policy, exp, bg)
+    shares = {r[0]: r[1::2] for r in rows}  # per chosen action: 'share % (count)', then the median change
+
+    def counts(label):
+        return np.array([int(c.split("(")[1].rstrip(")")) for c in shares[label]])
+
+    decided = np.array([int(c) for c in shares["decisions"]])
+    assert (counts("some single feature") + counts("no single feature") == decided).all()
+    assert decided.sum() == len(states) and len(header) == 1 + 2 * len(decided)
+    # a feature's count is what a search of that feature alone finds (to any other action)
+    f = rows[0][0]
+    alone = xairl.counterfactual(policy, states, index=None, features=[f], max_changes=1, target="any", background=bg)
+    assert counts(f).sum() == sum(r.reachable for r in alone) > 0
+    assert (counts(f) <= counts("some single feature")).all()
+    assert f in sentence or "No decision" in sentence
+
+
+def test_review_page_shows_the_counterfactual_beside_the_narrative(tmp_path):
+    policy = toy_policy()
+    bg = policy.background(50)
+    states = policy.background(4, seed=4)
+    exp = xairl.explain(policy, states, background=bg)
+    found = xairl.counterfactual(policy, states, index=None, background=bg, explanation=exp)
+    i = next(k for k, r in enumerate(found) if r.reachable)
+    store = FeedbackStore(tmp_path / "fb.sqlite")
+    n = xairl.narrate(exp, i, policy=policy, background=bg, robustness=False)
+    n.evidence["counterfactual"] = summary(found[i])
+    store.record(n, policy=policy)
+    html = page(store, "t")
+    assert "What would have changed it" in html and found[i].best.action in html
+    assert found[i].best.changes[0].feature in html.split("What would have changed it")[1]
+
+
+def test_a_narratives_counterfactual_sentence_shows_in_its_card():
+    policy = toy_policy()
+    bg = policy.background(50)
+    states = policy.background(6, seed=5)
+    exp = xairl.explain(policy, states, background=bg)
+    found = xairl.counterfactual(policy, states, index=None, background=bg, explanation=exp)
+    i = next(k for k, r in enumerate(found) if r.reachable)
+    n = xairl.narrate(exp, i, policy=policy, background=bg, robustness=False, counterfactual=found[i])
+    last, status = n.sentences[-1]
+    assert last.startswith("Had ") and found[i].best.action in last and status == "verified"
+    assert f"<span class='s verified' title='verified'>{last.split(' (')[0]}" in n._repr_html_()
+
+
+def test_the_single_flip_table_of_a_window_policy_takes_its_background_as_windows():
+    import torch
+
+    from .conftest import mlp
+
+    policy = xairl.Policy(
+        torch.nn.Sequential(torch.nn.Flatten(), mlp([12, 16, 3])), feature_names=list("abc"), window=4
+    )
+    rng = np.random.default_rng(0)
+    states, bg = rng.normal(size=(20, 4, 3)).astype(np.float32), rng.normal(size=(60, 4, 3)).astype(np.float32)
+    exp = xairl.explain(policy, states, background=bg)
+    _, _, rows, _ = flip_rows(policy, exp, bg)
+    assert {r[0] for r in rows[:-3]} == {f"{s}[t-{k}]" if k else f"{s}[t]" for s in "abc" for k in range(4)}
+    assert sum(int(c) for c in rows[-1][1::2]) == 20

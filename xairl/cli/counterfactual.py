@@ -1,0 +1,86 @@
+"""``xairl explain --counterfactual``: under each decision (the table, or its narrative with ``--narrate``), what would
+have had to differ for the policy to choose otherwise: the smallest change of at most ``--max-changes`` features
+within the bounds (:func:`xairl.counterfactual`, every result re-run through the policy), the action it then takes
+and its margin, or why none is reachable. The decisions are searched in one batch, guided by the explanation the
+command computed; ``--counterfactual-target`` asks for the runner-up (default), a named action or ``any``."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import InputError
+
+
+def counterfactual_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--counterfactual",
+        action="store_true",
+        help="under each decision, the smallest change of at most --max-changes features (within the data's range "
+        "and the declared bounds) that makes the policy choose another action, checked by running it",
+    )
+    p.add_argument(
+        "--counterfactual-target",
+        default=None,
+        metavar="NAME|any",
+        help="with --counterfactual: the action to reach (default: the runner-up), or 'any' other action",
+    )
+    p.add_argument(
+        "--max-changes",
+        type=int,
+        choices=(1, 2),
+        default=2,
+        help="with --counterfactual: at most this many features change (default 2)",
+    )
+
+
+def search(args, policy, exp, background):
+    """Each decision's :class:`xairl.Counterfactuals` (a tuple), or None without ``--counterfactual`` (the target
+    alone turns it on)."""
+    if not (args.counterfactual or args.counterfactual_target is not None):
+        return None
+    if exp.output != "actions":
+        raise InputError(
+            f"--counterfactual searches for another action: policy '{policy.name}' outputs {exp.output}, not "
+            "discrete actions; use xairl.counterfactual(..., target=xairl.Threshold(...)) from Python."
+        )
+    from ..counterfactuals import counterfactual
+
+    target = args.counterfactual_target
+    target = None if target in (None, "", "runner-up") else target
+    return counterfactual(
+        policy,
+        exp.states,
+        index=None,
+        target=target,
+        max_changes=args.max_changes,
+        background=background,
+        explanation=exp,
+    )
+
+
+def said(found, i: int, max_changes: int) -> dict:
+    """narrate's ``counterfactual`` argument for decision ``i``: its answer, for the template's sentence. An answer
+    of none found with ``--max-changes 1`` is not given (the sentence would say 'at most 2 features')."""
+    if found is None or (not found[i].reachable and max_changes != 2):
+        return {}
+    return {"counterfactual": found[i]}
+
+
+def summaries(found, policy) -> list[dict] | None:
+    """Each decision's answer as plain data (:func:`xairl.counterfactuals.show.summary`), its values written as
+    the narratives write them."""
+    if found is None:
+        return None
+    from ..counterfactuals.show import summary
+    from ..report_counterfactuals import writer
+
+    write = writer(policy)
+    return [summary(r, write) for r in found]
+
+
+def block(cf: dict) -> str:
+    """The terminal's lines of one decision: a heading, then one row per counterfactual (or why there is none)."""
+    from ..display import counterfactual_text
+
+    rows = "\n".join(f"      {line}" for line in counterfactual_text(cf))
+    return f"    what would have changed it (asked: {cf['target']}; re-run through the policy):\n{rows}"
