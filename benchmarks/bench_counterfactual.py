@@ -224,7 +224,7 @@ def _run_dice(case: Case, method: str, limit: float) -> Answers:
 def _one_dice(explainer, query, target: int, vary, permitted, extra) -> np.ndarray | None:
     """One DiCE query; None when it returns nothing (DiCE raises when no counterfactual is found)."""
     try:
-        with contextlib.redirect_stdout(io.StringIO()):
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):  # its chatter, bars
             out = explainer.generate_counterfactuals(
                 query, total_CFs=1, desired_class=target, features_to_vary=vary, permitted_range=permitted, **extra
             )
@@ -343,7 +343,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=float, default=10.0, help="seconds a DiCE query may take (default 10)")
     ap.add_argument("--cache", help="a folder to keep DiCE's answers in and reuse them for the same states")
     args = ap.parse_args(argv)
-    os.environ.setdefault("TQDM_DISABLE", "1")  # DiCE's progress bar, one per query (read when tqdm is imported)
     try:
         import dice_ml  # noqa: F401
     except ImportError:
