@@ -270,7 +270,8 @@ def score(case: Case, answers: Answers) -> Scores:
     cf = np.array([a if a is not None else s for a, s in zip(answers.states, case.states)])
     valid = answered & (case.policy.act(cf) == case.target)
     feasible = np.ones(len(cf), bool) if case.policy.feasible is None else np.asarray(case.policy.feasible(cf), bool)
-    moved = np.abs(cf - case.states) > 1e-9 * (1 + np.abs(case.states))  # any column, fixed ones included
+    # any column, fixed ones included; 1e-6 relative: DiCE's genetic method rounds unchanged features (up to 5e-7 m)
+    moved = np.abs(cf - case.states) > 1e-6 * (1 + np.abs(case.states))
     u = case.units
     before, after = u.values(case.states), u.values(cf)
     units = np.broadcast_to(np.arange(u.n), before.shape)
