@@ -12,15 +12,18 @@ For each decision:
 2. **Which units first.** The units that may change (:mod:`xairl.counterfactuals.bounds`) are ranked by the size of
    their contribution to the margin the change must overturn (``explanation`` if given, else
    :func:`xairl.explain` with its default method, once for all the states).
-3. **Single changes.** For the top units, a grid of 64 values (32 for an image) across each one's range is run through the policy in
-   one batched pass; the flipping value nearest the state (in background quantiles) is kept and the crossing between
-   it and its non-flipping neighbour refined by bisection (24 halvings), batched across units and states, so that
-   the value returned is just past the line: by a gap of 1e-4 x (1 + |the chosen score|) (or of the threshold), so
-   that a re-run in another batch, whose float32 sums may round differently, decides the same.
-4. **Pairs**, among the top 9 units (4 for an image), only for states no single change flips (or for all when
-   ``n > 1``): a 13x13 grid per pair over both ranges, zoomed in three times around the nearest flipping cell (a
-   13x13 grid over the cells beside it), then bisection along the line from the state to it. A pair no nearer than
-   one of its features changed alone is dropped (a single change with a needless second one).
+3. **Single changes.** For the top units, a grid of 64 values (32 for an image) across each one's range is run
+   through the policy in one batched pass; the flipping value nearest the state (in background quantiles) is kept
+   and the crossing between it and its non-flipping neighbour refined by bisection (24 halvings), batched across
+   units and states, so that the value returned is just past the line: by a gap of 1e-4 x (1 + |the chosen score|)
+   (or of the threshold), so that a re-run in another batch, whose float32 sums may round differently, decides the
+   same.
+4. **Pairs**, among the top 9 units: a 41x41 grid per pair over both ranges, zoomed in three times around the nearest
+   flipping cell (a 13x13 grid over the cells beside it), then bisection along the line from the state to it. A
+   pair may be nearer than the nearest single change, so a narrow state's pairs are always searched; an image's
+   (its top 4 regions, 13x13 grids: each pair costs hundreds of passes over the image) only where no single change
+   flips, or when ``n > 1``. A pair no nearer than one of its features changed alone, or one of whose changes moves
+   nothing, is dropped. A grid can miss a flip between its points: "none found" is the search's answer, no proof.
 5. **Checked.** The candidates, ranked by distance in quantiles (ties by the scaled distance), one per set of
    features, are run through the policy once more, all in one batch; one that does not flip (or is infeasible, or
    out of range) is dropped. What is returned is exactly what was run.
@@ -137,7 +140,10 @@ class _Search:
     def run(self, max_changes: int, n: int) -> None:
         self.singles()
         if max_changes >= 2:
-            need = self.active & (np.array([not c for c in self.candidates]) | (n > 1))
+            # a narrow state's pairs always (a pair may be nearer than the nearest single change: DiCE found one);
+            # an image's only where no single change flips (each pair costs hundreds of passes over the image)
+            narrow = self.xs.shape[1] <= WIDE
+            need = self.active & (np.array([not c for c in self.candidates]) | (n > 1) | narrow)
             self.pairs(np.flatnonzero(need))
         self.check(n)
 
@@ -238,8 +244,17 @@ class _Search:
         picks = []
         for s, found in enumerate(self.candidates):
             sizes = {units: self._sizes(s, units, values) for units, values in found.items()}
-            # a pair no nearer than one of its features alone is that single change with a needless extra one
-            kept = [k for k in found if len(k) == 1 or all(sizes.get((u,), (np.inf,)) > sizes[k] for u in k)]
+            # a pair no nearer than one of its features alone is that single change with a needless extra one, and so
+            # is a pair one of whose changes moves nothing
+            kept = [
+                k
+                for k in found
+                if len(k) == 1
+                or (
+                    all(sizes.get((u,), (np.inf,)) > sizes[k] for u in k)
+                    and all(abs(v - self.own[s, u]) > 1e-9 * self.scale[u] for u, v in zip(k, found[k]))
+                )
+            ]
             ranked = sorted(kept, key=sizes.__getitem__)
             picks += [(s, units, found[units]) for units in ranked[: 2 * n + 2]]
         if not picks:
