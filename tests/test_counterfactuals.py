@@ -270,6 +270,9 @@ def test_the_uav_dqn_never_changes_what_it_declares_immutable():
     lifted[:, 10] = ceiling + policy.feasible.tolerance + 0.1
     measured = bg[:, 10] > -24
     assert measured.any() and not policy.feasible(lifted[measured]).any()
+    hidden = lifted[measured].copy()  # the serving cell's RSRQ pushed to the detection limit: still measured, its
+    hidden[:, 9] = -30.0  # power still in the neighbour's ceiling (the third review: an 'empty' serving cell hid it)
+    assert not policy.feasible(hidden).any()
 
 
 def test_a_given_explanation_ranks_the_search_and_a_window_is_searched_slot_by_slot():
@@ -291,3 +294,15 @@ def test_a_given_explanation_ranks_the_search_and_a_window_is_searched_slot_by_s
     assert any(r.reachable for r in found)
     assert_valid(window, found, w)
     assert {c.feature for r in found for cf in r.found for c in cf.changes} <= set(window.feature_names)
+
+
+def test_the_cli_report_asks_what_its_flags_ask(tmp_path):
+    """xairl explain --out writes a report whose cards ask the --counterfactual-target (the third review: with --out
+    the flags were silently ignored and the cards asked the runner-up)."""
+    from xairl.cli import main
+
+    out = tmp_path / "r"
+    args = ["explain", "--n", "3", "--narrate", "--no-record", "--no-robustness", "--out", str(out)]
+    assert main([*args, "--counterfactual-target", "any", "--max-changes", "1"]) == 0
+    html = (out / "report.html").read_text()
+    assert html.count("asked: any other action") >= 1 and "asked: forward" not in html

@@ -61,6 +61,8 @@ class ReportRequest:
     progress: bool = True
     records: bool = True  # write explanations.jsonl (False when the explanations are already written as Parquet)
     counterfactuals: bool = True  # cards: 'What would have changed it'; the run: each feature's single flips
+    counterfactual_target: str | int | None = None  # the cards' target: the runner-up (None), an action or 'any'
+    max_changes: int = 2  # the cards' counterfactuals change at most this many features
 
 
 @dataclass
@@ -305,7 +307,8 @@ def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, sh
 
     idx = [pick] + [i for i in range(len(ref.values)) if i != pick][: max(req.n_narrated - 1, 0)]
     on = req.counterfactuals and cfs.shown(content.policy, ref)
-    found = cfs.decisions(content.policy, ref, idx, content.background) if on else {}
+    ask = (req.counterfactual_target, req.max_changes)
+    found = cfs.decisions(content.policy, ref, idx, content.background, *ask) if on else {}
     out = [
         narrate(
             ref,

@@ -53,13 +53,19 @@ def writer(policy: Policy) -> Callable[[str, float], str]:
     return write
 
 
-def decisions(policy: Policy, exp: Explanation, idx: list[int], background) -> dict[int, Counterfactuals]:
-    """Each decision ``idx`` of ``exp``'s counterfactuals (runner-up, at most 2 changes), searched in one batch."""
+def decisions(
+    policy: Policy, exp: Explanation, idx: list[int], background, target=None, max_changes: int = 2
+) -> dict[int, Counterfactuals]:
+    """Each decision ``idx`` of ``exp``'s counterfactuals (``target``: the runner-up by default; at most
+    ``max_changes`` changes), searched in one batch."""
     from .counterfactuals import counterfactual
 
     if not idx:
         return {}
-    found = counterfactual(policy, exp.states[idx], index=None, background=background, explanation=exp[idx])
+    found = counterfactual(
+        policy, exp.states[idx], index=None, target=target, max_changes=max_changes, background=background,
+        explanation=exp[idx],
+    )  # fmt: skip
     return {i: replace(r, index=i) for i, r in zip(idx, found)}  # numbered as the states of ``exp``
 
 

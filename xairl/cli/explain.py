@@ -153,7 +153,10 @@ def _write_report(args, exp, policy, bg) -> int:
 
     from ..report import ReportContent, write_report
 
-    req = report_request(args, Path(args.out), dict(exp.options), len(exp.values), progress=False)
+    req = report_request(
+        args, Path(args.out), dict(exp.options), len(exp.values), progress=False,
+        counterfactual_target=args.counterfactual_target, max_changes=args.max_changes,
+    )  # fmt: skip
     content = ReportContent(
         title=f"xairl: {policy.name}", policy=policy, background=bg, datasets=[("states", exp.states)]
     )

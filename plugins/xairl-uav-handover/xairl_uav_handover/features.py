@@ -183,7 +183,7 @@ class RsrqFeasible:
     (-6.0 dB for a lone, strong cell). A state is feasible when every measured candidate's RSRQ is at most that plus
     ``tolerance_db`` (the reported values carry the UE's measurement errors after the layer-3 filter: with the
     default errors, 1.5 dB RSRQ and 1.2 dB RSRP, filtered at k=4, about 1 dB together; 3 dB is three of them) and an
-    empty slot (RSRQ at or below the detection limit) is anything. Simulated states keep at least 0.9 dB below it.
+    empty candidate slot (RSRQ at or below the detection limit) is anything; the serving cell is always measured. Simulated states keep at least 0.9 dB below it.
     """
 
     def __init__(self, noise_figure_db: float = 9.0, detection_rsrq_db: float = -24.0, tolerance_db: float = 3.0):
@@ -201,6 +201,7 @@ class RsrqFeasible:
         rows = x.reshape(len(x), -1, len(SIGNALS))[..., : len(FEATURES)] if x.shape[1] != len(FEATURES) else x[:, None]
         rsrp, rsrq = rows[..., RSRP].reshape(-1, N_CANDIDATES), rows[..., RSRQ].reshape(-1, N_CANDIDATES)
         measured = rsrq > self.detection
+        measured[:, 0] = True  # the serving cell is measured whatever its RSRQ (no 'empty slot' to hide it in)
         ok = ~measured | (rsrq <= self.ceiling(rsrp, measured) + self.tolerance)
         return ok.all(axis=1).reshape(len(x), -1).all(axis=1)
 
