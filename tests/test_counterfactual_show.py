@@ -11,6 +11,7 @@ import pytest
 import xairl
 from xairl import plugins
 from xairl.counterfactuals.show import summary
+from xairl.display import counterfactual_text
 from xairl.feedback import FeedbackStore
 from xairl.report import ReportContent, ReportRequest, write_report
 from xairl.report_counterfactuals import flip_rows
@@ -199,3 +200,25 @@ def test_the_single_flip_table_of_a_window_policy_takes_its_background_as_window
     _, _, rows, _ = flip_rows(policy, exp, bg)
     assert {r[0] for r in rows[:-3]} == {f"{s}[t-{k}]" if k else f"{s}[t]" for s in "abc" for k in range(4)}
     assert sum(int(c) for c in rows[-1][1::2]) == 20
+
+
+def test_a_threshold_card_shows_the_new_output_and_a_miss_is_said_as_one():
+    """Review 56b, finding 6: a threshold's card shows the output's value after the change (re-run here); a search's
+    miss reads 'none found within the bounds (a grid search: ...)', never 'unreachable' next to 'no proof'."""
+    import torch
+
+    lin = torch.nn.Linear(2, 1)
+    with torch.no_grad():
+        lin.weight.copy_(torch.tensor([[1.0, 0.5]]))
+        lin.bias.zero_()
+    p = xairl.Policy(lin, ["a", "b"], ["steer"], output="continuous")
+    states = np.array([[0.2, 0.2]], np.float32)
+    bg = np.random.default_rng(0).uniform(-1, 1, (64, 2)).astype(np.float32)
+    r = xairl.counterfactual(p, states, index=0, background=bg, target=xairl.Threshold("steer", above=0.6))
+    out = float(p.scores(r.best.state[None].astype(np.float32))[0, 0])
+    card = r._repr_html_()
+    assert "then its output" in card and f"steer = {out:.3g}" in card and out > 0.6
+    miss = xairl.counterfactual(p, states, index=0, background=bg, target=xairl.Threshold("steer", above=50.0))
+    lines = counterfactual_text(summary(miss))
+    assert lines[0].startswith("none found within the bounds (a grid search: ") and "no proof" not in lines[0]
+    assert "None found within the bounds (a grid search: " in miss._repr_html_()

@@ -74,7 +74,7 @@ def counterfactual_text(cf: dict) -> list[str]:
     one per counterfactual, 'rsrp_1 -83.2 dBm -> -71.5 dBm: handover_to_candidate_1 (margin 0.0052)' (a threshold's:
     the output's new value), or the one line 'none found within the bounds (a grid search: <why>)'."""
     if not cf.get("found"):
-        return [f"none found within the bounds ({_miss(cf)})"]
+        return [_miss(cf)]
     return [f"{_changes(one, ' -> ')}: {_then(cf, one)} (margin {_g(one['margin'])}, distance {one['distance']:.2f})"
             for one in cf["found"]]  # fmt: skip
 
@@ -92,10 +92,11 @@ def counterfactual_meta(cf: dict, chosen: bool = True) -> str:
 
 
 def _miss(cf: dict) -> str:
-    """Why none was shown, as a search's miss: 'a grid search: ...' (a miss is no proof that none exists)."""
+    """Why none is shown: a search's miss as 'none found within the bounds (a grid search: ...)', never as a claim
+    that none exists; another reason ('it already chooses B') as 'none: ...'."""
     why = str(cf.get("reason") or "no change found")
-    why = why.replace(" (a grid search: a miss is no proof that none exists)", "")
-    return why if why.startswith("a grid search") else f"a grid search: {why}"
+    miss = " (a grid search: a miss is no proof that none exists)"
+    return f"none found within the bounds (a grid search: {why.replace(miss, '')})" if miss in why else f"none: {why}"
 
 
 def _then(cf: dict, one: dict) -> str:
@@ -103,10 +104,8 @@ def _then(cf: dict, one: dict) -> str:
     0.21'; 'steer = 0.21' where the answer does not hold the old one)."""
     if not (cf.get("threshold") and "output" in one):
         return str(one["action"])
-    old = cf.get("output", float("nan"))
-    return (
-        f"{one['action']} {_g(old)} -> {_g(one['output'])}" if old == old else f"{one['action']} = {_g(one['output'])}"
-    )
+    old, new = cf.get("output"), _g(one["output"])
+    return f"{one['action']} = {new}" if old is None else f"{one['action']} {_g(old)} -> {new}"
 
 
 def _g(x) -> str:
@@ -133,7 +132,7 @@ def counterfactual_html(cf: dict) -> str:
     e = html.escape
     head = f"<b>What would have changed it</b> <span class=meta>({e(counterfactual_meta(cf))})</span>"
     if not cf.get("found"):
-        body = f"<p class=cf-none>None found within the bounds ({e(_miss(cf))}).</p>"
+        body = f"<p class=cf-none>{e(_miss(cf)).capitalize()}.</p>"
     else:
         rows = "".join(
             f"<tr><td>{_changes(one, ' &rarr; ', e)}</td><td>{e(_then(cf, one))}</td><td>{_g(one['margin'])}</td>"
