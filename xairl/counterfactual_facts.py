@@ -19,19 +19,21 @@ never by its signal's words alone, which name the current value.
 
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import dataclass
+from dataclasses import replace as _replace
 
 import numpy as np
 
-from .counterfactuals import Counterfactuals
+from .counterfactuals import Counterfactual, Counterfactuals
 from .counterfactuals.goals import action_index as resolve  # (the one resolver of an action's name or alias)
 from .counterfactuals.goals import lead
+from .counterfactuals.show import outward as _outward  # (the one rounding rule: away from the line)
+from .counterfactuals.show import summary
 from .errors import InputError
 from .explanation import Explanation
 from .policy import FeatureInfo, Policy
-from .prompts import format_number, written_step
+from .prompts import format_number
 from .values import fill_and_text
 
 __all__ = [
@@ -39,6 +41,7 @@ __all__ = [
     "CounterfactualFact",
     "action_index",
     "action_words",
+    "as_written",
     "broken",
     "counterfactual_fact",
     "feature_words",
@@ -100,13 +103,6 @@ class CounterfactualFact:
     target: str
     max_changes: int
     reason: str = ""
-
-
-def _outward(x: float, down: bool, extra: int = 0) -> float:
-    """``x`` rounded to the digits it is written with, away from the line (down for 'below'), ``extra`` steps more."""
-    s = written_step(x)
-    n = math.floor(x / s + 1e-9) - extra if down else math.ceil(x / s - 1e-9) + extra
-    return float(format_number(n * s))
 
 
 def _written(before: float, after: float, info: FeatureInfo, extra: int) -> tuple[float, float | None, str]:
@@ -190,27 +186,67 @@ def counterfactual_fact(
     unknown = {c.feature for cf in found.found for c in cf.changes} - set(policy.feature_names)
     if unknown:  # (an image's regions: their change is every pixel of them shifted, which no sentence states yet)
         raise InputError(f"counterfactual words name the policy's features; {sorted(unknown)[0]!r} is none of them.")
-    state = np.asarray(exp.states[index], dtype=float)
-    said = [(cf, _said(policy, state, cf.changes, extra)) for cf in found.found for extra in _NUDGES]
-    said = [(cf, changes) for cf, changes in said if changes]
-    if not said:
-        return None
-    rows = np.repeat(state[None], len(said), axis=0)
-    for n, (_, changes) in enumerate(said):
-        rows[n, [policy.feature_names.index(c.name) for c in changes]] = [c.after for c in changes]
-    scores, avail = policy.scores(rows), policy.available(rows)
-    free = np.where(avail, scores, -np.inf)
-    chosen = policy.action_names.index(found.chosen)
-    breaks = broken(policy, rows, [[policy.feature_names.index(c.name) for c in changes] for _, changes in said])
+    picks = [p for p in _picks(policy, np.asarray(exp.states[index], dtype=float), found) if p is not None]
     # the search's own action as written first; else another action than the chosen one, which the words then name
-    for n in sorted(range(len(said)), key=lambda n: free[n].argmax() != policy.action_names.index(said[n][0].action)):
+    pick = next((p for p in picks if p[2] == p[0].action), picks[0] if picks else None)
+    if pick is None:
+        return None
+    _, changes, act, margin, _ = pick
+    words = action_words(policy, act)
+    return CounterfactualFact(True, changes, act, words, margin, found.chosen, found.target, max_changes)
+
+
+def _picks(policy: Policy, state: np.ndarray, found: Counterfactuals) -> list[tuple | None]:
+    """Per counterfactual of ``found``: (it, its changes as written, the action taken then, its margin, its score) for
+    the first rounding (of :data:`_NUDGES`) that, re-run as written, flips the decision to the search's action, else
+    to another than the one chosen, within the world's constraints and past the noise; None when none does. One
+    batch."""
+    said = [(k, _said(policy, state, cf.changes, extra)) for k, cf in enumerate(found.found) for extra in _NUDGES]
+    said = [(k, changes) for k, changes in said if changes]
+    out: list[tuple | None] = [None] * len(found.found)
+    if not said:
+        return out
+    rows = np.repeat(state[None], len(said), axis=0)
+    cols = [[policy.feature_names.index(c.name) for c in changes] for _, changes in said]
+    for n, (_, changes) in enumerate(said):
+        rows[n, cols[n]] = [c.after for c in changes]
+    scores, avail = policy.scores(rows), policy.available(rows)
+    free, chosen = np.where(avail, scores, -np.inf), policy.action_names.index(found.chosen)
+    breaks = broken(policy, rows, cols)
+    for n, (k, changes) in enumerate(said):
         a = int(free[n].argmax())
         margin = lead(scores[n], avail[n], a)
-        if a != chosen and not breaks[n] and margin > NOISE * max(1.0, np.abs(scores[n]).max()):
-            act = policy.action_names[a]
-            words = action_words(policy, act)
-            return CounterfactualFact(True, said[n][1], act, words, margin, found.chosen, found.target, max_changes)
-    return None
+        if a == chosen or breaks[n] or margin <= NOISE * max(1.0, np.abs(scores[n]).max()):
+            continue
+        own = policy.action_names[a] == found.found[k].action
+        if out[k] is None or (own and out[k][2] != found.found[k].action):
+            out[k] = (found.found[k], changes, policy.action_names[a], margin, float(scores[n, a]))
+    return out
+
+
+def as_written(policy: Policy, found: Counterfactuals, text=None, n: int = 3) -> dict:
+    """What the CLI and the report's cards show of ``found``: :func:`xairl.counterfactuals.show.summary` of its
+    counterfactuals as the words write them, each re-run through ``policy`` as written (the one that the sentence
+    says first among them, :func:`_picks`); one that flips as found but not as written is left out, a change that
+    the written digits do not show ('0 bit -> 0 bit') is no change, and one the same as written as another is left
+    out."""
+    if not found.found or policy.output != "actions":
+        return summary(found, text, n, as_written=policy.output == "actions")
+    cf0 = found.found[0]
+    state = np.asarray(cf0.state, dtype=float).copy()
+    for c in cf0.changes:  # (the state searched: the changed one with its changes undone)
+        state[policy.feature_names.index(c.feature)] = c.before
+    shown = []
+    for cf, changes, act, margin, output in (p for p in _picks(policy, state, found) if p is not None):
+        x, after = state.copy(), {c.name: c.after for c in changes}
+        x[[policy.feature_names.index(f) for f in after]] = list(after.values())
+        kept = tuple(_replace(c, after=float(after[c.feature])) for c in cf.changes if c.feature in after)
+        if any(kept == other.changes for other in shown):
+            continue  # (the same change as written as one shown: a no-op change left out)
+        shown.append(Counterfactual(kept, x, act, output, margin, cf.distance, cf.distance_scaled))
+    reason = found.reason or ("" if shown else "the search's changes flip it, but none as written: the line bends "
+                              "within one written digit of them")  # fmt: skip
+    return summary(Counterfactuals(found.index, found.chosen, found.target, tuple(shown), reason), text, n, True)
 
 
 def _said(policy: Policy, state: np.ndarray, changes, extra: int) -> tuple[ChangeFact, ...]:

@@ -71,14 +71,45 @@ def explanation_html(exp, states: int = 5, top: int = 6) -> str:
 
 def counterfactual_text(cf: dict) -> list[str]:
     """A decision's counterfactuals (the plain dict of :func:`xairl.counterfactuals.show.summary`) as terminal lines:
-    one per counterfactual, 'rsrp_1 -83.2 dBm -> -71.5 dBm: handover_to_candidate_1 (margin 0.0052)', or the one line
-    'unreachable within the bounds: <why>'."""
+    one per counterfactual, 'rsrp_1 -83.2 dBm -> -71.5 dBm: handover_to_candidate_1 (margin 0.0052)' (a threshold's:
+    the output's new value), or the one line 'none found within the bounds (a grid search: <why>)'."""
     if not cf.get("found"):
-        return [f"unreachable within the bounds: {cf.get('reason') or 'no change found'}"]
-    return [
-        f"{_changes(one, ' -> ')}: {one['action']} (margin {one['margin']:.3g}, distance {one['distance']:.2f})"
-        for one in cf["found"]
-    ]
+        return [_miss(cf)]
+    return [f"{_changes(one, ' -> ')}: {_then(cf, one)} (margin {_g(one['margin'])}, distance {one['distance']:.2f})"
+            for one in cf["found"]]  # fmt: skip
+
+
+def counterfactual_meta(cf: dict, chosen: bool = True) -> str:
+    """The heading's words: what was chosen and asked, and how the values shown were checked: re-run through the
+    policy as written (``as_written``), or, for a bare answer, rounded away from the state's value, just past the
+    line (the search re-ran its own unrounded values, not these)."""
+    how = (
+        "each re-run through the policy as shown"
+        if cf.get("as_written")
+        else "values rounded away from the state's, just past the line; the search re-ran its unrounded ones"
+    )
+    return f"{'chose ' + str(cf['chosen']) + '; ' if chosen else ''}asked: {cf['target']}; {how}"
+
+
+def _miss(cf: dict) -> str:
+    """Why none is shown: a search's miss as 'none found within the bounds (a grid search: ...)', never as a claim
+    that none exists; another reason ('it already chooses B') as 'none: ...'."""
+    why = str(cf.get("reason") or "no change found")
+    miss = " (a grid search: a miss is no proof that none exists)"
+    return f"none found within the bounds (a grid search: {why.replace(miss, '')})" if miss in why else f"none: {why}"
+
+
+def _then(cf: dict, one: dict) -> str:
+    """What the policy then does: the action, or a threshold's output, its old value and its new one ('steer 0.12 ->
+    0.21'; 'steer = 0.21' where the answer does not hold the old one)."""
+    if not (cf.get("threshold") and "output" in one):
+        return str(one["action"])
+    old, new = cf.get("output"), _g(one["output"])
+    return f"{one['action']} = {new}" if old is None else f"{one['action']} {_g(old)} -> {new}"
+
+
+def _g(x) -> str:
+    return f"{x:.3g}" if abs(x) >= 1e-3 or x == 0 else f"{x:.2e}"
 
 
 def _changes(one: dict, arrow: str, escape=lambda s: s) -> str:
@@ -99,20 +130,17 @@ def counterfactual_html(cf: dict) -> str:
     :func:`xairl.counterfactuals.show.summary`) as a small HTML card: each one's changes, the action the policy then
     takes and its margin, or why none is reachable within the bounds."""
     e = html.escape
-    head = (
-        f"<b>What would have changed it</b> <span class=meta>(chose {e(cf['chosen'])}; asked: {e(cf['target'])}; each "
-        "re-run through the policy)</span>"
-    )
+    head = f"<b>What would have changed it</b> <span class=meta>({e(counterfactual_meta(cf))})</span>"
     if not cf.get("found"):
-        body = f"<p class=cf-none>None found: {e(cf.get('reason') or 'no change found')}.</p>"
+        body = f"<p class=cf-none>{e(_miss(cf)).capitalize()}.</p>"
     else:
         rows = "".join(
-            f"<tr><td>{_changes(one, ' &rarr; ', e)}</td><td>{e(one['action'])}</td><td>{one['margin']:.3g}</td>"
+            f"<tr><td>{_changes(one, ' &rarr; ', e)}</td><td>{e(_then(cf, one))}</td><td>{_g(one['margin'])}</td>"
             f"<td>{one['distance']:.2f}</td></tr>"
             for one in cf["found"]
         )
+        then = "then its output" if cf.get("threshold") else "then the policy chooses"
         body = (
-            "<table><tr><th>change</th><th>then the policy chooses</th><th>margin</th>"
-            f"<th>distance (quantiles)</th></tr>{rows}</table>"
+            f"<table><tr><th>change</th><th>{then}</th><th>margin</th><th>distance (quantiles)</th></tr>{rows}</table>"
         )
     return f"<div class=xairl-cf>{head}{body}</div>"

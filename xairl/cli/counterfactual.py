@@ -21,8 +21,9 @@ def counterfactual_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--counterfactual-target",
         default=None,
-        metavar="NAME|any",
-        help="with --counterfactual: the action to reach (default: the runner-up), or 'any' other action",
+        metavar="NAME|INDEX|any",
+        help="with --counterfactual: the action to reach, by name or index (default: the runner-up), or 'any' other "
+        "action",
     )
     p.add_argument(
         "--max-changes",
@@ -47,6 +48,8 @@ def search(args, policy, exp, background):
 
     target = args.counterfactual_target
     target = None if target in (None, "", "runner-up") else target
+    if target is not None and target not in policy.action_names and target.lstrip("-").isdigit():
+        target = int(target)  # an action's index, as the docs say ('--counterfactual-target 2')
     return counterfactual(
         policy,
         exp.states,
@@ -58,29 +61,27 @@ def search(args, policy, exp, background):
     )
 
 
-def said(found, i: int, max_changes: int) -> dict:
-    """narrate's ``counterfactual`` argument for decision ``i``: its answer, for the template's sentence. An answer
-    of none found with ``--max-changes 1`` is not given (the sentence would say 'at most 2 features')."""
-    if found is None or (not found[i].reachable and max_changes != 2):
-        return {}
-    return {"counterfactual": found[i]}
+def said(found, i: int, max_changes: int | None = None) -> dict:
+    """narrate's ``counterfactual`` argument for decision ``i``: its answer, for the template's sentence (which says
+    nothing of a miss; ``max_changes`` is not needed: explain.py may stop passing it)."""
+    return {} if found is None else {"counterfactual": found[i]}
 
 
 def summaries(found, policy) -> list[dict] | None:
-    """Each decision's answer as plain data (:func:`xairl.counterfactuals.show.summary`), its values written as
-    the narratives write them."""
+    """Each decision's answer as plain data (:func:`xairl.counterfactual_facts.as_written`): its values as the
+    narratives write them, each re-run through the policy as written, so that the block and the sentence agree."""
     if found is None:
         return None
-    from ..counterfactuals.show import summary
+    from ..counterfactual_facts import as_written
     from ..report_counterfactuals import writer
 
     write = writer(policy)
-    return [summary(r, write) for r in found]
+    return [as_written(policy, r, write) for r in found]
 
 
 def block(cf: dict) -> str:
     """The terminal's lines of one decision: a heading, then one row per counterfactual (or why there is none)."""
-    from ..display import counterfactual_text
+    from ..display import counterfactual_meta, counterfactual_text
 
     rows = "\n".join(f"      {line}" for line in counterfactual_text(cf))
-    return f"    what would have changed it (asked: {cf['target']}; re-run through the policy):\n{rows}"
+    return f"    what would have changed it ({counterfactual_meta(cf, chosen=False)}):\n{rows}"

@@ -19,10 +19,15 @@ honoured), after the constraints of the world (:func:`xairl.counterfactual_facts
 changed, the declared bounds, the policy's ``feasible``), and:
 
 - the hypothetical values are verified when that state is allowed and the policy decides otherwise there;
-- the action after 'would have' (tracked from any field, or written: a name or an alias) must be the one it takes
-  there, and not the one it took; 'would not have' is contradicted when the action named is the one it takes there,
-  else unchecked (never verified); an action after 'chose' is the one it took;
-- the stated margin is that action's score minus the best other available one's, as written;
+- what it says the policy would have done, its *consequent*, is read in one of these forms only: 'would have
+  chosen/taken/picked/selected (to) X', 'would have handed over to X' (the action 'hand over to X'), 'would
+  choose/take (to) X', where X, up to the next punctuation, is an action's name or alias, whole (tracked from any
+  field, or written). X must be the action the policy takes there, and not the one it took. Negated ('would not
+  have chosen X'), it is contradicted when X is the one it takes there, else unchecked. Any other 'would' in the
+  sentence ('would likely have picked', 'would, in that case, have', 'would the policy have', 'would have avoided', 'would have chosen X rather than Y') is not read: the sentence is left unchecked, never
+  verified (its claims that would be verified become unchecked; a wrong value still contradicts it). So is one that
+  names an action anywhere else, unless as the one it took in a clause without 'would' ('it chose stay', checked);
+- the stated margin is the stated action's score minus the best other available one's, as written;
 - a direction word points from the state's value to the hypothetical one, and an actual value is the state's.
 
 Without the policy, or without the state as its input (an image narrated in regions), nothing of it is checked: its
@@ -37,7 +42,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...counterfactual_facts import NOISE, action_index, broken, feature_words, lead
+from ...counterfactual_facts import NOISE, broken, feature_words, lead
 from ...policy import FeatureInfo
 from ..verify import Claim
 from .lexicon import NUMBER
@@ -47,12 +52,19 @@ from .truth import Truth, close, number
 RULE = "tracked.counterfactual"
 _BELOW = r"below|under|less than|lower than|smaller than|at most|beneath"
 _ABOVE = r"above|over|more than|higher than|greater than|larger than|at least|exceed\w*"
-#: the forms that make a sentence counterfactual
-FORM = re.compile(r"\bhad\b.+?\bbeen\b|\bif\b.+?\bwere\b|\bwould\b(?:\s+\w+|n't){0,2}\s+have\b", re.I | re.S)
+#: the forms that make a sentence counterfactual (any 'would': its consequent must then be one that :data:`WOULD` reads)
+FORM = re.compile(r"\bhad\b.+?\bbeen\b|\bif\b.+?\bwere\b|\bwould", re.I | re.S)
+#: the one grammar of a consequent (module doc): 'would have chosen X', 'would have handed over to X', 'would choose X';
+#: negated ('would not have chosen X'): contradicted when X is what it takes there, else unchecked, never verified
+WOULD = re.compile(
+    r"\bwould(?P<neg>\s+not|\s+never|n't)?\s+(?:have\s+(?:chosen|taken|picked|selected)(?:\s+to)?|have\s+(?P<over>handed\s+over\s+to)|"
+    r"(?:choose|take)(?:\s+to)?)\s+(?P<x>[^(),.;:!?]+?)\s*(?=[(),.;:!?]|$)",
+    re.I,
+)
 _HYPO = re.compile(rf"\b(?:been|were|at|to)\s+(?:(?P<dir>{_BELOW}|{_ABOVE})\s+)?$", re.I)
 _ACTUAL = re.compile(rf"\b(?:was|is|are|were|now|currently|at)\s+(?:(?P<dir>{_BELOW}|{_ABOVE})\s+)?$", re.I)
-_WOULD = re.compile(r"\bwould(?P<neg>\s+not|n't|\s+never)?(?:\s+(?:still|also|then|instead|rather))?\s+have\b", re.I)
-_CHOSE = re.compile(r"\b(?:chose|chooses|took|takes|picked|selected|preferred)\b", re.I)
+#: a clause that says the action taken: the action right after one of these verbs (and no 'would' in its clause)
+_CHOSE = re.compile(r"\b(?:chose|chooses|took|takes|picked|selected|preferred)\s+(?:to\s+)?$", re.I)
 _VALUES = ("after_text", "after", "after_fill", "value_text", "value", "fill")
 _ACTIONS = ("action", "action_words", "chosen", "target")
 _MISS = "a search's miss is no proof (it tries a grid of changes): no re-run can check that nothing would flip it"
@@ -179,13 +191,15 @@ def check_counterfactual(s, cf: list[Part], truth: Truth) -> list[Claim]:
         for v in vals
         if not v.slot
     ]
-    hypo, acts = [v for v in vals if v.slot == "hypo"], _said_actions(s, cf, policy)
+    hypo, (acts, why) = [v for v in vals if v.slot == "hypo"], _said_actions(s, cf, policy)
     claims += _rerun(cf, hypo, acts, policy, state, truth, counterfactual)
-    # its change or its new action unread ('been storm', 'would have kept the UAV' written by hand): its other claims,
-    # true as they may be, do not verify what it says
-    if counterfactual and (not hypo or any(slot == "unread" for *_, slot in acts)):
-        unread = "what it says would have been, or been done, was not read: " + ("no value after 'had ... been', "
-                 "'if ... were', 'with ... at'" if not hypo else "no action named after 'would have'")  # fmt: skip
+    why = why or ("" if any(slot == "would" for *_, slot in acts) else "no action after 'would have chosen'")
+    # its change or its consequent unread ('been storm', 'would likely have picked stay'): its other claims, true as
+    # they may be, do not verify what it says
+    if counterfactual and (not hypo or why):
+        unread = "what it says would have been, or been done, was not read: " + (
+            "no value after 'had ... been', 'if ... were', 'with ... at'" if not hypo else why
+        )
         claims = [replace(c, status="unchecked", detail=unread) if c.status == "verified" else c for c in claims]
     return claims
 
@@ -210,40 +224,50 @@ def _actual(s, v: _Value, policy, state: np.ndarray) -> Claim:
     return _claim(v.part, "number", "verified" if ok else "contradicted", what, v.text)
 
 
-def _first_action(policy, words: list[str]) -> tuple[str, int] | None:
-    """(its words, the action) of the first action ``words`` name, by its name or an alias, longest first."""
-    for k in range(len(words)):
-        for e in range(len(words), k, -1):
-            a = action_index(policy, " ".join(words[k:e]))
-            if a is not None:
-                return " ".join(words[k:e]), a
-    return None
-
-
-def _said_actions(s, cf: list[Part], policy) -> list[tuple[Part | None, str, int | None, str]]:
-    """(its span or None, its text, the action it names, its slot) per action the sentence names: the first one
-    after each 'would (not) have' (slot 'would' or 'not'; 'unread' when those words name none), and every tracked
-    action of the fact elsewhere ('chose' after 'chose', 'took'; '' when said as neither)."""
-    out, covered = [], []
-    for m in _WOULD.finditer(s.text):
-        end = re.search(r"[(),.;]|$", s.text[m.end() :]).start() + m.end()
-        covered.append((m.end(), end))
-        hit = _first_action(policy, s.text[m.end() : end].split())
-        if hit is None:  # (a tracked action of the fact there that names no action, 'any other action': wrong)
-            named = next((p for p in cf if m.end() <= p.start < end and p.span.fact.quantity[3:] in _ACTIONS), None)
-            text = named.span.text if named else s.text[m.end() : end].strip()
-            out.append((named, text, None, "would" if named else "unread"))
-            continue
-        at = m.end() + s.text[m.end() : end].find(hit[0])
-        part = next((p for p in cf if p.start <= at < p.end), None)
-        negated = m["neg"] or re.search(r"\b(?:not|never)\b", s.text[m.end() : at], re.I)  # ('would have not')
-        out.append((part, hit[0], hit[1], "not" if negated else "would"))
-    for p in cf:
-        if p.span.fact.quantity[3:] in _ACTIONS and not any(a <= p.start < b for a, b in covered):
-            clause = s.text[: p.start].split(",")[-1]
-            slot = "chose" if _CHOSE.search(clause) else ""
-            out.append((p, p.span.text, action_index(policy, p.span.text), slot))
+def _lookup(policy) -> dict[str, int | None]:
+    """Every action's name and alias (lower case; not a bare number, which is a value) -> the action it names (None
+    for an alias several actions share)."""
+    out: dict[str, int | None] = {}
+    for a, name in enumerate(policy.action_names):
+        for w in (name, *policy.action_aliases.get(name, ())):
+            if w and not NUMBER.fullmatch(w.strip()):
+                out[_said(w)] = a if out.get(_said(w), a) == a else None
     return out
+
+
+def _said_actions(s, cf: list[Part], policy) -> tuple[list[tuple[Part | None, str, int | None, str]], str]:
+    """(its span or None, its text, the action it names, its slot) per action the sentence names, and why its
+    actions were not read ('' when they were): the action of each consequent :data:`WOULD` reads (slot 'would'),
+    one right after 'chose' in a clause without 'would' ('chose'), and the others (''); every other 'would', and
+    every action named outside those two places, leave it unread (module doc)."""
+    text, names, out, spans, why = s.text, _lookup(policy), [], [], ""
+    for m in WOULD.finditer(text):
+        x, at = m["x"], m.start("x")
+        a = names.get(_said(("hand over to " if m["over"] else "") + x))
+        part = next((p for p in cf if p.start <= at < p.end), None)
+        tracked = part is not None and part.span.fact.quantity[3:] in _ACTIONS and part.end >= m.end("x")
+        if a is not None or tracked:  # (a tracked field there that names no action, 'the runner-up': wrong)
+            out.append((part, x, a, "not" if m["neg"] else "would"))
+            spans.append((m.start(), m.end()))
+    if any(not any(a <= w.start() < b for a, b in spans) for w in re.finditer(r"\bwould", text, re.I)):
+        why = "a 'would' in a form the check does not read (it reads 'would have chosen X', 'would choose X')"
+    if not names:
+        return out, why
+    named = re.compile("|".join(rf"(?<!\w){re.escape(w)}(?!\w)" for w in sorted(names, key=len, reverse=True)), re.I)
+    for m in named.finditer(text):
+        if any(a <= m.start() < b for a, b in spans):
+            continue
+        clause, a = re.split(r"[,;()]", text[: m.start()])[-1], names[_said(m.group())]
+        part = next((p for p in cf if p.start <= m.start() < p.end), None)
+        taken = a is not None and _CHOSE.search(clause) and not re.search(r"\bwould", clause, re.I)
+        out.append((part, m.group(), a, "chose" if taken else ""))
+        if not taken:
+            why = (
+                why or f"'{m.group()}' is neither the action it would take ('would have chosen X') nor the one it took"
+            )
+    seen = {id(p) for p, *_ in out}
+    out += [(p, p.span.text, None, "") for p in cf if p.span.fact.quantity[3:] in _ACTIONS and id(p) not in seen]
+    return out, why
 
 
 def _rerun(
@@ -289,7 +313,11 @@ def _rerun(
             claims.append(
                 _claim(p, "action", "verified" if a == taken != chosen and not why else "contradicted", how, t)
             )
-    said = next((a for _, _, a, slot in acts if slot == "would" and a is not None), taken)
+    said = next(
+        (a for _, _, a, slot in acts if slot == "would" and a is not None), None
+    )  # (the margin is the stated action's)
+    if said is None:
+        return claims + [_claim(p, "number", "unchecked", "no action stated: whose margin?") for p in margins]
     return claims + _margins(margins, scores, lead(scores, avail, said), how)
 
 
@@ -303,7 +331,7 @@ def _taken(acts: list[tuple], chosen: int, name: str) -> list[Claim]:
     return claims + [
         _claim(p, "action", "unchecked", "no action it names is said as taken or as the one it would take", t)
         for p, t, a, slot in acts
-        if slot in ("", "unread")
+        if slot == ""
     ]
 
 
