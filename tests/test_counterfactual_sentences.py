@@ -182,3 +182,27 @@ def test_values_are_rounded_to_the_digits_format_number_writes(x):
     step = written_step(x)
     assert float(format_number(x)) / step == pytest.approx(round(float(format_number(x)) / step))
     assert format_number(round(x / step) * step) == format_number(x)
+
+
+def test_a_narrative_with_a_counterfactual_its_check_cannot_read_is_not_verified():
+    """'would surely have chosen stay' is wrong (below 19.9 % the policy goes) and in no form the check reads: its
+    sentence is unchecked, and the narrative with it must not pass as verified (it did at 75 % coverage)."""
+    from tests.counterfactual_cases import CAP, HAD, OWN, answer, linear_policy, template
+    from xairl.facts import decision_facts
+    from xairl.narrators.base import first_phrasings
+    from xairl.narrators.provenance import verify
+    from xairl.tracking import track_decision
+
+    p = linear_policy()
+    states = np.array([[160, -90], [120, -95]], dtype=np.float32)
+    bg = np.random.default_rng(0).uniform([0, -120], [CAP, -60], size=(64, 2)).astype(np.float32)
+    exp = xairl.explain(p, states, background=bg, method="exact")
+    fact = counterfactual_fact(exp, 0, p, answer(p, states, 0, {0: 40 - 1e-3}))
+    tpl = template("explain_action")
+    sentences = tpl.spec.sentences[:-1] + [[OWN + HAD + "the policy would surely have chosen stay.{% endif %}"]]
+    tpl = replace(tpl, spec=tpl.spec.model_copy(update={"sentences": sentences}))
+    facts = replace(decision_facts(exp, 0, p, 3), counterfactual=fact)
+    text = first_phrasings(tpl.render_variants(track_decision(facts.context())))
+    v = verify(text, exp, 0, p, provenance=text.spans)
+    assert [s.status for s in v.sentences][-1] == "unchecked" and v.coverage >= 0.5
+    assert not v.ok and v.status == "unchecked"

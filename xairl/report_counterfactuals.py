@@ -5,7 +5,7 @@ The cards: the narrated decisions are searched in one batch (:func:`xairl.counte
 at most two features that makes the policy choose its runner-up, every result re-run through the policy), guided by
 the report's own explanation of them; each answer is given to the narrator (its template's last sentence, 'Had ...
 been ..., the policy would have chosen ...', checked by re-running the policy on the values as written) and travels
-in its card's evidence (``evidence['counterfactual']``, :func:`xairl.counterfactuals.show.summary`), so the review
+in its card's evidence (``evidence['counterfactual']``, :func:`xairl.counterfactual_facts.as_written`), so the review
 page shows it as the report does.
 
 The run: for the first :data:`RUN` decisions, every feature that may change is tried alone (``max_changes=1``,
@@ -28,7 +28,7 @@ from dataclasses import replace
 import numpy as np
 
 from .counterfactuals import Counterfactuals
-from .counterfactuals.show import single_flips, summary
+from .counterfactuals.show import single_flips
 from .explanation import Explanation
 from .policy import Policy
 from .prompts import format_number
@@ -71,10 +71,12 @@ def decisions(
 
 def attach(pairs: list, found: dict[int, Counterfactuals], policy: Policy) -> None:
     """Put each decision's answer into its card's evidence (``(narrative, evidence)`` pairs), written as narrated."""
+    from .counterfactual_facts import as_written
+
     write = writer(policy)
     for n, ev in pairs:
-        if n.index in found and ev is not None:
-            ev["counterfactual"] = summary(found[n.index], write)
+        if n.index in found and ev is not None:  # the values as the sentence writes them, re-run as written
+            ev["counterfactual"] = as_written(policy, found[n.index], write)
 
 
 def flip_rows(policy: Policy, exp: Explanation, background, limit: int = RUN) -> tuple[str, list[str], list[list], str]:

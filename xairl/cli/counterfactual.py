@@ -61,9 +61,9 @@ def search(args, policy, exp, background):
     )
 
 
-def said(found, i: int, max_changes: int | None = None) -> dict:
+def said(found, i: int) -> dict:
     """narrate's ``counterfactual`` argument for decision ``i``: its answer, for the template's sentence (which says
-    nothing of a miss; ``max_changes`` is not needed: explain.py may stop passing it)."""
+    nothing of a miss)."""
     return {} if found is None else {"counterfactual": found[i]}
 
 

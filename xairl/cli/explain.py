@@ -228,7 +228,7 @@ def _print_narratives(args, exp, policy, bg, raw=None) -> int:
             robustness=not args.no_robustness,
             options=options,
             prompt_dirs=args.prompts,
-            **said(raw, i, args.max_changes),  # the template's counterfactual sentence, checked by a re-run
+            **said(raw, i),  # the template's counterfactual sentence, checked by a re-run
         )
         if found is not None and n.evidence is not None:  # the review page shows it beside the narrative
             n.evidence["counterfactual"] = found[i]

@@ -115,7 +115,7 @@ class Counterfactuals:
         """One line: the decision, then the best counterfactual (and how many more), or why there is none."""
         head = f"Counterfactuals(state {self.index}: chose {self.chosen}, asked {self.target}"
         if not self.found:
-            return f"{head}; unreachable: {self.reason})"
+            return f"{head}; none found: {self.reason})"
         more = f"; {len(self.found) - 1} more" if len(self.found) > 1 else ""
         return f"{head}; best {self.found[0]!r}{more})"
 

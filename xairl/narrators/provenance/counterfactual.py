@@ -44,12 +44,12 @@ import numpy as np
 
 from ...counterfactual_facts import NOISE, broken, feature_words, lead
 from ...policy import FeatureInfo
-from ..verify import Claim
+from ..verify import COUNTERFACTUAL, Claim
 from .lexicon import NUMBER
 from .parts import Part
 from .truth import Truth, close, number
 
-RULE = "tracked.counterfactual"
+RULE = COUNTERFACTUAL
 _BELOW = r"below|under|less than|lower than|smaller than|at most|beneath"
 _ABOVE = r"above|over|more than|higher than|greater than|larger than|at least|exceed\w*"
 #: the forms that make a sentence counterfactual (any 'would': its consequent must then be one that :data:`WOULD` reads)

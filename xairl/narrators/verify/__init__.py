@@ -49,6 +49,9 @@ from .vocabulary import split_words, vocabulary
 from .window import add_window_facts, per_signal
 
 MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
+#: the rule of a counterfactual sentence's claims (xairl.narrators.provenance.counterfactual): one left unchecked keeps
+#: the whole text from 'verified'
+COUNTERFACTUAL = "tracked.counterfactual"
 MAX_CHARS = 200_000  # longer texts are cut here (and the cut reported)
 #: a longer sentence is read in pieces of at most this many characters, cut at a clause boundary (commas, 'and'):
 #: the clause readers look back over their sentence, so a bound on its length keeps the time linear in the text
@@ -104,6 +107,8 @@ class Verification:
     def status(self) -> str:
         if any(s.status == "contradicted" for s in self.sentences):
             return "contradicted"
+        if any(c.rule == COUNTERFACTUAL and c.status == "unchecked" for c in self.claims):
+            return "unchecked"  # a counterfactual stated in a form its check cannot read: never passed as verified
         return "verified" if self.sentences and self.coverage >= MIN_COVERAGE else "unchecked"
 
     @property
