@@ -157,13 +157,18 @@ def test_report_cards_and_the_single_flip_table(tmp_path):
     assert f in sentence or "No decision" in sentence
 
 
-def test_review_page_shows_the_counterfactual_beside_the_narrative(tmp_path):
+def _toy_decision(n: int, seed: int):
+    """(policy, background, explanation, every state's counterfactuals, the first decision with one)."""
     policy = toy_policy()
     bg = policy.background(50)
-    states = policy.background(4, seed=4)
+    states = policy.background(n, seed=seed)
     exp = xairl.explain(policy, states, background=bg)
     found = xairl.counterfactual(policy, states, index=None, background=bg, explanation=exp)
-    i = next(k for k, r in enumerate(found) if r.reachable)
+    return policy, bg, exp, found, next(k for k, r in enumerate(found) if r.reachable)
+
+
+def test_review_page_shows_the_counterfactual_beside_the_narrative(tmp_path):
+    policy, bg, exp, found, i = _toy_decision(4, 4)
     store = FeedbackStore(tmp_path / "fb.sqlite")
     n = xairl.narrate(exp, i, policy=policy, background=bg, robustness=False)
     n.evidence["counterfactual"] = summary(found[i])
@@ -174,12 +179,7 @@ def test_review_page_shows_the_counterfactual_beside_the_narrative(tmp_path):
 
 
 def test_a_narratives_counterfactual_sentence_shows_in_its_card():
-    policy = toy_policy()
-    bg = policy.background(50)
-    states = policy.background(6, seed=5)
-    exp = xairl.explain(policy, states, background=bg)
-    found = xairl.counterfactual(policy, states, index=None, background=bg, explanation=exp)
-    i = next(k for k, r in enumerate(found) if r.reachable)
+    policy, bg, exp, found, i = _toy_decision(6, 5)
     n = xairl.narrate(exp, i, policy=policy, background=bg, robustness=False, counterfactual=found[i])
     last, status = n.sentences[-1]
     assert last.startswith("Had ") and found[i].best.action in last and status == "verified"
