@@ -156,3 +156,16 @@ def narration_arguments(p: argparse.ArgumentParser) -> None:
 
 #: how each sentence's status is shown: an unchecked sentence is said to be unchecked, never passed as verified
 MARKS = {"verified": "verified", "contradicted": "CONTRADICTED", "unchecked": "unchecked"}
+
+
+def feedback_arguments(p: argparse.ArgumentParser) -> None:
+    """--feedback-db, --no-record, --examples-from-feedback: where the narratives shown are recorded for review."""
+    p.add_argument(
+        "--feedback-db", type=new_file, default=None, help="SQLite store of shown narratives (default: in the user dir)"
+    )
+    p.add_argument("--no-record", action="store_true", help="do not record the narratives for review")
+    p.add_argument(
+        "--examples-from-feedback",
+        action="store_true",
+        help="give the local LM the operators' latest accepted or corrected narratives as examples",
+    )

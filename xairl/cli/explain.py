@@ -11,7 +11,16 @@ import re
 
 from .. import plugins
 from ..errors import InputError
-from .args import MARKS, count, make_dir, narration_arguments, new_file, out_dir, parse_options, report_request
+from .args import (
+    MARKS,
+    count,
+    feedback_arguments,
+    make_dir,
+    narration_arguments,
+    out_dir,
+    parse_options,
+    report_request,
+)
 from .counterfactual import block, counterfactual_arguments, said, search, summaries
 
 #: above this many states, ``--out DIR`` without a --format streams them into DIR/explanations.parquet (200,000 toy
@@ -383,13 +392,5 @@ def explain_parser(p: argparse.ArgumentParser) -> None:
     )
     narration_arguments(p)
     counterfactual_arguments(p)
-    p.add_argument(
-        "--feedback-db", type=new_file, default=None, help="SQLite store of shown narratives (default: in the user dir)"
-    )
-    p.add_argument("--no-record", action="store_true", help="do not record the narratives for review")
-    p.add_argument(
-        "--examples-from-feedback",
-        action="store_true",
-        help="give the local LM the operators' latest accepted or corrected narratives as examples",
-    )
+    feedback_arguments(p)
     p.set_defaults(run=cmd_explain)
