@@ -55,7 +55,9 @@ def main() -> None:
     bg, states = policy.background(200), policy.background(a.states, seed=3)
     exp = xairl.explain(policy, states, background=bg)
     t0 = time.perf_counter()
-    found = xairl.counterfactual(policy, states, index=None, background=bg, explanation=exp, max_changes=a.max_changes)
+    found = xairl.counterfactual(
+        policy, states, index=None, background=bg, explanation=exp, max_changes=a.max_changes, n=3
+    )
     t_search, t0 = time.perf_counter() - t0, time.perf_counter()
     tpl, counts, facts = last_sentence(a.template), collections.Counter(), {}
     for i, answer in enumerate(found):

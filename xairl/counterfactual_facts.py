@@ -294,8 +294,8 @@ def said_counterfactual(
     if ask is True:
         from .counterfactuals.search import counterfactual
 
-        ask = counterfactual(
-            policy, exp.states, index=index, background=background, explanation=exp, max_changes=max_changes
+        ask = counterfactual(  # (three, so that one still flips once its values are rounded away from the line)
+            policy, exp.states, index=index, background=background, explanation=exp, max_changes=max_changes, n=3
         )
     return counterfactual_fact(exp, index, policy, ask, max_changes)
 

@@ -63,9 +63,15 @@ def decisions(
     if not idx:
         return {}
     found = counterfactual(
-        policy, exp.states[idx], index=None, target=target, max_changes=max_changes, background=background,
+        policy,
+        exp.states[idx],
+        index=None,
+        target=target,
+        max_changes=max_changes,
+        background=background,
         explanation=exp[idx],
-    )  # fmt: skip
+        n=3,
+    )  # fmt: skip  (n=3: alternatives, so that one still flips once written as the words write it)
     return {i: replace(r, index=i) for i, r in zip(idx, found)}  # numbered as the states of ``exp``
 
 

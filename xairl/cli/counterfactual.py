@@ -58,6 +58,7 @@ def search(args, policy, exp, background):
         max_changes=args.max_changes,
         background=background,
         explanation=exp,
+        n=3,  # alternatives, so that one still flips once its values are written as the words write them
     )
 
 
