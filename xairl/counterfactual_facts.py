@@ -19,7 +19,6 @@ never by its signal's words alone, which name the current value.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from dataclasses import replace as _replace
 
@@ -127,18 +126,19 @@ def action_index(policy: Policy, text: str) -> int | None:
         return None
 
 
-_PAST_SLOT = re.compile(r"^(?P<signal>.+)\[t-(?P<k>\d+)\]$")
-
-
 def feature_words(policy: Policy, name: str) -> str:
     """How a counterfactual names a feature: its description, else its name; a window's past slot
-    (``speed[t-2]``) as its signal's words that many steps ago ('the speed 2 steps ago')."""
+    (``speed[t-2]``, :meth:`xairl.windows.Window.names`) as its signal's words that many steps ago ('the speed 2
+    steps ago')."""
     info = policy.features.get(name) or FeatureInfo()
-    slot = _PAST_SLOT.match(name) if policy.observation.kind == "window" else None
-    if slot is None:
-        return info.description or name
-    k = int(slot["k"])
-    return f"{info.description or slot['signal']} {k} step{'s' if k > 1 else ''} ago"
+    window = policy.observation.parts[0].window if policy.observation.kind == "window" else None
+    slots = window.names() if window is not None else []
+    if name in slots:
+        at = slots.index(name)
+        back, signal = window.steps - 1 - at // len(window.signals), window.signals[at % len(window.signals)]
+        if back:
+            return f"{info.description or signal} {back} step{'s' if back > 1 else ''} ago"
+    return info.description or name
 
 
 def broken(policy: Policy, states: np.ndarray, changed: list[list[int]]) -> list[str]:

@@ -100,12 +100,10 @@ def _miss(cf: dict) -> str:
 
 
 def _then(cf: dict, one: dict) -> str:
-    """What the policy then does: the action, or a threshold's output, its old value and its new one ('steer 0.12 ->
-    0.21'; 'steer = 0.21' where the answer does not hold the old one)."""
+    """What the policy then does: the action, or a threshold's output and its new value ('steer = 0.21')."""
     if not (cf.get("threshold") and "output" in one):
         return str(one["action"])
-    old, new = cf.get("output"), _g(one["output"])
-    return f"{one['action']} = {new}" if old is None else f"{one['action']} {_g(old)} -> {new}"
+    return f"{one['action']} = {_g(one['output'])}"
 
 
 def _g(x) -> str:

@@ -169,3 +169,31 @@ def feedback_arguments(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="give the local LM the operators' latest accepted or corrected narratives as examples",
     )
+
+
+def streaming_arguments(p: argparse.ArgumentParser) -> None:
+    """--chunk-size, --resume, --engine, --workers, --ray-address: a streamed run (--format parquet)."""
+    p.add_argument(
+        "--chunk-size",
+        type=count(1, 10_000_000),
+        default=50_000,
+        help="states per chunk with --format parquet (memory grows with it)",
+    )
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="with --format parquet (or --out alone): continue an interrupted run in --out",
+    )
+    p.add_argument(
+        "--engine",
+        choices=("local", "ray"),
+        default="local",
+        help="with --format parquet: this process (local) or Ray workers (pip install 'xairl[scale]')",
+    )
+    p.add_argument("--workers", type=count(1, 100_000), default=2, help="Ray workers (one CPU each; default 2)")
+    p.add_argument(
+        "--ray-address",
+        default=None,
+        metavar="ADDRESS",
+        help="a running Ray cluster (e.g. auto or ray://host:10001); default: Ray started on this machine",
+    )

@@ -20,6 +20,7 @@ from .args import (
     out_dir,
     parse_options,
     report_request,
+    streaming_arguments,
 )
 from .counterfactual import block, counterfactual_arguments, said, search, summaries
 
@@ -297,35 +298,44 @@ def marked_rows(text: str, sentences) -> str:
     return "\n".join(rows)
 
 
-def _streaming_arguments(p: argparse.ArgumentParser) -> None:
-    """--chunk-size, --resume, --engine, --workers, --ray-address: a streamed run (--format parquet)."""
-    p.add_argument(
-        "--chunk-size",
-        type=count(1, 10_000_000),
-        default=50_000,
-        help="states per chunk with --format parquet (memory grows with it)",
-    )
-    p.add_argument(
-        "--resume",
-        action="store_true",
-        help="with --format parquet (or --out alone): continue an interrupted run in --out",
-    )
-    p.add_argument(
-        "--engine",
-        choices=("local", "ray"),
-        default="local",
-        help="with --format parquet: this process (local) or Ray workers (pip install 'xairl[scale]')",
-    )
-    p.add_argument("--workers", type=count(1, 100_000), default=2, help="Ray workers (one CPU each; default 2)")
-    p.add_argument(
-        "--ray-address",
-        default=None,
-        metavar="ADDRESS",
-        help="a running Ray cluster (e.g. auto or ray://host:10001); default: Ray started on this machine",
-    )
-
-
 def explain_parser(p: argparse.ArgumentParser) -> None:
+    _input_arguments(p)
+    p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
+    p.add_argument(
+        "-o",
+        "--option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="an option of the method, validated against its schema; repeatable",
+    )
+    p.add_argument(
+        "--format",
+        choices=("table", "jsonl", "parquet"),
+        default=None,
+        help="table or jsonl on the terminal; parquet: streamed chunk by chunk into --out DIR (any number "
+        f"of states, resumable with --resume). Default: table, or parquet with --out above {STREAM_ABOVE:,} "
+        "states",
+    )
+    streaming_arguments(p)
+    p.add_argument("--top", type=count(1), default=5, help="features shown per state in the table")
+    p.add_argument(
+        "--view",
+        choices=("margin", "score"),
+        default="margin",
+        help="what the terminal table's contributions add up to for a decision: the margin over the "
+        "runner-up (default; the narratives' view) or the chosen action's score (reports and narratives "
+        "show the margin beside the score)",
+    )
+    narration_arguments(p)
+    counterfactual_arguments(p)
+    feedback_arguments(p)
+    p.set_defaults(run=cmd_explain)
+
+
+def _input_arguments(p: argparse.ArgumentParser) -> None:
+    """--policy, --policy-arg, --out, --states, --background, --background-size, --n, --seed: what is explained,
+    against what, and where it goes."""
     p.add_argument(
         "--policy",
         default="toy",
@@ -363,34 +373,3 @@ def explain_parser(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--n", type=count(1, 10_000_000), default=5, help="states to sample when --states is not given")
     p.add_argument("--seed", type=count(0, 2**32 - 1), default=0, help="seed of the sampled states and background")
-    p.add_argument("--method", default="deep_shap", help="attribution method (see `xairl attributors`)")
-    p.add_argument(
-        "-o",
-        "--option",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="an option of the method, validated against its schema; repeatable",
-    )
-    p.add_argument(
-        "--format",
-        choices=("table", "jsonl", "parquet"),
-        default=None,
-        help="table or jsonl on the terminal; parquet: streamed chunk by chunk into --out DIR (any number "
-        f"of states, resumable with --resume). Default: table, or parquet with --out above {STREAM_ABOVE:,} "
-        "states",
-    )
-    _streaming_arguments(p)
-    p.add_argument("--top", type=count(1), default=5, help="features shown per state in the table")
-    p.add_argument(
-        "--view",
-        choices=("margin", "score"),
-        default="margin",
-        help="what the terminal table's contributions add up to for a decision: the margin over the "
-        "runner-up (default; the narratives' view) or the chosen action's score (reports and narratives "
-        "show the margin beside the score)",
-    )
-    narration_arguments(p)
-    counterfactual_arguments(p)
-    feedback_arguments(p)
-    p.set_defaults(run=cmd_explain)

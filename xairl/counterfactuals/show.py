@@ -77,7 +77,6 @@ def summary(cfs, text: Callable[[str, float], str] | None = None, n: int = 3, as
         "found": found,
         "as_written": as_written,
         "threshold": threshold,
-        "output": _known(getattr(cfs, "output", None)),  # (a threshold's output in the state, where the answer has it)
     }
 
 
@@ -109,7 +108,3 @@ def single_flips(results: Sequence, features: Sequence[str]) -> dict[str, dict[s
 def _median(values: list[float]) -> float:
     known = [v for v in values if np.isfinite(v)]
     return float(np.median(known)) if known else float("nan")
-
-
-def _known(x) -> float | None:
-    return float(x) if x is not None and np.isfinite(x) else None
