@@ -3,17 +3,14 @@
 The corpus (``benchmarks/data/narratives``): 320 narratives about 32 explanations in four domains (house prices and
 credit default, one output each, not RL; the UAV handover DQN; the toy discrete policy), half accurate and half
 with one labelled error, in many voices. Cases 0-3 of each domain are the dev split (the verifier was tuned on it),
-cases 4-7 the test split (frozen before any tuning; report it apart); ``dev2/`` 76 more narratives on the dev
-cases in other voices (Q&A, LLM-style prose, shorthand, lists; 16 of them on two UAV 'stay' cases of its own) and
-``dev3/`` 55 more (shares, 'accounts for', pipes, counterfactuals), ``dev4/`` 44 in the voice of an LLM explaining
-SHAP values, ``dev5/`` 45 in memo, log, arrow and passive voices, ``dev6/`` to ``dev13/`` 23-48 each (markdown,
-tickets, voice memos, amount verbs, signs in words, comparisons between features, JSON-ish output, number formats,
-operators' corrections, sums, 'from x to y'), ``dev14/`` 31 in the storyteller voice of LLM-written SHAP narratives
-(values against the typical case), ``dev15/`` to ``dev20/`` 16-41 each (an analyst's terse notes, lists, everyday
-hedges, plain language, long reports, a second language) and ``dev21/`` 17 engineers' notes, each written after the
-freeze and measured once before tuning on it. ``test2/``: 48 more on the test cases (chat, letters, risk notes,
-decision logs), written after the test split's disagreements had been counted by cause (not read) and never tuned
-on: the second held-out figure. A narrative counts as agreeing when ``Verification.ok`` equals its label; the
+cases 4-7 the test split (frozen before any tuning; report it apart). ``voices/`` holds the sets written later, one
+folder a set, named by its split and its voices: ``voices/dev-*`` are 20 sets on the dev cases (16-76 narratives each:
+Q&A and shorthand, shares, an LLM explaining SHAP values, memos and logs, notes, comparisons, number formats,
+corrections, sums, the storyteller voice, an analyst's notes, lists, hedges, one-liners, long reports, a second
+language, engineers' notes; ``dev-qa-shorthand-lists/cases.json`` adds two UAV 'stay' cases), each written after the
+freeze and measured once before tuning on it. ``voices/test-chat-letters-logs/``: 48 more on the test cases (chat,
+letters, risk notes, decision logs), written after the test split's disagreements had been counted by cause (not
+read) and never tuned on: the second held-out figure. A narrative counts as agreeing when ``Verification.ok`` equals its label; the
 agreement of ``Verification.accurate`` (nothing contradicted, coverage aside) is printed beside it.
 
     .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain, error kind, cause; speed
@@ -60,22 +57,27 @@ from tests import narrative_domains as domains  # noqa: E402
 DATA = pathlib.Path(__file__).parent / "data" / "narratives"
 
 
-SPLITS = ("dev", *(f"dev{k}" for k in range(2, 22)), "test", "test2")
+# the narratives written after the first corpus, one folder a set of voices under voices/, named by split and voice
+VOICES = tuple(sorted(p.name for p in (DATA / "voices").iterdir() if p.is_dir()))
+SPLITS = ("dev", *(v for v in VOICES if v.startswith("dev-")), "test", *(v for v in VOICES if v.startswith("test-")))
 
 
 def load_corpus() -> list[dict]:
-    """Every narrative with its case's Explanation, domain, split, label and error kind. ``dev2`` to ``dev5`` hold
-    narratives written later, on the dev cases only, in other voices (tuning material like ``dev``)."""
+    """Every narrative with its case's Explanation, domain, split, label and error kind. Beside the first corpus, it holds the
+    narratives written later in other voices (``voices/dev-*`` on the dev cases, tuning material like ``dev``;
+    ``voices/test-*`` on the test cases, never tuned on)."""
     cases = {
-        c["id"]: c for path in (DATA / "cases.json", DATA / "dev2" / "cases.json") for c in json.loads(path.read_text())
+        c["id"]: c
+        for path in (DATA / "cases.json", DATA / "voices" / "dev-qa-shorthand-lists" / "cases.json")
+        for c in json.loads(path.read_text())
     }
     out = []
     for domain in domains.DOMAINS:
         for later in (None, *(s for s in SPLITS if s not in ("dev", "test"))):
-            path = DATA / (later or ".") / f"{domain}.yaml"
+            path = (DATA / "voices" / later if later else DATA) / f"{domain}.yaml"
             for case_id, items in yaml.safe_load(path.read_text()).items():
                 case = cases[case_id]
-                split = later.rstrip("0123456789") if later else None  # dev2..dev9 on dev cases, test2 on test
+                split = later.split("-")[0] if later else None  # voices/dev-* on dev cases, voices/test-* on test
                 assert not later or case["split"] == split, f"{path}: {case_id} is not a {split} case"
                 exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
                 for item in items:

@@ -392,29 +392,29 @@ def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
     floors = (
         ("dev", 0.98),
-        ("dev2", 0.95),
-        ("dev3", 0.93),
-        ("dev4", 0.95),
-        ("dev5", 0.93),
-        ("dev6", 0.97),
-        ("dev7", 0.97),
-        ("dev8", 0.9),
-        ("dev9", 0.97),
-        ("dev10", 0.97),
-        ("dev11", 0.94),
-        ("dev12", 0.94),
-        ("dev13", 0.95),
-        ("dev14", 0.93),
-        ("dev15", 0.92),
-        ("dev16", 0.95),
-        ("dev17", 0.9),
-        ("dev18", 0.88),
-        ("dev19", 0.95),
-        ("dev20", 0.93),
-        ("dev21", 0.88),  # (dev21: an invented "uplink SINR" given another
+        ("dev-qa-shorthand-lists", 0.95),
+        ("dev-shares-pipes", 0.93),
+        ("dev-llm-shap-voice", 0.95),
+        ("dev-memo-log-arrows", 0.93),
+        ("dev-lowercase-notes", 0.97),
+        ("dev-by-far-edged-out", 0.97),
+        ("dev-tutor-prose", 0.9),
+        ("dev-comparisons-json", 0.97),
+        ("dev-number-formats", 0.97),
+        ("dev-corrections-qa", 0.94),
+        ("dev-sums-shares", 0.94),
+        ("dev-increases-drops", 0.95),
+        ("dev-storyteller", 0.93),
+        ("dev-analyst-notes", 0.92),
+        ("dev-lists", 0.95),
+        ("dev-hedges", 0.9),
+        ("dev-operator-one-liners", 0.88),
+        ("dev-long-reports", 0.95),
+        ("dev-second-language", 0.93),
+        ("dev-engineers-notes", 0.88),  # (dev-engineers-notes: an invented "uplink SINR" given another
         # feature's exact +4.4 now reads as that feature in words the vocabulary lacks: unchecked)
         ("test", 0.93),
-        ("test2", 0.85),
+        ("test-chat-letters-logs", 0.85),
     )
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
@@ -527,7 +527,7 @@ def test_options_weighed_against_each_other():
     """'favoured turning by x' weighs turning against the runner-up (the margin's contribution holds as well as the
     score's); '(Q 3.10)' after an action is that action's score; a signed number after '<feature> argued for
     <action>' is the feature's contribution; 'the strongest argument for <runner-up>' ranks among the reasons
-    against the decision. Cases of the dev split (dev5's voices)."""
+    against the decision. Cases of the dev split (dev-memo-log-arrows's voices)."""
 
     def ok(text, case):
         return _on_case(text, case).ok
@@ -545,7 +545,7 @@ def test_options_weighed_against_each_other():
 
 
 def test_the_lead_and_what_is_no_direction():
-    """dev6's voices: 'beat staying by x' and 'the handover's lead of x' are the margin whatever is named before;
+    """dev-lowercase-notes's voices: 'beat staying by x' and 'the handover's lead of x' are the margin whatever is named before;
     'pulled in opposite directions' is no direction word."""
     # uav-1: the handover led staying by 0.63; uav-3: by 3.88, the serving RSRQ's share of it +24.5
     assert _on_case("Handing over beat staying by 0.63.", "uav-1").status == "verified"
@@ -558,7 +558,7 @@ def test_the_lead_and_what_is_no_direction():
 
 
 def test_dev7_voices():
-    """Each rule tuned on dev7, on its own case: 'the big one' is a pronoun; 'edged out B (2.52) by x' is the margin;
+    """Each rule tuned on dev-by-far-edged-out, on its own case: 'the big one' is a pronoun; 'edged out B (2.52) by x' is the margin;
     '0.341 base' the baseline; 'pull it down to x' the prediction; 'despite X, ...' is no subject of what follows;
     '2 Mbit' a value in bit; 'held it back from handing over' a direction; 'A outweighed B: list' gives the list to
     neither."""
@@ -590,7 +590,7 @@ def test_signs_in_words():
 
 
 def test_comparisons_between_features():
-    """dev9's voices: 'A mattered more than B', chained through 'which', 'A and B both ... more than C', 'less than',
+    """dev-comparisons-json's voices: 'A mattered more than B', chained through 'which', 'A and B both ... more than C', 'less than',
     'about as much as', 'outweighs'; a comparison with no feature after 'than' is no claim."""
     assert (
         _status("Odor mattered more than gill size, which in turn mattered more than the cap diameter.") == "verified"
@@ -629,7 +629,7 @@ def test_dev10_number_formats():
     "case,text,status", cases.params("on_corpus_cases", "on_corpus_cases", ("case", "text", "status"))
 )
 def test_phrasings_on_corpus_cases(case, text, status):
-    """Each rule tuned on dev8 and dev10 (and later dev splits), with a right and a wrong figure on its own corpus
+    """Each rule tuned on dev-tutor-prose and dev-number-formats (and later dev splits), with a right and a wrong figure on its own corpus
     case (benchmarks/data/verify_cases/on_corpus_cases.yaml)."""
     assert _on_case(text, case).status == status
 
@@ -743,7 +743,7 @@ def test_dev11_corrections():
 
 
 def test_sums_and_scoped_ranks():
-    """dev12's voices: 'A and B together add x' is their sum (a list 'x and y' and 'most of the x above the baseline'
+    """dev-sums-shares's voices: 'A and B together add x' is their sum (a list 'x and y' and 'most of the x above the baseline'
     are not); 'Among the positives, X is the largest' and 'Of the factors lowering it, X matters most' rank within
     that sign."""
     assert _status("Odor and gill size together add 0.26.") == "verified"
