@@ -25,8 +25,8 @@ from dataclasses import replace as _replace
 import numpy as np
 
 from .counterfactuals import Counterfactual, Counterfactuals
+from .counterfactuals.goals import NOISE, feasible, lead
 from .counterfactuals.goals import action_index as resolve  # (the one resolver of an action's name or alias)
-from .counterfactuals.goals import lead
 from .counterfactuals.show import outward as _outward  # (the one rounding rule: away from the line)
 from .counterfactuals.show import summary
 from .errors import InputError
@@ -50,9 +50,8 @@ __all__ = [
 
 #: extra rounding steps tried, away from the line, when the value as written does not flip the decision
 _NUDGES = (0, 1, 3)
-#: a flip by less than this share of the scores' size is noise: a float32 network's scores differ in their last bits
-#: between batch shapes, so the check's re-run (one row) could read it either way; the next nudge is said instead
-NOISE = 1e-5
+#: (NOISE: a flip by less than this share of the scores' size is noise, :mod:`xairl.counterfactuals.goals`; the next
+#: nudge is said instead)
 
 
 @dataclass(frozen=True)
@@ -145,7 +144,7 @@ def broken(policy: Policy, states: np.ndarray, changed: list[list[int]]) -> list
     """Per changed state (``states`` (n, F), row r with columns ``changed[r]`` changed): '' when the world allows
     it, else which constraint it breaks (an immutable feature changed, a declared bound crossed, the policy's
     ``feasible`` false), in words."""
-    ok = np.ones(len(states), bool) if policy.feasible is None else np.asarray(policy.feasible(states), bool)
+    ok = np.ones(len(states), bool) if policy.feasible is None else feasible(policy, np.asarray(states))
     out = []
     for r, cols in enumerate(changed):
         why = "" if ok[r] else f"policy '{policy.name}' calls that state infeasible (its feasible() is False)"
