@@ -4,7 +4,8 @@
 How it is built from a search's answer (:class:`xairl.counterfactuals.Counterfactuals`): each change's value is
 written as the narratives write values (:func:`xairl.values.value_text`: a buffer in % of its capacity, dBm, a
 category's label), and rounded *away from the line*, to the digits it is written with: 'below 37.6' for a line at
-37.64, never 'below 37.7', which rounds back across it. The state with the values as written is then run through the
+37.64, never 'below 37.7', which rounds back across it; nor past a declared bound, and a value at its bound is said
+with no direction word ('been -34 dB', not 'below -34 dB' where -34 dB is the floor). The state with the values as written is then run through the
 policy (all candidates in one batch, its action mask honoured); the first one that still takes the search's action is
 the fact (else the first that takes any other action than the one taken: the words name what the policy does there),
 with the action and the margin of that re-run. What a template prints is therefore exactly what the verifier
@@ -114,6 +115,8 @@ def _written(before: float, after: float, info: FeatureInfo, extra: int) -> tupl
         raw = fill * info.capacity / 100.0
         return raw, fill, fill_and_text(raw, info, None)[1]
     raw = _outward(after, down, extra)
+    if info.bounds is not None:  # rounded away from the line, never past a declared bound: at it ('been -34 dB')
+        raw = float(np.clip(raw, *info.bounds))
     return raw, None, fill_and_text(raw, info, None)[1]
 
 
@@ -258,8 +261,10 @@ def _said(policy: Policy, state: np.ndarray, changes, extra: int) -> tuple[Chang
         was, was_text = fill_and_text(before, info, _label(info, before))
         if _shown(raw, info) == _shown(before, info):
             continue  # no change in the digits written ('0 % full (it was 0 % full)'): left out, and not re-run
-        # no direction word for a category, nor at a capacity's end ('been 100 % full', not 'above 100 % full')
-        direction = "" if info.categories or fill in (0.0, 100.0) else "below" if raw < before else "above"
+        # no direction word for a category, nor at a capacity's end ('been 100 % full', not 'above 100 % full'), nor
+        # at a declared bound ('been -34 dB', not 'below -34 dB' where -34 dB is the floor)
+        end = fill in (0.0, 100.0) or (info.bounds is not None and raw in info.bounds)
+        direction = "" if info.categories or end else "below" if raw < before else "above"
         label = feature_words(policy, c.feature)
         out.append(ChangeFact(c.feature, label, info.unit, before, was_text, raw, text, direction, was, fill))
     return tuple(out)

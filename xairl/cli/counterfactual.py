@@ -34,6 +34,34 @@ def counterfactual_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
+def asked(args, policy) -> bool:
+    """Whether --counterfactual (or --counterfactual-target alone) was given, its target checked against the policy's
+    actions before anything is read, in every format (one line naming the known actions); and refused with
+    --format parquet, whose chunks are streamed to disk without a search."""
+    if not (args.counterfactual or args.counterfactual_target is not None):
+        return False
+    target = _target(args, policy)
+    if target is not None and target != "any":
+        from ..counterfactuals.goals import action_index
+
+        action_index(policy, target)
+    if args.format == "parquet":
+        raise InputError(
+            "--counterfactual is not searched when explanations stream into Parquet (--format parquet, or --out above "
+            "the streaming size); drop --counterfactual, or explain fewer states as a table, jsonl or report."
+        )
+    return True
+
+
+def _target(args, policy):
+    """The search's target of ``--counterfactual-target``: None (the runner-up), 'any', an action's name or index."""
+    target = args.counterfactual_target
+    target = None if target in (None, "", "runner-up") else target
+    if target is not None and target not in policy.action_names and target.lstrip("-").isdigit():
+        target = int(target)  # an action's index, as the docs say ('--counterfactual-target 2')
+    return target
+
+
 def search(args, policy, exp, background):
     """Each decision's :class:`xairl.Counterfactuals` (a tuple), or None without ``--counterfactual`` (the target
     alone turns it on)."""
@@ -46,10 +74,7 @@ def search(args, policy, exp, background):
         )
     from ..counterfactuals import counterfactual
 
-    target = args.counterfactual_target
-    target = None if target in (None, "", "runner-up") else target
-    if target is not None and target not in policy.action_names and target.lstrip("-").isdigit():
-        target = int(target)  # an action's index, as the docs say ('--counterfactual-target 2')
+    target = _target(args, policy)
     return counterfactual(
         policy,
         exp.states,
