@@ -221,3 +221,35 @@ def test_a_value_at_its_declared_bound_is_said_at_it():
     assert change.after == -34.0 and change.direction == "" and change.after_text == "-34 dB"
     text, status, _ = said(exp, 0, policy, fact, alone=True)
     assert "been -34 dB" in text and "below -34" not in text and status == "verified", text
+
+
+#: a --policy file.py:make of :func:`window_policy`
+WINDOW = """import torch, xairl
+
+
+def make():
+    lin = torch.nn.Linear(6, 2)
+    with torch.no_grad():
+        lin.weight.copy_(torch.tensor([[3.0, -3.0, 0.5, 0.0, 0.5, -0.5], [-3.0, 3.0, 0.0, 0.5, -0.5, 0.5]]))
+        lin.bias.zero_()
+    return xairl.Policy(torch.nn.Sequential(torch.nn.Flatten(), lin), feature_names=["speed", "gap"], window=3)
+"""
+
+
+def test_the_cli_changes_a_windows_past_only_when_asked(capsys, tmp_path):
+    import json
+
+    (tmp_path / "w.py").write_text(WINDOW)
+    rng = np.random.default_rng(0)
+    np.save(tmp_path / "s.npy", rng.normal(size=(6, 3, 2)).astype(np.float32))
+    np.save(tmp_path / "bg.npy", rng.normal(size=(100, 3, 2)).astype(np.float32))
+    common = ["explain", "--policy", f"{tmp_path / 'w.py'}:make", "--states", str(tmp_path / "s.npy")]
+    common += ["--background", str(tmp_path / "bg.npy"), "--counterfactual-target", "any", "--format", "jsonl"]
+    changed = {}
+    for flag in ([], ["--counterfactual-past"]):
+        rc, out, err = run(capsys, *common, *flag)
+        assert rc == 0, err
+        lines = [json.loads(line)["counterfactual"] for line in out.splitlines()]
+        changed[bool(flag)] = {c["feature"] for d in lines for f in d["found"] for c in f["changes"]}
+    assert changed[False] and changed[False] <= {"speed[t]", "gap[t]"}
+    assert {"speed[t-2]", "gap[t-2]"} <= changed[True]

@@ -26,6 +26,12 @@ def counterfactual_arguments(p: argparse.ArgumentParser) -> None:
         "action",
     )
     p.add_argument(
+        "--counterfactual-past",
+        action="store_true",
+        help="with --counterfactual, a window policy: change its past observations' slots too (default: only the "
+        "newest step's; a past slot changed alone is a history the present state cannot have)",
+    )
+    p.add_argument(
         "--max-changes",
         type=int,
         choices=(1, 2),
@@ -84,6 +90,7 @@ def search(args, policy, exp, background):
         background=background,
         explanation=exp,
         n=3,  # alternatives, so that one still flips once its values are written as the words write them
+        past=args.counterfactual_past,
     )
 
 

@@ -28,7 +28,14 @@ For each decision:
    features, are run through the policy once more, all in one batch; one that does not flip (or is infeasible, or
    out of range) is dropped. What is returned is exactly what was run.
 
-Windows (a memory policy's slots) are searched as flat features, each slot on its own. ``max_changes`` is 1 or 2.
+5b. A candidate whose scores are not finite (a float32 network overflowing near its largest number: the same state
+alone may score finitely and keep its action), whose flip is within float32's noise at its scores' size
+(:data:`~xairl.counterfactuals.goals.NOISE`), or after which the mask allows a single action (no other allowed
+action to report a margin over) is no flip either.
+
+Windows (a memory policy's slots) are searched as flat features, each slot on its own, the newest step's only unless
+``past`` (:mod:`xairl.counterfactuals.bounds`); a binary feature only whole. The decisions are searched
+:data:`CHUNK` at a time, so memory does not grow with the batch. ``max_changes`` is 1 or 2.
 """
 
 from __future__ import annotations
