@@ -26,12 +26,10 @@ For each decision:
    nothing, is dropped. A grid can miss a flip between its points: "none found" is the search's answer, no proof.
 5. **Checked.** The candidates, ranked by distance in quantiles (ties by the scaled distance), one per set of
    features, are run through the policy once more, all in one batch; one that does not flip (or is infeasible, or
-   out of range) is dropped. What is returned is exactly what was run.
-
-5b. A candidate whose scores are not finite (a float32 network overflowing near its largest number: the same state
-alone may score finitely and keep its action), whose flip is within float32's noise at its scores' size
-(:data:`~xairl.counterfactuals.goals.NOISE`), or after which the mask allows a single action (no other allowed
-action to report a margin over) is no flip either.
+   out of range) is dropped. What is returned is exactly what was run. Nor is any state a flip whose scores are not
+   finite (a float32 network overflowing near its largest number: the same state alone may score finitely and keep
+   its action), whose flip is within float32's noise at its scores' size (:data:`~.goals.NOISE`), or after which the
+   mask allows a single action (no other allowed action for a margin to be over).
 
 Windows (a memory policy's slots) are searched as flat features, each slot on its own, the newest step's only unless
 ``past`` (:mod:`xairl.counterfactuals.bounds`); a binary feature only whole. The decisions are searched
