@@ -301,7 +301,8 @@ class _Search:
             if gap[r] > 0 and inside and len(self.checked[s]) < n:
                 cf = self._counterfactual(s, units, x[r], after[r], scores[r], gap[r], avail, r)
                 # past the line by more than float32's noise at these scores' size (a re-run alone decides the same)
-                if cf.margin > NOISE * max(1.0, float(np.abs(scores[r]).max())):
+                size = np.abs(scores[r] if avail is None else scores[r][avail[r]]).max()
+                if cf.margin > NOISE * max(1.0, float(size)):
                     self.checked[s].append(cf)
 
     def _set(self, x: np.ndarray, r: int, s: int, u: int, value: float) -> None:
