@@ -12,8 +12,8 @@ words name what the policy does there), with the action and the margin of that r
 therefore exactly what the verifier re-runs (:mod:`xairl.narrators.provenance.counterfactual`). A candidate must
 also keep the state one the world allows as written (:func:`broken`: the policy's ``feasible``, the declared bounds,
 no immutable feature changed): rounding away from the line may step off the searched point. None of the candidates
-flipping as written (a line that
-bends within one rounding step) leaves the fact out: no sentence rather than a wrong one.
+flipping as written (a line that bends within one rounding step) leaves the fact out: no sentence rather than a
+wrong one.
 
 A window policy's past slot (``speed[t-2]``) is named as that slot, 'the speed 2 steps ago' (:func:`feature_words`),
 never by its signal's words alone, which name the current value.
