@@ -253,3 +253,14 @@ def test_the_cli_changes_a_windows_past_only_when_asked(capsys, tmp_path):
         changed[bool(flag)] = {c["feature"] for d in lines for f in d["found"] for c in f["changes"]}
     assert changed[False] and changed[False] <= {"speed[t]", "gap[t]"}
     assert {"speed[t-2]", "gap[t-2]"} <= changed[True]
+
+
+def test_a_decision_whose_outputs_are_not_finite_is_refused_in_one_line():
+    """As explain refuses it: a state that overflows the float32 network has no decision to change."""
+    policy, bg = toy_policy(), toy_background(100, 0)
+    x = toy_background(3, 1)
+    x[1] = 3e38
+    exp = xairl.explain(policy, x[[0, 2]], bg)
+    with pytest.raises(InputError, match="NaN or infinite for 1 state") as info:
+        xairl.counterfactual(policy, x, index=None, background=bg, explanation=exp[[0, 0, 1]])
+    assert "\n" not in str(info.value)

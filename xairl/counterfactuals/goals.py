@@ -38,6 +38,14 @@ class Goal:
     def __init__(self, policy: Policy, xs: np.ndarray, target) -> None:
         self.policy, self.threshold = policy, target if isinstance(target, Threshold) else None
         scores = policy.scores(xs)
+        bad = ~np.isfinite(scores).all(axis=1)
+        if bad.any():  # (as explain refuses them: no decision to overturn)
+            kind = np.dtype(policy.dtype)
+            raise InputError(
+                f"the policy's outputs are NaN or infinite for {int(bad.sum())} state(s) searched, first "
+                f"{int(np.argmax(bad))}: no decision to change; check the states' scale (a {kind.name} network "
+                f"overflows beyond ~{np.finfo(kind).max:.0e})."
+            )
         m, names = len(xs), policy.action_names
         self.skip = [""] * m  # why a state is not searched ('' where it is)
         if policy.output != "actions":
