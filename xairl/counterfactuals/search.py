@@ -249,11 +249,20 @@ class _Search:
         us = np.broadcast_to(units[:, None, None, :], values.shape)
         ws = np.broadcast_to(w[:, None, None], shape)
         good = self.gaps(ws.ravel(), us.reshape(-1, 2), (values - own[:, None, None, :]).reshape(-1, 2)) > 0
-        key = np.where(good.reshape(shape), self._distance(us, values, ws), np.inf).reshape(len(w), -1)
+        # the distance of each cell: its two axes' terms, each computed once per axis value (a grid's quantiles are
+        # separable: 41 times fewer than per cell), summed in the order _distance sums them
+        q = np.abs(self.units.quantile(axes, np.broadcast_to(units[:, :, None], axes.shape)) - self._q_own(w, units))
+        sc = np.abs(axes - own[:, :, None]) / self.scale[units][:, :, None]
+        dist = (q[:, 0, :, None] + q[:, 1, None, :]) + 1e-9 * (sc[:, 0, :, None] + sc[:, 1, None, :])
+        key = np.where(good.reshape(shape), dist, np.inf).reshape(len(w), -1)
         cell = key.argmin(axis=-1)
         has = np.isfinite(key[np.arange(len(w)), cell])
         found = values.reshape(len(w), -1, 2)[np.arange(len(w)), cell]
         return np.where(has[:, None], found, best), has | had
+
+    def _q_own(self, w: np.ndarray, units: np.ndarray) -> np.ndarray:
+        """(P, 2, 1) the background quantile of each state's own value of each unit of its pair."""
+        return self.units.quantile(self.own[w[:, None], units], units)[:, :, None]
 
     def _ray(self, who, unit, own, start, end) -> np.ndarray:
         """Points just past the line on the segments from ``start`` (no flip) to ``end`` (a flip), (N, k); ``own``
