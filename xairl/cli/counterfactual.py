@@ -42,7 +42,7 @@ def counterfactual_arguments(p: argparse.ArgumentParser) -> None:
 
 def asked(args, policy) -> bool:
     """Whether --counterfactual (or --counterfactual-target alone) was given, its target checked against the policy's
-    actions before anything is read, in every format (one line naming the known actions); and refused with
+    actions before any state is explained, in every format (one line naming the known actions); and refused with
     --format parquet, whose chunks are streamed to disk without a search."""
     if not (args.counterfactual or args.counterfactual_target is not None):
         return False

@@ -35,15 +35,16 @@ NOISE = 1e-5
 class Goal:
     """What a changed state must do, per state: a gap positive exactly when it decides otherwise."""
 
-    def __init__(self, policy: Policy, xs: np.ndarray, target) -> None:
+    def __init__(self, policy: Policy, xs: np.ndarray, target, rows: np.ndarray | None = None) -> None:
+        """``xs``: the states searched (``rows``: their rows among the states given, for a one-line error)."""
         self.policy, self.threshold = policy, target if isinstance(target, Threshold) else None
         scores = policy.scores(xs)
         bad = ~np.isfinite(scores).all(axis=1)
         if bad.any():  # (as explain refuses them: no decision to overturn)
             kind = np.dtype(policy.dtype)
             raise InputError(
-                f"the policy's outputs are NaN or infinite for {int(bad.sum())} state(s) searched, first "
-                f"{int(np.argmax(bad))}: no decision to change; check the states' scale (a {kind.name} network "
+                f"the policy's outputs are NaN or infinite for {int(bad.sum())} state(s) searched, first state "
+                f"{int(np.argmax(bad) if rows is None else rows[np.argmax(bad)])}: no decision to change; check the states' scale (a {kind.name} network "
                 f"overflows beyond ~{np.finfo(kind).max:.0e})."
             )
         m, names = len(xs), policy.action_names

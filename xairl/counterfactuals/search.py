@@ -97,7 +97,7 @@ def counterfactual(
     out: list[Counterfactuals] = []
     for start in range(0, len(rows), CHUNK):  # (memory: a chunk's grids at a time, never every decision's)
         part = rows[start : start + CHUNK]
-        goal = Goal(policy, x[part], target)
+        goal = Goal(policy, x[part], target, part)
         found = _Search(policy, x[part], units, goal)
         chunk = None if exp is None else exp[start : start + CHUNK]
         found.rank(pushes(policy, goal, units, x[part], bg, chunk) if units.n else None)
