@@ -307,6 +307,8 @@ class _Search:
         avail = self.policy.available(x) if self.policy.output == "actions" else None
         for r, (s, units, _) in enumerate(picks):
             inside = all(self.low[s, u] <= after[r, u] <= self.high[s, u] for u in units)
+            # a binary unit at one of its two values (a declared bound between them would leave a fraction)
+            inside &= all(after[r, u] in self.units.levels[u] for u in units if self.units.binary[u])
             if gap[r] > 0 and inside and len(self.checked[s]) < n:
                 cf = self._counterfactual(s, units, x[r], after[r], scores[r], gap[r], avail, r)
                 # past the line by more than float32's noise at these scores' size (a re-run alone decides the same)
