@@ -73,6 +73,11 @@ class FeatureInfo:
                     f"FeatureInfo bounds must be (low, high) numbers (or -inf/inf) with low <= high, got "
                     f"{self.bounds!r:.60}."
                 )
+            if b[0] == np.inf or b[1] == -np.inf:  # (inf, inf) holds no value: it cannot bound anything
+                raise InputError(
+                    f"FeatureInfo bounds {self.bounds!r:.60} hold no value: the low bound must be below inf and the "
+                    "high above -inf (use -inf/inf for no limit on a side)."
+                )
             object.__setattr__(self, "bounds", (float(b[0]), float(b[1])))
         if not isinstance(self.immutable, (bool, np.bool_)):
             raise InputError(f"FeatureInfo immutable is True or False, got {self.immutable!r:.40}.")
