@@ -13,7 +13,7 @@ import torch
 
 from .errors import InputError
 from .heads import check_kinds, heads
-from .network import PolicyNetwork, module_dtype
+from .network import PolicyNetwork, eval_mode, module_dtype
 from .observation import Observation, names_preview
 from .windows import slot_features
 
@@ -273,14 +273,10 @@ class Policy:
         return out
 
     def _raw_scores(self, x: np.ndarray) -> np.ndarray:
-        """The module's outputs for checked flat states, in eval mode, without gradients (its flag restored)."""
-        was_training = self.module.training
-        self.module.eval()
-        try:
-            with torch.no_grad():
-                out = self.network(torch.as_tensor(x, dtype=_TORCH[self.dtype], device=self.device))
-        finally:
-            self.module.train(was_training)
+        """The module's outputs for checked flat states, in eval mode, without gradients (its flags restored; layers
+        left in training mode that eval mode changes are named in a warning, once per policy)."""
+        with eval_mode(self.module, self), torch.no_grad():
+            out = self.network(torch.as_tensor(x, dtype=_TORCH[self.dtype], device=self.device))
         return out.detach().cpu().numpy().astype(np.float64)
 
     def available(self, states) -> np.ndarray:
