@@ -118,7 +118,8 @@ class Policy:
         ``kick``) is refused; say ``output="actions"`` where such names really are actions.
     :param features: optional :class:`FeatureInfo` per feature name, and per group name for a group narrated as
         one reason (``kind='group'``).
-    :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}`` (plots show each as one bar).
+    :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}``: plots show each as one bar, and
+        narratives name each as one reason (:attr:`reason_groups`), unless each of its members is described.
     :param background_sampler: optional ``f(n, seed) -> states`` of typical states (any form ``observation`` takes).
     :param name: how the policy is called in reports.
     :param action_aliases: other names of each action in text, e.g. ``{"stay": ["keep the serving BS"]}``.
@@ -237,8 +238,18 @@ class Policy:
 
     @property
     def reason_groups(self) -> dict[str, tuple[str, ...]]:
-        """Groups narrated as one reason (those described with ``FeatureInfo(kind='group')``)."""
-        return {g: tuple(self.groups[g]) for g, i in self.features.items() if i.kind == "group"}
+        """Groups narrated as one reason: those described with ``FeatureInfo(kind='group')``, then every other
+        declared group, except one whose members all have words of their own (a :class:`FeatureInfo` each: they keep
+        them, and the group sums them in figures and the report's grouped summary) or that shares a member with a
+        group before it."""
+        out = {g: tuple(self.groups[g]) for g, i in self.features.items() if i.kind == "group"}
+        taken = {f for members in out.values() for f in members}
+        for g, members in self.groups.items():
+            if g in out or taken.intersection(members) or all(f in self.features for f in members):
+                continue
+            out[g] = tuple(members)
+            taken.update(members)
+        return out
 
     @property
     def n_actions(self) -> int:
