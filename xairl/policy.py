@@ -138,6 +138,8 @@ class Policy:
         seconds between observations (:mod:`xairl.windows`).
     :param feasible: optional ``f(states (n, n_features)) -> bool (n,)``, True for the states the world allows
         (coupled constraints, such as an RSRQ its RSRP makes possible): a counterfactual it rejects is never returned.
+    :param description: what is explained, where the module alone does not say it (from_sb3: a recurrent policy's
+        LSTM unrolled over a window, and from which state); its explanations keep it as ``extras['policy']``.
     """
 
     module: torch.nn.Module
@@ -154,6 +156,7 @@ class Policy:
     output: Literal["actions", "continuous", "value"] | Sequence[str] | None = None
     window: int | None = None
     feasible: Callable[[np.ndarray], np.ndarray] | None = None
+    description: str = ""
 
     def __post_init__(self) -> None:
         if not isinstance(self.module, torch.nn.Module):
@@ -180,6 +183,7 @@ class Policy:
         window = self.observation.parts[0].window if self.observation.kind == "window" else None
         normalise("window", window.steps if window else None)
         normalise("name", str(self.name))
+        normalise("description", str(self.description))
         normalise("network", PolicyNetwork(self.module, self.observation, self.name))
         if self.action_names is None:  # count the outputs on one all-zero state
             n = 1 if self.output == "value" else self._raw_scores(np.zeros((1, self.observation.n_features))).shape[1]
@@ -321,9 +325,6 @@ class Policy:
                 "on the command line, background=array in Python."
             )
         return self.check_states(self.background_sampler(n, seed), "background")
-
-
-TorchPolicy = Policy  # the name users of plain torch networks (CleanRL style) look for
 
 
 def model_hash(module) -> str:

@@ -91,7 +91,7 @@ class Attributor:
             action_names=tuple(policy.action_names),
             method=self.name,
             options=self.options.model_dump(),
-            extras=extras,
+            extras=dict(extras) | ({"policy": policy.description} if policy.description else {}),
             background_quantiles=np.percentile(bg, [25, 50, 75], axis=0).astype(np.float64),
             available=None if policy.action_mask is None else policy.available(x),
             output=policy.output,
