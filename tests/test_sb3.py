@@ -215,6 +215,8 @@ def test_a_vec_frame_stack_is_a_stacked_window_explained_narrated_and_verified(s
     assert xairl.from_sb3(model, window=4).feature_names[0] == "obs_0[t-3]"
     with pytest.raises(InputError, match=r"stacks 4 observations \(VecFrameStack\) but window=3"):
         xairl.from_sb3(model, window=3)
+    with pytest.raises(InputError, match=r"number of observations \(k >= 2\); got 0"):
+        xairl.from_sb3(model, window=0)
     with pytest.raises(InputError, match="name the signals of one observation"):
         xairl.from_sb3(model, feature_names=SIGNALS[:3])
 

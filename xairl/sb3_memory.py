@@ -34,51 +34,63 @@ def window_observation(model, window, observation, feature_names, recurrent: boo
             "only (xairl.Observation.window(signals, k)): leave it out otherwise."
         )
     declared = observation.parts[0].window if observation is not None else None
+    steps = _steps(model, window, declared, recurrent)
+    if steps is None:
+        return None
+    signals = _signals(model, steps, declared, feature_names, recurrent)
+    layout = "sequence" if recurrent else "stacked"
+    if declared is not None:  # its signals, steps and step_s, laid out as the network takes them
+        laid_out = dataclasses.replace(declared, layout=layout)
+        return Observation("window", (dataclasses.replace(observation.parts[0], window=laid_out),))
+    return Observation.window(signals, steps, layout)
+
+
+def _steps(model, window, declared, recurrent: bool) -> int | None:
+    """The window's observations: given (``window=k`` or the declared window's), else the model's VecFrameStack's."""
+    algo = type(model).__name__
     if declared is not None and window is not None and window != declared.steps:
         raise InputError(
             f"window={window!r:.20} and the observation's {declared.steps} steps differ; give one of them."
         )
     stacked = _frame_stack(model)
     steps = window if window is not None else declared.steps if declared is not None else stacked
-    if steps is None:
-        if recurrent:
-            raise InputError(
-                f"{algo} is recurrent: its action depends on the LSTM's hidden state, which carries the whole "
-                "episode; give window=k to explain it over the last k observations, the LSTM unrolled over them "
-                "from a reset (or from the episode's own state with hidden=(h, c))."
-            )
-        return None
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)):
+    if steps is None and recurrent:
+        raise InputError(
+            f"{algo} is recurrent: its action depends on the LSTM's hidden state, which carries the whole "
+            "episode; give window=k to explain it over the last k observations, the LSTM unrolled over them "
+            "from a reset (or from the episode's own state with hidden=(h, c))."
+        )
+    if steps is not None and (isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 2):
         raise InputError(f"window is the number of observations (k >= 2); got {steps!r:.40}.")
-    if stacked is not None and not recurrent and steps != stacked:
+    if steps is not None and stacked is not None and not recurrent and steps != stacked:
         raise InputError(
             f"{algo}'s environment stacks {stacked} observations (VecFrameStack) but window={steps}; give "
             f"window={stacked} or leave it out."
         )
-    space = model.observation_space
-    flat = getattr(space, "shape", None) is not None and len(space.shape) == 1 and space.dtype.kind == "f"
-    if not flat:
+    return None if steps is None else int(steps)
+
+
+def _signals(model, steps: int, declared, feature_names, recurrent: bool) -> tuple[str, ...]:
+    """The names of the signals of one observation, checked against the model's flat observation space."""
+    algo, space = type(model).__name__, model.observation_space
+    if not (getattr(space, "shape", None) is not None and len(space.shape) == 1 and space.dtype.kind == "f"):
         raise InputError(
             f"a window of {algo}'s observations needs a flat Box observation space; this one is {space}"
             + (" (a stack of images is an image: explain it as frames without window=)." if not recurrent else ".")
         )
     size = int(space.shape[0])
     width = size if recurrent else size // steps
-    if not recurrent and width * steps != size:
+    if width * steps != size and not recurrent:
         raise InputError(f"{algo}'s observations have {size} values: not {steps} stacked observations of one size.")
-    signals = tuple(declared.signals) if declared is not None else feature_names or [f"obs_{i}" for i in range(width)]
-    if declared is not None and feature_names is not None and tuple(map(str, feature_names)) != signals:
+    if declared is not None and feature_names is not None and tuple(map(str, feature_names)) != declared.signals:
         raise InputError("the window names its signals; give them once (leave feature_names out).")
+    signals = declared.signals if declared is not None else feature_names or [f"obs_{i}" for i in range(width)]
     if len(signals) != width:
         raise InputError(
             f"{len(signals)} signal names for observations of {width} values; name the signals of one observation "
             f"({'each of the ' + str(steps) + ' stacked ones' if not recurrent else 'each step'}) once."
         )
-    layout = "sequence" if recurrent else "stacked"
-    if declared is not None:  # its signals, steps and step_s, laid out as the network takes them
-        window = dataclasses.replace(declared, layout=layout)
-        return Observation("window", (dataclasses.replace(observation.parts[0], window=window),))
-    return Observation.window(signals, steps, layout)
+    return tuple(map(str, signals))
 
 
 def _frame_stack(model) -> int | None:
