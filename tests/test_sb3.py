@@ -262,7 +262,7 @@ def test_recurrent_ppo_is_explained_over_a_window_from_a_reset(recurrent):
     )
     windows = np.stack([seen[t - 3 : t + 1] for t in range(3, len(seen))])
     exp = xairl.explain(policy, windows[-2:], background=windows, method="kernel_shap", options={"nsamples": 300})
-    assert exp.extras["policy"] == policy.description
+    assert exp.extras["policy"] == policy.description and repr(policy).endswith(f"; {policy.description})")
     verified_and_caught(policy, exp)
     assert xairl.from_sb3(model, window=4, head="value").output == "value"  # the critic's LSTM, checked too
 

@@ -218,7 +218,8 @@ class Policy:
         return (
             f"Policy({self.name!r}, {names_preview(self.feature_names, 'features')}; "
             f"{names_preview(self.action_names, 'actions' if self.output == 'actions' else 'outputs')}; "
-            f"output {self.output}, observation {self.observation.describe()})"
+            f"output {self.output}, observation {self.observation.describe()}"
+            f"{'; ' + self.description if self.description else ''})"
         )
 
     @classmethod
