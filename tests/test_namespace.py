@@ -66,3 +66,12 @@ def test_narrate_takes_its_options_by_keyword_only():
     with pytest.raises(TypeError):
         xairl.narrate(exp, 0, "template")
     assert xairl.narrate(exp, 0, narrator="template", robustness=False).text
+
+
+def test_an_old_name_says_its_successor():
+    """Issue 64: an old script's ``xairl.TorchPolicy`` names ``xairl.Policy`` instead of a bare AttributeError."""
+    with pytest.raises(AttributeError, match=r"TorchPolicy.*renamed xairl\.Policy"):
+        getattr(xairl, "TorchPolicy")  # noqa: B009 (the attribute access is what is tested)
+    assert not hasattr(xairl, "TorchPolicy") and "TorchPolicy" not in dir(xairl)
+    with pytest.raises(AttributeError, match="has no attribute 'NoSuchThing'$"):
+        getattr(xairl, "NoSuchThing")  # noqa: B009

@@ -215,7 +215,7 @@ def narration_units(exp: Explanation, policy: Policy | None) -> list[Unit]:
     for g, members in (policy.reason_groups if policy else {}).items():
         cols = tuple(index[f] for f in members if f in index)
         if cols and len(cols) == len(members) and not taken.intersection(cols):
-            out.append(Unit(g, cols, _info(policy, g)))
+            out.append(Unit(g, cols, policy.features.get(g) or FeatureInfo(kind="group")))  # declared alone too
             taken.update(cols)
     out += [Unit(f, (j,), _info(policy, f)) for j, f in enumerate(exp.feature_names) if j not in taken]
     return out

@@ -12,6 +12,7 @@ import torch
 
 from ..errors import InputError, UnsupportedModelError
 from ..explanation import Explanation
+from ..network import eval_mode, torch_threads
 from ..options import Options, parse_options
 from ..policy import Policy
 
@@ -43,8 +44,8 @@ class Attributor:
     def explain(self, policy: Policy, states, background=None) -> Explanation:
         """Explain ``states`` against ``background`` (default: 100 states from the policy's sampler).
 
-        The module runs in eval mode; its training flag and every hook this attributor added are restored
-        even when attribution fails.
+        The module runs in eval mode; its training flags and every hook this attributor added are restored
+        even when attribution fails. A small network runs on one torch thread (:func:`xairl.network.torch_threads`).
         """
         if not isinstance(policy, Policy):
             raise InputError(
@@ -69,16 +70,13 @@ class Attributor:
                 f"{int(np.argmax(bad))}: nothing can be explained; check the states' scale (a "
                 f"{kind.name} network overflows beyond ~{np.finfo(kind).max:.0e})."
             )
-        module = policy.network
-        was_training = policy.module.training  # the user's flag; the wrapper's own means nothing
-        module.eval()
         try:
-            values, base, extras = self._attribute(policy, x, bg)
+            with eval_mode(policy.module, policy), torch_threads(policy):
+                values, base, extras = self._attribute(policy, x, bg)
         finally:
             for handle in self._handles:
                 handle.remove()
             self._handles.clear()
-            module.train(was_training)
         n, f, a = len(x), policy.n_features, policy.n_actions
         values = np.asarray(values, dtype=np.float64).reshape(n, f, a)
         base = np.broadcast_to(np.asarray(base, dtype=np.float64), (n, a))
@@ -93,7 +91,7 @@ class Attributor:
             action_names=tuple(policy.action_names),
             method=self.name,
             options=self.options.model_dump(),
-            extras=extras,
+            extras=dict(extras) | ({"policy": policy.description} if policy.description else {}),
             background_quantiles=np.percentile(bg, [25, 50, 75], axis=0).astype(np.float64),
             available=None if policy.action_mask is None else policy.available(x),
             output=policy.output,
