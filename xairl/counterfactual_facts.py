@@ -32,7 +32,7 @@ from .counterfactuals.show import summary
 from .errors import InputError
 from .explanation import Explanation
 from .policy import FeatureInfo, Policy
-from .prompts import format_number
+from .numbers import format_number
 from .values import fill_and_text
 
 __all__ = [
