@@ -183,7 +183,7 @@ class Template:
                 "allows; templates may not recurse)."
             ) from None
         except TemplateSyntaxError as exc:
-            raise TemplateError(f"{where}: syntax error: {exc.message}.") from None
+            raise TemplateError(f"{where}: syntax error: {exc.message.rstrip('.')}.") from None
         except Exception as exc:  # a filter or test raising on odd data
             raise TemplateError(f"{where}: cannot render ({type(exc).__name__}: {exc}).") from None
 
