@@ -203,3 +203,25 @@ def test_no_raised_message_has_a_doubled_period_or_background_contain():
         if re.search(r"(?<![.\d])\.\.(?![.\d])", text) or "background contain " in text
     ]
     assert not bad, bad
+
+
+# ---- house: one options object for a narration ------------------------------------------------------------------------
+def test_narrate_takes_one_options_object_and_the_keywords_alike(toy):
+    p, e, _ = toy
+    bg = p.background(20)
+    how = xairl.NarrationOptions(policy=p, background=bg, robustness=False)
+    by_object = xairl.narrate(e, 1, narration=how)
+    by_keywords = xairl.narrate(e, 1, policy=p, background=bg, robustness=False)
+    assert by_object.text == by_keywords.text and by_object.components == by_keywords.components
+    assert xairl.narrate(e, 1, narration=how, k=1).text != by_object.text  # a keyword beside it wins
+    with pytest.raises(InputError, match=r"narration options \(polcy: unknown option\); options: template, policy"):
+        xairl.narrate(e, 1, polcy=p)
+
+
+def test_the_confidence_reads_the_narrations_options(toy):
+    from xairl.narrators.confidence import confidence
+
+    p, e, n = toy
+    measured = confidence(e, 0, True, xairl.NarrationOptions(policy=p, background=p.background(20)))[1]
+    assert measured["agreement"] is not None and measured["stability"] is not None
+    assert confidence(e, 0, True)[1]["agreement"] is None  # no policy: the robustness parts are not measured
