@@ -100,10 +100,14 @@ def _num(x, signed: bool = False) -> str:
 
 
 def _cap(t) -> str:
-    """The first letter capitalised (past a tracked value's markers)."""
+    """The first letter capitalised (past a tracked value's markers) when the first word is a plain lowercase word
+    ('pole angle' -> 'Pole angle'); a name as declared is kept ('cart_velocity', 'rsrp_1', 'dQ' are not words to
+    capitalise: 'Cart_velocity' names nothing)."""
     s = str(t)
     i = next((n for n, c in enumerate(s) if not "\ue000" <= c <= "\ue01f"), len(s))
-    return s[:i] + s[i : i + 1].upper() + s[i + 1 :]
+    word = "".join(c for c in s[i:].split(maxsplit=1)[0] if not "\ue000" <= c <= "\ue01f") if s[i:].strip() else ""
+    plain = word.rstrip(".,;:!?)").replace("-", "").replace("'", "")
+    return s[:i] + s[i : i + 1].upper() + s[i + 1 :] if plain.isalpha() and plain.islower() else s
 
 
 def _dir(x, toward: str = "toward", against: str = "against") -> str:
