@@ -134,11 +134,16 @@ def test_a_tracked_values_bookkeeping_is_not_printed(toy, tmp_path, attr):
     assert "Fact(" not in str(info.value)
 
 
-# ---- wording: no scientific notation --------------------------------------------------------------------------------
-@pytest.mark.parametrize("x, text", [(6.44e-4, "0.000644"), (6.44e-5, "0.000064"), (-1.2e-7, "0"), (0.00862, "0.00862")])
+# ---- wording: no scientific notation, one precision rule ---------------------------------------------------------------
+@pytest.mark.parametrize("x, text", [(6.44e-4, "0.00064"), (6.44e-5, "0.000064"), (-1.2e-7, "0"), (0.0999, "0.10")])
 def test_small_numbers_are_written_in_plain_decimals(x, text):
     assert format_number(x) == text and "e" not in format_number(x, signed=True)
     assert float(format_number(x)) == pytest.approx(round(x / written_step(x)) * written_step(x))
+
+
+def test_a_smaller_number_is_never_written_more_precisely_than_a_larger_one():
+    """'+0.07 beside +0.00862': below 0.1 every number keeps 2 significant digits, no more and no fewer."""
+    assert [format_number(x, True) for x in (0.0712, 0.00862, 0.49, 1.5)] == ["+0.071", "+0.0086", "+0.49", "+1.50"]
 
 
 def test_a_counterfactual_margin_is_written_as_the_words_write_it():
@@ -146,7 +151,7 @@ def test_a_counterfactual_margin_is_written_as_the_words_write_it():
 
     one = {"changes": [{"feature": "wind", "before_text": "1", "after_text": "2"}], "action": "go", "margin": 6.44e-4}
     (line,) = counterfactual_text({"found": [one | {"distance": 0.5}]})
-    assert "margin 0.000644" in line and "e-0" not in line
+    assert "margin 0.00064" in line and "e-0" not in line
 
 
 # ---- low: the review page says only its own messages ------------------------------------------------------------------

@@ -15,8 +15,9 @@ MAX_DECIMALS = 6
 
 def format_number(x: float, signed: bool = False) -> str:
     """How every number in a narrative is written (the ``num`` and ``signed`` filters, and the facts' own texts):
-    0 decimals from 100, 1 from 10, else 2; below 0.01, 3 significant digits in plain decimals (0.000644, never
-    6.44e-04), at most :data:`MAX_DECIMALS` of them."""
+    0 decimals from 100, 1 from 10, else 2, and more below 0.1 where a number needs them to keep 2 significant digits
+    ('0.071', '0.0086': never fewer digits than a smaller number beside it), in plain decimals (0.00064, never
+    6.4e-04), at most :data:`MAX_DECIMALS` of them."""
     x = float(x)
     a = abs(x)
     if x.is_integer() and a < 1e6:  # ids, counts
@@ -25,14 +26,23 @@ def format_number(x: float, signed: bool = False) -> str:
         s = f"{x:.0f}"
     elif a >= 10:
         s = f"{x:.1f}"
-    elif a >= 0.01 or a == 0:
+    elif a >= 0.1 or a == 0:
         s = f"{x:.2f}"
     else:
-        places = min(2 - math.floor(math.log10(a)), MAX_DECIMALS)
-        s = f"{x:.{places}f}".rstrip("0").rstrip(".")  # 3 significant digits, as written before: '0.005', not '0.00500'
+        s = _two_digits(x)
     if s.startswith("-") and float(s) == 0:
         s = s[1:]
     return ("+" + s) if signed and not s.startswith("-") else s
+
+
+def _two_digits(x: float) -> str:
+    """``x`` (0 < |x| < 0.1) to 2 significant digits, counted once rounded (0.0999 is '0.10'); '0' below the last
+    decimal written."""
+    places = min(1 - math.floor(math.log10(abs(x))), MAX_DECIMALS)
+    rounded = abs(round(x, places))
+    if rounded == 0:
+        return "0"
+    return f"{x:.{min(1 - math.floor(math.log10(rounded)), MAX_DECIMALS)}f}"
 
 
 def written_step(x: float) -> float:
