@@ -230,3 +230,40 @@ def test_the_confidence_reads_the_narrations_options(toy):
     measured = confidence(e, 0, True, xairl.NarrationOptions(policy=p, background=p.background(20)))[1]
     assert measured["agreement"] is not None and measured["stability"] is not None
     assert confidence(e, 0, True)[1]["agreement"] is None  # no policy: the robustness parts are not measured
+
+
+# ---- wording: names as declared, level words, a contradiction said once ----------------------------------------------
+def test_a_snake_case_name_is_not_capitalised_into_a_new_word():
+    import torch
+
+    torch.manual_seed(0)
+    net = torch.nn.Linear(2, 2)
+    policy = xairl.Policy(net, ["cart_velocity", "pole_angle"], ["left", "right"])
+    states = np.random.default_rng(0).normal(size=(12, 2)).astype(np.float32)
+    exp = xairl.explain(policy, states[:4], background=states[4:], method="exact")
+    texts = [xairl.narrate(exp, i, template="why_not", policy=policy, robustness=False).text for i in range(4)]
+    assert any(re.search(r"(^|\. )(cart_velocity|pole_angle) \(", t) for t in texts), texts  # at a sentence start
+    assert not any(re.search(r"Cart_velocity|Pole_angle", t) for t in texts), texts
+    assert prompts.environment().filters["cap"]("pole angle") == "Pole angle"
+
+
+def test_the_toys_level_words_say_a_level_not_a_state(toy):
+    """'(0.60, full)' for 0.6 standard deviations: the toy's battery is standardised, so its words say high or low."""
+    from xairl.facts import decision_facts
+
+    p, e, _ = toy
+    infos = p.features["battery"]
+    assert (infos.low, infos.high) == ("low charge", "high charge")
+    levels = {f.level_text for i in range(3) for f in decision_facts(e, i, p, k=5).top if f.name == "battery"}
+    assert levels and not levels & {"full", "nearly empty"}
+
+
+def test_a_contradicted_direction_word_is_said_once_by_prompts_check(tmp_path):
+    from xairl.narrators.battery import run
+
+    source = prompts.load("explain_action").path.read_text().replace("favoured", "opposed")
+    path = tmp_path / "opposed.yaml"
+    path.write_text(source)
+    lines = run(prompts.parse(path)).problems
+    assert lines and any("'opposed' is said of" in line for line in lines)
+    assert not [line for line in lines if "'opposed' 'opposed'" in line], lines[:2]

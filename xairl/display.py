@@ -109,7 +109,8 @@ def _then(cf: dict, one: dict) -> str:
 
 
 def _g(x) -> str:
-    return format_number(x)  # as the words write it: 0.000644, never 6.44e-04
+    """3 significant digits, never in scientific notation (0.00064 and 2391 as the words write them)."""
+    return f"{x:.3g}" if 1e-3 <= abs(x) < 1000 else format_number(x)
 
 
 def _changes(one: dict, arrow: str, escape=lambda s: s) -> str:

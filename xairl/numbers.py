@@ -36,16 +36,19 @@ def format_number(x: float, signed: bool = False) -> str:
 
 
 def _two_digits(x: float) -> str:
-    """``x`` (0 < |x| < 0.1) to 2 significant digits, counted once rounded (0.0999 is '0.10'); '0' below the last
-    decimal written."""
+    """``x`` (0 < |x| < 0.1) to 2 significant digits, counted once rounded (0.0999 is '0.10'), without trailing zeros;
+    '0' below the last decimal written."""
     places = min(1 - math.floor(math.log10(abs(x))), MAX_DECIMALS)
     rounded = abs(round(x, places))
     if rounded == 0:
         return "0"
-    return f"{x:.{min(1 - math.floor(math.log10(rounded)), MAX_DECIMALS)}f}"
+    if rounded >= 0.1:  # 0.0999: written as 0.1 and above are, '0.10'
+        return f"{x:.2f}"
+    text = f"{x:.{min(1 - math.floor(math.log10(rounded)), MAX_DECIMALS)}f}"
+    return text.rstrip("0").rstrip(".")  # as written before: a margin of '0.05', not '0.050'
 
 
 def written_step(x: float) -> float:
-    """The place of the last digit :func:`format_number` writes of ``x`` (1 for '120', 0.1 for '37.6', 1e-05 for
-    '0.00123'): a value rounded to it is written exactly."""
+    """The place of the last digit :func:`format_number` writes of ``x`` (1 for '120', 0.1 for '37.6', 0.0001 for
+    '0.0012'): a value rounded to it is written exactly."""
     return 10.0 ** decimal.Decimal(format_number(x)).as_tuple().exponent
