@@ -87,7 +87,7 @@ def test_a_template_whose_words_hold_a_bidi_override_is_refused(toy, tmp_path):
     ],
 )
 def test_prompts_check_names_an_unknown_filter_or_test(tmp_path, capsys, variant, said):
-    path = _template(tmp_path, f'  - |\n    The policy chose {{{{ action }}}}.\n    {variant}\n')
+    path = _template(tmp_path, f"  - |\n    The policy chose {{{{ action }}}}.\n    {variant}\n")
     assert main(["prompts", "check", str(path)]) == 1  # a problem of the template, listed as the others are
     out, err = capsys.readouterr()
     assert f"{path}:5: {said}; the " in out and "num" in out and "internal error" not in out + err
@@ -107,7 +107,7 @@ def test_a_template_of_too_many_sentences_is_refused(tmp_path):
 
 def test_a_template_of_too_many_variants_is_refused(tmp_path):
     variants = ", ".join(['"{{ action }} it was."'] * (prompts.MAX_VARIANTS + 1))
-    with pytest.raises(TemplateError, match=f"variants in all"):
+    with pytest.raises(TemplateError, match="variants in all"):
         prompts.load(_template(tmp_path, f"  - [{variants}]\n"))
 
 
@@ -120,7 +120,9 @@ def test_a_template_over_the_byte_limit_is_refused_unread(tmp_path, capsys):
 
 def test_a_rendering_past_the_clock_is_refused(monkeypatch):
     monkeypatch.setattr(sandbox, "MAX_SECONDS", 0.0)  # every rendering is then past its time
-    with pytest.raises(TemplateError, match=r"explain_action\.yaml:\d+: refused by the sandbox \(rendering took over 0 s"):
+    with pytest.raises(
+        TemplateError, match=r"explain_action\.yaml:\d+: refused by the sandbox \(rendering took over 0 s"
+    ):
         prompts.load("explain_action").render_variants(sample_context("decision"))
 
 
