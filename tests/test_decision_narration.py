@@ -122,7 +122,7 @@ def test_coverage_lowers_confidence_and_evidence_marks_sentences(case):
     from xairl.narrators.confidence import confidence
 
     v = xairl.verify(n.text + " It felt right. Nobody objected.", exp, 0, p)
-    lower, comp = confidence(exp, 0, v.ok, p, coverage=v.coverage)
+    lower, comp = confidence(exp, 0, v.ok, xairl.NarrationOptions(policy=p), coverage=v.coverage)
     assert v.ok and comp["coverage"] < 1 and lower < n.confidence
     ev = evidence(exp, n)
     assert ev["target"] == "margin of go over wait" and ev["features"][0]["name"] == "speed"

@@ -33,6 +33,7 @@ _LAZY = {
     "read_parquet": "xairl.stream",
     # narration and verification
     "narrate": "xairl.narrators",
+    "NarrationOptions": "xairl.narrators",
     "verify": "xairl.narrators",
     "Narrative": "xairl.narrators",
     "Verification": "xairl.narrators",

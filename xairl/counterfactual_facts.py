@@ -33,8 +33,8 @@ from .counterfactuals.show import outward as _outward  # (the one rounding rule:
 from .counterfactuals.show import summary
 from .errors import InputError
 from .explanation import Explanation
+from .numbers import format_number
 from .policy import FeatureInfo, Policy
-from .prompts import format_number
 from .values import fill_and_text
 
 __all__ = [

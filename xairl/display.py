@@ -13,6 +13,8 @@ import warnings
 
 import numpy as np
 
+from .numbers import format_number
+
 #: what tqdm.auto warns, once per process, in a notebook without ipywidgets (shap and transformers import it)
 _NO_WIDGETS = "IProgress not found"
 
@@ -107,7 +109,8 @@ def _then(cf: dict, one: dict) -> str:
 
 
 def _g(x) -> str:
-    return f"{x:.3g}" if abs(x) >= 1e-3 or x == 0 else f"{x:.2e}"
+    """3 significant digits, never in scientific notation (0.00064 and 2391 as the words write them)."""
+    return f"{x:.3g}" if 1e-3 <= abs(x) < 1000 else format_number(x)
 
 
 def _changes(one: dict, arrow: str, escape=lambda s: s) -> str:

@@ -12,8 +12,8 @@ import numpy as np
 from .counterfactual_facts import CounterfactualFact
 from .errors import InputError, PluginError
 from .explanation import Explanation
+from .numbers import format_number
 from .policy import FeatureInfo, Policy
-from .prompts import format_number
 from .values import fill_and_text, state_value_text, value_level, value_text
 from .windows import Window, said_change, trend, window_of
 

@@ -190,10 +190,10 @@ class Observation:
             shape = f"a 2-D array (n, {f})" if self.kind == "flat" else f"{self.describe()} or a flat (n, {f}) array"
             raise InputError(f"{what} must be {shape}; got shape {arr.shape}.")
         if arr.shape[0] == 0:
-            raise InputError(f"{what} is empty: give at least one state.")
+            raise InputError(f"{what} {_verb(what, 'are')} empty: give at least one state.")
         if arr.shape[1] != f:
             raise InputError(
-                f"{what} has {arr.shape[1]} features but the policy expects {f}"
+                f"{what} {_verb(what, 'have')} {arr.shape[1]} features but the policy expects {f}"
                 f"{' as ' + self.describe() if self.kind != 'flat' else ''}; check the column order/count."
             )
         return _finite(arr, what, dtype)
@@ -201,7 +201,9 @@ class Observation:
     def _columns(self, states: Mapping, what: str) -> list[np.ndarray]:
         missing = [p.key for p in self.parts if p.key not in states]
         if missing:
-            raise InputError(f"{what} lack key(s) {', '.join(missing)}; the policy takes {self.describe()}.")
+            raise InputError(
+                f"{what} {_verb(what, 'lack')} key(s) {', '.join(missing)}; the policy takes {self.describe()}."
+            )
         cols, n = [], None
         for p in self.parts:
             a = _numeric(states[p.key], f"{what}['{p.key}']")
@@ -335,7 +337,7 @@ def _numeric(data, what: str) -> np.ndarray:
         arr = np.asarray(data)
         if arr.dtype.kind in _REFUSED_KINDS:  # numpy would drop the imaginary part or count nanoseconds
             raise InputError(
-                f"{what} hold {_REFUSED_KINDS[arr.dtype.kind]} ({arr.dtype}); give real numbers "
+                f"{what} {_verb(what, 'hold')} {_REFUSED_KINDS[arr.dtype.kind]} ({arr.dtype}); give real numbers "
                 "(float or int), converting the column yourself if that is meant."
             )
         return arr.astype(np.float64)
@@ -344,10 +346,16 @@ def _numeric(data, what: str) -> np.ndarray:
             raise
         raise InputError(f"{what} must be numeric; could not convert ({' '.join(str(exc).split())[:120]}).") from None
     except RecursionError:
-        raise InputError(f"{what} are nested too deeply to be states.") from None
+        raise InputError(f"{what} {_verb(what, 'are')} nested too deeply to be states.") from None
 
 
 _REFUSED_KINDS = {"c": "complex numbers", "M": "dates", "m": "time spans"}
+
+
+def _verb(what: str, plural: str) -> str:
+    """The verb agreeing with ``what``: 'states contain', 'background contains' (the noun before any ':' says)."""
+    noun = (what.split(":")[0].split() or ["states"])[-1]
+    return plural if noun.endswith("s") else {"are": "is", "have": "has"}.get(plural, plural + "s")
 
 
 def _finite(arr: np.ndarray, what: str, dtype=np.float32) -> np.ndarray:
@@ -355,7 +363,7 @@ def _finite(arr: np.ndarray, what: str, dtype=np.float32) -> np.ndarray:
     if bad.any():
         r, c = np.argwhere(bad)[0]
         raise InputError(
-            f"{what} contain {int(bad.sum())} NaN/inf value(s), first at row {r}, column {c}; clean or drop them."
+            f"{what} {_verb(what, 'contain')} {int(bad.sum())} NaN/inf value(s), first at row {r}, column {c}; clean or drop them."
         )
     with np.errstate(over="ignore"):  # reported below in one line, not as a numpy warning
         out = arr.astype(dtype)
@@ -363,7 +371,7 @@ def _finite(arr: np.ndarray, what: str, dtype=np.float32) -> np.ndarray:
     if over.any():
         r, c = np.argwhere(over)[0]
         raise InputError(
-            f"{what} hold {int(over.sum())} value(s) beyond the {np.dtype(dtype).name} range (±"
+            f"{what} {_verb(what, 'hold')} {int(over.sum())} value(s) beyond the {np.dtype(dtype).name} range (±"
             f"{np.finfo(dtype).max:.2g}) the network computes in, first at row {r}, column {c} ({arr[r, c]:.3g}); "
             "scale those inputs down, or give a float64 network (module.double())."
         )

@@ -30,8 +30,8 @@ import numpy as np
 from .counterfactuals import Counterfactuals
 from .counterfactuals.show import single_flips
 from .explanation import Explanation
+from .numbers import format_number
 from .policy import Policy
-from .prompts import format_number
 from .values import value_text
 
 #: decisions of a run tried feature by feature (about 1 ms each for an MLP: one batched search)

@@ -101,6 +101,7 @@ def cmd_verify(args) -> int:
     reading (rule) that bound it."""
     from ..explanation import Explanation
     from ..narrators.verify import verify
+    from ..prompts import bidi_visible
 
     text = args.text if args.text != "-" else sys.stdin.read()
     try:
@@ -121,7 +122,7 @@ def cmd_verify(args) -> int:
         raise InputError(f"--index {args.index}: {exc}") from None
     result = verify(text, exp, args.index)
     for sentence in result.sentences:
-        print(f"[{sentence.status}] {sentence.text}")
+        print(f"[{sentence.status}] {bidi_visible(sentence.text)}")  # shown as read, not reordered
         for c in sentence.claims if args.trace else ():
             print(f"    {c.status:<12} {c.kind:<9} {c.text!r:<28} {c.rule or '-':<22} {c.detail}")
     if args.trace:  # what each reading that fired reads, from its entry in the rules' table
