@@ -13,6 +13,7 @@ verified like the contribution (:class:`xairl.facts.FeatureFact`).
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,12 @@ LAYOUTS = ("sequence", "stacked")
 TREND_SHARE = 1 / 3
 #: the trend words, by the sign of the change (newest minus oldest value)
 RISE, FALL = "rose", "fell"
+#: the most slots (steps x signals) a window may have: every slot is a feature, named, attributed and kept per
+#: state, so a window is as wide as an image (3 x 224 x 224 is 150,528 columns); past this its names alone take
+#: hundreds of MB, and ``window=10**8`` would build names until memory ran out
+MAX_SLOTS = 1_000_000
+#: a name as a window's slots are named: 'speed[t-3]', 'speed[t]', or a frame stack's 'patch A1 of frame 2'
+SLOT_FORM = re.compile(r"(.+)\[t(?:-\d+)?\]|(.+) of frame \d+", re.S)
 
 
 @dataclass(frozen=True)
@@ -67,6 +74,18 @@ class Window:
             raise InputError("a window needs at least one signal: name each column of one observation.")
         if len(set(self.signals)) != len(self.signals):
             raise InputError(f"the window's signals have duplicates ({', '.join(self.signals)}); name each once.")
+        if len(self.signals) * self.steps > MAX_SLOTS:
+            raise InputError(
+                f"a window of {self.steps} steps x {len(self.signals)} signal(s) has {self.steps * len(self.signals):,} "
+                f"slots, more than the {MAX_SLOTS:,} xairl explains (each slot is a feature); give the steps the "
+                "module really takes."
+            )
+        slotted = [s for s in self.signals if SLOT_FORM.fullmatch(s)]
+        if slotted:
+            raise InputError(
+                f"the window's signal '{slotted[0]:.60}' is named like a slot ('signal[t-1]', 'x of frame 2'), so "
+                "its slots could be read as another signal's; rename it."
+            )
         step = self.step_s
         if step is not None and (
             isinstance(step, bool) or not isinstance(step, (int, float, np.number)) or not 0 < step < float("inf")
@@ -153,6 +172,19 @@ def slot_features(features: dict, window: Window | None) -> dict:
             for j in slots[s]:
                 features.setdefault(names[j], features[s])
     return features
+
+
+def check_slot_names(window: Window, names, what: str = "feature_names") -> None:
+    """Names given to a window's columns: one in a slot's form ('a[t-1]') must be that very slot's name at its column,
+    so that no name says another step or signal than the column holds (names in no slot form are the caller's own)."""
+    slots = window.names()
+    for j, name in enumerate(names):
+        if SLOT_FORM.fullmatch(str(name)) and (j >= len(slots) or slots[j] != name):
+            held = f"holds {slots[j]}" if j < len(slots) else "is past the window's last slot"
+            raise InputError(
+                f"{what}: column {j} is named '{str(name):.60}' but, for a window of {window.steps} steps x "
+                f"{', '.join(window.signals)[:80]}, it {held}; the names and the window disagree."
+            )
 
 
 def window_of(exp) -> Window | None:
