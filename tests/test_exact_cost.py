@@ -7,7 +7,7 @@ import torch
 
 import xairl
 from xairl.attributors.exact import MAX_EVALUATIONS, Exact
-from xairl.errors import InputError
+from xairl.errors import InputError, UnsupportedModelError
 
 from .conftest import mlp, run
 from .test_references import brute_force_shapley
@@ -209,3 +209,24 @@ def test_exact_options_are_whole_numbers_not_bools(options):
     with pytest.raises(InputError, match="valid integer"):
         Exact(options)
     assert Exact({"max_evaluations": 10**9}).options.max_evaluations == 10**9
+
+
+def test_exact_is_recommended_first_where_it_is_cheaper_than_kernel_shap():
+    """Was: a GRU over a small window was pointed to integrated_gradients or kernel_shap first, where exact gave the
+    true values 4.3x faster (2^F coalitions <= kernel_shap's 2F + 2048 samples up to 11 features)."""
+
+    class SmallGru(torch.nn.Module):
+        def __init__(self, k):
+            super().__init__()
+            self.gru, self.head = torch.nn.GRU(k, 4, batch_first=True), torch.nn.Linear(4, 2)
+
+        def forward(self, x):
+            return self.head(self.gru(x)[0][:, -1])
+
+    for steps, signals, first in ((3, 3, "exact"), (4, 4, "integrated_gradients")):
+        names = [f"s{j}" for j in range(signals)]
+        policy = xairl.Policy(SmallGru(signals), feature_names=names, window=steps)
+        with pytest.raises(UnsupportedModelError) as err:
+            xairl.explain(policy, np.zeros((1, steps, signals)), background=np.ones((2, steps, signals)))
+        assert str(err.value).split("use method=")[1].startswith(f"'{first}'"), str(err.value)
+        assert ("exact: true Shapley values" in str(err.value)) == (first == "exact")
