@@ -141,3 +141,35 @@ def test_slot_like_names_are_refused():
         xairl.Policy(Sum(), observation=obs, feature_names=["a[t]", "x", "y", "z"])
     own = xairl.Policy(Sum(), observation=obs, feature_names=["a old", "b old", "a[t]", "b[t]"])
     assert own.feature_names[2] == "a[t]"  # a slot's own name at its own column is fine
+
+
+class Mean(torch.nn.Module):
+    """Q(go) - Q(stay) = -(the mean of rsrq over the window) + 0.1 load[t]: every step pushes."""
+
+    def forward(self, x):
+        seq = x.reshape(len(x), 5, 2)
+        go = -seq[:, :, 0].mean(dim=1) + 0.1 * seq[:, -1, 1]
+        return torch.stack([torch.zeros_like(go), go], dim=1)
+
+
+def test_a_frame_stacks_padding_after_a_reset_is_no_trend():
+    """Was: SB3's VecFrameStack fills the steps before an episode's first observations with zeros, and a signal
+    'fell' from them ('Pole_angle fell 0.04'). The trend is said over the observed steps only, and both readers
+    check it there; a window whose newest step alone is observed says no trend."""
+    obs = xairl.Observation.window(["rsrq", "load"], 5, step_s=0.2)
+    info = {"rsrq": xairl.FeatureInfo("dB", "the serving RSRQ")}
+    p = xairl.Policy(Mean(), observation=obs, action_names=["stay", "go"], features=info)
+    x = np.zeros((2, 5, 2))
+    x[0, 2:, 0], x[0, 2:, 1] = [-10.0, -11.0, -12.0], 1.0  # two steps of padding, then 3 observations
+    x[1, 4] = [-12.0, 1.0]  # just reset: only the newest step observed
+    bg = np.random.default_rng(0).normal(-10.0, 1.0, size=(8, 5, 2))
+    e = xairl.explain(p, x, method="exact", background=bg)
+    (f,) = xairl.facts.decision_facts(e, 0, p).trends
+    assert (f.trend, f.change, f.window) == ("fell", pytest.approx(-2.0), "the last 0.4 s")  # not 12 over 0.8 s
+    n = xairl.narrate(e, 0, policy=p)
+    assert "The serving RSRQ fell 2 dB over the last 0.4 s" in n.text and n.verified, n.text
+    again = xairl.verify(n.text, xairl.Explanation.from_json(e.to_json()), 0, p)
+    assert again.accurate, [(c.text, c.detail) for c in again.claims if c.status == "contradicted"]
+    wrong = n.text.replace("fell 2 dB over the last 0.4 s", "fell 12 dB over the last 0.8 s")
+    assert not xairl.verify(wrong, e, 0, p).accurate  # the padding's 'change' is refused
+    assert xairl.facts.decision_facts(e, 1, p).trends == () and " fell " not in xairl.narrate(e, 1, policy=p).text

@@ -15,7 +15,7 @@ from .explanation import Explanation
 from .policy import FeatureInfo, Policy
 from .prompts import format_number
 from .values import fill_and_text, state_value_text, value_level, value_text
-from .windows import Window, said_change, trend, window_of
+from .windows import Window, real_start, said_change, trend, window_of
 
 __all__ = [
     "Comparison",
@@ -244,6 +244,8 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
     q = exp.background_quantiles
     labels = exp.value_labels
     regions = (exp.extras or {}).get("regions") or {}  # an image's regions (xairl.in_regions)
+    window = next((u.window for u in us if u.window is not None), None)
+    start = int(real_start(exp.states[i : i + 1], window)[0]) if window else 0  # steps before it: padding
     out = []
     for n, u in enumerate(us):
         single = len(u.columns) == 1 or u.window is not None  # a signal's value is its newest
@@ -253,7 +255,8 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
         lvl, words = value_level(value, u.info, None if q is None or not single else (float(q[0, j]), float(q[2, j])))
         fill, text = fill_and_text(value, u.info, label, u.name in regions)
         numeric = u.window is not None and u.info.kind == "numeric"  # a label or an id has no trend
-        moved = trend(exp.states[i, list(u.columns)], contrib[list(u.columns)]) if numeric else None
+        seen = list(u.columns)[start:]  # its observed steps: a change from padding is no trend
+        moved = trend(exp.states[i, seen], contrib[seen]) if numeric else None
         change, change_unit = said_change(moved.change, u.info.unit, u.info.capacity) if moved else (None, "")
         out.append(
             FeatureFact(
@@ -272,7 +275,7 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
                 text,
                 change,
                 "" if moved is None else moved.word,
-                "" if moved is None else u.window.span_text(),
+                "" if moved is None else u.window.span_text(len(seen)),
                 change_unit,
             )
         )

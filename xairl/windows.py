@@ -28,6 +28,8 @@ LAYOUTS = ("sequence", "stacked")
 TREND_SHARE = 1 / 3
 #: the trend words, by the sign of the change (newest minus oldest value)
 RISE, FALL = "rose", "fell"
+#: what fills a window's steps before an episode has that many observations (SB3's VecFrameStack: zeros)
+PADDING = 0.0
 #: the most slots (steps x signals) a window may have: every slot is a feature, named, attributed and kept per
 #: state, so a window is as wide as an image (3 x 224 x 224 is 150,528 columns); past this its names alone take
 #: hundreds of MB, and ``window=10**8`` would build names until memory ran out
@@ -118,13 +120,14 @@ class Window:
         n = len(self.signals)
         return {step: offset + n * k + np.arange(n) for k, step in enumerate(self.step_names())}
 
-    def span_text(self) -> str:
-        """The window's span in words: 'the last 0.8 s' from its oldest to its newest observation (with ``step_s``),
-        else 'the last 5 observations'."""
+    def span_text(self, steps: int | None = None) -> str:
+        """The span of the newest ``steps`` (default: all) in words: 'the last 0.8 s' from the oldest to the newest
+        observation (with ``step_s``), else 'the last 5 observations'."""
+        steps = self.steps if steps is None else steps
         if self.step_s is not None:
-            seconds = (self.steps - 1) * self.step_s
+            seconds = (steps - 1) * self.step_s
             return f"the last {seconds / 60:.3g} min" if seconds >= 120 else f"the last {seconds:.3g} s"
-        return f"the last {self.steps} {'frames' if self.frames else 'observations'}"
+        return f"the last {steps} {'frames' if self.frames else 'observations'}"
 
     def to_dict(self) -> dict:
         out = {"signals": list(self.signals), "steps": self.steps, "layout": self.layout, "step_s": self.step_s}
@@ -159,6 +162,16 @@ def trend(values: np.ndarray, contributions: np.ndarray) -> Trend:
     history = float(size[:-1].sum() / size.sum()) if size.sum() > 0 else 0.0
     said = history >= TREND_SHARE and np.isfinite(change) and change != 0
     return Trend(change, (RISE if change > 0 else FALL) if said else "", history)
+
+
+def real_start(states: np.ndarray, window: Window) -> np.ndarray:
+    """Per state of flat window ``states`` (n, steps * signals), the first step that was observed. A frame stack
+    fills the steps an episode has not reached yet with :data:`PADDING` (SB3's VecFrameStack after a reset): its
+    oldest steps whose every signal is exactly that are no observations, and a change from them no trend (a window
+    that is padding throughout is taken whole: nothing in it changed)."""
+    steps = np.asarray(states).reshape(len(states), window.steps, len(window.signals))
+    pad = np.all(steps == PADDING, axis=2)
+    return np.where(pad.all(axis=1), 0, np.argmin(pad, axis=1))  # argmin: the first step that is not padding
 
 
 def slot_features(features: dict, window: Window | None) -> dict:
