@@ -173,3 +173,60 @@ def test_a_frame_stacks_padding_after_a_reset_is_no_trend():
     wrong = n.text.replace("fell 2 dB over the last 0.4 s", "fell 12 dB over the last 0.8 s")
     assert not xairl.verify(wrong, e, 0, p).accurate  # the padding's 'change' is refused
     assert xairl.facts.decision_facts(e, 1, p).trends == () and " fell " not in xairl.narrate(e, 1, policy=p).text
+
+
+def test_a_trends_push_is_said_once(tmp_path):
+    """Was: 'The biggest push ... came from the serving RSRQ (-12 dB), by +7.40. The serving RSRQ fell 4 dB over the
+    last 0.8 s (now -12 dB), which favoured go by 7.40.': the same push twice. A trend already said as a reason (or
+    as the concession) says its change only; one said nowhere else keeps its push."""
+    obs = xairl.Observation.window(["rsrq", "load"], 5, step_s=0.2)
+    info = {"rsrq": xairl.FeatureInfo("dB", "the serving RSRQ")}
+    p = xairl.Policy(Mean(), observation=obs, action_names=["stay", "go"], features=info)
+    x = np.zeros((1, 5, 2))
+    x[0, :, 0], x[0, :, 1] = np.linspace(-8.0, -12.0, 5), 1.0
+    bg = np.random.default_rng(0).normal(size=(8, 5, 2))
+    e = xairl.explain(p, x, method="exact", background=bg)
+    facts = xairl.facts.decision_facts(e, 0, p)
+    (f,) = facts.trends
+    assert f.name == facts.reasons[0].name
+    n = xairl.narrate(e, 0, policy=p)
+    assert "fell 4 dB over the last 0.8 s." in n.text and "which favoured go" not in n.text and n.verified, n.text
+    body = "{% for f in trends %}{{ f.label|cap }} {{ f.trend }} {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}, which favoured {{ action }} by {{ f.contribution|num }}.{% endfor %}"
+    (tmp_path / "t.yaml").write_text(json.dumps({"name": "t", "kind": "decision", "sentences": [[body]]}))
+    alone = xairl.narrate(e, 0, policy=p, template=str(tmp_path / "t.yaml"))  # a trend said nowhere else: its push
+    assert "which favoured go by" in alone.text and alone.verified, alone.text
+
+
+class Cancels(torch.nn.Module):
+    """Over 3 steps of a, b, c, d, e: a, b and c push go at their newest step, d against it, and e's two newest steps
+    push hard both ways (3 e[t] - 2.8 e[t-1]): its slots are the heat map's darkest, its sum the smallest."""
+
+    def forward(self, x):
+        s = x.reshape(len(x), 3, 5)
+        go = 1.0 * s[:, -1, 0] + 0.8 * s[:, -1, 1] + 0.6 * s[:, -1, 2] - 0.5 * s[:, -1, 3]
+        go = go + 3.0 * s[:, -1, 4] - 2.8 * s[:, -2, 4]
+        return torch.stack([torch.zeros_like(go), go], dim=1)
+
+
+def test_a_signal_whose_steps_cancel_is_said_to_pull_both_ways():
+    """Was: a signal whose sum was 6 % of its slots' sizes was ranked last, unexplained, while the heat map showed it
+    darkest. Its steps 'pulled both ways', a fact (FeatureFact.steps, DecisionFacts.both_ways) the template says
+    and both readers accept; a signal whose steps agree is never said so."""
+    names = ["a", "b", "c", "d", "e"]
+    p = xairl.Policy(Cancels(), feature_names=names, window=3, action_names=["stay", "go"])
+    x = np.ones((1, 3, 5))
+    x[0, :, 4] = [1.0, 2.0, 2.0]
+    e = xairl.explain(p, x, method="exact", background=np.zeros((3, 3, 5)))
+    facts = xairl.facts.decision_facts(e, 0, p)
+    (f,) = facts.both_ways
+    slots = e.margin()[0, 4::5]
+    assert f.name == "e" and f.steps == "pulled both ways" and abs(slots.sum()) < 0.1 * np.abs(slots).sum()
+    assert f.rank == 5 and all(not g.steps for g in facts.margin_top)
+    n = xairl.narrate(e, 0, policy=p)
+    assert "E's steps pulled both ways: they nearly cancelled, adding up to +0.40 to the margin." in n.text, n.text
+    assert n.verified, [(c.text, c.detail) for c in n.claims if c.status != "verified"]
+    again = xairl.verify(n.text, xairl.Explanation.from_json(e.to_json()), 0, p)
+    assert again.accurate, [(c.text, c.detail) for c in again.claims if c.status == "contradicted"]
+    x[0, :, 4] = [1.0, 1.0, 2.0]  # e's newest step outweighs: its steps no longer cancel
+    agree = xairl.explain(p, x, method="exact", background=np.zeros((3, 3, 5)))
+    assert xairl.facts.decision_facts(agree, 0, p).both_ways == ()

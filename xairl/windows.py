@@ -30,6 +30,11 @@ TREND_SHARE = 1 / 3
 RISE, FALL = "rose", "fell"
 #: what fills a window's steps before an episode has that many observations (SB3's VecFrameStack: zeros)
 PADDING = 0.0
+#: a signal's steps 'pulled both ways' when their pushes nearly cancel (their sum is at most this share of their
+#: sizes) though their sizes add up to as much as the decision's largest push: the heat map shows it dark while its
+#: sum ranks it low, and a reader is owed why
+CANCEL_SHARE = 0.25
+BOTH_WAYS = "pulled both ways"
 #: the most slots (steps x signals) a window may have: every slot is a feature, named, attributed and kept per
 #: state, so a window is as wide as an image (3 x 224 x 224 is 150,528 columns); past this its names alone take
 #: hundreds of MB, and ``window=10**8`` would build names until memory ran out
@@ -162,6 +167,31 @@ def trend(values: np.ndarray, contributions: np.ndarray) -> Trend:
     history = float(size[:-1].sum() / size.sum()) if size.sum() > 0 else 0.0
     said = history >= TREND_SHARE and np.isfinite(change) and change != 0
     return Trend(change, (RISE if change > 0 else FALL) if said else "", history)
+
+
+def pulled_both_ways(contributions: np.ndarray, largest: float) -> str:
+    """:data:`BOTH_WAYS` when a signal's slots (``contributions``) cancel out within :data:`CANCEL_SHARE` of their
+    sizes, which add up to at least ``largest`` (the largest |contribution| of a reason); else ''."""
+    contributions = np.asarray(contributions, float)
+    size = float(np.abs(contributions).sum())
+    return BOTH_WAYS if 0 < largest <= size and abs(contributions.sum()) <= CANCEL_SHARE * size else ""
+
+
+def signal_facts(unit, states, contrib, start: int, largest: float) -> tuple:
+    """(change, trend word, span, change's unit, :func:`pulled_both_ways`) of a narration unit
+    (:class:`xairl.facts.Unit`) over one state's ``states`` and ``contrib`` (one per column): for a signal of a
+    window, observed from step ``start`` on (a change from the padding before it is no trend; a label or an
+    identifier has none), ``largest`` the decision's largest push; nothing for any other unit."""
+    if unit.window is None:
+        return None, "", "", "", ""
+    cols, info = list(unit.columns), unit.info
+    values, contributions = np.asarray(states)[cols], np.asarray(contrib)[cols]
+    steps = pulled_both_ways(contributions, largest) if info.kind != "identifier" else ""
+    if info.kind != "numeric":
+        return None, "", "", "", steps
+    moved = trend(values[start:], contributions[start:])
+    change, change_unit = said_change(moved.change, info.unit, info.capacity)
+    return change, moved.word, unit.window.span_text(len(values) - start), change_unit, steps
 
 
 def real_start(states: np.ndarray, window: Window) -> np.ndarray:
