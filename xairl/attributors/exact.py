@@ -29,7 +29,10 @@ MAX_EVALUATIONS = 2**24
 class ExactOptions(Options):
     # strict: True is no count, and 2.5 rows no whole number (lax pydantic reads True as 1)
     max_rows: int = Field(
-        8_192, ge=1, strict=True, description="rows per forward batch; bounds memory (8,192: the fastest measured on a CPU)"
+        8_192,
+        ge=1,
+        strict=True,
+        description="rows per forward batch; bounds memory (8,192: the fastest measured on a CPU)",
     )
     max_evaluations: int = Field(
         MAX_EVALUATIONS,
