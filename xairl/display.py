@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import html
 import sys
+import time
 import warnings
 
 import numpy as np
@@ -45,6 +46,59 @@ def show_progress(progress: bool | None) -> bool:
         return progress
     isatty = getattr(sys.stderr, "isatty", None)
     return bool(isatty and isatty())
+
+
+#: seconds of work before progress shows unasked: a bar on a terminal past ``QUIET_S``; elsewhere (a log, a pipe, a
+#: notebook) a plain line every ``LINE_EVERY_S``, so that a run of minutes is never silent and a quick one says nothing
+QUIET_S, LINE_EVERY_S = 3.0, 10.0
+
+
+class WorkProgress:
+    """Progress over ``total`` units (states, or one state's batches), fed in fractions of a unit.
+
+    :param show: True, a bar at once; False, nothing; None (the default of long work), a bar past :data:`QUIET_S`
+        when stderr is a terminal, else a plain line to stderr every :data:`LINE_EVERY_S` ('exact: 37% (1.5 of 4
+        states), 52 s, about 88 s left').
+    """
+
+    def __init__(self, show: bool | None, total: int, desc: str, unit: str):
+        self.total, self.desc, self.unit, self.done = total, desc, unit, 0.0
+        self.start = self.shown_at = time.monotonic()
+        self.whole = 0  # whole units given to the bar
+        terminal = show_progress(None)
+        self.bar = (
+            progress(total=total, desc=desc, unit=unit, delay=0 if show else QUIET_S)
+            if show or (show is None and terminal)
+            else None
+        )
+        self.lines = show is None and not terminal
+
+    def advance(self, amount: float) -> None:
+        self.done += amount
+        now = time.monotonic()
+        if self.bar is not None:
+            whole = min(int(self.done + 1e-9), self.total)
+            if whole > self.whole:
+                self.bar.update(whole - self.whole)
+                self.whole = whole
+            elif now - self.shown_at >= 1 and now - self.start >= self.bar.delay:  # within a long unit: its share
+                self.bar.set_postfix_str(f"{self.done - whole:.0%} of the next {self.unit}")
+                self.shown_at = now
+        elif self.lines and now - self.shown_at >= LINE_EVERY_S:
+            took = now - self.start
+            left = f", about {took * (self.total - self.done) / self.done:.0f} s left" if self.done else ""
+            print(
+                f"{self.desc}: {self.done / self.total:.0%} ({self.done:.3g} of {self.total} "
+                f"{self.unit}{'es' if self.unit.endswith(('s', 'ch')) else 's'}), "
+                f"{took:.0f} s{left}",
+                file=sys.stderr,
+                flush=True,
+            )
+            self.shown_at = now
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
 
 
 def explanation_html(exp, states: int = 5, top: int = 6) -> str:

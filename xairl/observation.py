@@ -92,7 +92,12 @@ class Observation:
     def array(cls, shape: Sequence[int], key: str = "obs", channels: str = "channels") -> Observation:
         """States of shape ``(n, *shape)``, e.g. frames (n, 4, 84, 84); ``channels="frames"`` says that the first axis
         of an image is a frame stack (its regions are said as 'patch F6 of frame 2', not 'of channel 2')."""
-        return cls("array", (Part(key, tuple(int(s) for s in shape), channels=channels),))
+        shape = tuple(int(s) for s in shape)
+        if len(shape) < 2:  # a vector is 'flat': the explanation records either, and reads back the one it is
+            raise InputError(
+                f"Observation.array takes 2 axes or more, got {shape}; one vector per state is Observation.flat(n)."
+            )
+        return cls("array", (Part(key, shape, channels=channels),))
 
     @classmethod
     def dict(
@@ -123,6 +128,12 @@ class Observation:
     @classmethod
     def several(cls, shapes: Sequence[Sequence[int]]) -> Observation:
         """Several inputs, passed to the module as positional tensors ``module(x0, x1, ...)``."""
+        shapes = list(shapes)
+        if len(shapes) < 2:
+            raise InputError(
+                f"several inputs take 2 shapes or more, got {len(shapes)}; one input is given by its shape, e.g. "
+                "observation=(4, 84, 84)."
+            )
         return cls("tuple", tuple(Part(f"input{i}", tuple(int(s) for s in sh)) for i, sh in enumerate(shapes)))
 
     # ---- the flat view --------------------------------------------------------------------------------------
@@ -183,7 +194,7 @@ class Observation:
             if arr.shape == shape:
                 arr = arr[None]
             if arr.ndim == len(shape) + 1 and arr.shape[1:] == shape:
-                arr = arr.reshape(len(arr), -1)
+                arr = arr.reshape(len(arr), f)  # f, not -1: numpy cannot infer -1 for no states
         if arr.ndim == 1 and arr.size == f:
             arr = arr[None, :]
         if arr.ndim != 2:
@@ -208,7 +219,7 @@ class Observation:
         for p in self.parts:
             a = _numeric(states[p.key], f"{what}['{p.key}']")
             if p.categories:
-                a = a.reshape(len(a), -1) if a.ndim > 1 else a[:, None]
+                a = a.reshape(len(a), -1 if len(a) else 1) if a.ndim > 1 else a[:, None]
                 if a.shape[1] != 1 or not np.all((a == np.round(a)) & (a >= 0) & (a < p.categories)):
                     raise InputError(f"{what}['{p.key}'] must hold one integer in 0..{p.categories - 1} per state.")
                 a = np.eye(p.categories, dtype=np.float64)[a[:, 0].astype(int)]
@@ -219,11 +230,13 @@ class Observation:
                     raise InputError(
                         f"{what}['{p.key}'] has shape {a.shape}; expected (n, {', '.join(map(str, p.shape))})."
                     )
-                a = a.reshape(len(a), -1)
+                a = a.reshape(len(a), p.size)
             if n is not None and len(a) != n:
                 raise InputError(f"{what}: the parts have different numbers of states ({n} and {len(a)}).")
             n = len(a)
             cols.append(a)
+        if n == 0:
+            raise InputError(f"{what} is empty: give at least one state.")
         return cols
 
     def unflatten(self, x):

@@ -15,7 +15,7 @@ from .errors import InputError
 from .heads import check_kinds, heads
 from .network import PolicyNetwork, eval_mode, module_dtype
 from .observation import Observation, names_preview
-from .windows import slot_features
+from .windows import check_slot_names, slot_features
 
 
 @dataclass(frozen=True)
@@ -382,6 +382,8 @@ def _with_window(window, observation, feature_names) -> tuple[Observation, Seque
     if observation.kind == "window" and feature_names is not None:
         if tuple(map(str, feature_names)) == observation.parts[0].window.signals:
             feature_names = None  # the signals' names: the slots' are generated from them
+        else:  # names of the slots: none may say another slot than its column holds ('a[t-1]' beside signal 'a')
+            check_slot_names(observation.parts[0].window, list(map(str, feature_names)))
     return observation, feature_names
 
 

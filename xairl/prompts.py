@@ -48,6 +48,7 @@ DECISION_VARS = {
     "base_margin",
     "identifiers",
     "trends",
+    "both_ways",
     "counterfactual",
 }
 GLOBAL_VARS = {"n_states", "method", "ranking", "view", "target", "k"}
