@@ -2,13 +2,16 @@
 in the margin view (the narratives' view), the view named. A Narrative shows its evidence card
 (:func:`xairl.evidence.card_html`); a decision's counterfactuals their own small card (:func:`counterfactual_html`,
 also inside a decision card), or lines on a terminal (:func:`counterfactual_text`). Also a progress bar that is quiet
-in a notebook (:func:`progress`).
+in a notebook (:func:`progress`), and a long step's heartbeat on stderr (:func:`heartbeat`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import html
 import sys
+import threading
+import time
 import warnings
 
 import numpy as np
@@ -142,3 +145,43 @@ def counterfactual_html(cf: dict) -> str:
             f"<table><tr><th>change</th><th>{then}</th><th>margin</th><th>distance (quantiles)</th></tr>{rows}</table>"
         )
     return f"<div class=xairl-cf>{head}{body}</div>"
+
+
+#: the steps under way, innermost last: only the innermost says it is still running (one line every ``every`` s)
+_STEPS: list[object] = []
+
+
+@contextlib.contextmanager
+def heartbeat(what: str, enabled: bool = True, every: float = 10.0, stream=None):
+    """Says on stderr what a long step is doing, whatever stderr is (a terminal, a log, a pipe): ``xairl: WHAT ...``
+    as it starts, ``xairl: still WHAT (N s)`` every ``every`` seconds while it runs (only the innermost of nested
+    steps speaks), and ``xairl: WHAT: done in N s`` at its end. A progress bar on the same stream is cleared and
+    redrawn around each line (tqdm.write). ``enabled=False``: nothing is said."""
+    if not enabled:
+        yield
+        return
+    quiet_tqdm()
+    from tqdm.auto import tqdm
+
+    def say(line: str) -> None:
+        tqdm.write(f"xairl: {line}", file=stream or sys.stderr)
+        (stream or sys.stderr).flush()
+
+    t0, stop, token = time.monotonic(), threading.Event(), object()
+
+    def beat() -> None:
+        while not stop.wait(every):
+            if _STEPS and _STEPS[-1] is token:
+                say(f"still {what} ({time.monotonic() - t0:.0f} s)")
+
+    say(f"{what} ...")
+    _STEPS.append(token)
+    thread = threading.Thread(target=beat, name="xairl-heartbeat", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+        _STEPS.remove(token)
+    say(f"{what}: done in {time.monotonic() - t0:.0f} s")

@@ -57,13 +57,16 @@ def cmd_attributors(args) -> int:
 
 
 def cmd_report(args) -> int:
+    from ..display import heartbeat
     from ..report import write_report
 
     report = plugins.registry("report").load(args.plugin)(parse_options(args.option))
     method_options = plugins.get_attributor(args.method)(parse_options(args.method_option)).options.model_dump()
     req = report_request(args, args.out, method_options, args.n)
     make_dir(req.out)  # one line, before any work, where the folder cannot be made (--out /proc/x)
-    path = write_report(req, report.build(req))
+    with heartbeat(f"building the {args.plugin} report's content"):  # a plugin's minutes, said every 10 s
+        content = report.build(req)
+    path = write_report(req, content)
     print(f"report: {path.resolve()}")
     return 0
 

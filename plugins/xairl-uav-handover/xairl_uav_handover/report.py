@@ -66,7 +66,8 @@ class UAVReport(xairl.plugin.Report):
 
     def build(self, req: xairl.plugin.ReportRequest) -> xairl.plugin.ReportContent:
         real, real_setting = real_source(self.options.real)
-        loaded = _load_real(real) if real is not None else None  # a bad file is named before Table I's minutes
+        with xairl.plugin.heartbeat("reading the real flights", req.progress and real is not None):
+            loaded = _load_real(real) if real is not None else None  # a bad file is named before Table I's minutes
         ckpt = load_checkpoint(self.options.checkpoint)
         cfg = ckpt.sim_config
         policy = uav_policy(ckpt)
@@ -92,8 +93,12 @@ class UAVReport(xairl.plugin.Report):
                 "background is 100 states after 10 s of flight under conventional handover."
             ],
         )
-        flights = self._add_real_flights(content, ckpt, req, real, *loaded) if loaded else []
-        self._add_timelines(content, ckpt, req, flights[:1])
+        with xairl.plugin.heartbeat(
+            "comparing with the real flights (calibration, agreement)", req.progress and loaded
+        ):
+            flights = self._add_real_flights(content, ckpt, req, real, *loaded) if loaded else []
+        with xairl.plugin.heartbeat("simulating and explaining the flights at a glance", req.progress):
+            self._add_timelines(content, ckpt, req, flights[:1])
         if self.options.frontier:
             content.figures.append(frontier_section(self.options.frontier, req.out))
         return content
@@ -123,7 +128,8 @@ class UAVReport(xairl.plugin.Report):
 
         n, cfg = self.options.flights, ckpt.sim_config
         sa_mro = SAMRO(SAMROConfig(warmup_flights=n))  # the network adapts on as many flights as the table has
-        res = {c.name: with_intervals(flights(c, cfg, n, [seed])) for c in (CHM(), sa_mro, controller(ckpt))}
+        with xairl.plugin.heartbeat(f"Table I: {n} simulated flights each of CHM, SA-MRO and the DQN"):
+            res = {c.name: with_intervals(flights(c, cfg, n, [seed])) for c in (CHM(), sa_mro, controller(ckpt))}
         paper = ", ".join(f"{name} {ho} handovers and {pp} % ping-pongs" for name, (ho, pp) in PAPER.items())
         return (
             f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s (SA-MRO's offsets adapted on "
