@@ -147,34 +147,43 @@ def counterfactual_html(cf: dict) -> str:
     return f"<div class=xairl-cf>{head}{body}</div>"
 
 
-#: the steps under way, innermost last: only the innermost says it is still running (one line every ``every`` s)
+#: the longest a long step stays silent, in seconds (tests shorten it)
+EVERY = 10.0
+#: the steps under way, innermost last (only the innermost speaks), and when stderr last heard from one of them
 _STEPS: list[object] = []
+_LAST = [0.0]
 
 
 @contextlib.contextmanager
-def heartbeat(what: str, enabled: bool = True, every: float = 10.0, stream=None):
-    """Says on stderr what a long step is doing, whatever stderr is (a terminal, a log, a pipe): ``xairl: WHAT ...``
-    as it starts, ``xairl: still WHAT (N s)`` every ``every`` seconds while it runs (only the innermost of nested
-    steps speaks), and ``xairl: WHAT: done in N s`` at its end. A progress bar on the same stream is cleared and
-    redrawn around each line (tqdm.write). ``enabled=False``: nothing is said."""
+def heartbeat(what: str, enabled: bool = True, every: float | None = None, stream=None):
+    """Says on stderr what a long step is doing, whatever stderr is (a terminal, a log, a pipe), so that it is never
+    silent for more than ``every`` seconds (default :data:`EVERY`, 10): once nothing has been said for that long
+    (for half as long before the outermost step's first line), the innermost step under way says
+    ``xairl: WHAT ...`` (its first line), then ``xairl: still WHAT (N s)``; a step that was said ends with
+    ``xairl: WHAT: done in N s``. A quick step says nothing, so an error in it stays the one line on stderr. A progress bar on the stream is cleared and redrawn around each line
+    (tqdm.write). ``enabled=False``: nothing is said."""
     if not enabled:
         yield
         return
     quiet_tqdm()
     from tqdm.auto import tqdm
 
+    every = EVERY if every is None else every
+    t0, stop, token, said = time.monotonic(), threading.Event(), object(), []
+
     def say(line: str) -> None:
         tqdm.write(f"xairl: {line}", file=stream or sys.stderr)
         (stream or sys.stderr).flush()
-
-    t0, stop, token = time.monotonic(), threading.Event(), object()
+        _LAST[0] = time.monotonic()
+        said.append(line)
 
     def beat() -> None:
-        while not stop.wait(every):
-            if _STEPS and _STEPS[-1] is token:
-                say(f"still {what} ({time.monotonic() - t0:.0f} s)")
+        while not stop.wait(max(every / 10, 0.01)):
+            if _STEPS and _STEPS[-1] is token and time.monotonic() - _LAST[0] >= every:
+                say(f"still {what} ({time.monotonic() - t0:.0f} s)" if said else f"{what} ...")
 
-    say(f"{what} ...")
+    if not _STEPS:  # the silence starts now; the first step is said once it has run for half of ``every``
+        _LAST[0] = t0 - every / 2
     _STEPS.append(token)
     thread = threading.Thread(target=beat, name="xairl-heartbeat", daemon=True)
     thread.start()
@@ -184,4 +193,5 @@ def heartbeat(what: str, enabled: bool = True, every: float = 10.0, stream=None)
         stop.set()
         thread.join()
         _STEPS.remove(token)
-    say(f"{what}: done in {time.monotonic() - t0:.0f} s")
+    if said:
+        say(f"{what}: done in {time.monotonic() - t0:.0f} s")

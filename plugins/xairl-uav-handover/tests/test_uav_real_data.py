@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from xairl import InputError
+from xairl import InputError, display
 from xairl.cli import main
 from xairl.plugin import StateRecord
 from xairl_uav_handover.baselines import CHMConfig
@@ -150,20 +150,20 @@ def sim_report(tmp_path_factory):
     """One report without real data, read by the tests below (a report costs seconds); what it said on stderr is
     kept beside it, in stderr.txt."""
     out = tmp_path_factory.mktemp("sim") / "rep"
-    with contextlib.redirect_stderr(io.StringIO()) as err:
-        assert (
-            main(
-                ["report", "--plugin", "uav-handover", "--n", "40", "-o", "flights=20", "--narrate", "--out", str(out)]
-            )
-            == 0
-        )
+    every, display.EVERY = display.EVERY, 0.01  # each step is long at this scale: each is said
+    try:
+        with contextlib.redirect_stderr(io.StringIO()) as err:
+            argv = ["report", "--plugin", "uav-handover", "--n", "40", "-o", "flights=20", "--narrate"]
+            assert main([*argv, "--out", str(out)]) == 0
+    finally:
+        display.EVERY = every
     (out.parent / "stderr.txt").write_text(err.getvalue())
     return out
 
 
 def test_the_report_says_what_it_is_doing(sim_report):
-    """`make demo` printed nothing for 97 s, then for 124 s: each step is said as it starts and ends (and every 10 s
-    while it runs: tests/test_progress.py), the plugin's own steps inside the command's."""
+    """`make demo` printed nothing for 97 s, then for 124 s: each long step is said (every 10 s while it runs:
+    tests/test_progress.py), the plugin's own steps inside the command's."""
     said = [line for line in (sim_report.parent / "stderr.txt").read_text().splitlines() if line.startswith("xairl: ")]
     starts = [line[len("xairl: ") : -len(" ...")] for line in said if line.endswith(" ...")]
     assert starts == [
