@@ -243,7 +243,7 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     :param explained: explanations already computed, by dataset label (the others are explained here).
     """
     from .attributors import explain
-    from .display import heartbeat
+    from .display import heartbeat, progress
 
     t0 = time.time()
     out = Path(req.out)
@@ -251,7 +251,8 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     (out / "report.html").unlink(missing_ok=True)  # a failed re-run must not leave the last run's report beside it
     exps: list[tuple[str, Explanation]] = []
     explained = explained or {}
-    for label, states in content.datasets:  # each said as it runs, every 10 s (a bar of 2 steps said nothing)
+    bar = progress(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress)
+    for label, states in bar:  # a bar of a few steps: a long one also said every 10 s
         with heartbeat(
             f"explaining ({req.method}) {len(states)} {label} states", req.progress and label not in explained
         ):
