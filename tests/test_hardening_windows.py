@@ -98,7 +98,7 @@ def test_empty_window_states_are_one_line(tmp_path, capsys):
     p = xairl.Policy(Sum(), feature_names=["a", "b", "c"], window=4)
     bg = np.zeros((3, 4, 3))
     for states in (np.zeros((0, 4, 3)), np.zeros((0, 12))):
-        with pytest.raises(xairl.InputError, match="states is empty: give at least one state"):
+        with pytest.raises(xairl.InputError, match="states are empty: give at least one state"):
             xairl.explain(p, states, method="exact", background=bg)
     d = xairl.Observation.dict({"image": (2, 3, 3), "v": (1,)}, categories={"v": 3})
     with pytest.raises(xairl.InputError, match="is empty"):
@@ -116,7 +116,7 @@ def test_empty_window_states_are_one_line(tmp_path, capsys):
     args = ["explain", "--policy", f"{tmp_path / 'pol.py'}:make", "--states", str(tmp_path / "empty.npy")]
     assert main([*args, "--background", str(tmp_path / "bg.npy"), "--method", "exact"]) == 2
     err = capsys.readouterr().err.strip()
-    assert "states is empty" in err and "internal error" not in err and len(err.splitlines()) == 1
+    assert "states are empty" in err and "internal error" not in err and len(err.splitlines()) == 1
 
 
 @pytest.mark.parametrize("steps, signals", [(10**8, ("a",)), (MAX_SLOTS // 2 + 1, ("a", "b"))])

@@ -314,9 +314,11 @@ def test_narration_of_a_value_head_and_a_2d_actor_verifies(algo, obs, act, head)
         assert n.text.startswith(f"The value estimate was {xairl_fmt(e.outputs[0, 0])}")
         assert n.components["margin"] is None
     else:  # each action dimension is narrated on its own, nothing is chosen among them
-        assert [s for s in n.text.split(". ") if "was set to" in s][1].startswith("Action_1 was set to")
+        assert [s for s in n.text.split(". ") if "was set to" in s][1].startswith(
+            "action_1 was set to"
+        )  # a declared name, as declared
     # a wrong number in the same words is caught (a continuous action: against its own dimension)
-    view, text = (e, n.text) if head == "value" else (e.output_slice(0), n.text.split(" Action_1")[0])
+    view, text = (e, n.text) if head == "value" else (e.output_slice(0), n.text.split(" action_1 was set")[0])
     assert xairl.verify(text, view, 0, policy).ok
     first = next(c for c in n.claims if c.kind == "number" and "+" in c.text)
     assert not xairl.verify(text.replace(first.text, "+9.99", 1), view, 0, policy).ok

@@ -2,13 +2,15 @@
 in the margin view (the narratives' view), the view named. A Narrative shows its evidence card
 (:func:`xairl.evidence.card_html`); a decision's counterfactuals their own small card (:func:`counterfactual_html`,
 also inside a decision card), or lines on a terminal (:func:`counterfactual_text`). Also a progress bar that is quiet
-in a notebook (:func:`progress`).
+in a notebook (:func:`progress`), and a long step's heartbeat on stderr (:func:`heartbeat`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import html
 import sys
+import threading
 import time
 import warnings
 
@@ -199,3 +201,53 @@ def counterfactual_html(cf: dict) -> str:
             f"<table><tr><th>change</th><th>{then}</th><th>margin</th><th>distance (quantiles)</th></tr>{rows}</table>"
         )
     return f"<div class=xairl-cf>{head}{body}</div>"
+
+
+#: the longest a long step stays silent, in seconds (tests shorten it)
+EVERY = 10.0
+#: the steps under way, innermost last (only the innermost speaks), and when stderr last heard from one of them
+_STEPS: list[object] = []
+_LAST = [0.0]
+
+
+@contextlib.contextmanager
+def heartbeat(what: str, enabled: bool = True, every: float | None = None, stream=None):
+    """Says on stderr what a long step is doing, whatever stderr is (a terminal, a log, a pipe), so that it is never
+    silent for more than ``every`` seconds (default :data:`EVERY`, 10): once nothing has been said for that long
+    (for half as long before the outermost step's first line), the innermost step under way says
+    ``xairl: WHAT ...`` (its first line), then ``xairl: still WHAT (N s)``; a step that was said ends with
+    ``xairl: WHAT: done in N s``. A quick step says nothing, so an error in it stays the one line on stderr. A progress bar on the stream is cleared and redrawn around each line
+    (tqdm.write). ``enabled=False``: nothing is said."""
+    if not enabled:
+        yield
+        return
+    quiet_tqdm()
+    from tqdm.auto import tqdm
+
+    every = EVERY if every is None else every
+    t0, stop, token, said = time.monotonic(), threading.Event(), object(), []
+
+    def say(line: str) -> None:
+        tqdm.write(f"xairl: {line}", file=stream or sys.stderr)
+        (stream or sys.stderr).flush()
+        _LAST[0] = time.monotonic()
+        said.append(line)
+
+    def beat() -> None:
+        while not stop.wait(max(every / 10, 0.01)):
+            if _STEPS and _STEPS[-1] is token and time.monotonic() - _LAST[0] >= every:
+                say(f"still {what} ({time.monotonic() - t0:.0f} s)" if said else f"{what} ...")
+
+    if not _STEPS:  # the silence starts now; the first step is said once it has run for half of ``every``
+        _LAST[0] = t0 - every / 2
+    _STEPS.append(token)
+    thread = threading.Thread(target=beat, name="xairl-heartbeat", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+        _STEPS.remove(token)
+    if said:
+        say(f"{what}: done in {time.monotonic() - t0:.0f} s")
