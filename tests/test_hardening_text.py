@@ -255,7 +255,7 @@ def test_the_toys_level_words_say_a_level_not_a_state(toy):
 
     p, e, _ = toy
     infos = p.features["battery"]
-    assert (infos.low, infos.high) == ("low charge", "high charge")
+    assert (infos.low, infos.high) == ("low", "high")  # words of a level, which a standardised value has
     levels = {f.level_text for i in range(3) for f in decision_facts(e, i, p, k=5).top if f.name == "battery"}
     assert levels and not levels & {"full", "nearly empty"}
 

@@ -18,7 +18,7 @@ def policy():
 @pytest.mark.parametrize(
     "states, match",
     [
-        (np.zeros((2, 4)), "has 4 features but the policy expects 5"),
+        (np.zeros((2, 4)), "have 4 features but the policy expects 5"),
         (np.zeros((0, 5)), "empty"),
         (np.array([[np.nan, 0, 0, 0, 0]]), "NaN/inf value.*row 0, column 0"),
         (np.array([[0, 0, np.inf, 0, 0]]), "NaN/inf"),

@@ -6,11 +6,13 @@ import re
 import time
 
 import pytest
+import torch
 
+import xairl
 from xairl import display
 from xairl.display import heartbeat
 from xairl.report import ReportContent, ReportRequest, write_report
-from xairl.toy import toy_policy
+from xairl.toy import ACTIONS, FEATURES, toy_background, toy_network
 
 
 def test_a_long_step_is_said_and_then_every_interval_a_quick_one_is_not(capsys):
@@ -41,10 +43,23 @@ def test_nothing_is_said_when_disabled_and_a_step_that_fails_is_not_said_done(ca
     assert "quiet" not in err and "at once" not in err and "xairl: failing ..." in err and "done" not in err
 
 
+class _Slow(torch.nn.Module):
+    """The toy network, 50 ms a forward pass: every step of the report lasts long beyond its heartbeat's interval
+    however loaded the machine (a thread that must be scheduled in time is not what this test is about)."""
+
+    def __init__(self):
+        super().__init__()
+        self.net = toy_network()
+
+    def forward(self, x):
+        time.sleep(0.05)
+        return self.net(x)
+
+
 def test_a_report_says_each_of_its_long_steps(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(display, "EVERY", 0.01)  # every step is long at this scale
-    policy = toy_policy()
-    content = ReportContent("toy", policy, policy.background(20), [("sampled", policy.background(200, seed=1))])
+    policy = xairl.Policy(_Slow(), FEATURES, ACTIONS)
+    content = ReportContent("toy", policy, toy_background(20), [("sampled", toy_background(200, seed=1))])
     write_report(ReportRequest(out=tmp_path, narrate=True, n_narrated=2), content)
     err = capsys.readouterr().err
     for step in ("explaining (deep_shap) 200 sampled states", "drawing the figures", "narrating 2 decisions"):

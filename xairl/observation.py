@@ -366,8 +366,10 @@ _REFUSED_KINDS = {"c": "complex numbers", "M": "dates", "m": "time spans"}
 
 
 def _verb(what: str, plural: str) -> str:
-    """The verb agreeing with ``what``: 'states contain', 'background contains' (the noun before any ':' says)."""
-    noun = (what.split(":")[0].split() or ["states"])[-1]
+    """The verb agreeing with ``what``: 'states contain', 'background contains', 'FILE: rows 0..99 contain' (the
+    last word after the last ': ' says: a file's name or a row range is no noun)."""
+    words = [w.lstrip("-") for w in what.rsplit(": ", 1)[-1].split() if w.lstrip("-").isalpha()]
+    noun = (words or ["states"])[-1]
     return plural if noun.endswith("s") else {"are": "is", "have": "has"}.get(plural, plural + "s")
 
 

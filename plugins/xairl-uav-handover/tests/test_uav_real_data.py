@@ -166,14 +166,16 @@ def test_the_report_says_what_it_is_doing(sim_report):
     tests/test_progress.py), the plugin's own steps inside the command's."""
     said = [line for line in (sim_report.parent / "stderr.txt").read_text().splitlines() if line.startswith("xairl: ")]
     starts = [line[len("xairl: ") : -len(" ...")] for line in said if line.endswith(" ...")]
-    assert starts == [
+    steps = [
         "building the uav-handover report's content",
         "Table I: CHM, SA-MRO and the DQN on 20 simulated flights",
         "simulating and explaining the flights at a glance",
-        "explaining (deep_shap) 40 simulated states",
+        "explaining (deep_shap) 40 simulated states",  # a fraction of a second: said when the thread is in time
         "drawing the figures",
         "narrating 6 decisions",
-    ], said
+    ]
+    assert starts == [s for s in steps if s in starts], said  # in this order, each once
+    assert set(steps) - set(starts) <= {steps[3]}, said  # every step of a second or more is said
     assert all(any(line.startswith(f"xairl: {s}: done in ") for line in said) for s in starts), said
 
 
