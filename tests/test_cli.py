@@ -154,6 +154,7 @@ def test_background_of_wrong_width(tmp_path, capsys):
     assert rc == 2 and "has 3 features but the policy expects 5" in err
 
 
+@pytest.mark.slow
 def test_installed_script_smoke():
     exe = shutil.which("xairl", path=str(Path(sys.executable).parent)) or shutil.which("xairl")
     assert exe, "the console script `xairl` is not installed"

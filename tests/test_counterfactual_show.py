@@ -30,6 +30,7 @@ def uav():
     return policy, dqn_decision_states(ckpt, 12, seed=1), policy.background(100, seed=7)
 
 
+@pytest.mark.slow
 def test_notebook_card_names_the_change_and_the_new_action(uav):
     policy, states, bg = uav
     found = xairl.counterfactual(policy, states, index=None, background=bg)
@@ -101,6 +102,7 @@ def _rerun_printed(policy, states, shown: dict) -> list[str]:
     return [policy.action_names[a] for a in policy.act(np.array(rows))] if rows else []
 
 
+@pytest.mark.slow
 def test_the_cli_shows_values_that_flip_as_printed(capsys, monkeypatch, uav):
     """Review 56b, finding 2: every value the CLI prints, re-run as printed, gives the action it prints (the UAV DQN,
     whose lines the search's raw values sit within a rounding step of); a bare answer's card (no policy) rounds them
@@ -129,6 +131,7 @@ def test_cli_bad_target_or_max_changes_is_one_line(capsys):
     one_line_error(rc, err, "--max-changes")
 
 
+@pytest.mark.slow
 def test_report_cards_and_the_single_flip_table(tmp_path):
     policy = toy_policy()
     bg = policy.background(60)

@@ -62,6 +62,7 @@ def test_values_are_written_away_from_the_line(linear):
     assert status == "contradicted"
 
 
+@pytest.mark.slow
 def test_corpus_on_the_linear_policy(linear):
     p, states, exp, _ = linear
     found = one_change(p, states, {0: (0, CAP), 1: (-140, -40)})
@@ -79,6 +80,7 @@ def test_corpus_on_the_linear_policy(linear):
     assert sum(counts.values()) >= 50
 
 
+@pytest.mark.slow
 def test_corpus_on_the_toy_policy():
     p = toy_policy()
     bg, states = p.background(64), p.background(12, seed=5)
@@ -216,6 +218,7 @@ def test_the_words_name_the_action_the_policy_takes_as_written():
     assert fact.action == right.found[0].action != third and said(exp, i, p, fact, alone=True)[1] == "verified"
 
 
+@pytest.mark.slow
 def test_narrate_searches_when_asked(linear):
     """counterfactual=True runs the search (xairl.counterfactual) and says its answer; every said one verified."""
     p, states, exp, bg = linear

@@ -14,6 +14,7 @@ from tests.deep_models import NAMES, build, captum_values, shap_values
 CAPTUM_MAXPOOL_RULE_DIFFERS = {"mnist_cnn", "dict"} | {n for n in NAMES if n.startswith("multi_input")}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
 def test_deep_shap_equals_shap_and_captum(name):
     policy, x, bg, inputs = build(name)

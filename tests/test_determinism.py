@@ -6,6 +6,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 CODE = """
 import hashlib, xairl
 from xairl.toy import toy_policy
@@ -22,6 +24,7 @@ print(h.hexdigest())
 """
 
 
+@pytest.mark.slow
 def test_two_processes_same_bits():
     runs = [
         subprocess.run(

@@ -41,6 +41,7 @@ def test_relative_links_point_to_files(path):
     assert not broken, f"{path.relative_to(ROOT)}: links to missing files: {broken}"
 
 
+@pytest.mark.slow
 def test_site_builds_without_warnings(tmp_path):
     # no skip when MkDocs is missing: the docs extra (pip install -e '.[docs]') is part of the test set-up
     env = {**os.environ, "NO_COLOR": "1"}
@@ -64,6 +65,7 @@ def _python_blocks(path: Path) -> list[str]:
     return re.findall(r"^```python\n(.*?)^```", path.read_text(encoding="utf-8"), re.DOTALL | re.MULTILINE)
 
 
+@pytest.mark.slow
 def test_the_readmes_python_snippet_runs_as_written():
     """It once called undefined names (q_net, states, bg) and counterfactual() without its background."""
     blocks = _python_blocks(ROOT / "README.md")

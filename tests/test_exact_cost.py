@@ -76,6 +76,7 @@ def test_exact_over_16_features_refused_before_any_forward_pass():
     assert module.calls == 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("max_rows", [8_192, 20, 3])  # whole table at once; 2 coalitions a batch; a coalition split
 def test_exact_with_the_limit_raised_equals_brute_force_and_costs_what_it_said(max_rows):
     module, policy = counted(mlp([5, 16, 16, 3], seed=3), 5)

@@ -5,6 +5,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 EX = ROOT / "examples"
 
@@ -22,22 +24,26 @@ def run(args, env=None, timeout=300):
     return res.stdout
 
 
+@pytest.mark.slow
 def test_sb3_cartpole():
     out = run([str(EX / "sb3_cartpole.py"), "--timesteps", "300"])
     assert out.count("The policy chose push_") == 5 and "additivity gap" in out
 
 
+@pytest.mark.slow
 def test_cleanrl_style():
     out = run([str(EX / "cleanrl_style.py"), "--steps", "300"])
     assert "rather than" in out and "global: Over 3 states" in out
 
 
+@pytest.mark.slow
 def test_cleanrl_gru_over_a_window(tmp_path):
     out = run([str(EX / "cleanrl_gru.py"), "--steps", "300", "--out", str(tmp_path / "gru")])
     assert "per step: {'t-3'" in out and out.count("[verified]") == 3 and out.count("said as trends:") == 3
     assert (tmp_path / "gru" / "heatmap.png").stat().st_size > 5000
 
 
+@pytest.mark.slow
 def test_atari_cnn_and_its_cli_with_nothing_installed(tmp_path):
     out = run([str(EX / "atari_cnn.py"), "--out", str(tmp_path / "ex")])
     assert "strongest patches: ['patch[" in out and (tmp_path / "ex" / "image.png").stat().st_size > 5000
@@ -69,18 +75,21 @@ def test_atari_cnn_and_its_cli_with_nothing_installed(tmp_path):
     assert '"chosen":"' in first and '"obs[3,83,83]"' in first
 
 
+@pytest.mark.slow
 def test_continuous_actor():
     out = run([str(EX / "continuous_actor.py"), "--timesteps", "200"])
     assert "[continuous, verified=True" in out and "Torque was set to" in out
     assert "[value, verified=True" in out and "The Q estimate was" in out and "chose" not in out
 
 
+@pytest.mark.slow
 def test_custom_prompt():
     out = run([str(EX / "custom_prompt" / "run.py")])
     assert "explain_action.yaml ok" in out and "one_liner.yaml ok" in out
     assert "explain_action: Chose " in out and "[verified=True]" in out and ", mainly because of" in out
 
 
+@pytest.mark.slow
 def test_my_plugin_installs_and_registers(tmp_path):
     """pip installs the example plugin into its own folder; the entry point makes xairl find it."""
     target = tmp_path / "site"

@@ -50,6 +50,7 @@ def _writer(path, n, text, start=None):
         store.record(Narrative(f"{text} {i}", (), True, 0.5, {}, "template", "t", i))
 
 
+@pytest.mark.slow
 def test_concurrent_writers_lose_nothing(tmp_path):
     """Four processes write at once (a barrier holds them until all are up, so the test does not depend on how fast
     the machine imports): every row is kept, and the writers' rows interleave (the writes really were concurrent)."""
@@ -70,6 +71,7 @@ def test_concurrent_writers_lose_nothing(tmp_path):
     assert switches > 3, "the writers ran one after another: nothing concurrent was tested"
 
 
+@pytest.mark.slow
 def test_writer_killed_mid_run_leaves_store_readable(tmp_path):
     import os
     import signal

@@ -9,6 +9,7 @@ import json
 import string
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
@@ -36,6 +37,7 @@ arrays = hnp.arrays(
 methods = st.sampled_from(["deep_shap", "exact", "integrated_gradients", "kernel_shap", "nope", "", "DEEP_SHAP"])
 
 
+@pytest.mark.slow
 @fast(400)
 @given(
     states=st.one_of(
@@ -92,6 +94,7 @@ def _well_formed(exp, method, options):
 cell = st.one_of(st.floats(width=32).map(repr), st.text(string.printable, max_size=6), st.just(""), st.just("nan"))
 
 
+@pytest.mark.slow
 @fast(300)
 @given(
     header=st.lists(st.sampled_from(list(FEATURES) + ["junk", "", "x y"]), max_size=7),
@@ -104,6 +107,7 @@ def test_cli_csv_files(tmp_path_factory, header, rows, sep):
     _cli_ok(["explain", "--states", str(path), "--format", "jsonl"])
 
 
+@pytest.mark.slow
 @fast(300)
 @given(
     doc=st.recursive(
@@ -126,6 +130,7 @@ def test_cli_json_files(tmp_path_factory, doc, raw, garbage):
 NPY_DTYPES = ["<f4", "<f8", "<i8", "|b1", "<c8", "<M8[D]", "<m8[s]", "|O", "<U3", "|V4"]
 
 
+@pytest.mark.slow
 @fast(500)
 @given(
     dtype=st.sampled_from(NPY_DTYPES),
@@ -156,6 +161,7 @@ def test_cli_npy_and_npz_files_of_any_header_and_body(tmp_path_factory, dtype, s
     _cli_ok(["explain", "--states", str(path), "--method", "exact"])
 
 
+@pytest.mark.slow
 @fast(300)
 @given(
     flag=st.sampled_from(
@@ -229,6 +235,7 @@ json_values = st.recursive(
 )
 
 
+@pytest.mark.slow
 @fast(800)
 @given(
     edits=st.lists(
@@ -272,6 +279,7 @@ def test_explanation_from_json_with_any_edit(edits):
     _from_json_ok(text)
 
 
+@pytest.mark.slow
 @fast(500)
 @given(
     doc=st.dictionaries(
@@ -328,6 +336,7 @@ def _cli_ok(argv):
         assert text.count("\n") == 1 and text.startswith("xairl: error: ")
 
 
+@pytest.mark.slow
 @fast(200)
 @given(
     header=st.lists(st.sampled_from(list(FEATURES) + ["junk", ""]), max_size=7),

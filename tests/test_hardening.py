@@ -193,6 +193,7 @@ def test_bad_paths_are_one_line_errors(capsys, tmp_path):
     assert (missing / "r" / "report.html").exists()
 
 
+@pytest.mark.slow
 def test_a_model_folder_holding_a_pickle_is_refused_without_loading_it(tmp_path, capsys):
     """transformers would unpickle pytorch_model.bin; only safetensors (or GGUF) weights are read."""
     folder = tmp_path / "lm"

@@ -72,6 +72,7 @@ def _wait_until(condition, limit: float) -> bool:
     return condition()
 
 
+@pytest.mark.slow
 def test_clients_that_trickle_are_hung_up_on_at_the_deadline_and_a_normal_client_is_served(server):
     deadline, n = 1.5, 5
     srv, port = server(timeout=10.0, deadline=deadline, max_connections=n + 2)  # a read timeout alone never fires
@@ -106,6 +107,7 @@ def test_clients_that_trickle_are_hung_up_on_at_the_deadline_and_a_normal_client
     assert _wait_until(lambda: srv.open_connections == 0, 3)  # every thread freed
 
 
+@pytest.mark.slow
 def test_connections_beyond_the_cap_are_answered_503_until_the_held_ones_pass_their_deadline(server):
     deadline, cap = 1.0, 3
     srv, port = server(timeout=10.0, deadline=deadline, max_connections=cap)
@@ -124,6 +126,7 @@ def test_connections_beyond_the_cap_are_answered_503_until_the_held_ones_pass_th
     assert _get(port)[0] == 200
 
 
+@pytest.mark.slow
 def test_a_request_cut_at_its_deadline_is_not_answered(server):
     """Headers cut short by the hang-up are not taken for a whole request (no page rendered for a slow client)."""
     _, port = server(timeout=10.0, deadline=0.5)
@@ -335,6 +338,7 @@ def image_exp():
     return xairl.explain(policy, frames[:3], background=frames[3:])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("panels", [1, 2])
 def test_region_beeswarm_is_no_thin_strip_and_its_labels_neither_overlap_nor_leave_the_figure(panels, image_exp):
     for exp in (_long_regions(), image_exp):
@@ -359,6 +363,7 @@ def _texts(fig) -> str:
     return " ".join(" ".join(t.get_text().split()) for t in _all_texts(fig))  # a label wrapped is one label
 
 
+@pytest.mark.slow
 def test_every_figure_names_its_view_margin_by_default(toy, image_exp):
     _, exp = toy
     for make in (plots.beeswarm, plots.importance, plots.waterfall, plots.timeline):

@@ -19,6 +19,7 @@ METHODS = ["deep_shap", "integrated_gradients", "kernel_shap", "exact"]
 
 
 # 9. float64 networks ----------------------------------------------------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("net", [lambda: mlp([6, 12, 3]), ReusedActivations], ids=["sequential", "forward"])
 @pytest.mark.parametrize("method", METHODS)
 def test_a_float64_network_is_explained_in_float64(method, net):

@@ -74,6 +74,7 @@ def test_read_parquet_refuses_a_folder_that_holds_a_row_twice(runs, tmp_path):
     assert np.array_equal(read_parquet(tmp_path / DATASET).values, reference.values)
 
 
+@pytest.mark.slow
 def test_the_issues_cli_resumes_a_bit_flip_whole_and_refuses_part_07(tmp_path, capsys, caplog):
     argv = [
         "explain",
@@ -112,6 +113,7 @@ def _small_run(out):
     return ["explain", "--out", str(out), *flags]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("record", ["[1, 2]", "42", '"a run"', "null", "[" * 100_000 + "]" * 100_000, "{", ""])
 def test_a_run_json_that_is_no_record_is_refused_in_one_line(tmp_path, capsys, record):
     argv = _small_run(tmp_path / "r")
@@ -150,6 +152,7 @@ def test_a_report_out_folder_that_cannot_be_made_is_one_line(capsys, monkeypatch
     assert err.count("\n") == 1 and "/proc/forbidden: cannot write there" in err
 
 
+@pytest.mark.slow
 def test_out_on_many_states_streams_into_parquet_and_says_so(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(explain_cli, "STREAM_ABOVE", 1_000)  # (the default, 50,000, takes a while on 2 cores)
     assert main(["explain", "--n", "1001", "--out", str(tmp_path / "big"), "--background-size", "10"]) == 0
@@ -204,6 +207,7 @@ def run_3000(tmp_path_factory):
     return argv, root
 
 
+@pytest.mark.slow
 def test_a_part_whose_footer_statistics_were_flipped_is_explained_again_on_resume(run_3000, tmp_path, capsys, caplog):
     """Only the footer's statistics changed: the columns' checksum held, --resume kept the part, and a filtered read
     then skipped its row group (300 rows lost). The part's bytes are checked against the SHA-256 in run.json."""

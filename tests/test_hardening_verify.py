@@ -78,6 +78,7 @@ def test_every_pattern_of_the_verifier_is_swept():
     assert len(PATTERNS) >= 150 and "directions._JOIN" in {name for name, _ in PATTERNS}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name, pattern", PATTERNS, ids=[name for name, _ in PATTERNS])
 def test_no_pattern_backtracks_past_the_budget_on_a_hostile_run(name, pattern):
     """Every module-level pattern of the verifier, at the start of a run of 24 digits, spaces, commas, points,

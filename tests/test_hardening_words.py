@@ -51,6 +51,7 @@ def test_region_sentences_are_short_and_their_numbers_labelled(rgb):
         assert not re.search(r"\(\d[\d.]*\)", n.text), n.text  # no bare number in brackets after a region
 
 
+@pytest.mark.slow
 def test_a_frame_stack_is_said_in_frames_and_keeps_it_through_json(stack, rgb):
     policy, exp = stack
     assert in_regions(rgb[1]).feature_names[0] == "patch A1 of channel 0"  # channels stay channels by default

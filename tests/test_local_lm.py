@@ -16,6 +16,9 @@ from xairl.narrators.base import first_phrasings
 from xairl.toy import toy_policy
 from xairl.tracking import Rendered, track_decision
 
+# the real model: loaded once per process (seconds), then seconds a narration
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def toy():

@@ -44,6 +44,7 @@ def test_the_top_level_is_what_a_user_calls():
     assert "TorchPolicy" not in top and len(top) < 30
 
 
+@pytest.mark.slow
 def test_plots_are_reachable_after_a_bare_import():
     """`import xairl; xairl.plots.beeswarm(exp)` as the README says (an AttributeError before)."""
     code = "import xairl; assert callable(xairl.plots.beeswarm); assert callable(xairl.plugin.hookimpl)"

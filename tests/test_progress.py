@@ -44,7 +44,7 @@ def test_nothing_is_said_when_disabled_and_a_step_that_fails_is_not_said_done(ca
 
 
 class _Slow(torch.nn.Module):
-    """The toy network, 50 ms a forward pass: every step of the report lasts long beyond its heartbeat's interval
+    """The toy network, 20 ms a forward pass: every step of the report lasts long beyond its heartbeat's interval
     however loaded the machine (a thread that must be scheduled in time is not what this test is about)."""
 
     def __init__(self):
@@ -52,17 +52,17 @@ class _Slow(torch.nn.Module):
         self.net = toy_network()
 
     def forward(self, x):
-        time.sleep(0.05)
+        time.sleep(0.02)
         return self.net(x)
 
 
 def test_a_report_says_each_of_its_long_steps(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(display, "EVERY", 0.01)  # every step is long at this scale
     policy = xairl.Policy(_Slow(), FEATURES, ACTIONS)
-    content = ReportContent("toy", policy, toy_background(20), [("sampled", toy_background(200, seed=1))])
+    content = ReportContent("toy", policy, toy_background(20), [("sampled", toy_background(40, seed=1))])
     write_report(ReportRequest(out=tmp_path, narrate=True, n_narrated=2), content)
     err = capsys.readouterr().err
-    for step in ("explaining (deep_shap) 200 sampled states", "drawing the figures", "narrating 2 decisions"):
+    for step in ("explaining (deep_shap) 40 sampled states", "drawing the figures", "narrating 2 decisions"):
         assert f"xairl: {step} ..." in err and re.search(rf"xairl: {re.escape(step)}: done in \d+ s", err), step
     write_report(ReportRequest(out=tmp_path, narrate=False, progress=False), content)
     assert "xairl:" not in capsys.readouterr().err

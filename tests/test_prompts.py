@@ -18,6 +18,7 @@ from xairl.toy import toy_policy
 GOOD = 'name: explain_action\nkind: decision\nsentences:\n  - ["Custom: the policy chose {{ action }}."]\n'
 
 
+@pytest.mark.slow
 def test_builtins_are_found_and_clean():
     found = prompts.available()
     assert {"explain_action", "why_not", "global_summary"} <= set(found)
@@ -94,6 +95,7 @@ HOSTILE = sorted(HOSTILE_DIR.glob("*.yaml"))
 HOSTILE_CALLS = 2_000_000
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", HOSTILE, ids=lambda p: p.stem)
 def test_hostile_templates_are_refused_quickly(path):
     """Attribute escapes, mutation, runaway loops, bombs, recursion, imports: a clear error, after little work
@@ -110,6 +112,7 @@ def test_hostile_corpus_size():
     assert len(HOSTILE) >= 41
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", HOSTILE, ids=lambda p: p.stem)
 def test_hostile_templates_stay_small(path):
     """Bounds hold for the whole rendering: each attack is refused before it allocates or loops much."""

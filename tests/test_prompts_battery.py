@@ -75,6 +75,7 @@ def test_each_rendering_is_one_line_naming_the_decision(tmp_path):
     assert "flat, signs +,+,+" not in decisions and "flat, signs +,-,+" in decisions  # only what is wrong
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", sorted(prompts.builtin_dir().glob("*.yaml")), ids=lambda p: p.stem)
 def test_builtin_templates_report_nothing(path):
     assert check_template(path) == []

@@ -124,6 +124,7 @@ def test_a_body_over_the_limit_is_refused_unread(store, serve):
     assert _statuses(store) == [("pending", None)] * 2
 
 
+@pytest.mark.slow
 def test_a_stalled_request_is_dropped_and_others_are_served(store, serve):
     port = serve(timeout=1)
     stalled = [socket.create_connection(("127.0.0.1", port), timeout=10) for _ in range(5)]
@@ -155,6 +156,7 @@ def test_bad_ids_and_lengths_get_400(store, serve):
     assert status == 303 and _statuses(store) == [("pending", None)] * 2
 
 
+@pytest.mark.slow
 def test_hostile_requests_print_no_traceback(store, capfd, serve):
     port = serve()
     token = _token(port)
@@ -171,6 +173,7 @@ def test_hostile_requests_print_no_traceback(store, capfd, serve):
     assert "Traceback" not in err and err == ""
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(
     not BROWSER, reason="Debian's chromium and chromium-driver are not installed (make test installs them)"
 )

@@ -111,6 +111,7 @@ CASES = [  # algorithm, policy, observation, action space, head, reference, outp
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "algo, kind, obs, act, head, ref, output, steps", CASES, ids=[f"{c[0]}-{c[1]}-{c[4]}" for c in CASES]
 )

@@ -25,6 +25,7 @@ def local_ray():
     ray.shutdown()
 
 
+@pytest.mark.slow
 def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ray, capsys):
     """Resume on Ray as on the local engine (issue 51, item 2): lost parts are explained, a bit-flipped one is
     explained again to the same bits, a stray one is refused by name."""
@@ -73,6 +74,7 @@ def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ra
     assert np.array_equal(again.values, local.values) and parts[1].read_bytes() == whole  # every state once
 
 
+@pytest.mark.slow
 def test_ray_reads_parquet_by_row_group_and_csv_once_rewritten(tmp_path, local_ray):
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -100,6 +102,7 @@ def test_ray_reads_parquet_by_row_group_and_csv_once_rewritten(tmp_path, local_r
         assert not (tmp_path / name.replace(".", "_") / STAGED).exists()  # the CSV's rewrite is removed
 
 
+@pytest.mark.slow
 def test_ray_reports_a_users_error_in_one_line_and_keeps_what_was_written(tmp_path, local_ray):
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -128,6 +131,7 @@ def test_ray_reports_a_users_error_in_one_line_and_keeps_what_was_written(tmp_pa
     assert not (tmp_path / "o2" / STAGED).exists() and not list((tmp_path / "o2").glob(".*.part"))
 
 
+@pytest.mark.slow
 def test_narrations_on_ray_are_the_narrations_here_in_order(local_ray):
     import xairl
     from xairl.scale import narrate_on_ray
@@ -146,6 +150,7 @@ def test_narrations_on_ray_are_the_narrations_here_in_order(local_ray):
         narrate_on_ray(exp, [0], narrator="template", template="nope", policy=POLICY)
 
 
+@pytest.mark.slow
 def test_the_local_engine_imports_no_ray(tmp_path):
     code = (
         "import sys, numpy as np; from xairl.toy import toy_policy; from xairl.stream import explain_to_parquet; "

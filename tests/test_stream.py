@@ -115,6 +115,7 @@ def test_a_folder_holding_a_run_is_not_overwritten_and_resume_checks_it_is_the_s
         )
 
 
+@pytest.mark.slow
 def test_kill_9_then_resume_explains_every_state_exactly_once(tmp_path):
     states = tmp_path / "s.npy"
     np.save(states, POLICY.background(16_000, seed=9))

@@ -17,6 +17,7 @@ def toy():
     return p, xairl.explain(p, p.background(25, seed=3), background=p.background(100))
 
 
+@pytest.mark.slow
 def test_mutation_corpus_all_caught_no_paraphrase_rejected(toy):
     policy, exp = toy
     cases = corpus(exp, policy, ("explain_action", "why_not"), range(25))

@@ -388,6 +388,7 @@ def corpus():
     return run(load_corpus(), {d: domains.policy(d) for d in domains.DOMAINS})
 
 
+@pytest.mark.slow
 def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
     floors = (
@@ -423,6 +424,7 @@ def test_held_out_corpus_agreement(corpus):
     assert len(corpus) >= 300 and len({it["domain"] for it in corpus}) == 4
 
 
+@pytest.mark.slow
 def test_exact_restatements_verify_in_every_domain():
     for case in _CASES.values():
         exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
@@ -625,6 +627,7 @@ def test_dev10_number_formats():
     assert find_numbers("~14 pts")[0].points and not find_numbers("14 %")[0].points
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "case,text,status", cases.params("on_corpus_cases", "on_corpus_cases", ("case", "text", "status"))
 )

@@ -31,6 +31,7 @@ def test_every_rule_has_an_id_a_pattern_a_claim_and_examples():
             assert "name" in roles and roles & {"num", "dir", "rank", "word", "other"}, r.id
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "rule,case,text,fires",
     [(r.id, case, text, True) for r in RULES for case, text in r.fires]
@@ -65,6 +66,7 @@ def test_a_number_next_to_its_name_outranks_the_parse():
     assert read("The season lowered it a little, and wind speed (SHAP +6.9) pushed it up.", example("air"), 0).accurate
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "imports",
     [
@@ -100,6 +102,7 @@ def test_tokens_show_names_and_numbers_as_the_rules_see_them():
     assert kinds["traffic index"] == "FEATURE" and kinds["+7.2"] == "NUM" and kinds["effect"] == ""
 
 
+@pytest.mark.slow
 def test_no_sentence_of_the_tuning_voices_breaks_the_reader():
     """Every narrative of two tuning files (outside voices: logs, letters, tables, Q&A) is read without a reader
     failure: a failure would leave its sentence unchecked, silently (the reader never raises)."""

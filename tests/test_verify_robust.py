@@ -115,12 +115,14 @@ def _no_failure(result) -> None:
     assert not failed, failed[0].detail
 
 
+@pytest.mark.slow
 @settings(max_examples=2600, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 @given(text=st.text(max_size=300), index=st.integers(0, len(POOL) - 1))
 def test_any_unicode_text(text, index):
     _no_failure(verify(text, POOL[index], 0))
 
 
+@pytest.mark.slow
 @settings(max_examples=2340, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 @given(parts=st.lists(st.sampled_from(FRAGMENTS), max_size=30), index=st.integers(0, len(POOL) - 1))
 def test_sentences_of_names_numbers_and_hostile_fragments(parts, index):
@@ -134,6 +136,7 @@ WIDE = _explanation(
 )
 
 
+@pytest.mark.slow
 @settings(max_examples=60, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 @given(parts=st.lists(st.sampled_from(FRAGMENTS + ["f_3", "f_499", "f_12", "0.4"]), max_size=20))
 def test_five_hundred_features(parts):
@@ -226,6 +229,7 @@ def _policies():
     }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", list(_policies()))
 def test_our_template_verifies_on_every_kind_of_policy(kind):
     policy = _policies()[kind]

@@ -33,6 +33,7 @@ def _rules(text, exp, i, policy=None):
 _NEGATIVE_VALUE = re.compile(r"\(-(\d+\.\d+)")
 
 
+@pytest.mark.slow
 def test_template_narratives_stay_accurate_and_a_dropped_sign_is_caught(toy):
     policy, exp, texts = toy
     dropped = said = 0

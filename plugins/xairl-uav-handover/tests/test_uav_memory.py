@@ -106,6 +106,7 @@ def test_the_controller_acts_on_the_states_training_sees():
     assert took > 0  # the comparison crossed handovers
 
 
+@pytest.mark.slow
 def test_a_memory_checkpoint_loads_as_a_window_policy_whose_narratives_verify(tmp_path):
     torch.manual_seed(1)
     bg = background(64, seed=2, config=_sim())
@@ -181,6 +182,7 @@ TIME_SENTENCE = (
 )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "cell, rounding, verified",
     [
@@ -213,6 +215,7 @@ def test_ids_and_coarser_roundings_of_time_are_read_right(tmp_path, cell, roundi
     assert said and all(n.verified == verified for n in said), [(n.text, n.verified) for n in said]
 
 
+@pytest.mark.slow
 def test_a_flight_of_the_memory_dqn_at_a_glance_is_verified(tmp_path):
     from xairl_uav_handover.flight import narrate_flight, simulated_flight, timeline_figure
 

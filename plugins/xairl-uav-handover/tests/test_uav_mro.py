@@ -3,6 +3,7 @@ on how many flights one vector holds; and one ping-pong window (HandoverConfig.m
 metrics, the reward and MRO."""
 
 import numpy as np
+import pytest
 
 from xairl_uav_handover.baselines import CHM, SAMRO, MobilityRobustness, SAMROConfig
 from xairl_uav_handover.config import SimConfig
@@ -23,6 +24,7 @@ def test_a_flight_is_the_same_flight_in_any_batch():
     np.testing.assert_array_equal(alone.q[0], among.q[5])
 
 
+@pytest.mark.slow
 def test_samro_gives_the_same_handovers_in_batches_of_8_4_and_1():
     cfg = SAMROConfig(update_every_flights=2, warmup_flights=2)
     counts = []
@@ -37,6 +39,7 @@ def test_samro_gives_the_same_handovers_in_batches_of_8_4_and_1():
     np.testing.assert_array_equal(counts[0], counts[2])
 
 
+@pytest.mark.slow
 def test_the_network_keeps_its_offsets_and_raises_them_where_handovers_ping_pong():
     """Across 40 warm-up flights the network moves a few pairs' offsets (not all) and keeps them from run to run."""
     cfg = SimConfig.model_validate({"flight": {"duration_s": 30.0}})
@@ -50,6 +53,7 @@ def test_the_network_keeps_its_offsets_and_raises_them_where_handovers_ping_pong
     assert network.flown == 120 and (network.mro.cio != 0).any()
 
 
+@pytest.mark.slow
 def test_one_ping_pong_window_in_the_metrics_the_reward_and_mro():
     data = SHORT.model_dump()
     data["handover"]["min_time_of_stay_s"] = 5.0

@@ -21,6 +21,7 @@ def uav():
     return p, xairl.explain(p, p.background(40, seed=11), background=bg), bg
 
 
+@pytest.mark.slow
 def test_handover_template_comes_from_the_plugin(uav):
     policy, exp, bg = uav
     assert "xairl_uav_handover" in str(prompts.load("handover").path)
@@ -94,6 +95,7 @@ def test_a3_sentence_verifies_when_the_compared_candidate_is_not_the_strongest_n
     assert not xairl.verify(text.format("4.0", "2"), exp, 0, policy, facts=facts).ok  # and a wrong gap
 
 
+@pytest.mark.slow
 def test_mutation_corpus_on_the_reference_policy(uav):
     policy, exp, _ = uav
     # 20 states keep every kind of mutation (the full corpus of 7,641: benchmarks/bench_narration.py --verifier-only)
@@ -106,6 +108,7 @@ def test_mutation_corpus_on_the_reference_policy(uav):
     assert not wrongly, wrongly[:3]
 
 
+@pytest.mark.slow
 def test_a_flight_at_a_glance(uav, tmp_path):
     """A simulated flight: the DQN's and CHM's handovers on the same flight, a timeline figure, and a summary whose
     every number is verified; a wrong count is caught."""
@@ -126,6 +129,7 @@ def test_a_flight_at_a_glance(uav, tmp_path):
     assert png.stat().st_size > 20_000
 
 
+@pytest.mark.slow
 def test_narratives_lead_with_reasons_for_the_decision(uav):
     """Issue 14's targets on 40 states: the first reason named favours the decision (or is a concession), no
     identifier is a cause, and every narrative is verified with full coverage."""
@@ -183,6 +187,7 @@ def test_wrong_numbers_that_equal_another_fact_stay_contradicted(uav):
     assert checked >= 10
 
 
+@pytest.mark.slow
 def test_the_buffer_is_said_once(uav):
     """Issue 64: 'came from the uplink buffer (0 % full), by +1.85 ... The uplink buffer was 0 % full.' said it twice."""
     policy, exp, _ = uav

@@ -134,6 +134,7 @@ def test_cost_reproduces_the_simulator_sums(cfg, rec, ckpt, which):
     assert c.interrupted.sum() == c.handovers.sum() * rec.interrupt > 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("w_ho", [0.04, 0.5])
 def test_the_bound_replays_exactly(cfg, rec, ckpt, w_ho):
     """The bound's schedule flown through the env realises the planned cells, the planned costs and the simulator's

@@ -44,6 +44,7 @@ def test_pretrained_dqn_deep_shap_matches_shap():
     assert ours.additivity_gap.max() < 1e-4
 
 
+@pytest.mark.slow
 def test_pretrained_dqn_on_table_one():
     """The committed checkpoint, the paper's DQN (a plain DQN on the paper's reward), on 100 held-out flights
     (Table I with intervals, table.py): at most half of CHM's handovers per flight with its interval wholly below
@@ -59,6 +60,7 @@ def test_pretrained_dqn_on_table_one():
     assert dqn["pp_per_min"] <= chm["pp_per_min"] and dqn["availability"] >= 0.95 * chm["availability"]
 
 
+@pytest.mark.slow
 def test_buffer_leads_the_pretrained_dqns_score_not_its_margin():
     """The paper's Figure 2 finding, at small scale, on the committed DQN's own decision states: buffer_queue_size
     has the largest mean |contribution| to the chosen score; to the margin over the runner-up the serving cell's and
@@ -113,6 +115,7 @@ def test_checkpoint_metadata_is_checked_against_its_tensors_before_anything_is_b
     assert not built
 
 
+@pytest.mark.slow
 def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
     ckpt = tmp_path / "tiny.safetensors"
     assert (

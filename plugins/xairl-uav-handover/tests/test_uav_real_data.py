@@ -25,6 +25,7 @@ BALTACI = DATA / "baltaci-imc22-handovers"
 needs_data = pytest.mark.skipif(not UKM.is_dir(), reason="../shared/data/ukm-uav-lte is not here")
 
 
+@pytest.mark.slow
 @needs_data
 def test_load_one_flight():
     f = load_flight(UKM / "100m.csv")
@@ -79,6 +80,7 @@ def ukm_walks():
     return ckpt, [walk(f, ckpt.sim_config) for f in load_folder(UKM)[0]]
 
 
+@pytest.mark.slow
 @needs_data
 @pytest.mark.xfail(
     strict=True,
@@ -93,6 +95,7 @@ def test_real_states_lie_in_the_training_distribution(ukm_walks):
     assert outside(real, sim).any(axis=1).mean() <= 0.05
 
 
+@pytest.mark.slow
 @needs_data
 def test_calibration_targets_on_the_real_flights(ukm_walks):
     """Issue 11's calibration, on all 29 UKM flights against the committed checkpoint (small simulated samples): the
@@ -161,6 +164,7 @@ def sim_report(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_the_report_says_what_it_is_doing(sim_report):
     """`make demo` printed nothing for 97 s, then for 124 s: each long step is said (every 10 s while it runs:
     tests/test_progress.py), the plugin's own steps inside the command's."""
@@ -179,6 +183,7 @@ def test_the_report_says_what_it_is_doing(sim_report):
     assert all(any(line.startswith(f"xairl: {s}: done in ") for line in said) for s in starts), said
 
 
+@pytest.mark.slow
 def test_report_without_real_data(sim_report):
     out = sim_report
     html = (out / "report.html").read_text()
@@ -192,6 +197,7 @@ def test_report_without_real_data(sim_report):
     assert "values" in schema["properties"]
 
 
+@pytest.mark.slow
 @needs_data
 def test_report_with_real_data(tmp_path):
     real = tmp_path / "data" / "ukm"
@@ -226,6 +232,7 @@ def test_report_with_real_data(tmp_path):
     assert datasets == {"simulated", "real"}
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not shutil.which("chromium"), reason="chromium is not installed")
 def test_report_renders_in_headless_chromium(sim_report, tmp_path):
     import subprocess
@@ -254,6 +261,7 @@ def test_report_renders_in_headless_chromium(sim_report, tmp_path):
     assert shot.stat().st_size > 20_000
 
 
+@pytest.mark.slow
 @needs_data
 def test_the_uplink_reaches_the_measured_throughput_on_held_out_flights():
     """Issue 53: P0 and the other cells' uplink load were fitted on the even-named UKM flights; on the odd-named

@@ -9,6 +9,7 @@ from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.table import ROWS, flights, format_paper, format_rows, pooled_seeds, with_intervals
 
 
+@pytest.mark.slow
 def test_ping_pong_windows_nest_and_the_configured_one_matches_the_simulator():
     cfg = SimConfig()
     m = flights(CHM(), cfg, 12, [0])
@@ -19,6 +20,7 @@ def test_ping_pong_windows_nest_and_the_configured_one_matches_the_simulator():
     assert np.allclose(m["minutes"], cfg.flight.duration_s / 60, rtol=0.01)
 
 
+@pytest.mark.slow
 def test_every_row_has_an_interval_around_its_value():
     m = flights(CHM(), SimConfig(), 12, [0, 1])
     assert len(m["handovers"]) == 24

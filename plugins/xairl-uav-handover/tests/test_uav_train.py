@@ -3,6 +3,7 @@
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 import torch
 from stable_baselines3.common.buffers import ReplayBuffer
 
@@ -50,6 +51,7 @@ def test_margin_loss_is_zero_only_when_the_demonstrated_action_leads_by_the_marg
     assert margin_loss(q, batch, 5.0).item() == 7.5
 
 
+@pytest.mark.slow
 def test_pretraining_on_demonstrations_imitates_the_rule():
     sim = SimConfig.model_validate(
         {**SimConfig().model_dump(), "flight": {**SimConfig().flight.model_dump(), "duration_s": 20.0}}
