@@ -246,15 +246,14 @@ class SAMRO:
         """Flights to fly together next, of ``n`` left: none past the next update of the offsets."""
         return min(n, self.cfg.update_every_flights - self.flown % self.cfg.update_every_flights)
 
-    def warm_up(self, config) -> None:
-        """Fly ``warmup_flights`` flights on training seeds once, before the first evaluated flight."""
+    def warm_up(self, fly) -> None:
+        """Fly ``warmup_flights`` training flights once, before the first evaluated flight: ``fly(n)`` flies ``n``
+        of them in order under this controller (the evaluation's loop, :func:`evaluate.run_flights`, passes it: the
+        rules know no flight loop)."""
         if not self.warm:
-            from .evaluate import WARM_UP_SEED, fly_in_order
-            from .streams import flight_seeds
-
             self.warm = True
             if self.cfg.warmup_flights:
-                fly_in_order(self, config, flight_seeds(WARM_UP_SEED, 0, self.cfg.warmup_flights))
+                fly(self.cfg.warmup_flights)
 
     def reset(self, env) -> None:
         sim = env.sim
