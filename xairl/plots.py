@@ -68,12 +68,13 @@ def _fit(fig) -> None:
     """A wider figure while any of its text runs past an edge: tight_layout moves the axes, but cannot make room
     for an axis label wider than the figure (a waterfall's 'margin of handover_to_candidate_1 over stay: ...')."""
     renderer = fig.canvas.get_renderer()
-    for _ in range(4):
+    for _ in range(6):
         box = fig.get_tightbbox(renderer)  # inches, everything drawn
         over = max(0.0, -box.x0) + max(0.0, box.x1 - fig.get_figwidth())
         if over <= 0.01:
             return
-        fig.set_figwidth(fig.get_figwidth() + over + 0.1)
+        # a label centred under its axes gains half of what the figure gains on each side
+        fig.set_figwidth(fig.get_figwidth() + 2 * over + 0.1)
         fig.tight_layout()
 
 

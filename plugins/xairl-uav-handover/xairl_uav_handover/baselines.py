@@ -240,7 +240,7 @@ class SAMRO:
     def __init__(self, config: SAMROConfig | None = None):
         self.cfg = config or SAMROConfig()
         self.mro: MobilityRobustness | None = None
-        self.flown, self.warm = 0, False
+        self.flown, self.warm, self.updates = 0, False, 0
 
     def batch(self, n: int) -> int:
         """Flights to fly together next, of ``n`` left: none past the next update of the offsets."""
@@ -284,6 +284,7 @@ class SAMRO:
         self.flown += env.sim.K
         if self.flown % self.cfg.update_every_flights == 0:
             self.mro.update()
+            self.updates += 1
 
 
 class CHMOnSamples:
@@ -335,7 +336,7 @@ class SAMROOnSamples(CHMOnSamples):
         self.mro = MobilityRobustness(self.sa, len(self.cells), sim_config.handover.min_time_of_stay_s)
         self.failure = UplinkFailure(self.sa.rlf_s, 1)
         self.interference: dict[float, float] = {}
-        self.last_update = None
+        self.last_update, self.updates = None, 0
 
     def _radio_ok(self, state) -> bool:
         from .simulator import hex_layout
@@ -359,7 +360,7 @@ class SAMROOnSamples(CHMOnSamples):
         self.last_update = t if self.last_update is None else self.last_update
         if t - self.last_update >= self.sa.update_every_flights * self.sim_cfg.flight.duration_s:
             self.mro.update()
-            self.last_update = t
+            self.last_update, self.updates = t, self.updates + 1
         return self.mro.offsets(serving), self.sa.ttt_s
 
 

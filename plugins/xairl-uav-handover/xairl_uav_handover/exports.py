@@ -56,9 +56,7 @@ def check_plain(path: Path, limit: int, st: os.stat_result | None = None) -> os.
         kind = next((k for test, k in kinds if test(st.st_mode)), "not a regular file")
         raise InputError(f"{path}{link}: {kind}, not a regular file; refused unread; {GIVE_FILE}")
     if st.st_size > limit:
-        raise InputError(
-            f"{path}{link}: {st.st_size} bytes, more than the {limit} allowed here; refused unread."
-        )
+        raise InputError(f"{path}{link}: {st.st_size} bytes, more than the {limit} allowed here; refused unread.")
     return st
 
 
