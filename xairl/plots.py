@@ -28,6 +28,8 @@ from .files import save_figure
 from .regions import in_regions
 from .windows import window_of
 
+#: figures are laid out and saved at this many dots per inch
+DPI = 90
 #: more features than this are plotted in groups (image patches, dict keys) or only the strongest are shown
 MAX_SHOWN = 40
 #: a plot's axes are never narrower than this (inches), however long the feature names beside them
@@ -45,7 +47,7 @@ def _figure(**kwargs):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(**kwargs)
+    fig = Figure(**{"dpi": DPI, **kwargs})  # laid out at the dpi it is saved with: text measures as written
     FigureCanvasAgg(fig)
     return fig
 
@@ -67,10 +69,10 @@ def _layout(fig, axes, min_width: float = MIN_AXES_WIDTH) -> None:
 def _fit(fig) -> None:
     """A wider figure while any of its text runs past an edge: tight_layout moves the axes, but cannot make room
     for an axis label wider than the figure (a waterfall's 'margin of handover_to_candidate_1 over stay: ...')."""
-    renderer = fig.canvas.get_renderer()
+    renderer, pad = fig.canvas.get_renderer(), 0.15  # inches kept free at the right edge (tight_layout's at the left)
     for _ in range(6):
         box = fig.get_tightbbox(renderer)  # inches, everything drawn
-        over = max(0.0, -box.x0) + max(0.0, box.x1 - fig.get_figwidth())
+        over = max(0.0, -box.x0) + max(0.0, box.x1 - fig.get_figwidth() + pad)
         if over <= 0.01:
             return
         # a label centred under its axes gains half of what the figure gains on each side
@@ -105,8 +107,11 @@ def _cmap(name: str):
     return matplotlib.colormaps[name]
 
 
-def save(fig, path: str | Path, dpi: int = 90) -> Path:
+def save(fig, path: str | Path, dpi: int = DPI) -> Path:
     """Write ``fig`` to ``path`` (format from the suffix) atomically; returns the path."""
+    if dpi != fig.dpi:  # text measures a little differently at another dpi: fit it again there
+        fig.set_dpi(dpi)
+        _fit(fig)
     return save_figure(fig, path, dpi=dpi)
 
 

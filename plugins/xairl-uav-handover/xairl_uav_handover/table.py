@@ -182,7 +182,7 @@ def shown_rows(min_stay_s: float | None = None) -> list[tuple[str, str]]:
     if min_stay_s is None:
         return [(key, label) for key, label, _ in ROWS]
     same = {f"pp_{min_stay_s:g}s", f"pp_share_median_{min_stay_s:g}s"}
-    stay = f"minimum time of stay ({min_stay_s:g} s)"
+    stay = f"minimum time of stay of {min_stay_s:g} s"
     return [(key, label.replace("minimum time of stay", stay)) for key, label, _ in ROWS if key not in same]
 
 
