@@ -441,9 +441,9 @@ def test_report_refuses_a_folder_of_a_fifo_and_a_link_to_dev_zero_quickly(tmp_pa
 
 @needs_special_files
 def test_special_files_are_named_and_skipped_beside_a_good_flight(tmp_path):
-    from xairl_uav_handover.exports import load_folder
-
     import threading
+
+    from xairl_uav_handover.exports import load_folder
 
     files = special_files(tmp_path / "real")
     write_export(tmp_path / "real" / "50m.csv", export_lines())
