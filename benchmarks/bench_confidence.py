@@ -35,13 +35,14 @@ def auc(hi: list[float], lo: list[float]) -> float:
 
 def run(label: str, policy, states, bg, robustness: bool) -> None:
     exp = xairl.explain(policy, states, background=bg)
+    how = xairl.NarrationOptions(policy=policy, background=bg, robustness=robustness)
     true, wrong, vague, margins = [], [], [], []
     for i in range(len(states)):
-        n = xairl.narrate(exp, i, policy=policy, background=bg, robustness=robustness)
+        n = xairl.narrate(exp, i, narration=how)
         true.append(n.confidence)
         for text, out in ((_wrong_number(n.text), wrong), (n.text + VAGUE, vague)):
             v = xairl.verify(text, exp, i, policy)
-            out.append(confidence(exp, i, v.ok, policy, bg, robustness, coverage=v.coverage)[0])
+            out.append(confidence(exp, i, v.ok, how, coverage=v.coverage)[0])
         c, r = exp.chosen[i], exp.runner_up[i]
         margins.append(float(exp.outputs[i, c] - exp.outputs[i, r]))
     margins, true = np.array(margins), np.array(true)

@@ -31,62 +31,10 @@ import sys
 import time
 
 import numpy as np
-import yaml
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-import xairl  # noqa: E402
-from benchmarks.bench_verifier import manipulated, one_output  # noqa: E402
+from tests.narrative_corpus import HELDOUT, load  # noqa: E402
 from xairl.narrators.verify import parse  # noqa: E402
-
-HELDOUT = pathlib.Path(__file__).parent / "data" / "narratives" / "heldout"
-
-
-def case_explanation(case: dict) -> xairl.Explanation:
-    """A one-output Explanation from a case: [name, value, contribution] per feature (a string value is a category),
-    the base value and the output's words."""
-    names, values, contributions = zip(*[(str(f[0]), f[1], float(f[2])) for f in case["features"]])
-    return one_output(
-        list(names), list(values), list(contributions), float(case["base_value"]), case.get("output") or "prediction"
-    )
-
-
-def load(path: pathlib.Path) -> list[dict]:
-    items = []
-    for case in yaml.safe_load(path.read_text())["cases"]:
-        exp = case_explanation(case)
-        for entry in case["narratives"]:
-            ((label, text),) = entry.items()
-            items.append(
-                {
-                    "file": _name(path),
-                    "case": case["id"],
-                    "domain": case["domain"],
-                    "error": label,
-                    "accurate": label == "ok",
-                    "text": text,
-                    "explanation": exp,
-                    "wrong_facts": False,
-                }
-            )
-            if label == "ok":
-                for kind, e in manipulated(exp):
-                    items.append(
-                        {
-                            "file": _name(path),
-                            "case": case["id"],
-                            "domain": case["domain"],
-                            "error": kind,
-                            "accurate": False,
-                            "text": text,
-                            "explanation": e,
-                            "wrong_facts": True,
-                        }
-                    )
-    return items
-
-
-def _name(path: pathlib.Path) -> str:
-    return f"{'tuning' if path.parent.name == 'tuning' else 'held out'}: {path.stem}"
 
 
 def run(items: list[dict], reader) -> None:

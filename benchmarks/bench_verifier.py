@@ -3,17 +3,14 @@
 The corpus (``benchmarks/data/narratives``): 320 narratives about 32 explanations in four domains (house prices and
 credit default, one output each, not RL; the UAV handover DQN; the toy discrete policy), half accurate and half
 with one labelled error, in many voices. Cases 0-3 of each domain are the dev split (the verifier was tuned on it),
-cases 4-7 the test split (frozen before any tuning; report it apart); ``dev2/`` 76 more narratives on the dev
-cases in other voices (Q&A, LLM-style prose, shorthand, lists; 16 of them on two UAV 'stay' cases of its own) and
-``dev3/`` 55 more (shares, 'accounts for', pipes, counterfactuals), ``dev4/`` 44 in the voice of an LLM explaining
-SHAP values, ``dev5/`` 45 in memo, log, arrow and passive voices, ``dev6/`` to ``dev13/`` 23-48 each (markdown,
-tickets, voice memos, amount verbs, signs in words, comparisons between features, JSON-ish output, number formats,
-operators' corrections, sums, 'from x to y'), ``dev14/`` 31 in the storyteller voice of LLM-written SHAP narratives
-(values against the typical case), ``dev15/`` to ``dev20/`` 16-41 each (an analyst's terse notes, lists, everyday
-hedges, plain language, long reports, a second language) and ``dev21/`` 17 engineers' notes, each written after the
-freeze and measured once before tuning on it. ``test2/``: 48 more on the test cases (chat, letters, risk notes,
-decision logs), written after the test split's disagreements had been counted by cause (not read) and never tuned
-on: the second held-out figure. A narrative counts as agreeing when ``Verification.ok`` equals its label; the
+cases 4-7 the test split (frozen before any tuning; report it apart). ``voices/`` holds the sets written later, one
+folder a set, named by its split and its voices: ``voices/dev-*`` are 20 sets on the dev cases (16-76 narratives each:
+Q&A and shorthand, shares, an LLM explaining SHAP values, memos and logs, notes, comparisons, number formats,
+corrections, sums, the storyteller voice, an analyst's notes, lists, hedges, one-liners, long reports, a second
+language, engineers' notes; ``dev-qa-shorthand-lists/cases.json`` adds two UAV 'stay' cases), each written after the
+freeze and measured once before tuning on it. ``voices/test-chat-letters-logs/``: 48 more on the test cases (chat,
+letters, risk notes, decision logs), written after the test split's disagreements had been counted by cause (not
+read) and never tuned on: the second held-out figure. A narrative counts as agreeing when ``Verification.ok`` equals its label; the
 agreement of ``Verification.accurate`` (nothing contradicted, coverage aside) is printed beside it.
 
     .venv/bin/python benchmarks/bench_verifier.py             # agreement per split, domain, error kind, cause; speed
@@ -42,72 +39,23 @@ from __future__ import annotations
 
 import argparse
 import collections
-import functools
 import json
 import pathlib
-import re
 import sys
-import time
-from dataclasses import replace
 
 import numpy as np
-import yaml
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-import xairl  # noqa: E402
 from tests import narrative_domains as domains  # noqa: E402
-
-DATA = pathlib.Path(__file__).parent / "data" / "narratives"
-
-
-SPLITS = ("dev", *(f"dev{k}" for k in range(2, 22)), "test", "test2")
-
-
-def load_corpus() -> list[dict]:
-    """Every narrative with its case's Explanation, domain, split, label and error kind. ``dev2`` to ``dev5`` hold
-    narratives written later, on the dev cases only, in other voices (tuning material like ``dev``)."""
-    cases = {
-        c["id"]: c for path in (DATA / "cases.json", DATA / "dev2" / "cases.json") for c in json.loads(path.read_text())
-    }
-    out = []
-    for domain in domains.DOMAINS:
-        for later in (None, *(s for s in SPLITS if s not in ("dev", "test"))):
-            path = DATA / (later or ".") / f"{domain}.yaml"
-            for case_id, items in yaml.safe_load(path.read_text()).items():
-                case = cases[case_id]
-                split = later.rstrip("0123456789") if later else None  # dev2..dev9 on dev cases, test2 on test
-                assert not later or case["split"] == split, f"{path}: {case_id} is not a {split} case"
-                exp = xairl.Explanation.from_json(json.dumps(case["explanation"]))
-                for item in items:
-                    ((label, text),) = item.items()
-                    out.append(
-                        {
-                            "case": case_id,
-                            "domain": domain,
-                            "split": later or case["split"],
-                            "error": label,
-                            "accurate": label == "ok",
-                            "text": text,
-                            "explanation": exp,
-                        }
-                    )
-    return out
-
-
-def run(items: list[dict], policies: dict, reader: str = "old") -> list[dict]:
-    """Verify every item with ``xairl.verify`` (``reader="old"``) or the rule-table reader ``xairl.verify.read``."""
-    if reader == "new":
-        from xairl.verify import read as verify
-    else:
-        from xairl.narrators import verify  # not ``xairl.verify``: once imported, that name is the reader's package
-    for it in items:
-        t = time.perf_counter()
-        res = verify(it["text"], it["explanation"], 0, it.get("policy") or policies.get(it["domain"]))
-        it["seconds"] = time.perf_counter() - t
-        it["sentences"] = max(1, len(re.findall(r"[.!?\n](\s|$)", it["text"].strip() + " ")))
-        it["ok"] = res.ok
-        it["result"] = res
-    return items
+from tests.narrative_corpus import (  # noqa: E402
+    SPLITS,
+    explanation_from_tuples,
+    load_corpus,
+    manipulated,
+    run,
+    shapstories_case,
+    shapstories_cases,
+)
 
 
 def table(items: list[dict], key) -> list[tuple[str, int, int]]:
@@ -155,35 +103,6 @@ def report(items: list[dict], show: str | None) -> None:
     print(f"\nspeed: {1000 * per_sentence:.2f} ms per sentence (mean over {len(items)} narratives)")
 
 
-def explanation_from_tuples(text: str, output: str = "prediction") -> xairl.Explanation:
-    """A one-output Explanation from '(name, value, contribution), ...' tuples, as Explingo writes them (a value that
-    is not a number is a category); no baseline is given, so it is 0."""
-    tuples = re.findall(r"\(([^()]*?),\s*([^,()]+?),\s*(-?[\d.]+)\)", text)
-    values = [float(v) if re.fullmatch(r"-?[\d.]+", v.strip()) else v.strip() for _, v, _ in tuples]
-    return one_output([t[0].strip() for t in tuples], values, [float(t[2]) for t in tuples], output=output)
-
-
-def one_output(
-    names: list[str], values: list, contributions: list[float], base: float = 0.0, output: str = "prediction"
-) -> xairl.Explanation:
-    """A one-output Explanation of one state: each feature's value (a str is a category's label) and contribution;
-    the prediction is the baseline plus their sum."""
-    cats = {n: (v,) for n, v in zip(names, values) if isinstance(v, str)}
-    states = np.array([[0.0 if isinstance(v, str) else float(v) for v in values]])
-    contrib = np.array(contributions, dtype=float)
-    return xairl.Explanation(
-        values=contrib.reshape(1, -1, 1),
-        base_values=np.array([[base]]),
-        outputs=np.array([[base + contrib.sum()]]),
-        states=states,
-        feature_names=tuple(names),
-        action_names=(output,),
-        method="given",
-        output="value",
-        categories=cats or None,
-    )
-
-
 def explingo_items(path: str) -> list[dict]:
     """Explingo's labelled narratives, each with a one-output Explanation rebuilt from its tuples."""
     out = []
@@ -220,54 +139,11 @@ def explingo_items(path: str) -> list[dict]:
     return out
 
 
-@functools.cache
-def _shapstories_cases() -> dict:
-    """``data/narratives/outside/shapstories.yaml``, read once."""
-    return yaml.safe_load((DATA / "outside" / "shapstories.yaml").read_text())
-
-
-def shapstories_case(dataset: str, index: int) -> tuple[int, xairl.Explanation, xairl.Policy]:
-    """(batch, Explanation, Policy) built for narrative ``index`` of ``dataset`` in
-    ``data/narratives/outside/shapstories.yaml``: one output, the data dictionary's descriptions and categories."""
-    import torch
-
-    domain = _shapstories_cases()[dataset]
-    batch, prediction, given = domain["cases"][index]
-    feats = domain["features"]
-    names = tuple(feats)
-    cats = {f: tuple(d[1]) for f, d in feats.items() if isinstance(d[1], list)}
-    value = {f: (cats[f].index(v) if f in cats else v) for f, (v, _) in given.items()}
-    states = np.array(
-        [[value.get(f, min(2, len(cats[f]) - 1) if f in cats else feats[f][2]) for f in names]], float
-    )  # else the median (a category: its third code)
-    contrib = np.array([given[f][1] if f in given else 0.001 for f in names])
-    quartiles = np.array([[np.nan if f in cats else feats[f][k] for f in names] for k in (1, 2, 3)], float)
-    exp = xairl.Explanation(
-        values=contrib.reshape(1, -1, 1),
-        base_values=np.array([[prediction - contrib.sum()]]),
-        outputs=np.array([[prediction]]),
-        states=states,
-        feature_names=names,
-        action_names=(domain["output"],),
-        method="given",
-        output="value",
-        background_quantiles=quartiles,
-        categories=cats or None,
-    )
-    info = {
-        f: xairl.FeatureInfo(d[4] if len(d) > 4 else "", d[0], categories=cats.get(f, ())) for f, d in feats.items()
-    }
-    policy = xairl.Policy(
-        torch.nn.Linear(len(names), 1), list(names), [domain["output"]], features=info, output="value", name=dataset
-    )
-    return batch, exp, policy
-
-
 def shapstories_items(path: str) -> list[dict]:
     """The LLM-written narratives of SHAPnarrative-agents (``baseline_narratives.json``, ``..._best.json``,
     ``..._worst.json``) that have a case in ``data/narratives/outside/shapstories.yaml``; each is accurate for its case
     unless the file's entry there lists it as contradicting it."""
-    cases = _shapstories_cases()
+    cases = shapstories_cases()
     about = cases["files"].get(pathlib.Path(path).name, {})
     out = []
     for row in json.loads(pathlib.Path(path).read_text()):
@@ -292,21 +168,6 @@ def shapstories_items(path: str) -> list[dict]:
                 }
             )
     return out
-
-
-def manipulated(exp: xairl.Explanation) -> list[tuple[str, xairl.Explanation]]:
-    """The narrative's explanation changed the way SHAPnarrative-metrics manipulates SHAP tables, so that the same
-    (accurate) text becomes wrong: every contribution's sign inverted (the prediction mirrored about the baseline),
-    and the two largest contributions swapped."""
-    values = exp.values.copy()
-    order = np.argsort(-np.abs(values[0, :, 0]))
-    swapped = values.copy()
-    swapped[0, order[:2], 0] = values[0, order[1::-1], 0]
-    base = exp.base_values
-    return [
-        ("inverted signs", replace(exp, values=-values, outputs=base - values.sum(axis=1))),
-        ("top two swapped", replace(exp, values=swapped, outputs=base + swapped.sum(axis=1))),
-    ]
 
 
 def main() -> None:

@@ -7,7 +7,7 @@ Cases 0-3 of each domain are the dev split, 4-7 the test split; the split was fi
 written or any verifier change was made. Run once; the corpus refers to the stored numbers, not to a re-run.
 
     .venv/bin/python benchmarks/make_narrative_cases.py
-    .venv/bin/python benchmarks/make_narrative_cases.py --dev2   # dev2/cases.json: two UAV 'stay' dev cases
+    .venv/bin/python benchmarks/make_narrative_cases.py --stay-cases   # voices/dev-qa-shorthand-lists/cases.json: two UAV 'stay' dev cases
 """
 
 from __future__ import annotations
@@ -59,8 +59,8 @@ def _one(exp: xairl.Explanation, i: int) -> dict:
 
 
 def _dev2_cases() -> list[dict]:
-    """Two more UAV cases for the dev2 narratives, both 'stay' (the dev split's UAV cases are all handovers), from
-    another pool of states than the frozen cases: the registered policy's own sampler (``dev2/cases.json`` was
+    """Two more UAV cases for the dev-qa-shorthand-lists narratives, both 'stay' (the dev split's UAV cases are all handovers), from
+    another pool of states than the frozen cases: the registered policy's own sampler (``voices/dev-qa-shorthand-lists/cases.json`` was
     written from states the DQN visited on simulated flights; it stays as written)."""
     policy = xairl.get_policy("uav-dqn")  # through the plugin registry: the core imports no plugin
     pool = policy.background(400, seed=17)
@@ -71,8 +71,8 @@ def _dev2_cases() -> list[dict]:
 
 def main() -> None:
     torch.set_num_threads(1)
-    if "--dev2" in sys.argv:  # added after the freeze: new dev cases only, cases.json is left as it is
-        out = OUT.parent / "dev2" / "cases.json"
+    if "--stay-cases" in sys.argv:  # added after the freeze: new dev cases only, cases.json is left as it is
+        out = OUT.parent / "voices" / "dev-qa-shorthand-lists" / "cases.json"
         out.write_text(json.dumps(_dev2_cases(), indent=1) + "\n")
         print(f"wrote {out}")
         return

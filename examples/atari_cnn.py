@@ -1,7 +1,7 @@
 """An Atari-style CNN Q-network (SB3's NatureCNN on 4 stacked 84x84 frames) explained with xairl: pixels, patches,
 an image plot, and the same policy from the command line with nothing installed.
 
-Run: python examples/atari_cnn.py [--out atari-report]
+Run: python examples/atari_cnn.py [--out out/atari-report]
 CLI: xairl explain --policy examples/atari_cnn.py:make_policy --policy-arg seed=0 --states s.npy --background bg.npy \
        --out DIR        (s.npy, bg.npy: uint8 or float frames of shape (n, 4, 84, 84); this script writes both)
 """
@@ -59,7 +59,7 @@ def frames(n: int, seed: int) -> np.ndarray:
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
-    ap.add_argument("--out", default="atari-report")
+    ap.add_argument("--out", default="out/atari-report")
     args = ap.parse_args()
     policy = make_policy()
     states, background = frames(3, seed=1), frames(10, seed=2)

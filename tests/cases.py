@@ -37,5 +37,5 @@ def params(name: str, section: str, fields: tuple[str, ...]) -> list:
 
 
 def explanation(name: str) -> dict:
-    """second_review.yaml's explanation ``name``: the keyword arguments of benchmarks.bench_verifier.one_output."""
+    """second_review.yaml's explanation ``name``: the keyword arguments of tests.narrative_corpus.one_output."""
     return load("second_review")["explanations"][name]

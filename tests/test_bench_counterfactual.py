@@ -1,12 +1,17 @@
-"""The DiCE benchmark's own parts (benchmarks/bench_counterfactual.py): the classifier DiCE sees takes exactly the
-policy's actions, the scoring re-runs the policy (an answer that does not flip is counted invalid), and a quick run on
-the toy policy (only with dice-ml installed: the `bench` extra)."""
+"""The DiCE benchmark's parts (its cases and scoring, tests/counterfactual_scoring.py; the script itself,
+benchmarks/bench_counterfactual.py): the classifier DiCE sees takes exactly the policy's actions, the scoring re-runs
+the policy (an answer that does not flip is counted invalid), and a quick run of the script on the toy policy (only
+with dice-ml installed: the `bench` extra)."""
+
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import xairl
-from benchmarks import bench_counterfactual as bench
+from tests import counterfactual_scoring as bench
 
 
 @pytest.fixture(scope="module")
@@ -51,11 +56,14 @@ def test_the_measures_are_xairl_s_own(case):
 
 
 @pytest.mark.slow
-def test_quick_run_against_dice(case, capsys):
+def test_quick_run_against_dice():
     pytest.importorskip("dice_ml")
-    small = bench.make_case("toy", case.policy, case.states[:4], case.background)
-    answers = bench.dice_answers(small, "genetic")
-    s = bench.score(small, answers)
-    assert s.answered.any()
-    assert bench.main(["--quick", "--policy", "toy", "--methods", "genetic"]) == 0
-    assert "dice-genetic" in capsys.readouterr().out
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_counterfactual.py"
+    res = subprocess.run(
+        [sys.executable, str(script), "--quick", "--policy", "toy", "--methods", "genetic"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert "dice-genetic" in res.stdout

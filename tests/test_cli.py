@@ -12,7 +12,7 @@ import xairl
 from xairl.cli import main
 from xairl.toy import FEATURES, toy_policy
 
-from .conftest import run
+from .conftest import one_line_error, run
 
 
 def test_help_does_not_import_heavy_libraries():
@@ -117,6 +117,13 @@ def test_version_and_examples(capsys):
         (["explain", "-o", "novalue"], "is not key=value"),
         (["explain", "--method", "exact", "-o", "max_rows=-3"], "max_rows"),
         (["explain", "--states", "/nonexistent.csv"], "no such file"),
+        # -n is --narrator-option: `-n 3` once explained the default 5 states, and with --narrate named -o
+        (
+            ["explain", "-n", "3"],
+            "-n/--narrator-option: '3' is not key=value; write e.g. -n mode=rewrite; to explain 3",
+        ),
+        (["explain", "-n", "3", "--narrate"], "to explain 3 states, write --n 3"),
+        (["explain", "--narrate", "-n", "rewrite"], "'rewrite' is not key=value; write e.g. -n mode=rewrite;"),
     ],
 )
 def test_user_errors_are_one_line_exit_2(capsys, argv, match):
@@ -185,3 +192,50 @@ def test_verify_trace_names_the_reading_of_each_claim(tmp_path, capsys):
     assert rc == 2 and err.count("\n") == 1 and "--explanation" in err
     rc, _, err = run(capsys, "verify", "x", "--explanation", str(path), "--index", "3")
     assert rc == 2 and "--index 3" in err
+
+
+@pytest.fixture(scope="module")
+def report_dir(tmp_path_factory):
+    """``xairl explain --n 3 --out DIR`` under the umask 022: DIR holds explanations.jsonl and the report."""
+    out = tmp_path_factory.mktemp("report") / "r"
+    mask = os.umask(0o022)
+    try:
+        assert main(["explain", "--n", "3", "--out", str(out), "--background-size", "10"]) == 0
+    finally:
+        os.umask(mask)
+    return out
+
+
+def test_output_files_get_the_umasks_permissions_so_a_report_can_be_shared(report_dir, tmp_path):
+    """mkstemp made every file -rw-------: a report no web server or colleague could read."""
+    from xairl.files import write_text
+
+    modes = {p.name: p.stat().st_mode & 0o777 for p in report_dir.iterdir()}
+    assert {"report.html", "explanations.jsonl"} <= modes.keys() and set(modes.values()) == {0o644}, modes
+    mask = os.umask(0o027)
+    try:
+        write_text(tmp_path / "shared.txt", "x")
+    finally:
+        os.umask(mask)
+    assert (tmp_path / "shared.txt").stat().st_mode & 0o777 == 0o640
+
+
+def test_verify_reads_the_records_that_explain_out_writes(report_dir, capsys):
+    """`xairl verify --explanation DIR/explanations.jsonl` once failed with "Extra data: line 2": a record is chosen
+    with --index, and a file of several records without one is refused, saying how many it holds."""
+    path = str(report_dir / "explanations.jsonl")
+    records = [json.loads(line) for line in (report_dir / "explanations.jsonl").read_text().splitlines()]
+    rec = records[1]
+    margin = {f: v[rec["chosen"]] - v[rec["runner_up"]] for f, v in rec["values"].items()}
+    top = max(margin, key=lambda f: abs(margin[f]))
+    verb = "raised" if margin[top] > 0 else "lowered"
+    said = f"{top.capitalize()} {verb} the margin by {abs(margin[top]):.2f}. The policy chose {rec['chosen']}."
+    rc, out, _ = run(capsys, "verify", said, "--explanation", path, "--index", "1")
+    assert rc == 0 and out.count("[verified]") == 2 and "accurate: yes" in out, out
+    wrong = f"{top.capitalize()} {verb} the margin by {abs(margin[top]) + 1:.2f}."
+    rc, out, _ = run(capsys, "verify", wrong, "--explanation", path, "--index", "1")
+    assert rc == 1 and out.startswith("[contradicted]")
+    rc, _, err = run(capsys, "verify", said, "--explanation", path)
+    one_line_error(rc, err, "holds 3 records", "--index 0..2")
+    rc, _, err = run(capsys, "verify", said, "--explanation", path, "--index", "3")
+    one_line_error(rc, err, "--index 3", "holds 3 record(s)")

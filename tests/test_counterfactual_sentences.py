@@ -16,7 +16,7 @@ import xairl
 from xairl import FeatureInfo, InputError, Policy
 from xairl.counterfactual_facts import counterfactual_fact
 from xairl.counterfactuals import Counterfactuals
-from xairl.prompts import format_number, written_step
+from xairl.numbers import format_number, written_step
 
 from .counterfactual_cases import CAP, HAD, answer, linear_policy, said
 

@@ -198,7 +198,8 @@ def test_the_single_flip_table_of_a_window_policy_takes_its_background_as_window
     states, bg = rng.normal(size=(20, 4, 3)).astype(np.float32), rng.normal(size=(60, 4, 3)).astype(np.float32)
     exp = xairl.explain(policy, states, background=bg)
     _, _, rows, _ = flip_rows(policy, exp, bg)
-    assert {r[0] for r in rows[:-3]} == {f"{s}[t-{k}]" if k else f"{s}[t]" for s in "abc" for k in range(4)}
+    # the newest step's slots (a past slot changed alone is a history the present cannot have: issue 64)
+    assert {r[0] for r in rows[:-3]} == {f"{s}[t]" for s in "abc"}
     assert sum(int(c) for c in rows[-1][1::2]) == 20
 
 

@@ -122,10 +122,32 @@ def test_coverage_lowers_confidence_and_evidence_marks_sentences(case):
     from xairl.narrators.confidence import confidence
 
     v = xairl.verify(n.text + " It felt right. Nobody objected.", exp, 0, p)
-    lower, comp = confidence(exp, 0, v.ok, p, coverage=v.coverage)
+    lower, comp = confidence(exp, 0, v.ok, xairl.NarrationOptions(policy=p), coverage=v.coverage)
     assert v.ok and comp["coverage"] < 1 and lower < n.confidence
     ev = evidence(exp, n)
     assert ev["target"] == "margin of go over wait" and ev["features"][0]["name"] == "speed"
     assert ev["output"] == pytest.approx(5.5)
     card = card_html(n.text, ev)
     assert "wf-bar up" in card and "wf-bar down" in card and card.count("class='s verified'") == len(n.sentences)
+
+
+def test_declared_groups_are_narrated_as_one_without_a_group_description():
+    """Issue 64: ``Policy(groups=)`` alone changes the words: the position is one reason, not x and y. A group whose
+    members are each described keeps their words (a figure's group); one sharing a member with a group before it is
+    not narrated."""
+    p = _policy()
+    plain = xairl.Policy(p.module, p.feature_names, p.action_names, groups={"position": ("x", "y"), "xs": ("x",)})
+    assert plain.reason_groups == {"position": ("x", "y")}
+    figures = replace(
+        plain, groups={"motion": ("speed", "load")}, features={f: p.features[f] for f in ("speed", "load")}
+    )
+    assert figures.reason_groups == {}  # each member has words of its own: they keep them
+    exp = xairl.explain(plain, [[3.0, 0.5, 1.0, 1.0, 7.0]], background=np.zeros((20, 5)), method="exact")
+    d = decision_facts(exp, 0, plain)
+    assert [f.name for f in d.reasons] == ["speed", "position"]  # x and y are one reason: 0.5 * (1 + 1)
+    assert d.reasons[1].contribution == pytest.approx(1.0)
+    n = xairl.narrate(exp, 0, policy=plain, robustness=False)
+    assert n.verified and "position" in n.text.lower() and "nan" not in n.text, n.text
+    assert not {"x", "y"} & set(n.text.replace(".", " ").replace(",", " ").split()), n.text
+    assert xairl.verify("The position favoured action_0 over action_1 by +1.00.", exp, 0, plain).ok
+    assert not xairl.verify("The position favoured action_0 over action_1 by +3.00.", exp, 0, plain).ok

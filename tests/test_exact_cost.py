@@ -7,7 +7,7 @@ import torch
 
 import xairl
 from xairl.attributors.exact import MAX_EVALUATIONS, Exact
-from xairl.errors import InputError
+from xairl.errors import InputError, UnsupportedModelError
 
 from .conftest import mlp, run
 from .test_references import brute_force_shapley
@@ -168,3 +168,65 @@ def test_a_refused_stream_leaves_no_run_and_the_sampler_is_not_called(tmp_path):
     with pytest.raises(InputError, match="chunk_size"):
         xairl.explain_to_parquet(policy, np.zeros((30, 16)), out, np.zeros((300, 16)), "exact", progress=False)
     assert not (out / "run.json").exists()
+
+
+def test_a_long_exact_run_shows_progress_unasked(monkeypatch, capsys):
+    """Was: exact on 16 slots ran 6 minutes with nothing printed. Unasked (progress=None), a run past a few seconds
+    shows a bar on a terminal, and a plain line every 10 s when stderr is a log or a pipe (here the clock is made
+    short instead of the run long)."""
+    from xairl import display
+
+    _, policy = counted(mlp([6, 8, 3]), 6)
+    x, bg = _states(6, n=1, m=10)
+    options = {"max_rows": 100}  # 7 batches of coalitions
+    xairl.explain(policy, x, background=bg, method="exact", options=options)
+    assert capsys.readouterr().err == ""  # quick: silent
+    monkeypatch.setattr(display, "LINE_EVERY_S", 0.0)
+    xairl.explain(policy, x, background=bg, method="exact", options=options)
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 7 and lines[-1].startswith("exact: 100% (7 of 7 batches), ") and "s left" in lines[0]
+    x2, bg2 = _states(6, n=2, m=10)
+    xairl.explain(policy, x2, background=bg2, method="exact", options=options)
+    assert "exact: 50% (1 of 2 states)" in capsys.readouterr().err  # a state's batches move the line too
+    monkeypatch.setattr(display, "show_progress", lambda show: True)  # stderr a terminal
+    monkeypatch.setattr(display, "QUIET_S", 0.0)
+    xairl.explain(policy, x, background=bg, method="exact", options=options)
+    err = capsys.readouterr().err
+    assert "exact: 100%" in err and "7/7" in err and "exact: 100% (" not in err  # the bar, no plain line
+
+
+@pytest.mark.parametrize("n_states, n_background", [(-3, 100), (1.5, 100), (2, 0), (True, 10), (2, "100")])
+def test_a_cost_of_counts_that_are_no_counts_is_refused(n_states, n_background):
+    """Was: Exact().cost(policy, -3, 100) returned a negative number of evaluations, 1.5 states a fraction."""
+    _, policy = counted(mlp([4, 8, 3]), 4)
+    with pytest.raises(InputError, match="whole number of rows, at least 1"):
+        Exact().cost(policy, n_states, n_background)
+
+
+@pytest.mark.parametrize("options", [{"max_evaluations": True}, {"max_evaluations": 2.5}, {"max_rows": False}])
+def test_exact_options_are_whole_numbers_not_bools(options):
+    """Was: max_evaluations: True read as 1 (and refused every run with a limit nobody set)."""
+    with pytest.raises(InputError, match="valid integer"):
+        Exact(options)
+    assert Exact({"max_evaluations": 10**9}).options.max_evaluations == 10**9
+
+
+def test_exact_is_recommended_first_where_it_is_cheaper_than_kernel_shap():
+    """Was: a GRU over a small window was pointed to integrated_gradients or kernel_shap first, where exact gave the
+    true values 4.3x faster (2^F coalitions <= kernel_shap's 2F + 2048 samples up to 11 features)."""
+
+    class SmallGru(torch.nn.Module):
+        def __init__(self, k):
+            super().__init__()
+            self.gru, self.head = torch.nn.GRU(k, 4, batch_first=True), torch.nn.Linear(4, 2)
+
+        def forward(self, x):
+            return self.head(self.gru(x)[0][:, -1])
+
+    for steps, signals, first in ((3, 3, "exact"), (4, 4, "integrated_gradients")):
+        names = [f"s{j}" for j in range(signals)]
+        policy = xairl.Policy(SmallGru(signals), feature_names=names, window=steps)
+        with pytest.raises(UnsupportedModelError) as err:
+            xairl.explain(policy, np.zeros((1, steps, signals)), background=np.ones((2, steps, signals)))
+        assert str(err.value).split("use method=")[1].startswith(f"'{first}'"), str(err.value)
+        assert ("exact: true Shapley values" in str(err.value)) == (first == "exact")

@@ -70,3 +70,24 @@ def test_no_module_is_in_an_import_cycle(monkeypatch):
         if graph.chain_exists(importer=b, imported=a)
     }
     assert not cycles, "import cycles:\n" + "\n".join(sorted(cycles)[:10])
+
+
+def test_the_architecture_page_names_every_module_and_its_layer():
+    """docs/architecture.md's table lists each top-level module or package of xairl/ once, on the layer that
+    pyproject.toml's contract gives it (a new module that the page does not name fails here)."""
+    import re
+
+    import tomllib
+
+    contract = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"][0]
+    layer_of = {
+        m.strip().removeprefix("xairl."): i for i, line in enumerate(contract["layers"], 1) for m in line.split("|")
+    }
+    modules = {p.stem for p in (ROOT / "xairl").iterdir() if p.suffix == ".py" and p.stem != "__init__"}
+    modules |= {p.name for p in (ROOT / "xairl").iterdir() if (p / "__init__.py").exists()}
+    assert modules == set(layer_of), ("modules not in the layers contract, or gone", modules ^ set(layer_of))
+    rows = re.findall(r"^\| (\d+) \| (.+?) \|", (ROOT / "docs" / "architecture.md").read_text(), re.M)
+    documented = {m: int(n) for n, cell in rows for m in re.findall(r"`([a-z_]+)`", cell)}
+    assert documented == layer_of, {
+        m: (documented.get(m), layer_of.get(m)) for m in modules if documented.get(m) != layer_of.get(m)
+    }

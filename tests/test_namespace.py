@@ -60,9 +60,19 @@ def test_importing_the_plugin_namespace_stays_light():
 def test_narrate_takes_its_options_by_keyword_only():
     params = list(inspect.signature(xairl.narrate).parameters.values())
     assert [p.name for p in params[:2]] == ["explanation", "index"]
-    assert all(p.kind is inspect.Parameter.KEYWORD_ONLY for p in params[2:]), params
+    keyword = (inspect.Parameter.KEYWORD_ONLY, inspect.Parameter.VAR_KEYWORD)  # (the NarrationOptions' fields)
+    assert all(p.kind in keyword for p in params[2:]), params
     policy = xairl.get_policy("toy")
     exp = xairl.explain(policy, policy.background(2, seed=0), background=policy.background(20, seed=1))
     with pytest.raises(TypeError):
         xairl.narrate(exp, 0, "template")
     assert xairl.narrate(exp, 0, narrator="template", robustness=False).text
+
+
+def test_an_old_name_says_its_successor():
+    """Issue 64: an old script's ``xairl.TorchPolicy`` names ``xairl.Policy`` instead of a bare AttributeError."""
+    with pytest.raises(AttributeError, match=r"TorchPolicy.*renamed xairl\.Policy"):
+        getattr(xairl, "TorchPolicy")  # noqa: B009 (the attribute access is what is tested)
+    assert not hasattr(xairl, "TorchPolicy") and "TorchPolicy" not in dir(xairl)
+    with pytest.raises(AttributeError, match="has no attribute 'NoSuchThing'$"):
+        getattr(xairl, "NoSuchThing")  # noqa: B009

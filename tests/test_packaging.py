@@ -55,3 +55,35 @@ def test_wheels_install_into_a_fresh_venv_and_run(tmp_path):
     assert "chose" in out and "verified" in out
     out = _run([venv / "bin" / "xairl", "explain", "--policy", "uav-dqn", "--n", "1", "--top", "3"], cwd=tmp_path)
     assert out.count(": chose ") == 1
+
+
+# what the repository's root may hold: the source and its configuration, never a run's output (outputs go to out/,
+# which .gitignore keeps out of the repository)
+_ROOT_ENTRIES = {
+    ".ci",
+    ".gitignore",
+    "CONTRIBUTING.md",
+    "Makefile",
+    "README.md",
+    "benchmarks",
+    "conftest.py",
+    "docs",
+    "examples",
+    "mkdocs.yml",
+    "plugins",
+    "prompts",
+    "pyproject.toml",
+    "requirements-nlp.txt",
+    "tests",
+    "xairl",
+}
+
+
+def test_the_root_holds_source_only():
+    """Every tracked entry at the root is a known source folder or file (a committed report or figure folder fails)."""
+    res = subprocess.run(["git", "ls-files"], capture_output=True, text=True, cwd=ROOT)
+    if res.returncode != 0:
+        pytest.skip("not a git checkout")
+    top = {line.split("/")[0] for line in res.stdout.splitlines()}
+    assert top <= _ROOT_ENTRIES, f"not source, or a new root entry to add here: {sorted(top - _ROOT_ENTRIES)}"
+    assert "out/" in (ROOT / ".gitignore").read_text().split()

@@ -33,7 +33,7 @@ def test_functional_nonlinearity_is_refused_by_deep_shap():
     with pytest.raises(
         UnsupportedModelError,
         match=r"functional nonlinearity \(torch.tanh.*use method="
-        r"'integrated_gradients' or 'kernel_shap' or 'exact'",
+        r"'exact' or 'integrated_gradients' or 'kernel_shap' \(exact: true Shapley values",
     ):
         xairl.explain(policy, x, background=bg, method="deep_shap")
     # the same actor with the tanh as a module is explained exactly

@@ -170,12 +170,123 @@ def test_multidiscrete_is_explained_one_branch_at_a_time():
         np.testing.assert_array_equal(policy.act(x), model.predict(x, deterministic=True)[0][:, b])
 
 
-def test_recurrent_policies_are_refused():
+SIGNALS = ["cart_position", "cart_velocity", "pole_angle", "pole_velocity"]
+
+
+def verified_and_caught(policy, exp):
+    """Decision 0 narrated, every claim verified, and the same words with the first signed number changed caught."""
+    n = xairl.narrate(exp, 0, policy=policy, robustness=False)
+    assert n.verified and "over the last 4 observations" in n.text, n.text
+    assert xairl.verify(n.text, exp, 0, policy).ok
+    first = next(c for c in n.claims if c.kind == "number" and "+" in c.text)
+    assert not xairl.verify(n.text.replace(first.text, "+9.99", 1), exp, 0, policy).ok
+    return n
+
+
+@pytest.fixture(scope="module")
+def stacked():
+    """PPO trained 256 steps on CartPole behind VecFrameStack(n_stack=4), and 40 states it met (stacked rows)."""
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.vec_env import VecFrameStack
+
+    env = VecFrameStack(make_vec_env("CartPole-v1", n_envs=1, seed=0), n_stack=4)
+    model = PPO("MlpPolicy", env, n_steps=64, batch_size=32, n_epochs=2, seed=0, policy_kwargs={"net_arch": [32]})
+    model.learn(256)
+    obs = [env.reset()]
+    for _ in range(40):
+        obs.append(env.step(model.predict(obs[-1], deterministic=True)[0])[0])
+    return model, np.concatenate(obs)
+
+
+def test_a_vec_frame_stack_is_a_stacked_window_explained_narrated_and_verified(stacked):
+    """Issue 64: the VecFrameStack is found in the model's environment (or declared with window=4, or with a window
+    observation): a window of layout 'stacked', narrated per signal over the last 4 observations, and verified."""
+    model, states = stacked
+    policy = xairl.from_sb3(model, feature_names=SIGNALS)
+    assert policy.window == 4 and policy.observation.parts[0].window.layout == "stacked"
+    assert policy.feature_names[:5] == (*(f"{s}[t-3]" for s in SIGNALS), "cart_position[t-2]")
+    np.testing.assert_array_equal(policy.act(states), model.predict(states, deterministic=True)[0])
+    exp = xairl.explain(policy, states[-3:], background=states[:30])
+    assert exp.by_signal().feature_names == tuple(SIGNALS)
+    verified_and_caught(policy, exp)
+    declared = xairl.Observation.window(SIGNALS, 4, layout="stacked", step_s=0.02)
+    assert xairl.from_sb3(model, observation=declared).observation.parts[0].window.step_s == 0.02
+    assert xairl.from_sb3(model, window=4).feature_names[0] == "obs_0[t-3]"
+    with pytest.raises(InputError, match=r"stacks 4 observations \(VecFrameStack\) but window=3"):
+        xairl.from_sb3(model, window=3)
+    with pytest.raises(InputError, match=r"number of observations \(k >= 2\); got 0"):
+        xairl.from_sb3(model, window=0)
+    with pytest.raises(InputError, match="name the signals of one observation"):
+        xairl.from_sb3(model, feature_names=SIGNALS[:3])
+
+
+@pytest.fixture(scope="module")
+def recurrent():
+    """RecurrentPPO (MlpLstmPolicy) trained 256 steps on CartPole; an episode's observations (at least 8) and the
+    LSTM state predict returned after each."""
     from sb3_contrib import RecurrentPPO
 
-    model = RecurrentPPO("MlpLstmPolicy", gym.make("CartPole-v1"), n_steps=16, batch_size=16, seed=0)
-    with pytest.raises(InputError, match="recurrent: its action depends on the LSTM's hidden state"):
+    model = RecurrentPPO(
+        "MlpLstmPolicy",
+        gym.make("CartPole-v1"),
+        n_steps=64,
+        batch_size=32,
+        n_epochs=2,
+        seed=0,
+        policy_kwargs={"lstm_hidden_size": 16, "net_arch": [16]},
+    )
+    model.learn(256)
+    env = gym.make("CartPole-v1")
+    obs, state, seen, states = env.reset(seed=1)[0], None, [], []
+    for t in range(12):  # until the episode ends (it lasts 9 steps here), at most 12
+        seen.append(obs)
+        action, state = model.predict(obs, state=state, episode_start=np.array([t == 0]), deterministic=True)
+        states.append(state)
+        obs, _, terminated, *_ = env.step(int(action))
+        if terminated:
+            break
+    return model, np.array(seen), states
+
+
+def test_recurrent_ppo_is_explained_over_a_window_from_a_reset(recurrent):
+    """Issue 64: RecurrentPPO explained over its last 4 observations, the LSTM unrolled from a reset, which the
+    policy and its explanations say; narrated and verified. Without window= it says what to give."""
+    model, seen, _ = recurrent
+    with pytest.raises(InputError, match="recurrent: .* give window=k to explain it over the last k observations"):
         xairl.from_sb3(model)
+    policy = xairl.from_sb3(model, window=4, feature_names=SIGNALS)  # checked against sb3-contrib's own steps
+    assert (
+        policy.description
+        == "RecurrentPPO's LSTM unrolled over the last 4 observations from a reset (zero) hidden state"
+    )
+    windows = np.stack([seen[t - 3 : t + 1] for t in range(3, len(seen))])
+    exp = xairl.explain(policy, windows[-2:], background=windows, method="kernel_shap", options={"nsamples": 300})
+    assert exp.extras["policy"] == policy.description and repr(policy).endswith(f"; {policy.description})")
+    verified_and_caught(policy, exp)
+    assert xairl.from_sb3(model, window=4, head="value").output == "value"  # the critic's LSTM, checked too
+
+
+def test_recurrent_ppo_from_the_episode_hidden_state_is_the_decision_it_took(recurrent):
+    """With hidden= (the state predict returned one step before the window), the unrolled network's logits are the
+    ones sb3-contrib computed at that step of the episode."""
+    model, seen, states = recurrent
+    t = len(seen) - 1  # the episode's last decision, on the window seen[t-3..t]
+    assert t >= 7
+    policy = xairl.from_sb3(model, window=4, hidden=states[t - 4])  # the state before the window's first step
+    assert policy.description.endswith("from the episode's hidden state before the window (hidden=)")
+    p = model.policy
+    with torch.no_grad():  # what sb3-contrib computed at step t: its observation after the state of step t - 1
+        lstm = tuple(torch.as_tensor(s, dtype=torch.float32) for s in states[t - 1])
+        dist = p.get_distribution(p.obs_to_tensor(seen[t])[0], lstm, torch.zeros(1))[0].distribution
+    ours = torch.log_softmax(torch.as_tensor(policy.scores(seen[t - 3 : t + 1])), dim=1).numpy()
+    np.testing.assert_allclose(ours, dist.logits.numpy(), atol=1e-5)
+    reset = xairl.from_sb3(model, window=4).scores(seen[t - 3 : t + 1])  # from a reset: another function
+    assert np.abs(reset - policy.scores(seen[t - 3 : t + 1])).max() > 1e-4
+    with pytest.raises(InputError, match="hidden is the LSTM's"):
+        xairl.from_sb3(model, window=4, hidden=(np.zeros(3), np.zeros(3)))
+    with pytest.raises(InputError, match="hidden= is the LSTM state of a recurrent policy"):
+        xairl.from_sb3(build("PPO", "MlpPolicy", "CartPole-v1", None), hidden=states[0])
 
 
 def test_value_head_needs_an_actor_critic():
@@ -203,9 +314,11 @@ def test_narration_of_a_value_head_and_a_2d_actor_verifies(algo, obs, act, head)
         assert n.text.startswith(f"The value estimate was {xairl_fmt(e.outputs[0, 0])}")
         assert n.components["margin"] is None
     else:  # each action dimension is narrated on its own, nothing is chosen among them
-        assert [s for s in n.text.split(". ") if "was set to" in s][1].startswith("Action_1 was set to")
+        assert [s for s in n.text.split(". ") if "was set to" in s][1].startswith(
+            "action_1 was set to"
+        )  # a declared name, as declared
     # a wrong number in the same words is caught (a continuous action: against its own dimension)
-    view, text = (e, n.text) if head == "value" else (e.output_slice(0), n.text.split(" Action_1")[0])
+    view, text = (e, n.text) if head == "value" else (e.output_slice(0), n.text.split(" action_1 was set")[0])
     assert xairl.verify(text, view, 0, policy).ok
     first = next(c for c in n.claims if c.kind == "number" and "+" in c.text)
     assert not xairl.verify(text.replace(first.text, "+9.99", 1), view, 0, policy).ok

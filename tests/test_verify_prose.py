@@ -11,9 +11,9 @@ import pytest
 import torch
 
 import xairl
-from benchmarks.bench_verifier import explanation_from_tuples, load_corpus, run, shapstories_case
 from tests import cases
 from tests import narrative_domains as domains
+from tests.narrative_corpus import explanation_from_tuples, load_corpus, run, shapstories_case
 from tests.work_budget import calls
 from xairl.narrators.verify.book import clean_surface
 from xairl.narrators.verify.names import find_mentions
@@ -244,7 +244,7 @@ def test_ranks_of_several_names_and_of_one_side(text, accurate):
     "text,accurate", cases.params("phrasings", "outputs_own_words_idioms_and_totals", ("text", "accurate"))
 )
 def test_the_outputs_own_words_idioms_and_totals(text, accurate):
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     cost = one_output(["driver_age", "deductible_usd"], [44, 1000], [-88.0, -199.0], 1850.0, "expected claim cost")
     dropout = one_output(
@@ -282,7 +282,7 @@ def test_a_plus_sign_marks_a_push_not_the_output():
 
 
 def test_a_sum_of_probabilities_in_points():
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     churn = one_output(
         ["Contract", "tenure_months", "MonthlyCharges"],
@@ -312,7 +312,7 @@ def test_list_items_outputs_named_after_and_sums_with_unknown_members(text, accu
 def test_one_word_of_a_long_name_is_no_sure_binding():
     """'bill $109.9 +.097': 'bill' is one word of price_increase_last_bill_pct, and both numbers are the monthly
     charge's exactly: unchecked, not wrong; a number that is no fact after that word stays contradicted."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["price_increase_last_bill_pct", "MonthlyCharges"], [12, 109.9], [0.141, 0.097], 0.4, "churn")
 
@@ -324,7 +324,7 @@ def test_one_word_of_a_long_name_is_no_sure_binding():
 
 
 def test_a_heading_before_a_colon_is_no_invented_feature():
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["gpa", "scholarship"], [3.6, "yes"], [-7.0, -5.0], 18.0, "dropout risk")
     claims = xairl.verify(
@@ -392,29 +392,29 @@ def test_held_out_corpus_agreement(corpus):
     """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
     floors = (
         ("dev", 0.98),
-        ("dev2", 0.95),
-        ("dev3", 0.93),
-        ("dev4", 0.95),
-        ("dev5", 0.93),
-        ("dev6", 0.97),
-        ("dev7", 0.97),
-        ("dev8", 0.9),
-        ("dev9", 0.97),
-        ("dev10", 0.97),
-        ("dev11", 0.94),
-        ("dev12", 0.94),
-        ("dev13", 0.95),
-        ("dev14", 0.93),
-        ("dev15", 0.92),
-        ("dev16", 0.95),
-        ("dev17", 0.9),
-        ("dev18", 0.88),
-        ("dev19", 0.95),
-        ("dev20", 0.93),
-        ("dev21", 0.88),  # (dev21: an invented "uplink SINR" given another
+        ("dev-qa-shorthand-lists", 0.95),
+        ("dev-shares-pipes", 0.93),
+        ("dev-llm-shap-voice", 0.95),
+        ("dev-memo-log-arrows", 0.93),
+        ("dev-lowercase-notes", 0.97),
+        ("dev-by-far-edged-out", 0.97),
+        ("dev-tutor-prose", 0.9),
+        ("dev-comparisons-json", 0.97),
+        ("dev-number-formats", 0.97),
+        ("dev-corrections-qa", 0.94),
+        ("dev-sums-shares", 0.94),
+        ("dev-increases-drops", 0.95),
+        ("dev-storyteller", 0.93),
+        ("dev-analyst-notes", 0.92),
+        ("dev-lists", 0.95),
+        ("dev-hedges", 0.9),
+        ("dev-operator-one-liners", 0.88),
+        ("dev-long-reports", 0.95),
+        ("dev-second-language", 0.93),
+        ("dev-engineers-notes", 0.88),  # (dev-engineers-notes: an invented "uplink SINR" given another
         # feature's exact +4.4 now reads as that feature in words the vocabulary lacks: unchecked)
         ("test", 0.93),
-        ("test2", 0.85),
+        ("test-chat-letters-logs", 0.85),
     )
     for split, floor in floors:
         part = [it for it in corpus if it["split"] == split]
@@ -527,7 +527,7 @@ def test_options_weighed_against_each_other():
     """'favoured turning by x' weighs turning against the runner-up (the margin's contribution holds as well as the
     score's); '(Q 3.10)' after an action is that action's score; a signed number after '<feature> argued for
     <action>' is the feature's contribution; 'the strongest argument for <runner-up>' ranks among the reasons
-    against the decision. Cases of the dev split (dev5's voices)."""
+    against the decision. Cases of the dev split (dev-memo-log-arrows's voices)."""
 
     def ok(text, case):
         return _on_case(text, case).ok
@@ -545,7 +545,7 @@ def test_options_weighed_against_each_other():
 
 
 def test_the_lead_and_what_is_no_direction():
-    """dev6's voices: 'beat staying by x' and 'the handover's lead of x' are the margin whatever is named before;
+    """dev-lowercase-notes's voices: 'beat staying by x' and 'the handover's lead of x' are the margin whatever is named before;
     'pulled in opposite directions' is no direction word."""
     # uav-1: the handover led staying by 0.63; uav-3: by 3.88, the serving RSRQ's share of it +24.5
     assert _on_case("Handing over beat staying by 0.63.", "uav-1").status == "verified"
@@ -558,7 +558,7 @@ def test_the_lead_and_what_is_no_direction():
 
 
 def test_dev7_voices():
-    """Each rule tuned on dev7, on its own case: 'the big one' is a pronoun; 'edged out B (2.52) by x' is the margin;
+    """Each rule tuned on dev-by-far-edged-out, on its own case: 'the big one' is a pronoun; 'edged out B (2.52) by x' is the margin;
     '0.341 base' the baseline; 'pull it down to x' the prediction; 'despite X, ...' is no subject of what follows;
     '2 Mbit' a value in bit; 'held it back from handing over' a direction; 'A outweighed B: list' gives the list to
     neither."""
@@ -590,7 +590,7 @@ def test_signs_in_words():
 
 
 def test_comparisons_between_features():
-    """dev9's voices: 'A mattered more than B', chained through 'which', 'A and B both ... more than C', 'less than',
+    """dev-comparisons-json's voices: 'A mattered more than B', chained through 'which', 'A and B both ... more than C', 'less than',
     'about as much as', 'outweighs'; a comparison with no feature after 'than' is no claim."""
     assert (
         _status("Odor mattered more than gill size, which in turn mattered more than the cap diameter.") == "verified"
@@ -629,7 +629,7 @@ def test_dev10_number_formats():
     "case,text,status", cases.params("on_corpus_cases", "on_corpus_cases", ("case", "text", "status"))
 )
 def test_phrasings_on_corpus_cases(case, text, status):
-    """Each rule tuned on dev8 and dev10 (and later dev splits), with a right and a wrong figure on its own corpus
+    """Each rule tuned on dev-tutor-prose and dev-number-formats (and later dev splits), with a right and a wrong figure on its own corpus
     case (benchmarks/data/verify_cases/on_corpus_cases.yaml)."""
     assert _on_case(text, case).status == status
 
@@ -743,7 +743,7 @@ def test_dev11_corrections():
 
 
 def test_sums_and_scoped_ranks():
-    """dev12's voices: 'A and B together add x' is their sum (a list 'x and y' and 'most of the x above the baseline'
+    """dev-sums-shares's voices: 'A and B together add x' is their sum (a list 'x and y' and 'most of the x above the baseline'
     are not); 'Among the positives, X is the largest' and 'Of the factors lowering it, X matters most' rank within
     that sign."""
     assert _status("Odor and gill size together add 0.26.") == "verified"
@@ -759,7 +759,7 @@ def test_a_qualifier_after_an_ambiguous_name_and_a_compound_modifier():
     """'the queue on the east approach' is queue_east (its words qualify an ambiguous 'queue' after it, and the
     'approach' of approach_speed inside it names nothing); 'the 19-vehicle queue' is a queue, not the emergency
     vehicle; a wrong number for the qualified queue stays contradicted."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(
         ["queue_east", "queue_north", "emergency_vehicle", "approach_speed_avg_kmh"],
@@ -783,7 +783,7 @@ def test_a_qualifier_after_an_ambiguous_name_and_a_compound_modifier():
 
 
 def test_the_first_number_of_a_sentence_about_the_average_case_is_the_baseline():
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["Q3_grade", "attendance_pct"], [54, 71], [9.6, 7.2], 18.4, "probability of dropping out")
 
@@ -804,7 +804,7 @@ def test_the_first_number_of_a_sentence_about_the_average_case_is_the_baseline()
 
 def test_abbreviations_in_feature_names_are_read_as_the_words_people_write():
     """'dist_to_charger_m' is 'the distance', 'battery_pct' 'the battery': a ranking in those words is checked."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(
         ["dist_to_charger_m", "pending_orders", "battery_pct"],
@@ -826,7 +826,7 @@ def test_abbreviations_in_feature_names_are_read_as_the_words_people_write():
 
 def test_a_value_in_another_unit_of_the_one_its_name_ends_in():
     """'next_drop_dist_km' is 0.6: '600 m away' states it, '900 m' does not; 'wait_s' of 90 is '1.5 minutes'."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["next_drop_dist_km", "wait_s"], [0.6, 90], [1.15, -0.4], 3.1, "Q-value of continuing")
 
@@ -844,7 +844,7 @@ def test_a_value_in_another_unit_of_the_one_its_name_ends_in():
 def test_a_period_that_is_the_window_of_a_features_name_is_no_claim():
     """'in the past twelve months' of prior_returns_12m is the name's window even where the words bind the number
     to customer_tenure_mo (71 months); a period no name holds is still checked."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["customer_tenure_mo", "prior_returns_12m"], [71, 0], [-2.3, -1.9], 14.0, "return probability")
 
@@ -861,7 +861,7 @@ def test_a_period_that_is_the_window_of_a_features_name_is_no_claim():
 def test_fractions_state_a_probability_given_in_percent():
     """A dropout probability of 46.9 (%) from 18.4 with Q3_grade +9.6: 'p_dropout=0.469 ... (+0.096)' states it; a
     wrong fraction is caught; an output that is no probability does not read fractions as percentages."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["Q3_grade", "attendance_pct"], [54, 71], [9.6, 18.9], 18.4, "probability of dropping out")
 
@@ -880,7 +880,7 @@ def test_fractions_state_a_probability_given_in_percent():
 
 
 def test_a_change_since_last_time_is_the_features_value_not_its_push():
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["gpa_trend", "units_failed"], [-0.4, 3], [3.1, 11.3], 18.4, "probability of dropping out")
 
@@ -898,7 +898,7 @@ def test_a_change_since_last_time_is_the_features_value_not_its_push():
 def test_the_words_of_one_names_window_do_not_bind_a_number_to_another_name():
     """'in the last 90 days' spells num_support_calls_90d's window, not days_since_last_upgrade: the push after it
     is the support calls'."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(
         ["num_support_calls_90d", "days_since_last_upgrade"], [7, 612], [0.133, 0.029], 0.26, "churn probability"
@@ -912,7 +912,7 @@ def test_the_words_of_one_names_window_do_not_bind_a_number_to_another_name():
 def test_this_rounds_readings_do_not_let_wrong_numbers_through():
     """Counterexamples a second review found for the readings above, each a wrong (or right) number that must keep
     its status."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     def status(text, exp):
         return [c.status for c in xairl.verify(text, exp, 0).claims if c.kind == "number"]
@@ -938,7 +938,7 @@ def test_this_rounds_readings_do_not_let_wrong_numbers_through():
 
 def test_words_people_write_for_a_names_word():
     """'the charge' is battery_pct, 'the fever' temp_c (lexicon.SYNONYMS): their numbers are checked."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["battery_pct", "temp_c"], [76, 38.8], [0.92, 5.3], 3.1, "Q-value of continuing")
 
@@ -953,7 +953,7 @@ def test_words_people_write_for_a_names_word():
 def test_a_push_equal_only_to_a_decision_level_number_is_not_verified():
     """'piles on around 8 more' where the baseline is 8 and no feature pushes 8: not verified as 'a decision-level
     fact' (the words say it is a push)."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["lactate", "heart_rate"], [4.2, 118], [9.6, 4.1], 8.0, "sepsis risk")
 
@@ -1010,7 +1010,7 @@ def test_fronted_phrases_and_swaps():
 
 def test_a_unit_or_statistic_in_a_name_is_no_mention_on_its_own():
     """'14.7 min' names no hm_pr_min and 'avg 3.2' no AvgWait5m; the whole name, and a run of its words, still do."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["hm_pr_min", "AvgWait5m"], [121, 41], [11.2, 0.26], 252.0, "finish time")
     vocab = vocabulary(exp, None, clean_surface)
@@ -1026,7 +1026,7 @@ def test_a_unit_or_statistic_in_a_name_is_no_mention_on_its_own():
 def test_log_odds_given_as_a_probability_and_names_with_an_index_or_an_acronym():
     """A log-odds output and its baseline may be written as the probabilities they stand for; an index in square
     brackets ('forecast_price[+6h]') is part of a name, not a signed number; 'debt-to-income' is dti_ratio."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(
         ["dti_ratio", "forecast_price[+6h]", "FICO_score"],
@@ -1053,7 +1053,7 @@ def test_log_odds_given_as_a_probability_and_names_with_an_index_or_an_acronym()
 def test_a_span_of_time_names_no_feature():
     """'in the last two years' names no months_since_last_record: its 'two' is not that feature's value; the
     written-out acronym 'the antibiotics' still names abx_given_last_24h."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(
         ["delinq_2yrs", "months_since_last_record", "abx_given_last_24h"], [1, 14, 1], [2.6, 0.4, -3.3], 12.0, "risk"
@@ -1117,7 +1117,7 @@ def test_twice_the_size_of_and_more_than_twice_that_of():
 )
 def test_accurate_sentences_of_a_second_review_stay_accurate(explanation, text, accurate):
     """Accurate sentences a second review wrote against this session's readings (second_review.yaml)."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     result = xairl.verify(text, one_output(**cases.explanation(explanation)), 0)
     assert result.accurate == accurate, [
@@ -1127,7 +1127,7 @@ def test_accurate_sentences_of_a_second_review_stay_accurate(explanation, text, 
 
 def test_log_odds_are_no_percentages():
     """'The probability of default is 27%' of log-odds -0.27 (a probability of 43 %): contradicted."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     claims = xairl.verify("The probability of default is 27%.", one_output(**cases.explanation("loan")), 0).claims
     assert [c.status for c in claims if c.kind == "number"] == ["contradicted"]
@@ -1135,7 +1135,7 @@ def test_log_odds_are_no_percentages():
 
 def test_odds_of_a_larger_number_to_a_smaller_one():
     """'outweighs B by about 3 to 2' is a ratio of 1.5, checked; its numbers are no values; '2 to 3' is no odds."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["income", "late_payments"], [52000, 3], [1.46, -1.0], 3.0, "credit score")
 
@@ -1154,7 +1154,7 @@ def test_counterfactuals_output_names_and_pushes_in_other_words_stay_accurate(ex
     """A removal said after the name ('if A had contributed nothing'), a number of the output's name ('gate 4'), an
     index in brackets ('lag[-1]'), a subject in other words with its push in brackets, 'positive terms' and 'most of
     the positive push' (no subject of their own)."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     result = xairl.verify(text, one_output(**cases.explanation(explanation)), 0)
     assert result.accurate == accurate, [
@@ -1168,7 +1168,7 @@ def test_counterfactuals_output_names_and_pushes_in_other_words_stay_accurate(ex
 def test_their_near_misses_are_contradicted(explanation, text, accurate):
     """The same readings with a wrong counterfactual, an invented name whose bracketed number is no contribution, a
     wrong score beside the output's number."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     assert xairl.verify(text, one_output(**cases.explanation(explanation)), 0).accurate == accurate
 
@@ -1176,7 +1176,7 @@ def test_their_near_misses_are_contradicted(explanation, text, accurate):
 def test_an_opposite_of_the_label_is_a_wrong_category():
     """A label's opposite said in a sentence naming its feature, or its label's word in capitals ('outside the ECA'
     of 'inside_ECA'): contradicted; the label itself, or its opposite said beside it, is not."""
-    from benchmarks.bench_verifier import one_output
+    from tests.narrative_corpus import one_output
 
     exp = one_output(["stage", "zone", "yield_lag"], ["early", "inside_ECA", 30.0], [2.4, -0.3, 1.1], 20.0, "yield")
 

@@ -103,7 +103,7 @@ def test_tokens_show_names_and_numbers_as_the_rules_see_them():
 def test_no_sentence_of_the_tuning_voices_breaks_the_reader():
     """Every narrative of two tuning files (outside voices: logs, letters, tables, Q&A) is read without a reader
     failure: a failure would leave its sentence unchecked, silently (the reader never raises)."""
-    from benchmarks.bench_heldout import HELDOUT, load
+    from tests.narrative_corpus import HELDOUT, load
 
     items = [it for name in ("voices_a", "voices_h") for it in load(HELDOUT / "tuning" / f"{name}.yaml")]
     failed = [

@@ -33,6 +33,7 @@ _LAZY = {
     "read_parquet": "xairl.stream",
     # narration and verification
     "narrate": "xairl.narrators",
+    "NarrationOptions": "xairl.narrators",
     "verify": "xairl.narrators",
     "Narrative": "xairl.narrators",
     "Verification": "xairl.narrators",
@@ -40,6 +41,8 @@ _LAZY = {
     "XairlError": "xairl.errors",
     "InputError": "xairl.errors",
 }
+#: old public names -> their successors: an old script gets an error that says what to write instead
+_RENAMED = {"TorchPolicy": "Policy"}
 #: submodules reachable as attributes after a bare ``import xairl`` (``xairl.plots.beeswarm(exp)``)
 _SUBMODULES = ("errors", "facts", "plots", "plugin")
 
@@ -47,9 +50,12 @@ __all__ = sorted([*_LAZY, *_SUBMODULES])
 __version__ = "0.1.0"
 
 
-def lazy_attributes(module: str, table: dict[str, str], submodules: tuple[str, ...] = ()):
+def lazy_attributes(
+    module: str, table: dict[str, str], submodules: tuple[str, ...] = (), renamed: dict[str, str] | None = None
+):
     """``__getattr__`` and ``__dir__`` for ``module``, whose names in ``table`` (name -> 'module' or 'module:attr')
-    and ``submodules`` are imported on first use and then kept as ordinary attributes."""
+    and ``submodules`` are imported on first use and then kept as ordinary attributes; a name in ``renamed`` (old
+    name -> new) raises an AttributeError that names its successor, not a bare one."""
     names = sorted([*table, *submodules])
 
     def __getattr__(name: str):
@@ -58,6 +64,11 @@ def lazy_attributes(module: str, table: dict[str, str], submodules: tuple[str, .
         elif name in table:
             source, _, attr = table[name].partition(":")
             value = getattr(importlib.import_module(source), attr or name)
+        elif name in (renamed or {}):
+            raise AttributeError(
+                f"module '{module}' has no attribute '{name}': it was renamed {module}.{renamed[name]}, which takes "
+                "the same arguments"
+            )
         else:
             raise AttributeError(f"module '{module}' has no attribute '{name}'")
         setattr(sys.modules[module], name, value)
@@ -66,4 +77,4 @@ def lazy_attributes(module: str, table: dict[str, str], submodules: tuple[str, .
     return __getattr__, lambda: names
 
 
-__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, _SUBMODULES)
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, _SUBMODULES, _RENAMED)

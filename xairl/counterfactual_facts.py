@@ -4,14 +4,16 @@
 How it is built from a search's answer (:class:`xairl.counterfactuals.Counterfactuals`): each change's value is
 written as the narratives write values (:func:`xairl.values.value_text`: a buffer in % of its capacity, dBm, a
 category's label), and rounded *away from the line*, to the digits it is written with: 'below 37.6' for a line at
-37.64, never 'below 37.7', which rounds back across it. The state with the values as written is then run through the
-policy (all candidates in one batch, its action mask honoured); the first one that still takes the search's action is
-the fact (else the first that takes any other action than the one taken: the words name what the policy does there),
-with the action and the margin of that re-run. What a template prints is therefore exactly what the verifier
-re-runs (:mod:`xairl.narrators.provenance.counterfactual`). A candidate must also keep the state one the world
-allows as written (:func:`broken`: the policy's ``feasible``, the declared bounds, no immutable feature changed):
-rounding away from the line may step off the searched point. None of the candidates flipping as written (a line that
-bends within one rounding step) leaves the fact out: no sentence rather than a wrong one.
+37.64, never 'below 37.7', which rounds back across it; nor past a declared bound, and a value at its bound is said
+with no direction word ('been -34 dB', not 'below -34 dB' where -34 dB is the floor). The state with the values as
+written is then run through the policy (all candidates in one batch, its action mask honoured); the first one that
+still takes the search's action is the fact (else the first that takes any other action than the one taken: the
+words name what the policy does there), with the action and the margin of that re-run. What a template prints is
+therefore exactly what the verifier re-runs (:mod:`xairl.narrators.provenance.counterfactual`). A candidate must
+also keep the state one the world allows as written (:func:`broken`: the policy's ``feasible``, the declared bounds,
+no immutable feature changed): rounding away from the line may step off the searched point. None of the candidates
+flipping as written (a line that bends within one rounding step) leaves the fact out: no sentence rather than a
+wrong one.
 
 A window policy's past slot (``speed[t-2]``) is named as that slot, 'the speed 2 steps ago' (:func:`feature_words`),
 never by its signal's words alone, which name the current value.
@@ -25,14 +27,14 @@ from dataclasses import replace as _replace
 import numpy as np
 
 from .counterfactuals import Counterfactual, Counterfactuals
+from .counterfactuals.goals import NOISE, feasible, lead
 from .counterfactuals.goals import action_index as resolve  # (the one resolver of an action's name or alias)
-from .counterfactuals.goals import lead
 from .counterfactuals.show import outward as _outward  # (the one rounding rule: away from the line)
 from .counterfactuals.show import summary
 from .errors import InputError
 from .explanation import Explanation
+from .numbers import format_number
 from .policy import FeatureInfo, Policy
-from .prompts import format_number
 from .values import fill_and_text
 
 __all__ = [
@@ -50,9 +52,8 @@ __all__ = [
 
 #: extra rounding steps tried, away from the line, when the value as written does not flip the decision
 _NUDGES = (0, 1, 3)
-#: a flip by less than this share of the scores' size is noise: a float32 network's scores differ in their last bits
-#: between batch shapes, so the check's re-run (one row) could read it either way; the next nudge is said instead
-NOISE = 1e-5
+#: (NOISE: a flip by less than this share of the scores' size is noise, :mod:`xairl.counterfactuals.goals`; the next
+#: nudge is said instead)
 
 
 @dataclass(frozen=True)
@@ -115,6 +116,8 @@ def _written(before: float, after: float, info: FeatureInfo, extra: int) -> tupl
         raw = fill * info.capacity / 100.0
         return raw, fill, fill_and_text(raw, info, None)[1]
     raw = _outward(after, down, extra)
+    if info.bounds is not None:  # rounded away from the line, never past a declared bound: at it ('been -34 dB')
+        raw = float(np.clip(raw, *info.bounds))
     return raw, None, fill_and_text(raw, info, None)[1]
 
 
@@ -145,7 +148,7 @@ def broken(policy: Policy, states: np.ndarray, changed: list[list[int]]) -> list
     """Per changed state (``states`` (n, F), row r with columns ``changed[r]`` changed): '' when the world allows
     it, else which constraint it breaks (an immutable feature changed, a declared bound crossed, the policy's
     ``feasible`` false), in words."""
-    ok = np.ones(len(states), bool) if policy.feasible is None else np.asarray(policy.feasible(states), bool)
+    ok = np.ones(len(states), bool) if policy.feasible is None else feasible(policy, np.asarray(states))
     out = []
     for r, cols in enumerate(changed):
         why = "" if ok[r] else f"policy '{policy.name}' calls that state infeasible (its feasible() is False)"
@@ -259,8 +262,10 @@ def _said(policy: Policy, state: np.ndarray, changes, extra: int) -> tuple[Chang
         was, was_text = fill_and_text(before, info, _label(info, before))
         if _shown(raw, info) == _shown(before, info):
             continue  # no change in the digits written ('0 % full (it was 0 % full)'): left out, and not re-run
-        # no direction word for a category, nor at a capacity's end ('been 100 % full', not 'above 100 % full')
-        direction = "" if info.categories or fill in (0.0, 100.0) else "below" if raw < before else "above"
+        # no direction word for a category, nor at a capacity's end ('been 100 % full', not 'above 100 % full'), nor
+        # at a declared bound ('been -34 dB', not 'below -34 dB' where -34 dB is the floor)
+        end = fill in (0.0, 100.0) or (info.bounds is not None and raw in info.bounds)
+        direction = "" if info.categories or end else "below" if raw < before else "above"
         label = feature_words(policy, c.feature)
         out.append(ChangeFact(c.feature, label, info.unit, before, was_text, raw, text, direction, was, fill))
     return tuple(out)

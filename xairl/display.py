@@ -2,16 +2,21 @@
 in the margin view (the narratives' view), the view named. A Narrative shows its evidence card
 (:func:`xairl.evidence.card_html`); a decision's counterfactuals their own small card (:func:`counterfactual_html`,
 also inside a decision card), or lines on a terminal (:func:`counterfactual_text`). Also a progress bar that is quiet
-in a notebook (:func:`progress`).
+in a notebook (:func:`progress`), and a long step's heartbeat on stderr (:func:`heartbeat`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import html
 import sys
+import threading
+import time
 import warnings
 
 import numpy as np
+
+from .numbers import format_number
 
 #: what tqdm.auto warns, once per process, in a notebook without ipywidgets (shap and transformers import it)
 _NO_WIDGETS = "IProgress not found"
@@ -43,6 +48,59 @@ def show_progress(progress: bool | None) -> bool:
         return progress
     isatty = getattr(sys.stderr, "isatty", None)
     return bool(isatty and isatty())
+
+
+#: seconds of work before progress shows unasked: a bar on a terminal past ``QUIET_S``; elsewhere (a log, a pipe, a
+#: notebook) a plain line every ``LINE_EVERY_S``, so that a run of minutes is never silent and a quick one says nothing
+QUIET_S, LINE_EVERY_S = 3.0, 10.0
+
+
+class WorkProgress:
+    """Progress over ``total`` units (states, or one state's batches), fed in fractions of a unit.
+
+    :param show: True, a bar at once; False, nothing; None (the default of long work), a bar past :data:`QUIET_S`
+        when stderr is a terminal, else a plain line to stderr every :data:`LINE_EVERY_S` ('exact: 37% (1.5 of 4
+        states), 52 s, about 88 s left').
+    """
+
+    def __init__(self, show: bool | None, total: int, desc: str, unit: str):
+        self.total, self.desc, self.unit, self.done = total, desc, unit, 0.0
+        self.start = self.shown_at = time.monotonic()
+        self.whole = 0  # whole units given to the bar
+        terminal = show_progress(None)
+        self.bar = (
+            progress(total=total, desc=desc, unit=unit, delay=0 if show else QUIET_S)
+            if show or (show is None and terminal)
+            else None
+        )
+        self.lines = show is None and not terminal
+
+    def advance(self, amount: float) -> None:
+        self.done += amount
+        now = time.monotonic()
+        if self.bar is not None:
+            whole = min(int(self.done + 1e-9), self.total)
+            if whole > self.whole:
+                self.bar.update(whole - self.whole)
+                self.whole = whole
+            elif now - self.shown_at >= 1 and now - self.start >= self.bar.delay:  # within a long unit: its share
+                self.bar.set_postfix_str(f"{self.done - whole:.0%} of the next {self.unit}")
+                self.shown_at = now
+        elif self.lines and now - self.shown_at >= LINE_EVERY_S:
+            took = now - self.start
+            left = f", about {took * (self.total - self.done) / self.done:.0f} s left" if self.done else ""
+            print(
+                f"{self.desc}: {self.done / self.total:.0%} ({self.done:.3g} of {self.total} "
+                f"{self.unit}{'es' if self.unit.endswith(('s', 'ch')) else 's'}), "
+                f"{took:.0f} s{left}",
+                file=sys.stderr,
+                flush=True,
+            )
+            self.shown_at = now
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
 
 
 def explanation_html(exp, states: int = 5, top: int = 6) -> str:
@@ -107,7 +165,8 @@ def _then(cf: dict, one: dict) -> str:
 
 
 def _g(x) -> str:
-    return f"{x:.3g}" if abs(x) >= 1e-3 or x == 0 else f"{x:.2e}"
+    """3 significant digits, never in scientific notation (0.00064 and 2391 as the words write them)."""
+    return f"{x:.3g}" if 1e-3 <= abs(x) < 1000 else format_number(x)
 
 
 def _changes(one: dict, arrow: str, escape=lambda s: s) -> str:
@@ -142,3 +201,53 @@ def counterfactual_html(cf: dict) -> str:
             f"<table><tr><th>change</th><th>{then}</th><th>margin</th><th>distance (quantiles)</th></tr>{rows}</table>"
         )
     return f"<div class=xairl-cf>{head}{body}</div>"
+
+
+#: the longest a long step stays silent, in seconds (tests shorten it)
+EVERY = 10.0
+#: the steps under way, innermost last (only the innermost speaks), and when stderr last heard from one of them
+_STEPS: list[object] = []
+_LAST = [0.0]
+
+
+@contextlib.contextmanager
+def heartbeat(what: str, enabled: bool = True, every: float | None = None, stream=None):
+    """Says on stderr what a long step is doing, whatever stderr is (a terminal, a log, a pipe), so that it is never
+    silent for more than ``every`` seconds (default :data:`EVERY`, 10): once nothing has been said for that long
+    (for half as long before the outermost step's first line), the innermost step under way says
+    ``xairl: WHAT ...`` (its first line), then ``xairl: still WHAT (N s)``; a step that was said ends with
+    ``xairl: WHAT: done in N s``. A quick step says nothing, so an error in it stays the one line on stderr. A progress bar on the stream is cleared and redrawn around each line
+    (tqdm.write). ``enabled=False``: nothing is said."""
+    if not enabled:
+        yield
+        return
+    quiet_tqdm()
+    from tqdm.auto import tqdm
+
+    every = EVERY if every is None else every
+    t0, stop, token, said = time.monotonic(), threading.Event(), object(), []
+
+    def say(line: str) -> None:
+        tqdm.write(f"xairl: {line}", file=stream or sys.stderr)
+        (stream or sys.stderr).flush()
+        _LAST[0] = time.monotonic()
+        said.append(line)
+
+    def beat() -> None:
+        while not stop.wait(max(every / 10, 0.01)):
+            if _STEPS and _STEPS[-1] is token and time.monotonic() - _LAST[0] >= every:
+                say(f"still {what} ({time.monotonic() - t0:.0f} s)" if said else f"{what} ...")
+
+    if not _STEPS:  # the silence starts now; the first step is said once it has run for half of ``every``
+        _LAST[0] = t0 - every / 2
+    _STEPS.append(token)
+    thread = threading.Thread(target=beat, name="xairl-heartbeat", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+        _STEPS.remove(token)
+    if said:
+        say(f"{what}: done in {time.monotonic() - t0:.0f} s")

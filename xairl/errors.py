@@ -1,8 +1,18 @@
 """Exception types a user can cause. Each message is one line that says what is wrong and what to do."""
 
+import re
+
+#: two periods that end a sentence ('... could not parse it..'), not an ellipsis nor a range ('rows 0..99')
+_DOUBLED = re.compile(r"(?<![.\d])\.\.(?=\s|\)|$)")
+
 
 class XairlError(Exception):
     """Base class of every error xairl raises on purpose; the CLI prints it as one line and exits with status 2."""
+
+    def __init__(self, *args):
+        if args and isinstance(args[0], str):  # a message built around another that ends in '.': one period
+            args = (_DOUBLED.sub(".", args[0]), *args[1:])
+        super().__init__(*args)
 
 
 class InputError(XairlError, ValueError):

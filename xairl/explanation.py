@@ -86,7 +86,7 @@ class Explanation:
         from .explanation_io import check_observation, check_quartiles
 
         if self.observation is not None:  # narration and images read it: checked here, not when it is used
-            object.__setattr__(self, "observation", check_observation(self.observation, f))
+            object.__setattr__(self, "observation", check_observation(self.observation, self.feature_names))
         if self.background_quantiles is not None:  # (its NaN: a region's unknown quartiles, no level words)
             check_quartiles(self.background_quantiles, f)
         for name in ("values", "base_values", "outputs", "states"):  # (a missing quartile: no level words)

@@ -6,14 +6,18 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import MISSING, fields
+from functools import lru_cache
 from typing import Annotated, Any, Literal, get_type_hints
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
 from .errors import InputError, validation_message
+from .observation import Observation
+from .windows import check_slot_names
 
 
 class _Window(BaseModel):
@@ -45,9 +49,11 @@ class _Observation(BaseModel):
     parts: list[_Part] = Field(min_length=1)
 
 
-def check_observation(observation: Any, n_features: int) -> dict:
-    """``observation`` as a plain ``Observation.to_dict()`` of ``n_features`` columns; a one-line
-    :class:`InputError` for anything else (not a mapping, parts missing, a shape that is a number, other columns)."""
+def check_observation(observation: Any, feature_names: tuple[str, ...]) -> dict:
+    """``observation`` as a plain ``Observation.to_dict()`` of one column per feature name; a one-line
+    :class:`InputError` for anything else: not a mapping, parts missing, a shape that is a number, other columns, a
+    form its kind never has (a 'flat' image, a one-part 'tuple', a key twice), or names that say other columns (a
+    window's 'a[t-3]' where its window holds 'a[t-2]')."""
     try:
         obs = _Observation.model_validate(observation)
     except ValidationError as exc:
@@ -55,26 +61,77 @@ def check_observation(observation: Any, n_features: int) -> dict:
             f"Explanation.observation is not what Observation.to_dict() writes: "
             f"{validation_message(exc, 'observation', 'unknown field')}"
         ) from None
-    if obs.kind in ("flat", "array", "window") and len(obs.parts) != 1:
-        raise InputError(f"Explanation.observation of kind '{obs.kind}' has {len(obs.parts)} parts; it has one.")
+    _check_form(obs)
     columns = sum(p.categories or math.prod(p.shape) for p in obs.parts)
-    if columns != n_features:
+    if columns != len(feature_names):
         raise InputError(
             f"Explanation.observation describes {columns} input columns but the values have "
-            f"{n_features} features; give the observation of the explained policy (or None)."
+            f"{len(feature_names)} features; give the observation of the explained policy (or None)."
         )
-    window = obs.parts[0].window
-    if (obs.kind == "window") != (window is not None) or (
-        window is not None and obs.parts[0].shape != [window.steps, len(window.signals)]
-    ):
-        raise InputError("Explanation.observation: a 'window' has one part of shape (steps, signals) with its window.")
     out = obs.model_dump()
     for p in out["parts"]:
         if p["window"] is None:
             del p["window"]
         elif not p["window"]["frames"]:
             del p["window"]["frames"]
+    _check_names(json.dumps(out, sort_keys=True), tuple(feature_names))
     return out
+
+
+def _check_form(obs: _Observation) -> None:
+    """The forms Observation's constructors make, and no other: 'flat' one vector, 'array' one array of 2 axes or
+    more, 'window' one (steps, signals) part with its window, 'tuple' several inputs, 'dict' each key once."""
+    kind, parts = obs.kind, obs.parts
+    why = None
+    if kind in ("flat", "array", "window") and len(parts) != 1:
+        why = f"has {len(parts)} parts; it has one"
+    elif kind == "flat" and (len(parts[0].shape) != 1 or parts[0].categories):
+        why = f"has shape {parts[0].shape}; a flat observation is one vector, [n]"
+    elif kind == "array" and (len(parts[0].shape) < 2 or parts[0].categories):
+        why = f"has shape {parts[0].shape}; an array has 2 axes or more (one vector is 'flat')"
+    elif kind == "tuple" and len(parts) < 2:
+        why = "has one part; a tuple is several inputs (one input is 'flat' or 'array')"
+    elif kind in ("dict", "tuple") and len({p.key for p in parts}) != len(parts):
+        dup = sorted({p.key for p in parts if [q.key for q in parts].count(p.key) > 1})
+        why = f"names key '{dup[0]:.40}' twice"
+    elif (kind == "window") != (parts[0].window is not None) or any(p.window for p in parts[1:]):
+        why = "is inconsistent: a 'window' (and only a window) has one part with its window"
+    elif kind == "window" and parts[0].shape != [parts[0].window.steps, len(parts[0].window.signals)]:
+        w = parts[0].window
+        why = f"has shape {parts[0].shape} but its window is {w.steps} steps x {len(w.signals)} signals"
+    if why:
+        raise InputError(f"Explanation.observation of kind '{kind}' {why}; give what Observation.to_dict() writes.")
+
+
+#: a column's name as an array, a dict or a tuple generates it: 'key[2]', 'key[0,3,4]', 'key=1' (a window's slots:
+#: :data:`xairl.windows.SLOT_FORM`; a flat observation's 'obs_2' says no structure)
+_GENERATED = re.compile(r"(.+?)(?:\[[\d,]+\]|=\d+)", re.S)
+
+
+@lru_cache(maxsize=16)
+def _check_names(observation: str, names: tuple[str, ...]) -> None:
+    """Names that the observation would generate, or names of the caller's own: a name in a generated form of one
+    of its parts (or a window's slot form), or any name when all are in a generated form, must be the generated name
+    of its column, else the names and the observation describe different inputs (cached: an Explanation is checked
+    again at each slice)."""
+    obs = Observation.from_dict(json.loads(observation))
+    if obs.kind == "window":
+        return check_slot_names(obs.parts[0].window, names, "Explanation.feature_names")
+    if obs.kind == "flat":
+        return None
+    keys = {p.key for p in obs.parts}
+    formed = [(j, m.group(1)) for j, n in enumerate(names) if (m := _GENERATED.fullmatch(n))]
+    if not formed:
+        return None
+    generated = obs.feature_names()
+    whole = len(formed) == len(names)  # every name generated: by an observation, this one or another
+    for j, key in formed:
+        if names[j] != generated[j] and (whole or key in keys):
+            raise InputError(
+                f"Explanation.feature_names: column {j} is named '{names[j]:.60}' but the observation "
+                f"({obs.kind}, {obs.describe()}) names it '{generated[j]:.60}'; the names and the observation disagree."
+            )
+    return None
 
 
 def check_quartiles(quartiles: Any, n_features: int) -> None:
@@ -109,8 +166,15 @@ def from_json(cls, text: str | bytes):
         value = float(literal)
         return value if np.isfinite(value) else refuse(literal[:20])
 
+    def once(pairs):  # json keeps the last of a key given twice: which one was meant is unknowable
+        out = dict(pairs)
+        if len(out) != len(pairs):
+            seen = [k for k, _ in pairs]
+            raise ValueError(f"key '{next(k for k in seen if seen.count(k) > 1)[:40]}' is given twice")
+        return out
+
     try:
-        data = json.loads(text, parse_constant=refuse, parse_float=finite)
+        data = json.loads(text, parse_constant=refuse, parse_float=finite, object_pairs_hook=once)
     except RecursionError:
         raise InputError(
             "the explanation's JSON is nested too deeply; give the JSON that Explanation.to_json() writes."

@@ -12,10 +12,10 @@ import numpy as np
 from .counterfactual_facts import CounterfactualFact
 from .errors import InputError, PluginError
 from .explanation import Explanation
+from .numbers import format_number
 from .policy import FeatureInfo, Policy
-from .prompts import format_number
 from .values import fill_and_text, state_value_text, value_level, value_text
-from .windows import Window, said_change, trend, window_of
+from .windows import Window, real_start, signal_facts, window_of
 
 __all__ = [
     "Comparison",
@@ -57,6 +57,8 @@ class FeatureFact:
         third of its push, and it changed), else ''; ``window`` the span in words ('the last 0.8 s').
     :param change_unit: the unit of ``change``: the feature's, a dBm level's change in dB, and a quantity with a
         capacity changes in 'percentage points' of it (``change`` is then in them too: its level is said in % full).
+    :param steps: for such a signal, 'pulled both ways' when its steps' pushes nearly cancel though they weigh as
+        much as the largest reason (:func:`xairl.windows.pulled_both_ways`), else ''.
     """
 
     name: str
@@ -76,6 +78,7 @@ class FeatureFact:
     trend: str = ""
     window: str = ""
     change_unit: str = ""
+    steps: str = ""
 
 
 @dataclass(frozen=True)
@@ -127,7 +130,8 @@ class DecisionFacts:
     :param identifiers: the identifiers (``FeatureInfo(kind='identifier')``) with their values: context for the words
         ("while on BS 15"), never a reason.
     :param trends: the signals of a window said as trends (:attr:`FeatureFact.trend`), in the decision view (the
-        margin; the score when nothing is chosen), largest first, at most ``k``.
+        margin; the score when nothing is chosen), largest first, at most ``k``; ``both_ways`` those whose steps
+        pulled both ways (:attr:`FeatureFact.steps`), any rank.
     :param comparisons: the plugin's :class:`Comparison` facts; ``extras`` its named values (``DomainFacts``).
     :param output: the policy's output kind. For 'value' and 'continuous' (one dimension at a time) nothing is
         chosen: ``action`` names the output, ``score`` is its value, ``runner_up`` is ``action`` again and
@@ -155,6 +159,7 @@ class DecisionFacts:
     identifiers: tuple[FeatureFact, ...] = ()
     trends: tuple[FeatureFact, ...] = ()
     counterfactual: CounterfactualFact | None = None
+    both_ways: tuple[FeatureFact, ...] = ()
 
     def context(self) -> dict[str, Any]:
         """Variables a decision template sees: every field (feature facts as dicts) and ``k``."""
@@ -215,7 +220,7 @@ def narration_units(exp: Explanation, policy: Policy | None) -> list[Unit]:
     for g, members in (policy.reason_groups if policy else {}).items():
         cols = tuple(index[f] for f in members if f in index)
         if cols and len(cols) == len(members) and not taken.intersection(cols):
-            out.append(Unit(g, cols, _info(policy, g)))
+            out.append(Unit(g, cols, policy.features.get(g) or FeatureInfo(kind="group")))  # declared alone too
             taken.update(cols)
     out += [Unit(f, (j,), _info(policy, f)) for j, f in enumerate(exp.feature_names) if j not in taken]
     return out
@@ -244,6 +249,7 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
     q = exp.background_quantiles
     labels = exp.value_labels
     regions = (exp.extras or {}).get("regions") or {}  # an image's regions (xairl.in_regions)
+    start = int(real_start(exp.states[i : i + 1], w)[0]) if (w := window_of(exp)) else 0  # steps before: padding
     out = []
     for n, u in enumerate(us):
         single = len(u.columns) == 1 or u.window is not None  # a signal's value is its newest
@@ -252,9 +258,7 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
         label = None if not single or labels is None or labels[i, j] is None else str(labels[i, j])
         lvl, words = value_level(value, u.info, None if q is None or not single else (float(q[0, j]), float(q[2, j])))
         fill, text = fill_and_text(value, u.info, label, u.name in regions)
-        numeric = u.window is not None and u.info.kind == "numeric"  # a label or an id has no trend
-        moved = trend(exp.states[i, list(u.columns)], contrib[list(u.columns)]) if numeric else None
-        change, change_unit = said_change(moved.change, u.info.unit, u.info.capacity) if moved else (None, "")
+        moved = signal_facts(u, exp.states[i], contrib, start, float(np.abs(c).max()))  # a window's signal: its change
         out.append(
             FeatureFact(
                 u.name,
@@ -270,10 +274,7 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
                 u.info.kind,
                 fill,
                 text,
-                change,
-                "" if moved is None else moved.word,
-                "" if moved is None else u.window.span_text(),
-                change_unit,
+                *moved,
             )
         )
     return out
@@ -323,6 +324,7 @@ def decision_facts(
         base_margin=float(exp.base_values[index, c] - exp.base_values[index, r]) if deciding else 0.0,
         identifiers=tuple(f for f in chosen if f.kind == "identifier"),
         trends=tuple(f for f in (ranked if deciding else _top(chosen, len(chosen)))[:k] if f.trend),
+        both_ways=tuple(f for f in (ranked if deciding else _top(chosen, len(chosen))) if f.steps),
     )
 
 

@@ -3,7 +3,9 @@
 Everything xairl writes for a user (explanations, reports, figures, exports, checkpoints) goes through
 :func:`atomic_write`: the bytes go to a hidden temporary file beside the target (``.NAME.*.part``), are flushed to
 disk, and only then renamed over the target, which is atomic on POSIX and Windows file systems. A reader sees the
-old file or the complete new one, never a mix; an interrupted write leaves at most a ``.part`` file.
+old file or the complete new one, never a mix; an interrupted write leaves at most a ``.part`` file. The file gets
+the permissions any new file gets under the user's umask (``mkstemp`` alone makes it ``-rw-------``, which no web
+server or colleague can read).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ def atomic_write(path: str | Path, mode: str = "w") -> Iterator[IO]:
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
     try:
+        os.chmod(tmp, 0o666 & ~_umask())  # as open() would make it: a report can be served and shared
         with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8"})) as fh:
             yield fh
             fh.flush()
@@ -34,6 +37,13 @@ def atomic_write(path: str | Path, mode: str = "w") -> Iterator[IO]:
         except OSError:
             pass
         raise
+
+
+def _umask() -> int:
+    """The process's umask (read by setting it, then setting it back: the only way POSIX offers)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def write_text(path: str | Path, text: str) -> Path:

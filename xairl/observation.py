@@ -92,7 +92,12 @@ class Observation:
     def array(cls, shape: Sequence[int], key: str = "obs", channels: str = "channels") -> Observation:
         """States of shape ``(n, *shape)``, e.g. frames (n, 4, 84, 84); ``channels="frames"`` says that the first axis
         of an image is a frame stack (its regions are said as 'patch F6 of frame 2', not 'of channel 2')."""
-        return cls("array", (Part(key, tuple(int(s) for s in shape), channels=channels),))
+        shape = tuple(int(s) for s in shape)
+        if len(shape) < 2:  # a vector is 'flat': the explanation records either, and reads back the one it is
+            raise InputError(
+                f"Observation.array takes 2 axes or more, got {shape}; one vector per state is Observation.flat(n)."
+            )
+        return cls("array", (Part(key, shape, channels=channels),))
 
     @classmethod
     def dict(
@@ -123,6 +128,12 @@ class Observation:
     @classmethod
     def several(cls, shapes: Sequence[Sequence[int]]) -> Observation:
         """Several inputs, passed to the module as positional tensors ``module(x0, x1, ...)``."""
+        shapes = list(shapes)
+        if len(shapes) < 2:
+            raise InputError(
+                f"several inputs take 2 shapes or more, got {len(shapes)}; one input is given by its shape, e.g. "
+                "observation=(4, 84, 84)."
+            )
         return cls("tuple", tuple(Part(f"input{i}", tuple(int(s) for s in sh)) for i, sh in enumerate(shapes)))
 
     # ---- the flat view --------------------------------------------------------------------------------------
@@ -183,17 +194,17 @@ class Observation:
             if arr.shape == shape:
                 arr = arr[None]
             if arr.ndim == len(shape) + 1 and arr.shape[1:] == shape:
-                arr = arr.reshape(len(arr), -1)
+                arr = arr.reshape(len(arr), f)  # f, not -1: numpy cannot infer -1 for no states
         if arr.ndim == 1 and arr.size == f:
             arr = arr[None, :]
         if arr.ndim != 2:
             shape = f"a 2-D array (n, {f})" if self.kind == "flat" else f"{self.describe()} or a flat (n, {f}) array"
             raise InputError(f"{what} must be {shape}; got shape {arr.shape}.")
         if arr.shape[0] == 0:
-            raise InputError(f"{what} is empty: give at least one state.")
+            raise InputError(f"{what} {_verb(what, 'are')} empty: give at least one state.")
         if arr.shape[1] != f:
             raise InputError(
-                f"{what} has {arr.shape[1]} features but the policy expects {f}"
+                f"{what} {_verb(what, 'have')} {arr.shape[1]} features but the policy expects {f}"
                 f"{' as ' + self.describe() if self.kind != 'flat' else ''}; check the column order/count."
             )
         return _finite(arr, what, dtype)
@@ -201,12 +212,14 @@ class Observation:
     def _columns(self, states: Mapping, what: str) -> list[np.ndarray]:
         missing = [p.key for p in self.parts if p.key not in states]
         if missing:
-            raise InputError(f"{what} lack key(s) {', '.join(missing)}; the policy takes {self.describe()}.")
+            raise InputError(
+                f"{what} {_verb(what, 'lack')} key(s) {', '.join(missing)}; the policy takes {self.describe()}."
+            )
         cols, n = [], None
         for p in self.parts:
             a = _numeric(states[p.key], f"{what}['{p.key}']")
             if p.categories:
-                a = a.reshape(len(a), -1) if a.ndim > 1 else a[:, None]
+                a = a.reshape(len(a), -1 if len(a) else 1) if a.ndim > 1 else a[:, None]
                 if a.shape[1] != 1 or not np.all((a == np.round(a)) & (a >= 0) & (a < p.categories)):
                     raise InputError(f"{what}['{p.key}'] must hold one integer in 0..{p.categories - 1} per state.")
                 a = np.eye(p.categories, dtype=np.float64)[a[:, 0].astype(int)]
@@ -217,11 +230,13 @@ class Observation:
                     raise InputError(
                         f"{what}['{p.key}'] has shape {a.shape}; expected (n, {', '.join(map(str, p.shape))})."
                     )
-                a = a.reshape(len(a), -1)
+                a = a.reshape(len(a), p.size)
             if n is not None and len(a) != n:
                 raise InputError(f"{what}: the parts have different numbers of states ({n} and {len(a)}).")
             n = len(a)
             cols.append(a)
+        if n == 0:
+            raise InputError(f"{what} is empty: give at least one state.")
         return cols
 
     def unflatten(self, x):
@@ -335,7 +350,7 @@ def _numeric(data, what: str) -> np.ndarray:
         arr = np.asarray(data)
         if arr.dtype.kind in _REFUSED_KINDS:  # numpy would drop the imaginary part or count nanoseconds
             raise InputError(
-                f"{what} hold {_REFUSED_KINDS[arr.dtype.kind]} ({arr.dtype}); give real numbers "
+                f"{what} {_verb(what, 'hold')} {_REFUSED_KINDS[arr.dtype.kind]} ({arr.dtype}); give real numbers "
                 "(float or int), converting the column yourself if that is meant."
             )
         return arr.astype(np.float64)
@@ -344,10 +359,16 @@ def _numeric(data, what: str) -> np.ndarray:
             raise
         raise InputError(f"{what} must be numeric; could not convert ({' '.join(str(exc).split())[:120]}).") from None
     except RecursionError:
-        raise InputError(f"{what} are nested too deeply to be states.") from None
+        raise InputError(f"{what} {_verb(what, 'are')} nested too deeply to be states.") from None
 
 
 _REFUSED_KINDS = {"c": "complex numbers", "M": "dates", "m": "time spans"}
+
+
+def _verb(what: str, plural: str) -> str:
+    """The verb agreeing with ``what``: 'states contain', 'background contains' (the noun before any ':' says)."""
+    noun = (what.split(":")[0].split() or ["states"])[-1]
+    return plural if noun.endswith("s") else {"are": "is", "have": "has"}.get(plural, plural + "s")
 
 
 def _finite(arr: np.ndarray, what: str, dtype=np.float32) -> np.ndarray:
@@ -355,7 +376,7 @@ def _finite(arr: np.ndarray, what: str, dtype=np.float32) -> np.ndarray:
     if bad.any():
         r, c = np.argwhere(bad)[0]
         raise InputError(
-            f"{what} contain {int(bad.sum())} NaN/inf value(s), first at row {r}, column {c}; clean or drop them."
+            f"{what} {_verb(what, 'contain')} {int(bad.sum())} NaN/inf value(s), first at row {r}, column {c}; clean or drop them."
         )
     with np.errstate(over="ignore"):  # reported below in one line, not as a numpy warning
         out = arr.astype(dtype)
@@ -363,7 +384,7 @@ def _finite(arr: np.ndarray, what: str, dtype=np.float32) -> np.ndarray:
     if over.any():
         r, c = np.argwhere(over)[0]
         raise InputError(
-            f"{what} hold {int(over.sum())} value(s) beyond the {np.dtype(dtype).name} range (±"
+            f"{what} {_verb(what, 'hold')} {int(over.sum())} value(s) beyond the {np.dtype(dtype).name} range (±"
             f"{np.finfo(dtype).max:.2g}) the network computes in, first at row {r}, column {c} ({arr[r, c]:.3g}); "
             "scale those inputs down, or give a float64 network (module.double())."
         )

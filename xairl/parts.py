@@ -1,6 +1,8 @@
 """The parts of a streamed run: each chunk's Parquet file, carrying its run, its rows and a checksum, and the check
 of a folder's parts before a run resumes (a damaged part is explained again; a file that is no part of this run is
-refused by name)."""
+refused by name). The checksum inside a part covers its columns and metadata, not the Parquet footer's statistics,
+which filtered readers trust to skip row groups; so each part's bytes are also hashed as written, recorded in
+``run.json`` (key ``parts``), and a part is kept on resume only when its bytes still match."""
 
 from __future__ import annotations
 
@@ -16,6 +18,7 @@ from .errors import InputError, one_line
 from .explanation import Explanation
 
 DATASET = "explanations.parquet"
+RECORDED = "parts"  # run.json's key of the SHA-256 of each part's bytes, by name, as written
 PART = re.compile(r"part-(\d{12})\.parquet")  # a part's name: its first row
 
 
@@ -23,8 +26,9 @@ def part_name(first: int) -> str:
     return f"part-{first:012d}.parquet"
 
 
-def write_part(folder: Path, first: int, exp: Explanation, meta: dict) -> Path:
-    """One chunk as ``folder/part-<first>.parquet``, written whole or not at all."""
+def write_part(folder: Path, first: int, exp: Explanation, meta: dict) -> str:
+    """One chunk as ``folder/part-<first>.parquet``, written whole or not at all; returns the SHA-256 of its bytes
+    (for run.json)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -52,10 +56,21 @@ def write_part(folder: Path, first: int, exp: Explanation, meta: dict) -> Path:
     table = pa.table(columns)
     meta["sha256"] = _checksum(table, meta)
     table = table.replace_schema_metadata({"xairl": json.dumps(meta)})
-    path = folder / part_name(first)
-    with atomic_write(path, "wb") as fh:
-        pq.write_table(table, fh, compression="zstd")
-    return path
+    sink = pa.BufferOutputStream()  # a chunk's part is a few MB: hashed whole, as it goes to disk
+    pq.write_table(table, sink, compression="zstd")
+    data = sink.getvalue()
+    with atomic_write(folder / part_name(first), "wb") as fh:
+        fh.write(data)
+    return hashlib.sha256(data).hexdigest()
+
+
+def file_sha256(path: Path) -> str:
+    """SHA-256 of a file's bytes, read 1 MiB at a time."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while block := fh.read(1 << 20):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def _checksum(table, meta: dict) -> str:
@@ -103,9 +118,10 @@ def check_part(path: Path, first: int, rows: int, run: str) -> tuple[str, str]:
     return "ok", ""
 
 
-def existing_parts(out: Path, identity: dict, resume: bool, run: str, total) -> set[int]:
-    """First rows of the chunks an earlier run completed and that are whole (empty for a new folder); refuses
-    another run's folder, and any file in the dataset that is not a part of this run, by name."""
+def existing_parts(out: Path, identity: dict, resume: bool, run: str, total) -> dict[int, str]:
+    """First row -> SHA-256 of the chunks an earlier run completed and that are whole, their bytes as recorded in
+    run.json (empty for a new folder); refuses another run's folder, states that changed since the run began, and
+    any file in the dataset that is not a part of this run, by name."""
     folder = out / DATASET
     try:
         files = sorted(p for p in folder.iterdir() if not p.name.startswith((".", "_"))) if folder.is_dir() else []
@@ -113,15 +129,23 @@ def existing_parts(out: Path, identity: dict, resume: bool, run: str, total) -> 
         raise InputError(f"cannot read {folder} ({exc.strerror}); give a folder you can read and write.") from None
     parts = [p for p in files if PART.fullmatch(p.name)]
     if not files and not (out / "run.json").exists():
-        return set()
+        return {}
     if not resume and (parts or (out / "run.json").exists()):
         raise InputError(
             f"{out} already holds a run ({len(parts)} chunk(s) written); pass --resume to continue it, "
             "or give another folder."
         )
     earlier = _record(out / "run.json")
+    recorded = (earlier or {}).pop(RECORDED, None)
+    recorded = recorded if isinstance(recorded, dict) else {}  # (none recorded: every part is explained again)
     if earlier is not None and earlier != json.loads(json.dumps(identity)):
         changed = sorted(k for k in identity if earlier.get(k) != json.loads(json.dumps(identity))[k])
+        if changed == ["source_sha256"]:  # the same file, other contents: resuming would mix old rows and new
+            what = "the states array" if identity["source"] == "array" else identity["source"]
+            raise InputError(
+                f"{what} changed since the run in {out} began (its contents differ from the SHA-256 "
+                f"in run.json); rerun without --resume into another folder, or delete {out} and run again."
+            )
         raise InputError(
             f"{out} holds another run (it differs in {', '.join(changed) or 'run.json'}); resume needs "
             "the same states, policy, background, method, options and chunk size (if they are the same, "
@@ -140,16 +164,27 @@ def existing_parts(out: Path, identity: dict, resume: bool, run: str, total) -> 
             f"first rows multiples of {chunk} below {n}",
             folder,
         )
-    done = set()
+    done, unrecorded = {}, 0
     for path in parts:
         first = int(path.name[5:17])
         verdict, why = check_part(path, first, min(chunk, n - first), run)
         if verdict == "foreign":
             raise _not_ours([path], why, folder)
+        if verdict == "ok" and path.name not in recorded:  # written by a run cut off before it recorded the part
+            unrecorded += 1
+            continue
+        digest = file_sha256(path) if verdict == "ok" else ""
+        if verdict == "ok" and digest != recorded[path.name]:  # the footer's statistics, say: filters would skip rows
+            verdict, why = "bad", "its bytes differ from the SHA-256 recorded in run.json when it was written"
         if verdict == "ok":
-            done.add(first)
+            done[first] = digest
         else:  # written over when its chunk is explained again
             logging.getLogger("xairl").warning(f"xairl: {path}: damaged ({why}); its rows are explained again.")
+    if unrecorded:
+        logging.getLogger("xairl").warning(
+            f"xairl: {unrecorded} part(s) in {folder} have no SHA-256 in run.json (a run cut off as it wrote them, or "
+            "run.json deleted): their rows are explained again."
+        )
     return done
 
 
@@ -169,8 +204,8 @@ def _record(path: Path) -> dict | None:
         record, what = None, "not JSON"
     if not isinstance(record, dict):
         raise InputError(
-            f"{path}: not the record of a run ({what}); delete it and --resume again (each part is "
-            "checked against this run), or give another folder."
+            f"{path}: not the record of a run ({what}); delete it and --resume again (the parts are then "
+            "explained again), or give another folder."
         )
     return record
 

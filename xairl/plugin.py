@@ -32,6 +32,8 @@ _LAZY = {
     "save_figure": "xairl.files",
     # a progress bar that is quiet in a notebook without ipywidgets
     "progress": "xairl.display",
+    # a long step said on stderr as it starts, every 10 s while it runs, and when it ends (logs and pipes too)
+    "heartbeat": "xairl.display",
     # registries and checks
     "get_attributor": "xairl.plugins",
     "check_template": "xairl.narrators",

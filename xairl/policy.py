@@ -13,9 +13,9 @@ import torch
 
 from .errors import InputError
 from .heads import check_kinds, heads
-from .network import PolicyNetwork, module_dtype
+from .network import PolicyNetwork, eval_mode, module_dtype
 from .observation import Observation, names_preview
-from .windows import slot_features
+from .windows import check_slot_names, slot_features
 
 
 @dataclass(frozen=True)
@@ -73,6 +73,11 @@ class FeatureInfo:
                     f"FeatureInfo bounds must be (low, high) numbers (or -inf/inf) with low <= high, got "
                     f"{self.bounds!r:.60}."
                 )
+            if b[0] == np.inf or b[1] == -np.inf:  # (inf, inf) holds no value: it cannot bound anything
+                raise InputError(
+                    f"FeatureInfo bounds {self.bounds!r:.60} hold no value: the low bound must be below inf and the "
+                    "high above -inf (use -inf/inf for no limit on a side)."
+                )
             object.__setattr__(self, "bounds", (float(b[0]), float(b[1])))
         if not isinstance(self.immutable, (bool, np.bool_)):
             raise InputError(f"FeatureInfo immutable is True or False, got {self.immutable!r:.40}.")
@@ -118,7 +123,8 @@ class Policy:
         ``kick``) is refused; say ``output="actions"`` where such names really are actions.
     :param features: optional :class:`FeatureInfo` per feature name, and per group name for a group narrated as
         one reason (``kind='group'``).
-    :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}`` (plots show each as one bar).
+    :param groups: named groups of features, e.g. ``{"position": ("x", "y", "z")}``: plots show each as one bar, and
+        narratives name each as one reason (:attr:`reason_groups`), unless each of its members is described.
     :param background_sampler: optional ``f(n, seed) -> states`` of typical states (any form ``observation`` takes).
     :param name: how the policy is called in reports.
     :param action_aliases: other names of each action in text, e.g. ``{"stay": ["keep the serving BS"]}``.
@@ -137,6 +143,8 @@ class Policy:
         seconds between observations (:mod:`xairl.windows`).
     :param feasible: optional ``f(states (n, n_features)) -> bool (n,)``, True for the states the world allows
         (coupled constraints, such as an RSRQ its RSRP makes possible): a counterfactual it rejects is never returned.
+    :param description: what is explained, where the module alone does not say it (from_sb3: a recurrent policy's
+        LSTM unrolled over a window, and from which state); its explanations keep it as ``extras['policy']``.
     """
 
     module: torch.nn.Module
@@ -153,6 +161,7 @@ class Policy:
     output: Literal["actions", "continuous", "value"] | Sequence[str] | None = None
     window: int | None = None
     feasible: Callable[[np.ndarray], np.ndarray] | None = None
+    description: str = ""
 
     def __post_init__(self) -> None:
         if not isinstance(self.module, torch.nn.Module):
@@ -179,6 +188,7 @@ class Policy:
         window = self.observation.parts[0].window if self.observation.kind == "window" else None
         normalise("window", window.steps if window else None)
         normalise("name", str(self.name))
+        normalise("description", str(self.description))
         normalise("network", PolicyNetwork(self.module, self.observation, self.name))
         if self.action_names is None:  # count the outputs on one all-zero state
             n = 1 if self.output == "value" else self._raw_scores(np.zeros((1, self.observation.n_features))).shape[1]
@@ -213,7 +223,8 @@ class Policy:
         return (
             f"Policy({self.name!r}, {names_preview(self.feature_names, 'features')}; "
             f"{names_preview(self.action_names, 'actions' if self.output == 'actions' else 'outputs')}; "
-            f"output {self.output}, observation {self.observation.describe()})"
+            f"output {self.output}, observation {self.observation.describe()}"
+            f"{'; ' + self.description if self.description else ''})"
         )
 
     @classmethod
@@ -237,8 +248,18 @@ class Policy:
 
     @property
     def reason_groups(self) -> dict[str, tuple[str, ...]]:
-        """Groups narrated as one reason (those described with ``FeatureInfo(kind='group')``)."""
-        return {g: tuple(self.groups[g]) for g, i in self.features.items() if i.kind == "group"}
+        """Groups narrated as one reason: those described with ``FeatureInfo(kind='group')``, then every other
+        declared group, except one whose members all have words of their own (a :class:`FeatureInfo` each: they keep
+        them, and the group sums them in figures and the report's grouped summary) or that shares a member with a
+        group before it."""
+        out = {g: tuple(self.groups[g]) for g, i in self.features.items() if i.kind == "group"}
+        taken = {f for members in out.values() for f in members}
+        for g, members in self.groups.items():
+            if g in out or taken.intersection(members) or all(f in self.features for f in members):
+                continue
+            out[g] = tuple(members)
+            taken.update(members)
+        return out
 
     @property
     def n_actions(self) -> int:
@@ -273,14 +294,10 @@ class Policy:
         return out
 
     def _raw_scores(self, x: np.ndarray) -> np.ndarray:
-        """The module's outputs for checked flat states, in eval mode, without gradients (its flag restored)."""
-        was_training = self.module.training
-        self.module.eval()
-        try:
-            with torch.no_grad():
-                out = self.network(torch.as_tensor(x, dtype=_TORCH[self.dtype], device=self.device))
-        finally:
-            self.module.train(was_training)
+        """The module's outputs for checked flat states, in eval mode, without gradients (its flags restored; layers
+        left in training mode that eval mode changes are named in a warning, once per policy)."""
+        with eval_mode(self.module, self), torch.no_grad():
+            out = self.network(torch.as_tensor(x, dtype=_TORCH[self.dtype], device=self.device))
         return out.detach().cpu().numpy().astype(np.float64)
 
     def available(self, states) -> np.ndarray:
@@ -314,9 +331,6 @@ class Policy:
                 "on the command line, background=array in Python."
             )
         return self.check_states(self.background_sampler(n, seed), "background")
-
-
-TorchPolicy = Policy  # the name users of plain torch networks (CleanRL style) look for
 
 
 def model_hash(module) -> str:
@@ -368,6 +382,8 @@ def _with_window(window, observation, feature_names) -> tuple[Observation, Seque
     if observation.kind == "window" and feature_names is not None:
         if tuple(map(str, feature_names)) == observation.parts[0].window.signals:
             feature_names = None  # the signals' names: the slots' are generated from them
+        else:  # names of the slots: none may say another slot than its column holds ('a[t-1]' beside signal 'a')
+            check_slot_names(observation.parts[0].window, list(map(str, feature_names)))
     return observation, feature_names
 
 

@@ -9,7 +9,7 @@ Lookup of ``NAME``: explicit folders (``--prompts DIR``) > ``$XAIRL_USER_PATH/pr
 
 from __future__ import annotations
 
-import decimal
+import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -22,6 +22,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from . import sandbox
 from .errors import UnknownNameError, XairlError, validation_message
+from .numbers import format_number
 from .paths import user_dir
 from .sandbox import MAX_LOOP_DEPTH, loop_depth
 from .tracking import Rendered, TrackedFloat, TrackedInt, TrackedStr, recording, untangle
@@ -47,9 +48,30 @@ DECISION_VARS = {
     "base_margin",
     "identifiers",
     "trends",
+    "both_ways",
     "counterfactual",
 }
 GLOBAL_VARS = {"n_states", "method", "ranking", "view", "target", "k"}
+#: the size of a template: every variant is compiled and rendered on every narration, and `xairl prompts check`
+#: verifies each on ~100 decisions (the built-ins: under 5 KB, at most 7 sentences and 14 variants)
+MAX_BYTES = 32 * 1024
+MAX_SENTENCES = 30
+MAX_VARIANTS = 60
+
+
+#: bidirectional overrides, embeddings, isolates and marks: invisible, and they reorder what a reader sees ('by
+#: U+202E 5.03 U+202C' is shown as 'by 30.5'), so words holding one are never shown nor passed as verified
+_BIDI = re.compile("[\u061c\u200e\u200f\u202a-\u202e\u2066-\u2069]")
+
+
+def bidi_controls(text: str) -> str:
+    """The bidirectional control characters in ``text``, named ('U+202E, U+202C'); '' when it has none."""
+    return ", ".join(dict.fromkeys(f"U+{ord(c):04X}" for c in _BIDI.findall(text)))
+
+
+def bidi_visible(text: str) -> str:
+    """``text`` with each bidirectional control character written out ('<U+202E>'), for a terminal to show as is."""
+    return _BIDI.sub(lambda m: f"<U+{ord(m.group()):04X}>", text)
 
 
 class TemplateError(XairlError):
@@ -73,42 +95,20 @@ class TemplateSpec(BaseModel):
         return [[s] if isinstance(s, str) else s for s in v] if isinstance(v, list) else v
 
 
-def format_number(x: float, signed: bool = False) -> str:
-    """How every number in a narrative is written (the ``num`` and ``signed`` filters, and the facts' own texts):
-    0 decimals from 100, 1 from 10, else 2 (3 significant digits below 0.01)."""
-    x = float(x)
-    a = abs(x)
-    if x.is_integer() and a < 1e6:  # ids, counts
-        s = f"{x:.0f}"
-    elif a >= 100:
-        s = f"{x:.0f}"
-    elif a >= 10:
-        s = f"{x:.1f}"
-    elif a >= 0.01 or a == 0:
-        s = f"{x:.2f}"
-    else:
-        s = f"{x:.3g}"
-    if s.startswith("-") and float(s) == 0:
-        s = s[1:]
-    return ("+" + s) if signed and not s.startswith("-") else s
-
-
-def written_step(x: float) -> float:
-    """The place of the last digit :func:`format_number` writes of ``x`` (1 for '120', 0.1 for '37.6', 1e-05 for
-    '0.00123'): a value rounded to it is written exactly."""
-    return 10.0 ** decimal.Decimal(format_number(x)).as_tuple().exponent
-
-
 def _num(x, signed: bool = False) -> str:
     text = format_number(x, signed)
     return x.printed(text) if isinstance(x, (TrackedFloat, TrackedInt)) else text
 
 
 def _cap(t) -> str:
-    """The first letter capitalised (past a tracked value's markers)."""
+    """The first letter capitalised (past a tracked value's markers) when the first word is a plain lowercase word
+    ('pole angle' -> 'Pole angle'); a name as declared is kept ('cart_velocity', 'rsrp_1', 'dQ' are not words to
+    capitalise: 'Cart_velocity' names nothing)."""
     s = str(t)
     i = next((n for n, c in enumerate(s) if not "\ue000" <= c <= "\ue01f"), len(s))
-    return s[:i] + s[i : i + 1].upper() + s[i + 1 :]
+    word = "".join(c for c in s[i:].split(maxsplit=1)[0] if not "\ue000" <= c <= "\ue01f") if s[i:].strip() else ""
+    plain = word.rstrip(".,;:!?)").replace("-", "").replace("'", "")
+    return s[:i] + s[i : i + 1].upper() + s[i + 1 :] if plain.isalpha() and plain.islower() else s
 
 
 def _dir(x, toward: str = "toward", against: str = "against") -> str:
@@ -130,13 +130,18 @@ def _join(value, d: str = "", attribute=None) -> str:
     return str(d).join(str(x) for x in items)
 
 
+#: a tracked value's bookkeeping (:mod:`xairl.tracking`): '{{ score.fact }}' would print an internal record
+TRACKING = ("fact", "transform", "printed")
+
+
 def environment() -> ImmutableSandboxedEnvironment:
     """A fresh bounded sandbox (:mod:`xairl.sandbox`) with the template filters: ``num`` and ``signed`` write numbers
     as :func:`format_number` does, ``cap`` capitalises the first letter, ``dir('raised', 'lowered')`` writes the
     first word for a number >= 0 and the second for a negative one (default 'toward' / 'against'). Each keeps the
     fact of a tracked value (:mod:`xairl.tracking`)."""
     return sandbox.environment(
-        {"num": _num, "signed": lambda x: _num(x, True), "cap": _cap, "dir": _dir, "join": _join}
+        {"num": _num, "signed": lambda x: _num(x, True), "cap": _cap, "dir": _dir, "join": _join},
+        hidden=TRACKING,
     )
 
 
@@ -165,7 +170,14 @@ class Template:
         try:
             with recording() as record:
                 marked = sandbox.render(env, text, context)
+            if bidi := bidi_controls(marked):
+                raise TemplateError(
+                    f"{where}: the rendered words hold bidirectional control characters ({bidi}), which reorder "
+                    "what a reader sees; remove them from the template and from the names and descriptions it prints."
+                )
             return Rendered(*untangle(marked, record))
+        except TemplateError:
+            raise
         except SecurityError as exc:
             raise TemplateError(f"{where}: refused by the sandbox ({exc}).") from None
         except UndefinedError as exc:
@@ -176,7 +188,7 @@ class Template:
                 "allows; templates may not recurse)."
             ) from None
         except TemplateSyntaxError as exc:
-            raise TemplateError(f"{where}: syntax error: {exc.message}.") from None
+            raise TemplateError(f"{where}: syntax error: {exc.message.rstrip('.')}.") from None
         except Exception as exc:  # a filter or test raising on odd data
             raise TemplateError(f"{where}: cannot render ({type(exc).__name__}: {exc}).") from None
 
@@ -230,9 +242,17 @@ def _variant_lines(text: str) -> list[list[int]]:
 
 
 def _read(path: Path) -> str:
-    """The file's text; a file that cannot be read or is not UTF-8 text is no template to list problems of."""
+    """The file's text; a file that cannot be read, is larger than :data:`MAX_BYTES` or is not UTF-8 text is no
+    template to list problems of."""
     try:
-        return path.read_bytes().decode("utf-8")
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_BYTES + 1)
+        if len(data) > MAX_BYTES:
+            raise TemplateError(
+                f"{path}: larger than {MAX_BYTES // 1024} KB, the most a template may be (the built-ins are under "
+                "5 KB); say less in it, or split it into templates of their own."
+            )
+        return data.decode("utf-8")
     except OSError as exc:
         raise TemplateError(f"{path}: cannot read it ({exc}).") from None
     except UnicodeDecodeError as exc:
@@ -258,12 +278,29 @@ def _parse_text(path: Path, text: str) -> Template:
         spec = TemplateSpec.model_validate(data)
     except ValidationError as exc:
         raise TemplateError(f"{path}: {validation_message(exc, 'template')}") from None
+    variants = sum(map(len, spec.sentences))
+    if len(spec.sentences) > MAX_SENTENCES or variants > MAX_VARIANTS:
+        raise TemplateError(
+            f"{path}: {len(spec.sentences)} sentences with {variants} variants; a template may have at most "
+            f"{MAX_SENTENCES} sentences and {MAX_VARIANTS} variants in all (each is rendered and verified on every "
+            "narration): keep the sentences that say most, or split it into templates of their own."
+        )
     return Template(spec, path, lines or [[0] * len(s) for s in spec.sentences])
 
 
 def parse(path: Path) -> Template:
     """Read and validate a template file; raises :class:`TemplateError` naming the file and line."""
     return _parse_text(path, _read(path))
+
+
+def _unknown_callables(env: ImmutableSandboxedEnvironment, ast) -> list[tuple[int, str]]:
+    """(line in the variant, problem) for each filter or test the sandbox does not have ('x|nosuch', 'x is nosuch')."""
+    out = []
+    for node in ast.find_all((nodes.Filter, nodes.Test)):
+        kind, known = ("filter", env.filters) if isinstance(node, nodes.Filter) else ("test", env.tests)
+        if node.name not in known:
+            out.append((node.lineno, f"unknown {kind} '{node.name}'; the {kind}s are: {', '.join(sorted(known))}"))
+    return out
 
 
 def check(path: str | Path, sample: Callable[[str], dict] | None = None) -> list[str]:
@@ -298,7 +335,10 @@ def check(path: str | Path, sample: Callable[[str], dict] | None = None) -> list
                 for n in [a.target, *a.target.find_all(nodes.Name)]
                 if isinstance(n, nodes.Name)
             }
-            for name in sorted(meta.find_undeclared_variables(ast) - allowed - assigned):
+            unknown = _unknown_callables(env, ast)
+            problems += [f"{path}:{base + line - 1}: {problem}" for line, problem in unknown]
+            # (Jinja compiles the variant to find its variables, and fails at an unknown filter or test)
+            for name in sorted(set() if unknown else meta.find_undeclared_variables(ast) - allowed - assigned):
                 problems.append(
                     f"{path}:{base}: unknown variable '{name}'; a {tpl.spec.kind} template has: "
                     f"{', '.join(sorted(allowed))}"

@@ -233,7 +233,7 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     :param explained: explanations already computed, by dataset label (the others are explained here).
     """
     from .attributors import explain
-    from .display import progress
+    from .display import heartbeat, progress
 
     t0 = time.time()
     out = Path(req.out)
@@ -241,16 +241,20 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
     (out / "report.html").unlink(missing_ok=True)  # a failed re-run must not leave the last run's report beside it
     exps: list[tuple[str, Explanation]] = []
     explained = explained or {}
-    for label, states in progress(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress):
-        exps.append(
-            (
-                label,
-                explained.get(label)
-                or explain(
-                    content.policy, states, background=content.background, method=req.method, options=req.options
-                ),
+    bar = progress(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress)
+    for label, states in bar:  # a bar of a few steps: a long one also said every 10 s
+        with heartbeat(
+            f"explaining ({req.method}) {len(states)} {label} states", req.progress and label not in explained
+        ):
+            exps.append(
+                (
+                    label,
+                    explained.get(label)
+                    or explain(
+                        content.policy, states, background=content.background, method=req.method, options=req.options
+                    ),
+                )
             )
-        )
     if req.records:
         with atomic_write(out / "explanations.jsonl") as fh:
             for label, exp in exps:
@@ -259,7 +263,8 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
         write_text(out / "explanations.schema.json", json.dumps(StateRecord.model_json_schema(), indent=2))
     ref = exps[0][1]
     pick = _interesting(ref)
-    figures = _figures(exps, pick, dict(content.policy.groups), out, content.policy) + list(content.figures)
+    with heartbeat("drawing the figures", req.progress):
+        figures = _figures(exps, pick, dict(content.policy.groups), out, content.policy) + list(content.figures)
     # an image's importance by region (the top ones), not by pixel; its narratives' cards list regions too
     regioned = [(label, in_regions(e)) for label, e in exps]
     image = regioned[0][1] is not ref
@@ -274,7 +279,8 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
         title, header, rows, sentence = cfs.flip_rows(content.policy, ref, content.background)
         tables.append((title, table_html(header, rows)))
         notes.append(sentence)
-    narratives = _narratives(req, content, ref, regioned[0][1], pick) if req.narrate else []
+    with heartbeat(f"narrating {min(req.n_narrated, len(ref.values))} decisions", req.progress and req.narrate):
+        narratives = _narratives(req, content, ref, regioned[0][1], pick) if req.narrate else []
     settings = {
         "method": req.method,
         "options": req.options,

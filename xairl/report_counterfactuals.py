@@ -8,12 +8,12 @@ been ..., the policy would have chosen ...', checked by re-running the policy on
 in its card's evidence (``evidence['counterfactual']``, :func:`xairl.counterfactual_facts.as_written`), so the review
 page shows it as the report does.
 
-The run: for the first :data:`RUN` decisions, every feature that may change is tried alone (``max_changes=1``,
-``target='any'``: any other action; one batched search keeps each feature's nearest flipping value). Per feature
-and per chosen action: how many decisions a change of that feature alone flips, and the median change needed, in
-the feature's unit (a feature with a capacity in % of it) and in percentiles of the background (its quantile
-times 100). The rows
-'some single feature' and 'no single feature' add up to the decisions of each action.
+The run: for the first :data:`RUN` decisions, every feature that may change (a window's: its newest step's) is tried
+alone (``max_changes=1``, ``target='any'``: any other action; one batched search keeps each feature's nearest
+flipping value). Per feature and per chosen action: how many decisions a change of that feature alone flips, and the
+median change needed, in the feature's unit (a feature with a capacity in % of it) and in percentiles of the
+background (its quantile times 100). The rows 'some single feature' and 'no single feature' add up to the decisions
+of each action.
 
 Shown for discrete actions of flat, dict or window observations; an image's regions are not searched here (a
 search per region costs hundreds of forward passes of the network per decision).
@@ -30,8 +30,8 @@ import numpy as np
 from .counterfactuals import Counterfactuals
 from .counterfactuals.show import single_flips
 from .explanation import Explanation
+from .numbers import format_number
 from .policy import Policy
-from .prompts import format_number
 from .values import value_text
 
 #: decisions of a run tried feature by feature (about 1 ms each for an MLP: one batched search)

@@ -27,7 +27,7 @@ from urllib.parse import parse_qs, urlencode, urlparse
 
 from .errors import InputError
 from .evidence import CARD_STYLE, card_html, lines_html
-from .feedback import FeedbackStore, Record
+from .feedback import STATUSES, FeedbackStore, Record
 
 HOST = "127.0.0.1"
 MAX_BODY = 1_000_000  # a correction is a few sentences; more than this is not from the page
@@ -167,6 +167,22 @@ def page(store: FeedbackStore, token: str, show_all: bool = False, message: str 
     )
 
 
+#: what the page says after a review, by the code its address carries: never text from the address itself (a crafted
+#: link would make the page say anything)
+MESSAGES = {
+    **{status: f"#{{id}} {status}" for status in STATUSES},
+    "bad-status": "not stored: choose accept, reject or correct.",
+    "no-text": "not stored: a correction needs its text.",
+    "unknown-id": "not stored: there is no narrative #{id} in this store.",
+}
+
+
+def _message(query: dict) -> str:
+    """The message of the code in ``query['msg']`` (with its narrative's number); '' for no code or an unknown one."""
+    text, number = MESSAGES.get(query.get("msg", ""), ""), query.get("id", "")
+    return text.format(id=number) if _NUMBER.fullmatch(number) or "{id}" not in text else ""
+
+
 class _Handler(BaseHTTPRequestHandler):
     """One request; the store, the form token and the allowed Hosts are the server's (:func:`make_server`)."""
 
@@ -205,8 +221,8 @@ class _Handler(BaseHTTPRequestHandler):
         url = urlparse(self.path)
         if url.path != "/":
             return self._send(HTTPStatus.NOT_FOUND, "not found")
-        q = parse_qs(url.query)
-        self._send(HTTPStatus.OK, page(self.server.store, self.server.token, bool(q.get("all")), q.get("msg", [""])[0]))
+        q = {k: v[0] for k, v in parse_qs(url.query).items()}
+        self._send(HTTPStatus.OK, page(self.server.store, self.server.token, bool(q.get("all")), _message(q)))
 
     def _form(self) -> dict | None:
         """The posted form, once the Origin, the length and the token are checked; None after an error answer."""
@@ -243,10 +259,10 @@ class _Handler(BaseHTTPRequestHandler):
         correction = form.get("correction", "").strip() if status == "corrected" else None
         try:
             self.server.store.review(int(form["id"]), status, correction)
-            msg = f"#{form['id']} {status}"
-        except (InputError, ValueError) as exc:
-            msg = f"not stored: {exc}"
-        self._send(HTTPStatus.SEE_OTHER, location="/?" + urlencode({"msg": msg}))
+            code = status
+        except (InputError, ValueError):
+            code = "bad-status" if status not in STATUSES else "no-text" if status == "corrected" else "unknown-id"
+        self._send(HTTPStatus.SEE_OTHER, location="/?" + urlencode({"msg": code, "id": form["id"]}))
 
     def log_message(self, *args):  # quiet (log_error too): the terminal shows only the address
         pass

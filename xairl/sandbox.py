@@ -3,14 +3,15 @@ with bounds on the whole rendering, so that a template can neither escape nor ha
 
 Every value a template builds is sized, before it is built where the size can be predicted (``*``, ``+``, ``%``,
 ``~``, str.format, padding methods and filters), after otherwise; loops, macro calls and the work done spend a budget
-per rendering. Each bound is refused with jinja2's ``SecurityError`` naming it; :mod:`xairl.prompts` turns that into
-a one-line ``TemplateError`` with the file and line. ``tests/hostile_templates/`` holds the attacks.
+per rendering, and a clock (:data:`MAX_SECONDS`) bounds the rest. Each bound is refused with jinja2's ``SecurityError``
+naming it; :mod:`xairl.prompts` makes that a one-line ``TemplateError`` (file, line). ``tests/hostile_templates/``.
 """
 
 from __future__ import annotations
 
 import functools
 import re
+import time
 from collections.abc import Callable, Iterator, Mapping
 
 from jinja2 import StrictUndefined, nodes
@@ -27,6 +28,7 @@ MAX_STEPS = 10_000  # loop iterations and macro calls in one rendering: the buil
 MAX_WORK = 1_000_000  # characters and items built, read by calls or output in one rendering: a few MB, well under 1 s
 MAX_INT_BITS = 10_000  # an integer built by * or ** (3,000 digits): larger ones are slow to build and cannot be printed
 MAX_NESTING = 64  # depth of a variant's syntax tree: deeper ones would overflow Python's stack while compiling
+MAX_SECONDS = 2.0  # one rendering of a whole template, compiling included: the built-ins take milliseconds
 RESERVED = "xairl_"  # names of the sandbox's own helpers, which the rewritten template calls
 
 
@@ -78,8 +80,7 @@ def _iter_size(iterable) -> tuple[list, int]:
 
 def _replace_size(s, old, new, count=-1) -> int:
     s, old, new = (x if isinstance(x, (str, bytes)) else str(x) for x in (s, old, new))
-    n = s.count(old) if old else len(s) + 1
-    n = min(n, count) if isinstance(count, int) and count >= 0 else n
+    n = min(s.count(old) if old else len(s) + 1, count if isinstance(count, int) and count >= 0 else len(s) + 1)
     return len(s) + n * max(len(new) - len(old), 0)
 
 
@@ -112,7 +113,7 @@ class _Budget:
     """What one rendering may still spend: steps (loop iterations, macro calls) and work (sizes built or read)."""
 
     def __init__(self):
-        self.steps, self.work = MAX_STEPS, MAX_WORK
+        self.steps, self.work, self.deadline = MAX_STEPS, MAX_WORK, time.monotonic() + MAX_SECONDS
 
     def step(self, work: int = 0) -> None:
         self.steps -= 1
@@ -124,6 +125,8 @@ class _Budget:
         self.work -= work
         if self.work < 0:
             raise SecurityError(f"more than {MAX_WORK} characters and items built in one rendering")
+        if time.monotonic() > self.deadline:  # work within the bounds can still be slow: a clock bounds it too
+            raise SecurityError(f"rendering took over {MAX_SECONDS:g} s: loop over fewer items, write fewer sentences")
 
     def checked(self, value):
         """`value`, once sized and paid for; every value a template builds passes through here."""
@@ -183,15 +186,16 @@ class _BoundedEscapeFormatter(_BoundedFormatter, EscapeFormatter):
 
 
 class _Sandbox(ImmutableSandboxedEnvironment):
-    """Jinja's immutable sandbox (no private attributes, no mutation of data) with bounds for the whole rendering:
-    every value built is sized (before it is built where the size can be predicted), and loops, macro calls and
-    the work done spend a budget, so that a template can neither escape nor hang the process nor fill memory."""
+    """Jinja's immutable sandbox with the bounds of the module doc for the whole rendering."""
 
     intercepted_binops = frozenset(["*", "**", "+", "%"])
 
-    def __init__(self, budget: _Budget, **options):
+    def __init__(self, budget: _Budget, hidden: frozenset[str], **options):
         super().__init__(**options)
-        self.budget = budget
+        self.budget, self.hidden = budget, hidden
+
+    def is_safe_attribute(self, obj, attr, value) -> bool:  # the caller's bookkeeping is not the template's to print
+        return attr not in self.hidden and super().is_safe_attribute(obj, attr, value)
 
     def call_binop(self, context, operator, left, right):
         _fits(_binop_size(operator, left, right), f"'{operator}'")
@@ -202,8 +206,7 @@ class _Sandbox(ImmutableSandboxedEnvironment):
         return self.budget.checked(super().call_binop(context, operator, left, right))
 
     def call(__self, __context, __obj, *args, **kwargs):  # noqa: N805 (Jinja's signature: keywords stay free)
-        """Every call a template makes: a macro call spends a step, a recursive loop's items spend steps, padding
-        methods are sized first, and every result and argument is sized and paid for."""
+        """Every call a template makes, sized (padding methods first) and paid for; macro calls spend steps."""
         budget, args = __self.budget, list(args)
         if isinstance(__obj, (Macro, LoopContext)):
             budget.step()
@@ -357,12 +360,13 @@ def compile_variant(env: ImmutableSandboxedEnvironment, text: str):
     return env.from_string(ast)
 
 
-def environment(filters: Mapping[str, Callable] | None = None) -> ImmutableSandboxedEnvironment:
-    """A fresh sandbox per rendering (the range(), step and work budgets are per rendering), with ``filters`` added
-    to Jinja's built-in ones; every filter is bounded."""
+def environment(filters: Mapping[str, Callable] | None = None, hidden=()) -> ImmutableSandboxedEnvironment:
+    """A fresh sandbox per rendering (the range(), step, work and time budgets are per rendering), with ``filters``
+    added to Jinja's built-in ones (every filter is bounded); attributes named in ``hidden`` are refused."""
     budget = _Budget()
     env = _Sandbox(
         budget,
+        frozenset(hidden),
         undefined=StrictUndefined,
         autoescape=False,
         trim_blocks=True,
@@ -384,8 +388,7 @@ def environment(filters: Mapping[str, Callable] | None = None) -> ImmutableSandb
 
 def render(env: ImmutableSandboxedEnvironment, text: str, context: Mapping) -> str:
     """One variant rendered, streamed so that a runaway loop stops at MAX_OUTPUT, spaces collapsed within each line
-    and blank lines dropped (a template's line breaks are kept: a bullet list stays a list); raises jinja2's
-    SecurityError at any bound."""
+    and blank lines dropped (a bullet list stays a list); raises jinja2's SecurityError at any bound."""
     size, chunks = 0, []
     for chunk in compile_variant(env, text).generate(context):
         size += len(chunk)

@@ -17,6 +17,7 @@ import torch
 from .errors import InputError
 from .observation import Observation, Part
 from .policy import Policy
+from .sb3_memory import Unrolled, check_unrolled, describe, start_state, window_observation
 
 HEADS = ("policy", "value", "q")
 
@@ -102,41 +103,56 @@ def from_sb3(
     action_names=None,
     branch: int | None = None,
     check: bool = True,
+    window: int | None = None,
+    hidden=None,
     **kwargs,
 ) -> Policy:
     """A Stable-Baselines3 model as a :class:`Policy`.
 
     :param model: any SB3 model (DQN, PPO, A2C, SAC, TD3, DDPG; MlpPolicy, CnnPolicy, MultiInputPolicy), or an
-        sb3-contrib one built on the same policies (QR-DQN is not: its output is a distribution).
+        sb3-contrib one built on the same policies (QR-DQN is not: its output is a distribution); RecurrentPPO
+        with ``window=k``.
     :param head: 'policy': what decides the action (DQN's Q-values and PPO/A2C's logits for discrete actions, the
         deterministic action in environment units for continuous ones); 'value': V(s) of an actor-critic;
         'q': Q(s, actor(s)) of SAC/TD3/DDPG's first critic.
+    :param feature_names: a name per observation column; of a window, the signals of one observation.
     :param branch: for a MultiDiscrete action space, which sub-action's logits to explain (each is its own
         decision).
     :param check: compare the Policy's outputs with SB3's own on sample states and refuse a mismatch.
+    :param window: the observations the policy decides on (:mod:`xairl.sb3_memory`): a ``VecFrameStack`` of k flat
+        observations (found in the model's environment by itself when it has one), or the last k observations a
+        recurrent policy (RecurrentPPO) is unrolled over. ``observation=xairl.Observation.window(signals, k,
+        step_s=...)`` says the same with the signals' names and the time between observations.
+    :param hidden: of a recurrent policy, the LSTM's (h, c) before the window's first observation (what
+        ``model.predict`` returned one step before it): the explained function is then the decision the policy
+        took. Left out, the LSTM starts from a reset (zeros). ``Policy.description`` says which.
     :param kwargs: passed to :class:`Policy` (features, groups, background_sampler, name, ...).
     """
     from gymnasium import spaces
 
     if head not in HEADS:
         raise InputError(f"head '{head}' is unknown; use one of {', '.join(HEADS)}.")
-    policy = model.policy
-    if hasattr(policy, "lstm_actor"):
-        raise InputError(
-            f"{type(model).__name__} is recurrent: its action depends on the LSTM's hidden state, which "
-            "is not part of the observation, so an explanation of the observation alone would be of a "
-            "different policy; explain a feed-forward policy (PPO, A2C, DQN, SAC, ...) instead."
-        )
+    policy, algo = model.policy, type(model).__name__
+    recurrent = hasattr(policy, "lstm_actor")
+    if hidden is not None and not recurrent:
+        raise InputError(f"hidden= is the LSTM state of a recurrent policy (RecurrentPPO); {algo} has none.")
     if hasattr(policy, "quantile_net"):
         raise InputError(
-            f"{type(model).__name__} outputs quantiles per action; xairl explains one score per "
+            f"{algo} outputs quantiles per action; xairl explains one score per "
             "action: use DQN, or explain a module that averages the quantiles with xairl.Policy."
         )
     obs_space, act_space = model.observation_space, model.action_space
-    observation = _observation(obs_space)
+    windowed = window_observation(model, window, kwargs.pop("observation", None), feature_names, recurrent)
+    observation = windowed or _observation(obs_space)
     prep = _Preprocess(obs_space, getattr(policy, "normalize_images", True))
-    output, names, network = _head(model, policy, head, act_space, prep, branch, spaces)
-    if feature_names is None:
+    if recurrent:
+        output, names, network, start = _unrolled(model, policy, head, act_space, prep, branch, hidden, spaces)
+        kwargs.setdefault("description", describe(model, observation.parts[0].window.steps, hidden, head))
+    else:
+        output, names, network = _head(model, policy, head, act_space, prep, branch, spaces)
+    if windowed is not None:
+        feature_names = None  # the slots' names come from the window's signals
+    elif feature_names is None:
         feature_names = observation.feature_names()
     result = Policy(
         network.eval(),
@@ -144,10 +160,12 @@ def from_sb3(
         action_names or names,
         observation=observation,
         output=output,
-        name=kwargs.pop("name", f"{type(model).__name__.lower()}-{head}"),
+        name=kwargs.pop("name", f"{algo.lower()}-{head}"),
         **kwargs,
     )
-    if check:
+    if check and recurrent:
+        check_unrolled(model, result, head, start)
+    elif check:
         _check(model, result, head, branch, spaces)
     return result
 
@@ -210,41 +228,65 @@ def _head(model, policy, head, act_space, prep, branch, spaces):
         )
     if hasattr(policy, "action_net"):  # PPO, A2C
         extractor = getattr(policy, "pi_features_extractor", None) or policy.features_extractor
-        out = policy.action_net
-        if isinstance(act_space, spaces.Discrete):
-            names = [f"action_{i}" for i in range(int(act_space.n))]
-            kind = "actions"
-        elif isinstance(act_space, spaces.MultiDiscrete):
-            nvec = [int(v) for v in act_space.nvec]
-            if branch is None or not 0 <= branch < len(nvec):
-                raise InputError(
-                    f"{algo} has a MultiDiscrete action space with {len(nvec)} sub-actions, each its own "
-                    f"decision; pick one with branch=0..{len(nvec) - 1}."
-                )
-            start = sum(nvec[:branch])
-            out = torch.nn.Sequential(out, _Columns(start, start + nvec[branch]))
-            names, kind = [f"action_{branch}={i}" for i in range(nvec[branch])], "actions"
-        elif continuous:
-            if getattr(policy, "squash_output", False):
-                raise InputError(f"{algo} with squashed (gSDE) actions is not supported; train without squash_output.")
-            # SB3 clips the mean to the bounds: an affine map to [-1, 1], Hardtanh, and back keeps it a module
-            low, high = act_space.low, act_space.high
-            out = (
-                torch.nn.Sequential(out, _Scale(low, high, inverse=True), torch.nn.Hardtanh(), _Scale(low, high))
-                if np.all(np.isfinite(low)) and np.all(np.isfinite(high))
-                else out
-            )
-            names, kind = [f"action_{i}" for i in range(act_space.shape[0])], "continuous"
-        else:
-            raise InputError(
-                f"{algo}'s action space {act_space} is not supported; xairl explains Discrete, "
-                "MultiDiscrete (one branch at a time) and Box actions."
-            )
+        kind, names, out = _action_out(algo, policy, act_space, branch, spaces)
         return kind, names, _SB3Network(prep, extractor, _ActorCritic(policy.mlp_extractor, out, critic=False))
     raise InputError(
         f"unsupported SB3 policy {type(policy).__name__}: expected DQN (q_net), an actor-critic "
         "(action_net) or SAC/TD3/DDPG (actor)."
     )
+
+
+def _action_out(algo, policy, act_space, branch, spaces):
+    """(output kind, output names, layer) of an actor-critic's action head: its ``action_net`` with, for one branch
+    of a MultiDiscrete action, that branch's columns, and for a bounded Box, SB3's clipping as modules."""
+    out = policy.action_net
+    if isinstance(act_space, spaces.Discrete):
+        return "actions", [f"action_{i}" for i in range(int(act_space.n))], out
+    if isinstance(act_space, spaces.MultiDiscrete):
+        nvec = [int(v) for v in act_space.nvec]
+        if branch is None or not 0 <= branch < len(nvec):
+            raise InputError(
+                f"{algo} has a MultiDiscrete action space with {len(nvec)} sub-actions, each its own "
+                f"decision; pick one with branch=0..{len(nvec) - 1}."
+            )
+        start = sum(nvec[:branch])
+        out = torch.nn.Sequential(out, _Columns(start, start + nvec[branch]))
+        return "actions", [f"action_{branch}={i}" for i in range(nvec[branch])], out
+    if isinstance(act_space, spaces.Box):
+        if getattr(policy, "squash_output", False):
+            raise InputError(f"{algo} with squashed (gSDE) actions is not supported; train without squash_output.")
+        # SB3 clips the mean to the bounds: an affine map to [-1, 1], Hardtanh, and back keeps it a module
+        low, high = act_space.low, act_space.high
+        out = (
+            torch.nn.Sequential(out, _Scale(low, high, inverse=True), torch.nn.Hardtanh(), _Scale(low, high))
+            if np.all(np.isfinite(low)) and np.all(np.isfinite(high))
+            else out
+        )
+        return "continuous", [f"action_{i}" for i in range(act_space.shape[0])], out
+    raise InputError(
+        f"{algo}'s action space {act_space} is not supported; xairl explains Discrete, "
+        "MultiDiscrete (one branch at a time) and Box actions."
+    )
+
+
+def _unrolled(model, policy, head, act_space, prep, branch, hidden, spaces):
+    """(output kind, output names, network, start state) of a recurrent actor-critic (sb3-contrib's RecurrentPPO)
+    over a window: :class:`xairl.sb3_memory.Unrolled` with the head's LSTM (the critic's own, the shared one, or
+    none) and its layers after it."""
+    algo = type(model).__name__
+    start = start_state(model, hidden, head)
+    if head == "q":
+        raise InputError(f"{algo} has no action-value critic; head='q' is for SAC, TD3 and DDPG.")
+    if head == "value":
+        lstm = (
+            policy.lstm_critic if policy.lstm_critic is not None else policy.lstm_actor if policy.shared_lstm else None
+        )
+        after = _ActorCritic(policy.mlp_extractor, policy.value_net, critic=True)
+        net = Unrolled(prep, policy.vf_features_extractor, lstm, after, start, linear=policy.critic)
+        return "value", ["value"], net, start
+    kind, names, out = _action_out(algo, policy, act_space, branch, spaces)
+    after = _ActorCritic(policy.mlp_extractor, out, critic=False)
+    return kind, names, Unrolled(prep, policy.pi_features_extractor, policy.lstm_actor, after, start), start
 
 
 class _Columns(torch.nn.Module):

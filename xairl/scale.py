@@ -112,22 +112,28 @@ class _ChunkWorker:
         self.parts, self.meta = Path(parts), meta
 
     def __call__(self, batch: dict) -> dict:
-        """Each chunk explained and written; a user's error (NaN in the states, ...) is returned as its message, for
-        the driver to report in one line (Ray Data would only pass on its traceback)."""
+        """Each chunk explained and written, with the SHA-256 of its part's bytes for the driver to record in
+        run.json; a user's error (NaN in the states, ...) is returned as its message, for the driver to report in one
+        line (Ray Data would only pass on its traceback)."""
         from .attributors import explain
 
         states = self.states if isinstance(self.states, str) else np.asarray(self.states)
-        errors = []
+        errors, digests = [], []
         for first in batch["first"].tolist():
             try:
                 _, x = next(state_chunks(states, self.policy, self.chunk_size, start=first))
                 exp = explain(self.policy, x, background=self.bg, method=self.method, options=self.options)
             except XairlError as exc:
                 errors.append(str(exc))
+                digests.append("")
                 continue
-            write_part(self.parts, first, exp, self.meta)
+            digests.append(write_part(self.parts, first, exp, self.meta))
             errors.append("")
-        return {"first": batch["first"], "error": np.array(errors, dtype=object)}
+        return {
+            "first": batch["first"],
+            "error": np.array(errors, dtype=object),
+            "sha256": np.array(digests, dtype=object),
+        }
 
 
 def explain_on_ray(
@@ -189,7 +195,12 @@ def explain_on_ray(
                     )
                     .materialize()
                 )
-                failed = [row["error"] for row in done.select_columns(["error"]).take_all() if row["error"]]
+                rows = done.take_all()
+            for row in rows:  # each part written whole, in run.json: resume keeps it while its bytes match
+                if not row["error"]:
+                    run.done[int(row["first"])] = row["sha256"]
+            run.save()
+            failed = [row["error"] for row in rows if row["error"]]
             if failed:  # the chunks written so far stay: fix the states and --resume
                 raise InputError(failed[0])
     finally:

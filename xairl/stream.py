@@ -6,15 +6,17 @@ a Parquet file of its own as soon as it is done, and global figures from running
     exp = xairl.read_parquet("out/explanations.parquet")                      # back as one Explanation
 
 The output folder holds ``explanations.parquet/`` (a Parquet dataset, one ``part-<first row>.parquet`` per chunk:
-``pandas.read_parquet`` and ``pyarrow.dataset`` read the folder as one table), ``run.json`` (what ran: the source,
-the chunk size, the method and its options, hashes of the policy and the background; ``resume`` refuses another
-run) and ``summary.json`` (mean |contribution| per feature over all states). Each part is written to a hidden
+``pandas.read_parquet`` and ``pyarrow.dataset`` read the folder as one table), ``run.json`` (what ran: the source
+and a SHA-256 of its contents, the chunk size, the method and its options, hashes of the policy and the background,
+and the SHA-256 of each part's bytes as written; ``resume`` refuses another run, or states whose contents changed)
+and ``summary.json`` (mean |contribution| per feature over all states). Each part is written to a hidden
 ``.part`` file and renamed when complete, so an interrupted run leaves only whole chunks, and ``resume`` explains
 exactly the chunks that are missing.
 
 A part (:mod:`xairl.parts`) is trusted by its contents, not its name: its metadata holds the run it belongs to (a hash of ``run.json``'s
 record), its first row, its number of rows, and a SHA-256 of its columns and metadata. ``resume`` reads every part
-first: a damaged one (a flipped bit, cut short, rows other than its name says) is explained again; a whole part of
+first: a damaged one (a flipped bit, its footer's statistics changed, cut short, rows other than its name says, or
+bytes other than run.json recorded) is explained again; a whole part of
 another run, or a file that is no part of this run (``part-...07``, a chunk past the end), is refused by name before
 anything is explained, so the dataset holds every state exactly once.
 
@@ -39,7 +41,7 @@ from .chunks import CHUNK, count_states, state_chunks
 from .errors import InputError, one_line
 from .explanation import Explanation
 from .files import write_text
-from .parts import DATASET, existing_parts, part_name, write_part
+from .parts import DATASET, RECORDED, existing_parts, file_sha256, part_name, write_part
 from .policy import Policy, model_hash
 
 SAMPLE = 1_000  # states kept (uniformly, by reservoir sampling) for the figures of a streamed run
@@ -185,10 +187,10 @@ NOT_IDENTITY = frozenset({"progress", "max_evaluations", "max_rows"})
 def run_identity(
     policy: Policy, source, background: np.ndarray, method: str, options: dict, chunk_size: int
 ) -> dict[str, Any]:
-    """What makes two runs the same run (``resume`` continues only that)."""
+    """What makes two runs the same run (``resume`` continues only that). A file of states is known by its contents:
+    a file rewritten with the same size and time is another run's states."""
     if isinstance(source, (str, Path)):
-        stat = Path(source).stat()
-        where = {"source": str(Path(source).resolve()), "source_bytes": stat.st_size, "source_mtime": stat.st_mtime}
+        where = {"source": str(Path(source).resolve()), "source_sha256": file_sha256(Path(source))}
     else:
         where = {"source": "array", "source_sha256": hashlib.sha256(np.ascontiguousarray(source).tobytes()).hexdigest()}
     return {
@@ -233,7 +235,7 @@ def explain_to_parquet(
         for first, x in state_chunks(states, policy, chunk_size):
             if first not in run.done:  # (a whole chunk from an interrupted run is not explained again)
                 exp = explain(policy, x, background=run.background, method=method, options=run.options)
-                write_part(run.parts, first, exp, run.meta)
+                run.record(first, write_part(run.parts, first, exp, run.meta))
             summary.add(first, read_parquet(run.parts / part_name(first)))  # as written: resumed runs sum the same
             bar.update(len(x))
     return finish_run(run, summary, states)
@@ -242,18 +244,29 @@ def explain_to_parquet(
 @dataclass
 class Run:
     """A run's folder, once checked: its validated options, background, identity, the parts' metadata, and the
-    first rows of the chunks an interrupted run already wrote whole (a damaged part's chunk is not among them)."""
+    first rows of the chunks an interrupted run already wrote whole (a damaged part's chunk is not among them), with
+    the SHA-256 of their bytes."""
 
     out: Path
     options: dict
     background: np.ndarray
     identity: dict
     meta: dict
-    done: set[int]
+    done: dict[int, str]
 
     @property
     def parts(self) -> Path:
         return self.out / DATASET
+
+    def record(self, first: int, sha256: str) -> None:
+        """Notes in run.json the SHA-256 of a part just written whole: resume keeps a part only when its bytes match."""
+        self.done[first] = sha256
+        self.save()
+
+    def save(self) -> None:
+        """run.json: the run's identity and the SHA-256 of each part written whole, by name."""
+        recorded = {part_name(f): self.done[f] for f in sorted(self.done)}
+        write_text(self.out / "run.json", json.dumps({**self.identity, RECORDED: recorded}, indent=2))
 
 
 def start_run(
@@ -280,14 +293,15 @@ def start_run(
     identity = run_identity(policy, states, bg, method, options, chunk_size)
     meta = part_meta(policy, method, options, identity)
     done = existing_parts(out, identity, resume, meta["run"], lambda: count_rows(states, policy))
+    run = Run(out, options, bg, identity, meta, done)
     try:
         (out / DATASET).mkdir(parents=True, exist_ok=True)
-        write_text(out / "run.json", json.dumps(identity, indent=2))
+        run.save()
     except OSError as exc:
         raise InputError(
             f"cannot write the run into {out} ({exc.strerror or one_line(exc)}); give a folder you can write to."
         ) from None
-    return Run(out, options, bg, identity, meta, done)
+    return run
 
 
 def finish_run(run: Run, summary: RunningSummary, states) -> RunningSummary:

@@ -33,7 +33,7 @@ def toy_policy() -> Policy:
         FEATURES,
         ACTIONS,
         features={
-            "battery": FeatureInfo("", "battery charge (standardised)", "nearly empty", "full"),
+            "battery": FeatureInfo("", "battery charge (standardised)", "low charge", "high charge"),
             "distance": FeatureInfo("", "distance to the goal (standardised)", "close", "far"),
         },
         background_sampler=toy_background,

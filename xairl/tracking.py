@@ -311,6 +311,7 @@ _FEATURE_FIELDS = {
     "trend": "trend",
     "window": "window",
     "change_unit": "change_unit",
+    "steps": "steps",
     "mean_abs": "mean_abs",
     "mean": "mean",
     "high_values": "direction_high",
@@ -345,6 +346,10 @@ def track_decision(context: Mapping) -> dict:
         "trends": [
             _feature(f, "margin" if c["output"] == "actions" and c["runner_up"] != c["action"] else "score")
             for f in c.get("trends", ())
+        ],
+        "both_ways": [
+            _feature(f, "margin" if c["output"] == "actions" and c["runner_up"] != c["action"] else "score")
+            for f in c.get("both_ways", ())
         ],
         "comparisons": [
             {

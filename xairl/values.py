@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 from .explanation import Explanation
+from .numbers import format_number
 from .policy import FeatureInfo, Policy
-from .prompts import format_number
 
 
 def value_level(value: float, info: FeatureInfo, quartiles: tuple[float, float] | None) -> tuple[str, str]:

@@ -13,6 +13,7 @@ verified like the contribution (:class:`xairl.facts.FeatureFact`).
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,19 @@ LAYOUTS = ("sequence", "stacked")
 TREND_SHARE = 1 / 3
 #: the trend words, by the sign of the change (newest minus oldest value)
 RISE, FALL = "rose", "fell"
+#: what fills a window's steps before an episode has that many observations (SB3's VecFrameStack: zeros)
+PADDING = 0.0
+#: a signal's steps 'pulled both ways' when their pushes nearly cancel (their sum is at most this share of their
+#: sizes) though their sizes add up to as much as the decision's largest push: the heat map shows it dark while its
+#: sum ranks it low, and a reader is owed why
+CANCEL_SHARE = 0.25
+BOTH_WAYS = "pulled both ways"
+#: the most slots (steps x signals) a window may have: every slot is a feature, named, attributed and kept per
+#: state, so a window is as wide as an image (3 x 224 x 224 is 150,528 columns); past this its names alone take
+#: hundreds of MB, and ``window=10**8`` would build names until memory ran out
+MAX_SLOTS = 1_000_000
+#: a name as a window's slots are named: 'speed[t-3]', 'speed[t]', or a frame stack's 'patch A1 of frame 2'
+SLOT_FORM = re.compile(r"(.+)\[t(?:-\d+)?\]|(.+) of frame \d+", re.S)
 
 
 @dataclass(frozen=True)
@@ -67,6 +81,18 @@ class Window:
             raise InputError("a window needs at least one signal: name each column of one observation.")
         if len(set(self.signals)) != len(self.signals):
             raise InputError(f"the window's signals have duplicates ({', '.join(self.signals)}); name each once.")
+        if len(self.signals) * self.steps > MAX_SLOTS:
+            raise InputError(
+                f"a window of {self.steps} steps x {len(self.signals)} signal(s) has {self.steps * len(self.signals):,} "
+                f"slots, more than the {MAX_SLOTS:,} xairl explains (each slot is a feature); give the steps the "
+                "module really takes."
+            )
+        slotted = [s for s in self.signals if SLOT_FORM.fullmatch(s)]
+        if slotted:
+            raise InputError(
+                f"the window's signal '{slotted[0]:.60}' is named like a slot ('signal[t-1]', 'x of frame 2'), so "
+                "its slots could be read as another signal's; rename it."
+            )
         step = self.step_s
         if step is not None and (
             isinstance(step, bool) or not isinstance(step, (int, float, np.number)) or not 0 < step < float("inf")
@@ -99,13 +125,14 @@ class Window:
         n = len(self.signals)
         return {step: offset + n * k + np.arange(n) for k, step in enumerate(self.step_names())}
 
-    def span_text(self) -> str:
-        """The window's span in words: 'the last 0.8 s' from its oldest to its newest observation (with ``step_s``),
-        else 'the last 5 observations'."""
+    def span_text(self, steps: int | None = None) -> str:
+        """The span of the newest ``steps`` (default: all) in words: 'the last 0.8 s' from the oldest to the newest
+        observation (with ``step_s``), else 'the last 5 observations'."""
+        steps = self.steps if steps is None else steps
         if self.step_s is not None:
-            seconds = (self.steps - 1) * self.step_s
+            seconds = (steps - 1) * self.step_s
             return f"the last {seconds / 60:.3g} min" if seconds >= 120 else f"the last {seconds:.3g} s"
-        return f"the last {self.steps} {'frames' if self.frames else 'observations'}"
+        return f"the last {steps} {'frames' if self.frames else 'observations'}"
 
     def to_dict(self) -> dict:
         out = {"signals": list(self.signals), "steps": self.steps, "layout": self.layout, "step_s": self.step_s}
@@ -142,6 +169,41 @@ def trend(values: np.ndarray, contributions: np.ndarray) -> Trend:
     return Trend(change, (RISE if change > 0 else FALL) if said else "", history)
 
 
+def pulled_both_ways(contributions: np.ndarray, largest: float) -> str:
+    """:data:`BOTH_WAYS` when a signal's slots (``contributions``) cancel out within :data:`CANCEL_SHARE` of their
+    sizes, which add up to at least ``largest`` (the largest |contribution| of a reason); else ''."""
+    contributions = np.asarray(contributions, float)
+    size = float(np.abs(contributions).sum())
+    return BOTH_WAYS if 0 < largest <= size and abs(contributions.sum()) <= CANCEL_SHARE * size else ""
+
+
+def signal_facts(unit, states, contrib, start: int, largest: float) -> tuple:
+    """(change, trend word, span, change's unit, :func:`pulled_both_ways`) of a narration unit
+    (:class:`xairl.facts.Unit`) over one state's ``states`` and ``contrib`` (one per column): for a signal of a
+    window, observed from step ``start`` on (a change from the padding before it is no trend; a label or an
+    identifier has none), ``largest`` the decision's largest push; nothing for any other unit."""
+    if unit.window is None:
+        return None, "", "", "", ""
+    cols, info = list(unit.columns), unit.info
+    values, contributions = np.asarray(states)[cols], np.asarray(contrib)[cols]
+    steps = pulled_both_ways(contributions, largest) if info.kind != "identifier" else ""
+    if info.kind != "numeric":
+        return None, "", "", "", steps
+    moved = trend(values[start:], contributions[start:])
+    change, change_unit = said_change(moved.change, info.unit, info.capacity)
+    return change, moved.word, unit.window.span_text(len(values) - start), change_unit, steps
+
+
+def real_start(states: np.ndarray, window: Window) -> np.ndarray:
+    """Per state of flat window ``states`` (n, steps * signals), the first step that was observed. A frame stack
+    fills the steps an episode has not reached yet with :data:`PADDING` (SB3's VecFrameStack after a reset): its
+    oldest steps whose every signal is exactly that are no observations, and a change from them no trend (a window
+    that is padding throughout is taken whole: nothing in it changed)."""
+    steps = np.asarray(states).reshape(len(states), window.steps, len(window.signals))
+    pad = np.all(steps == PADDING, axis=2)
+    return np.where(pad.all(axis=1), 0, np.argmin(pad, axis=1))  # argmin: the first step that is not padding
+
+
 def slot_features(features: dict, window: Window | None) -> dict:
     """A window's :class:`FeatureInfo`: each signal's, given once, for every slot of it too (a slot's own wins)."""
     if window is None:
@@ -153,6 +215,19 @@ def slot_features(features: dict, window: Window | None) -> dict:
             for j in slots[s]:
                 features.setdefault(names[j], features[s])
     return features
+
+
+def check_slot_names(window: Window, names, what: str = "feature_names") -> None:
+    """Names given to a window's columns: one in a slot's form ('a[t-1]') must be that very slot's name at its column,
+    so that no name says another step or signal than the column holds (names in no slot form are the caller's own)."""
+    slots = window.names()
+    for j, name in enumerate(names):
+        if SLOT_FORM.fullmatch(str(name)) and (j >= len(slots) or slots[j] != name):
+            held = f"holds {slots[j]}" if j < len(slots) else "is past the window's last slot"
+            raise InputError(
+                f"{what}: column {j} is named '{str(name):.60}' but, for a window of {window.steps} steps x "
+                f"{', '.join(window.signals)[:80]}, it {held}; the names and the window disagree."
+            )
 
 
 def window_of(exp) -> Window | None:

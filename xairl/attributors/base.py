@@ -12,6 +12,7 @@ import torch
 
 from ..errors import InputError, UnsupportedModelError
 from ..explanation import Explanation
+from ..network import eval_mode, torch_threads
 from ..options import Options, parse_options
 from ..policy import Policy
 
@@ -43,8 +44,8 @@ class Attributor:
     def explain(self, policy: Policy, states, background=None) -> Explanation:
         """Explain ``states`` against ``background`` (default: 100 states from the policy's sampler).
 
-        The module runs in eval mode; its training flag and every hook this attributor added are restored
-        even when attribution fails.
+        The module runs in eval mode; its training flags and every hook this attributor added are restored
+        even when attribution fails. A small network runs on one torch thread (:func:`xairl.network.torch_threads`).
         """
         if not isinstance(policy, Policy):
             raise InputError(
@@ -69,16 +70,13 @@ class Attributor:
                 f"{int(np.argmax(bad))}: nothing can be explained; check the states' scale (a "
                 f"{kind.name} network overflows beyond ~{np.finfo(kind).max:.0e})."
             )
-        module = policy.network
-        was_training = policy.module.training  # the user's flag; the wrapper's own means nothing
-        module.eval()
         try:
-            values, base, extras = self._attribute(policy, x, bg)
+            with eval_mode(policy.module, policy), torch_threads(policy):
+                values, base, extras = self._attribute(policy, x, bg)
         finally:
             for handle in self._handles:
                 handle.remove()
             self._handles.clear()
-            module.train(was_training)
         n, f, a = len(x), policy.n_features, policy.n_actions
         values = np.asarray(values, dtype=np.float64).reshape(n, f, a)
         base = np.broadcast_to(np.asarray(base, dtype=np.float64), (n, a))
@@ -93,7 +91,7 @@ class Attributor:
             action_names=tuple(policy.action_names),
             method=self.name,
             options=self.options.model_dump(),
-            extras=extras,
+            extras=dict(extras) | ({"policy": policy.description} if policy.description else {}),
             background_quantiles=np.percentile(bg, [25, 50, 75], axis=0).astype(np.float64),
             available=None if policy.action_mask is None else policy.available(x),
             output=policy.output,
@@ -141,9 +139,20 @@ class Attributor:
 
 
 def alternatives(policy: Policy, exclude: str) -> str:
-    """What to use instead of method ``exclude``: only methods that accept this network."""
+    """What to use instead of method ``exclude``: only methods that accept this network, exact first where all its
+    coalitions cost no more network evaluations than kernel_shap's default samples (2^F <= 2F + 2048: up to 11
+    features), where it gives the true values for less (measured 4.3x faster on a small window)."""
+    f = policy.n_features
     options = [m for m in ("deep_shap", "integrated_gradients", "kernel_shap") if m != exclude]
-    if policy.n_features <= EXACT_MAX_FEATURES and exclude != "exact":
-        options.append("exact")
-    hint = " (kernel_shap: model-agnostic but sampled; give it a small background)" if policy.n_features > 64 else ""
+    cheap = 2**f <= kernel_auto_samples(f)
+    if f <= EXACT_MAX_FEATURES and exclude != "exact":
+        options.insert(0 if cheap else len(options), "exact")
+    hint = " (kernel_shap: model-agnostic but sampled; give it a small background)" if f > 64 else ""
+    if cheap and exclude != "exact":
+        hint = f" (exact: true Shapley values from all 2^{f} coalitions, fewer evaluations than kernel_shap's samples)"
     return f"use method={' or '.join(repr(o) for o in options)}{hint}."
+
+
+def kernel_auto_samples(f: int) -> int:
+    """kernel_shap's coalitions per state with ``nsamples='auto'``: 2F + 2048."""
+    return 2 * f + 2048

@@ -16,7 +16,7 @@ import numpy as np
 import torch
 from pydantic import Field
 
-from ..display import progress, show_progress
+from ..display import WorkProgress
 from ..errors import InputError
 from ..policy import Policy
 from .base import EXACT_MAX_FEATURES as MAX_FEATURES
@@ -27,12 +27,17 @@ MAX_EVALUATIONS = 2**24
 
 
 class ExactOptions(Options):
+    # strict: True is no count, and 2.5 rows no whole number (lax pydantic reads True as 1)
     max_rows: int = Field(
-        8_192, ge=1, description="rows per forward batch; bounds memory (8,192: the fastest measured on a CPU)"
+        8_192,
+        ge=1,
+        strict=True,
+        description="rows per forward batch; bounds memory (8,192: the fastest measured on a CPU)",
     )
     max_evaluations: int = Field(
         MAX_EVALUATIONS,
         ge=1,
+        strict=True,
         description=(
             "refuse above this many network evaluations (states x 2^F coalitions x background rows) before running; "
             "the default 2^24 takes about 40 s on one CPU core for a 64-unit GRU over 4 steps, 20 s for a "
@@ -40,7 +45,11 @@ class ExactOptions(Options):
         ),
     )
     progress: bool | None = Field(
-        None, description="show a progress bar: True, False, or None = only when stderr is a terminal"
+        None,
+        description=(
+            "show progress: True, a bar; False, nothing; None, a bar past 3 s on a terminal, else a plain line to "
+            "stderr every 10 s (a log, a pipe)"
+        ),
     )
 
 
@@ -102,6 +111,9 @@ class Exact(Attributor):
     def cost(self, policy: Policy, n_states: int, n_background: int) -> ExactCost:
         """The network evaluations and batch memory of explaining ``n_states`` states against ``n_background``
         background rows, without running anything."""
+        for what, count in (("n_states", n_states), ("n_background", n_background)):
+            if isinstance(count, (bool, np.bool_)) or not isinstance(count, (int, np.integer)) or count < 1:
+                raise InputError(f"Exact.cost: {what} is a whole number of rows, at least 1; got {count!r:.40}.")
         f, a = policy.n_features, policy.n_actions
         item = np.dtype(policy.dtype).itemsize
         rows = self._coalitions_per_forward(f, n_background) * n_background
@@ -134,13 +146,8 @@ class Exact(Attributor):
         bt = torch.as_tensor(bg, device=dev)[None, :, :]
         per = self._coalitions_per_forward(f, b)
         starts = range(0, k, per)
-        # one state: a bar over its batches of coalitions; several: a bar over the states
-        bar = progress(
-            total=n if n > 1 else len(starts),
-            desc="exact",
-            unit="state" if n > 1 else "batch",
-            disable=not show_progress(self.options.progress),
-        )
+        # one state: a bar over its batches of coalitions; several: a bar over the states (and a state's share)
+        bar = WorkProgress(self.options.progress, n if n > 1 else len(starts), "exact", "state" if n > 1 else "batch")
         values, v = np.empty((n, f, a)), np.empty((k, a))
         try:
             for i in range(n):
@@ -149,9 +156,8 @@ class Exact(Attributor):
                     rows = torch.where(mt[s : s + per], xi, bt).reshape(-1, f)
                     out = self._forward(policy, rows, self.options.max_rows)
                     v[s : s + per] = out.reshape(-1, b, a).mean(dim=1).numpy()
-                    bar.update(int(n == 1))
+                    bar.advance(1 if n == 1 else 1 / len(starts))
                 values[i] = shapley(v, masks, weights)
-                bar.update(int(n > 1))
         finally:
             bar.close()
         # the empty coalition is every feature from the background: the base value, the same for every state

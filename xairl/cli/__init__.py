@@ -57,13 +57,16 @@ def cmd_attributors(args) -> int:
 
 
 def cmd_report(args) -> int:
+    from ..display import heartbeat
     from ..report import write_report
 
     report = plugins.registry("report").load(args.plugin)(parse_options(args.option))
     method_options = plugins.get_attributor(args.method)(parse_options(args.method_option)).options.model_dump()
     req = report_request(args, args.out, method_options, args.n)
     make_dir(req.out)  # one line, before any work, where the folder cannot be made (--out /proc/x)
-    path = write_report(req, report.build(req))
+    with heartbeat(f"building the {args.plugin} report's content"):  # a plugin's minutes, said every 10 s
+        content = report.build(req)
+    path = write_report(req, content)
     print(f"report: {path.resolve()}")
     return 0
 
@@ -99,29 +102,15 @@ def cmd_prompts(args) -> int:
 def cmd_verify(args) -> int:
     """Check a text against an explanation; with --trace, every claim with the words it was read from and the
     reading (rule) that bound it."""
-    from ..explanation import Explanation
     from ..narrators.verify import verify
+    from ..prompts import bidi_visible
+    from .records import read_explanation
 
     text = args.text if args.text != "-" else sys.stdin.read()
-    try:
-        with open(args.explanation, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise InputError(
-            f"cannot read --explanation {args.explanation}: {exc.strerror}; give the JSON that "
-            f"Explanation.to_json() writes."
-        ) from None
-    try:
-        exp = Explanation.from_json(raw)
-    except InputError as exc:
-        raise InputError(f"--explanation {args.explanation}: {exc}") from None
-    try:
-        exp.check_index(args.index)
-    except InputError as exc:
-        raise InputError(f"--index {args.index}: {exc}") from None
-    result = verify(text, exp, args.index)
+    exp, index = read_explanation(args.explanation, args.index)
+    result = verify(text, exp, index)
     for sentence in result.sentences:
-        print(f"[{sentence.status}] {sentence.text}")
+        print(f"[{sentence.status}] {bidi_visible(sentence.text)}")  # shown as read, not reordered
         for c in sentence.claims if args.trace else ():
             print(f"    {c.status:<12} {c.kind:<9} {c.text!r:<28} {c.rule or '-':<22} {c.detail}")
     if args.trace:  # what each reading that fired reads, from its entry in the rules' table
@@ -208,7 +197,8 @@ COMMAND_EXAMPLES = {
   xairl explain --states big.npy --background bg.npy --format parquet --out run/ [--resume] [--engine ray]
 """,
     "verify": """examples:
-  (the --explanation file is what Explanation.to_json() writes in Python)
+  (the --explanation file is what Explanation.to_json() writes in Python, or xairl explain --out's JSON lines)
+  xairl verify "Speed lowered the score by 0.52." --explanation report/explanations.jsonl --index 2
   xairl verify "Speed lowered the score by 0.52." --explanation exp.json --index 0 --trace
   echo "..." | xairl verify - --explanation exp.json
 """,
@@ -275,9 +265,19 @@ def build_parser() -> argparse.ArgumentParser:
     p = _command(sub, "verify", help="check a text's claims against an explanation (exit 1 when one is contradicted)")
     p.add_argument("text", help="the text to check, or - to read it from standard input")
     p.add_argument(
-        "--explanation", required=True, metavar="FILE", help="the explanation, as Explanation.to_json() writes it"
+        "--explanation",
+        required=True,
+        metavar="FILE",
+        help="the explanation: the JSON Explanation.to_json() writes, or the explanations.jsonl of "
+        "xairl explain --out (or its --format jsonl lines)",
     )
-    p.add_argument("--index", type=count(0), default=0, help="which state of the explanation the text is about")
+    p.add_argument(
+        "--index",
+        type=count(0),
+        default=None,
+        help="which state the text is about: of an explanation (default 0), or which record (line) of a JSON-lines "
+        "file, from 0 (needed when it holds more than one)",
+    )
     p.add_argument("--trace", action="store_true", help="every claim: status, kind, words, rule, reason")
     p.set_defaults(run=cmd_verify)
     p = _command(

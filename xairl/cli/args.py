@@ -94,6 +94,22 @@ def make_dir(path: str, what: str = "--out"):
     return Path(path)
 
 
+def key_value(flag: str, example: str):
+    """An argparse type: ``KEY=VALUE`` text, checked when the command line is read (``flag`` and ``example`` name
+    the option in the message). ``-n 3`` is thus an error that says what ``-n`` is, not a narrator option that a
+    run without --narrate never reads."""
+
+    def parse(text: str) -> str:
+        key, sep, _ = text.partition("=")
+        if sep and key.strip():
+            return text
+        count = f"; to explain {text.strip()} states, write --n {text.strip()}" if text.strip().isdigit() else ""
+        raise argparse.ArgumentTypeError(f"{_short(text)!r} is not key=value; write e.g. {flag} {example}{count}")
+
+    parse.__name__ = "KEY=VALUE"
+    return parse
+
+
 def parse_options(pairs: Sequence[str]) -> dict:
     """``["n_steps=32", "method=riemann_left"]`` -> dict; values are read as JSON when they parse, else as text."""
     opts: dict = {}
@@ -142,6 +158,7 @@ def narration_arguments(p: argparse.ArgumentParser) -> None:
         "-n",
         "--narrator-option",
         action="append",
+        type=key_value("-n", "mode=rewrite"),
         default=[],
         metavar="KEY=VALUE",
         help="a narrator option, e.g. -n mode=rewrite or -n model=PATH",

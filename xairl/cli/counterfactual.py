@@ -26,12 +26,46 @@ def counterfactual_arguments(p: argparse.ArgumentParser) -> None:
         "action",
     )
     p.add_argument(
+        "--counterfactual-past",
+        action="store_true",
+        help="with --counterfactual, a window policy: change its past observations' slots too (default: only the "
+        "newest step's; a past slot changed alone is a history the present state cannot have)",
+    )
+    p.add_argument(
         "--max-changes",
         type=int,
         choices=(1, 2),
         default=2,
         help="with --counterfactual: at most this many features change (default 2)",
     )
+
+
+def asked(args, policy) -> bool:
+    """Whether --counterfactual (or --counterfactual-target alone) was given, its target checked against the policy's
+    actions before any state is explained, in every format (one line naming the known actions); and refused with
+    --format parquet, whose chunks are streamed to disk without a search."""
+    if not (args.counterfactual or args.counterfactual_target is not None):
+        return False
+    target = _target(args, policy)
+    if target is not None and target != "any":
+        from ..counterfactuals.goals import action_index
+
+        action_index(policy, target)
+    if args.format == "parquet":
+        raise InputError(
+            "--counterfactual is not searched when explanations stream into Parquet (--format parquet, or --out above "
+            "the streaming size); drop --counterfactual, or explain fewer states as a table, jsonl or report."
+        )
+    return True
+
+
+def _target(args, policy):
+    """The search's target of ``--counterfactual-target``: None (the runner-up), 'any', an action's name or index."""
+    target = args.counterfactual_target
+    target = None if target in (None, "", "runner-up") else target
+    if target is not None and target not in policy.action_names and target.lstrip("-").isdigit():
+        target = int(target)  # an action's index, as the docs say ('--counterfactual-target 2')
+    return target
 
 
 def search(args, policy, exp, background):
@@ -46,10 +80,7 @@ def search(args, policy, exp, background):
         )
     from ..counterfactuals import counterfactual
 
-    target = args.counterfactual_target
-    target = None if target in (None, "", "runner-up") else target
-    if target is not None and target not in policy.action_names and target.lstrip("-").isdigit():
-        target = int(target)  # an action's index, as the docs say ('--counterfactual-target 2')
+    target = _target(args, policy)
     return counterfactual(
         policy,
         exp.states,
@@ -59,6 +90,7 @@ def search(args, policy, exp, background):
         background=background,
         explanation=exp,
         n=3,  # alternatives, so that one still flips once its values are written as the words write them
+        past=args.counterfactual_past,
     )
 
 

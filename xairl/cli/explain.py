@@ -22,7 +22,7 @@ from .args import (
     report_request,
     streaming_arguments,
 )
-from .counterfactual import block, counterfactual_arguments, said, search, summaries
+from .counterfactual import asked, block, counterfactual_arguments, said, search, summaries
 
 #: above this many states, ``--out DIR`` without a --format streams them into DIR/explanations.parquet (200,000 toy
 #: states as one JSON-lines file: 207 MB built in memory, 1.18 GB peak RSS, written at the end with no progress bar;
@@ -40,6 +40,7 @@ def cmd_explain(args) -> int:
     if args.out:  # before anything is read: a folder that cannot be made fails at once
         make_dir(args.out)
     states = _choose_format(args, policy)
+    asked(args, policy)  # a bad --counterfactual-target, or --counterfactual with Parquet: one line, exit 2
     if args.format == "parquet" and not args.out:
         raise InputError("--format parquet writes a folder: give it with --out DIR.")
     if args.engine == "ray" and args.format != "parquet":

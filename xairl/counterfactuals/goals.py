@@ -27,14 +27,26 @@ EXPLAIN_BACKGROUND = 100
 #: how far past the line (relative to the scores' size) the search keeps: a re-run in another batch, whose float32
 #: sums may round differently, still decides the same
 TOLERANCE = 1e-4
+#: a flip by less than this share of the scores' size is noise: a float32 network's scores differ in their last bits
+#: between batch shapes, so a re-run of one row could read it either way; no counterfactual that near is returned
+NOISE = 1e-5
 
 
 class Goal:
     """What a changed state must do, per state: a gap positive exactly when it decides otherwise."""
 
-    def __init__(self, policy: Policy, xs: np.ndarray, target) -> None:
+    def __init__(self, policy: Policy, xs: np.ndarray, target, rows: np.ndarray | None = None) -> None:
+        """``xs``: the states searched (``rows``: their rows among the states given, for a one-line error)."""
         self.policy, self.threshold = policy, target if isinstance(target, Threshold) else None
         scores = policy.scores(xs)
+        bad = ~np.isfinite(scores).all(axis=1)
+        if bad.any():  # (as explain refuses them: no decision to overturn)
+            kind = np.dtype(policy.dtype)
+            raise InputError(
+                f"the policy's outputs are NaN or infinite for {int(bad.sum())} state(s) searched, first state "
+                f"{int(np.argmax(bad) if rows is None else rows[np.argmax(bad)])}: no decision to change; check the states' scale (a {kind.name} network "
+                f"overflows beyond ~{np.finfo(kind).max:.0e})."
+            )
         m, names = len(xs), policy.action_names
         self.skip = [""] * m  # why a state is not searched ('' where it is)
         if policy.output != "actions":
@@ -97,6 +109,21 @@ class Goal:
         return np.nan_to_num(g, nan=-np.inf)
 
 
+def feasible(policy: Policy, x: np.ndarray) -> np.ndarray:
+    """``policy.feasible(x)`` checked: a bool (n,) array, or one line naming the callback and what went wrong."""
+    try:
+        ok = np.asarray(policy.feasible(x))
+    except Exception as e:  # (the user's code: whatever it raises is told in one line, not as an internal error)
+        first = (str(e).strip().splitlines() or [""])[0]
+        raise InputError(
+            f"policy '{policy.name}': its feasible callback raised {type(e).__name__}: {first:.200} (on {len(x)} "
+            f"state(s) of {x.shape[1]} columns); fix it to return one bool per state."
+        ) from None
+    if ok.shape != (len(x),) or ok.dtype.kind != "b":
+        raise InputError(f"policy '{policy.name}': feasible must return bool ({len(x)},), got {ok.dtype} {ok.shape}.")
+    return ok
+
+
 def action_index(policy: Policy, name) -> int:
     """The output column named (or numbered) ``name``; a one-line error naming the known ones."""
     names = policy.action_names
@@ -120,31 +147,38 @@ def lead(scores: np.ndarray, available: np.ndarray, a: int) -> float:
     return float(scores[a] - others.max()) if np.isfinite(others).any() else -np.inf
 
 
-def pushes(policy: Policy, goal: Goal, units: Units, x: np.ndarray, rows: np.ndarray, bg, explanation) -> np.ndarray:
-    """(m, U) each unit's contribution to the margin the change must overturn, for the states ``x[rows]``."""
+def of_states(explanation, n: int, rows: np.ndarray) -> Explanation | None:
+    """``explanation`` (of all ``n`` states, or of the ``rows`` searched) as the explanation of the rows, in their
+    order; None when none was given."""
     if explanation is None:
+        return None
+    if not isinstance(explanation, Explanation):
+        raise InputError(f"explanation is an xairl.Explanation of the states, not {type(explanation).__name__}.")
+    if len(explanation) == n:
+        return explanation[rows]
+    if len(explanation) == len(rows):
+        return explanation
+    raise InputError(f"the explanation has {len(explanation)} state(s) but {n} were given; explain the same states.")
+
+
+def pushes(policy: Policy, goal: Goal, units: Units, xs: np.ndarray, bg, exp: Explanation | None) -> np.ndarray:
+    """(m, U) each unit's contribution to the margin the change must overturn, for the states ``xs`` (``exp``: their
+    explanation, :func:`of_states`; None: computed here)."""
+    if exp is None:
         from ..attributors import explain
 
         try:
-            exp = explain(policy, x[rows], bg[:EXPLAIN_BACKGROUND])
+            exp = explain(policy, xs, bg[:EXPLAIN_BACKGROUND])
         except UnsupportedModelError:  # a module deep_shap cannot walk: gradients along a path take any module
-            exp = explain(policy, x[rows], bg[:EXPLAIN_BACKGROUND], method="integrated_gradients")
-    elif not isinstance(explanation, Explanation):
-        raise InputError(f"explanation is an xairl.Explanation of the states, not {type(explanation).__name__}.")
-    elif len(explanation) in (len(x), len(rows)):
-        exp = explanation[rows] if len(explanation) == len(x) else explanation
-    else:
-        raise InputError(
-            f"the explanation has {len(explanation)} state(s) but {len(x)} were given; explain the same states."
-        )
-    m = np.arange(len(rows))
+            exp = explain(policy, xs, bg[:EXPLAIN_BACKGROUND], method="integrated_gradients")
+    m = np.arange(len(xs))
     v = exp.values
     if goal.threshold is not None:
         c = v[m, :, goal.j]
     else:
         c = v[m, :, goal.chosen] - v[m, :, goal.compare]
     index = {f: j for j, f in enumerate(exp.feature_names)}
-    out = np.zeros((len(rows), units.n))
+    out = np.zeros((len(xs), units.n))
     for u, name in enumerate(units.names):
         cols = [index.get(name)] if name in index else [index.get(policy.feature_names[j]) for j in units.columns[u]]
         if None not in cols:

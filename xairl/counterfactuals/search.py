@@ -26,9 +26,14 @@ For each decision:
    nothing, is dropped. A grid can miss a flip between its points: "none found" is the search's answer, no proof.
 5. **Checked.** The candidates, ranked by distance in quantiles (ties by the scaled distance), one per set of
    features, are run through the policy once more, all in one batch; one that does not flip (or is infeasible, or
-   out of range) is dropped. What is returned is exactly what was run.
+   out of range) is dropped. What is returned is exactly what was run. Nor is any state a flip whose scores are not
+   finite (a float32 network overflowing near its largest number: the same state alone may score finitely and keep
+   its action), whose flip is within float32's noise at its scores' size (:data:`~.goals.NOISE`), or after which the
+   mask allows a single action (no other allowed action for a margin to be over).
 
-Windows (a memory policy's slots) are searched as flat features, each slot on its own. ``max_changes`` is 1 or 2.
+Windows (a memory policy's slots) are searched as flat features, each slot on its own, the newest step's only unless
+``past`` (:mod:`xairl.counterfactuals.bounds`); a binary feature only whole. The decisions are searched
+:data:`CHUNK` at a time, so memory does not grow with the batch. ``max_changes`` is 1 or 2.
 """
 
 from __future__ import annotations
@@ -40,7 +45,7 @@ import numpy as np
 from ..errors import InputError
 from ..policy import Policy
 from . import bounds
-from .goals import Goal, lead, pushes
+from .goals import NOISE, Goal, feasible, lead, of_states, pushes
 from .result import Change, Counterfactual, Counterfactuals
 
 GRID, GRID2, TOP_SINGLE, TOP_PAIR, STEPS, ZOOMS = 64, 13, 16, 9, 24, 3
@@ -51,6 +56,9 @@ COARSE = 41
 #: forward passes of the network over the whole image) and searches single changes on a grid of GRID_WIDE
 WIDE, TOP_PAIR_WIDE, GRID_WIDE = 1024, 4, 32
 _BACKGROUND = 200  # states drawn from the policy's sampler when no background is given
+#: decisions searched at a time: a narrow state's pair grids take about 1 MB a decision, so a batch of any size
+#: stays within a few hundred MB (20,000 toy states at once needed 23 GB, issue 64)
+CHUNK = 64
 
 
 def counterfactual(
@@ -63,6 +71,7 @@ def counterfactual(
     background=None,
     explanation=None,
     n: int = 1,
+    past: bool = False,
 ) -> Counterfactuals | tuple[Counterfactuals, ...]:
     """What would have had to differ for ``policy`` to decide otherwise on ``states[index]``.
 
@@ -74,6 +83,7 @@ def counterfactual(
     :param background: typical states (default: the policy's sampler): the ranges and the quantiles.
     :param explanation: an :class:`xairl.Explanation` of ``states`` (or of the one state) to rank the features by.
     :param n: how many counterfactuals to return, each changing a different set of features.
+    :param past: a window policy: change its past observations' slots too (default: only the newest step's).
     """
     x = policy.check_states(states)
     rows = _rows(index, len(x))
@@ -82,12 +92,18 @@ def counterfactual(
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise InputError(f"n is how many counterfactuals to return per decision, a whole number >= 1; got {n!r:.40}.")
     bg = policy.background(_BACKGROUND) if background is None else policy.check_states(background, "background")
-    units, goal = bounds.units(policy, bg, features), Goal(policy, x[rows], target)
-    found = _Search(policy, x[rows], units, goal)
-    found.rank(pushes(policy, goal, units, x, rows, bg, explanation))
-    found.run(max_changes, int(n))
-    out = tuple(found.result(k, int(r), max_changes) for k, r in enumerate(rows))
-    return out if index is None else out[0]
+    units = bounds.units(policy, bg, features, past)
+    exp = of_states(explanation, len(x), rows)
+    out: list[Counterfactuals] = []
+    for start in range(0, len(rows), CHUNK):  # (memory: a chunk's grids at a time, never every decision's)
+        part = rows[start : start + CHUNK]
+        goal = Goal(policy, x[part], target, part)
+        found = _Search(policy, x[part], units, goal)
+        chunk = None if exp is None else exp[start : start + CHUNK]
+        found.rank(pushes(policy, goal, units, x[part], bg, chunk) if units.n else None)
+        found.run(max_changes, int(n))
+        out += [found.result(k, int(r), max_changes) for k, r in enumerate(part)]
+    return tuple(out) if index is None else out[0]
 
 
 class _Search:
@@ -102,6 +118,9 @@ class _Search:
         self.candidates: list[dict[tuple[int, ...], tuple[float, ...]]] = [{} for _ in xs]
         self.active = np.array([not s for s in goal.skip]) & (units.n > 0)
         self.checked: list[list[Counterfactual]] = [[] for _ in xs]
+        # an image's regions (or a very wide state): each change costs a pass over the whole image (issue 64: a
+        # 1x32x32 image, 1,024 columns, took the narrow path's 41x41 pair grids, 79,857 passes a decision)
+        self.wide = units.regions or xs.shape[1] > WIDE
 
     def rank(self, contributions: np.ndarray | None) -> None:
         """Order each state's units by |contribution| (``contributions`` (m, U) or None: as they come)."""
@@ -125,16 +144,18 @@ class _Search:
         return gap
 
     def _gap(self, x: np.ndarray, who: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The gap of each state ``x`` (no flip where a score is not finite, where the mask leaves one action: no
+        margin to report, or where ``feasible`` says no), and its scores."""
         p = self.policy
         scores = p.scores(x)
-        g = self.goal.gap(scores, p.available(x) if p.output == "actions" else None, who)
+        avail = p.available(x) if p.output == "actions" else None
+        g = self.goal.gap(scores, avail, who)
+        # a score that overflowed (a float32 network given values near its largest number) decides nothing: the same
+        # state alone may score finitely and keep its action (issue 64)
+        bad = ~np.isfinite(scores).all(axis=1) | (avail.sum(axis=1) < 2 if avail is not None else False)
+        g = np.where(bad, -np.inf, g)
         if p.feasible is not None:
-            ok = np.asarray(p.feasible(x))
-            if ok.shape != (len(x),) or ok.dtype.kind != "b":
-                raise InputError(
-                    f"policy '{p.name}': feasible must return bool ({len(x)},), got {ok.dtype} {ok.shape}."
-                )
-            g = np.where(ok, g, -np.inf)
+            g = np.where(feasible(p, x), g, -np.inf)
         return g, scores
 
     def run(self, max_changes: int, n: int) -> None:
@@ -159,12 +180,13 @@ class _Search:
         who = np.flatnonzero(self.active)
         if not len(who):
             return
-        k, size = min(TOP_SINGLE, self.units.n), GRID if self.xs.shape[1] <= WIDE else GRID_WIDE
+        k, size = min(TOP_SINGLE, self.units.n), GRID_WIDE if self.wide else GRID
         top = self.order[who, :k]
         lo, hi, own = (a[who[:, None], top] for a in (self.low, self.high, self.own))
         grid = lo[..., None] + (hi - lo)[..., None] * np.linspace(0.0, 1.0, size)  # (m, k, G)
         w = np.broadcast_to(who[:, None, None], grid.shape)
         u = np.broadcast_to(top[..., None], grid.shape)
+        grid = self.units.snap(grid, u)  # (a binary unit's grid: its two values)
         good = self.gaps(w.ravel(), u.reshape(-1, 1), (grid - own[..., None]).reshape(-1, 1)).reshape(grid.shape) > 0
         key = np.where(good, self._distance(u[..., None], grid[..., None], w), np.inf)
         g = key.argmin(axis=-1)
@@ -175,6 +197,7 @@ class _Search:
         inner = np.where(up, np.where(side > own, side, own), np.where(side < own, side, own))
         i, j = np.nonzero(has)
         done = self._bisect(who[i], top[i, j][:, None], own[i, j][:, None], inner[i, j][:, None], at[i, j][:, None])
+        done = np.where(self.units.binary[top[i, j]][:, None], at[i, j][:, None], done)  # (whole: no bisection)
         for s, unit, value in zip(who[i], top[i, j], done[:, 0]):
             self.candidates[s][(int(unit),)] = (float(value),)
 
@@ -191,7 +214,7 @@ class _Search:
     def pairs(self, who: np.ndarray) -> None:
         """Two units each, among the top ones: a 2-D grid over both ranges, zoomed in around the nearest flipping
         cell, then bisection along the line from the state to it."""
-        wide = self.xs.shape[1] > WIDE
+        wide = self.wide
         k = min(TOP_PAIR_WIDE if wide else TOP_PAIR, self.units.n)
         if not len(who) or k < 2:
             return
@@ -207,7 +230,9 @@ class _Search:
             step = (hi - lo) / (GRID2 - 1)
             lo, hi = np.maximum(lo, best - step), np.minimum(hi, best + step)
             best, has = self._grid2(w, units, own, lo, hi, has, best)
-        done = self._ray(w[has], units[has], own[has], best[has])
+        # a binary unit stays at its flipped value along the ray (only the other one is bisected: never a fraction)
+        start = np.where(self.units.binary[units], best, own)
+        done = self._ray(w[has], units[has], own[has], start[has], best[has])
         for s, us, vs in zip(w[has], units[has], done):
             self.candidates[s][tuple(int(u) for u in us)] = tuple(float(v) for v in vs)
 
@@ -216,6 +241,7 @@ class _Search:
         one (where none is, ``best`` and ``had`` as they were)."""
         lin = np.linspace(0.0, 1.0, size)
         axes = lo[:, :, None] + (hi - lo)[:, :, None] * lin  # (P, 2, G)
+        axes = self.units.snap(axes, np.broadcast_to(units[:, :, None], axes.shape))
         shape = (len(w), size, size)
         values = np.stack(
             [np.broadcast_to(axes[:, 0, :, None], shape), np.broadcast_to(axes[:, 1, None, :], shape)], -1
@@ -223,18 +249,28 @@ class _Search:
         us = np.broadcast_to(units[:, None, None, :], values.shape)
         ws = np.broadcast_to(w[:, None, None], shape)
         good = self.gaps(ws.ravel(), us.reshape(-1, 2), (values - own[:, None, None, :]).reshape(-1, 2)) > 0
-        key = np.where(good.reshape(shape), self._distance(us, values, ws), np.inf).reshape(len(w), -1)
+        # the distance of each cell: its two axes' terms, each computed once per axis value (a grid's quantiles are
+        # separable: 41 times fewer than per cell), summed in the order _distance sums them
+        q = np.abs(self.units.quantile(axes, np.broadcast_to(units[:, :, None], axes.shape)) - self._q_own(w, units))
+        sc = np.abs(axes - own[:, :, None]) / self.scale[units][:, :, None]
+        dist = (q[:, 0, :, None] + q[:, 1, None, :]) + 1e-9 * (sc[:, 0, :, None] + sc[:, 1, None, :])
+        key = np.where(good.reshape(shape), dist, np.inf).reshape(len(w), -1)
         cell = key.argmin(axis=-1)
         has = np.isfinite(key[np.arange(len(w)), cell])
         found = values.reshape(len(w), -1, 2)[np.arange(len(w)), cell]
         return np.where(has[:, None], found, best), has | had
 
-    def _ray(self, who, unit, start, end) -> np.ndarray:
-        """Points just past the line on the segments from ``start`` (no flip) to ``end`` (a flip), (N, k)."""
+    def _q_own(self, w: np.ndarray, units: np.ndarray) -> np.ndarray:
+        """(P, 2, 1) the background quantile of each state's own value of each unit of its pair."""
+        return self.units.quantile(self.own[w[:, None], units], units)[:, :, None]
+
+    def _ray(self, who, unit, own, start, end) -> np.ndarray:
+        """Points just past the line on the segments from ``start`` (no flip) to ``end`` (a flip), (N, k); ``own``
+        the state's values."""
         bad, good = np.zeros(len(who)), np.ones(len(who))
         for _ in range(STEPS):
             mid = (bad + good) / 2
-            ok = self.gaps(who, unit, mid[:, None] * (end - start)) > 0
+            ok = self.gaps(who, unit, start - own + mid[:, None] * (end - start)) > 0
             good, bad = np.where(ok, mid, good), np.where(ok, bad, mid)
         return start + good[:, None] * (end - start)
 
@@ -271,8 +307,14 @@ class _Search:
         avail = self.policy.available(x) if self.policy.output == "actions" else None
         for r, (s, units, _) in enumerate(picks):
             inside = all(self.low[s, u] <= after[r, u] <= self.high[s, u] for u in units)
+            # a binary unit at one of its two values (a declared bound between them would leave a fraction)
+            inside &= all(after[r, u] in self.units.levels[u] for u in units if self.units.binary[u])
             if gap[r] > 0 and inside and len(self.checked[s]) < n:
-                self.checked[s].append(self._counterfactual(s, units, x[r], after[r], scores[r], gap[r], avail, r))
+                cf = self._counterfactual(s, units, x[r], after[r], scores[r], gap[r], avail, r)
+                # past the line by more than float32's noise at these scores' size (a re-run alone decides the same)
+                size = np.abs(scores[r] if avail is None else scores[r][avail[r]]).max()
+                if cf.margin > NOISE * max(1.0, float(size)):
+                    self.checked[s].append(cf)
 
     def _set(self, x: np.ndarray, r: int, s: int, u: int, value: float) -> None:
         """Move unit ``u`` of row ``r`` (a copy of state ``s``) to ``value``, within its range once in the network's
@@ -308,8 +350,7 @@ class _Search:
         dist, scaled = self._sizes(s, units, after[list(units)])
         if policy.output == "actions":
             a = int(np.argmax(np.where(avail[r], scores, -np.inf)))
-            margin = lead(scores, avail[r], a)  # (the only available action: its lead over the unavailable ones)
-            margin = margin if np.isfinite(margin) else lead(scores, np.ones_like(avail[r]), a)
+            margin = lead(scores, avail[r], a)  # over the best other allowed action (a flip leaves at least two)
             action, output = policy.action_names[a], float(scores[a])
         else:
             j = self.goal.j

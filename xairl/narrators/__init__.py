@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
 from pathlib import Path
 
 from ..explanation import Explanation
-from ..policy import Policy
 from .base import Narrative, Narrator
 from .confidence import confidence
+from .options import NarrationOptions
 from .provenance import verify
 from .verify import Verification
 
@@ -18,16 +17,10 @@ def narrate(
     index: int | None = 0,
     *,
     narrator: str = "template",
-    template: str | None = None,
-    policy: Policy | None = None,
-    background=None,
     options: dict | None = None,
-    prompt_dirs: Iterable[str] = (),
-    k: int = 3,
     store=None,
-    robustness: bool = True,
-    history=None,
-    counterfactual=False,
+    narration: NarrationOptions | None = None,
+    **given,
 ) -> Narrative:
     """Words for decision ``index`` (``None``: a global summary over all states), checked against the numbers.
 
@@ -35,26 +28,16 @@ def narrate(
     :param options: the narrator's options (e.g. ``{"mode": "rewrite"}`` for local_lm), validated.
     :param store: a :class:`xairl.feedback.FeedbackStore` that records the shown narrative, with its evidence
         (the state, the margin's contributions, the sentences' statuses) for the review page.
-
-    The other parameters are those of :meth:`xairl.plugin.Narrator.narrate`.
+    :param narration: how to narrate (:class:`NarrationOptions`); its fields may be given as keyword arguments
+        instead (``xairl.narrate(exp, 0, policy=policy, background=bg)``), and those win.
     """
     from ..plugins import registry
 
+    how = NarrationOptions.of(narration, **given)  # (checked before a narrator, maybe a language model, loads)
     writer: Narrator = registry("narrator").load(narrator)(options)
-    narrative = writer.narrate(
-        explanation,
-        index,
-        template=template,
-        policy=policy,
-        background=background,
-        prompt_dirs=prompt_dirs,
-        k=k,
-        robustness=robustness,
-        history=history,
-        counterfactual=counterfactual,
-    )
+    narrative = writer.narrate(explanation, index, narration=how)
     if store is not None:
-        store.record(narrative, policy=policy)  # with its evidence: the numbers of what it says
+        store.record(narrative, policy=how.policy)  # with its evidence: the numbers of what it says
     return narrative
 
 
@@ -82,4 +65,13 @@ def check_template(path: str | Path, *, notes: bool = False, verbose=None) -> li
     return report.problems + (report.notes if notes else [])
 
 
-__all__ = ["Narrative", "Narrator", "Verification", "check_template", "confidence", "narrate", "verify"]
+__all__ = [
+    "NarrationOptions",
+    "Narrative",
+    "Narrator",
+    "Verification",
+    "check_template",
+    "confidence",
+    "narrate",
+    "verify",
+]

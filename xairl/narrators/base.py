@@ -26,6 +26,7 @@ from ..regions import in_regions
 from ..tracking import Rendered, Span, joined, locate, track_decision, track_global
 from ..values import state_value_text
 from .confidence import confidence
+from .options import NarrationOptions
 from .provenance import verify
 from .verify import Claim
 
@@ -127,34 +128,17 @@ class Narrator:
         self.options = parse_options(self.Options, options, f"{self.name} narrator options")
 
     def narrate(
-        self,
-        explanation: Explanation,
-        index: int | None = 0,
-        template: str | None = None,
-        policy: Policy | None = None,
-        background=None,
-        prompt_dirs: Iterable[str] = (),
-        k: int = 3,
-        robustness: bool = True,
-        history=None,
-        counterfactual=False,
+        self, explanation: Explanation, index: int | None = 0, *, narration: NarrationOptions | None = None, **given
     ) -> Narrative:
         """Words for decision ``index`` (``None``: a global summary over all states), verified, with confidence.
 
-        :param template: template name or .yaml path; default 'explain_action' (or 'global_summary').
-        :param policy: gives feature descriptions, domain facts, and (with ``background``) the robustness parts of
-            the confidence.
-        :param k: how many features the facts list.
-        :param robustness: measure agreement and stability (three extra explanations of the state).
-        :param history: the states before ``index`` in the same episode (oldest first), for a policy whose
-            ``facts_hook`` states facts over time ("the neighbour has been stronger for 3 decisions").
-        :param counterfactual: True: search what would have changed the decision (it needs ``policy``; the search
-            is guided by ``explanation`` and bounded by ``background``) and give the template its fact, or the
-            search's answer for this state (:class:`xairl.Counterfactuals`); its sentence is checked by running the
-            policy on it. Discrete actions only, one decision (not ``index=None``); anything else is refused.
+        :param narration: how to narrate (:class:`NarrationOptions`: template, policy, background, prompt_dirs, k,
+            robustness, history, counterfactual); any of its fields may be given as keyword arguments instead, and
+            those win.
         """
+        o = NarrationOptions.of(narration, **given)
         index = None if index is None else explanation.check_index(index)
-        tpl = _template(explanation, index, template, prompt_dirs)
+        tpl = _template(explanation, index, o.template, o.prompt_dirs)
         # an image is narrated in regions, not pixels (the confidence's robustness still reads the pixels); a
         # continuous action: each dimension is its own output, narrated and verified on its own
         narrated = in_regions(explanation)
@@ -163,17 +147,14 @@ class Narrator:
             if index is not None and explanation.output == "continuous"
             else [narrated]
         )
-        said = said_counterfactual(explanation, index, policy, counterfactual, background)
-        words = [self._words(view, index, tpl, policy, k, history, said) for view in views]
+        said = said_counterfactual(explanation, index, o.policy, o.counterfactual, o.background)
+        words = [self._words(view, index, tpl, o.policy, o.k, o.history, said) for view in views]
         scores, comps = zip(
-            *(
-                confidence(explanation, index, c.ok, policy, background, robustness, output=j, coverage=c.coverage)
-                for j, c in _checks(words)
-            )
+            *(confidence(explanation, index, c.ok, o, output=j, coverage=c.coverage) for j, c in _checks(words))
         )
         worst = int(np.argmin(scores))  # a continuous action is as trustworthy as its least trustworthy dimension
         told = self._told(words, scores[worst], comps[worst], tpl.name, index, explanation.method)
-        return replace(told, evidence=evidence(narrated, told, partial(state_value_text, narrated, policy=policy)))
+        return replace(told, evidence=evidence(narrated, told, partial(state_value_text, narrated, policy=o.policy)))
 
     def _told(self, words: list[tuple], score: float, components: dict, template: str, index, method) -> Narrative:
         """The narrative of the words of every view (a continuous action's dimensions, joined), with its confidence."""

@@ -79,10 +79,8 @@ def _contradictions(tpl: Template, case: Case, variants, domain, v: int) -> list
             s, u, _ = parts[max(k for k, start in enumerate(starts[: len(parts)]) if start <= pos)]
             if u == v:
                 where = f"{tpl.path}:{tpl.lines[s][u]}"
-                lines.setdefault(
-                    where,
-                    f"{where}: contradicted on {case.label}: {sentence.text!r}: {claim.text!r} {claim.detail}".rstrip(),
-                )
+                said = claim.detail if claim.detail.startswith(f"'{claim.text}'") else f"{claim.text!r} {claim.detail}"
+                lines.setdefault(where, f"{where}: contradicted on {case.label}: {sentence.text!r}: {said}".rstrip())
     return list(lines.values())
 
 

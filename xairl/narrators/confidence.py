@@ -12,8 +12,8 @@
 
 Cost: ``additivity`` and ``margin`` are read off the Explanation. ``agreement`` and ``stability`` (the robustness
 components) explain the one state three more times: once with the second method, twice with half the background.
-They run only with ``robustness=True`` and a policy and background; otherwise they are left out (shown as None) and
-the weights of the others are renormalised.
+They run only with ``robustness=True`` and a policy and background (:class:`NarrationOptions`); otherwise they are left
+out (shown as None) and the weights of the others are renormalised.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ import numpy as np
 
 from ..explanation import Explanation
 from ..policy import Policy
+from .options import NarrationOptions
 
 WEIGHTS = {"coverage": 0.2, "additivity": 0.15, "margin": 0.25, "agreement": 0.2, "stability": 0.2}  # as the doc says
 
@@ -70,15 +71,16 @@ def components(
     exp: Explanation,
     index: int | None,
     verified: bool,
-    policy: Policy | None = None,
-    background=None,
-    robustness: bool = True,
+    narration: NarrationOptions | None = None,
+    *,
     seed: int = 0,
     output: int | None = None,
     coverage: float | None = None,
 ) -> dict[str, float | None]:
     """Every component of the confidence (None where not measured); see the module doc.
 
+    :param narration: the narration's options: its ``policy``, ``background`` and ``robustness`` say whether the
+        robustness components are measured (default: not, without a policy).
     :param output: the output narrated when nothing is chosen (a value, one dimension of a continuous action);
         there the margin does not apply. Default: the chosen action.
     :param coverage: the verifier's coverage of the text (:attr:`xairl.Verification.coverage`); None: not known."""
@@ -98,8 +100,10 @@ def components(
     if exp.output == "actions" and r != c:  # one available action: no choice, so no tie to doubt
         tau = float(np.abs(exp.values[index, :, c]).mean()) or 1e-12
         comp["margin"] = float(1 - np.exp(-float(exp.outputs[index, c] - exp.outputs[index, r]) / tau))
-    if robustness and policy is not None and background is not None and exp.states is not None:
-        bg = policy.check_states(background, "background")
+    o = narration or NarrationOptions()
+    policy = o.policy
+    if o.robustness and policy is not None and o.background is not None and exp.states is not None:
+        bg = policy.check_states(o.background, "background")
         comp["agreement"] = _agreement(exp, index, policy, bg, c)
         comp["stability"] = _stability(exp, index, policy, bg, seed, c)
     return comp
@@ -109,15 +113,15 @@ def confidence(
     exp: Explanation,
     index: int | None,
     verified: bool,
-    policy: Policy | None = None,
-    background=None,
-    robustness: bool = True,
+    narration: NarrationOptions | None = None,
+    *,
     seed: int = 0,
     output: int | None = None,
     coverage: float | None = None,
 ) -> tuple[float, dict[str, float | None]]:
-    """The confidence of a narrative and its components (formula and cost in the module doc)."""
-    comp = components(exp, index, verified, policy, background, robustness, seed, output, coverage)
+    """The confidence of a narrative and its components (formula and cost in the module doc; the parameters are
+    those of :func:`components`)."""
+    comp = components(exp, index, verified, narration, seed=seed, output=output, coverage=coverage)
     measured = {k: v for k, v in comp.items() if k in WEIGHTS and v is not None}
     score = comp["verification"] * sum(WEIGHTS[k] * v for k, v in measured.items()) / sum(WEIGHTS[k] for k in measured)
     return float(np.clip(score, 0.0, 1.0)), comp

@@ -181,3 +181,16 @@ def test_wrong_numbers_that_equal_another_fact_stay_contradicted(uav):
             assert _claim(xairl.verify(text, exp, i, policy), f"{other:.1f}").status == "contradicted", text
             checked += 1
     assert checked >= 10
+
+
+def test_the_buffer_is_said_once(uav):
+    """Issue 64: 'came from the uplink buffer (0 % full), by +1.85 ... The uplink buffer was 0 % full.' said it twice."""
+    policy, exp, _ = uav
+    named = 0
+    for i in range(len(exp.values)):
+        facts = decision_facts(exp, i, policy)
+        said = [f.name for f in facts.reasons] + ([facts.concession.name] if facts.concession else [])
+        text = xairl.narrate(exp, i, template="handover", policy=policy, robustness=False).text
+        named += "buffer_queue_size" in said
+        assert text.count("uplink buffer") == 1 if "buffer_queue_size" in said else "The uplink buffer was" in text
+    assert named  # the seed has decisions where the buffer is a reason

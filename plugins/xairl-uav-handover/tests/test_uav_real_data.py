@@ -1,5 +1,7 @@
 """Real flight data (../shared/data, never committed) and the report. Skips cleanly where the data is absent."""
 
+import contextlib
+import io
 import json
 import shutil
 from pathlib import Path
@@ -7,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from xairl import InputError
+from xairl import InputError, display
 from xairl.cli import main
 from xairl.plugin import StateRecord
 from xairl_uav_handover.baselines import CHMConfig
@@ -145,13 +147,34 @@ def test_baltaci_rates():
 
 @pytest.fixture(scope="module")
 def sim_report(tmp_path_factory):
-    """One report without real data, read by the tests below (a report costs seconds)."""
+    """One report without real data, read by the tests below (a report costs seconds); what it said on stderr is
+    kept beside it, in stderr.txt."""
     out = tmp_path_factory.mktemp("sim") / "rep"
-    assert (
-        main(["report", "--plugin", "uav-handover", "--n", "40", "-o", "flights=20", "--narrate", "--out", str(out)])
-        == 0
-    )
+    every, display.EVERY = display.EVERY, 0.01  # each step is long at this scale: each is said
+    try:
+        with contextlib.redirect_stderr(io.StringIO()) as err:
+            argv = ["report", "--plugin", "uav-handover", "--n", "40", "-o", "flights=20", "--narrate"]
+            assert main([*argv, "--out", str(out)]) == 0
+    finally:
+        display.EVERY = every
+    (out.parent / "stderr.txt").write_text(err.getvalue())
     return out
+
+
+def test_the_report_says_what_it_is_doing(sim_report):
+    """`make demo` printed nothing for 97 s, then for 124 s: each long step is said (every 10 s while it runs:
+    tests/test_progress.py), the plugin's own steps inside the command's."""
+    said = [line for line in (sim_report.parent / "stderr.txt").read_text().splitlines() if line.startswith("xairl: ")]
+    starts = [line[len("xairl: ") : -len(" ...")] for line in said if line.endswith(" ...")]
+    assert starts == [
+        "building the uav-handover report's content",
+        "Table I: CHM, SA-MRO and the DQN on 20 simulated flights",
+        "simulating and explaining the flights at a glance",
+        "explaining (deep_shap) 40 simulated states",
+        "drawing the figures",
+        "narrating 6 decisions",
+    ], said
+    assert all(any(line.startswith(f"xairl: {s}: done in ") for line in said) for s in starts), said
 
 
 def test_report_without_real_data(sim_report):

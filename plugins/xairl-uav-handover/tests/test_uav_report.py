@@ -91,7 +91,9 @@ def test_the_open_loop_rows_that_equal_each_other_are_explained(page):
 
 
 def test_the_main_finding_comes_first_with_contents(page):
-    assert page.index("Figure 2 finding (buffer first") < page.index("<nav class=toc>") < page.index("<h2 id=s2>Settings")
+    assert (
+        page.index("Figure 2 finding (buffer first") < page.index("<nav class=toc>") < page.index("<h2 id=s2>Settings")
+    )
     toc = page[page.index("<nav class=toc>") : page.index("</nav>")]
     for heading in ("Table I", "Calibration", "Open-loop agreement", "Narrated decisions", "Notes"):
         assert f">{heading}" in toc, heading

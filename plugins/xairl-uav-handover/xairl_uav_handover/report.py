@@ -116,7 +116,8 @@ class UAVReport(xairl.plugin.Report):
 
     def build(self, req: xairl.plugin.ReportRequest) -> xairl.plugin.ReportContent:
         real, real_setting = real_source(self.options.real)
-        loaded = _load_real(real) if real is not None else None  # a bad file is named before Table I's minutes
+        with xairl.plugin.heartbeat("reading the real flights", req.progress and real is not None):
+            loaded = _load_real(real) if real is not None else None  # a bad file is named before Table I's minutes
         ckpt = load_checkpoint(self.options.checkpoint)
         cfg = ckpt.sim_config
         policy = uav_policy(ckpt)
@@ -146,8 +147,12 @@ class UAVReport(xairl.plugin.Report):
                 *same,
             ],
         )
-        flights = self._add_real_flights(content, ckpt, req, real, *loaded) if loaded else []
-        self._add_timelines(content, ckpt, req, flights[:1])
+        with xairl.plugin.heartbeat(
+            "comparing with the real flights (calibration, agreement)", req.progress and loaded
+        ):
+            flights = self._add_real_flights(content, ckpt, req, real, *loaded) if loaded else []
+        with xairl.plugin.heartbeat("simulating and explaining the flights at a glance", req.progress):
+            self._add_timelines(content, ckpt, req, flights[:1])
         if self.options.frontier:
             content.figures.append(frontier_section(self.options.frontier, req.out))
         return content
@@ -179,7 +184,8 @@ class UAVReport(xairl.plugin.Report):
         n, cfg = self.options.flights, ckpt.sim_config
         stay = cfg.handover.min_time_of_stay_s
         sa_mro = SAMRO(SAMROConfig(warmup_flights=n))  # the network adapts on as many flights as the table has
-        res = {c.name: with_intervals(flights(c, cfg, n, [seed])) for c in (CHM(), sa_mro, controller(ckpt))}
+        with xairl.plugin.heartbeat(f"Table I: CHM, SA-MRO and the DQN on {n} simulated flight{'s' * (n != 1)}"):
+            res = {c.name: with_intervals(flights(c, cfg, n, [seed])) for c in (CHM(), sa_mro, controller(ckpt))}
         paper = ", ".join(f"{name} {ho} handovers and {pp} % ping-pongs" for name, (ho, pp) in PAPER.items())
         same = []
         if res["SA-MRO"] == res["CHM"]:
@@ -222,21 +228,29 @@ class UAVReport(xairl.plugin.Report):
             seen = states
         pick = np.random.default_rng(req.seed).choice(len(states), size=min(req.n_states, len(states)), replace=False)
         content.datasets.append(("real", seen[np.sort(pick)]))
-        if memory_of(ckpt.meta):  # the newest step, times included, against the greedy DQN's own states: a time
-            # on the cell grows as the DQN stays, so only its own decisions compare like with like
-            names, states = SIGNALS, seen[:, -len(SIGNALS) :]
-            sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, n_flights=256)[:, -len(SIGNALS) :]
-        else:  # the mix of exploration and greedy steps that training sees
-            names, sim_ref = FEATURES, dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=256)
+        step = xairl.plugin.heartbeat(
+            "simulating 256 flights: the states the real ones are compared with", req.progress
+        )
+        with step:
+            if memory_of(ckpt.meta):  # the newest step, times included, against the greedy DQN's own states: a time
+                # on the cell grows as the DQN stays, so only its own decisions compare like with like
+                names, states = SIGNALS, seen[:, -len(SIGNALS) :]
+                sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, n_flights=256)[:, -len(SIGNALS) :]
+            else:  # the mix of exploration and greedy steps that training sees
+                names = FEATURES
+                sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=256)
+        with xairl.plugin.heartbeat("simulating handovers per altitude band (calibration)", req.progress):
+            bands = band_rows(flights, chm_real, cfg, req.seed, n_flights=8, duration_s=30.0)
+        mro: dict = {}  # what SA-MRO's network counted and did on the real samples
+        with xairl.plugin.heartbeat("replaying the real flights open-loop (agreement)", req.progress):
+            agreeing = agreement_rows(walks, ckpt, cfg, mro)
         queue = np.concatenate([w.queue_bits for w in walks])
         where = f"{len(flights)} real flights from {shown_path(real)}" + (f" ({len(bad)} skipped)" if bad else "")
         keep = [j for j, f in enumerate(names) if not _identifier(content.policy, f)]  # an id has no percentiles
-        mro: dict = {}
-        agreeing = agreement_rows(walks, ckpt, cfg, mro)
         content.tables += [
             (
                 f"Calibration: handovers per minute by altitude band ({where})",
-                _table(band_rows(flights, chm_real, cfg, req.seed, n_flights=8, duration_s=30.0)),
+                _table(bands),
             ),
             (
                 f"Real states in the training distribution: buffer full in {100 * np.mean(queue >= cfg.buffer.q_max_bits):.1f} "
@@ -258,7 +272,8 @@ class UAVReport(xairl.plugin.Report):
             )
             content.notes.append(same_as_chm(mro, f"the {len(flights)} real flights' samples", SAMROConfig(), why))
         content.notes += [f"skipped file: {b.replace(str(real), shown_path(real))}" for b in bad] + REAL_NOTES
-        content.figures.append(altitude_figure(req.out, str(real), cfg, flights, chm_real, req.seed))
+        with xairl.plugin.heartbeat("simulating handovers by altitude (the figure)", req.progress):
+            content.figures.append(altitude_figure(req.out, str(real), cfg, flights, chm_real, req.seed))
         return flights
 
 

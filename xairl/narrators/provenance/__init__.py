@@ -31,7 +31,7 @@ from ...facts import DomainFacts
 from ...policy import Policy
 from ...regions import in_regions
 from ...tracking import Span
-from ..verify import Claim, SentenceCheck, Verification, reader, sentences
+from ..verify import Claim, SentenceCheck, Verification, bidi_claims, bidi_note, reader, sentences
 from ..verify.checks import DIRECTION_RE
 from ..verify.numbers import normalise
 from .counterfactual import check_counterfactual, is_counterfactual
@@ -194,8 +194,8 @@ def verify(
                 check_sentence(sentence, own, book, read, smuggled) if own else [_own(c, book) for c in read(sentence)]
             )
         claims = [replace(c, span=c.span.shifted(a)) if c.span is not None else c for c in claims]
-        checks.append(SentenceCheck(sentence.strip(), tuple(claims)))
-    return Verification(tuple(checks))
+        checks.append(SentenceCheck(sentence.strip(), (*bidi_claims(sentence), *claims)))
+    return Verification(tuple(checks), bidi_note(text))
 
 
 _SEPARATOR_ROW = re.compile(r"\s*\|?(?:\s*:?-{3,}:?\s*\|)+\s*:?-*:?\s*")

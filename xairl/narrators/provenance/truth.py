@@ -83,7 +83,7 @@ def truth(exp: Explanation, index: int | None, policy: Policy | None, domain: Do
             features.setdefault(f.name, {})[view] = f
             for q in (
                 *("value", "value_text", "unit", "contribution", "share", "direction", "rank", "kind", "fill"),
-                *("trend", "window", "change_unit"),
+                *("trend", "window", "change_unit", "steps"),
             ):
                 values[(q, f.name, view, None)] = getattr(f, q)
             values[("value_change", f.name, view, None)] = f.change

@@ -38,6 +38,7 @@ import numpy as np
 from ...errors import InputError
 from ...explanation import Explanation
 from ...policy import Policy
+from ...prompts import bidi_controls
 from ...regions import in_regions
 from ...windows import window_of
 from . import binding, checks, clauses, directions, parse, quantities, regions, reread, sums
@@ -226,8 +227,28 @@ def verify(
     read = [read_one(text[a:b]) for a, b in spans]
     claims = iter(reread.swapped([c for cs in read for c in cs]))  # (two numbers that cross, anywhere in the text)
     return Verification(
-        tuple(SentenceCheck(text[a:b].strip(), tuple(next(claims) for _ in cs)) for (a, b), cs in zip(spans, read)),
-        note,
+        tuple(
+            SentenceCheck(text[a:b].strip(), (*bidi_claims(text[a:b]), *(next(claims) for _ in cs)))
+            for (a, b), cs in zip(spans, read)
+        ),
+        "; ".join(filter(None, [note, bidi_note(text)])),
+    )
+
+
+def bidi_claims(sentence: str) -> tuple[Claim, ...]:
+    """A contradicted claim for a sentence holding bidirectional control characters: what a reader sees is not the
+    text that was read ('by U+202E 5.03 U+202C' shows as 'by 30.5'), so it is never verified."""
+    found = bidi_controls(sentence)
+    return (Claim("text", found, "contradicted", f"holds bidirectional control characters ({found})"),) if found else ()
+
+
+def bidi_note(text: str) -> str:
+    """Why a text holding bidirectional control characters is not verified ('' for a text without)."""
+    found = bidi_controls(text)
+    return (
+        f"not verified: the text holds bidirectional control characters ({found}) that reorder what is shown"
+        if found
+        else ""
     )
 
 

@@ -10,7 +10,7 @@ import numpy as np
 from ...explanation import Explanation
 from ...facts import Comparison, DomainFacts, domain_facts
 from ...policy import Policy
-from ...windows import said_change, window_of
+from ...windows import real_start, said_change, window_of
 from .book import FactBook, FeatureFacts, add_facts
 
 
@@ -20,9 +20,12 @@ def per_signal(explanation: Explanation) -> Explanation:
     window = window_of(explanation)
     out = explanation.by_signal()
     cols = np.stack(list(window.signal_columns().values()))  # (signals, steps)
-    changes = explanation.states[:, cols[:, -1]] - explanation.states[:, cols[:, 0]]
-    span = None if window.step_s is None else (window.steps - 1) * window.step_s
-    kept = {"changes": changes, "span_s": span, "steps": window.steps, "states": explanation.states}
+    states, start = explanation.states, real_start(explanation.states, window)  # its padding is no observation
+    oldest = states[np.arange(len(states))[:, None], cols[:, start].T]
+    changes = states[:, cols[:, -1]] - oldest
+    steps = window.steps - start  # per state: the observed steps
+    span = None if window.step_s is None else (steps - 1) * window.step_s
+    kept = {"changes": changes, "span_s": span, "steps": steps, "states": states}
     if window.frames:  # a frame stack: each frame's patch stays citable by its own name ('patch F6 of frame 2')
         kept["slots"] = {"names": explanation.feature_names, "values": explanation.values}
     return replace(out, extras={**out.extras, "window": kept})
@@ -38,8 +41,9 @@ def _window_facts(explanation: Explanation, index: int, policy: Policy | None) -
             continue
         size, unit = said_change(float(w["changes"][index, j]), *((info.unit, info.capacity) if info else ("", None)))
         out.append(Comparison(f"{name} changed", abs(size), unit))
-    out += [Comparison("window", float(w["span_s"]), "s")] if w["span_s"] else []
-    return DomainFacts(comparisons=(*out, Comparison("window steps", float(w["steps"]), "observations")))
+    span = None if w["span_s"] is None else float(w["span_s"][index])
+    out += [Comparison("window", span, "s")] if span else []
+    return DomainFacts(comparisons=(*out, Comparison("window steps", float(w["steps"][index]), "observations")))
 
 
 def add_window_facts(book: FactBook, explanation: Explanation, index: int, policy: Policy | None) -> None:
