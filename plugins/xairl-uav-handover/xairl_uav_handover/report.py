@@ -121,13 +121,12 @@ class UAVReport(xairl.plugin.Report):
         ckpt = load_checkpoint(self.options.checkpoint)
         cfg = ckpt.sim_config
         policy = uav_policy(ckpt)
-        table_one, same = self._table_one(ckpt, req.seed)
         content = xairl.plugin.ReportContent(
             title="xairl report: UAV handover DQN (Meer et al.), calibrated reproduction",
             policy=policy,
             background=policy.background(100, seed=req.seed + 7),
             datasets=[("simulated", dqn_decision_states(ckpt, req.n_states, seed=req.seed + 1))],
-            tables=[table_one],
+            tables=[],  # Table I is put first below, computed after the states are drawn (the steps said in order)
             settings={
                 "checkpoint": ckpt.path.name,
                 "training command": ckpt.meta.get("command"),
@@ -144,9 +143,11 @@ class UAVReport(xairl.plugin.Report):
                 "Q-value over the runner-up's, in every figure, card and importance table (the main findings also "
                 "rank by the chosen action's own Q-value); the background is 100 states after 10 s of flight under "
                 "conventional handover.",
-                *same,
             ],
         )
+        table_one, same = self._table_one(ckpt, req.seed)
+        content.tables.insert(0, table_one)
+        content.notes += same
         with xairl.plugin.heartbeat(
             "comparing with the real flights (calibration, agreement)", req.progress and loaded
         ):
