@@ -67,3 +67,47 @@ def test_contributions_in_the_margin_view_add_up_to_the_margin(exp):
     margin = exp.outputs[idx, exp.chosen] - exp.outputs[idx, exp.runner_up]
     expected = exp.base_values[idx, exp.chosen] - exp.base_values[idx, exp.runner_up]
     assert np.allclose(expected + c.sum(axis=1), margin, atol=1e-4)
+
+
+def _inside(fig) -> bool:
+    """Whether everything drawn lies within the figure (a clipped label runs past an edge of the PNG)."""
+    fig.canvas.draw()
+    box = fig.get_tightbbox(fig.canvas.get_renderer())
+    return box.x0 >= -0.01 and box.x1 <= fig.get_figwidth() + 0.01 and box.y0 >= -0.01
+
+
+def test_a_waterfalls_axis_label_is_never_clipped(exp):
+    """The UAV DQN's waterfall label ('margin of handover_to_candidate_1 over stay: expected -28.7 -> this state
+    5.62') ran past the figure's right edge: the figure widens to hold it."""
+    import dataclasses
+
+    long = dataclasses.replace(exp, action_names=[f"handover_to_candidate_{k}_of_the_neighbour_list" for k in range(3)])
+    for e in (exp, long):
+        assert _inside(plots.waterfall(e, 3)), e.action_names
+
+
+def test_side_by_side_beeswarms_share_one_x_scale(exp):
+    p = toy_policy()
+    calm = np.repeat(p.background(40, seed=2).mean(axis=0, keepdims=True), 6, axis=0)  # small contributions
+    near = xairl.explain(p, calm + 0.01 * np.arange(6)[:, None], background=p.background(40, seed=2))
+    fig = plots.beeswarm([("spread", exp), ("calm", near)])
+    lims = [ax.get_xlim() for ax in fig.axes[:2]]
+    assert lims[0] == lims[1] and np.abs(contributions_of(near)).max() < 0.5 * np.abs(contributions_of(exp)).max()
+
+
+def contributions_of(e):
+    return plots.contributions(e)
+
+
+def test_a_beeswarm_greys_an_identifier_and_colours_quantities(exp):
+    """An id (a serving cell's number) has no low or high: its dots are one grey, a quantity's run blue to red."""
+    from types import SimpleNamespace
+
+    ident = exp.feature_names[0]
+    policy = SimpleNamespace(features={ident: xairl.FeatureInfo("", "the cell's id", kind="identifier")})
+    fig = plots.beeswarm(exp, policy=policy)
+    ax = fig.axes[0]
+    rows = [t.get_text() for t in ax.get_yticklabels()]
+    colours = {rows[k]: np.unique(c.get_facecolors().round(3), axis=0) for k, c in enumerate(ax.collections)}
+    assert len(colours[ident]) == 1 and all(len(v) > 1 for f, v in colours.items() if f != ident)
+    assert ident in fig.axes[-1].get_ylabel()  # the colour bar says which is grey

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import html
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
@@ -24,9 +24,11 @@ SHOWN = 8
 STATUS_MARK = {"verified": "&#10003;", "contradicted": "&#10007;", "unchecked": "?"}
 
 
-def evidence(exp: Explanation, narrative) -> dict[str, Any]:
+def evidence(exp: Explanation, narrative, value_text: Callable[[int, int], str] | None = None) -> dict[str, Any]:
     """What a card shows for ``narrative`` of ``exp`` (its state ``narrative.index``; a global summary has no
-    state and only its sentences and confidence)."""
+    state and only its sentences and confidence). ``value_text(i, j)``: state ``i``'s value of feature ``j`` as the
+    narratives write it, in its unit ('19.0 % full', not 2.89e+06: :func:`xairl.values.state_value_text` with the
+    policy, which the callers have and this layer does not); the card shows it beside the number kept."""
     out: dict[str, Any] = {
         "sentences": [list(s) for s in narrative.sentences],
         "components": {k: v for k, v in narrative.components.items() if v is not None},
@@ -48,6 +50,7 @@ def evidence(exp: Explanation, narrative) -> dict[str, Any]:
             {
                 "name": exp.feature_names[j],
                 "value": label if label is not None else float(exp.states[i, j]),
+                **({"value_text": value_text(i, int(j))} if value_text is not None else {}),
                 "contribution": float(view[j]),
                 "to_chosen": float(exp.values[i, j, c]),
             }
@@ -153,7 +156,8 @@ def card_html(narrative_text: str, ev: dict, meta: str = "", controls: str = "")
     side = [f"<table class=comp><tr><th>confidence</th><th>{ev.get('confidence', 0):.2f}</th></tr>{comps}</table>"]
     if "features" in ev:
         state = "".join(
-            f"<tr><td>{html.escape(f['name'])}</td><td>{_num(f['value'])}</td><td>{f['contribution']:+.3g}</td></tr>"
+            f"<tr><td>{html.escape(f['name'])}</td><td>{_num(f.get('value_text') or f['value'])}</td>"
+            f"<td>{f['contribution']:+.3g}</td></tr>"
             for f in ev["features"]
         )
         side.insert(

@@ -28,6 +28,8 @@ from .files import save_figure
 from .regions import in_regions
 from .windows import window_of
 
+#: figures are laid out and saved at this many dots per inch
+DPI = 90
 #: more features than this are plotted in groups (image patches, dict keys) or only the strongest are shown
 MAX_SHOWN = 40
 #: a plot's axes are never narrower than this (inches), however long the feature names beside them
@@ -45,21 +47,37 @@ def _figure(**kwargs):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(**kwargs)
+    fig = Figure(**{"dpi": DPI, **kwargs})  # laid out at the dpi it is saved with: text measures as written
     FigureCanvasAgg(fig)
     return fig
 
 
 def _layout(fig, axes, min_width: float = MIN_AXES_WIDTH) -> None:
     """tight_layout, then a wider figure while the narrowest of ``axes`` is under ``min_width`` inches: long tick
-    labels (region names, 'name = value unit') take width from the figure, not from the plot."""
+    labels (region names, 'name = value unit') take width from the figure, not from the plot; then :func:`_fit`."""
     for _ in range(3):
         fig.tight_layout()
         narrowest = min(ax.get_position().width for ax in axes) * fig.get_figwidth()
         if narrowest >= min_width - 0.05:
-            return
+            break
         fig.set_figwidth(fig.get_figwidth() + (min_width - narrowest) * len(axes) + 0.1)
-    fig.tight_layout()
+    else:
+        fig.tight_layout()
+    _fit(fig)
+
+
+def _fit(fig) -> None:
+    """A wider figure while any of its text runs past an edge: tight_layout moves the axes, but cannot make room
+    for an axis label wider than the figure (a waterfall's 'margin of handover_to_candidate_1 over stay: ...')."""
+    renderer, pad = fig.canvas.get_renderer(), 0.15  # inches kept free at the right edge (tight_layout's at the left)
+    for _ in range(6):
+        box = fig.get_tightbbox(renderer)  # inches, everything drawn
+        over = max(0.0, -box.x0) + max(0.0, box.x1 - fig.get_figwidth() + pad)
+        if over <= 0.01:
+            return
+        # a label centred under its axes gains half of what the figure gains on each side
+        fig.set_figwidth(fig.get_figwidth() + 2 * over + 0.1)
+        fig.tight_layout()
 
 
 def _keep_inside(fig, ax, texts, pad: float = 4.0) -> None:
@@ -80,6 +98,7 @@ def _keep_inside(fig, ax, texts, pad: float = 4.0) -> None:
         ax.set_xlim(lo - 1.3 * max(left, 0) * per_px, hi + 1.3 * max(right, 0) * per_px)
     else:
         fig.tight_layout()
+    _fit(fig)
 
 
 def _cmap(name: str):
@@ -88,8 +107,11 @@ def _cmap(name: str):
     return matplotlib.colormaps[name]
 
 
-def save(fig, path: str | Path, dpi: int = 90) -> Path:
+def save(fig, path: str | Path, dpi: int = DPI) -> Path:
     """Write ``fig`` to ``path`` (format from the suffix) atomically; returns the path."""
+    if dpi != fig.dpi:  # text measures a little differently at another dpi: fit it again there
+        fig.set_dpi(dpi)
+        _fit(fig)
     return save_figure(fig, path, dpi=dpi)
 
 
@@ -135,21 +157,34 @@ def importance_order(exp: Explanation, view: str = "margin") -> np.ndarray:
     return np.argsort(-np.abs(contributions(exp, view)).mean(axis=0), kind="stable")
 
 
-def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | None = None, max_display: int = 20):
+def beeswarm(
+    explanations: Panels,
+    view: str = "margin",
+    order: np.ndarray | None = None,
+    max_display: int = 20,
+    *,
+    policy=None,
+):
     """One dot per state and feature at its contribution, coloured by the feature's value (low blue, high red);
-    several titled explanations side by side share one feature order (the first's importance unless ``order``).
-    Images and dict observations are shown by patch and by key."""
+    several titled explanations side by side share one feature order (the first's importance unless ``order``) and
+    one x scale. Images and dict observations are shown by patch and by key.
+
+    :param policy: the :class:`xairl.Policy` explained: a feature it declares an identifier or a category (a cell's
+        id, a colour) is drawn grey, for its value has no low or high.
+    """
     panels = [(t, readable(e)) for t, e in _panels(explanations)]
     order = (importance_order(panels[0][1], view) if order is None else order)[:max_display]
     rng = np.random.default_rng(0)
     fig = _figure(figsize=(7.5 * len(panels), 0.3 * len(order) + 2))
-    axes = fig.subplots(1, len(panels), squeeze=False)
+    axes = fig.subplots(1, len(panels), squeeze=False, sharex=True)  # one scale: panels compare at a glance
+    features = getattr(policy, "features", None) or {}
     for ax, (title, exp) in zip(axes[0], panels):
         c = contributions(exp, view)
         keep = rng.choice(len(c), size=min(len(c), 2000), replace=False)  # enough dots to show the spread
         for row, j in enumerate(order):
             colour = "0.4"
-            if exp.states is not None:
+            info = features.get(exp.feature_names[j])
+            if exp.states is not None and getattr(info, "kind", "numeric") not in ("identifier", "categorical"):
                 colour = _cmap("coolwarm")(np.argsort(np.argsort(exp.states[keep, j])) / max(len(keep) - 1, 1))
             ax.scatter(c[keep, j], row + rng.uniform(-0.3, 0.3, len(keep)), s=4, c=colour, alpha=0.7, linewidths=0)
         ax.axvline(0, color="0.5", lw=0.8)
@@ -163,7 +198,9 @@ def beeswarm(explanations: Panels, view: str = "margin", order: np.ndarray | Non
 
         bar = fig.colorbar(ScalarMappable(cmap="coolwarm"), ax=axes[0, -1], ticks=[0, 1], fraction=0.03)
         bar.ax.set_yticklabels(["low", "high"])
-        bar.set_label("feature value")
+        named = [panels[0][1].feature_names[j] for j in order]
+        grey = [f for f in named if getattr(features.get(f), "kind", "numeric") in ("identifier", "categorical")]
+        bar.set_label("feature value" + (f"\n(grey: {', '.join(grey)}, no low or high)" if grey else ""))
     _layout(fig, list(axes[0]))
     return fig
 

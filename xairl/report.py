@@ -7,25 +7,26 @@ rest the same way for every plugin (:func:`write_report`).
 
 from __future__ import annotations
 
-import base64
-import html
 import json
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
 
 from . import report_counterfactuals as cfs
-from .evidence import CARD_STYLE, card_html, evidence
+from .evidence import evidence
 from .explanation import Explanation
 from .explanation_io import StateRecord
 from .files import atomic_write, write_text
 from .options import Options, parse_options
 from .policy import Policy
 from .regions import in_regions
+from .report_html import page, table_html
+from .values import state_value_text
 from .windows import window_of
 
 #: an image's report lists this many regions by importance (its cards list every region, sorted)
@@ -75,8 +76,8 @@ class ReportContent:
     :param template: the decision template narrated by default (None: 'explain_action' for discrete actions,
         'explain_output' for a value or a continuous action).
     :param commentary: optional ``f({label: Explanation}) -> [sentence, ...]``, called once the datasets are
-        explained: the plugin's reading of the explanations (e.g. which of a paper's findings hold), listed first
-        among the notes.
+        explained: the plugin's reading of the explanations (e.g. which of a paper's findings hold), the page's
+        main findings, shown first.
     """
 
     title: str
@@ -107,17 +108,6 @@ class Report:
     def build(self, request: ReportRequest) -> ReportContent:
         """The plugin's content for ``request`` (figures it draws go into ``request.out``)."""
         raise NotImplementedError
-
-
-def table_html(header: list[str], rows: list[list]) -> str:
-    """An HTML table; floats with two decimals, everything else escaped."""
-
-    def cell(v):
-        return f"{v:.2f}" if isinstance(v, float) else html.escape(str(v))
-
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
-    body = "".join("<tr>" + "".join(f"<td>{cell(v)}</td>" for v in r) + "</tr>" for r in rows)
-    return f"<table><tr>{head}</tr>{body}</table>"
 
 
 def importance_table(
@@ -181,7 +171,7 @@ def _figures(
                 f"SHAP values, {target}: {' vs '.join(label for label, _ in exps)} (same feature order, by {ref_label} "
                 "importance)"
             ),
-            plots.save(plots.beeswarm(shown), out / "beeswarm.png"),
+            plots.save(plots.beeswarm(shown, policy=policy), out / "beeswarm.png"),
         ),
         (f"Global importance: mean |{target}|", plots.save(plots.importance(shown), out / "importance.png")),
         (
@@ -283,7 +273,8 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
         if len(exps) > 1 or image
         else []
     )
-    notes = (content.commentary({label: e for label, e in exps}) if content.commentary else []) + content.notes
+    findings = content.commentary({label: e for label, e in exps}) if content.commentary else []
+    notes = list(content.notes)
     if req.counterfactuals and cfs.shown(content.policy, ref):  # the run's distance to another action, by feature
         title, header, rows, sentence = cfs.flip_rows(content.policy, ref, content.background)
         tables.append((title, table_html(header, rows)))
@@ -300,7 +291,19 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
         **content.settings,
     }
     path = out / "report.html"
-    write_text(path, _html(content.title, tables, notes, exps, figures, narratives, settings))
+    write_text(
+        path,
+        page(
+            content.title,
+            findings=findings,
+            tables=tables,
+            notes=notes,
+            exps=exps,
+            figures=figures,
+            narratives=narratives,
+            settings=settings,
+        ),
+    )
     return path
 
 
@@ -331,64 +334,11 @@ def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, sh
         for i in progress(idx, desc=f"narrating ({req.narrator})", disable=not req.progress)
     ]
     out.append(narrate(ref, None, policy=content.policy, prompt_dirs=req.prompt_dirs))
-    pairs = [(n, n.evidence if n.evidence is not None else evidence(shown, n)) for n in out]  # of its regions
+    texts = partial(state_value_text, shown, policy=content.policy)  # values in their units, as the words say them
+    pairs = [(n, n.evidence if n.evidence is not None else evidence(shown, n, texts)) for n in out]  # its regions
     cfs.attach(pairs, found, content.policy)
     if content.policy.groups:
         grouped = ref.grouped(dict(content.policy.groups))
         n = narrate(grouped, None, policy=content.policy, prompt_dirs=req.prompt_dirs)
-        pairs.append((n, evidence(grouped, n)))
+        pairs.append((n, evidence(grouped, n, partial(state_value_text, grouped, policy=content.policy))))
     return pairs
-
-
-def _img(path: Path) -> str:
-    return "data:image/png;base64," + base64.b64encode(Path(path).read_bytes()).decode()
-
-
-def _html(title, tables, notes, exps, figures, narratives, settings) -> str:
-    parts = [f"<h1>{html.escape(title)}</h1>"]
-    parts.append(
-        "<h2>Settings</h2>"
-        + table_html(
-            ["setting", "value"],
-            [[k, json.dumps(v) if isinstance(v, (dict, list)) else v] for k, v in settings.items()],
-        )
-    )
-    for heading, table in tables:
-        parts.append(f"<h2>{html.escape(heading)}</h2>{table}")
-    parts.append(
-        "<h2>Explanations</h2><p>"
-        + ", ".join(
-            f"{html.escape(label)}: {len(e.values)} states, largest additivity gap {e.additivity_gap.max():.1e}"
-            for label, e in exps
-        )
-        + "</p>"
-    )
-    for caption, png in figures:
-        parts.append(
-            f"<figure><img src='{_img(png)}' alt='{html.escape(caption)}'><figcaption>"
-            f"{html.escape(caption)}</figcaption></figure>"
-        )
-    if narratives:
-        parts.append(
-            "<h2>Narrated decisions</h2><p class=meta>Each sentence is marked &#10003; verified, &#10007; "
-            "contradicted or ? unchecked (no claim the verifier could check); the waterfall builds the margin "
-            "of the chosen action over the runner-up (the score, when nothing is chosen) from its background "
-            "average, feature by feature.</p>"
-        )
-        for n, ev in narratives:
-            where = "all states" if n.index is None else f"state {n.index}"
-            meta = f"{where} &middot; template {html.escape(n.template)} &middot; {html.escape(n.source)}" + (
-                "" if n.verified else " &middot; <span class=bad>NOT verified</span>"
-            )
-            parts.append(card_html(n.text, ev, meta))
-    if notes:
-        parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in notes) + "</ul>")
-    style = (
-        "body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}table{border-collapse:collapse;"
-        "margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}"
-        "img{max-width:100%}.ok{color:#070;font-weight:bold}.bad{color:#b00;font-weight:bold}" + CARD_STYLE
-    )
-    return (
-        f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
-        f"<style>{style}</style></head><body>{''.join(parts)}</body></html>"
-    )

@@ -10,6 +10,7 @@ from __future__ import annotations
 import html
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Any, ClassVar
 
 import numpy as np
@@ -23,6 +24,7 @@ from ..options import Options, parse_options
 from ..policy import Policy
 from ..regions import in_regions
 from ..tracking import Rendered, Span, joined, locate, track_decision, track_global
+from ..values import state_value_text
 from .confidence import confidence
 from .options import NarrationOptions
 from .provenance import verify
@@ -152,7 +154,7 @@ class Narrator:
         )
         worst = int(np.argmin(scores))  # a continuous action is as trustworthy as its least trustworthy dimension
         told = self._told(words, scores[worst], comps[worst], tpl.name, index, explanation.method)
-        return replace(told, evidence=evidence(narrated, told))
+        return replace(told, evidence=evidence(narrated, told, partial(state_value_text, narrated, policy=o.policy)))
 
     def _told(self, words: list[tuple], score: float, components: dict, template: str, index, method) -> Narrative:
         """The narrative of the words of every view (a continuous action's dimensions, joined), with its confidence."""

@@ -199,31 +199,8 @@ def test_report_without_real_data(sim_report):
 
 @pytest.mark.slow
 @needs_data
-def test_report_with_real_data(tmp_path):
-    real = tmp_path / "data" / "ukm"
-    real.mkdir(parents=True)
-    for name in ("25m.csv", "100m.csv"):
-        shutil.copy(UKM / name, real / name)
-    shutil.copytree(BALTACI, tmp_path / "data" / "baltaci-imc22-handovers")
-    out = tmp_path / "rep"
-    assert (
-        main(
-            [
-                "report",
-                "--plugin",
-                "uav-handover",
-                "--n",
-                "30",
-                "-o",
-                f"real={real}",
-                "-o",
-                "flights=20",
-                "--out",
-                str(out),
-            ]
-        )
-        == 0
-    )
+def test_report_with_real_data(real_report):
+    out, _ = real_report
     html = (out / "report.html").read_text()
     assert "Calibration: handovers per minute by altitude band (2 real flights" in html and "Baltaci" in html
     assert "Open-loop agreement with the live network" in html and "Spearman rank correlation real vs simulated" in html

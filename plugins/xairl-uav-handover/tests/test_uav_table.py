@@ -77,3 +77,24 @@ def test_intervals_over_training_seeds_of_unequal_sizes():
     m, groups = pooled_seeds([_known([1, 2, 3], [0, 0, 1]), _known([5, 6], [1, 0])])
     res = with_intervals(m, resamples=100, groups=groups)
     assert res["handovers"][0] == pytest.approx(17 / 5) and res["handovers"][1] <= res["handovers"][2]
+
+
+def test_table_one_repeats_no_row_and_labels_every_column():
+    """The 1 s window is the minimum time of stay (the simulator counts both alike): its share and its median share
+    were each shown twice. Shown once, the minimum time of stay's rows say which window it is."""
+    from xairl_uav_handover.table import html_table, verdict
+
+    stay = SimConfig().handover.min_time_of_stay_s
+    m = _known([1, 2, 3, 4, 100], [0, 1, 0, 2, 10])
+    for k, w in enumerate((2, 5, 10), 1):  # a wider window counts more: its rows differ
+        m[f"pingpongs_{w}s"] = m[f"pingpongs_{w}s"] + k
+    res = with_intervals(m, resamples=50)
+    header, rows = html_table({"CHM": res, "SA-MRO": res}, stay)
+    assert all(header) and header[1:] == ["CHM", "SA-MRO"]
+    cells = [tuple(r[1:]) for r in rows]
+    labels = [r[0] for r in rows]
+    assert len(set(labels)) == len(labels) and f"{stay:g} s window" not in " ".join(labels)
+    assert "ping-pong share, minimum time of stay of 1 s (%)" in labels
+    pingpong = [c for label, c in zip(labels, cells) if "ping-pong share" in label]
+    assert len(set(pingpong)) == len(pingpong), "two ping-pong rows hold the same figures"
+    assert "1 s window" not in verdict({"DQN": res, "CHM": res}, min_stay_s=stay)

@@ -170,7 +170,8 @@ def test_report_skips_the_real_half_when_ukm_cannot_be_had(monkeypatch, capsys, 
     monkeypatch.setattr(ukm, "URL", server.url)
     monkeypatch.setattr(ukm, "SHA256", sha(server.payload))
     folder, setting = real_source("ukm")
-    assert folder is not None and str(folder) in setting and "GPL-3.0" in setting
+    assert folder is not None and "GPL-3.0" in setting
+    assert setting.startswith(f"{folder.name} (") and str(folder) not in setting  # a shared report: no local path
     assert real_source(None)[0] is None
     with pytest.raises(InputError, match="nowhere: no such folder or zip of flight exports"):
         real_source(str(tmp_path / "nowhere"))  # refused before Table I is computed

@@ -240,21 +240,20 @@ class SAMRO:
     def __init__(self, config: SAMROConfig | None = None):
         self.cfg = config or SAMROConfig()
         self.mro: MobilityRobustness | None = None
-        self.flown, self.warm = 0, False
+        self.flown, self.warm, self.updates = 0, False, 0
 
     def batch(self, n: int) -> int:
         """Flights to fly together next, of ``n`` left: none past the next update of the offsets."""
         return min(n, self.cfg.update_every_flights - self.flown % self.cfg.update_every_flights)
 
-    def warm_up(self, config) -> None:
-        """Fly ``warmup_flights`` flights on training seeds once, before the first evaluated flight."""
+    def warm_up(self, fly) -> None:
+        """Fly ``warmup_flights`` training flights once, before the first evaluated flight: ``fly(n)`` flies ``n``
+        of them in order under this controller (the evaluation's loop, :func:`evaluate.run_flights`, passes it: the
+        rules know no flight loop)."""
         if not self.warm:
-            from .evaluate import WARM_UP_SEED, fly_in_order
-            from .streams import flight_seeds
-
             self.warm = True
             if self.cfg.warmup_flights:
-                fly_in_order(self, config, flight_seeds(WARM_UP_SEED, 0, self.cfg.warmup_flights))
+                fly(self.cfg.warmup_flights)
 
     def reset(self, env) -> None:
         sim = env.sim
@@ -285,6 +284,7 @@ class SAMRO:
         self.flown += env.sim.K
         if self.flown % self.cfg.update_every_flights == 0:
             self.mro.update()
+            self.updates += 1
 
 
 class CHMOnSamples:
@@ -336,7 +336,7 @@ class SAMROOnSamples(CHMOnSamples):
         self.mro = MobilityRobustness(self.sa, len(self.cells), sim_config.handover.min_time_of_stay_s)
         self.failure = UplinkFailure(self.sa.rlf_s, 1)
         self.interference: dict[float, float] = {}
-        self.last_update = None
+        self.last_update, self.updates = None, 0
 
     def _radio_ok(self, state) -> bool:
         from .simulator import hex_layout
@@ -360,7 +360,7 @@ class SAMROOnSamples(CHMOnSamples):
         self.last_update = t if self.last_update is None else self.last_update
         if t - self.last_update >= self.sa.update_every_flights * self.sim_cfg.flight.duration_s:
             self.mro.update()
-            self.last_update = t
+            self.last_update, self.updates = t, self.updates + 1
         return self.mro.offsets(serving), self.sa.ttt_s
 
 

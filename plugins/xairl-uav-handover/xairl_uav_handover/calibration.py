@@ -127,8 +127,17 @@ def quantile_rows(sim: np.ndarray, real: np.ndarray, names=FEATURES) -> list[Qua
     return [QuantileRow(f, *ps[:, j], *pr[:, j], out[j]) for j, f in enumerate(names)]
 
 
-def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
+def agreement_rows(walks, ckpt: Checkpoint, cfg, mro: dict | None = None) -> list[AgreementRow]:
+    """One row per policy (the DQN, CHM, SA-MRO) proposing at every real sample (open loop). ``mro``: a dict that
+    receives what SA-MRO's network did on the walks: the events it counted (too early, too late, wrong cell,
+    ping-pong), its offsets' updates and largest offset (dB), which say why its row may equal CHM's."""
     from .real_data import agreement
+
+    networks = []
+
+    def samro(walk):
+        networks.append(SAMROOnSamples(walk.cells, cfg))
+        return networks[-1]
 
     def dqn(walk):  # the DQN's action at every sample of the walk in one batch (with memory: its windows)
         states = walk_states(walk, cfg) if memory_of(ckpt.meta) else walk.states
@@ -139,7 +148,7 @@ def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
     for name, make in (
         ("DQN", dqn),
         ("CHM (A3 2 dB, 160 ms)", lambda w: CHMOnSamples(w.cells)),
-        ("SA-MRO", lambda w: SAMROOnSamples(w.cells, cfg)),
+        ("SA-MRO", samro),
     ):
         a = agreement(walks, make)
         rows.append(
@@ -153,7 +162,18 @@ def agreement_rows(walks, ckpt: Checkpoint, cfg) -> list[AgreementRow]:
                 100 * a.target_agreement,
             )
         )
+    if mro is not None:
+        mro.update(mro_record(networks))
     return rows
+
+
+def mro_record(networks) -> dict:
+    """What SA-MRO networks did (:class:`baselines.SAMROOnSamples` after their walks): the events counted over all,
+    their offsets' updates, and the largest offset any pair reached (dB beyond CHM's)."""
+    counted = {k: sum(n.mro.counted[k] for n in networks) for k in ("too_early", "too_late", "wrong_cell", "pingpong")}
+    updates = sum(n.updates for n in networks)
+    largest = max((float(np.abs(n.mro.cio).max()) for n in networks if n.mro.cio.size), default=0.0)
+    return {"counted": counted, "updates": updates, "largest_offset_db": largest}
 
 
 def rsrq_spread(states: np.ndarray, measured: np.ndarray, resolution_db: float = 1.0) -> np.ndarray:

@@ -140,7 +140,7 @@ def run_evaluate(args) -> int:
         print(
             f"Table I: {args.flights} held-out flights of {cfg.flight.duration_s:g} s x evaluation seeds "
             f"{args.seeds}, value [bootstrap 95 % interval]; a ping-pong is a handover back to the previous BS "
-            f"within the window its row names\n{format_rows(res)}\n{format_paper(res)}\n"
-            f"{verdict(res)}"
+            f"within the window its row names\n{format_rows(res, cfg.handover.min_time_of_stay_s)}\n{format_paper(res)}\n"
+            f"{verdict(res, min_stay_s=cfg.handover.min_time_of_stay_s)}"
         )
     return 0

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .baselines import CHM
 from .config import SimConfig
 from .env import METRICS, PINGPONG_WINDOWS_S, HandoverVecEnv
 from .features import BUFFER
@@ -30,8 +31,8 @@ def run_flights(controller, config: SimConfig, n_flights: int, seed: int, first:
     the same flight in any batch. A controller that learns across flights (``batch``/``warm_up``: SA-MRO's network)
     first warms up, then flies them in order, as many together as its cadence allows (:func:`fly_in_order`)."""
     warm_up = getattr(controller, "warm_up", None)
-    if warm_up is not None:
-        warm_up(config)
+    if warm_up is not None:  # on flights of WARM_UP_SEED, not held out
+        warm_up(lambda n: fly_in_order(controller, config, flight_seeds(WARM_UP_SEED, 0, n)))
     return fly_in_order(controller, config, flight_seeds(HELD_OUT_SEED + seed, first, n_flights))
 
 
@@ -141,8 +142,6 @@ def chm_rate_by_altitude(
 ) -> np.ndarray:
     """Conventional handovers per minute for flights held at each altitude (simulator); with ``sample_s`` CHM sees
     the measurements only that often, as CHM replayed on a real log does (calibration.band_rows)."""
-    from .baselines import CHM
-
     every = 1 if sample_s is None else max(1, int(round(sample_s / config.flight.dt_s)))
     rates = []
     for h in altitudes:

@@ -2,14 +2,23 @@
 read and checked.
 
 Rows are events; rows with the same Time form one time step (forward-filled over two steps for the sparse neighbour
-lists and SNR). The last lines are a footer and are dropped (any row whose Time does not parse). The number of
-detected-cell slots varies, so columns are selected by name. Altitude is the nominal height in the file name. A
-measurement no UE can report (inf, 1e400, an RSRP of 0 dBm) is refused by file, line and column.
+lists and SNR). The last lines are a footer and are dropped (the rows after the last one whose Time parses). The
+number of detected-cell slots varies, so columns are selected by name. Altitude is the nominal height in the file
+name. A measurement no UE can report (inf, 1e400, an RSRP of 0 dBm) is refused by file, line and column.
+
+An export is machine-written (the 29 UKM ones hold no such row), so a row it cannot be read from is a broken file,
+never dropped in silence: a file with any row before the footer that holds a NUL byte, more fields than the header,
+a Time that does not parse, or text where a measurement belongs, is refused in one line that counts those rows and
+names the first (:func:`_check_rows`). Only regular files of at most :data:`MAX_FILE_BYTES` are read
+(:func:`read_plain`, the zip path's check too): a FIFO would block for ever and a link to /dev/zero never ends.
 """
 
 from __future__ import annotations
 
+import io
+import os
 import re
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -21,6 +30,51 @@ REF_LAT, REF_LON = 2.9228, 101.7715  # centre of the UKM campaign area: local me
 PCI, RSRP, RSRQ = "Physical cell identity (LTE pcell)", "RSRP (LTE pcell)", "RSRQ (LTE pcell)"
 REQUIRED = ("Time", "Latitude", "Longitude", PCI, RSRP, RSRQ, "RS SNR")
 TIME_RE = r"^\d{1,2}:\d{2}:\d{2}(\.\d+)?$"
+#: the most bytes one flight export may hold, on disk or unpacked from a zip (ukm.py): the UKM's largest is 1.2 MB
+MAX_FILE_BYTES = 16 << 20
+#: what a user can give instead, ending a refusal of a file that is no export
+GIVE_FILE = "give a folder of flight exports (Nemo CSV, regular files)."
+
+
+def check_plain(path: Path, limit: int, st: os.stat_result | None = None) -> os.stat_result:
+    """Refuse, in one line, a ``path`` that is no regular file (a FIFO blocks a read for ever, a device such as
+    /dev/zero never ends, a socket cannot be read) or holds more than ``limit`` bytes; a link is followed to what it
+    names. ``st``: the stat of the file already opened (the same check, without a second look-up)."""
+    try:
+        st = st or path.stat()
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read it ({exc.strerror or type(exc).__name__}); {GIVE_FILE}") from None
+    link = f" (a link to {os.readlink(path)})" if path.is_symlink() else ""
+    if not stat.S_ISREG(st.st_mode):
+        kinds = (
+            (stat.S_ISFIFO, "a named pipe (FIFO)"),
+            (stat.S_ISCHR, "a character device"),
+            (stat.S_ISBLK, "a block device"),
+            (stat.S_ISSOCK, "a socket"),
+            (stat.S_ISDIR, "a folder"),
+        )
+        kind = next((k for test, k in kinds if test(st.st_mode)), "not a regular file")
+        raise InputError(f"{path}{link}: {kind}, not a regular file; refused unread; {GIVE_FILE}")
+    if st.st_size > limit:
+        raise InputError(f"{path}{link}: {st.st_size} bytes, more than the {limit} allowed here; refused unread.")
+    return st
+
+
+def read_plain(path: Path, limit: int = MAX_FILE_BYTES) -> bytes:
+    """The bytes of regular file ``path``, at most ``limit`` (:func:`check_plain` before it is opened, and again on
+    what was opened, in case the name changed in between; opened without blocking, so a FIFO put there in between
+    cannot hang the read)."""
+    check_plain(path, limit)
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read it ({exc.strerror or type(exc).__name__}); {GIVE_FILE}") from None
+    with os.fdopen(fd, "rb") as fh:
+        check_plain(path, limit, os.fstat(fd))
+        data = fh.read(limit + 1)
+    if len(data) > limit:  # it grew since
+        raise InputError(f"{path}: more than the {limit} bytes a flight export may have; refused.")
+    return data
 
 
 @dataclass
@@ -102,8 +156,10 @@ def _read_export(path: Path):
     """The export's event rows with a parseable Time, numeric columns as numbers, and its detected-cell slots."""
     import pandas as pd
 
-    try:
-        df = pd.read_csv(path, low_memory=False, dtype={"Time": str}, skip_blank_lines=False)  # index + 2: line
+    data = read_plain(path)
+    _check_fields(data, path)
+    try:  # (index + 2: the row's line in the file; blank lines are kept)
+        df = pd.read_csv(io.BytesIO(data), low_memory=False, dtype={"Time": str}, skip_blank_lines=False)
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise InputError(f"{path}: cannot read it as CSV ({str(exc).splitlines()[0]}).") from None
     missing = [c for c in REQUIRED if c not in df.columns]
@@ -113,10 +169,13 @@ def _read_export(path: Path):
             + (f" (and {len(missing) - 1} more)" if len(missing) > 1 else "")
             + "."
         )
+    blank = df.isna().all(axis=1).to_numpy()  # a blank line is no row
     df["Time"] = df["Time"].astype(str).str.strip()
-    df = df[df["Time"].str.match(TIME_RE)].copy()
-    if df.empty:
+    timed = df["Time"].str.match(TIME_RE).to_numpy()
+    if not timed.any():
         raise InputError(f"{path}: no rows with a parseable Time (H:MM:SS.mmm); the file looks truncated.")
+    footer = int(np.flatnonzero(timed)[-1]) + 1  # the rows after the last timed one: the export's footer
+    body, timed, blank = df.iloc[:footer], timed[:footer], blank[:footer]
     slots = sorted(
         int(m.group(1))
         for c in df.columns
@@ -128,10 +187,58 @@ def _read_export(path: Path):
             )
         )
     )
-    for c in ["Latitude", "Longitude", PCI, RSRP, RSRQ, "RS SNR", *_neighbour_columns(slots, df.columns)]:
+    numeric = ["Latitude", "Longitude", PCI, RSRP, RSRQ, "RS SNR", *_neighbour_columns(slots, df.columns)]
+    _check_rows(body, timed, blank, numeric, path)
+    df = body[timed].copy()
+    for c in numeric:
         df[c] = pd.to_numeric(df[c], errors="coerce")
     _check_measurements(df, path)
     return df, slots
+
+
+def _check_fields(data: bytes, path: Path) -> None:
+    """Refuse a file with a NUL byte, or a row with more fields than its header (pandas would shift or cut it)."""
+    import csv
+
+    if b"\0" in data:
+        lines = data.split(b"\n")
+        bad = [k for k, line in enumerate(lines) if b"\0" in line]
+        raise InputError(
+            f"{path}: {len(bad)} row(s) hold a NUL byte (binary data, not text), first on line {bad[0] + 1}; fix or "
+            "delete those rows."
+        )
+    rows = csv.reader(io.StringIO(data.decode("utf-8", "replace"), newline=""))
+    width = len(next(rows, []))
+    long = [(rows.line_num, len(r)) for r in rows if len(r) > width]
+    if long:
+        line, n = long[0]
+        raise InputError(
+            f"{path}: {len(long)} row(s) hold more fields than the header's {width}, first line {line} ({n}); fix or "
+            "delete those rows."
+        )
+
+
+def _check_rows(body, timed: np.ndarray, blank: np.ndarray, numeric: list[str], path: Path) -> None:
+    """Refuse rows before the footer that cannot be read: a Time that does not parse (``timed``: it does), or text
+    (not a number) where a measurement belongs; a ``blank`` line is no row. One line: how many, and the first."""
+    import pandas as pd
+
+    why = np.where(~timed & ~blank, "its Time does not parse (H:MM:SS.mmm)", "").astype(object)
+    for c in numeric:
+        v = body[c]
+        if v.dtype.kind in "fiu":  # parsed as numbers throughout: no text in it
+            continue
+        text = v.notna().to_numpy() & pd.to_numeric(v, errors="coerce").isna().to_numpy()
+        for k in np.flatnonzero(text & (why == "")):
+            if str(v.iloc[k]).strip():
+                why[k] = f"column '{c}' holds the text {str(v.iloc[k])[:40]!r}, not a number"
+    bad = np.flatnonzero(why != "")
+    if len(bad):
+        k = int(bad[0])
+        raise InputError(
+            f"{path}: {len(bad)} of {int((~blank).sum())} rows cannot be read, first line {int(body.index[k]) + 2}: {why[k]}; "
+            "fix or delete those rows."
+        )
 
 
 #: per measurement: (lowest, highest) a UE can report, with a margin (TS 36.133: RSRP -156..-31 dBm, RSRQ -34..2.5
@@ -208,7 +315,7 @@ def load_folder(folder: str | Path) -> tuple[list[RealFlight], list[str]]:
     if not folder.is_dir():
         raise InputError(f"{folder}: no such folder of flight exports.")
     flights, bad = [], []
-    for f in sorted(folder.rglob("*.csv")):
+    for f in sorted(folder.rglob("*.csv")):  # (each read by read_plain: regular files of bounded size only)
         try:
             flights.append(load_flight(f))
         except InputError as exc:

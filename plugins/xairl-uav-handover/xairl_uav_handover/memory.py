@@ -26,6 +26,9 @@ import numpy as np
 
 import xairl
 
+from .acting import DQNController, greedy, memory_of
+from .baselines import CHM, CHMConfig
+from .env import HandoverVecEnv
 from .features import (
     ACTION_ALIASES,
     ACTIONS,
@@ -38,7 +41,6 @@ from .features import (
     state_rows,
 )
 from .features import MEMORY_STEPS as STEPS
-from .policy import DQNController, greedy, memory_of
 
 #: the times are capped here (seconds): a 120 s flight's cells last tens of seconds, and a cap keeps a rare long
 #: stay from stretching the network's input scale
@@ -126,9 +128,6 @@ def controller(ckpt):
 def background(n: int, seed: int = 0, config=None) -> np.ndarray:
     """``n`` memory states met in flight: ``n`` simulated UAVs after 10 s under conventional handover, decided every
     0.2 s (the memory's cadence)."""
-    from .baselines import CHM
-    from .env import HandoverVecEnv
-
     env = HandoverVecEnv(config, n_flights=n)
     env.reset(seed=seed)
     chm, memory = CHM(), Memory()
@@ -144,8 +143,6 @@ def memory_policy(ckpt) -> xairl.Policy:
     """The DQN with memory as an xairl Policy (``uav_policy`` of its checkpoint): a window of :data:`SIGNALS`, so
     its explanations group per signal and per step and its narratives speak of trends; the action mask, the facts
     hook and the rule comparisons read the newest observation."""
-    from .baselines import CHMConfig
-
     config = ckpt.sim_config
     facts = HandoverFacts(config.buffer.q_max_bits, CHMConfig().offset_db, config.observation.detection_rsrq_db)
     info = {k: v for k, v in feature_info(config.buffer.q_max_bits).items() if v.kind != "group"}

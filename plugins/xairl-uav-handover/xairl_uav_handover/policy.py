@@ -15,8 +15,11 @@ import numpy as np
 import torch
 
 import xairl
-from xairl import InputError, Policy
+from xairl import Policy
 
+from .acting import DQNController as DQNController  # (callers import the controller from here too)
+from .acting import greedy, memory_of, random_available
+from .baselines import CHM, CHMConfig
 from .config import SimConfig, without_retired
 from .env import HandoverVecEnv
 from .features import (
@@ -33,6 +36,7 @@ from .features import (
 from .features import (
     MEMORY_STEPS as STEPS,
 )
+from .memory import Memory, memory_policy
 
 DEFAULT_CHECKPOINT = Path(__file__).parent / "checkpoints" / "uav-dqn.safetensors"
 
@@ -121,12 +125,6 @@ def load_checkpoint(path: str | Path | None = None) -> Checkpoint:
     return Checkpoint(path, net.eval(), meta, config)
 
 
-def memory_of(meta: dict) -> bool:
-    """Whether a checkpoint's network is the DQN with memory (memory.py): its training config says so."""
-    tc = meta.get("train_config")
-    return bool(tc.get("memory")) if isinstance(tc, dict) else False
-
-
 def _hidden_widths(path: Path, meta: dict, tensors: dict) -> tuple[int, ...]:
     """The hidden widths the metadata states, checked against the tensors before anything is built (a 200-byte
     file could otherwise ask for a network of 40 GB)."""
@@ -148,51 +146,8 @@ def _hidden_widths(path: Path, meta: dict, tensors: dict) -> tuple[int, ...]:
     return widths
 
 
-def greedy(net: torch.nn.Module, obs: np.ndarray, config: SimConfig) -> np.ndarray:
-    """The best available action per state: a handover only to a measured candidate (invalid-action masking)."""
-    x = torch.as_tensor(np.asarray(obs), dtype=torch.float32)
-    with torch.no_grad():
-        q = net(x).numpy()
-    bad = ~np.isfinite(q).all(axis=1)
-    if bad.any():  # argmax would read a NaN row as action 0 ("stay") and the decision would look sane
-        _refuse_q(net, x.numpy(), int(np.flatnonzero(bad)[0]))
-    return np.where(available_actions(obs, config.observation), q, -np.inf).argmax(axis=1)
-
-
-def _refuse_q(net: torch.nn.Module, x: np.ndarray, i: int) -> None:
-    """Say why the Q-values of state ``i`` of ``x`` (the network's float32 input) are NaN or inf."""
-    where = f"the DQN cannot act on state {i} of {len(x)}"
-    if not all(torch.isfinite(p).all() for p in net.parameters()):
-        raise xairl.plugin.CheckpointError(
-            f"{where}: the Q-network's weights hold NaN or inf (a corrupt checkpoint, or training "
-            "that diverged); re-train or re-download it."
-        )
-    row = x[i].reshape(-1)
-    names = FEATURES if len(row) == len(FEATURES) else xairl.Observation.window(SIGNALS, STEPS).feature_names()
-    bad = np.flatnonzero(~np.isfinite(row))
-    if len(bad):
-        j = int(bad[0])
-        raise InputError(
-            f"{where}: {names[j]} = {row[j]:g} is not a finite number (as float32, the network's "
-            "input); fix that state."
-        )
-    j = int(np.abs(row).argmax())
-    raise InputError(
-        f"{where}: its Q-values overflow to NaN or inf (largest input {names[j]} = {row[j]:g}, far "
-        "beyond any measurement); fix that state."
-    )
-
-
-def random_available(rng: np.random.Generator, obs: np.ndarray, config: SimConfig) -> np.ndarray:
-    """A uniformly random available action per state (exploration)."""
-    mask = available_actions(obs, config.observation)
-    return (rng.uniform(size=mask.shape) * mask).argmax(axis=1)
-
-
 def background_states(n: int, seed: int = 0, config: SimConfig | None = None) -> np.ndarray:
     """``n`` states the policy meets in flight: ``n`` simulated UAVs after 10 s under conventional handover."""
-    from .baselines import CHM
-
     env = HandoverVecEnv(config, n_flights=n, decision_every=1)
     obs, _ = env.reset(seed=seed)
     chm = CHM()
@@ -206,12 +161,8 @@ def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
     """The trained handover DQN as an xairl Policy (the plugin's ``uav-dqn``)."""
     ckpt = checkpoint if isinstance(checkpoint, Checkpoint) else load_checkpoint(checkpoint)
     if memory_of(ckpt.meta):
-        from .memory import memory_policy  # (memory.py builds on this module)
-
         return memory_policy(ckpt)
     config = ckpt.sim_config
-    from .baselines import CHMConfig
-
     facts = HandoverFacts(config.buffer.q_max_bits, CHMConfig().offset_db, config.observation.detection_rsrq_db)
     return Policy(
         ckpt.net,
@@ -237,8 +188,6 @@ def dqn_decision_states(
     env = HandoverVecEnv(ckpt.sim_config, n_flights=n_flights)
     obs, _ = env.reset(seed=2_000_000 + seed)
     if memory_of(ckpt.meta):  # the DQN with memory decides on its window
-        from .memory import Memory
-
         memory = Memory()
         obs = memory.start(env)
     rng = np.random.default_rng(seed)
@@ -251,20 +200,3 @@ def dqn_decision_states(
         obs = memory.step(env, info["handover"]) if memory_of(ckpt.meta) else obs
     states = np.concatenate(seen)
     return states[np.random.default_rng(seed).choice(len(states), size=min(n, len(states)), replace=False)]
-
-
-class DQNController:
-    """Acts greedily among available actions with a Q-network, one decision per env step (every
-    ``decision_every`` simulator steps)."""
-
-    name = "DQN"
-    decision_every = None  # the simulator config's
-
-    def __init__(self, net: torch.nn.Module):
-        self.net = net.eval()
-
-    def reset(self, env) -> None:
-        pass
-
-    def __call__(self, env) -> np.ndarray:
-        return greedy(self.net, env.obs, env.cfg)

@@ -18,11 +18,12 @@ import xairl
 from xairl import Explanation, InputError
 
 from .baselines import CHM, SAMRO, SAMROConfig
-from .calibration import agreement_rows, band_rows, outside, quantile_rows
-from .evaluate import PAPER, chm_rate_by_altitude
+from .calibration import LOG_INTERVAL_S, agreement_rows, band_rows, outside, quantile_rows
+from .evaluate import PAPER
 from .features import FEATURES, GROUPS, SIGNALS
 from .memory import controller, walk_states
 from .policy import Checkpoint, dqn_decision_states, load_checkpoint, memory_of, uav_policy
+from .report_figures import altitude_figure, frontier_section
 
 
 class UAVReportOptions(xairl.plugin.Options):
@@ -58,6 +59,55 @@ def _table(rows: list) -> str:
     return xairl.plugin.table_html(type(rows[0]).HEADER, [list(astuple(r)) for r in rows])
 
 
+def _identifier(policy: xairl.Policy, name: str) -> bool:
+    """Whether ``policy`` declares feature ``name`` an identifier or a category: a label, not a quantity."""
+    return getattr(policy.features.get(name), "kind", "numeric") in ("identifier", "categorical")
+
+
+def _quantiles(rows: list, policy: xairl.Policy) -> str:
+    """The quantile table with each value in its unit, as the narratives write it ('77.2 % full', '-85.8 dBm')."""
+    return xairl.plugin.table_html(
+        type(rows[0]).HEADER,
+        [
+            [r.feature, *(xairl.facts.value_text(v, policy.features.get(r.feature)) for v in astuple(r)[1:-1])]
+            + [r.real_outside_pct]
+            for r in rows
+        ],
+    )
+
+
+def shown_path(path) -> str:
+    """``path`` as a shared report may print it: relative to the working folder when inside it, else its name
+    (an absolute path says where the author keeps files, and is wrong on every other machine)."""
+    p = Path(path)
+    try:
+        return str(p.resolve().relative_to(Path.cwd().resolve()))
+    except (ValueError, OSError):
+        return p.name or str(p)
+
+
+def same_as_chm(did: dict, where: str, cfg: SAMROConfig, why: str = "") -> str:
+    """Why SA-MRO's figures equal CHM's on ``where``: its offsets start at CHM's and move only on the events it
+    counts; ``did`` says what its network counted and did (:func:`calibration.mro_record`)."""
+    c = did["counted"]
+    events = (
+        f"{c['too_early']} too-early, {c['too_late']} too-late and {c['wrong_cell']} wrong-cell handovers and "
+        f"{c['pingpong']} ping-pongs"
+    )
+    updates = f"{did['updates']} update{'' if did['updates'] == 1 else 's'}"
+    moved = (
+        f"its offsets never left CHM's ({updates})"
+        if did["largest_offset_db"] == 0
+        else f"its offsets moved by at most {did['largest_offset_db']:g} dB ({updates}), which changed no decision"
+    )
+    return (
+        f"SA-MRO's figures equal CHM's on {where}. SA-MRO is CHM's A3 rule ({cfg.offset_db:g} dB, "
+        f"{1000 * cfg.ttt_s:g} ms) plus a per-cell-pair offset that its network moves only after too-early, "
+        f"too-late or wrong-cell handovers and ping-pongs, at most once per {cfg.update_every_flights} flights' "
+        f"time; it counted {events}, so {moved}.{why}"
+    )
+
+
 class UAVReport(xairl.plugin.Report):
     """Table I on held-out simulated flights; with ``real``, the calibration and agreement with real flights."""
 
@@ -76,12 +126,12 @@ class UAVReport(xairl.plugin.Report):
             policy=policy,
             background=policy.background(100, seed=req.seed + 7),
             datasets=[("simulated", dqn_decision_states(ckpt, req.n_states, seed=req.seed + 1))],
-            tables=[self._table_one(ckpt, req.seed)],
+            tables=[],  # Table I is put first below, computed after the states are drawn (the steps said in order)
             settings={
                 "checkpoint": ckpt.path.name,
                 "training command": ckpt.meta.get("command"),
                 "simulated states": req.n_states,
-                "real data": real_setting,
+                "real data": real_setting,  # (a path as shown_path writes it: a report is shared)
                 "video rate Mbit/s": cfg.buffer.video_rate_mbps,
                 "x, y quantised to (m)": cfg.observation.position_grid_m or "not quantised",
             },
@@ -89,10 +139,15 @@ class UAVReport(xairl.plugin.Report):
             commentary=findings,
             notes=[
                 "Simulated states: the DQN's own decision states on held-out flights (TR 36.777 UMa-AV, the "
-                "calibrated link and load of config.py). Contributions are to the chosen action's Q-value; the "
-                "background is 100 states after 10 s of flight under conventional handover."
+                "calibrated link and load of config.py). Contributions are to the margin of the chosen action's "
+                "Q-value over the runner-up's, in every figure, card and importance table (the main findings also "
+                "rank by the chosen action's own Q-value); the background is 100 states after 10 s of flight under "
+                "conventional handover.",
             ],
         )
+        table_one, same = self._table_one(ckpt, req.seed)
+        content.tables.insert(0, table_one)
+        content.notes += same
         with xairl.plugin.heartbeat(
             "comparing with the real flights (calibration, agreement)", req.progress and loaded
         ):
@@ -122,20 +177,30 @@ class UAVReport(xairl.plugin.Report):
                 (f"Flight at a glance: {tl.label}. {text} [{mark}, coverage {check.coverage:.0%}]", path)
             )
 
-    def _table_one(self, ckpt: Checkpoint, seed: int) -> tuple[str, str]:
-        """Table I with bootstrap 95 % intervals (table.py), and in words where the DQN loses to CHM."""
+    def _table_one(self, ckpt: Checkpoint, seed: int) -> tuple[tuple[str, str], list[str]]:
+        """Table I with bootstrap 95 % intervals (table.py), and in words where the DQN loses to CHM; and a note
+        when SA-MRO's column is CHM's (why)."""
         from .table import flights, html_table, verdict, with_intervals
 
         n, cfg = self.options.flights, ckpt.sim_config
+        stay = cfg.handover.min_time_of_stay_s
         sa_mro = SAMRO(SAMROConfig(warmup_flights=n))  # the network adapts on as many flights as the table has
         with xairl.plugin.heartbeat(f"Table I: CHM, SA-MRO and the DQN on {n} simulated flight{'s' * (n != 1)}"):
             res = {c.name: with_intervals(flights(c, cfg, n, [seed])) for c in (CHM(), sa_mro, controller(ckpt))}
         paper = ", ".join(f"{name} {ho} handovers and {pp} % ping-pongs" for name, (ho, pp) in PAPER.items())
-        return (
+        same = []
+        if res["SA-MRO"] == res["CHM"]:
+            largest = float(np.abs(sa_mro.mro.cio).max())
+            did = {"counted": sa_mro.mro.counted, "updates": sa_mro.updates, "largest_offset_db": largest}
+            where = f"Table I's {2 * n} simulated flights ({n} to adapt on, then {n} held out)"
+            same.append(same_as_chm(did, where, sa_mro.cfg))
+        table = (
             f"Table I: {n} held-out simulated flights of {cfg.flight.duration_s:g} s (SA-MRO's offsets adapted on "
-            f"{n} flights first), value [bootstrap 95 % interval]. {verdict(res)} (The paper's medians per flight: {paper}.)",
-            xairl.plugin.table_html(*html_table(res)),
+            f"{n} flights first), value [bootstrap 95 % interval]. {verdict(res, min_stay_s=stay)} (The paper's "
+            f"medians per flight: {paper}.)",
+            xairl.plugin.table_html(*html_table(res, stay)),
         )
+        return table, same
 
     def _add_real_flights(
         self,
@@ -177,10 +242,12 @@ class UAVReport(xairl.plugin.Report):
                 sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=256)
         with xairl.plugin.heartbeat("simulating handovers per altitude band (calibration)", req.progress):
             bands = band_rows(flights, chm_real, cfg, req.seed, n_flights=8, duration_s=30.0)
+        mro: dict = {}  # what SA-MRO's network counted and did on the real samples
         with xairl.plugin.heartbeat("replaying the real flights open-loop (agreement)", req.progress):
-            agreement = agreement_rows(walks, ckpt, cfg)
+            agreeing = agreement_rows(walks, ckpt, cfg, mro)
         queue = np.concatenate([w.queue_bits for w in walks])
-        where = f"{len(flights)} real flights from {real}" + (f" ({len(bad)} skipped)" if bad else "")
+        where = f"{len(flights)} real flights from {shown_path(real)}" + (f" ({len(bad)} skipped)" if bad else "")
+        keep = [j for j, f in enumerate(names) if not _identifier(content.policy, f)]  # an id has no percentiles
         content.tables += [
             (
                 f"Calibration: handovers per minute by altitude band ({where})",
@@ -189,40 +256,26 @@ class UAVReport(xairl.plugin.Report):
             (
                 f"Real states in the training distribution: buffer full in {100 * np.mean(queue >= cfg.buffer.q_max_bits):.1f} "
                 f"% of real states, non-empty in {100 * np.mean(queue > 0):.1f} %; any feature outside the simulated "
-                f"0.5-99.5 % range in {100 * outside(states, sim_ref).any(axis=1).mean():.1f} % of real states",
-                _table(quantile_rows(sim_ref, states, names)),
+                f"0.5-99.5 % range in {100 * outside(states[:, keep], sim_ref[:, keep]).any(axis=1).mean():.1f} % of real states",
+                _quantiles(quantile_rows(sim_ref[:, keep], states[:, keep], [names[j] for j in keep]), content.policy),
             ),
             (
                 f"Open-loop agreement with the live network's decisions ({where})",
-                _table(agreement),
+                _table(agreeing),
             ),
         ]
-        content.notes += [f"skipped file: {b}" for b in bad] + REAL_NOTES
+        by = {r.policy.split(" ")[0]: astuple(r)[1:] for r in agreeing}
+        if by["CHM"] == by["SA-MRO"]:
+            why = (
+                " On real samples a failure comes only from the modelled uplink (the logs record none), and a return "
+                f"within the {cfg.handover.min_time_of_stay_s:g} s minimum time of stay cannot show between samples "
+                f"{LOG_INTERVAL_S:g} s apart (the logs' median)."
+            )
+            content.notes.append(same_as_chm(mro, f"the {len(flights)} real flights' samples", SAMROConfig(), why))
+        content.notes += [f"skipped file: {b.replace(str(real), shown_path(real))}" for b in bad] + REAL_NOTES
         with xairl.plugin.heartbeat("simulating handovers by altitude (the figure)", req.progress):
-            content.figures.append(_altitude_figure(req.out, str(real), cfg, flights, chm_real, req.seed))
+            content.figures.append(altitude_figure(req.out, str(real), cfg, flights, chm_real, req.seed))
         return flights
-
-
-def frontier_section(path: str, out) -> tuple[str, Path]:
-    """The hindsight bound's figure from benchmarks/oracle_frontier.py's JSON at ``path``, and its caption."""
-    import json
-
-    try:
-        data = json.loads(Path(path).read_text())
-        chm, dqn = data["policies"]["CHM"], data["policies"]["DQN"]
-    except (OSError, ValueError, KeyError) as e:
-        raise InputError(
-            f"cannot read the frontier {path} ({e}); give the frontier.json that benchmarks/oracle_frontier.py wrote."
-        ) from None
-    caption = (
-        f"What hindsight allows on {data['flights']} held-out flights: the least time below the RSRQ threshold for "
-        f"each number of handovers, exact over decisions every {data['decision_s']:g} s among the env's candidates, "
-        f"and with 0.2-5 s of foresight. At CHM's RSRQ time ({chm['rsrq_pct']:.1f} %) the bound needs "
-        f"{chm['bound_handovers_at_rsrq']:.2f} handovers per flight (CHM {chm['handovers']:.2f}); at the DQN's "
-        f"{dqn['handovers']:.2f} it reaches {dqn['bound_rsrq_at_handovers']:.1f} % (DQN {dqn['rsrq_pct']:.1f} %). "
-        "The bound knows each flight's future: the gap to it is what prediction could win, not what physics forbids."
-    )
-    return caption, Path(frontier_figure(data, Path(out) / "frontier.png"))
 
 
 def _load_real(real: Path) -> tuple[list, list[str]]:
@@ -255,13 +308,16 @@ def real_source(real: str | None) -> tuple[Path | None, str]:
                 f"-o real={real}: no such folder or zip of flight exports; give the folder of the "
                 f"Nemo CSVs, the UKM zip, or -o real={ukm.KEYWORD} to fetch the UKM flights."
             )
-        return folder, real
+        return folder, shown_path(real)
     try:
         folder = ukm.flights_folder()
     except InputError as exc:
         print(f"xairl: report: real-data half skipped: {exc}", file=sys.stderr)
         return None, f"not available: {exc}"
-    return folder, f"{folder} (-o real={ukm.KEYWORD}: UKM flights, {ukm.LICENCE}, {ukm.REPO} at {ukm.COMMIT[:12]})"
+    return (
+        folder,
+        f"{shown_path(folder)} (-o real={ukm.KEYWORD}: UKM flights, {ukm.LICENCE}, {ukm.REPO} at {ukm.COMMIT[:12]})",
+    )
 
 
 REAL_NOTES = [
@@ -309,75 +365,3 @@ def findings(exps: dict[str, Explanation]) -> list[str]:
             f"buffer ranks {buf_score} and position {by_score.index('position') + 1}.{why}"
         )
     return out
-
-
-def _altitude_figure(out: Path, real: str, cfg, flights, chm_real: list[int], seed: int) -> tuple[str, Path]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .real_data import baltaci_rate_by_altitude
-
-    alts = np.arange(20, 161, 20)
-    fig, ax = plt.subplots(figsize=(7.5, 4.5))
-    ax.plot(alts, chm_rate_by_altitude(alts, cfg, seed=seed), "o-", label="simulator, CHM (A3 2 dB / 160 ms)")
-    long = [(f, n) for f, n in zip(flights, chm_real) if f.t[-1] > 60]
-    ax.plot(
-        [f.altitude_m for f, _ in long], [n / (f.t[-1] / 60) for f, n in long], "x", label="CHM on the UKM measurements"
-    )
-    ax.plot(
-        [f.altitude_m for f, _ in long],
-        [f.observed_handovers / (f.t[-1] / 60) for f, _ in long],
-        "s",
-        label="UKM flights, live network (nominal height)",
-    )
-    baltaci = next(
-        (
-            p / "baltaci-imc22-handovers"
-            for p in Path(real).resolve().parents
-            if (p / "baltaci-imc22-handovers" / "handovers.csv").is_file()
-        ),
-        None,
-    )
-    caption = "Handover rate vs altitude"
-    if baltaci is not None:
-        bins, rate, n = baltaci_rate_by_altitude(baltaci)
-        ax.plot(bins + 5, rate, "^-", label=f"Baltaci et al. IMC'22 flights ({n} handovers, per modem)")
-        caption += f" (Baltaci et al. data: {baltaci})"
-    ax.set_xlabel("height (m)")
-    ax.set_ylabel("handovers per minute")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    path = Path(out) / "handover_rate_vs_altitude.png"
-    xairl.plugin.save_figure(fig, path, dpi=90)
-    plt.close(fig)
-    return caption, path
-
-
-def frontier_figure(data: dict, path) -> str:
-    """The frontier of ``data`` (benchmarks/oracle_frontier.py's frontier.json) with the receding horizons and each
-    policy's place, as a PNG at ``path``; returns the path."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    ax.plot(data["frontier"]["handovers"], data["frontier"]["rsrq_pct"], "k-o", ms=3, label="hindsight bound")
-    for h, pts in data.get("receding", {}).items():
-        ax.plot(pts["handovers"], pts["rsrq_pct"], "--.", lw=1, label=f"{h} s of foresight")
-    policies = data.get("policies", {})
-    for (name, p), marker in zip(policies.items(), "s^Dvp", strict=False):
-        ax.plot(p["handovers"], p["rsrq_pct"], marker, ms=8, label=name)
-    seen = [p["rsrq_pct"] for p in policies.values()] + data["frontier"]["rsrq_pct"]
-    ax.set_ylim(0.9 * min(seen), 2.5 * max([p["rsrq_pct"] for p in policies.values()] or seen))
-    ax.set_xlabel("handovers per flight (mean)")
-    ax.set_ylabel("time below the RSRQ threshold (%)")
-    ax.set_title(f"What hindsight allows: {data.get('flights', '?')} held-out flights")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return str(path)

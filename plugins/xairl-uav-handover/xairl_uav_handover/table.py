@@ -8,7 +8,8 @@ the interval holds the spread between seeds too. Each per-flight figure is given
 Table I reports medians: :func:`format_paper` sets ours beside them). Shares pooled over handovers (ping-pong share,
 handovers taken with an empty or a full buffer) are ratios of sums, resampled as such. The ping-pong window is
 ``HandoverConfig.min_time_of_stay_s`` (the rows that say 'minimum time of stay'); the 1, 2, 5 and 10 s windows are
-shown beside it.
+shown beside it, except the one equal to the minimum time of stay (given ``min_stay_s``, :func:`shown_rows`): its
+rows would repeat the minimum time of stay's.
 """
 
 from __future__ import annotations
@@ -175,42 +176,53 @@ def format_paper(results: dict[str, dict[str, tuple[float, float, float]]]) -> s
     return "\n".join(lines)
 
 
-def format_rows(results: dict[str, dict[str, tuple[float, float, float]]]) -> str:
-    """One line per row, one column per policy: 'value [low, high]'."""
+def shown_rows(min_stay_s: float | None = None) -> list[tuple[str, str]]:
+    """(key, label) of the rows a table shows: every row of :data:`ROWS`; given the configured minimum time of stay,
+    its value in the rows that count at it, and without the window rows at that same window (the same counts)."""
+    if min_stay_s is None:
+        return [(key, label) for key, label, _ in ROWS]
+    same = {f"pp_{min_stay_s:g}s", f"pp_share_median_{min_stay_s:g}s"}
+    stay = f"minimum time of stay of {min_stay_s:g} s"
+    return [(key, label.replace("minimum time of stay", stay)) for key, label, _ in ROWS if key not in same]
+
+
+def format_rows(results: dict[str, dict[str, tuple[float, float, float]]], min_stay_s: float | None = None) -> str:
+    """One line per row (:func:`shown_rows`), one column per policy: 'value [low, high]'."""
     names = list(results)
     lines = [f"{'':<62}" + "".join(f"{n:>24}" for n in names)]
-    for key, label, _ in ROWS:
+    for key, label in shown_rows(min_stay_s):
         cells = [results[n][key] for n in names]
         lines.append(f"{label:<62}" + "".join(f"{v:>9.2f} [{lo:.2f}, {hi:.2f}]".rjust(24) for v, lo, hi in cells))
     return "\n".join(lines)
 
 
-def worse(res: dict, a: str, b: str) -> list[str]:
-    """Labels of the rows where policy ``a`` is worse than ``b`` beyond doubt: its interval lies wholly on the worse
-    side of ``b``'s interval."""
+def worse(res: dict, a: str, b: str, min_stay_s: float | None = None) -> list[str]:
+    """Labels of the rows (:func:`shown_rows`) where policy ``a`` is worse than ``b`` beyond doubt: its interval
+    lies wholly on the worse side of ``b``'s interval."""
     out = []
-    for key, label, _ in ROWS:
+    for key, label in shown_rows(min_stay_s):
         (_, alo, ahi), (_, blo, bhi) = res[a][key], res[b][key]
         if (ahi < blo) if key in HIGHER_IS_BETTER else (alo > bhi):
             out.append(label)
     return out
 
 
-def html_table(res: dict) -> tuple[list[str], list[list[str]]]:
-    """(header, rows) for an HTML table: one row per figure, one column per policy, 'value [low, high]'."""
+def html_table(res: dict, min_stay_s: float | None = None) -> tuple[list[str], list[list[str]]]:
+    """(header, rows) for an HTML table: one row per figure (:func:`shown_rows`), one column per policy,
+    'value [low, high]'."""
     names = list(res)
     return (
-        ["", *names],
+        ["figure (per flight, or pooled over flights)", *names],
         [
             [label, *(f"{res[n][key][0]:.2f} [{res[n][key][1]:.2f}, {res[n][key][2]:.2f}]" for n in names)]
-            for key, label, _ in ROWS
+            for key, label in shown_rows(min_stay_s)
         ],
     )
 
 
-def verdict(res: dict, a: str = "DQN", b: str = "CHM") -> str:
+def verdict(res: dict, a: str = "DQN", b: str = "CHM", min_stay_s: float | None = None) -> str:
     """In words, where policy ``a`` loses to ``b`` beyond the intervals (:func:`worse`)."""
-    losses = worse(res, a, b)
+    losses = worse(res, a, b, min_stay_s)
     return (
         f"The {a} is worse than {b} beyond the intervals on: " + "; ".join(losses) + "."
         if losses

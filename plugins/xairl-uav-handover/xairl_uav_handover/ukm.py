@@ -34,6 +34,8 @@ from pathlib import Path, PurePosixPath
 
 from xairl import InputError
 
+from .exports import MAX_FILE_BYTES, check_plain
+
 REPO = "https://github.com/Mehranbjt/Empirical-3D-Channel-Modeling-for-Cellular-Connected-UAVs"
 COMMIT = "5fa8f2ad98efde4d28466f5922c61ceb470f840a"
 URL = f"{REPO}/raw/{COMMIT}/raw_dataset.zip"
@@ -45,7 +47,7 @@ FOLDER = "ukm-uav-lte"  # the extracted copy under data_home()
 MEMBER_DIR = "Measured Data"
 TIMEOUT_S = 20.0
 MAX_DOWNLOAD = 64 << 20  # bytes; the pinned zip is a few MB
-MAX_MEMBER = 16 << 20  # uncompressed bytes per CSV (the largest is 1.2 MB)
+MAX_MEMBER = MAX_FILE_BYTES  # uncompressed bytes per CSV (the largest is 1.2 MB), as a CSV in a folder
 MAX_TOTAL = 128 << 20  # uncompressed bytes extracted in all (the 29 CSVs: 22 MB)
 MAX_MEMBERS = 1000
 NAME_MAX = 255  # bytes of a file name on the usual file systems (ext4, APFS, NTFS in UTF-16 units)
@@ -105,10 +107,10 @@ def _given(path: Path, root: Path) -> Path | None:
 
 
 def _check_zip_file(path: Path) -> None:
-    """Refuse, in one line, a path that exists but is not a zip that can be opened: not a plain file, unreadable,
-    empty, truncated (a zip's directory is at its end), or some other kind of file."""
-    if not path.is_file():
-        raise InputError(f"{path}: neither a folder nor a zip of flight exports (not a plain file); {_GIVE}")
+    """Refuse, in one line, a path that exists but is not a zip that can be opened: not a regular file (a FIFO, a
+    device: the folder path's check, :func:`exports.check_plain`), larger than a download may be, unreadable, empty,
+    truncated (a zip's directory is at its end), or some other kind of file."""
+    check_plain(path, MAX_DOWNLOAD)
     try:
         with open(path, "rb") as fh:
             head = fh.read(4)

@@ -1,0 +1,99 @@
+"""The UAV report as a reader meets it (issue 64): the words about contributions agree with the figures, numbers
+have units, an identifier gets no percentiles, every column a label, no local path, Table I no repeated row and a
+reason where SA-MRO's figures equal CHM's, and the main findings first. All read one report (``real_report``)."""
+
+import html as htmllib
+import re
+
+import pytest
+
+
+@pytest.fixture(scope="module")
+def page(real_report) -> str:
+    out, _ = real_report
+    return (out / "report.html").read_text()
+
+
+def text_of(page: str) -> str:
+    """The page's visible text: no images, no style, tags as spaces."""
+    page = re.sub(r"<style>.*?</style>|data:image/png;base64,[A-Za-z0-9+/=]+", " ", page, flags=re.S)
+    return htmllib.unescape(re.sub(r"<[^>]+>", " ", page))
+
+
+def section(page: str, heading: str) -> str:
+    """The HTML of the section under the first <h2> that starts with ``heading``, up to the next <h2>."""
+    start = re.search(rf"<h2 id=s\d+>{re.escape(heading)}", page)
+    assert start, heading
+    end = page.find("<h2", start.end())
+    return page[start.start() : end if end > 0 else len(page)]
+
+
+def rows(table_html: str) -> list[list[str]]:
+    return [
+        [htmllib.unescape(c) for c in re.findall(r"<t[dh]>(.*?)</t[dh]>", r)]
+        for r in re.findall(r"<tr>(.*?)</tr>", table_html)
+    ]
+
+
+def test_the_notes_name_the_view_every_figure_shows(page):
+    notes = text_of(section(page, "Notes"))
+    assert "Contributions are to the chosen action's Q-value" not in notes
+    assert "margin of the chosen action's Q-value over the runner-up's" in notes
+    assert "contribution to the margin over the runner-up" in page  # the figures' captions
+
+
+def test_numbers_are_readable_and_the_buffer_has_a_unit(page):
+    shown = text_of(page)
+    big = re.findall(r"\S*\d(?:\.\d+)?e\+\d\d\S*", shown)  # 2.391e+06: a number no reader reads at a glance
+    assert not big, big[:5]
+    cards = [r for r in rows(section(page, "Narrated decisions")) if r and r[0] == "buffer_queue_size"]
+    assert cards and all(r[1].endswith("% full") for r in cards), cards
+    quantiles = {r[0]: r for r in rows(section(page, "Real states in the training distribution"))}
+    assert all(v.endswith("% full") for v in quantiles["buffer_queue_size"][1:7]), quantiles["buffer_queue_size"]
+    assert quantiles["rsrp_0"][2].endswith(" dBm")
+
+
+def test_an_identifier_gets_no_percentiles(page):
+    quantiles = [r[0] for r in rows(section(page, "Real states in the training distribution"))]
+    assert "rsrp_0" in quantiles and "serving_bs" not in quantiles
+
+
+def test_every_column_has_a_label(page):
+    headers = re.findall(r"<tr>((?:<th>.*?</th>)+)</tr>", page)
+    assert headers and all("<th></th>" not in h for h in headers)
+
+
+def test_no_local_path_is_printed(page, real_report):
+    _, real = real_report
+    shown = text_of(page)
+    assert str(real) not in page and str(real.parent.parent) not in page
+    assert "real flights from ukm" in shown  # the folder, by name
+
+
+def test_table_one_repeats_no_row_and_says_why_sa_mro_equals_chm(page):
+    table = rows(section(page, "Table I"))
+    labels = [r[0] for r in table[1:]]
+    assert len(set(labels)) == len(labels)
+    pingpong = [tuple(r[1:]) for r in table[1:] if "ping-pong share" in r[0]]
+    assert len(set(pingpong)) == len(pingpong), "two ping-pong rows repeat the same figures"
+    sa, chm = ([r[table[0].index(n)] for r in table[1:]] for n in ("SA-MRO", "CHM"))
+    notes = text_of(section(page, "Notes"))
+    assert sa == chm and "SA-MRO's figures equal CHM's on Table I's 8 simulated flights" in notes
+    assert "so its offsets never left CHM's" in notes
+
+
+def test_the_open_loop_rows_that_equal_each_other_are_explained(page):
+    table = {r[0].split(" ")[0]: r[1:] for r in rows(section(page, "Open-loop agreement"))}
+    assert table["CHM"] == table["SA-MRO"]
+    notes = text_of(section(page, "Notes"))
+    assert "SA-MRO's figures equal CHM's on the 2 real flights' samples" in notes
+    assert "it counted 0 too-early, 0 too-late and 0 wrong-cell handovers and 0 ping-pongs" in notes
+
+
+def test_the_main_finding_comes_first_with_contents(page):
+    assert (
+        page.index("Figure 2 finding (buffer first") < page.index("<nav class=toc>") < page.index("<h2 id=s2>Settings")
+    )
+    toc = page[page.index("<nav class=toc>") : page.index("</nav>")]
+    for heading in ("Table I", "Calibration", "Open-loop agreement", "Narrated decisions", "Notes"):
+        assert f">{heading}" in toc, heading
