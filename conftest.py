@@ -4,7 +4,7 @@ import os
 
 import pytest
 
-from xairl import plugins
+from xairl.registry import plugins
 
 
 @pytest.fixture(autouse=True)

@@ -18,12 +18,12 @@ from dataclasses import replace
 import numpy as np
 
 import xairl
-from xairl import prompts
 from xairl.counterfactual_facts import counterfactual_fact
 from xairl.facts import decision_facts
 from xairl.narrators.base import first_phrasings
 from xairl.narrators.provenance import verify
-from xairl.tracking import track_decision
+from xairl.templates import prompts
+from xairl.templates.tracking import track_decision
 
 
 def last_sentence(name: str):

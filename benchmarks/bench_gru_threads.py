@@ -1,6 +1,6 @@
 """The memory doc's GRU (4 signals x 4 steps, 32 units) explained and narrated, timed: issue 64's "a GRU narration takes
 35 s" and "one state took 37 s with torch's 2 threads and 7.4 s with one". Attributions now run a small network on
-one torch thread (xairl.network.torch_threads); run this with torch's default threads (no OMP_NUM_THREADS) on the
+one torch thread (xairl.policies.network.torch_threads); run this with torch's default threads (no OMP_NUM_THREADS) on the
 code before and after to compare.
 
 Run: env -u OMP_NUM_THREADS .venv/bin/python benchmarks/bench_gru_threads.py [--background 20]

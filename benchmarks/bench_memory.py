@@ -35,7 +35,7 @@ if __name__ == "__main__":
     ap.add_argument("--states", type=int, default=100_000)
     ap.add_argument("--policy", default=None, help="registered policy (default uav-dqn if installed, else toy)")
     args = ap.parse_args()
-    import xairl.plugins
+    import xairl.registry.plugins
 
     name = args.policy or ("uav-dqn" if "uav-dqn" in xairl.plugins.registry("policy").names() else "toy")
     n = args.states

@@ -16,9 +16,9 @@ import sys
 import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-from xairl import prompts  # noqa: E402
 from xairl.narrators import battery_cases, check_template  # noqa: E402
-from xairl.plugins import prompt_dirs  # noqa: E402
+from xairl.registry.plugins import prompt_dirs  # noqa: E402
+from xairl.templates import prompts  # noqa: E402
 
 CUSTOM = pathlib.Path(__file__).parent / "data" / "templates" / "custom"
 

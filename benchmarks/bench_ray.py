@@ -5,7 +5,7 @@
 2. kernel_shap and exact Shapley on M states: Ray with 1 worker and with 2 workers; the speed-up per added worker
    (target: close to 2 on 2 cores), and the local engine beside them.
 3. local_lm narration (mode choose, one torch thread per worker) of K states: in this process, and with
-   xairl.scale.narrate_on_ray on 1 and 2 workers (each loads the model once; Ray's start-up included).
+   xairl.runs.scale.narrate_on_ray on 1 and 2 workers (each loads the model once; Ray's start-up included).
 
 Run: .venv/bin/python benchmarks/bench_ray.py [--states 200000] [--kernel-states 1000] [--exact-states 1000]
      [--narrations 16]                                      (0 skips a part)
@@ -21,8 +21,8 @@ import numpy as np
 from fleet_mlp import make_policy
 
 import xairl
-from xairl.scale import explain_on_ray, narrate_on_ray
-from xairl.stream import explain_to_parquet, read_parquet
+from xairl.runs.scale import explain_on_ray, narrate_on_ray
+from xairl.runs.stream import explain_to_parquet, read_parquet
 
 
 def timed(fn, *args, **kwargs) -> float:

@@ -39,8 +39,8 @@ import torch
 import yaml
 
 import xairl
-from xairl import prompts as xprompts
 from xairl.errors import XairlError
+from xairl.templates import prompts as xprompts
 from xairl.toy import toy_background, toy_policy
 
 HERE = Path(__file__).resolve().parent
@@ -221,7 +221,7 @@ def builtin_templates(kinds) -> list[dict]:
     for path in sorted(xprompts.builtin_dir().glob("*.yaml")):
         spec = read_template(path)
         found.append({"name": spec["name"], "path": path, "spec": spec, "kinds": template_kinds(spec, kinds)})
-    from xairl.plugins import prompt_dirs
+    from xairl.registry.plugins import prompt_dirs
 
     for _, folder in prompt_dirs():
         for path in sorted(Path(folder).glob("*.yaml")):

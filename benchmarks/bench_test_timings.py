@@ -22,8 +22,8 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 import xairl  # noqa: E402
-from xairl import prompts  # noqa: E402
 from xairl.narrators.samples import sample_context  # noqa: E402
+from xairl.templates import prompts  # noqa: E402
 from xairl.toy import toy_policy  # noqa: E402
 
 HOSTILE = sorted((pathlib.Path(__file__).resolve().parents[1] / "tests" / "hostile_templates").glob("*.yaml"))

@@ -11,7 +11,7 @@ import argparse
 import numpy as np
 
 import xairl
-import xairl.plugins
+import xairl.registry.plugins
 
 
 def spearman(a, b):

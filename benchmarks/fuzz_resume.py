@@ -26,7 +26,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from xairl.errors import InputError
-from xairl.stream import DATASET, explain_to_parquet, read_parquet
+from xairl.runs.stream import DATASET, explain_to_parquet, read_parquet
 from xairl.toy import toy_policy
 
 POLICY = toy_policy()
@@ -96,7 +96,7 @@ def mutate(kind: str, parts: Path, other: Path, rng: random.Random) -> str | Non
 
 def not_a_part_of_the_run(path: Path, run: str) -> bool:
     """run.json when it is no record of a run, a file whose name is no chunk's, or another run's whole part."""
-    from xairl.parts import PART, check_part
+    from xairl.runs.parts import PART, check_part
 
     if path.name == "run.json":
         try:
@@ -154,7 +154,7 @@ def main() -> None:
     if args.engine == "ray":
         import ray
 
-        from xairl.scale import explain_on_ray
+        from xairl.runs.scale import explain_on_ray
 
         ray.init(
             num_cpus=2,

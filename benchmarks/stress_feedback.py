@@ -14,8 +14,8 @@ from pathlib import Path
 
 
 def writer(path, n, tag):
-    from xairl.feedback import FeedbackStore
     from xairl.narrators.base import Narrative
+    from xairl.outputs.feedback import FeedbackStore
 
     store = FeedbackStore(path)
     for i in range(n):
@@ -23,7 +23,7 @@ def writer(path, n, tag):
 
 
 def run(procs: int, writes: int, path: Path) -> tuple[int, float]:
-    from xairl.feedback import FeedbackStore
+    from xairl.outputs.feedback import FeedbackStore
 
     FeedbackStore(path)
     ctx = mp.get_context("spawn")
@@ -38,7 +38,7 @@ def run(procs: int, writes: int, path: Path) -> tuple[int, float]:
 
 
 def killed_writer(path: Path) -> tuple[int, str]:
-    from xairl.feedback import FeedbackStore
+    from xairl.outputs.feedback import FeedbackStore
 
     ctx = mp.get_context("spawn")
     p = ctx.Process(target=writer, args=(path, 100_000, "victim"))

@@ -5,8 +5,8 @@ import pytest
 import torch
 
 import xairl
-from xairl import plugins
 from xairl.cli import main
+from xairl.registry import plugins
 
 
 @pytest.fixture(autouse=True)

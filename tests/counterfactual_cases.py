@@ -12,13 +12,14 @@ import numpy as np
 import pytest
 import torch
 
-from xairl import FeatureInfo, Policy, prompts
+from xairl import FeatureInfo, Policy
 from xairl.counterfactual_facts import _outward, action_words
 from xairl.counterfactuals import Change, Counterfactual, Counterfactuals
 from xairl.facts import decision_facts
 from xairl.narrators.base import first_phrasings
 from xairl.narrators.provenance import verify
-from xairl.tracking import track_decision
+from xairl.templates import prompts
+from xairl.templates.tracking import track_decision
 from xairl.values import fill_and_text
 
 CAP = 200.0  # the linear policy's queue capacity (kbit): its fill is said in % of it

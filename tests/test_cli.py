@@ -9,10 +9,9 @@ import numpy as np
 import pytest
 
 import xairl
+from tests.conftest import one_line_error, run
 from xairl.cli import main
 from xairl.toy import FEATURES, toy_policy
-
-from .conftest import one_line_error, run
 
 
 def test_help_does_not_import_heavy_libraries():
@@ -209,7 +208,7 @@ def report_dir(tmp_path_factory):
 
 def test_output_files_get_the_umasks_permissions_so_a_report_can_be_shared(report_dir, tmp_path):
     """mkstemp made every file -rw-------: a report no web server or colleague could read."""
-    from xairl.files import write_text
+    from xairl.runs.files import write_text
 
     modes = {p.name: p.stat().st_mode & 0o777 for p in report_dir.iterdir()}
     assert {"report.html", "explanations.jsonl"} <= modes.keys() and set(modes.values()) == {0o644}, modes

@@ -5,10 +5,9 @@ import pytest
 import torch
 
 import xairl
-from xairl import plugins
+from tests.conftest import ReusedActivations, mlp
 from xairl.attributors.base import Attributor
-
-from .conftest import ReusedActivations, mlp
+from xairl.registry import plugins
 
 MODELS = {
     "relu_mlp": lambda: mlp([5, 16, 16, 3]),

@@ -11,13 +11,12 @@ import pytest
 import torch
 
 import xairl
+from tests.conftest import one_line_error, run
+from tests.counterfactual_cases import said
+from tests.test_counterfactuals import assert_valid, flat_policy, normal
 from xairl import FeatureInfo, InputError
 from xairl.counterfactuals import search
 from xairl.toy import toy_background, toy_policy
-
-from .conftest import one_line_error, run
-from .counterfactual_cases import said
-from .test_counterfactuals import assert_valid, flat_policy, normal
 
 
 def flips_alone(policy, results):

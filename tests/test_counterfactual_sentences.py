@@ -13,12 +13,11 @@ import pytest
 import torch
 
 import xairl
+from tests.counterfactual_cases import CAP, HAD, answer, linear_policy, said
 from xairl import FeatureInfo, InputError, Policy
 from xairl.counterfactual_facts import counterfactual_fact
 from xairl.counterfactuals import Counterfactuals
 from xairl.numbers import format_number, written_step
-
-from .counterfactual_cases import CAP, HAD, answer, linear_policy, said
 
 THEN = "the policy would have chosen {{ cf.action }} (margin {{ cf.margin|num }})."
 
@@ -191,7 +190,7 @@ def test_a_narrative_with_a_counterfactual_its_check_cannot_read_is_not_verified
     from xairl.facts import decision_facts
     from xairl.narrators.base import first_phrasings
     from xairl.narrators.provenance import verify
-    from xairl.tracking import track_decision
+    from xairl.templates.tracking import track_decision
 
     p = linear_policy()
     states = np.array([[160, -90], [120, -95]], dtype=np.float32)

@@ -9,16 +9,15 @@ import numpy as np
 import pytest
 
 import xairl
-from xairl import plugins
+from tests.conftest import one_line_error, run
 from xairl.counterfactuals.show import summary
-from xairl.display import counterfactual_text
-from xairl.feedback import FeedbackStore
-from xairl.report import ReportContent, ReportRequest, write_report
-from xairl.report_counterfactuals import flip_rows
-from xairl.review import page
+from xairl.explanations.display import counterfactual_text
+from xairl.outputs.feedback import FeedbackStore
+from xairl.outputs.report import ReportContent, ReportRequest, write_report
+from xairl.outputs.report_counterfactuals import flip_rows
+from xairl.outputs.review import page
+from xairl.registry import plugins
 from xairl.toy import toy_policy
-
-from .conftest import one_line_error, run
 
 
 @pytest.fixture(scope="module")
@@ -50,7 +49,7 @@ def test_notebook_card_names_the_change_and_the_new_action(uav):
 
 
 def test_summary_writes_values_as_the_narratives_do(uav):
-    from xairl.report_counterfactuals import writer
+    from xairl.outputs.report_counterfactuals import writer
 
     policy, states, bg = uav
     found = xairl.counterfactual(policy, states, index=None, background=bg, features=["rsrp_0"], target="any")
@@ -192,7 +191,7 @@ def test_a_narratives_counterfactual_sentence_shows_in_its_card():
 def test_the_single_flip_table_of_a_window_policy_takes_its_background_as_windows():
     import torch
 
-    from .conftest import mlp
+    from tests.conftest import mlp
 
     policy = xairl.Policy(
         torch.nn.Sequential(torch.nn.Flatten(), mlp([12, 16, 3])), feature_names=list("abc"), window=4

@@ -14,12 +14,11 @@ import pytest
 import torch
 
 import xairl
+from tests.counterfactual_cases import CAP, answer, at, caught_by_the_rerun, corpus, linear_policy, one_change, said
 from xairl import FeatureInfo, InputError, Policy
 from xairl.counterfactual_facts import counterfactual_fact
 from xairl.counterfactuals import Counterfactuals
 from xairl.toy import toy_policy
-
-from .counterfactual_cases import CAP, answer, at, caught_by_the_rerun, corpus, linear_policy, one_change, said
 
 
 @pytest.fixture(scope="module")

@@ -8,9 +8,8 @@ import pytest
 import torch
 
 import xairl
+from tests.conftest import mlp, small_cnn
 from xairl import FeatureInfo, InputError, Threshold
-
-from .conftest import mlp, small_cnn
 
 
 def flat_policy(**kwargs):

@@ -9,7 +9,7 @@ import torch
 
 import xairl
 from xairl.errors import InputError
-from xairl.evidence import card_html, evidence
+from xairl.explanations.evidence import card_html, evidence
 from xairl.facts import decision_facts, value_level
 
 

@@ -6,11 +6,10 @@ import pytest
 import torch
 
 import xairl
+from tests.conftest import mlp, run
+from tests.test_references import brute_force_shapley
 from xairl.attributors.exact import MAX_EVALUATIONS, Exact
 from xairl.errors import InputError, UnsupportedModelError
-
-from .conftest import mlp, run
-from .test_references import brute_force_shapley
 
 SIGNALS, STEPS = 4, 4
 NAMES = [f"s{j}_t{t}" for t in range(STEPS) for j in range(SIGNALS)]  # time-major, as observation=(4, 4) flattens
@@ -175,7 +174,7 @@ def test_a_long_exact_run_shows_progress_unasked(monkeypatch, capsys):
     """Was: exact on 16 slots ran 6 minutes with nothing printed. Unasked (progress=None), a run past a few seconds
     shows a bar on a terminal, and a plain line every 10 s when stderr is a log or a pipe (here the clock is made
     short instead of the run long)."""
-    from xairl import display
+    from xairl.explanations import display
 
     _, policy = counted(mlp([6, 8, 3]), 6)
     x, bg = _states(6, n=1, m=10)

@@ -10,7 +10,7 @@ import pytest
 import xairl
 from xairl.cli import main
 from xairl.errors import InputError
-from xairl.feedback import FeedbackStore
+from xairl.outputs.feedback import FeedbackStore
 from xairl.toy import toy_policy
 
 
@@ -40,8 +40,8 @@ def test_record_review_export(tmp_path, narrative):
 
 
 def _writer(path, n, text, start=None):
-    from xairl.feedback import FeedbackStore
     from xairl.narrators.base import Narrative
+    from xairl.outputs.feedback import FeedbackStore
 
     store = FeedbackStore(path)
     if start is not None:  # every writer waits until all have imported, so their writes overlap whatever the load

@@ -346,7 +346,7 @@ def _cli_ok(argv):
 )
 def test_streamed_readers_of_any_csv_or_parquet(tmp_path_factory, header, rows, as_parquet, chunk):
     """The streaming engine's readers (pyarrow's CSV and Parquet): chunks of checked states, or one InputError line."""
-    from xairl.chunks import state_chunks
+    from xairl.runs.chunks import state_chunks
 
     folder = tmp_path_factory.mktemp("stream")
     path = folder / "s.csv"

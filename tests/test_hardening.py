@@ -16,12 +16,11 @@ import numpy as np
 import pytest
 
 import xairl
+from tests.conftest import one_line_error, run
 from xairl.cli import main
 from xairl.errors import InputError
-from xairl.inputs import read_states
+from xairl.runs.inputs import read_states
 from xairl.toy import FEATURES, toy_policy
-
-from .conftest import one_line_error, run
 
 POLICY = toy_policy()
 
@@ -262,7 +261,7 @@ def test_a_killed_writer_leaves_no_partial_file_under_the_final_name(tmp_path):
     target.write_text("the previous complete run\n")
     code = textwrap.dedent(f"""
         import sys, time
-        from xairl.files import atomic_write
+        from xairl.runs.files import atomic_write
         with atomic_write({str(target)!r}) as fh:
             for i in range(100000):
                 fh.write('{{"index": %d}}\\n' % i)

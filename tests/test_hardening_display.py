@@ -16,9 +16,9 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 import xairl
 from xairl import plots
-from xairl.feedback import FeedbackStore
-from xairl.policy import FeatureInfo
-from xairl.review import serve_in_thread
+from xairl.outputs.feedback import FeedbackStore
+from xairl.outputs.review import serve_in_thread
+from xairl.policies.policy import FeatureInfo
 from xairl.toy import toy_policy
 
 # --- item 7: a total deadline per connection and a cap on connections (loopback only) ---------------------------
@@ -144,7 +144,7 @@ def test_a_request_cut_at_its_deadline_is_not_answered(server):
 
 def test_review_limits_must_be_positive(tmp_path):
     from xairl.errors import InputError
-    from xairl.review import make_server
+    from xairl.outputs.review import make_server
 
     for limits in ({"deadline": 0}, {"max_connections": 0}, {"timeout": -1}):
         with pytest.raises(InputError, match="positive"):
@@ -290,7 +290,7 @@ def test_timeline_gives_actions_their_own_colours_and_markers(toy):
 
 def test_a_decision_with_one_action_available_is_no_margin_of_an_action_over_itself(toy, tmp_path):
     """A mask leaving one action: its waterfall is the score's (as its card), and the report picks a real choice."""
-    from xairl.report import _interesting
+    from xairl.outputs.report import _interesting
 
     _, exp = toy
     available = np.ones(exp.outputs.shape, dtype=bool)
@@ -378,7 +378,7 @@ def test_every_figure_names_its_view_margin_by_default(toy, image_exp):
 
 
 def test_the_reports_figures_and_table_are_in_the_margin_view_and_say_so(toy, tmp_path):
-    from xairl.report import _figures, importance_table
+    from xairl.outputs.report import _figures, importance_table
 
     policy, exp = toy
     figures = _figures([("sampled", exp), ("again", exp)], 3, {"motion": ("speed", "distance")}, tmp_path, policy)
@@ -394,8 +394,8 @@ def test_the_reports_figures_and_table_are_in_the_margin_view_and_say_so(toy, tm
 
 def test_the_reports_region_table_gives_each_grid_name_its_pixels(image_exp):
     """Short region names in words, the rows and columns they cover in the table (issue 51, item 13)."""
-    from xairl.regions import in_regions
-    from xairl.report import REGIONS_ARE, TOP_REGIONS, importance_table
+    from xairl.outputs.report import REGIONS_ARE, TOP_REGIONS, importance_table
+    from xairl.policies.regions import in_regions
 
     regions = in_regions(image_exp)
     title, table = importance_table([("frames", regions)], TOP_REGIONS, REGIONS_ARE)
@@ -431,7 +431,7 @@ def test_the_notebook_check_is_real():
 
 def test_progress_bars_are_quiet_in_a_notebook_and_still_count():
     run = _in_a_notebook(
-        "from xairl.display import progress\n"
+        "from xairl.explanations.display import progress\n"
         "assert sum(progress(range(3), desc='explaining')) == 3\n"
         "import tqdm.auto  # as shap and transformers do, later\n"
         "print(len(list(progress(range(4), disable=True))))\n"
@@ -445,7 +445,7 @@ def test_a_report_in_a_notebook_leaves_tqdm_auto_quiet_for_the_libraries_after_i
     """The report's bars are the notebook-safe ones: tqdm.auto is then imported quietly, and shap or transformers
     importing it later in the same kernel print nothing."""
     run = _in_a_notebook(
-        "from xairl.report import ReportContent, ReportRequest, write_report\n"
+        "from xairl.outputs.report import ReportContent, ReportRequest, write_report\n"
         "from xairl.toy import toy_policy\n"
         "p = toy_policy()\n"
         f"write_report(ReportRequest(out={str(tmp_path)!r}, narrate=False), ReportContent('toy', p, p.background(30),"

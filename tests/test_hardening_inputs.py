@@ -9,10 +9,9 @@ import pytest
 import torch
 
 import xairl
+from tests.conftest import ReusedActivations, mlp, one_line_error, run
 from xairl.errors import InputError
 from xairl.toy import FEATURES, toy_policy
-
-from .conftest import ReusedActivations, mlp, one_line_error, run
 
 POLICY = toy_policy()
 METHODS = ["deep_shap", "integrated_gradients", "kernel_shap", "exact"]
@@ -91,7 +90,7 @@ def test_a_parquet_states_file_is_explained(tmp_path, capsys):
     other columns (an episode id) are ignored, the features read in the policy's order."""
     cols, x = _columns()
     path = _parquet(tmp_path / "s.parquet", {"episode": np.arange(4), **dict(reversed(list(cols.items())))})
-    from xairl.inputs import read_states
+    from xairl.runs.inputs import read_states
 
     np.testing.assert_array_equal(read_states(path, FEATURES), x)
     rc, out, err = run(capsys, "explain", "--states", path, "--background", path, "--method", "exact")

@@ -13,11 +13,11 @@ import pyarrow.parquet as pq
 import pytest
 
 from benchmarks.fuzz_resume import BG, CHUNK, POLICY, STATES, N, make_runs, mutate, one_case, part
-from xairl import plugins
 from xairl.cli import explain as explain_cli
 from xairl.cli import main
 from xairl.errors import InputError
-from xairl.stream import DATASET, explain_to_parquet, read_parquet
+from xairl.registry import plugins
+from xairl.runs.stream import DATASET, explain_to_parquet, read_parquet
 
 CASES = 210  # with a fixed seed: the resume fuzz of the "done when" (benchmarks/fuzz_resume.py runs more)
 

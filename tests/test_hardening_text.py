@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 import xairl
-from xairl import prompts, sandbox
 from xairl.cli import main
 from xairl.errors import InputError
 from xairl.narrators import check_template
 from xairl.narrators.samples import sample_context
 from xairl.numbers import format_number, written_step
-from xairl.prompts import TemplateError
+from xairl.templates import prompts, sandbox
+from xairl.templates.prompts import TemplateError
 from xairl.toy import toy_policy
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -149,7 +149,7 @@ def test_a_smaller_number_is_never_written_more_precisely_than_a_larger_one():
 
 
 def test_a_counterfactual_margin_is_written_as_the_words_write_it():
-    from xairl.display import counterfactual_text
+    from xairl.explanations.display import counterfactual_text
 
     one = {"changes": [{"feature": "wind", "before_text": "1", "after_text": "2"}], "action": "go", "margin": 6.44e-4}
     (line,) = counterfactual_text({"found": [one | {"distance": 0.5}]})
@@ -158,8 +158,8 @@ def test_a_counterfactual_margin_is_written_as_the_words_write_it():
 
 # ---- low: the review page says only its own messages ------------------------------------------------------------------
 def test_the_review_page_does_not_reflect_a_crafted_message(tmp_path):
-    from xairl.feedback import FeedbackStore
-    from xairl.review import serve_in_thread
+    from xairl.outputs.feedback import FeedbackStore
+    from xairl.outputs.review import serve_in_thread
 
     server, url = serve_in_thread(FeedbackStore(tmp_path / "fb.sqlite"))
     try:

@@ -10,8 +10,8 @@ import pytest
 import torch
 
 import xairl
-from xairl.observation import Observation
-from xairl.windows import MAX_SLOTS, Window
+from xairl.policies.observation import Observation
+from xairl.policies.windows import MAX_SLOTS, Window
 
 
 class Sum(torch.nn.Module):

@@ -9,11 +9,10 @@ import pytest
 import torch
 
 import xairl
-from xairl.observation import Observation
-from xairl.regions import in_regions
+from tests.conftest import small_cnn
+from xairl.policies.observation import Observation
+from xairl.policies.regions import in_regions
 from xairl.toy import toy_policy
-
-from .conftest import small_cnn
 
 
 def _cnn(channels: str = "channels"):

@@ -6,11 +6,10 @@ import pytest
 import torch
 
 import xairl
+from tests.conftest import small_cnn
 from tests.work_budget import calls
-from xairl.regions import in_regions
-from xairl.report import ReportContent, ReportRequest, write_report
-
-from .conftest import small_cnn
+from xairl.outputs.report import ReportContent, ReportRequest, write_report
+from xairl.policies.regions import in_regions
 
 NARRATE_CALLS = 1_000_000  # function calls to narrate one state of the CNN below, verification included
 

@@ -6,7 +6,7 @@ import torch
 
 import xairl
 from xairl.errors import InputError, UnknownNameError
-from xairl.inputs import read_states
+from xairl.runs.inputs import read_states
 from xairl.toy import FEATURES, toy_policy
 
 

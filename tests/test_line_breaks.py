@@ -13,10 +13,10 @@ import xairl
 from tests.conftest import run
 from xairl.cli import main
 from xairl.cli.explain import marked_rows
-from xairl.evidence import card_html, sentence_lines
-from xairl.feedback import FeedbackStore
-from xairl.report import ReportContent, ReportRequest, write_report
-from xairl.review import page
+from xairl.explanations.evidence import card_html, sentence_lines
+from xairl.outputs.feedback import FeedbackStore
+from xairl.outputs.report import ReportContent, ReportRequest, write_report
+from xairl.outputs.review import page
 from xairl.toy import toy_policy
 
 #: one plain sentence, then one sentence of several lines: a heading with characters HTML must escape and a list

@@ -8,13 +8,13 @@ import sys
 import pytest
 
 import xairl
-from xairl import prompts
 from xairl.errors import InputError
 from xairl.facts import decision_facts
 from xairl.narrators import fill, local_lm
 from xairl.narrators.base import first_phrasings
+from xairl.templates import prompts
+from xairl.templates.tracking import Rendered, track_decision
 from xairl.toy import toy_policy
-from xairl.tracking import Rendered, track_decision
 
 # the real model: loaded once per process (seconds), then seconds a narration
 pytestmark = pytest.mark.slow

@@ -7,7 +7,7 @@ from matplotlib.figure import Figure
 
 import xairl
 from xairl import plots
-from xairl.evidence import evidence
+from xairl.explanations.evidence import evidence
 from xairl.toy import toy_policy
 
 

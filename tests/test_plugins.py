@@ -6,8 +6,8 @@ from dataclasses import replace
 import pytest
 
 import xairl
-from xairl import plugins
 from xairl.errors import PluginError, UnknownNameError
+from xairl.registry import plugins
 
 
 class DuplicateAttributor:
@@ -135,7 +135,7 @@ def test_plugins_are_selected_by_environment(tmp_path, monkeypatch):
 def test_import_is_lazy():
     """`import xairl` loads no plugin and no heavy library; the first lookup does."""
     code = (
-        "import sys, xairl; heavy = [m for m in ('torch', 'shap', 'transformers', 'captum', 'xairl.builtins') "
+        "import sys, xairl; heavy = [m for m in ('torch', 'shap', 'transformers', 'captum', 'xairl.registry.builtins') "
         "if m in sys.modules]; print(heavy)"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout

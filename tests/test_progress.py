@@ -9,9 +9,9 @@ import pytest
 import torch
 
 import xairl
-from xairl import display
-from xairl.display import heartbeat
-from xairl.report import ReportContent, ReportRequest, write_report
+from xairl.explanations import display
+from xairl.explanations.display import heartbeat
+from xairl.outputs.report import ReportContent, ReportRequest, write_report
 from xairl.toy import ACTIONS, FEATURES, toy_background, toy_network
 
 

@@ -7,12 +7,12 @@ import pytest
 
 import xairl
 from tests.work_budget import calls
-from xairl import prompts
 from xairl.cli import main
 from xairl.errors import UnknownNameError
 from xairl.narrators import check_template
 from xairl.narrators.samples import sample_context
-from xairl.prompts import TemplateError
+from xairl.templates import prompts
+from xairl.templates.prompts import TemplateError
 from xairl.toy import toy_policy
 
 GOOD = 'name: explain_action\nkind: decision\nsentences:\n  - ["Custom: the policy chose {{ action }}."]\n'

@@ -5,9 +5,10 @@ import re
 
 import pytest
 
-from xairl import plugins, prompts
 from xairl.cli import main
 from xairl.narrators import battery, battery_cases, check_template
+from xairl.registry import plugins
+from xairl.templates import prompts
 
 HEAD = "name: t\nkind: decision\noutputs: [actions]\nsentences:\n"
 CHOSE = (

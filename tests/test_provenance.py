@@ -10,16 +10,16 @@ import torch
 import yaml
 
 import xairl
-from xairl import Explanation, prompts, tracking
+from tests.conftest import mlp
+from xairl import Explanation
 from xairl.facts import decision_facts
 from xairl.narrators import provenance
 from xairl.narrators.base import first_phrasings
 from xairl.narrators.verify import verify as read_prose
 from xairl.narrators.verify.rules import example
+from xairl.templates import prompts, tracking
+from xairl.templates.tracking import Fact, Span
 from xairl.toy import toy_background, toy_policy
-from xairl.tracking import Fact, Span
-
-from .conftest import mlp
 
 #: robot: turn (3.2) over recharge (2.0); chosen score: speed +0.5, battery -0.3, obstacle +2.0; margin: speed +0.7,
 #: battery -1.5, obstacle +2.0; values 0.4, 0.3, 0.9; with these quartiles speed is low, battery and obstacle high

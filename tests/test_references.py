@@ -8,9 +8,8 @@ import pytest
 import torch
 
 import xairl
+from tests.conftest import ReusedActivations, mlp
 from xairl.errors import InputError, UnsupportedModelError
-
-from .conftest import ReusedActivations, mlp
 
 
 def policy_of(net, f, a):

@@ -5,7 +5,7 @@ import re
 
 import pytest
 
-from xairl.report import ReportContent, ReportRequest, write_report
+from xairl.outputs.report import ReportContent, ReportRequest, write_report
 from xairl.toy import toy_policy
 
 FINDING = "Finding of the toy: distance leads, as designed."
@@ -47,7 +47,7 @@ def test_the_contents_link_every_section_and_figure(page):
 
 
 def test_a_long_table_title_is_a_short_heading_over_its_caption(page):
-    from xairl.report_html import short_heading
+    from xairl.outputs.report_html import short_heading
 
     assert "<h2 id=s3>Table I</h2><p class=caption>" in page and short_heading(LONG) == "Table I"
     assert short_heading("Open-loop agreement with the live network's decisions (29 real flights from x)") == (

@@ -11,8 +11,8 @@ import urllib.request
 import pytest
 
 import xairl
-from xairl.feedback import FeedbackStore
-from xairl.review import TIMEOUT, page, serve_in_thread
+from xairl.outputs.feedback import FeedbackStore
+from xairl.outputs.review import TIMEOUT, page, serve_in_thread
 from xairl.toy import toy_policy
 
 BROWSER = shutil.which("chromium") and shutil.which("chromedriver")

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from xairl.cli import main
-from xairl.stream import explain_to_parquet, read_parquet
+from xairl.runs.stream import explain_to_parquet, read_parquet
 from xairl.toy import toy_policy
 
 ray = pytest.importorskip("ray", reason="the Ray engine is the 'scale' extra (make test installs it)")
@@ -29,7 +29,7 @@ def local_ray():
 def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ray, capsys):
     """Resume on Ray as on the local engine (issue 51, item 2): lost parts are explained, a bit-flipped one is
     explained again to the same bits, a stray one is refused by name."""
-    from xairl.scale import explain_on_ray
+    from xairl.runs.scale import explain_on_ray
 
     states = tmp_path / "s.npy"
     np.save(states, POLICY.background(6_000, seed=4))
@@ -79,7 +79,7 @@ def test_ray_reads_parquet_by_row_group_and_csv_once_rewritten(tmp_path, local_r
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    from xairl.scale import STAGED, explain_on_ray
+    from xairl.runs.scale import STAGED, explain_on_ray
     from xairl.toy import FEATURES
 
     states, bg = POLICY.background(2_500, seed=5), POLICY.background(20)
@@ -108,7 +108,7 @@ def test_ray_reports_a_users_error_in_one_line_and_keeps_what_was_written(tmp_pa
     import pyarrow.parquet as pq
 
     from xairl.errors import InputError
-    from xairl.scale import STAGED, explain_on_ray
+    from xairl.runs.scale import STAGED, explain_on_ray
     from xairl.toy import FEATURES
 
     states = POLICY.background(2_500, seed=6).astype(float)
@@ -134,7 +134,7 @@ def test_ray_reports_a_users_error_in_one_line_and_keeps_what_was_written(tmp_pa
 @pytest.mark.slow
 def test_narrations_on_ray_are_the_narrations_here_in_order(local_ray):
     import xairl
-    from xairl.scale import narrate_on_ray
+    from xairl.runs.scale import narrate_on_ray
 
     bg = POLICY.background(20)
     exp = xairl.explain(POLICY, POLICY.background(6, seed=8), background=bg)
@@ -153,7 +153,7 @@ def test_narrations_on_ray_are_the_narrations_here_in_order(local_ray):
 @pytest.mark.slow
 def test_the_local_engine_imports_no_ray(tmp_path):
     code = (
-        "import sys, numpy as np; from xairl.toy import toy_policy; from xairl.stream import explain_to_parquet; "
+        "import sys, numpy as np; from xairl.toy import toy_policy; from xairl.runs.stream import explain_to_parquet; "
         f"p = toy_policy(); explain_to_parquet(p, p.background(100), {str(tmp_path / 'o')!r}, progress=False); "
         "print('ray' in sys.modules)"
     )

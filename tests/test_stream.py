@@ -14,10 +14,10 @@ import pyarrow.parquet as pq
 import pytest
 
 import xairl
-from xairl.chunks import _table_batches, stage_parquet, state_chunks
 from xairl.cli import main
 from xairl.errors import InputError
-from xairl.stream import explain_chunks, explain_to_parquet, read_parquet
+from xairl.runs.chunks import _table_batches, stage_parquet, state_chunks
+from xairl.runs.stream import explain_chunks, explain_to_parquet, read_parquet
 from xairl.toy import FEATURES, toy_policy
 
 POLICY = toy_policy()

@@ -1,4 +1,4 @@
-"""Tracked rendering (xairl.tracking): every value a template prints keeps the fact it came from (issue 52)."""
+"""Tracked rendering (xairl.templates.tracking): every value a template prints keeps the fact it came from (issue 52)."""
 
 import pickle
 import re
@@ -8,10 +8,10 @@ import pytest
 import yaml
 
 import xairl
-from xairl import prompts, tracking
 from xairl.facts import decision_facts
 from xairl.narrators.base import first_phrasings
 from xairl.narrators.verify.rules import example
+from xairl.templates import prompts, tracking
 from xairl.toy import toy_background, toy_policy
 
 MARKERS = re.compile("[\ue000-\ue01f]")

@@ -11,9 +11,9 @@ import torch
 import yaml
 
 import xairl
-import xairl.region_names
+import xairl.policies.region_names
 from xairl import plots
-from xairl.windows import TREND_SHARE, Window, over_time, trend
+from xairl.policies.windows import TREND_SHARE, Window, over_time, trend
 
 SIGNALS = ("rsrq", "load")
 STEPS = 5
@@ -157,7 +157,7 @@ def test_frame_stack_groups_per_region_and_frame():
     e = xairl.explain(p, rng.random((2, 4, 24, 24)), method="deep_shap", background=rng.random((6, 4, 24, 24)))
     steps, regions = e.by_step(), e.by_signal()
     assert steps.feature_names == ("frame 0", "frame 1", "frame 2", "frame 3")
-    side = 24 // xairl.region_names.region_size(24, 24)
+    side = 24 // xairl.policies.region_names.region_size(24, 24)
     assert regions.feature_names[0] == "patch A1" and len(regions.feature_names) == side * side
     for g in (steps, regions):
         np.testing.assert_allclose(g.values.sum(axis=1), e.values.sum(axis=1), atol=1e-9)
@@ -185,7 +185,7 @@ def test_a_frame_stacked_cnn_is_narrated_in_trends_over_its_frames():
     assert regions.feature_names[0] == "patch A1 of frame 0" and e.by_step().feature_names[-1] == "frame 3"
     patch = [f for f in regions.feature_names if f.endswith(" of frame 0")]
     j = regions.feature_names.index(patch[0])
-    size = xairl.region_names.region_size(84, 84)
+    size = xairl.policies.region_names.region_size(84, 84)
     np.testing.assert_allclose(regions.states[0, j], frames[0, 0, :size, :size].mean(), rtol=1e-5)
     plots.window_heatmap(e, 0)
     said = 0
@@ -280,8 +280,8 @@ def test_a_label_has_no_trend(data):
 
 
 def test_a_report_of_a_window_shows_signals_over_time(exp, data, tmp_path):
+    from xairl.outputs.report import write_report
     from xairl.plugin import ReportContent, ReportRequest
-    from xairl.report import write_report
 
     x, bg = data
     req = ReportRequest(out=tmp_path, method="exact", n_narrated=1, progress=False, robustness=False)

@@ -13,24 +13,24 @@ import sys
 #: public name -> module (or 'module:attr' where the module's name for it differs)
 _LAZY = {
     # policies and results
-    "Policy": "xairl.policy",
-    "FeatureInfo": "xairl.policy",
-    "from_sb3": "xairl.sb3",
-    "Observation": "xairl.observation",
-    "patches": "xairl.region_names",
-    "in_regions": "xairl.regions",
-    "Explanation": "xairl.explanation",
-    "get_policy": "xairl.plugins",
+    "Policy": "xairl.policies.policy",
+    "FeatureInfo": "xairl.policies.policy",
+    "from_sb3": "xairl.policies.sb3",
+    "Observation": "xairl.policies.observation",
+    "patches": "xairl.policies.region_names",
+    "in_regions": "xairl.policies.regions",
+    "Explanation": "xairl.explanations.explanation",
+    "get_policy": "xairl.registry.plugins",
     # attribution, in memory or streamed chunk by chunk to a resumable Parquet dataset
     "explain": "xairl.attributors",
-    "explain_chunks": "xairl.stream",
+    "explain_chunks": "xairl.runs.stream",
     # counterfactuals: what would have had to differ for another decision, each checked by running the policy
     "counterfactual": "xairl.counterfactuals.search",
     "Counterfactual": "xairl.counterfactuals.result",
     "Counterfactuals": "xairl.counterfactuals.result",
     "Threshold": "xairl.counterfactuals.result",
-    "explain_to_parquet": "xairl.stream",
-    "read_parquet": "xairl.stream",
+    "explain_to_parquet": "xairl.runs.stream",
+    "read_parquet": "xairl.runs.stream",
     # narration and verification
     "narrate": "xairl.narrators",
     "NarrationOptions": "xairl.narrators",

@@ -26,16 +26,16 @@ from dataclasses import replace as _replace
 
 import numpy as np
 
-from .counterfactuals import Counterfactual, Counterfactuals
-from .counterfactuals.goals import NOISE, feasible, lead
-from .counterfactuals.goals import action_index as resolve  # (the one resolver of an action's name or alias)
-from .counterfactuals.show import outward as _outward  # (the one rounding rule: away from the line)
-from .counterfactuals.show import summary
-from .errors import InputError
-from .explanation import Explanation
-from .numbers import format_number
-from .policy import FeatureInfo, Policy
-from .values import fill_and_text
+from xairl.counterfactuals import Counterfactual, Counterfactuals
+from xairl.counterfactuals.goals import NOISE, feasible, lead
+from xairl.counterfactuals.goals import action_index as resolve  # (the one resolver of an action's name or alias)
+from xairl.counterfactuals.show import outward as _outward  # (the one rounding rule: away from the line)
+from xairl.counterfactuals.show import summary
+from xairl.errors import InputError
+from xairl.explanations.explanation import Explanation
+from xairl.numbers import format_number
+from xairl.policies.policy import FeatureInfo, Policy
+from xairl.values import fill_and_text
 
 __all__ = [
     "ChangeFact",
@@ -131,7 +131,7 @@ def action_index(policy: Policy, text: str) -> int | None:
 
 def feature_words(policy: Policy, name: str) -> str:
     """How a counterfactual names a feature: its description, else its name; a window's past slot
-    (``speed[t-2]``, :meth:`xairl.windows.Window.names`) as its signal's words that many steps ago ('the speed 2
+    (``speed[t-2]``, :meth:`xairl.policies.windows.Window.names`) as its signal's words that many steps ago ('the speed 2
     steps ago')."""
     info = policy.features.get(name) or FeatureInfo()
     window = policy.observation.parts[0].window if policy.observation.kind == "window" else None
@@ -297,7 +297,7 @@ def said_counterfactual(
     if many:
         ask = next((a for a in ask if a.index == index), None) or _refuse(index)  # a batch answer (index=None)
     if ask is True:
-        from .counterfactuals.search import counterfactual
+        from xairl.counterfactuals.search import counterfactual
 
         ask = counterfactual(  # (three, so that one still flips once its values are rounded away from the line)
             policy, exp.states, index=index, background=background, explanation=exp, max_changes=max_changes, n=3

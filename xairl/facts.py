@@ -9,13 +9,13 @@ from typing import Any
 
 import numpy as np
 
-from .counterfactual_facts import CounterfactualFact
-from .errors import InputError, PluginError
-from .explanation import Explanation
-from .numbers import format_number
-from .policy import FeatureInfo, Policy
-from .values import fill_and_text, state_value_text, value_level, value_text
-from .windows import Window, real_start, signal_facts, window_of
+from xairl.counterfactual_facts import CounterfactualFact
+from xairl.errors import InputError, PluginError
+from xairl.explanations.explanation import Explanation
+from xairl.numbers import format_number
+from xairl.policies.policy import FeatureInfo, Policy
+from xairl.policies.windows import Window, real_start, signal_facts, window_of
+from xairl.values import fill_and_text, state_value_text, value_level, value_text
 
 __all__ = [
     "Comparison",
@@ -51,14 +51,14 @@ class FeatureFact:
     :param fill: for a feature with a capacity, its value as a percentage of it; else None.
     :param value_text: the value as a narrative writes it: '-85.3 dBm', '12.0 % full', a category's label, 'mean
         pixel value 33.1' for an image region (:func:`xairl.in_regions`), or empty for a group.
-    :param change: for a signal of a window (:mod:`xairl.windows`): its newest value minus its oldest (``value`` is
+    :param change: for a signal of a window (:mod:`xairl.policies.windows`): its newest value minus its oldest (``value`` is
         its newest); None for other features.
     :param trend: for such a signal: 'rose' or 'fell' when it is said as a trend (its earlier steps carry at least a
         third of its push, and it changed), else ''; ``window`` the span in words ('the last 0.8 s').
     :param change_unit: the unit of ``change``: the feature's, a dBm level's change in dB, and a quantity with a
         capacity changes in 'percentage points' of it (``change`` is then in them too: its level is said in % full).
     :param steps: for such a signal, 'pulled both ways' when its steps' pushes nearly cancel though they weigh as
-        much as the largest reason (:func:`xairl.windows.pulled_both_ways`), else ''.
+        much as the largest reason (:func:`xairl.policies.windows.pulled_both_ways`), else ''.
     """
 
     name: str
@@ -340,7 +340,7 @@ def domain_facts(
     policy: Policy | None, state: np.ndarray, chosen: int, runner_up: int, history: np.ndarray | None = None
 ) -> DomainFacts:
     """The policy plugin's ``facts_hook`` output, checked for its type; ``history`` goes to hooks that take it. An
-    image narrated in regions (:mod:`xairl.regions`) has no pixel state to give the hook: it is not called there."""
+    image narrated in regions (:mod:`xairl.policies.regions`) has no pixel state to give the hook: it is not called there."""
     if policy is None or policy.facts_hook is None or len(state) != policy.n_features:
         return DomainFacts()
     if history is not None and len(history) and _takes_history(policy.facts_hook):

@@ -11,7 +11,7 @@ from typing import TypeVar
 
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from .errors import InputError, validation_message
+from xairl.errors import InputError, validation_message
 
 T = TypeVar("T", bound=BaseModel)
 

@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .explanation import Explanation
-from .facts import state_value_text
-from .files import save_figure
-from .regions import in_regions
-from .windows import window_of
+from xairl.explanations.explanation import Explanation
+from xairl.facts import state_value_text
+from xairl.policies.regions import in_regions
+from xairl.policies.windows import window_of
+from xairl.runs.files import save_figure
 
 #: figures are laid out and saved at this many dots per inch
 DPI = 90
@@ -289,7 +289,7 @@ def image(exp: Explanation, index: int = 0, view: str = "margin"):
     """An image policy's frame (mean over channels) beside its contributions summed over channels (red raises, blue
     lowers): in the ``"margin"`` view (discrete actions) one map of the margin of the chosen action over the
     runner-up; in the ``"score"`` view (or when nothing is chosen) one map per output, of its own score."""
-    from .errors import InputError
+    from xairl.errors import InputError
 
     shape = exp.image_shape
     if shape is None:
@@ -370,10 +370,10 @@ def timeline(exp: Explanation, view: str = "margin", top: int = 5, title: str = 
 
 
 def window_heatmap(exp: Explanation, index: int | None = None, view: str = "margin", top: int = 12):
-    """A policy that sees time (:mod:`xairl.windows`): contributions per signal (rows, the ``top`` largest) and per
+    """A policy that sees time (:mod:`xairl.policies.windows`): contributions per signal (rows, the ``top`` largest) and per
     time step (columns, oldest to newest) for state ``index``, or their mean |contribution| over every state
     (``index=None``), so a reader sees which signals and which moments of the window drove the decisions."""
-    from .windows import over_time
+    from xairl.policies.windows import over_time
 
     groups = exp.time_groups()
     signals, steps = (list(g) for g in groups)

@@ -13,29 +13,29 @@ from xairl import lazy_attributes
 
 #: public name -> the module that defines it
 _LAZY = {
-    # hooks (xairl.hookspecs holds the specifications and their documentation)
-    "hookimpl": "xairl.hookspecs",
-    "hookspec": "xairl.hookspecs",
+    # hooks (xairl.registry.hookspecs holds the specifications and their documentation)
+    "hookimpl": "xairl.registry.hookspecs",
+    "hookspec": "xairl.registry.hookspecs",
     # base classes of what a plugin registers
     "Attributor": "xairl.attributors",
     "Narrator": "xairl.narrators",
-    "Report": "xairl.report",
-    "ReportRequest": "xairl.report",
-    "ReportContent": "xairl.report",
-    "table_html": "xairl.report",
-    "StateRecord": "xairl.explanation_io",
+    "Report": "xairl.outputs.report",
+    "ReportRequest": "xairl.outputs.report",
+    "ReportContent": "xairl.outputs.report",
+    "table_html": "xairl.outputs.report",
+    "StateRecord": "xairl.explanations.explanation_io",
     # options: a plugin's own settings, validated like the built-ins'
     "Options": "xairl.options",
     "parse_options": "xairl.options",
     # files written whole or not at all (a crash never leaves a partial file under its final name)
-    "atomic_write": "xairl.files",
-    "save_figure": "xairl.files",
+    "atomic_write": "xairl.runs.files",
+    "save_figure": "xairl.runs.files",
     # a progress bar that is quiet in a notebook without ipywidgets
-    "progress": "xairl.display",
+    "progress": "xairl.explanations.display",
     # a long step said on stderr as it starts, every 10 s while it runs, and when it ends (logs and pipes too)
-    "heartbeat": "xairl.display",
+    "heartbeat": "xairl.explanations.display",
     # registries and checks
-    "get_attributor": "xairl.plugins",
+    "get_attributor": "xairl.registry.plugins",
     "check_template": "xairl.narrators",
     "corpus": "xairl.testing",
     # errors a plugin raises (xairl.XairlError and xairl.InputError are the user-facing ones)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from .narrators.verify import NUMBER_RE
+from xairl.narrators.verify import NUMBER_RE
 
 FLIPS = {"toward": "against", "against": "toward"}
 
@@ -118,8 +118,8 @@ def corpus(
     States where the chosen action was the only available one (an ``action_mask``) have no runner-up, so the
     ``why_not`` template is skipped there.
     """
-    from . import prompts
-    from .facts import decision_facts
+    from xairl.facts import decision_facts
+    from xairl.templates import prompts
 
     cases: list[Case] = []
     for name in templates:

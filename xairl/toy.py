@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from .policy import FeatureInfo, Policy
+from xairl.policies.policy import FeatureInfo, Policy
 
 FEATURES = ("battery", "distance", "speed", "obstacle", "wind")
 ACTIONS = ("forward", "turn", "recharge")

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .explanation import Explanation
-from .numbers import format_number
-from .policy import FeatureInfo, Policy
+from xairl.explanations.explanation import Explanation
+from xairl.numbers import format_number
+from xairl.policies.policy import FeatureInfo, Policy
 
 
 def value_level(value: float, info: FeatureInfo, quartiles: tuple[float, float] | None) -> tuple[str, str]:

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from ..explanation import Explanation
-from ..policy import Policy
-from .base import Attributor, Options
+from xairl.attributors.base import Attributor, Options
+from xairl.explanations.explanation import Explanation
+from xairl.policies.policy import Policy
 
 
 def explain(policy: Policy, states, background=None, method: str = "deep_shap", options=None) -> Explanation:
@@ -16,7 +16,7 @@ def explain(policy: Policy, states, background=None, method: str = "deep_shap", 
     :param method: a registered attributor name (``xairl attributors`` lists them).
     :param options: dict of the method's options (validated; unknown keys are an error).
     """
-    from ..plugins import get_attributor
+    from xairl.registry.plugins import get_attributor
 
     return get_attributor(method)(options).explain(policy, states, background)
 

@@ -10,11 +10,11 @@ from typing import Any, ClassVar
 import numpy as np
 import torch
 
-from ..errors import InputError, UnsupportedModelError
-from ..explanation import Explanation
-from ..network import eval_mode, torch_threads
-from ..options import Options, parse_options
-from ..policy import Policy
+from xairl.errors import InputError, UnsupportedModelError
+from xairl.explanations.explanation import Explanation
+from xairl.options import Options, parse_options
+from xairl.policies.network import eval_mode, torch_threads
+from xairl.policies.policy import Policy
 
 #: background states drawn from the policy's sampler when none are given
 DEFAULT_BACKGROUND = 100
@@ -45,7 +45,7 @@ class Attributor:
         """Explain ``states`` against ``background`` (default: 100 states from the policy's sampler).
 
         The module runs in eval mode; its training flags and every hook this attributor added are restored
-        even when attribution fails. A small network runs on one torch thread (:func:`xairl.network.torch_threads`).
+        even when attribution fails. A small network runs on one torch thread (:func:`xairl.policies.network.torch_threads`).
         """
         if not isinstance(policy, Policy):
             raise InputError(

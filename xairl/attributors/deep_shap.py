@@ -24,8 +24,8 @@ import numpy as np
 import torch
 from pydantic import Field
 
-from ..errors import UnsupportedModelError
-from .base import Attributor, Options, alternatives
+from xairl.attributors.base import Attributor, Options, alternatives
+from xairl.errors import UnsupportedModelError
 
 nn = torch.nn
 #: layers whose gradient already is the DeepLIFT multiplier (linear in eval mode)

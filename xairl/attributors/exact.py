@@ -16,11 +16,11 @@ import numpy as np
 import torch
 from pydantic import Field
 
-from ..display import WorkProgress
-from ..errors import InputError
-from ..policy import Policy
-from .base import EXACT_MAX_FEATURES as MAX_FEATURES
-from .base import Attributor, Options
+from xairl.attributors.base import EXACT_MAX_FEATURES as MAX_FEATURES
+from xairl.attributors.base import Attributor, Options
+from xairl.errors import InputError
+from xairl.explanations.display import WorkProgress
+from xairl.policies.policy import Policy
 
 #: the default limit, 2^24 (one 16-feature state against 256 background rows): see ExactOptions.max_evaluations
 MAX_EVALUATIONS = 2**24

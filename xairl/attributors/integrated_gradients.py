@@ -8,7 +8,7 @@ import numpy as np
 import torch
 from pydantic import Field
 
-from .base import Attributor, Options
+from xairl.attributors.base import Attributor, Options
 
 
 class IntegratedGradientsOptions(Options):

@@ -8,8 +8,8 @@ import numpy as np
 import torch
 from pydantic import Field
 
-from ..display import quiet_tqdm, show_progress
-from .base import Attributor, Options
+from xairl.attributors.base import Attributor, Options
+from xairl.explanations.display import quiet_tqdm, show_progress
 
 
 class KernelShapOptions(Options):

@@ -12,10 +12,19 @@ import os
 import sys
 from collections.abc import Sequence
 
-from .. import plugins
-from ..errors import InputError, XairlError
-from .args import Parser, count, make_dir, narration_arguments, new_file, out_dir, parse_options, report_request
-from .explain import explain_parser, marked_rows
+from xairl.cli.args import (
+    Parser,
+    count,
+    make_dir,
+    narration_arguments,
+    new_file,
+    out_dir,
+    parse_options,
+    report_request,
+)
+from xairl.cli.explain import explain_parser, marked_rows
+from xairl.errors import InputError, XairlError
+from xairl.registry import plugins
 
 
 def cmd_plugins(args) -> int:
@@ -57,8 +66,8 @@ def cmd_attributors(args) -> int:
 
 
 def cmd_report(args) -> int:
-    from ..display import heartbeat
-    from ..report import write_report
+    from xairl.explanations.display import heartbeat
+    from xairl.outputs.report import write_report
 
     report = plugins.registry("report").load(args.plugin)(parse_options(args.option))
     method_options = plugins.get_attributor(args.method)(parse_options(args.method_option)).options.model_dump()
@@ -72,7 +81,7 @@ def cmd_report(args) -> int:
 
 
 def cmd_prompts(args) -> int:
-    from .. import prompts
+    from xairl.templates import prompts
 
     if args.action == "list":
         for name, path in sorted(prompts.available(args.prompts).items()):
@@ -88,7 +97,7 @@ def cmd_prompts(args) -> int:
         print(f"# {tpl.path}")
         print(tpl.path.read_text(), end="")
         return 0
-    from ..narrators import check_template
+    from xairl.narrators import check_template
 
     lines = check_template(args.target, notes=True, verbose=print if args.verbose else None)
     problems = [p for p in lines if not p.startswith("note:")]
@@ -102,9 +111,9 @@ def cmd_prompts(args) -> int:
 def cmd_verify(args) -> int:
     """Check a text against an explanation; with --trace, every claim with the words it was read from and the
     reading (rule) that bound it."""
-    from ..narrators.verify import verify
-    from ..prompts import bidi_visible
-    from .records import read_explanation
+    from xairl.cli.records import read_explanation
+    from xairl.narrators.verify import verify
+    from xairl.templates.prompts import bidi_visible
 
     text = args.text if args.text != "-" else sys.stdin.read()
     exp, index = read_explanation(args.explanation, args.index)
@@ -114,7 +123,7 @@ def cmd_verify(args) -> int:
         for c in sentence.claims if args.trace else ():
             print(f"    {c.status:<12} {c.kind:<9} {c.text!r:<28} {c.rule or '-':<22} {c.detail}")
     if args.trace:  # what each reading that fired reads, from its entry in the rules' table
-        from ..narrators.verify.rules import BY_ID
+        from xairl.narrators.verify.rules import BY_ID
 
         fired = sorted({c.rule for c in result.claims if c.rule in BY_ID})
         print("rules:" if fired else "rules: none fired", *(f"  {r}: {BY_ID[r].reads}" for r in fired), sep="\n")
@@ -126,16 +135,16 @@ def cmd_verify(args) -> int:
 
 
 def cmd_review(args) -> int:
-    from ..feedback import FeedbackStore
+    from xairl.outputs.feedback import FeedbackStore
 
     store = FeedbackStore(args.db)
     if args.serve:
-        from ..review import serve
+        from xairl.outputs.review import serve
 
         serve(store, args.port)
         return 0
     if args.export:
-        from ..files import atomic_write
+        from xairl.runs.files import atomic_write
 
         with atomic_write(args.export) as fh:
             n = store.export_corrections(fh)

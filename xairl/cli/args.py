@@ -7,7 +7,7 @@ import argparse
 import json
 from collections.abc import Sequence
 
-from ..errors import InputError
+from xairl.errors import InputError
 
 
 class Parser(argparse.ArgumentParser):
@@ -129,7 +129,7 @@ def report_request(args, out, options: dict, n_states: int, **more):
     ``--narrator``, ``--template``, ``--prompts``, ``--seed``, ``--no-robustness``), for ``n_states`` states."""
     from pathlib import Path
 
-    from ..report import ReportRequest
+    from xairl.outputs.report import ReportRequest
 
     return ReportRequest(
         out=Path(out),

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..errors import InputError
+from xairl.errors import InputError
 
 
 def counterfactual_arguments(p: argparse.ArgumentParser) -> None:
@@ -48,7 +48,7 @@ def asked(args, policy) -> bool:
         return False
     target = _target(args, policy)
     if target is not None and target != "any":
-        from ..counterfactuals.goals import action_index
+        from xairl.counterfactuals.goals import action_index
 
         action_index(policy, target)
     if args.format == "parquet":
@@ -78,7 +78,7 @@ def search(args, policy, exp, background):
             f"--counterfactual searches for another action: policy '{policy.name}' outputs {exp.output}, not "
             "discrete actions; use xairl.counterfactual(..., target=xairl.Threshold(...)) from Python."
         )
-    from ..counterfactuals import counterfactual
+    from xairl.counterfactuals import counterfactual
 
     target = _target(args, policy)
     return counterfactual(
@@ -105,8 +105,8 @@ def summaries(found, policy) -> list[dict] | None:
     narratives write them, each re-run through the policy as written, so that the block and the sentence agree."""
     if found is None:
         return None
-    from ..counterfactual_facts import as_written
-    from ..report_counterfactuals import writer
+    from xairl.counterfactual_facts import as_written
+    from xairl.outputs.report_counterfactuals import writer
 
     write = writer(policy)
     return [as_written(policy, r, write) for r in found]
@@ -114,7 +114,7 @@ def summaries(found, policy) -> list[dict] | None:
 
 def block(cf: dict) -> str:
     """The terminal's lines of one decision: a heading, then one row per counterfactual (or why there is none)."""
-    from ..display import counterfactual_meta, counterfactual_text
+    from xairl.explanations.display import counterfactual_meta, counterfactual_text
 
     rows = "\n".join(f"      {line}" for line in counterfactual_text(cf))
     return f"    what would have changed it ({counterfactual_meta(cf, chosen=False)}):\n{rows}"

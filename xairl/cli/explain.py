@@ -9,9 +9,7 @@ import argparse
 import json
 import re
 
-from .. import plugins
-from ..errors import InputError
-from .args import (
+from xairl.cli.args import (
     MARKS,
     count,
     feedback_arguments,
@@ -22,7 +20,9 @@ from .args import (
     report_request,
     streaming_arguments,
 )
-from .counterfactual import asked, block, counterfactual_arguments, said, search, summaries
+from xairl.cli.counterfactual import asked, block, counterfactual_arguments, said, search, summaries
+from xairl.errors import InputError
+from xairl.registry import plugins
 
 #: above this many states, ``--out DIR`` without a --format streams them into DIR/explanations.parquet (200,000 toy
 #: states as one JSON-lines file: 207 MB built in memory, 1.18 GB peak RSS, written at the end with no progress bar;
@@ -31,8 +31,8 @@ STREAM_ABOVE = 50_000
 
 
 def cmd_explain(args) -> int:
-    from ..attributors import explain
-    from ..inputs import read_states
+    from xairl.attributors import explain
+    from xairl.runs.inputs import read_states
 
     policy = plugins.load_policy(args.policy, parse_options(args.policy_arg), _state_shape(args.states))
     method = plugins.get_attributor(args.method)  # unknown names fail before any file is read
@@ -81,8 +81,8 @@ def _choose_format(args, policy):
     import sys
     from pathlib import Path
 
-    from ..chunks import count_rows
-    from ..inputs import read_states
+    from xairl.runs.chunks import count_rows
+    from xairl.runs.inputs import read_states
 
     if args.format is not None:
         return None
@@ -146,7 +146,7 @@ def _print_table(exp, top: int, view: str, found=None) -> int:
 def _state_shape(path):
     """The shape of one state in a .npy file (what a bare torch module given as --policy takes), from its header;
     else None."""
-    from ..inputs import npy_header
+    from xairl.runs.inputs import npy_header
 
     if not path or not str(path).lower().endswith(".npy"):
         return None
@@ -162,7 +162,7 @@ def _write_report(args, exp, policy, bg) -> int:
     """explanations.jsonl, figures and report.html for any policy (``--out DIR``)."""
     from pathlib import Path
 
-    from ..report import ReportContent, write_report
+    from xairl.outputs.report import ReportContent, write_report
 
     req = report_request(
         args, Path(args.out), dict(exp.options), len(exp.values), progress=False,
@@ -182,14 +182,14 @@ def _stream(args, policy, states, bg, options: dict) -> int:
     import time
     from pathlib import Path
 
-    from ..report import ReportContent, table_html, write_report
-    from ..stream import explain_to_parquet
+    from xairl.outputs.report import ReportContent, table_html, write_report
+    from xairl.runs.stream import explain_to_parquet
 
     out = Path(args.out)
     t0 = time.time()
     common = dict(background=bg, method=args.method, options=options, chunk_size=args.chunk_size, resume=args.resume)
     if args.engine == "ray":
-        from ..scale import explain_on_ray
+        from xairl.runs.scale import explain_on_ray
 
         summary = explain_on_ray(policy, states, out, **common, workers=args.workers, address=args.ray_address)
     else:
@@ -220,8 +220,8 @@ def _stream(args, policy, states, bg, options: dict) -> int:
 
 
 def _print_narratives(args, exp, policy, bg, raw=None) -> int:
-    from ..feedback import FeedbackStore
-    from ..narrators import narrate
+    from xairl.narrators import narrate
+    from xairl.outputs.feedback import FeedbackStore
 
     store = None if args.no_record else FeedbackStore(args.feedback_db)
     options = parse_options(args.narrator_option)
@@ -280,7 +280,7 @@ def marked_rows(text: str, sentences) -> str:
     a sentence that starts a line of a list gets its bullet back, the sentences after it on that line are indented
     under the item's words, a blank line stays a blank row, and a sentence's own lines (a text without sentences)
     are indented under its first."""
-    from ..evidence import sentence_lines
+    from xairl.explanations.evidence import sentence_lines
 
     if not sentences:
         return "\n".join(f"    {line}" for line in text.splitlines())

@@ -8,8 +8,8 @@ import json
 
 import numpy as np
 
-from ..errors import InputError
-from ..explanation import Explanation
+from xairl.errors import InputError
+from xairl.explanations.explanation import Explanation
 
 #: the keys that tell a record line from an explanation's JSON written on one line
 _RECORD_KEYS = frozenset({"index", "scores", "base_values", "values", "additivity_gap"})
@@ -53,7 +53,7 @@ def _from_records(path: str, lines: list[bytes], index: int | None) -> Explanati
     """Record ``index`` (its line among the file's records, from 0) as an explanation of one state."""
     from pydantic import ValidationError
 
-    from ..explanation_io import StateRecord
+    from xairl.explanations.explanation_io import StateRecord
 
     n = len(lines)
     if index is None and n > 1:

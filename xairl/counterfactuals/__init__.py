@@ -7,8 +7,7 @@ first use.
 """
 
 from xairl import lazy_attributes
-
-from .result import Change, Counterfactual, Counterfactuals, Threshold
+from xairl.counterfactuals.result import Change, Counterfactual, Counterfactuals, Threshold
 
 __all__ = ["Change", "Counterfactual", "Counterfactuals", "Threshold", "counterfactual"]
 __getattr__ = lazy_attributes(__name__, {"counterfactual": "xairl.counterfactuals.search"})[0]

@@ -32,8 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from ..policy import Policy
+from xairl.errors import InputError
+from xairl.policies.policy import Policy
 
 
 @dataclass(frozen=True)

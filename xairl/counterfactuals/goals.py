@@ -16,11 +16,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError, UnsupportedModelError
-from ..explanation import Explanation
-from ..policy import Policy
-from .bounds import Units
-from .result import Threshold
+from xairl.counterfactuals.bounds import Units
+from xairl.counterfactuals.result import Threshold
+from xairl.errors import InputError, UnsupportedModelError
+from xairl.explanations.explanation import Explanation
+from xairl.policies.policy import Policy
 
 #: background states an explanation is measured against when the search computes one
 EXPLAIN_BACKGROUND = 100
@@ -165,7 +165,7 @@ def pushes(policy: Policy, goal: Goal, units: Units, xs: np.ndarray, bg, exp: Ex
     """(m, U) each unit's contribution to the margin the change must overturn, for the states ``xs`` (``exp``: their
     explanation, :func:`of_states`; None: computed here)."""
     if exp is None:
-        from ..attributors import explain
+        from xairl.attributors import explain
 
         try:
             exp = explain(policy, xs, bg[:EXPLAIN_BACKGROUND])

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from xairl.errors import InputError
 
 
 @dataclass(frozen=True)
@@ -121,7 +121,7 @@ class Counterfactuals:
 
     def _repr_html_(self) -> str:
         """Jupyter's view: the card of the report's decisions ('What would have changed it')."""
-        from ..display import CF_STYLE, counterfactual_html
-        from .show import summary
+        from xairl.counterfactuals.show import summary
+        from xairl.explanations.display import CF_STYLE, counterfactual_html
 
         return f"<style>{CF_STYLE}</style>" + counterfactual_html(summary(self))

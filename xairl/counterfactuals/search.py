@@ -42,11 +42,11 @@ from itertools import combinations
 
 import numpy as np
 
-from ..errors import InputError
-from ..policy import Policy
-from . import bounds
-from .goals import NOISE, Goal, feasible, lead, of_states, pushes
-from .result import Change, Counterfactual, Counterfactuals
+from xairl.counterfactuals import bounds
+from xairl.counterfactuals.goals import NOISE, Goal, feasible, lead, of_states, pushes
+from xairl.counterfactuals.result import Change, Counterfactual, Counterfactuals
+from xairl.errors import InputError
+from xairl.policies.policy import Policy
 
 GRID, GRID2, TOP_SINGLE, TOP_PAIR, STEPS, ZOOMS = 64, 13, 16, 9, 24, 3
 #: the first grid over a pair of a narrow state (41 x 41: a 13 x 13 one missed a flip of one UAV decision in seven

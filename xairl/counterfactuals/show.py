@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..numbers import format_number, written_step
+from xairl.numbers import format_number, written_step
 
 
 def outward(x: float, down: bool, extra: int = 0) -> float:

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..explanation import Explanation
-from .base import Narrative, Narrator
-from .confidence import confidence
-from .options import NarrationOptions
-from .provenance import verify
-from .verify import Verification
+from xairl.explanations.explanation import Explanation
+from xairl.narrators.base import Narrative, Narrator
+from xairl.narrators.confidence import confidence
+from xairl.narrators.options import NarrationOptions
+from xairl.narrators.provenance import verify
+from xairl.narrators.verify import Verification
 
 
 def narrate(
@@ -26,12 +26,12 @@ def narrate(
 
     :param narrator: a registered narrator ('template', 'local_lm', or a plugin's).
     :param options: the narrator's options (e.g. ``{"mode": "rewrite"}`` for local_lm), validated.
-    :param store: a :class:`xairl.feedback.FeedbackStore` that records the shown narrative, with its evidence
+    :param store: a :class:`xairl.outputs.feedback.FeedbackStore` that records the shown narrative, with its evidence
         (the state, the margin's contributions, the sentences' statuses) for the review page.
     :param narration: how to narrate (:class:`NarrationOptions`); its fields may be given as keyword arguments
         instead (``xairl.narrate(exp, 0, policy=policy, background=bg)``), and those win.
     """
-    from ..plugins import registry
+    from xairl.registry.plugins import registry
 
     how = NarrationOptions.of(narration, **given)  # (checked before a narrator, maybe a language model, loads)
     writer: Narrator = registry("narrator").load(narrator)(options)
@@ -42,7 +42,7 @@ def narrate(
 
 
 def check_template(path: str | Path, *, notes: bool = False, verbose=None) -> list[str]:
-    """Problems of a template file, one line each: the static checks of :func:`xairl.prompts.check` with a trial
+    """Problems of a template file, one line each: the static checks of :func:`xairl.templates.prompts.check` with a trial
     rendering on sample facts, then the battery (:mod:`xairl.narrators.battery`): the template rendered on
     generated decisions of every policy kind, each rendering verified by provenance, and each contradicted one
     reported with the template's file:line, the decision, the sentence and the claim. What ``xairl prompts check``
@@ -52,9 +52,9 @@ def check_template(path: str | Path, *, notes: bool = False, verbose=None) -> li
         ``dir`` filter would track them; a plugin template that needs its plugin's extras), after the problems.
     :param verbose: called with a line saying how many cases and renderings the battery ran, and in what time.
     """
-    from .. import prompts
-    from .battery import run
-    from .samples import sample_context
+    from xairl.narrators.battery import run
+    from xairl.narrators.samples import sample_context
+    from xairl.templates import prompts
 
     problems = prompts.check(path, sample_context)
     if problems:

@@ -15,20 +15,20 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..counterfactual_facts import said_counterfactual
-from ..errors import InputError
-from ..evidence import CARD_STYLE, card_html, evidence
-from ..explanation import Explanation
-from ..facts import DomainFacts, decision_facts, global_facts
-from ..options import Options, parse_options
-from ..policy import Policy
-from ..regions import in_regions
-from ..tracking import Rendered, Span, joined, locate, track_decision, track_global
-from ..values import state_value_text
-from .confidence import confidence
-from .options import NarrationOptions
-from .provenance import verify
-from .verify import Claim
+from xairl.counterfactual_facts import said_counterfactual
+from xairl.errors import InputError
+from xairl.explanations.evidence import CARD_STYLE, card_html, evidence
+from xairl.explanations.explanation import Explanation
+from xairl.facts import DomainFacts, decision_facts, global_facts
+from xairl.narrators.confidence import confidence
+from xairl.narrators.options import NarrationOptions
+from xairl.narrators.provenance import verify
+from xairl.narrators.verify import Claim
+from xairl.options import Options, parse_options
+from xairl.policies.policy import Policy
+from xairl.policies.regions import in_regions
+from xairl.templates.tracking import Rendered, Span, joined, locate, track_decision, track_global
+from xairl.values import state_value_text
 
 
 @dataclass(frozen=True)
@@ -39,11 +39,11 @@ class Narrative:
     :param rejected: the narrator's own text when it failed verification and the template's was shown instead.
     :param sentences: (sentence, status) per sentence of ``text``: 'verified', 'contradicted' or 'unchecked' (no
         checkable claim), as the verifier found them; the report and the review page mark each.
-    :param evidence: what an operator checks the words against (:func:`xairl.evidence.evidence`: the state, the
+    :param evidence: what an operator checks the words against (:func:`xairl.explanations.evidence.evidence`: the state, the
         contributions to the margin, the sentences' statuses); a notebook shows it as the report's card.
     :param claims: every claim the verifier checked; a claim about a value the template printed carries its tracked
         span (``Claim.span``: where, and the fact it came from).
-    :param provenance: the tracked span of every value xairl printed (:class:`xairl.tracking.Span`); give it back to
+    :param provenance: the tracked span of every value xairl printed (:class:`xairl.templates.tracking.Span`); give it back to
         ``xairl.verify(text, ..., provenance=narrative.provenance)`` to check the text again by its facts.
     """
 
@@ -73,7 +73,7 @@ class Narrative:
 
 def join_sentences(sentences: Iterable[str]) -> Rendered:
     """Sentences joined by a space, or by a line break next to a sentence of several lines (a template's list), with
-    the tracked spans of those that have them (:class:`xairl.tracking.Rendered`)."""
+    the tracked spans of those that have them (:class:`xairl.templates.tracking.Rendered`)."""
     parts = [s for s in sentences if s]
     seps = [("\n" if "\n" in a + b else " ") for a, b in zip(parts, parts[1:])]
     return joined([(s, getattr(s, "spans", ())) for s in parts], seps)
@@ -93,7 +93,7 @@ def _checks(words: list[tuple]):
 def _template(explanation: Explanation, index: int | None, template: str | None, prompt_dirs: Iterable[str]):
     """The template to narrate with (``template``, or the default for the output kind), refused in one line when it
     does not fit a decision or a summary, or the policy's output kind."""
-    from .. import prompts
+    from xairl.templates import prompts
 
     default = (
         "global_summary" if index is None else "explain_action" if explanation.output == "actions" else "explain_output"

@@ -18,12 +18,12 @@ from dataclasses import dataclass, field
 
 from jinja2 import nodes
 
-from ..facts import DomainFacts, decision_facts, global_facts
-from ..prompts import Template, TemplateError, environment
-from ..sandbox import parse_variant
-from ..tracking import joined, track_decision, track_global
-from .battery_cases import Case, cases
-from .provenance import verify
+from xairl.facts import DomainFacts, decision_facts, global_facts
+from xairl.narrators.battery_cases import Case, cases
+from xairl.narrators.provenance import verify
+from xairl.templates.prompts import Template, TemplateError, environment
+from xairl.templates.sandbox import parse_variant
+from xairl.templates.tracking import joined, track_decision, track_global
 
 #: direction words that a template should write with the ``dir`` filter when a sign test chooses them
 _DIRECTION = re.compile(

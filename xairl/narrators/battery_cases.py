@@ -15,9 +15,9 @@ from functools import cache
 import numpy as np
 import torch
 
-from ..explanation import Explanation
-from ..policy import FeatureInfo, Policy
-from ..regions import in_regions
+from xairl.explanations.explanation import Explanation
+from xairl.policies.policy import FeatureInfo, Policy
+from xairl.policies.regions import in_regions
 
 #: (name, value, what it means, quartiles of the background) of the flat policy's features, in the order the sign
 #: patterns use them: a negative value with a unit, a queue with a capacity, a categorical, a high value, an id
@@ -197,7 +197,7 @@ def global_cases(decisions: list[Case]) -> list[Case]:
 def _load_plugin_policy(name: str, target: str):
     """(policy, None), or (None, why not) when it fails or takes longer than :data:`PLUGIN_LOAD_S`; once per
     process for a registered ``target``."""
-    from ..plugins import get_policy
+    from xairl.registry.plugins import get_policy
 
     box: dict = {}
 
@@ -217,7 +217,7 @@ def _load_plugin_policy(name: str, target: str):
 
 def plugin_policies() -> tuple[tuple[str, Policy | None, str | None], ...]:
     """(name, policy or None, why not) of every loaded plugin's registered policy."""
-    from ..plugins import registry
+    from xairl.registry.plugins import registry
 
     reg = registry("policy")
     entries = [reg.entry(n) for n in reg.names()]

@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..explanation import Explanation
-from ..policy import Policy
-from .options import NarrationOptions
+from xairl.explanations.explanation import Explanation
+from xairl.narrators.options import NarrationOptions
+from xairl.policies.policy import Policy
 
 WEIGHTS = {"coverage": 0.2, "additivity": 0.15, "margin": 0.25, "agreement": 0.2, "stability": 0.2}  # as the doc says
 
@@ -40,8 +40,8 @@ def _additivity(gap: float, score: float) -> float:
 
 def _agreement(exp: Explanation, index: int, policy: Policy, bg: np.ndarray, c: int) -> float | None:
     """Rank agreement of |contributions| to output ``c`` with a second method; None when it refuses this network."""
-    from ..attributors import explain
-    from ..errors import XairlError
+    from xairl.attributors import explain
+    from xairl.errors import XairlError
 
     second = "deep_shap" if exp.method == "integrated_gradients" else "integrated_gradients"
     try:
@@ -54,7 +54,7 @@ def _agreement(exp: Explanation, index: int, policy: Policy, bg: np.ndarray, c: 
 def _stability(exp: Explanation, index: int, policy: Policy, bg: np.ndarray, seed: int, c: int) -> float:
     """Mean rank agreement of the contributions to output ``c`` with those from two half-size resamples of the
     background."""
-    from ..attributors import explain
+    from xairl.attributors import explain
 
     rng = np.random.default_rng(seed)
     rhos = []

@@ -15,7 +15,7 @@ import re
 import unicodedata
 from functools import lru_cache
 
-from ..tracking import Rendered, Span
+from xairl.templates.tracking import Rendered, Span
 
 INSTRUCTION = (
     "Reword this sentence so that it reads well for an operator. Keep every name and number exactly as written, "
@@ -163,7 +163,7 @@ def fill(model, tok, prefix, sentences: list[Rendered], attempt: int, context: d
     the template did not) keeps the template's words. None when no sentence's rewording was accepted. The result's
     ``reworded`` is (sentences the model reworded, sentences whose words it kept or reworded and were accepted,
     sentences with facts)."""
-    from .base import join_sentences
+    from xairl.narrators.base import join_sentences
 
     out, accepted, reworded, total = [], 0, 0, 0
     for sentence in sentences:

@@ -41,12 +41,12 @@ from typing import Literal
 
 from pydantic import Field
 
-from ..display import quiet_tqdm
-from ..errors import InputError, XairlError
-from ..options import Options
-from ..paths import model_cache_dir
-from ..tracking import Rendered
-from .base import Narrator, first_phrasings
+from xairl.errors import InputError, XairlError
+from xairl.explanations.display import quiet_tqdm
+from xairl.narrators.base import Narrator, first_phrasings
+from xairl.options import Options
+from xairl.runs.paths import model_cache_dir
+from xairl.templates.tracking import Rendered
 
 SYSTEM = (
     "You write short, factual explanations of an automated controller's decisions for the engineers who "
@@ -174,7 +174,7 @@ class LocalLMNarrator(Narrator):
             yield self._compose(variants, context)
             return
         self._threads()
-        from .fill import fill
+        from xairl.narrators.fill import fill
 
         for attempt in range(self.options.tries):
             yield fill(self.model, self.tok, self._prefix, [v[0] for v in variants if v and v[0]], attempt, context)

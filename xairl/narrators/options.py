@@ -9,8 +9,8 @@ from typing import Any
 
 from pydantic import ConfigDict, Field
 
-from ..options import Options, parse_options
-from ..policy import Policy
+from xairl.options import Options, parse_options
+from xairl.policies.policy import Policy
 
 
 class NarrationOptions(Options):

@@ -3,8 +3,8 @@ plausible values of every variable a decision or global template may use."""
 
 from __future__ import annotations
 
-from ..counterfactual_facts import ChangeFact, CounterfactualFact
-from ..facts import Comparison, DecisionFacts, FeatureFact, GlobalFacts
+from xairl.counterfactual_facts import ChangeFact, CounterfactualFact
+from xairl.facts import Comparison, DecisionFacts, FeatureFact, GlobalFacts
 
 
 class _SampleExtras(dict):

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .base import Narrator, first_phrasings
+from xairl.narrators.base import Narrator, first_phrasings
 
 
 class TemplateNarrator(Narrator):

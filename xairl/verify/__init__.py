@@ -19,22 +19,22 @@ from __future__ import annotations
 import sys
 import types
 
-from ..errors import InputError
-from ..explanation import Explanation
-from ..narrators.verify import SentenceCheck, Verification, aids, inputs, sentences
-from ..narrators.verify.checks import Claim
-from ..policy import Policy
-from . import check, rules
-from .parse import Sentence
-from .parse import parse as parse_sentences
-from .resolve import Decision, resolve
+from xairl.errors import InputError
+from xairl.explanations.explanation import Explanation
+from xairl.narrators.verify import SentenceCheck, Verification, aids, inputs, sentences
+from xairl.narrators.verify.checks import Claim
+from xairl.policies.policy import Policy
+from xairl.verify import check, rules
+from xairl.verify.parse import Sentence
+from xairl.verify.parse import parse as parse_sentences
+from xairl.verify.resolve import Decision, resolve
 
 __all__ = ["read", "trace", "tokens"]
 
 
 class _CallableModule(types.ModuleType):
     def __call__(self, *args, **kwargs) -> Verification:
-        from ..narrators import verify
+        from xairl.narrators import verify
 
         return verify(*args, **kwargs)
 

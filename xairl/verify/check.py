@@ -10,16 +10,16 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from ..narrators.verify.book import FactBook
-from ..narrators.verify.checks import EITHER, Claim, check_direction, over_keys, resolve_action
-from ..narrators.verify.comparisons import check_comparison
-from ..narrators.verify.names import Mention
-from ..narrators.verify.numbers import matches, percent_reading
-from ..narrators.verify.quantities import feature_number
-from ..narrators.verify.vocabulary import split_words, stem
-from .lexicon import lexicon
-from .parse import Sentence
-from .rules import Candidate
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import EITHER, Claim, check_direction, over_keys, resolve_action
+from xairl.narrators.verify.comparisons import check_comparison
+from xairl.narrators.verify.names import Mention
+from xairl.narrators.verify.numbers import matches, percent_reading
+from xairl.narrators.verify.quantities import feature_number
+from xairl.narrators.verify.vocabulary import split_words, stem
+from xairl.verify.lexicon import lexicon
+from xairl.verify.parse import Sentence
+from xairl.verify.rules import Candidate
 
 
 def view(s: Sentence, book: FactBook) -> str:

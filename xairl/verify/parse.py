@@ -14,10 +14,10 @@ from dataclasses import dataclass
 
 from spacy.tokens import Doc, Token
 
-from ..narrators.verify.names import find_mentions
-from ..narrators.verify.numbers import Number, find_numbers
-from ..narrators.verify.parse import _symbol_runs, pipeline
-from .lexicon import lexicon
+from xairl.narrators.verify.names import find_mentions
+from xairl.narrators.verify.numbers import Number, find_numbers
+from xairl.narrators.verify.parse import _symbol_runs, pipeline
+from xairl.verify.lexicon import lexicon
 
 for _attr, _default in (("keys", ()), ("label", ""), ("number", None), ("form", "")):
     if not Token.has_extension(_attr):

@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections import defaultdict
 from dataclasses import dataclass
 
-from .rules import Candidate
+from xairl.verify.rules import Candidate
 
 _NUMBERS = ("number", "output", "net", "skip")  # claims on a number: they compete for it
 

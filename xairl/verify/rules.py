@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import yaml
 from spacy.matcher import DependencyMatcher, Matcher
 
-from .lexicon import RULES_DIR, lexicon
+from xairl.verify.lexicon import RULES_DIR, lexicon
 
 
 @dataclass(frozen=True, eq=False)

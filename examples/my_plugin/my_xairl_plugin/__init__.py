@@ -47,7 +47,7 @@ def register_commands(register):
         parser.set_defaults(run=run)
 
     def run(args):
-        from .thermostat import thermostat_policy
+        from my_xairl_plugin.thermostat import thermostat_policy
 
         policy = thermostat_policy()
         exp = xairl.explain(policy, [[args.temperature, 1.0]], method="exact")

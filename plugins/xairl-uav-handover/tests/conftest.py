@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from xairl import plugins
+from xairl.registry import plugins
 
 DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
 UKM = DATA / "ukm-uav-lte" / "raw"

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import xairl
-from xairl import prompts
 from xairl.facts import decision_facts
+from xairl.templates import prompts
 from xairl.testing import corpus
 from xairl_uav_handover.features import LABEL_WORDS, handover_facts
 from xairl_uav_handover.policy import uav_policy

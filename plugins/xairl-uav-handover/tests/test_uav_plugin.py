@@ -7,9 +7,9 @@ import pytest
 import torch
 
 import xairl
-from xairl import plugins
 from xairl.cli import main
 from xairl.plugin import CheckpointError
+from xairl.registry import plugins
 from xairl_uav_handover.baselines import CHM
 from xairl_uav_handover.evaluate import rankings
 from xairl_uav_handover.features import FEATURES

@@ -9,8 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from xairl import InputError, display
+from xairl import InputError
 from xairl.cli import main
+from xairl.explanations import display
 from xairl.plugin import StateRecord
 from xairl_uav_handover.baselines import CHMConfig
 from xairl_uav_handover.calibration import agreement_rows, outside

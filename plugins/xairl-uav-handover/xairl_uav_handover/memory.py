@@ -4,7 +4,7 @@ A snapshot DQN decides on one 0.2 s state (:data:`features.FEATURES`). The hinds
 of foresight gives both fewer handovers and less RSRQ time than CHM, where a 0.2 s snapshot does not. A policy cannot
 see the future, but it can see the recent past: whether a neighbour's RSRQ is rising or the serving cell's falling.
 
-**The state.** It is a window (:mod:`xairl.windows`) of :data:`STEPS` decisions, oldest first, of :data:`SIGNALS`:
+**The state.** It is a window (:mod:`xairl.policies.windows`) of :data:`STEPS` decisions, oldest first, of :data:`SIGNALS`:
 
 - the 13 features of the snapshot;
 - ``on_cell_s``: seconds since the UAV came onto its serving cell, by handover or by re-establishment after a

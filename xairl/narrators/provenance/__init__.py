@@ -1,6 +1,6 @@
 """Verification of xairl's own words by provenance.
 
-A narrative xairl rendered carries, for every value it printed, the fact it came from (:mod:`xairl.tracking`). A
+A narrative xairl rendered carries, for every value it printed, the fact it came from (:mod:`xairl.templates.tracking`). A
 tracked span *is* its fact: it is checked against the explanation (recomputed, never trusted) and never re-bound by
 its position. What is left, the template's (or the language model's) literal words, is judged against the tracked
 spans of its sentence by the rules of :data:`RULES`:
@@ -25,20 +25,20 @@ import re
 from collections.abc import Sequence
 from dataclasses import replace
 
-from ...errors import InputError
-from ...explanation import Explanation
-from ...facts import DomainFacts
-from ...policy import Policy
-from ...regions import in_regions
-from ...tracking import Span
-from ..verify import Claim, SentenceCheck, Verification, bidi_claims, bidi_note, reader, sentences
-from ..verify.checks import DIRECTION_RE
-from ..verify.numbers import normalise
-from .counterfactual import check_counterfactual, is_counterfactual
-from .lexicon import NUMERIC, SAID_OF_FEATURE, SUPERLATIVE
-from .parts import Part, literal
-from .spans import Sentence
-from .truth import Truth, check_fact, close, number, truth
+from xairl.errors import InputError
+from xairl.explanations.explanation import Explanation
+from xairl.facts import DomainFacts
+from xairl.narrators.provenance.counterfactual import check_counterfactual, is_counterfactual
+from xairl.narrators.provenance.lexicon import NUMERIC, SAID_OF_FEATURE, SUPERLATIVE
+from xairl.narrators.provenance.parts import Part, literal
+from xairl.narrators.provenance.spans import Sentence
+from xairl.narrators.provenance.truth import Truth, check_fact, close, number, truth
+from xairl.narrators.verify import Claim, SentenceCheck, Verification, bidi_claims, bidi_note, reader, sentences
+from xairl.narrators.verify.checks import DIRECTION_RE
+from xairl.narrators.verify.numbers import normalise
+from xairl.policies.policy import Policy
+from xairl.policies.regions import in_regions
+from xairl.templates.tracking import Span
 
 __all__ = ["RULES", "Truth", "check_fact", "check_sentence", "truth", "verify"]
 
@@ -158,7 +158,7 @@ def verify(
 
     The other parameters are those of the reader's :func:`xairl.narrators.verify.verify`.
     """
-    from ..verify import verify as read_prose
+    from xairl.narrators.verify import verify as read_prose
 
     several = explanation.output == "continuous" and explanation.values.shape[2] > 1 and index is not None
     if not provenance or several:  # (the spans of several dimensions do not say which one: narrate checks each)

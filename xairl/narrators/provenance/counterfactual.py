@@ -42,12 +42,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...counterfactual_facts import NOISE, broken, feature_words, lead
-from ...policy import FeatureInfo
-from ..verify import COUNTERFACTUAL, Claim
-from .lexicon import NUMBER
-from .parts import Part
-from .truth import Truth, close, number
+from xairl.counterfactual_facts import NOISE, broken, feature_words, lead
+from xairl.narrators.provenance.lexicon import NUMBER
+from xairl.narrators.provenance.parts import Part
+from xairl.narrators.provenance.truth import Truth, close, number
+from xairl.narrators.verify import COUNTERFACTUAL, Claim
+from xairl.policies.policy import FeatureInfo
 
 RULE = COUNTERFACTUAL
 _BELOW = r"below|under|less than|lower than|smaller than|at most|beneath"

@@ -159,7 +159,7 @@ LEVEL = re.compile(
     r"\b(?:low|high|typical|normal|moderate|average)\b(?!\s+(?:value|values|of|score|margin|when))", re.I
 )
 NEGATED = re.compile(r"(?:\b(?:not|never|no longer|neither|nor)|n't)\b\W*(?:\w+\W+){0,2}$", re.IGNORECASE)
-#: a trend word right before a number: the number is a signal's change over its window (:mod:`xairl.windows`), and
+#: a trend word right before a number: the number is a signal's change over its window (:mod:`xairl.policies.windows`), and
 #: an 'up' or 'down' word says its sign ('changed', 'moved' say none)
 TREND_BEFORE = re.compile(
     r"\b(?:(?P<up>rose|risen|rising|climbed|climbing|increased|increasing|grew|growing|gained|jumped|went up)|"

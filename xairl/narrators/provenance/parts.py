@@ -6,8 +6,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ...tracking import Span
-from .lexicon import BLOCK, SEGMENT
+from xairl.narrators.provenance.lexicon import BLOCK, SEGMENT
+from xairl.templates.tracking import Span
 
 
 @dataclass(frozen=True)

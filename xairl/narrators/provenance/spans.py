@@ -7,9 +7,7 @@ import re
 from collections.abc import Sequence
 from dataclasses import replace
 
-from ...tracking import Span
-from ..verify import Claim
-from .lexicon import (
+from xairl.narrators.provenance.lexicon import (
     AS_CONTRIBUTION,
     BASE_WORDS,
     CELL_SCORE,
@@ -33,9 +31,11 @@ from .lexicon import (
     TREND_FITS,
     VIEW_AFTER,
 )
-from .parts import Part, is_name, literal, parts
-from .truth import MISSING, Truth, number, view_of
-from .words import WordRules
+from xairl.narrators.provenance.parts import Part, is_name, literal, parts
+from xairl.narrators.provenance.truth import MISSING, Truth, number, view_of
+from xairl.narrators.provenance.words import WordRules
+from xairl.narrators.verify import Claim
+from xairl.templates.tracking import Span
 
 
 class Sentence(WordRules):

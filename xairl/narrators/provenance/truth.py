@@ -9,13 +9,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...explanation import Explanation
-from ...facts import DomainFacts, decision_facts, global_facts
-from ...policy import Policy
-from ...tracking import Span
-from ..verify import Claim
-from ..verify.checks import DIRECTION_RE
-from .lexicon import EXTRA_DIRECTIONS, KINDS, NUMBER, NUMERIC
+from xairl.explanations.explanation import Explanation
+from xairl.facts import DomainFacts, decision_facts, global_facts
+from xairl.narrators.provenance.lexicon import EXTRA_DIRECTIONS, KINDS, NUMBER, NUMERIC
+from xairl.narrators.verify import Claim
+from xairl.narrators.verify.checks import DIRECTION_RE
+from xairl.policies.policy import Policy
+from xairl.templates.tracking import Span
 
 
 @dataclass

@@ -7,9 +7,7 @@ import re
 
 import numpy as np
 
-from ..verify import Claim
-from ..verify.checks import DIRECTION_RE
-from .lexicon import (
+from xairl.narrators.provenance.lexicon import (
     CHANGE_NEXT,
     CHOSEN_SIDE,
     EXTRA_DIRECTIONS,
@@ -25,8 +23,10 @@ from .lexicon import (
     SIGNED_CONTEXT,
     SUPERLATIVE,
 )
-from .parts import Part
-from .truth import view_of
+from xairl.narrators.provenance.parts import Part
+from xairl.narrators.provenance.truth import view_of
+from xairl.narrators.verify import Claim
+from xairl.narrators.verify.checks import DIRECTION_RE
 
 
 class WordRules:

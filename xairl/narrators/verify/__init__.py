@@ -35,19 +35,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InputError
-from ...explanation import Explanation
-from ...policy import Policy
-from ...prompts import bidi_controls
-from ...regions import in_regions
-from ...windows import window_of
-from . import binding, checks, clauses, directions, parse, quantities, regions, reread, sums
-from .book import FactBook, add_facts, clean_surface, fact_book
-from .checks import CHECKED, Claim
-from .names import Mention, find_mentions, named_features
-from .numbers import NUMBER_RE, find_numbers, matches, normalise, unit_in_name
-from .vocabulary import split_words, vocabulary
-from .window import add_window_facts, per_signal
+from xairl.errors import InputError
+from xairl.explanations.explanation import Explanation
+from xairl.narrators.verify import binding, checks, clauses, directions, parse, quantities, regions, reread, sums
+from xairl.narrators.verify.book import FactBook, add_facts, clean_surface, fact_book
+from xairl.narrators.verify.checks import CHECKED, Claim
+from xairl.narrators.verify.names import Mention, find_mentions, named_features
+from xairl.narrators.verify.numbers import NUMBER_RE, find_numbers, matches, normalise, unit_in_name
+from xairl.narrators.verify.vocabulary import split_words, vocabulary
+from xairl.narrators.verify.window import add_window_facts, per_signal
+from xairl.policies.policy import Policy
+from xairl.policies.regions import in_regions
+from xairl.policies.windows import window_of
+from xairl.templates.prompts import bidi_controls
 
 MIN_COVERAGE = 0.5  # share of sentences that must carry a checked claim for a text to be ok
 #: the rule of a counterfactual sentence's claims (xairl.narrators.provenance.counterfactual): one left unchecked keeps

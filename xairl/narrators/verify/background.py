@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import re
 
-from .book import FactBook
-from .checks import Claim, over_keys
-from .decision import reads_output
-from .numbers import Number, matches
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import Claim, over_keys
+from xairl.narrators.verify.decision import reads_output
+from xairl.narrators.verify.numbers import Number, matches
 
 #: 'the typical borrower of about 48', 'the median home from 1966', 'the dataset average of 0.8', 'the average sale
 #: price of $230,061', 'the baseline of 0.34': a statistic of the background, of a feature or of the output

@@ -9,11 +9,11 @@ import functools
 import re
 from dataclasses import replace
 
-from . import background, checks, decision, quantities, sums
-from .book import FactBook
-from .checks import Claim
-from .numbers import matches
-from .vocabulary import split_words
+from xairl.narrators.verify import background, checks, decision, quantities, sums
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import Claim
+from xairl.narrators.verify.numbers import matches
+from xairl.narrators.verify.vocabulary import split_words
 
 _SCORE_GAP = re.compile(
     r"^\W{0,3}(?:\(|=|:|\s)*(?:(?:q(?:[\s-]*value)?(?:\s*(?:=|:|of))?|scored|scores|score of|"

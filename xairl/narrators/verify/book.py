@@ -8,9 +8,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...explanation import Explanation
-from ...facts import DomainFacts, decision_facts, global_facts, narration_units, unit_ranks
-from ...policy import Policy
+from xairl.explanations.explanation import Explanation
+from xairl.facts import DomainFacts, decision_facts, global_facts, narration_units, unit_ranks
+from xairl.policies.policy import Policy
 
 _CLAIMY = re.compile(
     r"[+\-\u2212]\d|\d\.\d|%|\b(toward|towards|against|raises|lowers|increases|decreases|pushes|"
@@ -47,7 +47,7 @@ class FeatureFacts:
     quartiles: tuple[float, float, float] | None = None  # the background's 25th, 50th and 75th percentiles
     legend: dict[int, str] = field(default_factory=dict)  # code -> its meaning, from the description's legend
     identifier: bool = False  # an id (kind 'identifier'): its number is its value
-    change: float | None = None  # a window's signal: its newest value minus its oldest (xairl.windows)
+    change: float | None = None  # a window's signal: its newest value minus its oldest (xairl.policies.windows)
 
 
 @dataclass

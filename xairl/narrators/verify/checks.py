@@ -9,10 +9,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .book import FactBook
-from .lexicon import CLOSED_CLASSES
-from .names import Mention
-from .vocabulary import split_words, stem
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.lexicon import CLOSED_CLASSES
+from xairl.narrators.verify.names import Mention
+from xairl.narrators.verify.vocabulary import split_words, stem
 
 
 @dataclass(frozen=True)
@@ -28,7 +28,7 @@ class Claim:
     #: (the feature a number was bound to, the feature whose fact it states instead), for a number left unchecked
     #: because it states another feature's fact: two numbers of a text that cross this way are swapped
     crosses: tuple[str, ...] = field(default=(), repr=False, compare=False)
-    #: the tracked span (:class:`xairl.tracking.Span`: where, what fact) of a claim about a value xairl printed
+    #: the tracked span (:class:`xairl.templates.tracking.Span`: where, what fact) of a claim about a value xairl printed
     #: itself; None for a claim the reader made from words
     span: object = field(default=None, repr=False, compare=False)
 

@@ -10,7 +10,7 @@ import functools
 import re
 from dataclasses import replace
 
-from . import (
+from xairl.narrators.verify import (
     background,
     binding,
     checks,
@@ -24,11 +24,11 @@ from . import (
     reread,
     sums,
 )
-from .book import FactBook
-from .checks import Claim
-from .names import Mention, named_features
-from .numbers import find_numbers, matches
-from .vocabulary import split_words, stem
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import Claim
+from xairl.narrators.verify.names import Mention, named_features
+from xairl.narrators.verify.numbers import find_numbers, matches
+from xairl.narrators.verify.vocabulary import split_words, stem
 
 #: the numbers of one clause that are read (the rest: unchecked, 'number.too-many')
 MAX_NUMBERS = 40

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import re
 
-from .book import FactBook
-from .checks import EITHER, Claim, over_keys
-from .lexicon import RATIO_HEDGE
-from .names import Mention, named_features
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import EITHER, Claim, over_keys
+from xairl.narrators.verify.lexicon import RATIO_HEDGE
+from xairl.narrators.verify.names import Mention, named_features
 
 #: 'A mattered more than B', 'a bigger effect on the margin than B', 'lowers the risk less than B does', 'A outweighs
 #: B', 'cuts it by about as much as B adds': how large |contribution| is beside another feature's

@@ -8,10 +8,10 @@ from __future__ import annotations
 import math
 import re
 
-from . import quantities
-from .book import FactBook
-from .checks import Claim
-from .numbers import Number, matches, percent_reading
+from xairl.narrators.verify import quantities
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import Claim
+from xairl.narrators.verify.numbers import Number, matches, percent_reading
 
 MARGIN_BEFORE = re.compile(
     r"\b(margin|lead|edge|gap|advantage|difference)(?: of)?\W*(?:about|around|roughly|only|"

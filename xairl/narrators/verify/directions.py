@@ -8,15 +8,15 @@ import functools
 import re
 from dataclasses import replace
 
-from . import checks
-from .book import FactBook
-from .checks import Claim
-from .lexicon import GENERIC
-from .names import Mention, named_features
-from .numbers import find_numbers, matches
-from .parse import said_of, same_clause
-from .ranks import NOUN
-from .vocabulary import split_words, stem
+from xairl.narrators.verify import checks
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import Claim
+from xairl.narrators.verify.lexicon import GENERIC
+from xairl.narrators.verify.names import Mention, named_features
+from xairl.narrators.verify.numbers import find_numbers, matches
+from xairl.narrators.verify.parse import said_of, same_clause
+from xairl.narrators.verify.ranks import NOUN
+from xairl.narrators.verify.vocabulary import split_words, stem
 
 _GENERIC_SUBJECT = re.compile(
     r"^\W*(?:[qa]\s*:\s*)?(?:and\s+|but\s+|also\s+|so\s+)?(?:(?:nearly|almost|virtually|"

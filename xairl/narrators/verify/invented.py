@@ -9,14 +9,14 @@ from __future__ import annotations
 
 import re
 
-from . import checks, sums
-from .book import FactBook
-from .checks import Claim
-from .lexicon import GENERIC, STOP, UNIT_PARTS
-from .names import Mention
-from .numbers import matches
-from .quantities import CONTRIB_BEFORE
-from .vocabulary import split_words, stem
+from xairl.narrators.verify import checks, sums
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import Claim
+from xairl.narrators.verify.lexicon import GENERIC, STOP, UNIT_PARTS
+from xairl.narrators.verify.names import Mention
+from xairl.narrators.verify.numbers import matches
+from xairl.narrators.verify.quantities import CONTRIB_BEFORE
+from xairl.narrators.verify.vocabulary import split_words, stem
 
 #: identifiers: snake_case ('wind_speed'), camelCase ('windSpeed'), a name and its index ('obs[7]', 'sensor_data[2,3]')
 _INDEX = r"\[\s*[+\-]?\d+(?:\s*,\s*[+\-]?\d+)*\s*\]"

@@ -15,8 +15,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from ...region_names import REGION_RE
-from .vocabulary import Vocabulary, region_key, split_words
+from xairl.narrators.verify.vocabulary import Vocabulary, region_key, split_words
+from xairl.policies.region_names import REGION_RE
 
 
 @dataclass(frozen=True)

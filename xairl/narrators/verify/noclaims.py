@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import re
 
-from .lexicon import RATIO_HEDGE
-from .numbers import Number
+from xairl.narrators.verify.lexicon import RATIO_HEDGE
+from xairl.narrators.verify.numbers import Number
 
 _SKIP_AFTER = re.compile(
     r"^\s*(?:(?:background|samples?|rows?|states?|draws|features|narratives|coalitions|"

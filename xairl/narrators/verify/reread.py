@@ -7,13 +7,13 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
-from . import decision, quantities
-from .binding import GUESSED
-from .book import FactBook
-from .checks import EITHER, Claim
-from .numbers import find_numbers, matches
-from .parse import quantified, same_clause
-from .vocabulary import split_words, stem
+from xairl.narrators.verify import decision, quantities
+from xairl.narrators.verify.binding import GUESSED
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import EITHER, Claim
+from xairl.narrators.verify.numbers import find_numbers, matches
+from xairl.narrators.verify.parse import quantified, same_clause
+from xairl.narrators.verify.vocabulary import split_words, stem
 
 
 def read_again(

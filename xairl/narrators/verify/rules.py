@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...explanation import Explanation
+from xairl.explanations.explanation import Explanation
 
 
 @dataclass(frozen=True)

@@ -7,9 +7,9 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
-from .book import FactBook
-from .checks import EITHER, Claim
-from .numbers import Number, matches, percent_reading
+from xairl.narrators.verify.book import FactBook
+from xairl.narrators.verify.checks import EITHER, Claim
+from xairl.narrators.verify.numbers import Number, matches, percent_reading
 
 #: words that say a number sums over the features: 'the positives add up to', 'total absolute attribution',
 #: 'sum_shap=', 'net', 'n_features='

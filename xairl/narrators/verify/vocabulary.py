@@ -9,13 +9,13 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from ...explanation import Explanation
-from ...policy import Policy
-from ...region_names import REGION_RE
-from .book import legend
-from .lexicon import ABBREVIATIONS, GENERIC, SPAN, STOP, SYNONYMS, UNIT_PARTS
-from .lexicon import BASE_FORM as _BASE_FORM
-from .lexicon import IRREGULAR as _IRREGULAR
+from xairl.explanations.explanation import Explanation
+from xairl.narrators.verify.book import legend
+from xairl.narrators.verify.lexicon import ABBREVIATIONS, GENERIC, SPAN, STOP, SYNONYMS, UNIT_PARTS
+from xairl.narrators.verify.lexicon import BASE_FORM as _BASE_FORM
+from xairl.narrators.verify.lexicon import IRREGULAR as _IRREGULAR
+from xairl.policies.policy import Policy
+from xairl.policies.region_names import REGION_RE
 
 #: what a model's input describes: a word of a feature's description, never a feature on its own
 _INSTANCES = frozenset(
@@ -180,7 +180,7 @@ def _regions(exp: Explanation) -> dict[str, str]:
 
 
 def region_key(phrase: str) -> str:
-    """A region phrase (:data:`xairl.region_names.REGION_RE`) in one spelling, to look it up: 'The 8×8 patch at rows
+    """A region phrase (:data:`xairl.policies.region_names.REGION_RE`) in one spelling, to look it up: 'The 8×8 patch at rows
     16-23 and columns 40 to 47 in channel 1' -> '8x8 patch at rows 16 to 23 columns 40 to 47 of channel 1'."""
     key = re.sub(r"\s*(?:\bto\b|-|–|\bthrough\b)\s*", " to ", phrase.lower().replace("×", "x").replace(",", " "))
     key = re.sub(r"\b(?:spanning|covering|over)\b", "at", re.sub(r"\bin\b", "of", key))

@@ -1,4 +1,4 @@
-"""A window of observations (:mod:`xairl.windows`) read as it is narrated: per signal, with each signal's newest
+"""A window of observations (:mod:`xairl.policies.windows`) read as it is narrated: per signal, with each signal's newest
 value, its change over the window and the window's span among the numbers a text may cite."""
 
 from __future__ import annotations
@@ -7,11 +7,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...explanation import Explanation
-from ...facts import Comparison, DomainFacts, domain_facts
-from ...policy import Policy
-from ...windows import real_start, said_change, window_of
-from .book import FactBook, FeatureFacts, add_facts
+from xairl.explanations.explanation import Explanation
+from xairl.facts import Comparison, DomainFacts, domain_facts
+from xairl.narrators.verify.book import FactBook, FeatureFacts, add_facts
+from xairl.policies.policy import Policy
+from xairl.policies.windows import real_start, said_change, window_of
 
 
 def per_signal(explanation: Explanation) -> Explanation:
@@ -32,7 +32,7 @@ def per_signal(explanation: Explanation) -> Explanation:
 
 
 def _window_facts(explanation: Explanation, index: int, policy: Policy | None) -> DomainFacts:
-    """Each signal's change over the window as narratives say it (:func:`xairl.windows.said_change`, before its
+    """Each signal's change over the window as narratives say it (:func:`xairl.policies.windows.said_change`, before its
     unit) and the window's span."""
     w, out = explanation.extras["window"], []
     for j, name in enumerate(explanation.feature_names):

@@ -1,0 +1,1 @@
+"""The policy side: what is explained, its observation and outputs."""

@@ -1,0 +1,1 @@
+"""The plugin registry: hook specifications, what the core registers, lookup."""

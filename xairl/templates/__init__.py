@@ -1,0 +1,1 @@
+"""Narration templates: files and lookup, the bounded sandbox, tracked rendering."""
