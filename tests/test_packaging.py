@@ -32,7 +32,7 @@ def test_wheels_install_into_a_fresh_venv_and_run(tmp_path):
     core, plugin = sorted(dist.glob("xairl-*.whl")), sorted(dist.glob("xairl_uav_handover-*.whl"))
     assert len(core) == 1 and len(plugin) == 1, sorted(dist.iterdir())
     names = zipfile.ZipFile(core[0]).namelist()
-    assert "xairl/templates/prompts/explain_action.yaml" in names and not any(n.startswith("tests/") for n in names)
+    assert "xairl/prompts/explain_action.yaml" in names and not any(n.startswith("tests/") for n in names)
     assert any(n.endswith("uav-dqn.safetensors") for n in zipfile.ZipFile(plugin[0]).namelist())
 
     venv = tmp_path / "venv"
