@@ -12,7 +12,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from benchmarks.fuzz_resume import BG, CHUNK, POLICY, STATES, N, make_runs, mutate, one_case, part
+from tests.resume_fuzz import BG, CHUNK, POLICY, STATES, N, make_runs, mutate, one_case, part
 from xairl.cli import explain as explain_cli
 from xairl.cli import main
 from xairl.errors import InputError

@@ -98,3 +98,14 @@ def test_the_architecture_page_names_every_module_and_its_layer():
         for m in modules | set(documented)
         if documented.get(m) != layer_of.get(m)
     }
+
+
+@pytest.mark.parametrize(
+    "path",
+    sorted([*(ROOT / "tests").glob("*.py"), *(PLUGIN / "tests").glob("*.py")]),
+    ids=lambda p: str(p.relative_to(ROOT)),
+)
+def test_tests_import_no_benchmark_script(path):
+    """A benchmark is a script (it may load a peer library, time, print); what a test shares with it lives in a
+    test helper module that the benchmark imports (tests/narrative_corpus.py, tests/resume_fuzz.py, ...)."""
+    assert not {m for m in _imports(path) if m.split(".")[0] == "benchmarks"}
