@@ -233,9 +233,11 @@ def heartbeat(what: str, enabled: bool = True, every: float | None = None, strea
         _LAST[0] = time.monotonic()
         said.append(line)
 
+    poll = max(every / 10, 0.01)
+
     def beat() -> None:
-        while not stop.wait(max(every / 10, 0.01)):
-            if _STEPS and _STEPS[-1] is token and time.monotonic() - _LAST[0] >= every:
+        while not stop.wait(poll):  # said one poll early, so that the silence never runs past ``every``
+            if _STEPS and _STEPS[-1] is token and time.monotonic() - _LAST[0] >= every - poll:
                 say(f"still {what} ({time.monotonic() - t0:.0f} s)" if said else f"{what} ...")
 
     if not _STEPS:  # the silence starts now; the first step is said once it has run for half of ``every``
