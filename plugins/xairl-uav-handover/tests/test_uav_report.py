@@ -7,6 +7,9 @@ import re
 
 import pytest
 
+# every test here reads one report built with the real flights (a session fixture of about a minute)
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def page(real_report) -> str:
