@@ -174,7 +174,7 @@ def explain_on_ray(
         if todo:
             with _unwrapped(ray):
                 ray.data.DataContext.get_current().enable_progress_bars = False
-                done = (
+                chunks = (
                     ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo))
                     .map_batches(
                         _ChunkWorker,
@@ -193,13 +193,13 @@ def explain_on_ray(
                             "threads": 1,
                         },
                     )
-                    .materialize()
                 )
-                rows = done.take_all()
-            for row in rows:  # each part written whole, in run.json: resume keeps it while its bytes match
-                if not row["error"]:
-                    run.done[int(row["first"])] = row["sha256"]
-            run.save()
+                rows = []
+                for row in chunks.iter_rows():  # streamed: each part in run.json as it arrives, so that an
+                    rows.append(row)  # interrupted run resumes from every part it wrote
+                    if not row["error"]:
+                        run.done[int(row["first"])] = row["sha256"]
+                        run.save()
             failed = [row["error"] for row in rows if row["error"]]
             if failed:  # the chunks written so far stay: fix the states and --resume
                 raise InputError(failed[0])
