@@ -37,7 +37,7 @@ if __name__ == "__main__":
     args = ap.parse_args()
     import xairl.registry.plugins
 
-    name = args.policy or ("uav-dqn" if "uav-dqn" in xairl.plugins.registry("policy").names() else "toy")
+    name = args.policy or ("uav-dqn" if "uav-dqn" in xairl.registry.plugins.registry("policy").names() else "toy")
     n = args.states
     base, _ = peak(n, False, name)
     mem, secs = peak(n, True, name)

@@ -25,7 +25,7 @@ def main():
     ap.add_argument("--policy", default=None, help="registered policy (default uav-dqn if installed, else toy)")
     args = ap.parse_args()
     n = args.states
-    name = args.policy or ("uav-dqn" if "uav-dqn" in xairl.plugins.registry("policy").names() else "toy")
+    name = args.policy or ("uav-dqn" if "uav-dqn" in xairl.registry.plugins.registry("policy").names() else "toy")
     p = xairl.get_policy(name)
     bg, x = p.background(50, seed=1), p.background(n, seed=3)
     deep = xairl.explain(p, x, background=bg, method="deep_shap")

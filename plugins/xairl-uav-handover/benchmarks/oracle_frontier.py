@@ -29,7 +29,7 @@ from xairl_uav_handover.baselines import CHM, SAMRO
 from xairl_uav_handover.evaluate import run_flights
 from xairl_uav_handover.memory import controller
 from xairl_uav_handover.policy import DQNController, load_checkpoint
-from xairl_uav_handover.report import frontier_figure
+from xairl_uav_handover.report_figures import frontier_figure
 from xairl_uav_handover.table import with_intervals
 
 HORIZONS_S = (0.2, 1.0, 2.0, 5.0)
