@@ -55,7 +55,7 @@ def lazy_attributes(
 ):
     """``__getattr__`` and ``__dir__`` for ``module``, whose names in ``table`` (name -> 'module' or 'module:attr')
     and ``submodules`` are imported on first use and then kept as ordinary attributes; a name in ``renamed`` (old
-    name -> new) raises an AttributeError that names its successor, not a bare one."""
+    name -> new) gives its successor with a FutureWarning that names it."""
     names = sorted([*table, *submodules])
 
     def __getattr__(name: str):
@@ -64,11 +64,17 @@ def lazy_attributes(
         elif name in table:
             source, _, attr = table[name].partition(":")
             value = getattr(importlib.import_module(source), attr or name)
-        elif name in (renamed or {}):
-            raise AttributeError(
-                f"module '{module}' has no attribute '{name}': it was renamed {module}.{renamed[name]}, which takes "
-                "the same arguments"
+        elif name in (renamed or {}):  # an old script runs on, told the new name (an error would be lost to
+            # ``from xairl import OldName``, which Python turns into a bare ImportError)
+            import warnings
+
+            warnings.warn(
+                f"{module}.{name} was renamed {module}.{renamed[name]}, which takes the same arguments; the old name "
+                "will go",
+                FutureWarning,
+                stacklevel=2,
             )
+            return __getattr__(renamed[name])
         else:
             raise AttributeError(f"module '{module}' has no attribute '{name}'")
         setattr(sys.modules[module], name, value)
