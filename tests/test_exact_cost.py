@@ -205,10 +205,12 @@ def test_a_cost_of_counts_that_are_no_counts_is_refused(n_states, n_background):
 
 @pytest.mark.parametrize("options", [{"max_evaluations": True}, {"max_evaluations": 2.5}, {"max_rows": False}])
 def test_exact_options_are_whole_numbers_not_bools(options):
-    """Was: max_evaluations: True read as 1 (and refused every run with a limit nobody set)."""
-    with pytest.raises(InputError, match="valid integer"):
+    """Was: max_evaluations: True read as 1 (and refused every run with a limit nobody set). A whole number written
+    as a float, a numpy integer or '2e7' on the command line is still a count."""
+    with pytest.raises(InputError, match="a count is a whole number"):
         Exact(options)
-    assert Exact({"max_evaluations": 10**9}).options.max_evaluations == 10**9
+    for count in (10**9, 1e9, np.int64(10**9), "1e9"):
+        assert Exact({"max_evaluations": count}).options.max_evaluations == 10**9
 
 
 def test_exact_is_recommended_first_where_it_is_cheaper_than_kernel_shap():

@@ -14,7 +14,7 @@ from math import factorial
 
 import numpy as np
 import torch
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from xairl.attributors.base import EXACT_MAX_FEATURES as MAX_FEATURES
 from xairl.attributors.base import Attributor, Options
@@ -27,17 +27,14 @@ MAX_EVALUATIONS = 2**24
 
 
 class ExactOptions(Options):
-    # strict: True is no count, and 2.5 rows no whole number (lax pydantic reads True as 1)
     max_rows: int = Field(
         8_192,
         ge=1,
-        strict=True,
         description="rows per forward batch; bounds memory (8,192: the fastest measured on a CPU)",
     )
     max_evaluations: int = Field(
         MAX_EVALUATIONS,
         ge=1,
-        strict=True,
         description=(
             "refuse above this many network evaluations (states x 2^F coalitions x background rows) before running; "
             "the default 2^24 takes about 40 s on one CPU core for a 64-unit GRU over 4 steps, 20 s for a "
@@ -51,6 +48,24 @@ class ExactOptions(Options):
             "stderr every 10 s (a log, a pipe)"
         ),
     )
+
+    @field_validator("max_rows", "max_evaluations", mode="before")
+    @classmethod
+    def _a_whole_count(cls, v):
+        """A count is a whole number however it is written (100000, 1e9, numpy's int64, '2e7' on the command line);
+        True is no count (lax pydantic would read it as 1) and 2.5 rows no whole number."""
+        if isinstance(v, (bool, np.bool_)):
+            raise ValueError("a count is a whole number, not true or false")
+        if isinstance(v, str):
+            try:
+                v = float(v.strip())
+            except ValueError:
+                return v  # pydantic names what it is not
+        if isinstance(v, (float, np.floating, np.integer)):
+            if not np.isfinite(v) or not float(v).is_integer():
+                raise ValueError(f"a count is a whole number, not {v}")
+            return int(v)
+        return v
 
 
 @dataclass(frozen=True)
