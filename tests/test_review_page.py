@@ -235,3 +235,28 @@ def test_review_in_headless_chromium(store, tmp_path):
     got = {r.id: (r.status, r.correction) for r in store.records()}
     assert got == {int(first): ("accepted", None), int(second): ("corrected", "The policy turned: the goal was close.")}
     assert (tmp_path / "review.png").stat().st_size > 10_000
+
+
+def test_each_refusal_is_said_for_what_it_is(store, serve):
+    """A correction of a narrative that does not exist says so (was: 'a correction needs its text'); a correction
+    without text says that."""
+    import http.client
+
+    port = serve()
+    token = _token(port)
+    ids = [r.id for r in store.records()]
+
+    def location(form):
+        conn = http.client.HTTPConnection("127.0.0.1", port, timeout=5)
+        conn.request("POST", "/review", form, {"Content-Type": "application/x-www-form-urlencoded"})
+        res = conn.getresponse()
+        conn.close()
+        return res.status, res.getheader("Location")
+
+    unknown = max(ids) + 10
+    assert location(f"id={unknown}&status=corrected&correction=It+turned.&token={token}") == (
+        303,
+        f"/?msg=unknown-id&id={unknown}",
+    )
+    assert location(f"id={ids[0]}&status=corrected&correction=&token={token}") == (303, f"/?msg=no-text&id={ids[0]}")
+    assert _statuses(store) == [("pending", None)] * 2

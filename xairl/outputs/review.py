@@ -261,7 +261,7 @@ class _Handler(BaseHTTPRequestHandler):
             self.server.store.review(int(form["id"]), status, correction)
             code = status
         except (InputError, ValueError):
-            code = "bad-status" if status not in STATUSES else "no-text" if status == "corrected" else "unknown-id"
+            code = "bad-status" if status not in STATUSES else "no-text" if correction == "" else "unknown-id"
         self._send(HTTPStatus.SEE_OTHER, location="/?" + urlencode({"msg": code, "id": form["id"]}))
 
     def log_message(self, *args):  # quiet (log_error too): the terminal shows only the address
