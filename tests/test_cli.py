@@ -239,3 +239,13 @@ def test_verify_reads_the_records_that_explain_out_writes(report_dir, capsys):
     one_line_error(rc, err, "holds 3 records", "--index 0..2")
     rc, _, err = run(capsys, "verify", said, "--explanation", path, "--index", "3")
     one_line_error(rc, err, "--index 3", "holds 3 record(s)")
+
+
+def test_verify_names_a_file_of_narratives_for_what_it_is(tmp_path, capsys):
+    """explain --narrate --format jsonl writes narratives, not explanations: verify says so (was: 'the explanation is
+    not valid JSON (Extra data: line 2 ...)')."""
+    rc, out, _ = run(capsys, "explain", "--policy", "toy", "--n", "2", "--format", "jsonl", "--narrate", "--no-record")
+    assert rc == 0
+    (tmp_path / "o.jsonl").write_text(out)
+    rc, _, err = run(capsys, "verify", "x", "--explanation", str(tmp_path / "o.jsonl"), "--index", "0")
+    one_line_error(rc, err, "holds narratives", "explanations.jsonl")

@@ -29,6 +29,11 @@ def read_explanation(path: str, index: int | None) -> tuple[Explanation, int]:
     lines = [line for line in raw.splitlines() if line.strip()]
     if lines and _is_record(lines[0]):
         return _from_records(path, lines, index), 0
+    if lines and _is_narrative(lines[0]):
+        raise InputError(
+            f"--explanation {path} holds narratives (xairl explain --narrate's lines), not explanations; give the "
+            "explanations.jsonl that xairl explain --out writes, or explain again without --narrate."
+        )
     try:
         exp = Explanation.from_json(raw)
     except InputError as exc:
@@ -47,6 +52,14 @@ def _is_record(line: bytes) -> bool:
     except (ValueError, RecursionError):
         return False
     return isinstance(first, dict) and _RECORD_KEYS <= first.keys() and isinstance(first["values"], dict)
+
+
+def _is_narrative(line: bytes) -> bool:
+    try:
+        first = json.loads(line)
+    except (ValueError, RecursionError):
+        return False
+    return isinstance(first, dict) and {"text", "verified"} <= first.keys()
 
 
 def _from_records(path: str, lines: list[bytes], index: int | None) -> Explanation:
