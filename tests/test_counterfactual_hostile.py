@@ -119,6 +119,13 @@ def test_the_cli_refuses_counterfactuals_it_would_not_search(capsys, tmp_path):
         rc, _, err = run(capsys, "explain", "--n", "2", *fmt, "--counterfactual-target", "jump")
         one_line_error(rc, err, "action 'jump' is unknown")
     assert not (tmp_path / "r" / "report.html").exists()
+    # --counterfactual-past alone turns the search on (was: silently ignored), and is refused with Parquet too
+    rc, out, _ = run(capsys, "explain", "--n", "2", "--counterfactual-past")
+    assert rc == 0 and "what would have changed it" in out, out
+    rc, _, err = run(
+        capsys, "explain", "--n", "2", "--format", "parquet", "--out", str(tmp_path / "s"), "--counterfactual-past"
+    )
+    one_line_error(rc, err, "--counterfactual", "Parquet")
 
 
 def test_a_small_image_takes_the_regions_path():

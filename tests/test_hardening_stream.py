@@ -39,7 +39,7 @@ def test_resume_fuzz_ends_in_every_state_exactly_once_or_a_refusal_naming_the_pa
     """Bit flips, truncation, short parts, deletions, swapped names, stray and foreign parts, one to three at a time
     (and run.json made no record in one case in ten): each resume ends with every state exactly once and the values
     of an undamaged run, or in one line naming a file that is no part of this run, and deleting that file and resuming
-    again ends whole; damage alone is never refused (the checks are in benchmarks/fuzz_resume.one_case)."""
+    again ends whole; damage alone is never refused (the checks are in tests/resume_fuzz.one_case)."""
     monkeypatch.setattr(os, "fsync", lambda fd: None)  # durability is not what is tested here; fsync was half the time
     root, reference, run = runs
     rng = random.Random(51)
@@ -123,7 +123,7 @@ def test_a_run_json_that_is_no_record_is_refused_in_one_line(tmp_path, capsys, r
     assert main(argv + ["--resume"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "run.json: not the record of a run" in err and "delete it" in err
-    (tmp_path / "r" / "run.json").unlink()  # as the line says: the parts are checked against the run, and kept
+    (tmp_path / "r" / "run.json").unlink()  # as the line says: with no record of their bytes, the parts are explained again
     assert main(argv + ["--resume"]) == 0
     assert json.loads((tmp_path / "r" / "run.json").read_text())["chunk_size"] == 10
 

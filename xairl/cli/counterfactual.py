@@ -41,10 +41,10 @@ def counterfactual_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def asked(args, policy) -> bool:
-    """Whether --counterfactual (or --counterfactual-target alone) was given, its target checked against the policy's
+    """Whether --counterfactual (or --counterfactual-target or --counterfactual-past alone) was given, its target checked against the policy's
     actions before any state is explained, in every format (one line naming the known actions); and refused with
     --format parquet, whose chunks are streamed to disk without a search."""
-    if not (args.counterfactual or args.counterfactual_target is not None):
+    if not _on(args):
         return False
     target = _target(args, policy)
     if target is not None and target != "any":
@@ -59,6 +59,12 @@ def asked(args, policy) -> bool:
     return True
 
 
+def _on(args) -> bool:
+    """--counterfactual, or one of its own options alone (--counterfactual-target, --counterfactual-past), turns the
+    search on: an option of the search is never silently ignored."""
+    return bool(args.counterfactual or args.counterfactual_target is not None or args.counterfactual_past)
+
+
 def _target(args, policy):
     """The search's target of ``--counterfactual-target``: None (the runner-up), 'any', an action's name or index."""
     target = args.counterfactual_target
@@ -71,7 +77,7 @@ def _target(args, policy):
 def search(args, policy, exp, background):
     """Each decision's :class:`xairl.Counterfactuals` (a tuple), or None without ``--counterfactual`` (the target
     alone turns it on)."""
-    if not (args.counterfactual or args.counterfactual_target is not None):
+    if not _on(args):
         return None
     if exp.output != "actions":
         raise InputError(
