@@ -123,7 +123,8 @@ def test_a_run_json_that_is_no_record_is_refused_in_one_line(tmp_path, capsys, r
     assert main(argv + ["--resume"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "run.json: not the record of a run" in err and "delete it" in err
-    (tmp_path / "r" / "run.json").unlink()  # as the line says: with no record of their bytes, the parts are explained again
+    # as the line says: with no record of their bytes, the parts are explained again
+    (tmp_path / "r" / "run.json").unlink()
     assert main(argv + ["--resume"]) == 0
     assert json.loads((tmp_path / "r" / "run.json").read_text())["chunk_size"] == 10
 

@@ -174,25 +174,22 @@ def explain_on_ray(
         if todo:
             with _unwrapped(ray):
                 ray.data.DataContext.get_current().enable_progress_bars = False
-                chunks = (
-                    ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo))
-                    .map_batches(
-                        _ChunkWorker,
-                        batch_size=1,
-                        num_cpus=1,
-                        compute=ray.data.ActorPoolStrategy(size=_usable(ray, workers)),
-                        fn_constructor_kwargs={
-                            "policy": policy,
-                            "states": ref,
-                            "background": run.background,
-                            "method": method,
-                            "options": run.options,
-                            "chunk_size": chunk_size,
-                            "parts": str(run.parts),
-                            "meta": run.meta,
-                            "threads": 1,
-                        },
-                    )
+                chunks = ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo)).map_batches(
+                    _ChunkWorker,
+                    batch_size=1,
+                    num_cpus=1,
+                    compute=ray.data.ActorPoolStrategy(size=_usable(ray, workers)),
+                    fn_constructor_kwargs={
+                        "policy": policy,
+                        "states": ref,
+                        "background": run.background,
+                        "method": method,
+                        "options": run.options,
+                        "chunk_size": chunk_size,
+                        "parts": str(run.parts),
+                        "meta": run.meta,
+                        "threads": 1,
+                    },
                 )
                 rows = []
                 for row in chunks.iter_rows():  # streamed: each part in run.json as it arrives, so that an
