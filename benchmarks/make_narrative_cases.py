@@ -6,7 +6,7 @@ credit-default classifier explained with exact Shapley values against 100 backgr
 Cases 0-3 of each domain are the dev split, 4-7 the test split; the split was fixed before any narrative was
 written or any verifier change was made. Run once; the corpus refers to the stored numbers, not to a re-run.
 
-    .venv/bin/python benchmarks/make_narrative_cases.py
+    .venv/bin/python benchmarks/make_narrative_cases.py --write
     .venv/bin/python benchmarks/make_narrative_cases.py --stay-cases   # voices/dev-qa-shorthand-lists/cases.json: two UAV 'stay' dev cases
 """
 
@@ -71,6 +71,11 @@ def _dev2_cases() -> list[dict]:
 
 def main() -> None:
     torch.set_num_threads(1)
+    if not {"--write", "--stay-cases"} & set(sys.argv[1:]):  # the corpus is frozen: never rewritten by accident
+        sys.exit(
+            f"{OUT} is the frozen corpus the narratives speak of; --write rewrites it, --stay-cases writes the two "
+            "UAV 'stay' cases (--help is this line)"
+        )
     if "--stay-cases" in sys.argv:  # added after the freeze: new dev cases only, cases.json is left as it is
         out = OUT.parent / "voices" / "dev-qa-shorthand-lists" / "cases.json"
         out.write_text(json.dumps(_dev2_cases(), indent=1) + "\n")
