@@ -21,7 +21,8 @@ def only_this_plugin(monkeypatch):
 @pytest.fixture(scope="session")
 def real_report(tmp_path_factory) -> tuple[Path, Path]:
     """(report folder, real-flights folder): two UKM flights with the Baltaci events beside them, few simulated
-    flights (Table I's SA-MRO then never updates: its columns equal CHM's), narrated without robustness."""
+    flights (Table I's SA-MRO then never updates: its columns equal CHM's) and 16 calibration flights, narrated
+    without robustness."""
     from xairl.cli import main
 
     if not UKM.is_dir():
@@ -35,7 +36,7 @@ def real_report(tmp_path_factory) -> tuple[Path, Path]:
         shutil.copytree(BALTACI, root / "data" / "baltaci-imc22-handovers")
     out = root / "rep"
     argv = ["report", "--plugin", "uav-handover", "--n", "30", "-o", f"real={real}", "-o", "flights=4"]
-    argv += ["-o", "timelines=0", "--narrate", "--no-robustness", "--out", str(out)]
+    argv += ["-o", "timelines=0", "-o", "calibration_flights=16", "--narrate", "--no-robustness", "--out", str(out)]
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv(plugins.LOAD_ENV, "uav-handover")
         assert main(argv) == 0

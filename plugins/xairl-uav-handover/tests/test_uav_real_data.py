@@ -199,18 +199,6 @@ def test_report_without_real_data(sim_report):
 
 
 @pytest.mark.slow
-@needs_data
-def test_report_with_real_data(real_report):
-    out, _ = real_report
-    html = (out / "report.html").read_text()
-    assert "Calibration: handovers per minute by altitude band (2 real flights" in html and "Baltaci" in html
-    assert "Open-loop agreement with the live network" in html and "Spearman rank correlation real vs simulated" in html
-    assert "finding (buffer first, position second)" in html
-    datasets = {json.loads(x)["dataset"] for x in (out / "explanations.jsonl").read_text().splitlines()}
-    assert datasets == {"simulated", "real"}
-
-
-@pytest.mark.slow
 @pytest.mark.skipif(not shutil.which("chromium"), reason="chromium is not installed")
 def test_report_renders_in_headless_chromium(sim_report, tmp_path):
     import subprocess

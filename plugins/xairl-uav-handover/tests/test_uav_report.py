@@ -3,6 +3,7 @@ have units, an identifier gets no percentiles, every column a label, no local pa
 reason where SA-MRO's figures equal CHM's, and the main findings first. All read one report (``real_report``)."""
 
 import html as htmllib
+import json
 import re
 
 import pytest
@@ -100,3 +101,14 @@ def test_the_main_finding_comes_first_with_contents(page):
     toc = page[page.index("<nav class=toc>") : page.index("</nav>")]
     for heading in ("Table I", "Calibration", "Open-loop agreement", "Narrated decisions", "Notes"):
         assert f">{heading}" in toc, heading
+
+
+def test_report_with_real_data(real_report):
+    """Its sections with the real flights, and both datasets explained (in this file: the one report built once)."""
+    out, _ = real_report
+    html = (out / "report.html").read_text()
+    assert "Calibration: handovers per minute by altitude band (2 real flights" in html and "Baltaci" in html
+    assert "Open-loop agreement with the live network" in html and "Spearman rank correlation real vs simulated" in html
+    assert "finding (buffer first, position second)" in html
+    datasets = {json.loads(x)["dataset"] for x in (out / "explanations.jsonl").read_text().splitlines()}
+    assert datasets == {"simulated", "real"}

@@ -37,6 +37,13 @@ class UAVReportOptions(xairl.plugin.Options):
         "downloaded once; skipped with a note when they cannot be had)",
     )
     flights: int = Field(100, ge=1, le=10_000, description="held-out simulated flights for Table I")
+    calibration_flights: int = Field(
+        256,
+        ge=8,
+        le=10_000,
+        description="simulated flights the real ones are compared with: the reference states (x1) and the handover "
+        "rate at each altitude of the figure (5/32 of them, 40 by default); fewer make a quick, rougher report",
+    )
     timelines: int = Field(
         2,
         ge=0,
@@ -229,17 +236,18 @@ class UAVReport(xairl.plugin.Report):
             seen = states
         pick = np.random.default_rng(req.seed).choice(len(states), size=min(req.n_states, len(states)), replace=False)
         content.datasets.append(("real", seen[np.sort(pick)]))
+        n_ref = self.options.calibration_flights
         step = xairl.plugin.heartbeat(
-            "simulating 256 flights: the states the real ones are compared with", req.progress
+            f"simulating {n_ref} flights: the states the real ones are compared with", req.progress
         )
         with step:
             if memory_of(ckpt.meta):  # the newest step, times included, against the greedy DQN's own states: a time
                 # on the cell grows as the DQN stays, so only its own decisions compare like with like
                 names, states = SIGNALS, seen[:, -len(SIGNALS) :]
-                sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, n_flights=256)[:, -len(SIGNALS) :]
+                sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, n_flights=n_ref)[:, -len(SIGNALS) :]
             else:  # the mix of exploration and greedy steps that training sees
                 names = FEATURES
-                sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=256)
+                sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=n_ref)
         with xairl.plugin.heartbeat("simulating handovers per altitude band (calibration)", req.progress):
             bands = band_rows(flights, chm_real, cfg, req.seed, n_flights=8, duration_s=30.0)
         mro: dict = {}  # what SA-MRO's network counted and did on the real samples
@@ -274,7 +282,9 @@ class UAVReport(xairl.plugin.Report):
             content.notes.append(same_as_chm(mro, f"the {len(flights)} real flights' samples", SAMROConfig(), why))
         content.notes += [f"skipped file: {b.replace(str(real), shown_path(real))}" for b in bad] + REAL_NOTES
         with xairl.plugin.heartbeat("simulating handovers by altitude (the figure)", req.progress):
-            content.figures.append(altitude_figure(req.out, str(real), cfg, flights, chm_real, req.seed))
+            content.figures.append(
+                altitude_figure(req.out, str(real), cfg, flights, chm_real, req.seed, max(8, n_ref * 5 // 32))
+            )
         return flights
 
 

@@ -37,7 +37,9 @@ def frontier_section(path: str, out) -> tuple[str, Path]:
     return caption, Path(frontier_figure(data, Path(out) / "frontier.png"))
 
 
-def altitude_figure(out: Path, real: str, cfg, flights, chm_real: list[int], seed: int) -> tuple[str, Path]:
+def altitude_figure(
+    out: Path, real: str, cfg, flights, chm_real: list[int], seed: int, n_flights: int = 40
+) -> tuple[str, Path]:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -47,7 +49,12 @@ def altitude_figure(out: Path, real: str, cfg, flights, chm_real: list[int], see
 
     alts = np.arange(20, 161, 20)
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
-    ax.plot(alts, chm_rate_by_altitude(alts, cfg, seed=seed), "o-", label="simulator, CHM (A3 2 dB / 160 ms)")
+    ax.plot(
+        alts,
+        chm_rate_by_altitude(alts, cfg, n_flights=n_flights, seed=seed),
+        "o-",
+        label="simulator, CHM (A3 2 dB / 160 ms)",
+    )
     long = [(f, n) for f, n in zip(flights, chm_real) if f.t[-1] > 60]
     ax.plot(
         [f.altitude_m for f, _ in long], [n / (f.t[-1] / 60) for f, n in long], "x", label="CHM on the UKM measurements"
