@@ -247,6 +247,27 @@ def version_line() -> str:
     return f"xairl {own}" + (f" (plugins: {', '.join(extra)})" if extra else "")
 
 
+def _verify_parser(p: argparse.ArgumentParser) -> None:
+    """``xairl verify``'s arguments."""
+    p.add_argument("text", help="the text to check, or - to read it from standard input")
+    p.add_argument(
+        "--explanation",
+        required=True,
+        metavar="FILE",
+        help="the explanation: the JSON Explanation.to_json() writes, or the explanations.jsonl of "
+        "xairl explain --out (or its --format jsonl lines)",
+    )
+    p.add_argument(
+        "--index",
+        type=count(0),
+        default=None,
+        help="which state the text is about: of an explanation (default 0), or which record (line) of a JSON-lines "
+        "file, from 0 (needed when it holds more than one)",
+    )
+    p.add_argument("--trace", action="store_true", help="every claim: status, kind, words, rule, reason")
+    p.set_defaults(run=cmd_verify)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(
         prog="xairl",
@@ -271,24 +292,9 @@ def build_parser() -> argparse.ArgumentParser:
         "-v", "--verbose", action="store_true", help="check: say how many cases the battery rendered, and in what time"
     )
     p.set_defaults(run=cmd_prompts)
-    p = _command(sub, "verify", help="check a text's claims against an explanation (exit 1 when one is contradicted)")
-    p.add_argument("text", help="the text to check, or - to read it from standard input")
-    p.add_argument(
-        "--explanation",
-        required=True,
-        metavar="FILE",
-        help="the explanation: the JSON Explanation.to_json() writes, or the explanations.jsonl of "
-        "xairl explain --out (or its --format jsonl lines)",
+    _verify_parser(
+        _command(sub, "verify", help="check a text's claims against an explanation (exit 1 when one is contradicted)")
     )
-    p.add_argument(
-        "--index",
-        type=count(0),
-        default=None,
-        help="which state the text is about: of an explanation (default 0), or which record (line) of a JSON-lines "
-        "file, from 0 (needed when it holds more than one)",
-    )
-    p.add_argument("--trace", action="store_true", help="every claim: status, kind, words, rule, reason")
-    p.set_defaults(run=cmd_verify)
     p = _command(
         sub,
         "review",

@@ -232,35 +232,15 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
 
     :param explained: explanations already computed, by dataset label (the others are explained here).
     """
-    from xairl.attributors import explain
-    from xairl.explanations.display import heartbeat, progress
+    from xairl.explanations.display import heartbeat
 
     t0 = time.time()
     out = Path(req.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "report.html").unlink(missing_ok=True)  # a failed re-run must not leave the last run's report beside it
-    exps: list[tuple[str, Explanation]] = []
-    explained = explained or {}
-    bar = progress(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress)
-    for label, states in bar:  # a bar of a few steps: a long one also said every 10 s
-        with heartbeat(
-            f"explaining ({req.method}) {len(states)} {label} states", req.progress and label not in explained
-        ):
-            exps.append(
-                (
-                    label,
-                    explained.get(label)
-                    or explain(
-                        content.policy, states, background=content.background, method=req.method, options=req.options
-                    ),
-                )
-            )
+    exps = _explain_datasets(req, content, explained or {})
     if req.records:
-        with atomic_write(out / "explanations.jsonl") as fh:
-            for label, exp in exps:
-                for rec in exp.records(dataset=label):
-                    fh.write(rec.model_dump_json() + "\n")
-        write_text(out / "explanations.schema.json", json.dumps(StateRecord.model_json_schema(), indent=2))
+        _write_records(out, exps)
     ref = exps[0][1]
     pick = _interesting(ref)
     with heartbeat("drawing the figures", req.progress):
@@ -305,6 +285,32 @@ def write_report(req: ReportRequest, content: ReportContent, explained: dict[str
         ),
     )
     return path
+
+
+def _explain_datasets(req: ReportRequest, content: ReportContent, explained: dict) -> list[tuple[str, Explanation]]:
+    """(label, explanation) of each dataset: the ones in ``explained`` as given, the others explained here."""
+    from xairl.attributors import explain
+    from xairl.explanations.display import heartbeat, progress
+
+    exps = []
+    bar = progress(content.datasets, desc=f"explaining ({req.method})", disable=not req.progress)
+    for label, states in bar:  # a bar of a few steps: a long one also said every 10 s
+        said = req.progress and label not in explained
+        with heartbeat(f"explaining ({req.method}) {len(states)} {label} states", said):
+            exp = explained.get(label) or explain(
+                content.policy, states, background=content.background, method=req.method, options=req.options
+            )
+        exps.append((label, exp))
+    return exps
+
+
+def _write_records(out: Path, exps: list[tuple[str, Explanation]]) -> None:
+    """explanations.jsonl (one StateRecord a state, by dataset) and its JSON schema."""
+    with atomic_write(out / "explanations.jsonl") as fh:
+        for label, exp in exps:
+            for rec in exp.records(dataset=label):
+                fh.write(rec.model_dump_json() + "\n")
+    write_text(out / "explanations.schema.json", json.dumps(StateRecord.model_json_schema(), indent=2))
 
 
 def _narratives(req: ReportRequest, content: ReportContent, ref: Explanation, shown: Explanation, pick: int) -> list:

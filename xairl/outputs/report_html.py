@@ -41,6 +41,43 @@ def _img(path: Path) -> str:
     return "data:image/png;base64," + base64.b64encode(Path(path).read_bytes()).decode()
 
 
+def _figures_body(exps, figures) -> tuple[str, list[tuple[str, str]]]:
+    """The figures section's HTML (each dataset's size and additivity gap, then each figure) and its entries in the
+    contents."""
+    body = (
+        "<p>"
+        + ", ".join(
+            f"{html.escape(label)}: {len(e.values)} states, largest additivity gap {e.additivity_gap.max():.1e}"
+            for label, e in exps
+        )
+        + "</p>"
+    )
+    subs = []
+    for k, (caption, png) in enumerate(figures, 1):
+        body += (
+            f"<figure id=f{k}><img src='{_img(png)}' alt='{html.escape(caption)}'><figcaption>"
+            f"{html.escape(caption)}</figcaption></figure>"
+        )
+        subs.append((f"f{k}", short_heading(caption)))
+    return body, subs
+
+
+def _narratives_body(narratives) -> str:
+    """The narrated decisions' HTML: what the marks mean, then one card a narrative."""
+    body = (
+        "<p class=meta>Each sentence is marked &#10003; verified, &#10007; contradicted or ? unchecked (no "
+        "claim the verifier could check); the waterfall builds the margin of the chosen action over the "
+        "runner-up (the score, when nothing is chosen) from its background average, feature by feature.</p>"
+    )
+    for n, ev in narratives:
+        where = "all states" if n.index is None else f"state {n.index}"
+        meta = f"{where} &middot; template {html.escape(n.template)} &middot; {html.escape(n.source)}" + (
+            "" if n.verified else " &middot; <span class=bad>NOT verified</span>"
+        )
+        body += card_html(n.text, ev, meta)
+    return body
+
+
 def page(title, *, findings, tables, notes, exps, figures, narratives, settings) -> str:
     """The page. ``findings``: the plugin's reading of the explanations (first); ``tables`` (title, HTML) and
     ``figures`` (caption, PNG) pairs; ``narratives`` (narrative, evidence) pairs; ``settings`` a dict."""
@@ -62,35 +99,9 @@ def page(title, *, findings, tables, notes, exps, figures, narratives, settings)
     )
     for heading, table in tables:
         add(heading, table)
-    body = (
-        "<p>"
-        + ", ".join(
-            f"{html.escape(label)}: {len(e.values)} states, largest additivity gap {e.additivity_gap.max():.1e}"
-            for label, e in exps
-        )
-        + "</p>"
-    )
-    subs = []
-    for k, (caption, png) in enumerate(figures, 1):
-        body += (
-            f"<figure id=f{k}><img src='{_img(png)}' alt='{html.escape(caption)}'><figcaption>"
-            f"{html.escape(caption)}</figcaption></figure>"
-        )
-        subs.append((f"f{k}", short_heading(caption)))
-    add("Explanations and figures", body, subs)
+    add("Explanations and figures", *_figures_body(exps, figures))
     if narratives:
-        body = (
-            "<p class=meta>Each sentence is marked &#10003; verified, &#10007; contradicted or ? unchecked (no "
-            "claim the verifier could check); the waterfall builds the margin of the chosen action over the "
-            "runner-up (the score, when nothing is chosen) from its background average, feature by feature.</p>"
-        )
-        for n, ev in narratives:
-            where = "all states" if n.index is None else f"state {n.index}"
-            meta = f"{where} &middot; template {html.escape(n.template)} &middot; {html.escape(n.source)}" + (
-                "" if n.verified else " &middot; <span class=bad>NOT verified</span>"
-            )
-            body += card_html(n.text, ev, meta)
-        add("Narrated decisions", body)
+        add("Narrated decisions", _narratives_body(narratives))
     if notes:
         add("Notes", "<ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in notes) + "</ul>")
     toc = "".join(

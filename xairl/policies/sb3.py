@@ -130,17 +130,9 @@ def from_sb3(
     """
     from gymnasium import spaces
 
-    if head not in HEADS:
-        raise InputError(f"head '{head}' is unknown; use one of {', '.join(HEADS)}.")
+    _refuse_unsupported(model, head, hidden)
     policy, algo = model.policy, type(model).__name__
     recurrent = hasattr(policy, "lstm_actor")
-    if hidden is not None and not recurrent:
-        raise InputError(f"hidden= is the LSTM state of a recurrent policy (RecurrentPPO); {algo} has none.")
-    if hasattr(policy, "quantile_net"):
-        raise InputError(
-            f"{algo} outputs quantiles per action; xairl explains one score per "
-            "action: use DQN, or explain a module that averages the quantiles with xairl.Policy."
-        )
     obs_space, act_space = model.observation_space, model.action_space
     windowed = window_observation(model, window, kwargs.pop("observation", None), feature_names, recurrent)
     observation = windowed or _observation(obs_space)
@@ -168,6 +160,21 @@ def from_sb3(
     elif check:
         _check(model, result, head, branch, spaces)
     return result
+
+
+def _refuse_unsupported(model, head: str, hidden) -> None:
+    """One line for a head that does not exist, an LSTM state given to a policy without one, and a distributional
+    output (QR-DQN's quantiles per action)."""
+    algo = type(model).__name__
+    if head not in HEADS:
+        raise InputError(f"head '{head}' is unknown; use one of {', '.join(HEADS)}.")
+    if hidden is not None and not hasattr(model.policy, "lstm_actor"):
+        raise InputError(f"hidden= is the LSTM state of a recurrent policy (RecurrentPPO); {algo} has none.")
+    if hasattr(model.policy, "quantile_net"):
+        raise InputError(
+            f"{algo} outputs quantiles per action; xairl explains one score per "
+            "action: use DQN, or explain a module that averages the quantiles with xairl.Policy."
+        )
 
 
 def _observation(space) -> Observation:

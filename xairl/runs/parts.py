@@ -138,19 +138,7 @@ def existing_parts(out: Path, identity: dict, resume: bool, run: str, total) -> 
     earlier = _record(out / "run.json")
     recorded = (earlier or {}).pop(RECORDED, None)
     recorded = recorded if isinstance(recorded, dict) else {}  # (none recorded: every part is explained again)
-    if earlier is not None and earlier != json.loads(json.dumps(identity)):
-        changed = sorted(k for k in identity if earlier.get(k) != json.loads(json.dumps(identity))[k])
-        if changed == ["source_sha256"]:  # the same file, other contents: resuming would mix old rows and new
-            what = "the states array" if identity["source"] == "array" else identity["source"]
-            raise InputError(
-                f"{what} changed since the run in {out} began (its contents differ from the SHA-256 "
-                f"in run.json); rerun without --resume into another folder, or delete {out} and run again."
-            )
-        raise InputError(
-            f"{out} holds another run (it differs in {', '.join(changed) or 'run.json'}); resume needs "
-            "the same states, policy, background, method, options and chunk size (if they are the same, "
-            "run.json was damaged: delete it and resume; every part is checked against this run)."
-        )
+    _same_run(out, earlier, identity)
     n, chunk = (total() if files else 0), identity["chunk_size"]
     strays = [
         p
@@ -164,6 +152,29 @@ def existing_parts(out: Path, identity: dict, resume: bool, run: str, total) -> 
             f"first rows multiples of {chunk} below {n}",
             folder,
         )
+    return _whole_parts(parts, recorded, chunk, n, run, folder)
+
+
+def _same_run(out: Path, earlier: dict | None, identity: dict) -> None:
+    """Refuses a run.json that records another run (or the same states file with other contents)."""
+    if earlier is not None and earlier != json.loads(json.dumps(identity)):
+        changed = sorted(k for k in identity if earlier.get(k) != json.loads(json.dumps(identity))[k])
+        if changed == ["source_sha256"]:  # the same file, other contents: resuming would mix old rows and new
+            what = "the states array" if identity["source"] == "array" else identity["source"]
+            raise InputError(
+                f"{what} changed since the run in {out} began (its contents differ from the SHA-256 "
+                f"in run.json); rerun without --resume into another folder, or delete {out} and run again."
+            )
+        raise InputError(
+            f"{out} holds another run (it differs in {', '.join(changed) or 'run.json'}); resume needs "
+            "the same states, policy, background, method, options and chunk size (if they are the same, "
+            "run.json was damaged: delete it and resume; every part is checked against this run)."
+        )
+
+
+def _whole_parts(parts: list[Path], recorded: dict, chunk: int, n: int, run: str, folder: Path) -> dict[int, str]:
+    """First row -> SHA-256 of each part that is whole and whose bytes are those recorded in run.json; a damaged or
+    unrecorded part is left to be explained again (said in a warning), a foreign one refused by name."""
     done, unrecorded = {}, 0
     for path in parts:
         first = int(path.name[5:17])

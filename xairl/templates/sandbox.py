@@ -144,9 +144,8 @@ class _Budget:
 
     def concat(self, *pieces) -> str:
         """The `~` operator, sized before it joins."""
-        texts = [
-            str(p) for p in pieces
-        ]  # each as it prints (a tracked value with its markers, xairl.templates.tracking)
+        # each piece as it prints (a tracked value with its markers, xairl.templates.tracking)
+        texts = [str(p) for p in pieces]
         _fits(sum(map(len, texts)), "'~'")
         return self.checked("".join(texts))
 

@@ -237,17 +237,7 @@ class UAVReport(xairl.plugin.Report):
         pick = np.random.default_rng(req.seed).choice(len(states), size=min(req.n_states, len(states)), replace=False)
         content.datasets.append(("real", seen[np.sort(pick)]))
         n_ref = self.options.calibration_flights
-        step = xairl.plugin.heartbeat(
-            f"simulating {n_ref} flights: the states the real ones are compared with", req.progress
-        )
-        with step:
-            if memory_of(ckpt.meta):  # the newest step, times included, against the greedy DQN's own states: a time
-                # on the cell grows as the DQN stays, so only its own decisions compare like with like
-                names, states = SIGNALS, seen[:, -len(SIGNALS) :]
-                sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, n_flights=n_ref)[:, -len(SIGNALS) :]
-            else:  # the mix of exploration and greedy steps that training sees
-                names = FEATURES
-                sim_ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=n_ref)
+        names, states, sim_ref = _reference(ckpt, states, seen, req, n_ref)
         with xairl.plugin.heartbeat("simulating handovers per altitude band (calibration)", req.progress):
             bands = band_rows(flights, chm_real, cfg, req.seed, n_flights=8, duration_s=30.0)
         mro: dict = {}  # what SA-MRO's network counted and did on the real samples
@@ -272,14 +262,7 @@ class UAVReport(xairl.plugin.Report):
                 _table(agreeing),
             ),
         ]
-        by = {r.policy.split(" ")[0]: astuple(r)[1:] for r in agreeing}
-        if by["CHM"] == by["SA-MRO"]:
-            why = (
-                " On real samples a failure comes only from the modelled uplink (the logs record none), and a return "
-                f"within the {cfg.handover.min_time_of_stay_s:g} s minimum time of stay cannot show between samples "
-                f"{LOG_INTERVAL_S:g} s apart (the logs' median)."
-            )
-            content.notes.append(same_as_chm(mro, f"the {len(flights)} real flights' samples", SAMROConfig(), why))
+        content.notes += _why_samro_is_chm(agreeing, mro, cfg, len(flights))
         content.notes += [f"skipped file: {b.replace(str(real), shown_path(real))}" for b in bad] + REAL_NOTES
         with xairl.plugin.heartbeat("simulating handovers by altitude (the figure)", req.progress):
             content.figures.append(
@@ -375,3 +358,30 @@ def findings(exps: dict[str, Explanation]) -> list[str]:
             f"buffer ranks {buf_score} and position {by_score.index('position') + 1}.{why}"
         )
     return out
+
+
+def _reference(ckpt: Checkpoint, states, seen, req, n_ref: int) -> tuple:
+    """(feature names, the real states, the simulated reference states) compared in the in-distribution table, from
+    ``n_ref`` simulated flights."""
+    with xairl.plugin.heartbeat(
+        f"simulating {n_ref} flights: the states the real ones are compared with", req.progress
+    ):
+        if memory_of(ckpt.meta):  # the newest step, times included, against the greedy DQN's own states: a time on
+            # the cell grows as the DQN stays, so only its own decisions compare like with like
+            ref = dqn_decision_states(ckpt, 5000, seed=req.seed + 2, n_flights=n_ref)
+            return SIGNALS, seen[:, -len(SIGNALS) :], ref[:, -len(SIGNALS) :]
+        # the mix of exploration and greedy steps that training sees
+        return FEATURES, states, dqn_decision_states(ckpt, 5000, seed=req.seed + 2, epsilon=0.5, n_flights=n_ref)
+
+
+def _why_samro_is_chm(agreeing: list, mro: dict, cfg, n_flights: int) -> list[str]:
+    """The note saying why SA-MRO's open-loop row equals CHM's, when it does (from what its network counted)."""
+    by = {r.policy.split(" ")[0]: astuple(r)[1:] for r in agreeing}
+    if by["CHM"] != by["SA-MRO"]:
+        return []
+    why = (
+        " On real samples a failure comes only from the modelled uplink (the logs record none), and a return within "
+        f"the {cfg.handover.min_time_of_stay_s:g} s minimum time of stay cannot show between samples "
+        f"{LOG_INTERVAL_S:g} s apart (the logs' median)."
+    )
+    return [same_as_chm(mro, f"the {n_flights} real flights' samples", SAMROConfig(), why)]
