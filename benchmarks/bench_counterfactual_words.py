@@ -21,9 +21,9 @@ import xairl
 from xairl.counterfactual_facts import counterfactual_fact
 from xairl.facts import decision_facts
 from xairl.narrators.base import first_phrasings
-from xairl.narrators.provenance import verify
 from xairl.templates import prompts
 from xairl.templates.tracking import track_decision
+from xairl.verification.own import verify
 
 
 def last_sentence(name: str):

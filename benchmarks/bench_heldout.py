@@ -94,7 +94,7 @@ def report(items: list[dict], show: str | None) -> None:
 def rule_effects(items: list[dict]) -> None:
     """Per rule of the table and per file: claims made / labelled errors contradicted / accurate texts falsely
     contradicted (only the rule-table reader names its rules by the table)."""
-    from xairl.verify import rules
+    from xairl.verification.prose import rules
 
     files = sorted({it["file"] for it in items})
     made = collections.Counter()

@@ -17,10 +17,10 @@ from xairl.counterfactual_facts import _outward, action_words
 from xairl.counterfactuals import Change, Counterfactual, Counterfactuals
 from xairl.facts import decision_facts
 from xairl.narrators.base import first_phrasings
-from xairl.narrators.provenance import verify
 from xairl.templates import prompts
 from xairl.templates.tracking import track_decision
 from xairl.values import fill_and_text
+from xairl.verification.own import verify
 
 CAP = 200.0  # the linear policy's queue capacity (kbit): its fill is said in % of it
 

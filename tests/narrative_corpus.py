@@ -63,12 +63,10 @@ def load_corpus() -> list[dict]:
     return out
 
 
-def run(items: list[dict], policies: dict, reader: str = "old") -> list[dict]:
-    """Verify every item with ``xairl.verify`` (``reader="old"``) or the rule-table reader ``xairl.verify.read``."""
-    if reader == "new":
-        from xairl.verify import read as verify
-    else:
-        from xairl.narrators import verify  # not ``xairl.verify``: once imported, that name is the reader's package
+def run(items: list[dict], policies: dict) -> list[dict]:
+    """Verify every item with ``xairl.verify`` (outside prose: the rule-table reader)."""
+    from xairl.verification import verify
+
     for it in items:
         t = time.perf_counter()
         res = verify(it["text"], it["explanation"], 0, it.get("policy") or policies.get(it["domain"]))

@@ -189,8 +189,8 @@ def test_a_narrative_with_a_counterfactual_its_check_cannot_read_is_not_verified
     from tests.counterfactual_cases import CAP, HAD, OWN, answer, linear_policy, template
     from xairl.facts import decision_facts
     from xairl.narrators.base import first_phrasings
-    from xairl.narrators.provenance import verify
     from xairl.templates.tracking import track_decision
+    from xairl.verification.own import verify
 
     p = linear_policy()
     states = np.array([[160, -90], [120, -95]], dtype=np.float32)

@@ -169,9 +169,9 @@ def test_a_regions_other_names_cost_no_pattern_each(stack):
     patterns overflowed re's cache: narrating one frame took 2.8 s instead of 0.2 s). Counted, not timed."""
     import importlib
 
-    from xairl.narrators.verify.book import clean_surface
+    from xairl.verification.prose.book import clean_surface
 
-    vocabulary = importlib.import_module("xairl.narrators.verify.vocabulary").vocabulary
+    vocabulary = importlib.import_module("xairl.verification.prose.vocabulary").vocabulary
     policy, exp = stack
     regions = in_regions(exp)
     vocab = vocabulary(regions, policy, clean_surface)

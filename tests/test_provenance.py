@@ -11,15 +11,15 @@ import yaml
 
 import xairl
 from tests.conftest import mlp
+from tests.rule_examples import example
 from xairl import Explanation
 from xairl.facts import decision_facts
-from xairl.narrators import provenance
 from xairl.narrators.base import first_phrasings
-from xairl.narrators.verify import verify as read_prose
-from xairl.narrators.verify.rules import example
 from xairl.templates import prompts, tracking
 from xairl.templates.tracking import Fact, Span
 from xairl.toy import toy_background, toy_policy
+from xairl.verification import own as provenance
+from xairl.verification.prose import read as read_prose
 
 #: robot: turn (3.2) over recharge (2.0); chosen score: speed +0.5, battery -0.3, obstacle +2.0; margin: speed +0.7,
 #: battery -1.5, obstacle +2.0; values 0.4, 0.3, 0.9; with these quartiles speed is low, battery and obstacle high
@@ -53,7 +53,7 @@ def rendered(tmp_path, sentences, exp, i=0, policy=None):
 def check(tmp_path, sentence, exp, i=0, policy=None):
     text = rendered(tmp_path, [sentence], exp, i, policy)
     assert text.spans, "the sentence prints tracked values"
-    return text, provenance.verify(text, exp, i, policy, provenance=text.spans)
+    return text, xairl.verify(text, exp, i, policy, provenance=text.spans)
 
 
 def by_rule(v, rule, status="contradicted"):
@@ -312,21 +312,21 @@ def test_fact_a_tracked_number_is_its_fact(exps):
     robot = exps["robot"]
     name = Fact("name", "speed", "score")
     wrong = "speed added +0.90 to the score."
-    v = provenance.verify(wrong, robot, 0, provenance=spans_of(wrong, ("speed", name), ("+0.90", _c("speed"))))
+    v = xairl.verify(wrong, robot, 0, provenance=spans_of(wrong, ("speed", name), ("+0.90", _c("speed"))))
     assert [c.text for c in by_rule(v, "tracked.fact")] == ["+0.90"] and not v.ok
     lying = dataclasses.replace(_c("speed"), value=0.9)  # the recorded value says 0.9; the explanation says 0.5
     right = "speed added +0.50 to the score."
-    v = provenance.verify(right, robot, 0, provenance=spans_of(right, ("speed", name), ("+0.50", lying)))
+    v = xairl.verify(right, robot, 0, provenance=spans_of(right, ("speed", name), ("+0.50", lying)))
     assert v.ok and by_rule(v, "tracked.fact", "verified"), contradicted(v)
     # the template's transformation is part of the fact: -0.50 is speed's contribution negated, not speed's
     text = "speed: -0.50."
-    v = provenance.verify(text, robot, 0, provenance=spans_of(text, ("speed", name), ("-0.50", _c("speed"))))
+    v = xairl.verify(text, robot, 0, provenance=spans_of(text, ("speed", name), ("-0.50", _c("speed"))))
     assert by_rule(v, "tracked.fact")
-    v = provenance.verify(text, robot, 0, provenance=spans_of(text, ("speed", name), ("-0.50", _c("speed"), "neg")))
+    v = xairl.verify(text, robot, 0, provenance=spans_of(text, ("speed", name), ("-0.50", _c("speed"), "neg")))
     assert v.ok, contradicted(v)
     # a tracked action or name is its fact's word
     text = "The policy chose forward."
-    v = provenance.verify(text, robot, 0, provenance=spans_of(text, ("forward", Fact("action", role="chosen"))))
+    v = xairl.verify(text, robot, 0, provenance=spans_of(text, ("forward", Fact("action", role="chosen"))))
     assert by_rule(v, "tracked.fact") and not v.ok
 
 
@@ -345,14 +345,14 @@ def test_fact_scaled_values_count_only_as_percentages(tmp_path, exps):
 def test_unknown_a_fact_the_explanation_does_not_have(exps):
     robot = exps["robot"]
     text = "wind added +0.50 to the score."
-    v = provenance.verify(
+    v = xairl.verify(
         text, robot, 0, provenance=spans_of(text, ("wind", Fact("name", "wind", "score")), ("+0.50", _c("wind")))
     )
     assert len(by_rule(v, "tracked.unknown")) == 2 and not v.ok
     text = "speed added +0.50 to the score."
-    v = provenance.verify(text, robot, 0, provenance=spans_of(text, ("+0.50", _c("speed", "sideways"))))
+    v = xairl.verify(text, robot, 0, provenance=spans_of(text, ("+0.50", _c("speed", "sideways"))))
     assert by_rule(v, "tracked.unknown")
-    v = provenance.verify(
+    v = xairl.verify(
         text, robot, 0, provenance=spans_of(text, ("speed", Fact("name", "speed", "score")), ("+0.50", _c("speed")))
     )
     assert v.ok and not by_rule(v, "tracked.unknown"), contradicted(v)
@@ -489,5 +489,5 @@ def test_names_and_descriptions_cannot_smuggle_claims_with_provenance(tmp_path):
     assert not v.ok
     text = rendered(tmp_path, ["The policy chose {{ action }}. {{ margin_top[1].label|cap }}."], exp, 0, policy)
     assert "pushing toward go by +9.99" in text
-    v = provenance.verify(text, exp, 0, policy, provenance=text.spans)
+    v = xairl.verify(text, exp, 0, policy, provenance=text.spans)
     assert not v.ok and any(c.kind in ("number", "rank", "direction") for c in v.problems()), v.claims

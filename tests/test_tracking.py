@@ -8,9 +8,9 @@ import pytest
 import yaml
 
 import xairl
+from tests.rule_examples import example
 from xairl.facts import decision_facts
 from xairl.narrators.base import first_phrasings
-from xairl.narrators.verify.rules import example
 from xairl.templates import prompts, tracking
 from xairl.toy import toy_background, toy_policy
 

@@ -15,10 +15,11 @@ from tests import cases
 from tests import narrative_domains as domains
 from tests.narrative_corpus import explanation_from_tuples, load_corpus, run, shapstories_case
 from tests.work_budget import calls
-from xairl.narrators.verify.book import clean_surface
-from xairl.narrators.verify.names import find_mentions
-from xairl.narrators.verify.numbers import find_numbers, matches, normalise
-from xairl.narrators.verify.vocabulary import vocabulary
+from xairl.verification.prose.book import clean_surface
+from xairl.verification.prose.names import find_mentions
+from xairl.verification.prose.numbers import find_numbers, matches
+from xairl.verification.prose.vocabulary import vocabulary
+from xairl.verification.text import normalise
 
 
 @pytest.mark.parametrize(

@@ -1,10 +1,10 @@
-"""The rule-table reader (xairl.verify, issue 54 stage 1): every rule's examples from rules/rules.yaml, the table's
+"""The rule-table reader (xairl.verification.prose): every rule's examples from rules/rules.yaml, the table's
 shape, and the claims it makes on sentences written for these tests."""
 
 import pytest
 
-from xairl.narrators.verify.rules import example
-from xairl.verify import read, rules, trace
+from tests.rule_examples import example
+from xairl.verification.prose import read, rules, trace
 
 RULES = rules.table()
 
@@ -66,36 +66,20 @@ def test_a_number_next_to_its_name_outranks_the_parse():
     assert read("The season lowered it a little, and wind speed (SHAP +6.9) pushed it up.", example("air"), 0).accurate
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize(
-    "imports",
-    [
-        "import xairl; import xairl.verify",
-        "import xairl.verify; import xairl",
-        "from xairl import verify; import xairl",
-    ],
-)
-def test_xairl_verify_stays_the_public_verifier_in_any_import_order(imports):
-    """Importing the package ``xairl.verify`` sets the attribute ``xairl.verify`` to it; the package is callable, so
-    ``xairl.verify(text, explanation)`` stays the public verifier whatever was imported first (a fresh process each)."""
-    import subprocess
-    import sys
+def test_xairl_verify_is_a_plain_function():
+    """``xairl.verify`` is the function of :mod:`xairl.verification` (no package of that name shadows it)."""
+    import inspect
 
-    code = (
-        f"{imports}\n"
-        "from xairl.narrators.verify.rules import example\n"
-        "from xairl.narrators import verify as public\n"
-        "text = 'pm2_5_lag1 (+14.7) raised the forecast.'\n"
-        "got = xairl.verify(text, example('air'), 0)\n"
-        "assert type(got) is type(public(text, example('air'), 0)) and got.accurate, got\n"
-        "assert not xairl.verify('pm2_5_lag1 (-3.0) lowered the forecast.', example('air'), 0).accurate\n"
-    )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr[-2000:]
+    import xairl
+    from xairl.verification import verify
+
+    assert xairl.verify is verify and inspect.isfunction(xairl.verify)
+    assert xairl.verify("pm2_5_lag1 (+14.7) raised the forecast.", example("air"), 0).accurate
+    assert not xairl.verify("pm2_5_lag1 (-3.0) lowered the forecast.", example("air"), 0).accurate
 
 
 def test_tokens_show_names_and_numbers_as_the_rules_see_them():
-    from xairl.verify import tokens
+    from xairl.verification.prose import tokens
 
     (sentence,) = tokens("The effect of the traffic index was +7.2.", example("air"))
     kinds = {text: kind for text, kind, _, _ in sentence}

@@ -13,8 +13,8 @@ from hypothesis import strategies as st
 
 import xairl
 from tests.work_budget import calls
+from xairl import verify
 from xairl.errors import InputError
-from xairl.narrators.verify import verify
 
 
 def _explanation(values, names, states=None, actions=("out",), output="value", categories=None):

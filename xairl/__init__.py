@@ -34,9 +34,9 @@ _LAZY = {
     # narration and verification
     "narrate": "xairl.narrators",
     "NarrationOptions": "xairl.narrators",
-    "verify": "xairl.narrators",
+    "verify": "xairl.verification",
     "Narrative": "xairl.narrators",
-    "Verification": "xairl.narrators",
+    "Verification": "xairl.verification",
     # errors a user can cause (every one is an XairlError; the others are in xairl.errors)
     "XairlError": "xairl.errors",
     "InputError": "xairl.errors",

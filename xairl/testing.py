@@ -13,7 +13,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from xairl.narrators.verify import NUMBER_RE
+from xairl.verification.prose.numbers import NUMBER_RE
 
 FLIPS = {"toward": "against", "against": "toward"}
 

@@ -112,8 +112,8 @@ def cmd_verify(args) -> int:
     """Check a text against an explanation; with --trace, every claim with the words it was read from and the
     reading (rule) that bound it."""
     from xairl.cli.records import read_explanation
-    from xairl.narrators.verify import verify
     from xairl.templates.prompts import bidi_visible
+    from xairl.verification import verify
 
     text = args.text if args.text != "-" else sys.stdin.read()
     exp, index = read_explanation(args.explanation, args.index)
@@ -123,7 +123,9 @@ def cmd_verify(args) -> int:
         for c in sentence.claims if args.trace else ():
             print(f"    {c.status:<12} {c.kind:<9} {c.text!r:<28} {c.rule or '-':<22} {c.detail}")
     if args.trace:  # what each reading that fired reads, from its entry in the rules' table
-        from xairl.narrators.verify.rules import BY_ID
+        from xairl.verification.prose.rules import by_id
+
+        BY_ID = by_id()
 
         fired = sorted({c.rule for c in result.claims if c.rule in BY_ID})
         print("rules:" if fired else "rules: none fired", *(f"  {r}: {BY_ID[r].reads}" for r in fired), sep="\n")

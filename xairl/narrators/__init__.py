@@ -8,8 +8,8 @@ from xairl.explanations.explanation import Explanation
 from xairl.narrators.base import Narrative, Narrator
 from xairl.narrators.confidence import confidence
 from xairl.narrators.options import NarrationOptions
-from xairl.narrators.provenance import verify
-from xairl.narrators.verify import Verification
+from xairl.verification import verify
+from xairl.verification.result import Verification
 
 
 def narrate(

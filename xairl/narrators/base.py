@@ -22,13 +22,13 @@ from xairl.explanations.explanation import Explanation
 from xairl.facts import DomainFacts, decision_facts, global_facts
 from xairl.narrators.confidence import confidence
 from xairl.narrators.options import NarrationOptions
-from xairl.narrators.provenance import verify
-from xairl.narrators.verify import Claim
 from xairl.options import Options, parse_options
 from xairl.policies.policy import Policy
 from xairl.policies.regions import in_regions
 from xairl.templates.tracking import Rendered, Span, joined, locate, track_decision, track_global
 from xairl.values import state_value_text
+from xairl.verification import verify
+from xairl.verification.result import Claim
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ a *slot* it must fill, in order, exactly once. It cannot write a digit of its ow
 text starts that slot and the rest is written for it; a slot it withholds too long is written for it; it cannot stop
 before the last slot. So no number can be invented and none can drift; a name it writes outside the slots that the
 template did not write is refused afterwards (a try of :func:`fill` returns None). The slots keep their spans and
-facts, and the model's own words between them are judged by :mod:`xairl.narrators.provenance` against those facts.
+facts, and the model's own words between them are judged by :mod:`xairl.verification.own` against those facts.
 """
 
 from __future__ import annotations

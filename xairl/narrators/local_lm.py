@@ -8,7 +8,7 @@ Three modes:
   (:mod:`xairl.narrators.fill`): every name, number and direction the facts gave is a slot its constrained decoding
   must write, in order, exactly as given, and it can write no digit of its own. A try whose words wander from the
   template's or name something new is refused; the output is verified by provenance (its slots by their facts, its
-  words by the rules of :mod:`xairl.narrators.provenance`); up to ``tries`` tries (greedy, then sampled), then the
+  words by the rules of :mod:`xairl.verification.own`); up to ``tries`` tries (greedy, then sampled), then the
   template's text is shown.
 - ``choose``: for each sentence the template offers phrasings that state the same facts; the model picks the one it
   finds most fluent after the text so far (highest mean token log-probability). Numbers, names and directions come

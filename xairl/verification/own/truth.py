@@ -1,0 +1,203 @@
+"""The facts a tracked span may name, recomputed from the explanation (never taken from the span), and the check of
+one span against its fact."""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from xairl.explanations.explanation import Explanation
+from xairl.facts import DomainFacts, decision_facts, global_facts
+from xairl.policies.policy import Policy
+from xairl.templates.tracking import Span
+from xairl.verification.own.lexicon import EXTRA_DIRECTIONS, KINDS, NUMBER, NUMERIC
+from xairl.verification.prose.checks import DIRECTION_RE
+from xairl.verification.result import Claim
+
+
+@dataclass
+class Truth:
+    """The facts of one decision (or of the global view) recomputed from the explanation, by (quantity, feature,
+    view, role)."""
+
+    values: dict
+    features: dict  # name -> {view: FeatureFact or ranking dict}
+    actions: dict  # role -> name
+    output: str
+    policy: Policy | None = None  # a counterfactual sentence is checked by running it (provenance.counterfactual)
+    state: np.ndarray | None = None  # the decision's state, flat, when it is the policy's input
+
+    def get(self, span: Span):
+        f = span.fact
+        return self.values.get((f.quantity, f.feature, view_of(f.view), f.role), MISSING)
+
+
+MISSING = object()
+
+
+def view_of(view: str | None) -> str | None:
+    return "score" if view == "output" else view
+
+
+def truth(exp: Explanation, index: int | None, policy: Policy | None, domain: DomainFacts | None) -> Truth:
+    """Every fact a tracked span may name, recomputed from ``exp``."""
+    values, features = {}, {}
+    if index is None:
+        for view in ("margin", "score"):
+            g = global_facts(exp, policy, k=len(exp.feature_names), view=view)
+            v = view_of(g.view)
+            values[("n_states", None, None, None)] = g.n_states
+            values[("target", None, v, None)] = g.target
+            for r in g.ranking:
+                features.setdefault(r["name"], {})[v] = r
+                for q, key in (("mean_abs", "mean_abs"), ("mean", "mean"), ("rank", "rank"), ("name", "name")):
+                    values[(q, r["name"], v, None)] = r[key]
+                values[("direction", r["name"], v, None)] = r["direction"]
+                values[("direction_high", r["name"], v, None)] = r["high_values"]
+                values[("direction_low", r["name"], v, None)] = r["low_values"]
+                values[("unit", r["name"], v, None)] = r["unit"]
+        values[("method", None, None, None)] = exp.method
+        return Truth(values, features, {}, exp.output)
+    d = decision_facts(exp, index, policy, k=len(exp.feature_names))
+    domain = domain or DomainFacts(d.extras, d.comparisons)  # the policy's facts hook, called again
+    actions = {"chosen": d.action, "runner_up": d.runner_up}
+    values.update(
+        {
+            ("index", None, None, None): d.index,
+            ("action", None, None, "chosen"): d.action,
+            ("action", None, None, "runner_up"): d.runner_up,
+            ("score", None, "score", "chosen"): d.score,
+            ("score", None, "score", "runner_up"): d.runner_up_score,
+            ("margin", None, "margin", None): d.q_margin,
+            ("base_value", None, "score", "chosen"): d.base_value,
+            ("base_margin", None, "margin", None): d.base_margin,
+            ("gap", None, None, None): d.additivity_gap,
+            ("method", None, None, None): d.method,
+        }
+    )
+    for view, facts in (("score", d.top), ("margin", d.margin_top)):
+        for f in facts + (d.identifiers if view == "score" else ()):
+            features.setdefault(f.name, {})[view] = f
+            for q in (
+                *("value", "value_text", "unit", "contribution", "share", "direction", "rank", "kind", "fill"),
+                *("trend", "window", "change_unit", "steps"),
+            ):
+                values[(q, f.name, view, None)] = getattr(f, q)
+            values[("value_change", f.name, view, None)] = f.change
+            values[("name", f.name, view, None)] = f.name
+            values[("level", f.name, view, None)] = f.level_text or f.level
+    for c in domain.comparisons if domain else ():
+        values[("comparison", c.text, None, None)] = c.text
+        values[("comparison_value", c.text, None, None)] = c.value
+    for k, v in (domain.extras if domain else {}).items():
+        values[("extra", str(k), None, None)] = v
+    flat = exp.states is not None and policy is not None and exp.states.shape[1] == policy.n_features
+    return Truth(values, features, actions, exp.output, policy, np.asarray(exp.states[index]) if flat else None)
+
+
+def number(text: str) -> float | None:
+    m = NUMBER.search(text.replace("\u2212", "-"))
+    if m is None:
+        return None
+    try:
+        return float(m.group(0).replace(",", ""))
+    except ValueError:
+        return None
+
+
+def _transformed(x: float, transform: str, percent: bool = False) -> float:
+    """``x`` as the template transformed it; a scaling counts only as a percentage (x100 with '%' written after it):
+    any other multiple of a fact printed as if it were the fact is not that fact."""
+    for step in filter(None, transform.split("+")):
+        if step == "neg":
+            x = -x
+        elif step == "abs":
+            x = abs(x)
+        elif step.startswith("scale:") and percent and float(step[6:]) == 100:
+            x *= 100
+    return x
+
+
+def close(printed: float, expected: float, text: str, transform: str = "") -> bool:
+    """``printed`` (as ``text`` writes it) is ``expected`` rounded: within half a unit of its last digit (3
+    significant digits at least), or of the digits a ``round:N`` transform kept ('|round' prints -1.0 for -1.21)."""
+    if not math.isfinite(expected):
+        return False
+    digits = re.search(r"\.(\d+)", text)
+    step = 10.0 ** -(len(digits.group(1)) if digits else 0)
+    for kept in re.findall(r"round:(-?\d+)", transform):
+        step = max(step, 10.0 ** -int(kept))
+    return abs(printed - expected) <= 0.5 * step + 5e-4 * abs(expected) + 1e-12
+
+
+def _words_similar(a: str, b: str) -> bool:
+    return " ".join(str(a).lower().split()) == " ".join(str(b).lower().split())
+
+
+def check_fact(span: Span, truth: Truth, after: str = "") -> Claim:
+    """The span against its recomputed fact (the claim carries the span); ``after``: the words that follow it."""
+    return replace(_check_fact(span, truth, bool(re.match(r"\s?(?:%|per ?cent)", after))), span=span)
+
+
+def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
+    f = span.fact
+    expected = truth.get(span)
+    kind = KINDS.get(f.quantity, "number" if f.quantity in NUMERIC else "feature")
+    if f.quantity == "value_text":
+        kind = "number" if re.search(r"\d", span.text) else "category"
+    if (
+        percent
+        and f.quantity in NUMERIC
+        and f.quantity not in ("share", "fill", "value", "value_change")  # (a fill changes in points)
+        and "scale:100" not in span.transform
+    ):
+        return Claim(
+            kind,
+            span.text,
+            "contradicted",
+            f"the {f.quantity.replace('_', ' ')}, written as a percentage",
+            "tracked.label",
+        )
+    if expected is MISSING:
+        what = f"{f.quantity} of {f.feature}" if f.feature else f.quantity
+        return Claim(
+            kind, span.text, "contradicted", f"no {what} in this explanation ({f.view or ''} view)", "tracked.unknown"
+        )
+    if isinstance(expected, (int, float, np.floating)) and not isinstance(expected, bool):
+        printed = number(span.text)
+        want = _transformed(float(expected), span.transform, percent)
+        ok = printed is not None and close(printed, want, span.text, span.transform)
+        detail = f"{f.quantity}{' of ' + f.feature if f.feature else ''} = {float(expected):.4g}"
+        detail += f" ({span.transform}: {want:.4g})" if span.transform else ""
+        return Claim("number", span.text, "verified" if ok else "contradicted", detail, "tracked.fact")
+    if expected is None:  # e.g. the fill of a feature without a capacity, printed as 'None'
+        return Claim(kind, span.text, "unchecked", f"{f.quantity} of {f.feature}: none", "tracked.fact")
+    accepted = [expected]
+    if f.quantity == "name":  # its name or its label (description)
+        accepted += [
+            getattr(v, "label", None) or (v.get("label") if isinstance(v, dict) else None)
+            for v in truth.features.get(f.feature, {}).values()
+        ]
+    elif f.quantity == "level":
+        accepted += [getattr(v, "level", None) for v in truth.features.get(f.feature, {}).values()]
+    elif f.quantity in ("direction", "direction_high", "direction_low"):
+        said = _polarity(span.text)
+        if said and expected in ("toward", "against"):
+            accepted.append(span.text if said == (1 if expected == "toward" else -1) else None)
+    ok = any(a is not None and _words_similar(span.text, a) for a in accepted)
+    return Claim(kind, span.text, "verified" if ok else "contradicted", f"{f.quantity} = {expected}", "tracked.fact")
+
+
+def _polarity(word: str) -> int:
+    """+1 for a word that raises ('raised', 'toward', 'up'), -1 for one that lowers, 0 for neither."""
+    m = DIRECTION_RE.search(word) or EXTRA_DIRECTIONS.search(word)
+    if m is None:
+        return (
+            1
+            if re.fullmatch(r"\W*(?:up|higher|more|for)\W*", word, re.I)
+            else (-1 if re.fullmatch(r"\W*(?:down|lower|less)\W*", word, re.I) else 0)
+        )
+    return 1 if m.groupdict().get("pos") or m.groupdict().get("for") else -1
