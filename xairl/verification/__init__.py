@@ -51,5 +51,14 @@ def verify(
     if not provenance or several or normalise(text) != text:
         # (the spans of several dimensions do not say which one: narrate checks each; a text whose spelling
         # normalisation changes was not rendered as it stands, so its offsets would not hold)
-        return prose.read(text, explanation, index, policy, facts)
-    return own.verify(text, explanation, index, policy, facts, provenance, prose.reader)
+        result = prose.read(text, explanation, index, policy, facts)
+    else:
+        result = own.verify(text, explanation, index, policy, facts, provenance, prose.reader)
+    # what the text's features account for of the margin, and what it leaves out (issue 65: beside the coverage)
+    from dataclasses import replace
+
+    from xairl.policies.regions import in_regions
+    from xairl.verification.account import account, features_named
+
+    named = features_named(result.claims, provenance or ())
+    return replace(result, account=account(in_regions(explanation), index, named))
