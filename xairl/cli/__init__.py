@@ -108,10 +108,15 @@ def cmd_prompts(args) -> int:
     return 0 if not problems else 1
 
 
+#: ``xairl verify``'s exit status by verdict (2 stays a user error)
+VERIFY_EXIT = {"verified": 0, "contradicted": 1, "partly checked": 3}
+
+
 def cmd_verify(args) -> int:
     """Check a text against an explanation; with --trace, every claim with the words it was read from and the
     reading (rule) that bound it."""
     from xairl.cli.records import read_explanation
+    from xairl.explanations.evidence import verdict_text
     from xairl.templates.prompts import bidi_visible
     from xairl.verification import verify
 
@@ -129,14 +134,14 @@ def cmd_verify(args) -> int:
 
         fired = sorted({c.rule for c in result.claims if c.rule in BY_ID})
         print("rules:" if fired else "rules: none fired", *(f"  {r}: {BY_ID[r].reads}" for r in fired), sep="\n")
-    print(
-        f"accurate: {'yes' if result.accurate else 'no'}; ok: {'yes' if result.ok else 'no'} "
-        f"(coverage {result.coverage:.0%}){'; ' + result.note if result.note else ''}"
-    )
-    return 0 if result.accurate else 1
+    print(f"verdict: {verdict_text(result.status, result.coverage)}{'; ' + result.note if result.note else ''}")
+    if result.account:
+        print(f"account: {result.account}")
+    return VERIFY_EXIT[result.status]
 
 
 def cmd_review(args) -> int:
+    from xairl.explanations.evidence import verdict_text
     from xairl.outputs.feedback import FeedbackStore
 
     store = FeedbackStore(args.db)
@@ -155,11 +160,13 @@ def cmd_review(args) -> int:
     pending = store.records("pending")
     print(f"{len(pending)} narrative(s) to review in {store.path}")
     for r in pending:
-        bad = [c for c in r.claims if c["status"] != "verified"]
+        bad = sum(c["status"] != "verified" for c in r.claims)
         print(
             f"\n#{r.id} [{r.template}, {r.source}, confidence {r.confidence:.2f}, "
-            f"{'verified' if r.verified else f'{len(bad)} unverified claim(s)'}]"
+            f"{verdict_text(r.verdict, r.coverage)}{f': {bad} claim(s) not verified' if bad else ''}]"
         )
+        if r.account:
+            print(f"    account: {r.account}")
         marked = (r.evidence or {}).get("sentences") or []
         print(marked_rows(r.text, marked))
         while True:
@@ -212,6 +219,12 @@ COMMAND_EXAMPLES = {
   xairl verify "Speed lowered the score by 0.52." --explanation report/explanations.jsonl --index 2
   xairl verify "Speed lowered the score by 0.52." --explanation exp.json --index 0 --trace
   echo "..." | xairl verify - --explanation exp.json
+
+it prints each sentence's status, then the verdict and the account:
+  verdict: verified | contradicted | partly checked (coverage 62 %)
+  account: what the text's features account for of the margin (or score), and what it leaves out
+exit status: 0 verified (every claim checked, and true), 1 contradicted (a claim is false), 3 partly checked
+(nothing false, but not every claim could be checked), 2 a usage error (a missing file, a bad --index)
 """,
     "report": """examples:
   xairl report --plugin uav-handover --out out/report                 Table I and SHAP on simulated flights
@@ -295,7 +308,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(run=cmd_prompts)
     _verify_parser(
-        _command(sub, "verify", help="check a text's claims against an explanation (exit 1 when one is contradicted)")
+        _command(
+            sub,
+            "verify",
+            help="check a text's claims against an explanation: verified (exit 0), contradicted (1) or partly checked (3)",
+        )
     )
     p = _command(
         sub,

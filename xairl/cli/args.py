@@ -172,7 +172,7 @@ def narration_arguments(p: argparse.ArgumentParser) -> None:
 
 
 #: how each sentence's status is shown: an unchecked sentence is said to be unchecked, never passed as verified
-MARKS = {"verified": "verified", "contradicted": "CONTRADICTED", "unchecked": "unchecked"}
+MARKS = {"verified": "verified", "contradicted": "CONTRADICTED", "unchecked": "unchecked", "none": "(no claim)"}
 
 
 def feedback_arguments(p: argparse.ArgumentParser) -> None:

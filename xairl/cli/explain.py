@@ -220,6 +220,7 @@ def _stream(args, policy, states, bg, options: dict) -> int:
 
 
 def _print_narratives(args, exp, policy, bg, raw=None) -> int:
+    from xairl.explanations.evidence import verdict_text
     from xairl.narrators import narrate
     from xairl.outputs.feedback import FeedbackStore
 
@@ -252,6 +253,9 @@ def _print_narratives(args, exp, policy, bg, raw=None) -> int:
                         "index": i,
                         "text": n.text,
                         "verified": n.verified,
+                        "verdict": n.status,
+                        "coverage": n.coverage,
+                        "account": n.account,
                         "confidence": n.confidence,
                         "components": n.components,
                         "source": n.source,
@@ -262,10 +266,11 @@ def _print_narratives(args, exp, policy, bg, raw=None) -> int:
                 )
             )
             continue
-        mark = "verified" if n.verified else "NOT VERIFIED"
         parts = ", ".join(f"{k} {v:.2f}" for k, v in n.components.items() if v is not None)
-        print(f"state {i} [{mark}, confidence {n.confidence:.2f}: {parts}; {n.source}]")
+        print(f"state {i} [{verdict_text(n.status, n.coverage)}, confidence {n.confidence:.2f}: {parts}; {n.source}]")
         print(marked_rows(n.text, n.sentences))
+        if n.account:
+            print(f"    account: {n.account}")
         if found is not None:
             print(block(found[i]))
     return 0

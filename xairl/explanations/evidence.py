@@ -2,7 +2,8 @@
 
 An operator checks a narrative against the state and the numbers: :func:`evidence` collects them (the decision,
 every feature's value and contributions to the margin over the runner-up and to the chosen score, each sentence's
-verification status, the confidence components; a decision's counterfactuals where they were searched, under
+verification status, the verdict on the whole text with its claim coverage and its account of the margin, the
+confidence components; a decision's counterfactuals where they were searched, under
 ``'counterfactual'``) as plain JSON-ready data; the feedback store keeps it with the narrative, and :func:`card_html`
 draws the same card in the HTML report and on the review page.
 """
@@ -21,7 +22,27 @@ from xairl.explanations.explanation import Explanation
 
 #: how many contributions the card's waterfall shows (the rest as one bar)
 SHOWN = 8
-STATUS_MARK = {"verified": "&#10003;", "contradicted": "&#10007;", "unchecked": "?"}
+STATUS_MARK = {"verified": "&#10003;", "contradicted": "&#10007;", "unchecked": "?", "none": ""}
+#: the three verdicts on a text (:attr:`xairl.Verification.status`), worst last
+VERDICTS = ("verified", "partly checked", "contradicted")
+
+
+def verdict_text(status: str, coverage: float | None = None) -> str:
+    """How every surface says a verdict: 'verified', 'contradicted' or 'partly checked (coverage 62 %)'."""
+    if status == "partly checked" and coverage is not None:
+        return f"partly checked (coverage {100 * coverage:.0f} %)"
+    return status
+
+
+def verdict_of(ev: dict) -> str:
+    """The verdict an evidence dict holds; one recorded before there were three (only 'verified': true or false) is
+    read from its sentences: contradicted when one is, else partly checked."""
+    if ev.get("status") in VERDICTS:
+        return ev["status"]
+    if ev.get("verified"):
+        return "verified"
+    said = [st for _, st in ev.get("sentences") or []]
+    return "contradicted" if "contradicted" in said else "partly checked"
 
 
 def evidence(exp: Explanation, narrative, value_text: Callable[[int, int], str] | None = None) -> dict[str, Any]:
@@ -34,6 +55,9 @@ def evidence(exp: Explanation, narrative, value_text: Callable[[int, int], str] 
         "components": {k: v for k, v in narrative.components.items() if v is not None},
         "confidence": narrative.confidence,
         "verified": narrative.verified,
+        "status": narrative.status,
+        "coverage": narrative.coverage,
+        "account": narrative.account,
     }
     i = narrative.index
     if i is None or exp.states is None or exp.values.ndim != 3:
@@ -148,7 +172,7 @@ def card_html(narrative_text: str, ev: dict, meta: str = "", controls: str = "")
             f"<sup>{STATUS_MARK.get(st, '?')}</sup></span>"
         )
     comps = "".join(f"<tr><td>{html.escape(k)}</td><td>{v:.2f}</td></tr>" for k, v in ev.get("components", {}).items())
-    parts = [f"<p class=narrative>{text}</p>"]
+    parts = [f"<p class=narrative>{text}</p>", verdict_html(ev)]
     if meta:
         parts.append(f"<p class=meta>{meta}</p>")
     if ev.get("counterfactual"):  # what would have changed it (xairl.counterfactuals.show.summary)
@@ -170,6 +194,15 @@ def card_html(narrative_text: str, ev: dict, meta: str = "", controls: str = "")
     return f"<div class=card>{''.join(parts)}{controls}</div>"
 
 
+def verdict_html(ev: dict) -> str:
+    """The verdict line under a card's narrative: the verdict (with the coverage when partly checked) and the account
+    of the margin (what the narrative's features account for, what it leaves out)."""
+    status = verdict_of(ev)
+    words = html.escape(verdict_text(status, ev.get("coverage")))
+    account = f" &middot; {html.escape(ev['account'])}" if ev.get("account") else ""
+    return f"<p class='check {status.split()[0]}'>verdict: <b>{words}</b>{account}</p>"
+
+
 CARD_STYLE = (
     ".card{border:1px solid #ccd;border-radius:6px;padding:.6em 1em;margin:1em 0}.narrative{font-size:105%}"
     ".s.verified sup{color:#070}.s.contradicted{background:#fdd}.s.contradicted sup{color:#b00}"
@@ -179,5 +212,6 @@ CARD_STYLE = (
     "white-space:nowrap}.wf-track{position:relative;flex:1;height:1em;background:#f4f4f4}.wf-bar{position:"
     "absolute;top:0;height:100%}.wf-bar.up{background:#d62728}.wf-bar.down{background:#1f77b4}"
     ".wf-val{width:5em;text-align:right}.wf-head{font-weight:bold;margin-bottom:.2em}"
-    ".meta{color:#555;font-size:90%}" + CF_STYLE
+    ".meta{color:#555;font-size:90%}.check{font-size:90%;margin:.2em 0}.check.verified b{color:#070}"
+    ".check.contradicted b{color:#b00}.check.partly b{color:#a60}" + CF_STYLE
 )

@@ -17,7 +17,7 @@ import numpy as np
 
 from xairl.counterfactual_facts import said_counterfactual
 from xairl.errors import InputError
-from xairl.explanations.evidence import CARD_STYLE, card_html, evidence
+from xairl.explanations.evidence import CARD_STYLE, VERDICTS, card_html, evidence
 from xairl.explanations.explanation import Explanation
 from xairl.facts import DomainFacts, decision_facts, global_facts
 from xairl.narrators.confidence import confidence
@@ -28,7 +28,7 @@ from xairl.policies.regions import in_regions
 from xairl.templates.tracking import Rendered, Span, joined, locate, track_decision, track_global
 from xairl.values import state_value_text
 from xairl.verification import verify
-from xairl.verification.result import Claim
+from xairl.verification.result import Claim, Verification
 
 
 @dataclass(frozen=True)
@@ -37,14 +37,22 @@ class Narrative:
 
     :param source: the narrator's name, or 'template (fallback: ...)' when its text failed verification.
     :param rejected: the narrator's own text when it failed verification and the template's was shown instead.
-    :param sentences: (sentence, status) per sentence of ``text``: 'verified', 'contradicted' or 'unchecked' (no
-        checkable claim), as the verifier found them; the report and the review page mark each.
+    :param verified: the verdict is 'verified' (every claim checked, and true).
+    :param sentences: (sentence, status) per sentence of ``text``: 'verified', 'contradicted', 'unchecked' (a claim
+        left unchecked) or 'none' (nothing to check), as the verifier found them; the report and the review page mark
+        each.
     :param evidence: what an operator checks the words against (:func:`xairl.explanations.evidence.evidence`: the state, the
         contributions to the margin, the sentences' statuses); a notebook shows it as the report's card.
     :param claims: every claim the verifier checked; a claim about a value the template printed carries its tracked
         span (``Claim.span``: where, and the fact it came from).
     :param provenance: the tracked span of every value xairl printed (:class:`xairl.templates.tracking.Span`); give it back to
         ``xairl.verify(text, ..., provenance=narrative.provenance)`` to check the text again by its facts.
+    :param status: the verdict on all its checks: 'verified', 'contradicted' or 'partly checked'
+        (:attr:`xairl.Verification.status`); a narrative of several outputs (a continuous action's dimensions) takes
+        the worst: contradicted, then partly checked. Left out, it is read from ``verified`` and the sentences.
+    :param coverage: the share of its checkable claims that were checked (:attr:`xairl.Verification.coverage`).
+    :param account: what its features account for of the margin (or score) and what it leaves out
+        (:attr:`xairl.Verification.account`); one per output, joined by ' | ', for several.
     """
 
     text: str
@@ -60,13 +68,34 @@ class Narrative:
     sentences: tuple[tuple[str, str], ...] = ()
     evidence: dict | None = field(default=None, repr=False, compare=False)
     provenance: tuple[Span, ...] = field(default=(), repr=False, compare=False)
+    status: str = ""
+    coverage: float = 1.0
+    account: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.status:
+            said = {st for _, st in self.sentences}
+            worst = "verified" if self.verified else "contradicted" if "contradicted" in said else "partly checked"
+            object.__setattr__(self, "status", worst)
+        elif self.status not in VERDICTS or self.verified != (self.status == "verified"):
+            raise InputError(
+                f"a narrative's status is one of {', '.join(VERDICTS)}, and 'verified' exactly when "
+                f"verified is true; got {self.status!r} with verified={self.verified}."
+            )
 
     def _repr_html_(self) -> str:
         """Jupyter's view: the evidence card of the HTML report (each sentence marked, the state, the waterfall)."""
         meta = html.escape(f"{self.source}, template {self.template}, state {self.index}")
         return f"<style>{CARD_STYLE}</style>" + card_html(
             self.text,
-            self.evidence or {"sentences": [list(s) for s in self.sentences], "confidence": self.confidence},
+            self.evidence
+            or {
+                "sentences": [list(s) for s in self.sentences],
+                "confidence": self.confidence,
+                "status": self.status,
+                "coverage": self.coverage,
+                "account": self.account,
+            },
             meta,
         )
 
@@ -161,6 +190,8 @@ class Narrator:
         reworded = [sum(counts) for counts in zip(*(getattr(w[0], "reworded", (0, 0, 0)) or (0, 0, 0) for w in words))]
         sources = [source for _, _, source, _, _ in words]
         text = joined([(w[0], w[0].spans) for w in words], [" "] * (len(words) - 1))
+        checks = [check for _, check, _, _, _ in words]
+        statuses = {check.status for check in checks}
         return Narrative(
             text=text,
             claims=tuple(c for _, check, _, _, _ in words for c in check.claims),
@@ -175,6 +206,9 @@ class Narrator:
             extras={"method": method, "tries": max(w[4] for w in words)}
             | ({"reworded": tuple(reworded)} if reworded[2] else {}),
             sentences=tuple((s.text, s.status) for _, check, _, _, _ in words for s in check.sentences),
+            status=next(v for v in reversed(VERDICTS) if v in statuses),  # the worst of its outputs'
+            coverage=Verification(tuple(s for check in checks for s in check.sentences)).coverage,
+            account=" | ".join(check.account for check in checks if check.account),
         )
 
     def _words(

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TextIO
 
 from xairl.errors import InputError
+from xairl.explanations.evidence import verdict_of
 from xairl.policies.policy import model_hash
 from xairl.runs.paths import user_dir
 
@@ -32,8 +33,14 @@ CREATE TABLE IF NOT EXISTS narratives (
     status TEXT NOT NULL DEFAULT 'pending' CHECK (status IN ('pending', 'accepted', 'rejected', 'corrected')),
     correction TEXT,
     reviewed REAL,
-    evidence TEXT
+    evidence TEXT,
+    verdict TEXT,
+    coverage REAL,
+    account TEXT
 )"""
+#: columns added after the first release, each with its type: a store from before them gains them when opened (its
+#: rows read the verdict from ``verified`` and their evidence's sentences)
+ADDED = {"evidence": "TEXT", "verdict": "TEXT", "coverage": "REAL", "account": "TEXT"}
 STATUSES = ("accepted", "rejected", "corrected")
 
 
@@ -47,9 +54,21 @@ class Record:
     claims: list
     verified: bool
     confidence: float
-    status: str
+    status: str  # the operator's: pending, accepted, rejected or corrected
     correction: str | None
     evidence: dict | None = None  # xairl.explanations.evidence.evidence(): the state, contributions, sentence statuses
+    verdict: str = ""  # the verifier's: verified, contradicted or partly checked
+    coverage: float | None = None  # the share of the text's claims that were checked (None: not recorded)
+    account: str = ""  # what its features account for of the margin, and what it leaves out
+
+
+def _record(r: tuple) -> Record:
+    """A row as a :class:`Record`; a row from before the three verdicts reads its verdict from ``verified`` and its
+    evidence's sentences (:func:`xairl.explanations.evidence.verdict_of`)."""
+    ev = json.loads(r[10]) if r[10] else None
+    verdict = r[11] or verdict_of({**(ev or {}), "verified": bool(r[6])})
+    coverage = r[12] if r[12] is not None else (ev or {}).get("coverage")
+    return Record(*r[:5], json.loads(r[5]), bool(r[6]), *r[7:10], ev, verdict, coverage, r[13] or "")
 
 
 class FeedbackStore:
@@ -68,8 +87,10 @@ class FeedbackStore:
         try:
             with self._tx() as db:
                 db.execute(SCHEMA)
-                if "evidence" not in {row[1] for row in db.execute("PRAGMA table_info(narratives)")}:
-                    db.execute("ALTER TABLE narratives ADD COLUMN evidence TEXT")  # a store from before 0.3
+                have = {row[1] for row in db.execute("PRAGMA table_info(narratives)")}
+                for column, kind in ADDED.items():
+                    if column not in have:  # a store from before it
+                        db.execute(f"ALTER TABLE narratives ADD COLUMN {column} {kind}")
         except sqlite3.DatabaseError as exc:
             raise InputError(
                 f"{self.path}: not a usable feedback store ({exc}); move it away or pass another path."
@@ -112,12 +133,15 @@ class FeedbackStore:
             int(narrative.verified),
             narrative.confidence,
             json.dumps(ev) if ev is not None else None,
+            getattr(narrative, "status", None) or ("verified" if narrative.verified else None),
+            getattr(narrative, "coverage", None),
+            getattr(narrative, "account", ""),
         )
         with self._tx() as db:
             cur = db.execute(
                 "INSERT INTO narratives (created, policy, model_hash, template, source, method, "
-                "state_index, text, claims, verified, confidence, evidence) "
-                "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)",
+                "state_index, text, claims, verified, confidence, evidence, verdict, coverage, account) "
+                "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
                 row,
             )
             return int(cur.lastrowid)
@@ -127,27 +151,14 @@ class FeedbackStore:
         try:
             q = (
                 "SELECT id, policy, template, source, text, claims, verified, confidence, status, correction, "
-                "evidence FROM narratives" + (" WHERE status = ?" if status else "") + " ORDER BY id"
+                "evidence, verdict, coverage, account FROM narratives"
+                + (" WHERE status = ?" if status else "")
+                + " ORDER BY id"
             )
             rows = db.execute(q, (status,) if status else ()).fetchall()
         finally:
             db.close()
-        return [
-            Record(
-                r[0],
-                r[1],
-                r[2],
-                r[3],
-                r[4],
-                json.loads(r[5]),
-                bool(r[6]),
-                r[7],
-                r[8],
-                r[9],
-                json.loads(r[10]) if r[10] else None,
-            )
-            for r in rows
-        ]
+        return [_record(r) for r in rows]
 
     def review(self, record_id: int, status: str, correction: str | None = None) -> None:
         """Mark a narrative accepted, rejected or corrected (with the operator's text)."""

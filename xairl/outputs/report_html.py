@@ -65,16 +65,17 @@ def _figures_body(exps, figures) -> tuple[str, list[tuple[str, str]]]:
 def _narratives_body(narratives) -> str:
     """The narrated decisions' HTML: what the marks mean, then one card a narrative."""
     body = (
-        "<p class=meta>Each sentence is marked &#10003; verified, &#10007; contradicted or ? unchecked (no "
-        "claim the verifier could check); the waterfall builds the margin of the chosen action over the "
-        "runner-up (the score, when nothing is chosen) from its background average, feature by feature.</p>"
+        "<p class=meta>Each sentence is marked &#10003; verified, &#10007; contradicted or ? unchecked (a claim "
+        "the verifier could not check). Each narrative's verdict is <b>verified</b> (every claim checked, and "
+        "true), <b>contradicted</b> (a claim is false) or <b>partly checked</b> (nothing false; the coverage is "
+        "the share of its claims checked); beside it, what the features it names account for of the margin and "
+        "what it leaves out. The waterfall builds the margin of the chosen action over the runner-up (the score, "
+        "when nothing is chosen) from its background average, feature by feature.</p>"
     )
     for n, ev in narratives:
         where = "all states" if n.index is None else f"state {n.index}"
-        meta = f"{where} &middot; template {html.escape(n.template)} &middot; {html.escape(n.source)}" + (
-            "" if n.verified else " &middot; <span class=bad>NOT verified</span>"
-        )
-        body += card_html(n.text, ev, meta)
+        meta = f"{where} &middot; template {html.escape(n.template)} &middot; {html.escape(n.source)}"
+        body += card_html(n.text, {**ev, "status": n.status, "coverage": n.coverage, "account": n.account}, meta)
     return body
 
 

@@ -1,6 +1,7 @@
 """``xairl review --serve``: operators review recorded narratives in a local web page, with the evidence beside
 each one (the state, the margin's waterfall, each sentence marked verified / contradicted / unchecked, the
-confidence components), and accept, reject or correct it. Verdicts go to the same SQLite store as the terminal
+verdict: verified, contradicted or partly checked with its coverage, and the account of the margin, the confidence
+components), and accept, reject or correct it. Their decisions go to the same SQLite store as the terminal
 review.
 
 The server is Python's own (http.server), bound to 127.0.0.1 only. Defended against pages on other sites open in
@@ -144,7 +145,12 @@ def _item(r: Record, token: str) -> str:
         f"<textarea name=correction rows=2 cols=70 placeholder='corrected text'></textarea> "
         f"<button name=status value=corrected class=correct>Correct</button></form>"
     )
-    ev = r.evidence or {"sentences": [], "components": {}, "confidence": r.confidence, "verified": r.verified}
+    ev = {
+        **(r.evidence or {"sentences": [], "components": {}, "confidence": r.confidence}),
+        "status": r.verdict,
+        "coverage": r.coverage,
+        "account": r.account or (r.evidence or {}).get("account", ""),
+    }
     return f"<section class=item id='item-{r.id}'>{card_html(r.text, ev, meta, form)}</section>"
 
 

@@ -178,11 +178,14 @@ class UAVReport(xairl.plugin.Report):
         for n, tl in enumerate(lines):
             exp = explain(content.policy, tl.states, background=content.background)
             text, check = narrate_flight(tl, exp, content.policy)
-            mark = "verified" if check.ok else "NOT verified"
-            path = timeline_figure(tl, exp, content.policy, Path(req.out) / f"flight_{n}.png")
-            content.figures.append(
-                (f"Flight at a glance: {tl.label}. {text} [{mark}, coverage {check.coverage:.0%}]", path)
+            # the verdict as every surface says it (verified, contradicted, partly checked with its coverage), then
+            # what the summary's features carry of the importance and what it leaves out
+            mark = check.status + (
+                f" (coverage {100 * check.coverage:.0f} %)" if check.status == "partly checked" else ""
             )
+            path = timeline_figure(tl, exp, content.policy, Path(req.out) / f"flight_{n}.png")
+            said = f"; {check.account}" if check.account else ""
+            content.figures.append((f"Flight at a glance: {tl.label}. {text} [verdict: {mark}{said}]", path))
 
     def _table_one(self, ckpt: Checkpoint, seed: int) -> tuple[tuple[str, str], list[str]]:
         """Table I with bootstrap 95 % intervals (table.py), and in words where the DQN loses to CHM; and a note
