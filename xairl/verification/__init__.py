@@ -52,4 +52,4 @@ def verify(
         # (the spans of several dimensions do not say which one: narrate checks each; a text whose spelling
         # normalisation changes was not rendered as it stands, so its offsets would not hold)
         return prose.read(text, explanation, index, policy, facts)
-    return own.verify(text, explanation, index, policy, facts, provenance, prose.reader)
+    return own.verify(text, explanation, index, policy, facts, provenance)

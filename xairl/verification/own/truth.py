@@ -13,8 +13,7 @@ from xairl.explanations.explanation import Explanation
 from xairl.facts import DomainFacts, decision_facts, global_facts
 from xairl.policies.policy import Policy
 from xairl.templates.tracking import Span
-from xairl.verification.own.lexicon import EXTRA_DIRECTIONS, KINDS, NUMBER, NUMERIC
-from xairl.verification.prose.checks import DIRECTION_RE
+from xairl.verification.own.lexicon import KINDS, NUMBER, NUMERIC
 from xairl.verification.result import Claim
 
 
@@ -175,29 +174,26 @@ def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
         return Claim("number", span.text, "verified" if ok else "contradicted", detail, "tracked.fact")
     if expected is None:  # e.g. the fill of a feature without a capacity, printed as 'None'
         return Claim(kind, span.text, "unchecked", f"{f.quantity} of {f.feature}: none", "tracked.fact")
+    if f.quantity in CLAIMS:  # a declared claim word: its fact says which way, whatever the author's words
+        said = f.value if f.value is not None else span.text
+        if _words_similar(span.text, expected) or span.text.strip().lower() not in CANONICAL:
+            ok = _words_similar(said, expected)
+        else:  # a canonical word ('toward', 'high') printed for another fact ('|replace' keeps the fact)
+            ok = False
+        return Claim(
+            kind, span.text, "verified" if ok else "contradicted", f"{f.quantity} = {expected}", "tracked.fact"
+        )
     accepted = [expected]
     if f.quantity == "name":  # its name or its label (description)
         accepted += [
             getattr(v, "label", None) or (v.get("label") if isinstance(v, dict) else None)
             for v in truth.features.get(f.feature, {}).values()
         ]
-    elif f.quantity == "level":
-        accepted += [getattr(v, "level", None) for v in truth.features.get(f.feature, {}).values()]
-    elif f.quantity in ("direction", "direction_high", "direction_low"):
-        said = _polarity(span.text)
-        if said and expected in ("toward", "against"):
-            accepted.append(span.text if said == (1 if expected == "toward" else -1) else None)
     ok = any(a is not None and _words_similar(span.text, a) for a in accepted)
     return Claim(kind, span.text, "verified" if ok else "contradicted", f"{f.quantity} = {expected}", "tracked.fact")
 
 
-def _polarity(word: str) -> int:
-    """+1 for a word that raises ('raised', 'toward', 'up'), -1 for one that lowers, 0 for neither."""
-    m = DIRECTION_RE.search(word) or EXTRA_DIRECTIONS.search(word)
-    if m is None:
-        return (
-            1
-            if re.fullmatch(r"\W*(?:up|higher|more|for)\W*", word, re.I)
-            else (-1 if re.fullmatch(r"\W*(?:down|lower|less)\W*", word, re.I) else 0)
-        )
-    return 1 if m.groupdict().get("pos") or m.groupdict().get("for") else -1
+#: the quantities of a claim word (declared by a filter): checked by the fact's value, never by the word
+CLAIMS = frozenset({"direction", "direction_high", "direction_low", "level", "trend"})
+#: the words a fact prints itself ('{{ f.direction }}'): printed for another fact, they are wrong
+CANONICAL = frozenset({"toward", "against", "mixed", "low", "typical", "high", "moderate", "rose", "fell", "steady"})
