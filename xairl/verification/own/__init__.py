@@ -10,12 +10,11 @@ own words (``dir('grew', 'shrank')``, Spanish) need no word list. What is left, 
   (:func:`xairl.verification.claims.claim_words`): its sentence is unchecked, never verified nor contradicted;
 - a label, a sign word, a view or a trend word right beside a tracked number is judged against it (adjacency:
   ``score=`` before the margin, '+0.46 to the score' for a contribution to the margin);
-- a counterfactual sentence is re-run through the policy (:mod:`xairl.verification.counterfactual`).
+- a counterfactual sentence is re-run through the policy (:mod:`xairl.verification.own.counterfactual`).
 """
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Sequence
 from dataclasses import replace
@@ -26,7 +25,7 @@ from xairl.policies.policy import Policy
 from xairl.policies.regions import in_regions
 from xairl.templates.tracking import Span
 from xairl.verification.claims import claim_words
-from xairl.verification.counterfactual import check_counterfactual, is_counterfactual
+from xairl.verification.own.counterfactual import check_counterfactual, is_counterfactual
 from xairl.verification.own.lexicon import NUMBER, NUMERIC, SAID_OF_FEATURE
 from xairl.verification.own.parts import Part
 from xairl.verification.own.spans import Sentence
@@ -87,21 +86,23 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, names: Se
         if q == "score" and p.span.fact.role:
             extra.append(s.role(p))
         claims += [c for c in extra if c is not None]
-    if not counterfactual:  # (a counterfactual's words are its check's to judge)
-        claims += undeclared(sentence, s.spans, len(truth.features), names)
+    claims += undeclared(sentence, s.spans, len(truth.features), names, numbers_only=bool(counterfactual))
     return claims
 
 
-def undeclared(sentence: str, spans: Sequence[Part], n_features: int, names: Sequence[str] = ()) -> list[Claim]:
+def undeclared(
+    sentence: str, spans: Sequence[Part], n_features: int, names: Sequence[str] = (), numbers_only: bool = False
+) -> list[Claim]:
     """The claims a template wrote itself, outside every tracked span: claim words, names and identifiers
-    (:func:`~xairl.verification.claims.claim_words`), and numbers other than a small count ('the top 3')."""
+    (:func:`~xairl.verification.claims.claim_words`), and numbers other than a small count ('the top 3'). Of a
+    counterfactual sentence (``numbers_only``) only the numbers: its words are its re-run's to judge."""
     blank = list(sentence)
     for p in spans:
         blank[p.start : p.end] = " " * (p.end - p.start)
     words = "".join(blank)
     out = [
         Claim(w.kind, w.word, "unchecked", f"'{w.word}' is a claim the template wrote itself: {w.use}", UNDECLARED)
-        for w in claim_words(words, names)
+        for w in ([] if numbers_only else claim_words(words, names))
     ]
     for m in NUMBER.finditer(words):
         x = number(m.group())
