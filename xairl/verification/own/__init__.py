@@ -85,6 +85,18 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, names: Se
             extra.append(s.base(p))
         if q == "score" and p.span.fact.role:
             extra.append(s.role(p))
+        if counterfactual and q in DECISION_NUMBERS:
+            what = q.replace("_", " ")
+            extra.append(
+                Claim(
+                    "number",
+                    p.span.text,
+                    "unchecked",
+                    f"the decision's {what}, in a sentence about the "
+                    "counterfactual: print the counterfactual's (counterfactual.margin)",
+                    UNDECLARED,
+                )
+            )
         claims += [c for c in extra if c is not None]
     claims += undeclared(sentence, s.spans, len(truth.features), names, numbers_only=bool(counterfactual))
     return claims
@@ -121,6 +133,8 @@ def undeclared(
 
 
 UNDECLARED = "tracked.undeclared"
+#: the decision's own numbers: in a counterfactual sentence they read as the counterfactual's
+DECISION_NUMBERS = frozenset({"margin", "score", "base_value", "base_margin"})
 
 
 def _names(truth: Truth, policy: Policy | None) -> tuple[str, ...]:

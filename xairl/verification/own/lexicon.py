@@ -38,6 +38,7 @@ KINDS = {
     "extra": "number",
 }
 SAID_OF_FEATURE = {
+    "direction",
     "value",
     "value_text",
     "fill",
