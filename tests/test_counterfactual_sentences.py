@@ -82,6 +82,8 @@ def line():
         ),  # fmt: skip
         # (right, but the reader of untracked words takes a number after a feature's name for its state's value)
         ("Had the queue been below 19.9 % full (it was 80 % full), " + THEN, "unchecked"),  # (numbers written in)
+        # the decision's margin printed as the counterfactual's (issue 65: 10.7 for 0.0017)
+        (HAD + "the policy would have chosen {{ cf.action }} (margin {{ q_margin|num }}).", "unchecked"),
     ],
 )
 def test_the_sentence_is_read_by_its_words(line, sentence, status):
