@@ -23,7 +23,7 @@ from xairl.facts import decision_facts
 from xairl.narrators.base import first_phrasings
 from xairl.templates import prompts
 from xairl.templates.tracking import track_decision
-from xairl.verification.own import verify
+from xairl.verification import verify
 
 
 def last_sentence(name: str):

@@ -75,7 +75,7 @@ def _exp():
 
 
 def verify_times() -> tuple[float, float, float]:
-    from xairl.narrators.verify import verify
+    from xairl.verification import verify
 
     exp = _exp()
     verify("odor adds 0.15.", exp, 0)  # warm: the parser

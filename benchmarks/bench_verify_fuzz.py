@@ -30,7 +30,7 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 import xairl  # noqa: E402
-from xairl.narrators.verify import verify  # noqa: E402
+from xairl.verification import verify  # noqa: E402
 
 
 def _explanation(names, actions=("out",), seed=0):

@@ -20,7 +20,7 @@ from xairl.narrators.base import first_phrasings
 from xairl.templates import prompts
 from xairl.templates.tracking import track_decision
 from xairl.values import fill_and_text
-from xairl.verification.own import verify
+from xairl.verification import verify
 
 CAP = 200.0  # the linear policy's queue capacity (kbit): its fill is said in % of it
 

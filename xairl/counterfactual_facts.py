@@ -9,7 +9,7 @@ with no direction word ('been -34 dB', not 'below -34 dB' where -34 dB is the fl
 written is then run through the policy (all candidates in one batch, its action mask honoured); the first one that
 still takes the search's action is the fact (else the first that takes any other action than the one taken: the
 words name what the policy does there), with the action and the margin of that re-run. What a template prints is
-therefore exactly what the verifier re-runs (:mod:`xairl.verification.counterfactual`). A candidate must
+therefore exactly what the verifier re-runs (:mod:`xairl.verification.own.counterfactual`). A candidate must
 also keep the state one the world allows as written (:func:`broken`: the policy's ``feasible``, the declared bounds,
 no immutable feature changed): rounding away from the line may step off the searched point. None of the candidates
 flipping as written (a line that bends within one rounding step) leaves the fact out: no sentence rather than a

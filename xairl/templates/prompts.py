@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
@@ -24,8 +24,9 @@ from xairl.errors import UnknownNameError, XairlError, validation_message
 from xairl.numbers import format_number
 from xairl.runs.paths import user_dir
 from xairl.templates import sandbox
+from xairl.templates.claim_filters import FILTERS as CLAIM_FILTERS
 from xairl.templates.sandbox import MAX_LOOP_DEPTH, loop_depth
-from xairl.templates.tracking import Rendered, TrackedFloat, TrackedInt, TrackedStr, recording, untangle
+from xairl.templates.tracking import Rendered, TrackedFloat, TrackedInt, recording, untangle
 
 DECISION_VARS = {
     "index",
@@ -111,16 +112,6 @@ def _cap(t) -> str:
     return s[:i] + s[i : i + 1].upper() + s[i + 1 :] if plain.isalpha() and plain.islower() else s
 
 
-def _dir(x, toward: str = "toward", against: str = "against") -> str:
-    """``toward`` for a number >= 0, else ``against``; of a tracked number, a tracked direction word (its fact is the
-    number's feature and view, so the verifier judges the word against that feature's sign)."""
-    word = str(toward if x >= 0 else against)
-    if isinstance(x, (TrackedFloat, TrackedInt)):
-        direction = "toward" if x >= 0 else "against"
-        return str(TrackedStr(word, replace(x.fact, quantity="direction", value=direction)))
-    return word
-
-
 def _join(value, d: str = "", attribute=None) -> str:
     """Jinja's ``join``, with each item as it prints (a tracked value keeps its fact)."""
     items = list(value)
@@ -136,11 +127,13 @@ TRACKING = ("fact", "transform", "printed")
 
 def environment() -> ImmutableSandboxedEnvironment:
     """A fresh bounded sandbox (:mod:`xairl.templates.sandbox`) with the template filters: ``num`` and ``signed`` write numbers
-    as :func:`format_number` does, ``cap`` capitalises the first letter, ``dir('raised', 'lowered')`` writes the
-    first word for a number >= 0 and the second for a negative one (default 'toward' / 'against'). Each keeps the
-    fact of a tracked value (:mod:`xairl.templates.tracking`)."""
+    as :func:`format_number` does, ``cap`` capitalises the first letter, and the claim filters
+    (:mod:`xairl.templates.claim_filters`) write the author's word for a claim: ``dir('raised', 'lowered')`` the first
+    word for a number >= 0 and the second for a negative one, ``level('low', 'typical', 'high')``, ``rank('first',
+    'second', other='')``, ``cmp(other, 'more', 'less')`` and ``role('chose', 'came second')``. Each keeps the fact
+    of a tracked value (:mod:`xairl.templates.tracking`)."""
     return sandbox.environment(
-        {"num": _num, "signed": lambda x: _num(x, True), "cap": _cap, "dir": _dir, "join": _join},
+        {"num": _num, "signed": lambda x: _num(x, True), "cap": _cap, "join": _join} | CLAIM_FILTERS,
         hidden=TRACKING,
     )
 

@@ -33,11 +33,20 @@ class Fact:
         'fill' as a percentage of its capacity, 'level' its level word), 'contribution', 'share', 'rank',
         'direction', 'action', 'score', 'margin', 'base_value', 'base_margin', 'gap', 'comparison' (a domain fact's
         text; 'comparison_value' its number), 'extra' (a plugin's named value), 'mean_abs', 'mean' (a global
-        summary's), 'n_states', 'method', 'index', 'unit', 'kind', 'target'.
+        summary's), 'n_states', 'method', 'index', 'unit', 'kind', 'target'; a counterfactual's 'cf_<field>'
+        (:func:`track_counterfactual`). A *claim word* printed by a claim filter (:mod:`xairl.templates.claim_filters`)
+        is the author's word, and its fact has ``of`` set: 'direction' (``dir``: value 'toward' or 'against', the sign
+        of the quantity ``of`` of the feature, view and role; 'direction_high' / 'direction_low' keep theirs), 'level'
+        (``level``: value 'low', 'typical', 'high' or 'unknown'), 'rank' (``rank``: value the rank), 'comparison'
+        (``cmp``: value 'more', 'less' or 'same', the feature's |contribution| against that of the feature named in
+        ``role``; a domain comparison's fact has ``of`` None), 'role' (``role``: value the action's name, ``role``
+        'chosen', 'runner_up', 'only' or 'counterfactual').
     :param feature: the feature (or group) it is about; for 'extra' the key; else None.
     :param view: 'score' (the chosen action's score, or the output), 'margin' (over the runner-up) or None.
-    :param role: for an action and its score: 'chosen' or 'runner_up'.
+    :param role: for an action and its score: 'chosen' or 'runner_up'; for a claim word, see ``quantity``.
     :param value: the fact's value when it was rendered.
+    :param of: for a claim word, the quantity of the tracked value its filter read ('contribution', 'margin',
+        'level', 'rank', 'action', 'cf_action', ...); None for a value printed as it is.
     """
 
     quantity: str
@@ -45,6 +54,7 @@ class Fact:
     view: str | None = None
     role: str | None = None
     value: object = None
+    of: str | None = None
 
 
 @dataclass(frozen=True)

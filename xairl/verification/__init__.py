@@ -53,7 +53,7 @@ def verify(
         # normalisation changes was not rendered as it stands, so its offsets would not hold)
         result = prose.read(text, explanation, index, policy, facts)
     else:
-        result = own.verify(text, explanation, index, policy, facts, provenance, prose.reader)
+        result = own.verify(text, explanation, index, policy, facts, provenance)
     # what the text's features account for of the margin, and what it leaves out (issue 65: beside the coverage)
     from dataclasses import replace
 

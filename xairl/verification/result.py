@@ -37,7 +37,7 @@ class Claim:
 CHECKED = frozenset(
     {"number", "direction", "rank", "action", "category", "magnitude", "level", "comparison", "role", "text"}
 )
-#: the rule of a counterfactual sentence's claims (:mod:`xairl.verification.counterfactual`)
+#: the rule of a counterfactual sentence's claims (:mod:`xairl.verification.own.counterfactual`)
 COUNTERFACTUAL = "tracked.counterfactual"
 VERDICTS = ("verified", "contradicted", "partly checked")
 

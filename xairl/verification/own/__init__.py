@@ -1,26 +1,20 @@
-"""Verification of xairl's own words by provenance.
+"""Verification of xairl's own words by provenance: a lookup, never a reading.
 
-A narrative xairl rendered carries, for every value it printed, the fact it came from (:mod:`xairl.templates.tracking`). A
-tracked span *is* its fact: it is checked against the explanation (recomputed, never trusted) and never re-bound by
-its position. What is left, the template's (or the language model's) literal words, is judged against the tracked
-spans of its sentence by the rules of :data:`RULES`:
+A narrative xairl rendered carries, for every value it printed, the fact it came from (:mod:`xairl.templates.tracking`).
+A tracked span *is* its fact: it is checked against the explanation (recomputed, never trusted) and never re-bound to
+another name by its position. A claim word (a direction, level, rank, comparison or an action's role) is declared
+through a template filter (``dir``, ``level``, ``rank``, ``cmp``, ``role``): its fact says which way, so the author's
+own words (``dir('grew', 'shrank')``, Spanish) need no word list. What is left, the template's literal words:
 
-- a number said of another feature than the one named before it (crossed numbers), a value written without its
-  sign, an action named in the wrong role ('chose' the runner-up), a label beside a value that is not its quantity
-  (``score=`` before the margin), a direction word against its feature's sign, a rank or comparison word against
-  the tracked facts it joins: each is contradicted;
-- words inside a tracked name never make a claim ('runner-up' is not the action 'up');
-- a sentence with no tracked span, and any untracked number or identifier in the literal words, is read by the
-  reader of outside prose (:mod:`xairl.narrators.verify`) as before.
-
-How it reads a sentence: the spans are the facts; the literal words between them are cut into segments at
-``; : | ( )``, line breaks, commas and clause words ('but', 'while'), and each rule looks only at the words of its
-segment and the spans around them.
+- a claim word, a name of a feature or action, an identifier or a number the template wrote itself is *undeclared*
+  (:func:`xairl.verification.claims.claim_words`): its sentence is unchecked, never verified nor contradicted;
+- a label, a sign word, a view or a trend word right beside a tracked number is judged against it (adjacency:
+  ``score=`` before the margin, '+0.46 to the score' for a contribution to the margin);
+- a counterfactual sentence is re-run through the policy (:mod:`xairl.verification.own.counterfactual`).
 """
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Sequence
 from dataclasses import replace
@@ -30,12 +24,12 @@ from xairl.facts import DomainFacts
 from xairl.policies.policy import Policy
 from xairl.policies.regions import in_regions
 from xairl.templates.tracking import Span
-from xairl.verification.counterfactual import check_counterfactual, is_counterfactual
-from xairl.verification.own.lexicon import NUMERIC, SAID_OF_FEATURE, SUPERLATIVE
-from xairl.verification.own.parts import Part, literal
+from xairl.verification.claims import claim_words
+from xairl.verification.own.counterfactual import check_counterfactual, is_counterfactual
+from xairl.verification.own.lexicon import NUMBER, NUMERIC, SAID_OF_FEATURE
+from xairl.verification.own.parts import Part
 from xairl.verification.own.spans import Sentence
-from xairl.verification.own.truth import Truth, check_fact, close, number, truth
-from xairl.verification.prose.checks import DIRECTION_RE
+from xairl.verification.own.truth import Truth, check_fact, number, truth
 from xairl.verification.result import Claim, SentenceCheck, Verification
 from xairl.verification.text import bidi_claims, bidi_note, sentences
 
@@ -45,16 +39,15 @@ __all__ = ["RULES", "Truth", "check_fact", "check_sentence", "truth", "verify"]
 RULES = {
     "tracked.fact": "a tracked number or word is its fact's value as printed (with the template's transformation)",
     "tracked.unknown": "a tracked span whose fact is not in the explanation (an unknown feature, action or view)",
-    "tracked.binding": "a tracked number of one feature printed where the words say it is another's",
+    "tracked.binding": "a tracked number of one feature printed beside another feature's name (unchecked: binding by "
+    "position never contradicts)",
+    "tracked.trend": "a number after a trend word ('fell 4.1 dB') that is no change over the window, or of the other sign",
     "tracked.sign": "a feature's value printed without its sign, and no word that carries the sign",
     "tracked.label": "a label beside a tracked number ('score=', 'margin of') that is not its quantity",
     "tracked.view": "'to the margin' / 'to the score' beside a contribution of the other view",
-    "tracked.role": "an action named with words of the other role ('chose' the runner-up)",
-    "tracked.direction": "a direction word ('raised', 'against', 'favoured B') against its feature's sign",
-    "tracked.rank": "a rank word ('most', 'biggest', 'second') against the rank of the feature it names",
-    "tracked.level": "a level word ('low', 'normal', 'high') against the level of the feature it is said of",
-    "tracked.untracked": "a number the template wrote itself that the reader cannot bind and that is no fact of the decision",
-    "tracked.comparison": "'A mattered more than B' against the sizes of their contributions",
+    "tracked.role": "a score printed beside the other action ('turn (score 1.85)' with 1.85 the runner-up's)",
+    "tracked.undeclared": "a claim word, name, identifier or number the template wrote itself (not through a filter): "
+    "the sentence is unchecked",
     "tracked.counterfactual": "a counterfactual ('had X been below v, it would have chosen B') re-run: the policy on "
     "the stated values takes another action than it did, the stated one, by the stated margin",
 }
@@ -62,20 +55,20 @@ RULES = {
 
 def _claimy(span: Span) -> bool:
     """A name that carries claims of its own ('speed, the most important feature, pushing toward go by +9.99' as a
-    description): not trusted as a name, its words are read like any other."""
+    description): not trusted as a name, its words are literal words like any other."""
     return (
         span.fact.quantity in ("name", "action")
         and bool(re.search(r"[,;]", span.text))
-        and bool(DIRECTION_RE.search(span.text) or SUPERLATIVE.search(span.text) or re.search(r"\d", span.text))
+        and bool(re.search(r"\d", span.text) or any(w.kind != "name" for w in claim_words(span.text)))
     )
 
 
-def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, read, smuggled: bool = False) -> list[Claim]:
-    """The claims of one sentence of an own narrative: its tracked spans by their facts, its literal words by the
-    rules of this module, and its untracked numbers and identifiers by the reader (``read``: sentence -> claims;
-    every claim it makes of the untracked words when ``smuggled``: a name that carried claims was left untracked)."""
+def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, names: Sequence[str] = ()) -> list[Claim]:
+    """The claims of one sentence of an own narrative: its tracked spans by their facts and the literal words right
+    beside them; a counterfactual by re-running it; any claim word the template wrote itself is undeclared."""
     s = Sentence(sentence, spans, truth)
-    claims = check_counterfactual(s, [p for p in s.spans if is_counterfactual(p)], truth)
+    counterfactual = [p for p in s.spans if is_counterfactual(p)]
+    claims = check_counterfactual(s, counterfactual, truth)
     for p in s.spans:
         if is_counterfactual(p):
             continue
@@ -90,55 +83,70 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, read, smu
             extra += [s.label(p), s.trend(p)]
         if q in ("base_value", "base_margin"):
             extra.append(s.base(p))
-        if q in ("action", "score") and p.span.fact.role:
+        if q == "score" and p.span.fact.role:
             extra.append(s.role(p))
+        if counterfactual and q in DECISION_NUMBERS:
+            what = q.replace("_", " ")
+            extra.append(
+                Claim(
+                    "number",
+                    p.span.text,
+                    "unchecked",
+                    f"the decision's {what}, in a sentence about the "
+                    "counterfactual: print the counterfactual's (counterfactual.margin)",
+                    UNDECLARED,
+                )
+            )
         claims += [c for c in extra if c is not None]
-    claims += s.directions() + s.levels() + s.ranks() + s.comparisons()
-    words = literal(sentence, s.parts, 0, len(sentence))
-    if smuggled or re.search(r"\d|[A-Za-z][A-Za-z0-9]*_[A-Za-z0-9]", words):  # an untracked number or identifier
-        named = {p.span.fact.feature for p in s.names}
-        claims += [_own(c, truth, named) for c in read(sentence) if _untracked(c, sentence, s.spans, smuggled)]
+    claims += undeclared(sentence, s.spans, len(truth.features), names, numbers_only=bool(counterfactual))
     return claims
 
 
-def _own(c: Claim, truth: Truth, named: set[str] = frozenset()) -> Claim:
-    """A reader's claim in an own narrative: a number the template wrote itself that the reader leaves unchecked
-    must at least be one of the decision's own numbers (a score, the margin, a base value), a fact of a feature
-    the sentence names, or a count or rank (a whole number up to the number of features); one that is none of them
-    is made up, and contradicted."""
-    if c.kind != "number" or c.status != "unchecked":
-        return c
-    printed = number(c.text)
-    facts = [
-        float(v)
-        for (quantity, feature, _, _), v in truth.values.items()
-        if isinstance(v, (int, float))
-        and not isinstance(v, bool)
-        and (feature is None or feature in named)
-        and quantity not in ("extra",)
+def undeclared(
+    sentence: str, spans: Sequence[Part], n_features: int, names: Sequence[str] = (), numbers_only: bool = False
+) -> list[Claim]:
+    """The claims a template wrote itself, outside every tracked span: claim words, names and identifiers
+    (:func:`~xairl.verification.claims.claim_words`), and numbers other than a small count ('the top 3'). Of a
+    counterfactual sentence (``numbers_only``) only the numbers: its words are its re-run's to judge."""
+    blank = list(sentence)
+    for p in spans:
+        blank[p.start : p.end] = " " * (p.end - p.start)
+    words = "".join(blank)
+    out = [
+        Claim(w.kind, w.word, "unchecked", f"'{w.word}' is a claim the template wrote itself: {w.use}", UNDECLARED)
+        for w in ([] if numbers_only else claim_words(words, names))
     ]
-    whole = printed is not None and printed == int(printed) and 0 < printed <= max(len(truth.features), 3)
-    if printed is None or whole or any(close(abs(printed), abs(v), c.text) for v in facts if math.isfinite(v)):
-        return c
-    return Claim(
-        "number",
-        c.text,
-        "contradicted",
-        f"not taken from the facts, and none of this decision's numbers ({c.detail})",
-        "tracked.untracked",
-    )
+    for m in NUMBER.finditer(words):
+        x = number(m.group())
+        if x is not None and x == int(x) and 0 < x <= max(n_features, 3) and "." not in m.group():
+            continue  # a count or a list's number
+        out.append(
+            Claim(
+                "number",
+                m.group(),
+                "unchecked",
+                "a number the template wrote itself: print it from the facts",
+                UNDECLARED,
+            )
+        )
+    return out
 
 
-def _untracked(c: Claim, sentence: str, spans: list[Part], any_kind: bool = False) -> bool:
-    """A reader's claim about words outside every tracked span (a number or name the template wrote itself)."""
-    if (c.kind not in ("number", "feature", "action") and not any_kind) or not c.text:
-        return False
-    at = sentence.find(c.text)
-    while at >= 0:
-        if not any(p.start <= at < p.end or at <= p.start < at + len(c.text) for p in spans):
-            return True
-        at = sentence.find(c.text, at + 1)
-    return False
+UNDECLARED = "tracked.undeclared"
+#: the decision's own numbers: in a counterfactual sentence they read as the counterfactual's
+DECISION_NUMBERS = frozenset({"margin", "score", "base_value", "base_margin"})
+
+
+def _names(truth: Truth, policy: Policy | None) -> tuple[str, ...]:
+    """The names a literal word may be: every feature's name and label, every action's."""
+    out = list(truth.features) + [a for a in truth.actions.values() if a]
+    for views in truth.features.values():
+        for f in views.values():
+            label = getattr(f, "label", None) or (f.get("label") if isinstance(f, dict) else None)
+            out += [label] if label else []
+    if policy is not None:
+        out += list(policy.action_names or ()) + list(policy.feature_names or ())
+    return tuple(dict.fromkeys(str(n) for n in out))
 
 
 def verify(
@@ -148,38 +156,30 @@ def verify(
     policy: Policy | None,
     facts: DomainFacts | None,
     provenance: Sequence[Span],
-    reader,
 ) -> Verification:
     """Check every claim of an own narrative ``text`` against the explanation of state ``index`` (``None``: the
-    global view), each tracked span (``provenance``) by its fact and the words around it by their sentence's spans
-    (module doc). ``reader(exp, index, policy, facts)`` gives the reader of one untracked sentence."""
+    global view): each tracked span (``provenance``) by its fact, the words around it as the module doc says."""
     index = None if index is None else explanation.check_index(index)
     claimy = [s for s in provenance if _claimy(s)]
     provenance = [s for s in provenance if not _claimy(s)]
-    exp = in_regions(explanation)
-    book = truth(exp, index, policy, facts)
-    readers = []
-
-    def read(sentence: str) -> list[Claim]:  # the reader of outside prose, set up only when a sentence needs it
-        if not readers:
-            readers.append(reader(exp, index, policy, facts))
-        return readers[0](sentence)
-
+    book = truth(in_regions(explanation), index, policy, facts)
+    names = _names(book, policy)
     checks, header = [], None
     for a, b in sentences(text):
         own = [s.shifted(-a) for s in provenance if a <= s.start and s.end <= b]
         sentence = text[a:b]
-        smuggled = any(a <= s.start < b for s in claimy)
         header, labelled = _table_row(sentence, own, header)
         if labelled is not None:  # a table's row, each cell read after its column's header ('chosen: turn')
             sentence_read, spans_read, back = labelled
-            claims = check_sentence(sentence_read, spans_read, book, read, smuggled)
+            claims = check_sentence(sentence_read, spans_read, book, names)
             claims = [replace(c, span=back.get(id(c.span), c.span)) for c in claims]
         else:
-            claims = (
-                check_sentence(sentence, own, book, read, smuggled) if own else [_own(c, book) for c in read(sentence)]
-            )
+            claims = check_sentence(sentence, own, book, names)
         claims = [replace(c, span=c.span.shifted(a)) if c.span is not None else c for c in claims]
+        if any(a <= s.start < b for s in claimy):
+            claims.append(
+                Claim("feature", sentence.strip()[:80], "unchecked", "a name that holds claims of its own", UNDECLARED)
+            )
         checks.append(SentenceCheck(sentence.strip(), (*bidi_claims(sentence), *claims)))
     return Verification(tuple(checks), bidi_note(text))
 

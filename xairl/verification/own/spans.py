@@ -1,5 +1,7 @@
-"""One sentence of an own narrative: its tracked spans, and the rules that tie each span to the words around it
-(binding, sign, label, view, role, base); :class:`WordRules` reads the rest of the words."""
+"""One sentence of an own narrative: its tracked spans, and the rules that tie each span to the literal words right
+beside it (sign, label, view, trend, a score's action, base) or to its feature's name (binding). No rule reads a
+claim word: a claim word is declared through a template filter (its fact checks it), and a literal one leaves the
+sentence unchecked (:func:`xairl.verification.own.undeclared`)."""
 
 from __future__ import annotations
 
@@ -12,16 +14,12 @@ from xairl.verification.own.lexicon import (
     AS_CONTRIBUTION,
     BASE_WORDS,
     CELL_SCORE,
-    CHOSEN_AFTER,
-    CHOSEN_BEFORE,
     DIFFERENCE,
     LABEL_FITS,
     LABELS,
     LESS,
     MORE,
     NUMERIC,
-    RUNNER_AFTER,
-    RUNNER_BEFORE,
     SCORE_FOR_AFTER,
     SCORE_OF_BEFORE,
     SCORE_SUBJECT,
@@ -34,11 +32,10 @@ from xairl.verification.own.lexicon import (
 )
 from xairl.verification.own.parts import Part, is_name, literal, parts
 from xairl.verification.own.truth import MISSING, Truth, number, view_of
-from xairl.verification.own.words import WordRules
 from xairl.verification.result import Claim
 
 
-class Sentence(WordRules):
+class Sentence:
     """One sentence's tracked spans and literal words, and the rules that judge the words."""
 
     def __init__(self, sentence: str, spans: Sequence[Span], truth: Truth):
@@ -102,11 +99,14 @@ class Sentence(WordRules):
         )
 
     def _crossed(self, p: Part, other: Part) -> Claim:
+        """Which name a value is said of is a binding by position: it may verify, never contradict (a list whose
+        line breaks were lost would read each value as the next name's)."""
         return Claim(
             "number",
             p.span.text,
-            "contradicted",
-            f"{p.span.text} is {p.span.fact.feature}'s {p.span.fact.quantity}, written as {other.span.fact.feature}'s",
+            "unchecked",
+            f"{p.span.text} is {p.span.fact.feature}'s {p.span.fact.quantity}, written next to "
+            f"{other.span.fact.feature}'s name: print it beside its own feature",
             "tracked.binding",
         )
 
@@ -176,7 +176,7 @@ class Sentence(WordRules):
         q = p.span.fact.quantity
         if q not in NUMERIC | {"value_text"}:
             return None
-        before = self.before(p, 24)
+        before = SEGMENT.split(self.before(p, 24))[-1]  # ('+0.46 to the margin, 16.8 %': the share's own segment)
         if DIFFERENCE.match(self.after(p, 20)):  # 'its score was 2.34 higher': a difference, not the score
             return None
         if q in TREND_FITS and self.trend_word(p)[0]:  # 'fell by 4.1 dB': the trend rule judges it
@@ -213,25 +213,10 @@ class Sentence(WordRules):
         return None
 
     def role(self, p: Part) -> Claim | None:
-        """An action named with the other role's words, or a score beside the other action."""
-        role = p.span.fact.role
+        """A score printed beside the other action (the words naming an action's role are declared with ``role``)."""
         if self.truth.output != "actions" or self.truth.actions.get("chosen") == self.truth.actions.get("runner_up"):
             return None
-        if p.span.fact.quantity == "score":
-            return self._score_role(p)
-        before, after = self.before(p, 30), self.after(p, 30)
-        prev = next((q for q in reversed(self.spans) if q.end <= p.start), None)
-        if prev is not None and prev.span.fact.quantity == "action" and re.fullmatch(r"\s+over\s+", before):
-            said = "chosen" if prev.span.fact.role == "runner_up" else "runner_up"  # 'A over B': the other one
-            return None if said == role else self._role_claim(p, role, said)
-        said = (
-            "chosen"
-            if CHOSEN_BEFORE.search(before) or CHOSEN_AFTER.search(after)
-            else "runner_up"
-            if RUNNER_BEFORE.search(before) or RUNNER_AFTER.search(after)
-            else None
-        )
-        return None if said is None or said == role else self._role_claim(p, role, said)
+        return self._score_role(p) if p.span.fact.quantity == "score" else None
 
     @staticmethod
     def _role_claim(p: Part, role: str, said: str) -> Claim:

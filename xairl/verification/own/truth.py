@@ -13,8 +13,7 @@ from xairl.explanations.explanation import Explanation
 from xairl.facts import DomainFacts, decision_facts, global_facts
 from xairl.policies.policy import Policy
 from xairl.templates.tracking import Span
-from xairl.verification.own.lexicon import EXTRA_DIRECTIONS, KINDS, NUMBER, NUMERIC
-from xairl.verification.prose.checks import DIRECTION_RE
+from xairl.verification.own.lexicon import KINDS, NUMBER, NUMERIC
 from xairl.verification.result import Claim
 
 
@@ -144,6 +143,13 @@ def check_fact(span: Span, truth: Truth, after: str = "") -> Claim:
 
 def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
     f = span.fact
+    if getattr(f, "of", None) is not None:  # a declared claim word: its fact says which way, never the word
+        want = _claimed(f, truth)
+        ok = want is not MISSING and want is not None and str(f.value) == str(want)
+        detail = f"{f.quantity} of {f.feature or f.value} = {want if want is not MISSING else 'unknown'}"
+        return Claim(
+            KINDS.get(f.quantity, f.quantity), span.text, "verified" if ok else "contradicted", detail, "tracked.fact"
+        )
     expected = truth.get(span)
     kind = KINDS.get(f.quantity, "number" if f.quantity in NUMERIC else "feature")
     if f.quantity == "value_text":
@@ -175,29 +181,52 @@ def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
         return Claim("number", span.text, "verified" if ok else "contradicted", detail, "tracked.fact")
     if expected is None:  # e.g. the fill of a feature without a capacity, printed as 'None'
         return Claim(kind, span.text, "unchecked", f"{f.quantity} of {f.feature}: none", "tracked.fact")
+    if (
+        f.quantity in CANONICAL_OF
+        and span.text.strip().lower() in CANONICAL
+        and not _words_similar(span.text, expected)
+    ):
+        return Claim(kind, span.text, "contradicted", f"{f.quantity} = {expected}", "tracked.fact")
     accepted = [expected]
     if f.quantity == "name":  # its name or its label (description)
         accepted += [
             getattr(v, "label", None) or (v.get("label") if isinstance(v, dict) else None)
             for v in truth.features.get(f.feature, {}).values()
         ]
-    elif f.quantity == "level":
-        accepted += [getattr(v, "level", None) for v in truth.features.get(f.feature, {}).values()]
-    elif f.quantity in ("direction", "direction_high", "direction_low"):
-        said = _polarity(span.text)
-        if said and expected in ("toward", "against"):
-            accepted.append(span.text if said == (1 if expected == "toward" else -1) else None)
     ok = any(a is not None and _words_similar(span.text, a) for a in accepted)
     return Claim(kind, span.text, "verified" if ok else "contradicted", f"{f.quantity} = {expected}", "tracked.fact")
 
 
-def _polarity(word: str) -> int:
-    """+1 for a word that raises ('raised', 'toward', 'up'), -1 for one that lowers, 0 for neither."""
-    m = DIRECTION_RE.search(word) or EXTRA_DIRECTIONS.search(word)
-    if m is None:
-        return (
-            1
-            if re.fullmatch(r"\W*(?:up|higher|more|for)\W*", word, re.I)
-            else (-1 if re.fullmatch(r"\W*(?:down|lower|less)\W*", word, re.I) else 0)
-        )
-    return 1 if m.groupdict().get("pos") or m.groupdict().get("for") else -1
+#: the facts that print a word of their own ('{{ f.direction }}': 'toward'), and those words: one printed for another
+#: value of its fact ('|replace' keeps the fact) is wrong
+CANONICAL_OF = frozenset({"direction", "direction_high", "direction_low", "level", "trend"})
+CANONICAL = frozenset({"toward", "against", "mixed", "low", "typical", "high", "moderate", "rose", "fell", "steady"})
+
+
+def _claimed(f, truth: Truth):
+    """What a claim word's fact (a claim filter's, :mod:`xairl.templates.claim_filters`) should say, recomputed:
+    the sign of the quantity it read, the feature's level or rank, the larger of two contributions, the action of
+    the role."""
+    view = view_of(f.view)
+    if f.quantity == "role":
+        chosen, runner = truth.actions.get("chosen"), truth.actions.get("runner_up")
+        said = {"chosen": chosen, "runner_up": runner if runner != chosen else MISSING}.get(f.role, MISSING)
+        if f.role == "only":
+            said = chosen if chosen == runner else MISSING
+        return f.value if f.role == "counterfactual" else said  # (a counterfactual's action: its re-run checks it)
+    if f.quantity == "comparison" and f.of == "contribution":
+        a, b = (truth.values.get(("contribution", x, view, None)) for x in (f.feature, f.role))
+        if a is None or b is None:
+            return MISSING
+        return "more" if abs(a) > abs(b) else "less" if abs(a) < abs(b) else "same"
+    if f.quantity == "level":
+        fact = truth.features.get(f.feature, {}).get(view)
+        return getattr(fact, "level", MISSING) if fact is not None else MISSING
+    if f.quantity in ("direction_high", "direction_low") or f.of.startswith("direction"):
+        return truth.values.get((f.of, f.feature, view, None), MISSING)
+    x = truth.values.get((f.of, f.feature, view, f.role), MISSING)
+    if f.quantity == "rank":
+        return x
+    if f.quantity == "direction" and isinstance(x, (int, float, np.floating)) and math.isfinite(x):
+        return "toward" if x >= 0 else "against"
+    return MISSING
