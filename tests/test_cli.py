@@ -184,10 +184,10 @@ def test_verify_trace_names_the_reading_of_each_claim(tmp_path, capsys):
     rc, out, _ = run(
         capsys, "verify", "Speed raised the risk by 0.3 over the last 30 days.", "--explanation", str(path), "--trace"
     )
-    assert rc == 0 and "accurate: yes; ok: yes" in out
+    assert rc == 0 and "verdict: verified" in out
     assert "number.name-before" in out and "parse.counts-other" in out and "it counts 'days'" in out
     rc, out, _ = run(capsys, "verify", "The load lowered it by 0.5.", "--explanation", str(path))
-    assert rc == 1 and out.startswith("[contradicted]") and "accurate: no" in out
+    assert rc == 1 and out.startswith("[contradicted]") and "verdict: contradicted" in out
     rc, _, err = run(capsys, "verify", "x", "--explanation", str(tmp_path / "missing.json"))
     assert rc == 2 and err.count("\n") == 1 and "--explanation" in err
     rc, _, err = run(capsys, "verify", "x", "--explanation", str(path), "--index", "3")
@@ -231,7 +231,7 @@ def test_verify_reads_the_records_that_explain_out_writes(report_dir, capsys):
     verb = "raised" if margin[top] > 0 else "lowered"
     said = f"{top.capitalize()} {verb} the margin by {abs(margin[top]):.2f}. The policy chose {rec['chosen']}."
     rc, out, _ = run(capsys, "verify", said, "--explanation", path, "--index", "1")
-    assert rc == 0 and out.count("[verified]") == 2 and "accurate: yes" in out, out
+    assert rc == 0 and out.count("[verified]") == 2 and "verdict: verified" in out, out
     wrong = f"{top.capitalize()} {verb} the margin by {abs(margin[top]) + 1:.2f}."
     rc, out, _ = run(capsys, "verify", wrong, "--explanation", path, "--index", "1")
     assert rc == 1 and out.startswith("[contradicted]")
@@ -239,6 +239,53 @@ def test_verify_reads_the_records_that_explain_out_writes(report_dir, capsys):
     one_line_error(rc, err, "holds 3 records", "--index 0..2")
     rc, _, err = run(capsys, "verify", said, "--explanation", path, "--index", "3")
     one_line_error(rc, err, "--index 3", "holds 3 record(s)")
+
+
+def test_verify_says_the_verdict_and_its_exit_status_says_which(tmp_path, capsys):
+    """Three verdicts, three exit statuses (issue 65): 0 verified, 1 contradicted, 3 partly checked (with the
+    coverage); 2 stays a usage error. Real texts about the toy policy's decision: its feature pushing hardest against
+    the choice, said rightly, said the wrong way, and said rightly beside a number that is no fact of it. Each run
+    prints the account: the features the text leaves out, with their sum (was: 'accurate: yes; ok: no', exit 0)."""
+    policy = toy_policy()
+    exp = xairl.explain(policy, policy.background(2, seed=3), background=policy.background(40))
+    path = tmp_path / "exp.json"
+    path.write_text(exp.to_json())
+    margin = dict(zip(exp.feature_names, exp.margin()[0]))
+    against = min(margin, key=margin.get)
+    assert margin[against] < 0
+    said = f"{against.capitalize()} lowered the margin by {-margin[against]:.2f}"
+    left_out = sorted((f for f in margin if f != against), key=lambda f: -abs(margin[f]))
+    cases = [
+        (f"{said}.", 0, "verdict: verified"),
+        (f"{against.capitalize()} raised the margin by {-margin[against]:.2f}.", 1, "verdict: contradicted"),
+        (f"{said} while 731 birds flew past.", 3, "verdict: partly checked (coverage 67 %)"),  # 731 is no fact
+    ]
+    for text, code, verdict in cases:
+        rc, out, err = run(capsys, "verify", text, "--explanation", str(path), "--index", "0")
+        assert (rc, err) == (code, ""), out
+        assert verdict in out.splitlines(), out
+        account = next(line for line in out.splitlines() if line.startswith("account: "))
+        assert account.startswith("account: its 1 feature accounts for ") and left_out[0] in account, account
+    with pytest.raises(SystemExit):
+        main(["verify", "--help"])
+    out = capsys.readouterr().out
+    assert "0 verified" in out and "1 contradicted" in out and "3 partly checked" in out
+
+
+@pytest.mark.parametrize("status, code", [("verified", 0), ("contradicted", 1), ("partly checked", 3)])
+def test_verify_exit_status_follows_the_verdict_alone(status, code, tmp_path, capsys, monkeypatch):
+    """The exit status is the verdict's, whatever the reader (a stand-in verification of each verdict)."""
+    import xairl.verification as verification
+    from xairl.verification.result import Claim, SentenceCheck, Verification
+
+    claim = {"verified": "verified", "contradicted": "contradicted", "partly checked": "unchecked"}[status]
+    result = Verification((SentenceCheck("A.", (Claim("number", "1", claim), Claim("number", "2", "verified"))),))
+    monkeypatch.setattr(verification, "verify", lambda *a, **k: result)
+    exp = xairl.explain(toy_policy(), toy_policy().background(1), background=toy_policy().background(10))
+    (tmp_path / "e.json").write_text(exp.to_json())
+    rc, out, _ = run(capsys, "verify", "A.", "--explanation", str(tmp_path / "e.json"))
+    words = {"partly checked": "partly checked (coverage 50 %)"}.get(status, status)
+    assert rc == code and f"verdict: {words}" in out
 
 
 def test_verify_names_a_file_of_narratives_for_what_it_is(tmp_path, capsys):
