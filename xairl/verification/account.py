@@ -79,7 +79,7 @@ def account(explanation: Explanation, index: int | None, features_named: Iterabl
         def share(x: float) -> str:
             return f"{100 * abs(x) / total:.0f} %"
 
-        head = f"{k} carr{'ies' if len(shown) == 1 else 'y'} {share(values[shown].sum())} of the mean |contribution| over {len(exp.values)} states"
+        head = f"{k} carr{'ies' if len(shown) == 1 else 'y'} {share(values[shown].sum())} of the mean |contribution| over {len(exp.values)} state{'s' * (len(exp.values) != 1)}"
         rest = _left_out(values, names, shown, ("are left out", ""), share)
         return "; ".join([head if shown else "it names no feature", *rest])
     c, r = int(exp.focus[index]), int(exp.runner_up[index])
