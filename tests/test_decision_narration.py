@@ -11,6 +11,7 @@ import xairl
 from xairl.errors import InputError
 from xairl.explanations.evidence import card_html, evidence
 from xairl.facts import decision_facts, value_level
+from xairl.verification.result import CHECKED
 
 
 def _policy(**features):
@@ -115,15 +116,26 @@ def test_history_reaches_a_hook_that_takes_it(case):
     assert xairl.narrate(exp, 0, policy=plain, robustness=False, history=np.zeros((4, 5))).verified
 
 
-def test_coverage_lowers_confidence_and_evidence_marks_sentences(case):
-    p, exp = case
-    n = xairl.narrate(exp, 0, policy=p, robustness=False)
-    assert n.components["coverage"] == 1.0 and all(s == "verified" for _, s in n.sentences)
+def test_coverage_is_the_share_of_claims_checked_and_evidence_marks_sentences(case):
+    """The confidence's coverage is the verifier's: the share of the text's claims checked. A sentence that states
+    nothing neither counts nor blocks; a number left unchecked makes the text partly checked, with no confidence."""
     from xairl.narrators.confidence import confidence
 
-    v = xairl.verify(n.text + " It felt right. Nobody objected.", exp, 0, p)
-    lower, comp = confidence(exp, 0, v.ok, xairl.NarrationOptions(policy=p), coverage=v.coverage)
-    assert v.ok and comp["coverage"] < 1 and lower < n.confidence
+    p, exp = case
+    n = xairl.narrate(exp, 0, policy=p, robustness=False)
+    assert n.components["coverage"] == n.coverage and (n.status == "verified" or n.confidence == 0.0)
+
+    def check(more: str):
+        v = xairl.verify(n.text + more, exp, 0, p, provenance=n.provenance)
+        return v, *confidence(exp, 0, v.ok, xairl.NarrationOptions(policy=p), coverage=v.coverage)
+
+    v, same, comp = check(" It felt right. Nobody objected.")
+    assert [s.status for s in v.sentences][-2:] == ["none", "none"]
+    assert (v.status, v.coverage, comp["coverage"]) == (n.status, n.coverage, n.coverage) and same == n.confidence
+    v, lower, comp = check(" The rest came to 731.")  # a number that is no fact of it
+    counted = [c for c in v.claims if c.status == "unchecked" or c.kind in CHECKED]
+    assert v.status == "partly checked" and lower == 0.0 and comp["coverage"] == v.coverage < n.coverage
+    assert v.coverage == sum(c.status != "unchecked" for c in counted) / len(counted)
     ev = evidence(exp, n)
     assert ev["target"] == "margin of go over wait" and ev["features"][0]["name"] == "speed"
     assert ev["output"] == pytest.approx(5.5)

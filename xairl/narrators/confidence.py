@@ -1,7 +1,10 @@
 """The confidence score of a narrative, in [0, 1]: ``verification x weighted mean of the measured components``.
 
-- ``verification``: 1 when every claim of the shown text was verified, else 0 (an unverified text has no confidence);
-- ``coverage`` (weight 0.2): the share of the text's sentences that hold a checked claim (the verifier's coverage);
+- ``verification``: 1 when the verdict is 'verified' (every claim checked, and true), else 0: a contradicted or a
+  partly checked text has no confidence;
+- ``coverage`` (weight 0.2): the share of the text's checkable claims that were checked
+  (:attr:`xairl.Verification.coverage`). A verified text has checked them all, so it is 1 wherever the score is not
+  0; it is kept among the components to show how much of a partly checked text was checked;
 - ``additivity`` (weight 0.15): 1 / (1 + gap / (1e-3 * max(1, |score|))): 1 when contributions add up to the score;
 - ``margin`` (weight 0.25): 1 - exp(-q_margin / tau), tau = the mean |contribution| per feature: a Q-gap smaller than
   a typical single feature's effect is a near tie (discrete actions only: a value or a continuous action has none);
@@ -83,7 +86,8 @@ def components(
         robustness components are measured (default: not, without a policy).
     :param output: the output narrated when nothing is chosen (a value, one dimension of a continuous action);
         there the margin does not apply. Default: the chosen action.
-    :param coverage: the verifier's coverage of the text (:attr:`xairl.Verification.coverage`); None: not known."""
+    :param coverage: the share of the text's checkable claims that were checked (:attr:`xairl.Verification.coverage`);
+        None: not known."""
     comp: dict[str, float | None] = {
         "verification": 1.0 if verified else 0.0,
         "coverage": coverage,
