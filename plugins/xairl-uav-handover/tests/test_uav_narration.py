@@ -121,6 +121,7 @@ def test_a_flight_at_a_glance(uav, tmp_path):
     exp = xairl.explain(policy, tl.states, background=bg)
     text, check = narrate_flight(tl, exp, policy)
     assert check.ok and check.coverage == 1.0
+    assert "of the mean |contribution| over 600 states" in check.account  # what its features carry, and leave out
     assert f"handed over {int(tl.dqn_handover.sum())} time" in text and f"handed over {len(tl.chm_times)} time" in text
     _, facts = summary(tl, exp, policy)
     wrong = text.replace(f"at {int((~tl.dqn_handover).sum())} of", "at 17 of")

@@ -112,3 +112,24 @@ def test_report_with_real_data(real_report):
     assert "finding (buffer first, position second)" in html
     datasets = {json.loads(x)["dataset"] for x in (out / "explanations.jsonl").read_text().splitlines()}
     assert datasets == {"simulated", "real"}
+
+
+@pytest.mark.parametrize(
+    "statuses, verdict",
+    [
+        (("verified",), "verified"),
+        (("contradicted",), "contradicted"),
+        (("verified", "unchecked"), "partly checked (coverage 50 %)"),
+    ],
+)
+def test_a_flight_at_a_glance_says_its_verdict_and_account(statuses, verdict):
+    """The caption says the summary's verdict (was: 'verified' or 'NOT verified') and its account of the importance."""
+    from xairl.verification.result import Claim, SentenceCheck, Verification
+    from xairl_uav_handover.report import glance_caption
+
+    account = "its 2 features carry 61 % of the mean |contribution| over 600 states; 3 more features are left out"
+    check = Verification(
+        (SentenceCheck("A.", tuple(Claim("number", str(k), st) for k, st in enumerate(statuses))),), account=account
+    )
+    caption = glance_caption("simulated flight 1", "It handed over twice.", check)
+    assert caption == f"Flight at a glance: simulated flight 1. It handed over twice. [verdict: {verdict}; {account}]"

@@ -26,6 +26,14 @@ from .policy import Checkpoint, dqn_decision_states, load_checkpoint, memory_of,
 from .report_figures import altitude_figure, frontier_section
 
 
+def glance_caption(label: str, text: str, check) -> str:
+    """A flight at a glance's caption: its summary, the verdict as every surface says it (verified, contradicted, or
+    partly checked with its coverage) and what the summary's features carry of the importance, and leave out."""
+    mark = check.status + (f" (coverage {100 * check.coverage:.0f} %)" if check.status == "partly checked" else "")
+    said = f"; {check.account}" if check.account else ""
+    return f"Flight at a glance: {label}. {text} [verdict: {mark}{said}]"
+
+
 class UAVReportOptions(xairl.plugin.Options):
     """The UAV report's own settings (``-o key=value``)."""
 
@@ -178,14 +186,8 @@ class UAVReport(xairl.plugin.Report):
         for n, tl in enumerate(lines):
             exp = explain(content.policy, tl.states, background=content.background)
             text, check = narrate_flight(tl, exp, content.policy)
-            # the verdict as every surface says it (verified, contradicted, partly checked with its coverage), then
-            # what the summary's features carry of the importance and what it leaves out
-            mark = check.status + (
-                f" (coverage {100 * check.coverage:.0f} %)" if check.status == "partly checked" else ""
-            )
             path = timeline_figure(tl, exp, content.policy, Path(req.out) / f"flight_{n}.png")
-            said = f"; {check.account}" if check.account else ""
-            content.figures.append((f"Flight at a glance: {tl.label}. {text} [verdict: {mark}{said}]", path))
+            content.figures.append((glance_caption(tl.label, text, check), path))
 
     def _table_one(self, ckpt: Checkpoint, seed: int) -> tuple[tuple[str, str], list[str]]:
         """Table I with bootstrap 95 % intervals (table.py), and in words where the DQN loses to CHM; and a note
