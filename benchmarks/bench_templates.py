@@ -233,6 +233,13 @@ def builtin_templates(kinds) -> list[dict]:
     return found
 
 
+def flagged(path: Path) -> list[str]:
+    """What `xairl prompts check` says of the template's literal claim words (file:line, word, filter to use)."""
+    from xairl.narrators.battery import undeclared
+
+    return undeclared(xprompts.load(path))
+
+
 def set_templates(name: str, kinds) -> list[dict]:
     folder = DATA / name
     manifest = yaml.safe_load((folder / "MANIFEST.yaml").read_text())
@@ -246,6 +253,7 @@ def set_templates(name: str, kinds) -> list[dict]:
                 "name": spec["name"],
                 "path": path,
                 "spec": spec,
+                "flagged": flagged(path),
                 "correct": bool(t["correct"]),
                 "kinds": template_kinds(spec, kinds),
                 "twin": twin if not t["correct"] else None,

@@ -42,7 +42,11 @@ def summarise_set(set_name, templates, results, twins, n, kinds):
             if kind not in t["kinds"]:
                 continue
             row = {"template": t["name"], "kind": kind, "correct": t["correct"], "rendered": 0, "na": 0, "errors": 0}
-            row.update({"verified": 0} if t["correct"] else {"wrong": 0, "caught": 0, "same_as_twin": 0})
+            row.update(
+                {"verified": 0, "contradicted": 0}
+                if t["correct"]
+                else {"wrong": 0, "caught": 0, "same_as_twin": 0, "verified": 0}
+            )
             trow = {"template": t["name"], "kind": kind, "rendered": 0, "verified": 0, "na": 0}
             for i in decisions_of(t["spec"], n):
                 res = results[((set_name, t["name"]), kind, i)]
@@ -53,6 +57,7 @@ def summarise_set(set_name, templates, results, twins, n, kinds):
                 row["rendered"] += 1
                 if t["correct"]:
                     row["verified"] += res["verified"]
+                    row["contradicted"] += bool(_bad_claims(res))
                     if not res["verified"]:
                         false_rejections.append(_example(t["name"], kind, i, res))
                     continue
@@ -69,6 +74,7 @@ def summarise_set(set_name, templates, results, twins, n, kinds):
                     continue
                 row["wrong"] += 1
                 row["caught"] += not res["verified"]
+                row["verified"] += res["verified"]
                 if res["verified"]:
                     misses.append(_example(t["name"], kind, i, res, {"twin_text": twin["text"]}))
             rows.append(row)
@@ -76,7 +82,14 @@ def summarise_set(set_name, templates, results, twins, n, kinds):
                 twin_rows.append(trow)
     correct = [r for r in rows if r["correct"]]
     wrong = [r for r in rows if not r["correct"]]
+    flagged = {t["name"] for t in templates if t.get("flagged")}
+    failing = sorted({r["template"] for r in correct if r["verified"] < r["rendered"]})
     summary = {
+        "correct_contradicted": sum(r["contradicted"] for r in correct),
+        "wrong_verified": sum(r["verified"] for r in wrong),
+        # issue 65: every correct template verifies every rendering, or `xairl prompts check` flags it
+        "correct_neither_verified_nor_flagged": [t for t in failing if t not in flagged],
+        "flagged_by_prompts_check": {t["name"]: t["flagged"] for t in templates if t.get("flagged")},
         "correct_verified": sum(r["verified"] for r in correct),
         "correct_rendered": sum(r["rendered"] for r in correct),
         "wrong_caught": sum(r["caught"] for r in wrong),
@@ -85,7 +98,7 @@ def summarise_set(set_name, templates, results, twins, n, kinds):
         "twins_rendered": sum(r["rendered"] for r in twin_rows),
         "not_applicable": sum(r["na"] for r in rows),
         "errors": sum(r["errors"] for r in rows),
-        "failing_correct_templates": sorted({r["template"] for r in correct if r["verified"] < r["rendered"]}),
+        "failing_correct_templates": failing,
         "templates_with_missed_wrong": sorted({r["template"] for r in wrong if r["caught"] < r["wrong"]}),
         "twins_not_verified": sorted({r["template"] for r in twin_rows if r["verified"] < r["rendered"]}),
     }
@@ -287,7 +300,15 @@ def _print_set(s, res, templates, kinds):
         )
     sm = res["summary"]
     print(
-        f"  => correct renderings verified {_pct(sm['correct_verified'], sm['correct_rendered'])}; wrong renderings "
+        f"  => correct renderings contradicted: {sm['correct_contradicted']}; wrong renderings verified: "
+        f"{sm['wrong_verified']}; correct templates neither verified on every rendering nor flagged by prompts "
+        f"check: {sm['correct_neither_verified_nor_flagged']}"
+    )
+    for name, lines in sm["flagged_by_prompts_check"].items():  # (a held-out set's words are not printed)
+        example = "" if s == "heldout" else f", e.g. {lines[0].split('/')[-1][:150]}"
+        print(f"     prompts check flags {name}: {len(lines)} line(s){example}")
+    print(
+        f"     correct renderings verified {_pct(sm['correct_verified'], sm['correct_rendered'])}; wrong renderings "
         f"caught {_pct(sm['wrong_caught'], sm['wrong_renderings'])}; twins verified "
         f"{_pct(sm['twins_verified'], sm['twins_rendered'])}; n/a {sm['not_applicable']}, errors {sm['errors']}"
     )

@@ -76,8 +76,11 @@ def test_every_claim_filter_verifies_its_true_rendering(tmp_path, robot):
         # 'Without wind, the policy would still have chosen recharge.'
         ("Without {{ margin_top[2].label }}, the policy would still have chosen {{ runner_up }}.", {"without"}),
         # a literal made-up feature: '...came from obstacle (+2), helped by cell_load.'
-        ("The push came from {{ margin_top[0].label }} ({{ margin_top[0].contribution|signed }}), helped by "
-         "cell_load.", {"cell_load"}),
+        (
+            "The push came from {{ margin_top[0].label }} ({{ margin_top[0].contribution|signed }}), helped by "
+            "cell_load.",
+            {"cell_load"},
+        ),
         # 'The margin was increased most strongly by X' (judged once against X's overall rank)
         ("The margin was increased most strongly by {{ margin_top[1].label }}.", {"increased", "most"}),
         # 'The policy chose recharge.' (the runner-up)
@@ -113,7 +116,9 @@ def test_a_value_beside_another_name_is_never_contradicted_by_position(tmp_path,
 
 def test_a_share_after_to_the_margin_is_read_as_a_share(tmp_path, robot):
     """'+2 to the margin, 47.1 % of the total': the share is not bound to 'margin' (issue 65, set B)."""
-    sentence = MARGIN + "{{ f.label|cap }}: {{ f.contribution|signed }} to the margin, {{ f.share|num }} % of the total."
+    sentence = (
+        MARGIN + "{{ f.label|cap }}: {{ f.contribution|signed }} to the margin, {{ f.share|num }} % of the total."
+    )
     text, v = verdict(tmp_path, sentence, robot, NAME="obstacle")
     assert v.status == "verified", (text, v.problems())
 

@@ -43,7 +43,9 @@ VERDICTS = ("verified", "contradicted", "partly checked")
 
 
 def _counts(claims) -> bool:
-    return any(c.status == "unchecked" or c.kind in CHECKED for c in claims)
+    """Whether a sentence's claims state something: a checkable kind, a tracked value (a name printed from the facts
+    is checked by its fact) or anything left unchecked."""
+    return any(c.status == "unchecked" or c.kind in CHECKED or c.span is not None for c in claims)
 
 
 @dataclass(frozen=True)
@@ -82,7 +84,7 @@ class Verification:
     @property
     def coverage(self) -> float:
         """The share of the text's checkable claims that were checked (1.0 for a text that states nothing)."""
-        counted = [c for c in self.claims if c.status == "unchecked" or c.kind in CHECKED]
+        counted = [c for c in self.claims if _counts((c,))]
         return sum(c.status != "unchecked" for c in counted) / len(counted) if counted else 0.0
 
     @property
