@@ -181,3 +181,17 @@ def test_a_store_from_before_the_three_verdicts_opens_and_reads_them(tmp_path, c
     new = store.records()[2]
     assert (new.verdict, new.coverage, new.account) == ("partly checked", 0.5, ACCOUNT)
     assert "partly checked (coverage 50 %)" in review_page(store, "t")
+
+
+@pytest.mark.parametrize(
+    "ev, verdict",
+    [
+        ({"sentences": [["A.", "verified"], ["B.", "none"]]}, "verified"),
+        ({"sentences": [["A.", "verified"], ["B.", "unchecked"]]}, "partly checked"),
+        ({"sentences": [["A.", "contradicted"]], "verified": False}, "contradicted"),
+        ({"sentences": [], "verified": True}, "verified"),
+        ({"sentences": []}, "partly checked"),
+    ],
+)
+def test_a_card_without_a_recorded_verdict_reads_it_from_its_sentences(ev, verdict):
+    assert f"verdict: <b>{verdict}</b>" in card_html(" ".join(s for s, _ in ev["sentences"]) or "A.", ev)

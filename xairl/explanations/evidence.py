@@ -35,13 +35,14 @@ def verdict_text(status: str, coverage: float | None = None) -> str:
 
 
 def verdict_of(ev: dict) -> str:
-    """The verdict an evidence dict holds; one recorded before there were three (only 'verified': true or false) is
-    read from its sentences: contradicted when one is, else partly checked."""
+    """The verdict an evidence dict holds; one recorded before there were three (only 'verified': true or false, or
+    only its sentences) is read from them: verified when it says so (or every sentence is), contradicted when a
+    sentence is, else partly checked."""
     if ev.get("status") in VERDICTS:
         return ev["status"]
-    if ev.get("verified"):
+    said = [st for _, st in ev.get("sentences") or [] if st != "none"]
+    if ev.get("verified", bool(said) and all(st == "verified" for st in said)):
         return "verified"
-    said = [st for _, st in ev.get("sentences") or []]
     return "contradicted" if "contradicted" in said else "partly checked"
 
 
