@@ -66,7 +66,7 @@ def _narratives_body(narratives) -> str:
     """The narrated decisions' HTML: what the marks mean, then one card a narrative."""
     body = (
         "<p class=meta>Each sentence is marked &#10003; verified, &#10007; contradicted or ? unchecked (a claim "
-        "the verifier could not check). Each narrative's verdict is <b>verified</b> (every claim checked, and "
+        "the verifier could not check); one that states nothing to check is left unmarked. Each narrative's verdict is <b>verified</b> (every claim checked, and "
         "true), <b>contradicted</b> (a claim is false) or <b>partly checked</b> (nothing false; the coverage is "
         "the share of its claims checked); beside it, what the features it names account for of the margin and "
         "what it leaves out. The waterfall builds the margin of the chosen action over the runner-up (the score, "
