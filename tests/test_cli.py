@@ -184,7 +184,7 @@ def test_verify_trace_names_the_reading_of_each_claim(tmp_path, capsys):
     rc, out, _ = run(
         capsys, "verify", "Speed raised the risk by 0.3 over the last 30 days.", "--explanation", str(path), "--trace"
     )
-    assert rc == 0 and "verdict: verified" in out
+    assert rc == 3 and "verdict: partly checked (coverage " in out  # '30 days' is left unchecked
     assert "number.name-before" in out and "parse.counts-other" in out and "it counts 'days'" in out
     rc, out, _ = run(capsys, "verify", "The load lowered it by 0.5.", "--explanation", str(path))
     assert rc == 1 and out.startswith("[contradicted]") and "verdict: contradicted" in out
