@@ -29,12 +29,18 @@ def forms(word: str) -> set[str]:
     return {word, third, stem + "ed", stem + "ing"}
 
 
+#: the lexicon's sections that are not the reader's (provenance's words, the claim words of templates)
+OTHER_SECTIONS = ("own", "claims")
+
+
 @functools.cache
 def lexicon() -> dict:
     """The word lists, verbs with their forms; ``ordinals`` a word -> rank map."""
     raw = yaml.safe_load(LEXICON.read_text(encoding="utf-8"))
     out = {}
     for key, words in raw.items():
+        if key in OTHER_SECTIONS:
+            continue
         if key == "closed_classes":
             out[key] = [frozenset(str(w).lower() for w in group) for group in words]
         elif key == "tag_pos":
