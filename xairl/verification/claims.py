@@ -85,11 +85,15 @@ def lexicon(path: Path = LEXICON) -> Lexicon:
     words: dict[str, tuple[str, str]] = {}
     for kind in KINDS:
         for word, use in (data.get(kind) or {}).items():
-            key = normalise(str(word))
+            if not isinstance(word, str):  # YAML reads a bare no, on or false as a boolean
+                raise ValueError(f"{path}: claim word {word!r} ({kind}) is not a string; quote it.")
+            key = normalise(word)
             if key in words:
                 raise ValueError(f"{path}: claim word {word!r} is listed twice ({words[key][0]} and {kind}).")
             words[key] = (kind, str(use))
-    filler = frozenset(normalise(str(w)) for w in data.get("filler") or ())
+    if not all(isinstance(w, str) for w in data.get("filler") or ()):
+        raise ValueError(f"{path}: a filler word is not a string; quote it.")
+    filler = frozenset(normalise(w) for w in data.get("filler") or ())
     if clash := sorted(filler & set(words)):
         raise ValueError(f"{path}: {', '.join(clash)} listed both as claim words and as filler.")
     return Lexicon(words, filler, re.compile(_alternation(words), re.IGNORECASE))
