@@ -142,7 +142,7 @@ def _literals(node: nodes.Node) -> Iterable[tuple[int, str]]:
     """(line in the variant, text) of each piece of literal text the template may print: its text outside tags and
     the strings in its expressions, but not a claim filter's words (the author's, declared), a test's or a
     comparison's operands ('stay' in ``runner_up == 'stay'`` is never printed) nor a subscript's key."""
-    todo = [node]
+    todo = [node]  # (depth first, in the template's order)
     while todo:
         n = todo.pop()
         if isinstance(n, nodes.TemplateData):
@@ -150,14 +150,14 @@ def _literals(node: nodes.Node) -> Iterable[tuple[int, str]]:
         elif isinstance(n, nodes.Const) and isinstance(n.value, str):
             yield n.lineno, n.value
         elif isinstance(n, nodes.Filter) and n.name in FILTERS:
-            todo += [n.node] if n.node is not None else []
+            todo.append(n.node)
         elif isinstance(n, (nodes.Compare, nodes.Test)):
             continue
         elif isinstance(n, nodes.Getitem):
             todo.append(n.node)
         else:
             tests = [getattr(n, "test", None)] if isinstance(n, (nodes.If, nodes.CondExpr, nodes.For)) else []
-            todo += [c for c in n.iter_child_nodes() if all(c is not t for t in tests)]
+            todo += reversed([c for c in n.iter_child_nodes() if all(c is not t for t in tests)])
 
 
 def undeclared(tpl: Template, names: Iterable[str] = ()) -> list[str]:
@@ -172,13 +172,14 @@ def undeclared(tpl: Template, names: Iterable[str] = ()) -> list[str]:
                 continue
             found = [
                 (tpl.lines[s][v] + line - 1 + literal.count("\n", 0, w.start), n, w.start, w)
-                for n, (line, literal) in enumerate(sorted(_literals(ast), key=lambda x: x[0]))
+                for n, (line, literal) in enumerate(_literals(ast))
                 for w in claim_words(literal, names)
             ]
-            for line, _, _, w in sorted(found, key=lambda x: x[:3]):
+            for line, _, _, w in sorted(found, key=lambda x: x[:3]):  # (in the template's order)
                 said = " ".join(w.word.split())
                 where = f"{tpl.path}:{line}"
                 out.setdefault(
-                    (where, said.lower()), f"{where}: {said!r} is a claim the template wrote itself; write it with {w.use}"
+                    (where, said.lower()),
+                    f"{where}: {said!r} is a claim the template wrote itself; write it with {w.use}",
                 )
     return list(out.values())

@@ -30,10 +30,8 @@ KINDS = ("direction", "level", "rank", "comparison", "negation", "cause", "role"
 #: the prefix of a counterfactual fact's quantity (:func:`xairl.templates.tracking.track_counterfactual`), and the
 #: template variable that holds them
 COUNTERFACTUAL, COUNTERFACTUAL_VARIABLE = "cf_", "counterfactual"
-NAME_USE = "print it from the facts: {{ f.label }} (or {{ f.name }}) for a feature, {{ action }} or {{ runner_up }}"
-IDENTIFIER_USE = (
-    "print names from the facts ({{ f.label }}, {{ action }}); a name the policy lacks is an invented feature"
-)
+NAME_USE = "{{ f.label }} (or {{ f.name }}) for a feature, {{ action }} or {{ runner_up }} for an action"
+IDENTIFIER_USE = "{{ f.label }} or {{ action }} from the facts (a name no fact holds is an invented one)"
 
 # An identifier: letters or digits joined by an underscore ('cell_load', 'rsrp_1'), or camelCase with two lowercase
 # letters before a capital ('cellLoad'; units such as 'dBm', 'kHz' or 'mWh' are not identifiers)
