@@ -102,8 +102,9 @@ def role(context, x, chosen: str = "", runner_up: str = "", only: str | None = N
     'only'|'counterfactual', value=the action's name, of='action'|'cf_action')``."""
     f = x.fact if isinstance(x, TrackedStr) and x.fact.quantity in ("action", "cf_action") else None
     alone = only is not None and context.get("action") is not None and context.get("runner_up") == context.get("action")
-    if f is None:
-        return str(only if alone else chosen)
+    if f is None:  # (an untracked rendering: its role by its name)
+        plain = runner_up if x == context.get("runner_up") and x != context.get("action") else chosen
+        return str(only if alone else plain)
     which = "counterfactual" if f.quantity == "cf_action" else "only" if alone else f.role
     word = {"chosen": chosen, "counterfactual": chosen, "only": only, "runner_up": runner_up}.get(which, "")
     return _claim(word, Fact("role", role=which, value=str.__str__(x), of=f.quantity))
