@@ -70,13 +70,14 @@ def level(x, low: str = "low", typical: str = "typical", high: str = "high", unk
 def rank(x, *words: str, other: str = "") -> str:
     """The ``n``-th of ``words`` for a feature ranked ``n`` in its view (1 for the largest |contribution|, or mean
     |contribution| in a global view), ``other`` past the last word (and for an identifier, which has no rank),
-    given the feature dict or its ``rank``. Tracked, its fact is ``Fact('rank', feature, view, value=the rank,
-    of='rank')``."""
+    given the feature dict or its ``rank``; given its ``rank_same_way``, by its rank among the pushes of its sign
+    (1: the biggest push its way). Tracked, its fact is ``Fact('rank', feature, view, value=the rank, of='rank')``
+    (``'rank_same_way'`` for both the quantity and ``of`` of the latter)."""
     x = _field(x, "rank")
     n = int(x)
     word = words[n - 1] if 1 <= n <= len(words) else other
-    f = x.fact if isinstance(x, TrackedInt) and x.fact.quantity == "rank" else None
-    return _claim(word, None if f is None else Fact("rank", f.feature, f.view, value=n, of="rank"))
+    f = x.fact if isinstance(x, TrackedInt) and x.fact.quantity in ("rank", "rank_same_way") else None
+    return _claim(word, None if f is None else Fact(f.quantity, f.feature, f.view, value=n, of=f.quantity))
 
 
 def compare(x, other, more: str = "more", less: str = "less", same: str | None = None) -> str:
