@@ -220,3 +220,42 @@ def test_a_plugin_policy_that_fails_to_load_is_one_line_and_the_battery_goes_on(
     decisions, left_out = battery.cases(("actions",))
     assert left_out == ["note: plugin policy 'broken' left out of the battery: RuntimeError: no checkpoint"]
     assert len(decisions) > 20
+
+
+ROOT = prompts.builtin_dir().parent
+SHIPPED = sorted(
+    [
+        *prompts.builtin_dir().glob("*.yaml"),
+        *(ROOT / "examples" / "custom_prompt" / "prompts").glob("*.yaml"),
+        *(ROOT / "examples" / "my_plugin" / "my_xairl_plugin" / "prompts").glob("*.yaml"),
+        *(ROOT / "plugins" / "xairl-uav-handover" / "xairl_uav_handover" / "prompts").glob("*.yaml"),
+    ]
+)
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.stem)
+def test_every_shipped_template_declares_every_claim(path):
+    names = battery.names(battery_cases.flat_cases() + battery_cases.kind_cases())
+    try:
+        from xairl_uav_handover.features import ACTIONS, FEATURE_INFO
+
+        names += [*FEATURE_INFO, *ACTIONS, *(i.description for i in FEATURE_INFO.values() if i.description)]
+    except ImportError:  # (the plugin is not installed: its names are left out)
+        pass
+    assert len(SHIPPED) >= 9
+    assert battery.undeclared(prompts.parse(path), names) == []
+
+
+def test_a_template_in_its_authors_own_words_passes(tmp_path):
+    # (issue 65: dir('aumentó', 'redujo') and dir('grew', 'shrank') were contradicted in 119 true renderings)
+    body = HEAD + (
+        "  - [\"{% if runner_up != action %}La política {{ action|role('eligió') }} {{ action }} "
+        "{{ runner_up|role('', 'y no') }} {{ runner_up }}"
+        "{% else %}La política {{ action|role('eligió', only='la única acción posible') }}{% endif %}.\"]\n"
+        "  - [\"{% for f in top %}{{ f.label|cap }} {{ f|dir('aumentó', 'redujo') }} la puntuación en "
+        "{{ f.contribution|abs|num }}{{ ', ' if not loop.last else '.' }}{% endfor %}\"]\n"
+        "  - [\"{% if reasons %}{{ reasons[0].label|cap }}: {{ reasons[0].rank_same_way|rank('el mayor empuje', "
+        "other='un empuje') }}, {{ reasons[0]|level('con valor bajo', 'con valor normal', 'con valor alto') }}"
+        '{% endif %}"]\n'
+    )
+    assert check_template(write(tmp_path, body)) == []
