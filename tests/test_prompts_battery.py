@@ -259,3 +259,26 @@ def test_a_template_in_its_authors_own_words_passes(tmp_path):
         '{% endif %}"]\n'
     )
     assert check_template(write(tmp_path, body)) == []
+
+
+@pytest.mark.parametrize("path", sorted(prompts.builtin_dir().glob("*.yaml")), ids=lambda p: p.stem)
+def test_a_builtins_renderings_hold_no_literal_claim_word(path):
+    """What the static pass promises holds at render time: with every tracked span blanked, the words left over in
+    each rendering (but a counterfactual sentence's) hold no claim word of the lexicon nor any name of the case."""
+    from xairl.verification.claims import checked_by_counterfactual, claim_words
+
+    tpl = prompts.parse(path)
+    outputs = tpl.spec.outputs if tpl.spec.kind == "decision" else ("actions", "continuous", "value")
+    rendered = 0
+    for case in battery.cases(outputs, tpl.spec.kind)[0]:
+        context, _ = battery._facts(case)
+        names = battery.names([case])
+        for r in (r for variants in tpl.render_variants(context) for r in variants if r):
+            if checked_by_counterfactual(r.spans):
+                continue
+            text = list(str(r))
+            for s in r.spans:
+                text[s.start : s.end] = " " * (s.end - s.start)
+            assert claim_words("".join(text), names) == [], (case.label, str(r))
+            rendered += 1
+    assert rendered >= 8
