@@ -128,7 +128,9 @@ def test_a_counterfactual_phrasing_is_left_to_the_counterfactual_check(tmp_path)
     context, _ = battery._facts(cases[0])
     (variants,) = prompts.parse(write(tmp_path, HEAD + CF)).render_variants(context)
     assert variants[0].startswith("Had ") and any(s.fact.quantity == "cf_margin" for s in variants[0].spans)
-    # its literal words are claims anywhere else
+    # its literal words are claims anywhere else, and in a phrasing that only tests the counterfactual
+    tested = HEAD + '  - ["{% if counterfactual or true %}The policy chose {{ action }}.{% endif %}"]\n'
+    assert "'chose' is a claim" in battery.undeclared(prompts.parse(write(tmp_path, tested)))[0]
     plain = HEAD + '  - ["Had it been slower, the policy would have chosen {{ runner_up }}."]\n'
     assert [p.split(": ", 1)[1] for p in battery.undeclared(prompts.parse(write(tmp_path, plain)))][0] == (
         "'would have' is a claim the template wrote itself; write it with the counterfactual facts "

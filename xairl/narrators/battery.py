@@ -150,7 +150,7 @@ def _literals(node: nodes.Node) -> Iterable[tuple[int, str]]:
         elif isinstance(n, nodes.Const) and isinstance(n.value, str):
             yield n.lineno, n.value
         elif isinstance(n, nodes.Filter) and n.name in FILTERS:
-            todo.append(n.node)
+            todo += [n.node] if n.node is not None else []  # ('{% filter dir(...) %}' has none)
         elif isinstance(n, (nodes.Compare, nodes.Test)):
             continue
         elif isinstance(n, nodes.Getitem):
@@ -158,6 +158,21 @@ def _literals(node: nodes.Node) -> Iterable[tuple[int, str]]:
         else:
             tests = [getattr(n, "test", None)] if isinstance(n, (nodes.If, nodes.CondExpr, nodes.For)) else []
             todo += reversed([c for c in n.iter_child_nodes() if all(c is not t for t in tests)])
+
+
+def _prints_counterfactual(ast: nodes.Template) -> bool:
+    """Whether a phrasing prints a counterfactual fact: ``counterfactual``, or a name set or looped from it
+    (``{% set cf = counterfactual %}``, ``{% for c in cf.changes %}``), inside ``{{ }}`` (a mere test of it is no
+    counterfactual sentence)."""
+    tainted, grew = {COUNTERFACTUAL_VARIABLE}, True
+    while grew:
+        before = len(tainted)
+        for n in ast.find_all((nodes.Assign, nodes.For)):
+            source = n.node if isinstance(n, nodes.Assign) else n.iter
+            if any(x.name in tainted for x in [source, *source.find_all(nodes.Name)] if isinstance(x, nodes.Name)):
+                tainted |= {t.name for t in [n.target, *n.target.find_all(nodes.Name)] if isinstance(t, nodes.Name)}
+        grew = len(tainted) > before
+    return any(x.name in tainted for o in ast.find_all(nodes.Output) for x in o.find_all(nodes.Name))
 
 
 def undeclared(tpl: Template, names: Iterable[str] = ()) -> list[str]:
@@ -168,7 +183,7 @@ def undeclared(tpl: Template, names: Iterable[str] = ()) -> list[str]:
     for s, variants in enumerate(tpl.spec.sentences):
         for v, text in enumerate(variants):
             ast = parse_variant(env, text)
-            if any(n.name == COUNTERFACTUAL_VARIABLE for n in ast.find_all(nodes.Name)):
+            if _prints_counterfactual(ast):
                 continue
             found = [
                 (tpl.lines[s][v] + line - 1 + literal.count("\n", 0, w.start), n, w.start, w)
