@@ -124,3 +124,22 @@ def test_untracked_inputs_give_the_plain_word(facts):
             compare({"contribution": 0.1}, {"contribution": -0.3}, "more", "less"),
         ]
     assert words == ["down", "up", "h", "b", "less"] and record == []
+
+
+def test_rank_same_way_is_the_rank_among_pushes_of_its_sign(tmp_path):
+    # the two biggest pushes on the margin are against the chosen action: the first reason ranks 3rd, and 1st its way
+    c = next(c for c in flat_cases() if c.label == "flat, signs -,-,+")
+    facts = decision_facts(c.explanation, 0, c.policy, 3)
+    assert facts.reasons[0].rank == 3 and facts.reasons[0].rank_same_way == 1
+    ctx = tracking.track_decision(facts.context())
+    r = render(tmp_path, "{{ reasons[0].rank_same_way|rank('the biggest', other='a') }}", ctx)
+    name = facts.reasons[0].name
+    assert str(r) == "the biggest" and claims(r)[0][1] == Fact(
+        "rank_same_way", name, "margin", value=1, of="rank_same_way"
+    )
+    text = first_sentence(prompts.load("explain_action"), ctx, 1)
+    assert text.startswith(f"The biggest push toward {facts.action} over {facts.runner_up} came from "), text
+
+
+def first_sentence(tpl, ctx, s):
+    return str(tpl.render_variants(ctx)[s][0])

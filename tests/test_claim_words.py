@@ -28,7 +28,7 @@ from xairl.verification.claims import KINDS, ClaimWord, checked_by_counterfactua
         ("Recharge beat it.", "beat", "role", "role('beat')"),
         ("Hold came second.", "came second", "role", "role('came first', 'came second')"),
         ("Left rather than right.", "rather than", "role", "role('', 'rather than')"),
-        ("Every feature favoured it.", "Every", "rank", "name each feature"),
+        ("Every feature favoured it.", "Every", "rank", "each feature's own filter"),
     ],
 )
 def test_each_kind_of_claim_word_is_found_with_its_filter(text, word, kind, use):
@@ -73,7 +73,7 @@ def test_names_labels_and_identifiers_are_claims():
         ("turn_left", "name"),
     ]
     assert "{{ f.label }}" in found[0].use
-    assert "invented feature" in found[3].use  # not a name of the policy
+    assert "invented one" in found[3].use  # not a name of the policy
 
 
 def test_a_label_holding_a_claim_word_is_one_name():

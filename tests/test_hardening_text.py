@@ -263,9 +263,16 @@ def test_the_toys_level_words_say_a_level_not_a_state(toy):
 def test_a_contradicted_direction_word_is_said_once_by_prompts_check(tmp_path):
     from xairl.narrators.battery import run
 
-    source = prompts.load("explain_action").path.read_text().replace("favoured", "opposed")
+    # (a literal direction word: named as undeclared, and contradicted where it is false, each said once)
+    source = prompts.load("explain_action").path.read_text().replace("{{ f|dir('toward', 'against') }}", "opposing")
     path = tmp_path / "opposed.yaml"
     path.write_text(source)
     lines = run(prompts.parse(path)).problems
-    assert lines and any("'opposed' is said of" in line for line in lines)
-    assert not [line for line in lines if "'opposed' 'opposed'" in line], lines[:2]
+    assert any(
+        line.endswith(
+            "'opposing' is a claim the template wrote itself; write it with dir('favouring', 'going against')"
+        )
+        for line in lines
+    ), lines[:2]
+    assert any("'opposing' is said of" in line for line in lines), lines[:3]
+    assert not [line for line in lines if "'opposing' 'opposing'" in line], lines[:2]

@@ -223,7 +223,7 @@ def test_a_signal_whose_steps_cancel_is_said_to_pull_both_ways():
     assert f.name == "e" and f.steps == "pulled both ways" and abs(slots.sum()) < 0.1 * np.abs(slots).sum()
     assert f.rank == 5 and all(not g.steps for g in facts.margin_top)
     n = xairl.narrate(e, 0, policy=p)
-    assert "E's steps pulled both ways: they nearly cancelled, adding up to +0.40 to the margin." in n.text, n.text
+    assert "E's steps pulled both ways: they nearly cancelled, together +0.40 to the margin." in n.text, n.text
     assert n.verified, [(c.text, c.detail) for c in n.claims if c.status != "verified"]
     again = xairl.verify(n.text, xairl.Explanation.from_json(e.to_json()), 0, p)
     assert again.accurate, [(c.text, c.detail) for c in again.claims if c.status == "contradicted"]

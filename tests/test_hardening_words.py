@@ -133,10 +133,10 @@ def test_each_feature_is_said_to_push_the_way_it_pushed_on_average(toy):
     for clause in text.split(". ", 1)[1].split(";"):
         for j, f in enumerate(exp.feature_names):
             label = policy.features.get(f).description if policy.features.get(f) else f
-            word = re.search(rf"{re.escape(label)} pushed (toward|against)", clause)
+            word = re.search(rf"{re.escape(label)} (raised|lowered)", clause)
             if word:
                 said += 1
-                assert word.group(1) == ("toward" if margin[:, j].mean() > 0 else "against"), (f, clause)
+                assert word.group(1) == ("raised" if margin[:, j].mean() > 0 else "lowered"), (f, clause)
     assert said >= 2, text
 
 

@@ -46,9 +46,8 @@ class FeatureFact:
     :param level: 'low', 'typical' or 'high': from the feature's capacity or thresholds when it has them, else from
         the background's quartiles when they are distinct, else 'unknown'; ``level_text`` the feature's own words for
         it (``FeatureInfo.low`` / ``high``, 'typical' or 'moderate'; empty when unknown).
-    :param rank: 1 for the largest |contribution| among the reasons (identifiers are context, not reasons).
-    :param kind: the feature's ``FeatureInfo.kind``.
-    :param fill: for a feature with a capacity, its value as a percentage of it; else None.
+    :param rank: 1 for the largest |contribution| among the reasons (not identifiers); ``rank_same_way`` of its sign.
+    :param kind: the feature's ``FeatureInfo.kind``; ``fill`` for one with a capacity its value in % of it, else None.
     :param value_text: the value as a narrative writes it: '-85.3 dBm', '12.0 % full', a category's label, 'mean
         pixel value 33.1' for an image region (:func:`xairl.in_regions`), or empty for a group.
     :param change: for a signal of a window (:mod:`xairl.policies.windows`): its newest value minus its oldest (``value`` is
@@ -79,6 +78,7 @@ class FeatureFact:
     window: str = ""
     change_unit: str = ""
     steps: str = ""
+    rank_same_way: int = 0
 
 
 @dataclass(frozen=True)
@@ -245,7 +245,7 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
     """A :class:`FeatureFact` per narration unit of state ``i`` for ``contrib`` (one value per feature)."""
     us = narration_units(exp, policy)
     c = np.array([float(contrib[list(u.columns)].sum()) for u in us])
-    rank, _, share = unit_ranks(c, np.array([u.info.kind != "identifier" for u in us]))
+    rank, same, share = unit_ranks(c, np.array([u.info.kind != "identifier" for u in us]))
     q = exp.background_quantiles
     labels = exp.value_labels
     regions = (exp.extras or {}).get("regions") or {}  # an image's regions (xairl.in_regions)
@@ -275,6 +275,7 @@ def _feature_facts(exp: Explanation, i: int, contrib: np.ndarray, policy: Policy
                 fill,
                 text,
                 *moved,
+                rank_same_way=int(same[n]),
             )
         )
     return out
@@ -287,9 +288,8 @@ def _top(facts: list[FeatureFact], k: int) -> tuple[FeatureFact, ...]:
 def decision_facts(
     exp: Explanation, index: int = 0, policy: Policy | None = None, k: int = 3, history: np.ndarray | None = None
 ) -> DecisionFacts:
-    """Facts about state ``index``: the action, runner-up, Q-gap, top-``k`` reasons for the chosen action's score,
-    for the margin against the runner-up, the reasons that favour the decision and its strongest concession, the
-    identifiers as context, and the policy plugin's own facts (given ``history``, the episode's earlier states)."""
+    """Facts about state ``index``: action, runner-up, Q-gap, top-``k`` reasons for the chosen score and the margin,
+    the reasons for the decision, its concession, identifiers as context, the plugin's facts (``history``: the past)."""
     index = exp.check_index(index)
     if exp.states is None:
         raise InputError("this explanation has no states (it was grouped); narrate the ungrouped explanation.")

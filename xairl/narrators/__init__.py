@@ -43,14 +43,15 @@ def narrate(
 
 def check_template(path: str | Path, *, notes: bool = False, verbose=None) -> list[str]:
     """Problems of a template file, one line each: the static checks of :func:`xairl.templates.prompts.check` with a trial
-    rendering on sample facts, then the battery (:mod:`xairl.narrators.battery`): the template rendered on
-    generated decisions of every policy kind, each rendering verified by provenance, and each contradicted one
-    reported with the template's file:line, the decision, the sentence and the claim. What ``xairl prompts check``
-    prints.
+    rendering on sample facts, then the battery (:mod:`xairl.narrators.battery`): each claim word the template writes
+    as literal text (with its file:line and the filter to write it with), then the template rendered on generated
+    decisions of every policy kind, each rendering verified by provenance, and each contradicted one reported with
+    the template's file:line, the decision, the sentence and the claim. What ``xairl prompts check`` prints.
 
-    :param notes: also return the advice lines, prefixed 'note:' (direction words a template chooses itself where the
-        ``dir`` filter would track them; a plugin template that needs its plugin's extras), after the problems.
-    :param verbose: called with a line saying how many cases and renderings the battery ran, and in what time.
+    :param notes: also return the advice lines, prefixed 'note:' (a plugin template that needs its plugin's extras;
+        a plugin policy left out of the battery), after the problems.
+    :param verbose: called with a line saying how many cases and renderings the battery ran, how many problems it
+        found, and in what time.
     """
     from xairl.narrators.battery import run
     from xairl.narrators.samples import sample_context

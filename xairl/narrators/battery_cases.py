@@ -3,7 +3,8 @@
 :class:`xairl.FeatureInfo` (units, a capacity, a categorical, an identifier). Every sign pattern of the top three
 features, ties, zero contributions, 1, 3 and 50 features, one feature alone favouring the chosen action, none
 favouring it, a single available action and a masked best one, on each policy kind (flat, dict, image in regions,
-continuous, value), global views over several states, and every installed plugin's policy."""
+continuous, value), decisions with a counterfactual (what would have changed them), global views over several
+states, and every installed plugin's policy."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from functools import cache
 import numpy as np
 import torch
 
+from xairl.counterfactual_facts import CounterfactualFact, said_counterfactual
 from xairl.explanations.explanation import Explanation
 from xairl.policies.policy import FeatureInfo, Policy
 from xairl.policies.regions import in_regions
@@ -43,6 +45,7 @@ class Case:
     explanation: Explanation
     policy: Policy
     index: int | None = 0
+    counterfactual: CounterfactualFact | None = None  # what would have changed the decision, as narration says it
 
 
 def _signs(s) -> str:
@@ -174,6 +177,25 @@ def kind_cases() -> list[Case]:
     return cases
 
 
+@cache
+def counterfactual_cases() -> tuple[Case, ...]:
+    """Decisions of the toy robot (a policy that runs: a counterfactual sentence is checked by re-running it) with
+    what would have changed them, searched and written as narration writes it: two changes, and one."""
+    import xairl
+    from xairl.toy import toy_background, toy_policy
+
+    p, background = toy_policy(), toy_background(30)
+    exp = xairl.explain(p, toy_background(4, seed=3), background=background, method="exact")
+    out = []
+    for i in (0, 2):
+        cf = said_counterfactual(exp, i, p, True, background)
+        if cf is not None and cf.reachable:
+            n = len(cf.changes)
+            label = f"counterfactual, toy robot, {n} change{'s' * (n > 1)} to {cf.action}"
+            out.append(Case(label, "counterfactual", exp, p, i, cf))
+    return tuple(out)
+
+
 def _stack(cases: list[Case]) -> Explanation:
     """One explanation of the states of ``cases`` (same policy)."""
     e = [c.explanation for c in cases]
@@ -249,7 +271,7 @@ def plugin_cases(p: Policy, name: str) -> list[Case]:
 def cases(outputs=("actions", "continuous", "value"), kind: str = "decision") -> tuple[list[Case], list[str]]:
     """The battery's cases for a template of ``kind`` that narrates ``outputs``, and a line for each plugin policy
     left out."""
-    decisions = flat_cases() + kind_cases()
+    decisions = flat_cases() + kind_cases() + list(counterfactual_cases())
     left_out = []
     for name, policy, why in plugin_policies():
         if policy is None:

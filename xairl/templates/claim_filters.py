@@ -70,13 +70,14 @@ def level(x, low: str = "low", typical: str = "typical", high: str = "high", unk
 def rank(x, *words: str, other: str = "") -> str:
     """The ``n``-th of ``words`` for a feature ranked ``n`` in its view (1 for the largest |contribution|, or mean
     |contribution| in a global view), ``other`` past the last word (and for an identifier, which has no rank),
-    given the feature dict or its ``rank``. Tracked, its fact is ``Fact('rank', feature, view, value=the rank,
-    of='rank')``."""
+    given the feature dict or its ``rank``; given its ``rank_same_way``, by its rank among the pushes of its sign
+    (1: the biggest push its way). Tracked, its fact is ``Fact('rank', feature, view, value=the rank, of='rank')``
+    (``'rank_same_way'`` for both the quantity and ``of`` of the latter)."""
     x = _field(x, "rank")
     n = int(x)
     word = words[n - 1] if 1 <= n <= len(words) else other
-    f = x.fact if isinstance(x, TrackedInt) and x.fact.quantity == "rank" else None
-    return _claim(word, None if f is None else Fact("rank", f.feature, f.view, value=n, of="rank"))
+    f = x.fact if isinstance(x, TrackedInt) and x.fact.quantity in ("rank", "rank_same_way") else None
+    return _claim(word, None if f is None else Fact(f.quantity, f.feature, f.view, value=n, of=f.quantity))
 
 
 def compare(x, other, more: str = "more", less: str = "less", same: str | None = None) -> str:
@@ -102,8 +103,9 @@ def role(context, x, chosen: str = "", runner_up: str = "", only: str | None = N
     'only'|'counterfactual', value=the action's name, of='action'|'cf_action')``."""
     f = x.fact if isinstance(x, TrackedStr) and x.fact.quantity in ("action", "cf_action") else None
     alone = only is not None and context.get("action") is not None and context.get("runner_up") == context.get("action")
-    if f is None:
-        return str(only if alone else chosen)
+    if f is None:  # (an untracked rendering: its role by its name)
+        plain = runner_up if x == context.get("runner_up") and x != context.get("action") else chosen
+        return str(only if alone else plain)
     which = "counterfactual" if f.quantity == "cf_action" else "only" if alone else f.role
     word = {"chosen": chosen, "counterfactual": chosen, "only": only, "runner_up": runner_up}.get(which, "")
     return _claim(word, Fact("role", role=which, value=str.__str__(x), of=f.quantity))

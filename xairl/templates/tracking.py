@@ -37,7 +37,8 @@ class Fact:
         (:func:`track_counterfactual`). A *claim word* printed by a claim filter (:mod:`xairl.templates.claim_filters`)
         is the author's word, and its fact has ``of`` set: 'direction' (``dir``: value 'toward' or 'against', the sign
         of the quantity ``of`` of the feature, view and role; 'direction_high' / 'direction_low' keep theirs), 'level'
-        (``level``: value 'low', 'typical', 'high' or 'unknown'), 'rank' (``rank``: value the rank), 'comparison'
+        (``level``: value 'low', 'typical', 'high' or 'unknown'), 'rank' (``rank``: value the rank; 'rank_same_way' of
+        ``f.rank_same_way|rank(...)``, the rank among the pushes of the feature's sign), 'comparison'
         (``cmp``: value 'more', 'less' or 'same', the feature's |contribution| against that of the feature named in
         ``role``; a domain comparison's fact has ``of`` None), 'role' (``role``: value the action's name, ``role``
         'chosen', 'runner_up', 'only' or 'counterfactual').
@@ -315,6 +316,7 @@ _FEATURE_FIELDS = {
     "level": "level",
     "level_text": "level",
     "rank": "rank",
+    "rank_same_way": "rank_same_way",
     "kind": "kind",
     "fill": "fill",
     "change": "value_change",

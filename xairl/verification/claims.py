@@ -30,10 +30,8 @@ KINDS = ("direction", "level", "rank", "comparison", "negation", "cause", "role"
 #: the prefix of a counterfactual fact's quantity (:func:`xairl.templates.tracking.track_counterfactual`), and the
 #: template variable that holds them
 COUNTERFACTUAL, COUNTERFACTUAL_VARIABLE = "cf_", "counterfactual"
-NAME_USE = "print it from the facts: {{ f.label }} (or {{ f.name }}) for a feature, {{ action }} or {{ runner_up }}"
-IDENTIFIER_USE = (
-    "print names from the facts ({{ f.label }}, {{ action }}); a name the policy lacks is an invented feature"
-)
+NAME_USE = "{{ f.label }} (or {{ f.name }}) for a feature, {{ action }} or {{ runner_up }} for an action"
+IDENTIFIER_USE = "{{ f.label }} or {{ action }} from the facts (a name no fact holds is an invented one)"
 
 # An identifier: letters or digits joined by an underscore ('cell_load', 'rsrp_1'), or camelCase with two lowercase
 # letters before a capital ('cellLoad'; units such as 'dBm', 'kHz' or 'mWh' are not identifiers)
@@ -85,11 +83,15 @@ def lexicon(path: Path = LEXICON) -> Lexicon:
     words: dict[str, tuple[str, str]] = {}
     for kind in KINDS:
         for word, use in (data.get(kind) or {}).items():
-            key = normalise(str(word))
+            if not isinstance(word, str):  # YAML reads a bare no, on or false as a boolean
+                raise ValueError(f"{path}: claim word {word!r} ({kind}) is not a string; quote it.")
+            key = normalise(word)
             if key in words:
                 raise ValueError(f"{path}: claim word {word!r} is listed twice ({words[key][0]} and {kind}).")
             words[key] = (kind, str(use))
-    filler = frozenset(normalise(str(w)) for w in data.get("filler") or ())
+    if not all(isinstance(w, str) for w in data.get("filler") or ()):
+        raise ValueError(f"{path}: a filler word is not a string; quote it.")
+    filler = frozenset(normalise(w) for w in data.get("filler") or ())
     if clash := sorted(filler & set(words)):
         raise ValueError(f"{path}: {', '.join(clash)} listed both as claim words and as filler.")
     return Lexicon(words, filler, re.compile(_alternation(words), re.IGNORECASE))

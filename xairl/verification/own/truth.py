@@ -81,7 +81,8 @@ def truth(exp: Explanation, index: int | None, policy: Policy | None, domain: Do
         for f in facts + (d.identifiers if view == "score" else ()):
             features.setdefault(f.name, {})[view] = f
             for q in (
-                *("value", "value_text", "unit", "contribution", "share", "direction", "rank", "kind", "fill"),
+                *("value", "value_text", "unit", "contribution", "share", "direction", "rank", "rank_same_way"),
+                *("kind", "fill"),
                 *("trend", "window", "change_unit", "steps"),
             ):
                 values[(q, f.name, view, None)] = getattr(f, q)
