@@ -226,7 +226,7 @@ def _claimed(f, truth: Truth):
     if f.quantity in ("direction_high", "direction_low") or f.of.startswith("direction"):
         return truth.values.get((f.of, f.feature, view, None), MISSING)
     x = truth.values.get((f.of, f.feature, view, f.role), MISSING)
-    if f.quantity == "rank":
+    if f.quantity in ("rank", "rank_same_way"):
         return x
     if f.quantity == "direction" and isinstance(x, (int, float, np.floating)) and math.isfinite(x):
         return "toward" if x >= 0 else "against"
