@@ -25,14 +25,14 @@ LISTED = """\
 name: listed
 kind: decision
 sentences:
-  - ["The policy chose {{ action }} over {{ runner_up }}."]
+  - ["The policy {{ action|role('chose') }} {{ action }} over {{ runner_up }}."]
   - - |
-      Reasons <for> & against:
+      Reasons <why> & how:
       {% for f in margin_top %}
       - {{ f.label }} moved the margin by {{ f.contribution|signed }}. It is item {{ loop.index }}.
       {% endfor %}
 """
-HEADING = "Reasons <for> & against:"
+HEADING = "Reasons <why> & how:"
 ITEM = re.compile(r"- .+ moved the margin by [-+]\d\.\d+\. It is item (\d)\.")
 
 
@@ -58,7 +58,7 @@ def check_lines(lines: list[str]) -> None:
 def test_the_text_keeps_the_template_lines(listed):
     n, _, _ = listed
     check_lines(n.text.split("\n"))
-    assert n.source == "template" and dict(n.sentences)[HEADING] == "unchecked"
+    assert n.source == "template" and dict(n.sentences)[HEADING] == "none"  # (a heading states nothing)
     items = [s for s, _ in n.sentences if s.startswith("It is item")]  # an item's sentences are two sentences
     assert items == [f"It is item {k}." for k in range(1, len(n.text.split("\n")) - 1)]
 
@@ -77,11 +77,11 @@ def terminal_lines(rows: list[str]) -> list[tuple[str, str]]:
 def check_rows(rows: list[str], text: str) -> None:
     """A row per sentence: each list item on its own row with its bullet and mark, its second sentence indented
     under the item's words; joined back line by line, the rows are the text's lines."""
-    shown = terminal_lines(rows)
-    assert shown[0][0] == "verified" and shown[1] == ("unchecked", HEADING)
+    shown = terminal_lines([r for r in rows if not r.startswith("    account: ")])
+    assert shown[0][0] == "verified" and shown[1] == ("(no claim)", HEADING)
     lines, items = [], 0
     for mark, words in shown:
-        assert mark in ("verified", "unchecked"), (mark, words)
+        assert mark in ("verified", "(no claim)"), (mark, words)
         if words.startswith("  "):  # a sentence after the one before on its line
             assert words.startswith("  It is item") and lines[-1].startswith("- ")
             lines[-1] += " " + words.strip()
@@ -109,7 +109,7 @@ def test_marked_rows_of_the_narrative(listed):
     n, _, _ = listed
     rows = marked_rows(n.text, n.sentences).split("\n")
     check_rows(rows, n.text)
-    assert rows[2].startswith("    verified      - ") and rows[3].startswith("    verified        It is item 1.")
+    assert rows[2].startswith("    verified      - ") and rows[3].startswith("    (no claim)      It is item 1.")
 
 
 def test_marked_rows_of_prose_are_as_before():
@@ -186,7 +186,7 @@ class Narratives(HTMLParser):
 
 def check_card(lines: list[tuple[str, list[str]]], text: str) -> None:
     """The card's lines are the text's, each sentence followed by its mark (✓ or ?)."""
-    marks = {"verified": "\u2713", "unchecked": "?"}
+    marks = {"verified": "\u2713", "unchecked": "?", "none": ""}
     expected = []
     for line in text.split("\n"):
         sentences = re.split(r"(?<=[.:])\s+(?=[A-Z])", line)
@@ -196,14 +196,14 @@ def check_card(lines: list[tuple[str, list[str]]], text: str) -> None:
     for (words, statuses), sentences, line in zip(lines, expected, text.split("\n")):
         assert len(statuses) == len(sentences), (words, statuses)
         bullet = "- " if line.startswith("- ") else ""
-        assert words == bullet + " ".join(f"{s} {marks[st]}" for s, st in zip(sentences, statuses)), words
-    assert lines[1] == (HEADING + " ?", ["unchecked"])
+        assert words == bullet + " ".join(f"{s} {marks[st]}".rstrip() for s, st in zip(sentences, statuses)), words
+    assert lines[1] == (HEADING, ["none"])
 
 
 def test_the_card_has_a_line_break_between_the_lines_and_stays_escaped(listed):
     n, _, _ = listed
     html = card_html(n.text, n.evidence)
-    assert "Reasons &lt;for&gt; &amp; against:" in html and "<for>" not in html
+    assert "Reasons &lt;why&gt; &amp; how:" in html and "<for>" not in html
     assert html.count("<br>") == len(n.text.split("\n")) - 1
     (lines,) = Narratives.of(html)
     check_card(lines, n.text)
@@ -233,8 +233,8 @@ def test_the_report_card_keeps_the_lines(listed, tmp_path):
     )
     path = write_report(req, ReportContent("toy", p, p.background(30), [("states", p.background(2, seed=3))]))
     html = path.read_text()
-    assert "Reasons &lt;for&gt; &amp; against:" in html and "<for>" not in html
-    cards = [lines for lines in Narratives.of(html) if len(lines) > 1 and lines[1][0] == HEADING + " ?"]
+    assert "Reasons &lt;why&gt; &amp; how:" in html and "<for>" not in html
+    cards = [lines for lines in Narratives.of(html) if len(lines) > 1 and lines[1][0] == HEADING]
     assert len(cards) == 1
     text = "\n".join(words.replace(" \u2713", "").replace(" ?", "") for words, _ in cards[0])
     check_lines(text.split("\n"))
@@ -251,7 +251,8 @@ def test_the_review_page_and_the_terminal_review_keep_the_lines(listed, tmp_path
     assert main(["review", "--db", str(store.path)]) == 0
     shown = capsys.readouterr().out.splitlines()
     start = next(i for i, row in enumerate(shown) if row.startswith(f"#{rid} ")) + 1
-    check_rows(shown[start : start + len(n.sentences)], n.text)
+    rows = [row for row in shown[start:] if not row.startswith("    account: ")]
+    check_rows(rows[: len(n.sentences)], n.text)
     store.review(rid, "corrected", "First line <i>.\r\nSecond line.")  # the page's textarea sends CRLF
     html = page(store, "token", show_all=True)
     assert "correction: <i>First line &lt;i&gt;.<br>Second line.</i>" in html

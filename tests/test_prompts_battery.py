@@ -60,12 +60,17 @@ def test_a_correct_template_reports_nothing(tmp_path):
 
 
 def test_a_wrong_template_is_reported_with_its_line(tmp_path):
+    """A value printed beside another feature's name is never contradicted by its position, but each rendering
+    left unchecked is a problem with its line and why (issue 65: 'unchecked' is never passed as fine)."""
     path = write(tmp_path, CROSSED)
     problems = check_template(path)
-    assert problems and all(p.startswith(f"{path}:6: contradicted on ") for p in problems), problems
-    assert any("contribution, written as" in p for p in problems), problems
+    assert problems and all(p.startswith(f"{path}:6: unchecked on ") for p in problems), problems
+    assert any("contribution, written next to" in p for p in problems), problems
     assert all("\n" not in p for p in problems)
-    assert any(re.search(r"contradicted on flat, signs [+-],[+-],[+-]: '", p) for p in problems)
+    assert any(re.search(r"unchecked on flat, signs [+-],[+-],[+-]: '", p) for p in problems)
+    path = write(tmp_path, HEAD + CHOSE + '  - ["{{ action }} (score {{ runner_up_score|num }})."]\n', "role.yaml")
+    problems = check_template(path)
+    assert problems and all(p.startswith(f"{path}:6: contradicted on ") for p in problems), problems
 
 
 @pytest.mark.parametrize(
@@ -82,8 +87,8 @@ def test_a_literal_claim_word_is_a_problem_naming_its_line_and_filter(tmp_path, 
 
 def test_each_rendering_is_one_line_naming_the_decision(tmp_path):
     problems = check_template(write(tmp_path, CROSSED))
-    decisions = [p.split(": contradicted on ")[1].split(": ")[0] for p in problems]
-    assert len(decisions) == len(set(decisions))  # one line per contradicted rendering
+    decisions = [p.split(": unchecked on ")[1].split(": ")[0] for p in problems]
+    assert len(decisions) == len(set(decisions))  # one line per rendering left unchecked
     assert "flat, 1 feature, signs +" not in decisions and "flat, signs +,-,+" in decisions  # only what is wrong
 
 
@@ -213,8 +218,10 @@ def test_an_installed_plugins_policy_is_in_the_battery(uav_plugin, tmp_path):
     uav = [c for c in decisions if c.kind == "uav-dqn"]
     assert left_out == [] and len(uav) == 4
     assert all(c.policy.facts_hook is not None for c in uav)
-    problems = check_template(write(tmp_path, RUNNER_UP))
-    assert any("contradicted on uav-dqn, state 0" in p for p in problems)
+    problems = check_template(
+        write(tmp_path, HEAD + CHOSE + '  - ["{{ action }} (score {{ runner_up_score|num }})."]\n')
+    )
+    assert any("contradicted on uav-dqn, state 0" in p for p in problems), problems
 
 
 def test_a_plugin_policy_that_fails_to_load_is_one_line_and_the_battery_goes_on(monkeypatch):

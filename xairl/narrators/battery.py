@@ -27,6 +27,7 @@ from xairl.templates.sandbox import parse_variant
 from xairl.templates.tracking import joined, track_decision, track_global
 from xairl.verification import verify
 from xairl.verification.claims import COUNTERFACTUAL_VARIABLE, claim_words
+from xairl.verification.own import UNDECLARED
 
 
 @dataclass
@@ -60,7 +61,8 @@ def _facts(case: Case):
 
 def _contradictions(tpl: Template, case: Case, variants, domain, v: int) -> list[str]:
     """One line per template line whose sentence, in the rendering of each sentence's variant ``v`` (or its last),
-    is contradicted; none for a sentence whose variant ``v`` does not exist (its last was checked already)."""
+    is contradicted, or left unchecked for another reason than a literal claim word (:func:`undeclared` names
+    those once); none for a sentence whose variant ``v`` does not exist (its last was checked already)."""
     picked = [(s, min(v, len(vs) - 1)) for s, vs in enumerate(variants) if vs]
     parts = [(s, u, variants[s][u]) for s, u in picked if variants[s][u]]
     seps = [("\n" if "\n" in a + b else " ") for (_, _, a), (_, _, b) in zip(parts, parts[1:])]
@@ -71,14 +73,14 @@ def _contradictions(tpl: Template, case: Case, variants, domain, v: int) -> list
     for sentence in check.sentences:
         at = max(text.find(sentence.text, cursor), 0)
         cursor = at + len(sentence.text)
-        # (a claim word a filter printed is the author's word for its fact: true by identity, whatever the word)
-        for claim in (c for c in sentence.claims if c.status == "contradicted"):
+        for claim in (c for c in sentence.claims if c.status != "verified" and c.rule != UNDECLARED):
             pos = claim.span.start if claim.span is not None else at + max(sentence.text.find(claim.text), 0)
             s, u, _ = parts[max(k for k, start in enumerate(starts[: len(parts)]) if start <= pos)]
             if u == v:
                 where = f"{tpl.path}:{tpl.lines[s][u]}"
                 said = claim.detail if claim.detail.startswith(f"'{claim.text}'") else f"{claim.text!r} {claim.detail}"
-                lines.setdefault(where, f"{where}: contradicted on {case.label}: {sentence.text!r}: {said}".rstrip())
+                line = f"{where}: {claim.status} on {case.label}: {sentence.text!r}: {said}".rstrip()
+                lines.setdefault((where, claim.status), line)
     return list(lines.values())
 
 
