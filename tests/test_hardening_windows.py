@@ -191,7 +191,7 @@ def test_a_trends_push_is_said_once(tmp_path):
     assert f.name == facts.reasons[0].name
     n = xairl.narrate(e, 0, policy=p)
     assert "fell 4 dB over the last 0.8 s." in n.text and "which favoured go" not in n.text and n.verified, n.text
-    body = "{% for f in trends %}{{ f.label|cap }} {{ f.trend }} {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}, which favoured {{ action }} by {{ f.contribution|num }}.{% endfor %}"
+    body = "{% for f in trends %}{{ f.label|cap }} {{ f.trend }} {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}, which {{ f|dir('favoured', 'went against') }} {{ action }} by {{ f.contribution|abs|num }}.{% endfor %}"
     (tmp_path / "t.yaml").write_text(json.dumps({"name": "t", "kind": "decision", "sentences": [[body]]}))
     alone = xairl.narrate(e, 0, policy=p, template=str(tmp_path / "t.yaml"))  # a trend said nowhere else: its push
     assert "which favoured go by" in alone.text and alone.verified, alone.text

@@ -121,7 +121,7 @@ def test_a_window_is_summarised_per_signal(exp):
     assert {r["name"] for r in g.ranking} == set(SIGNALS)
 
 
-MUTANTS = {  # a template that misstates a trend -> the claim that must be contradicted
+MUTANTS = {  # a template that misstates a trend, or says it in words it did not declare: never verified
     "rose": "{{ f.label|cap }} rose {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}.",
     "value as change": "{{ f.label|cap }} {{ f.trend }} {{ f.value|abs|num }} {{ f.unit }} over {{ f.window }}.",
     "push as change": "{{ f.label|cap }} {{ f.trend }} {{ f.contribution|abs|num }} {{ f.unit }} over {{ f.window }}.",
@@ -129,10 +129,12 @@ MUTANTS = {  # a template that misstates a trend -> the claim that must be contr
 }
 
 
-RIGHT = {  # correct ways to say the same trend: each must verify
+RIGHT = {  # correct ways to say the same trend, each word declared: each must verify
     "right": "{{ f.label|cap }} {{ f.trend }} by {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}.",
-    "went down": "{{ f.label|cap }} went down by {{ f.change|abs|num }} {{ f.unit }} over {{ f.window }}.",
-    "decreased": "{{ f.label|cap }} decreased by about {{ f.change|abs|num }} {{ f.unit }}.",
+    "went down": "{{ f.label|cap }} {{ f.change|dir('went up', 'went down') }} by {{ f.change|abs|num }} {{ f.unit }} "
+    "over {{ f.window }}.",
+    "decreased": "{{ f.label|cap }} {{ f.change|dir('increased', 'decreased') }} by about {{ f.change|abs|num }} "
+    "{{ f.unit }}.",
     "changed": "{{ f.label|cap }} changed by {{ f.change|num }} {{ f.unit }} over {{ f.window }}.",
 }
 
@@ -191,7 +193,7 @@ def test_a_frame_stacked_cnn_is_narrated_in_trends_over_its_frames():
     said = 0
     for i in range(2):
         n = xairl.narrate(e, i, policy=p, robustness=False)
-        assert n.verified and xairl.verify(n.text, e, i, p).status == "verified", n.text
+        assert n.verified and xairl.verify(n.text, e, i, p).accurate, n.text  # (read again as prose: nothing false)
         said += len(re.findall(r"(?:rose|fell) [\d.]+ over the last 4 frames", n.text))
     assert said >= 2
 
@@ -232,7 +234,10 @@ def test_an_explanation_without_time_is_refused_in_one_line():
 
 def test_a_trend_word_about_a_score_is_no_trend(exp, tmp_path):
     """'the margin grew by X' (X a contribution) is no signal's change, with or without a window."""
-    body = "{% for f in reasons[:1] %}The margin of {{ action }} grew by {{ f.contribution|num }} from {{ f.label }}.{% endfor %}"
+    body = (
+        "{% for f in reasons[:1] %}The margin of {{ action }} {{ f.contribution|dir('grew', 'shrank') }} by "
+        "{{ f.contribution|abs|num }} from {{ f.label }}.{% endfor %}"
+    )
     path = tmp_path / "m.yaml"
     path.write_text(yaml.safe_dump({"name": "m", "kind": "decision", "description": "m", "sentences": [[body]]}))
     assert xairl.narrate(exp, 0, policy=policy(), template=str(path)).verified

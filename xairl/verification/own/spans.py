@@ -115,8 +115,13 @@ class Sentence:
         trend's own tracked word, which its fact checks). A literal one counts only for a signal of a window (a
         feature with a change over it), and not when a score is its subject ('the margin grew by 8.8')."""
         prev = [r for r in self.spans if r.end <= p.start]
-        if prev and prev[-1].span.fact.quantity == "trend":
-            if re.fullmatch(r"\s*(?:by\s*)?", self.text[prev[-1].end : p.start]):
+        if prev and (
+            prev[-1].span.fact.quantity == "trend" or getattr(prev[-1].span.fact, "of", None) == "value_change"
+        ):
+            if re.fullmatch(
+                r"\s*(?:by\s*)?(?:(?:about|around|roughly|some|nearly|almost|just)\s*)?",
+                self.text[prev[-1].end : p.start],
+            ):
                 return True, 0
         f = p.span.fact
         if self.truth.get(Span(0, 0, "", replace(f, quantity="value_change"))) in (None, MISSING):
