@@ -47,7 +47,7 @@ def _wrapped(text: str) -> str:
 
 def test_text_with_a_bidi_override_is_not_verified(toy):
     p, e, n = toy
-    assert n.verified and xairl.verify(n.text, e, 0, p).ok  # the same words without the override verify
+    assert n.verified and xairl.verify(n.text, e, 0, p).accurate  # the same words without the override: not false
     bad = _wrapped(n.text)
     for check in (xairl.verify(bad, e, 0, p), xairl.verify(bad, e, 0, p, provenance=n.provenance)):
         assert not check.ok and check.status == "contradicted"
@@ -263,7 +263,7 @@ def test_the_toys_level_words_say_a_level_not_a_state(toy):
 def test_a_contradicted_direction_word_is_said_once_by_prompts_check(tmp_path):
     from xairl.narrators.battery import run
 
-    # (a literal direction word: named as undeclared, and contradicted where it is false, each said once)
+    # (a literal direction word: named as undeclared once, with the filter to use; unchecked at render time)
     source = prompts.load("explain_action").path.read_text().replace("{{ f|dir('toward', 'against') }}", "opposing")
     path = tmp_path / "opposed.yaml"
     path.write_text(source)
@@ -274,5 +274,5 @@ def test_a_contradicted_direction_word_is_said_once_by_prompts_check(tmp_path):
         )
         for line in lines
     ), lines[:2]
-    assert any("'opposing' is said of" in line for line in lines), lines[:3]
+    assert sum("'opposing'" in line for line in lines) == 1, lines[:3]
     assert not [line for line in lines if "'opposing' 'opposing'" in line], lines[:2]
