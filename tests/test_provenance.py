@@ -98,7 +98,8 @@ CASES = {
     "tracked.role": (
         "robot",
         "{{ action }} (score {{ runner_up_score|num }}).",
-        "{{ action }} (score {{ score|num }}), {{ runner_up }} (score {{ runner_up_score|num }}).",
+        "{{ action }} (score {{ score|num }}), {{ runner_up|role('', 'runner-up') }} {{ runner_up }} (score "
+        "{{ runner_up_score|num }}).",
         "turn (score 2).",
         "contradicted",
     ),

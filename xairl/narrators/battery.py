@@ -172,6 +172,25 @@ def _prints_counterfactual(ast: nodes.Template) -> bool:
     return any(x.name in tainted for o in ast.find_all(nodes.Output) for x in o.find_all(nodes.Name))
 
 
+def _runner_up_printed(node: nodes.Node) -> tuple[int | None, bool]:
+    """(the line of the first place a phrasing prints ``runner_up`` itself, whether a ``role`` filter declares the
+    runner-up's role in it): a runner-up named without its role may read as the chosen action."""
+    first, declared, todo = None, False, [node]
+    while todo:
+        n = todo.pop()
+        if isinstance(n, nodes.Filter) and n.name == "role":
+            declared |= isinstance(n.node, nodes.Name) and n.node.name == "runner_up"
+            continue
+        if isinstance(n, (nodes.Compare, nodes.Test)):
+            continue
+        if isinstance(n, nodes.Name) and n.name == "runner_up" and n.ctx == "load":
+            first = n.lineno if first is None else min(first, n.lineno)
+            continue
+        tests = [getattr(n, "test", None)] if isinstance(n, (nodes.If, nodes.CondExpr, nodes.For)) else []
+        todo += [c for c in n.iter_child_nodes() if all(c is not t for t in tests)]
+    return first, declared
+
+
 def undeclared(tpl: Template, names: Iterable[str] = ()) -> list[str]:
     """One problem per claim word ``tpl`` writes as literal text (:func:`xairl.verification.claims.claim_words`; a
     name of ``names`` too), with its file:line, the word and the filter to write it with. A phrasing that prints
@@ -187,6 +206,13 @@ def undeclared(tpl: Template, names: Iterable[str] = ()) -> list[str]:
                 for n, (line, literal) in enumerate(_literals(ast))
                 for w in claim_words(literal, names)
             ]
+            line, declared = _runner_up_printed(ast)
+            if line is not None and not declared:
+                where = f"{tpl.path}:{tpl.lines[s][v] + line - 1}"
+                out[(where, "runner_up")] = (
+                    f"{where}: the runner-up is printed without its role; declare it with runner_up|role('', 'over') "
+                    "(the words that say it is the runner-up)"
+                )
             for line, _, _, w in sorted(found, key=lambda x: x[:3]):  # (in the template's order)
                 said = " ".join(w.word.split())
                 where = f"{tpl.path}:{line}"

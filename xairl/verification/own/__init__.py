@@ -85,6 +85,17 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, names: Se
             extra.append(s.base(p))
         if q == "score" and p.span.fact.role:
             extra.append(s.role(p))
+        if q == "action" and p.span.fact.role == "runner_up" and not _role_declared(s.spans, p, truth):
+            extra.append(
+                Claim(
+                    "role",
+                    p.span.text,
+                    "unchecked",
+                    "the runner-up named without its role: write the words "
+                    "that say it with runner_up|role('chose', 'over')",
+                    UNDECLARED,
+                )
+            )
         if counterfactual and q in DECISION_NUMBERS:
             what = q.replace("_", " ")
             extra.append(
@@ -100,6 +111,16 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, names: Se
         claims += [c for c in extra if c is not None]
     claims += undeclared(sentence, s.spans, len(truth.features), names, numbers_only=bool(counterfactual))
     return claims
+
+
+def _role_declared(spans: Sequence[Part], p: Part, truth: Truth) -> bool:
+    """Whether the sentence declares the role of the action ``p`` names (a ``role`` word of that action), or there
+    is no other action it could be taken for."""
+    if truth.actions.get("chosen") == truth.actions.get("runner_up"):
+        return True
+    return any(q.span.fact.quantity == "role" and q.span.fact.value == p.span.text for q in spans) or any(
+        q.span.fact.quantity == "role" and q.span.fact.role == "runner_up" for q in spans
+    )
 
 
 def undeclared(

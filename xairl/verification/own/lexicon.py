@@ -90,3 +90,6 @@ LABELS = tuple((re.compile(x["before"], re.IGNORECASE), x["group"]) for x in _WO
 DIFFERENCE, MORE, LESS = _compiled("difference"), _compiled("more"), _compiled("less")
 #: a trend word right before a number (its sign in the groups up/down), and a score as the trend's subject
 TREND_BEFORE, SCORE_SUBJECT = _compiled("trend_before"), _compiled("score_subject")
+#: a role's label right before a score ('runner-up: 2.0', 'won with a score of 3.1'), and what may stand between
+#: an action and its own score ('turn (score 3.05)', 'turn: 3.05')
+RUNNER_LABEL, CHOSEN_LABEL, SCORE_NEXT = (_compiled(k) for k in ("runner_label", "chosen_label", "score_next"))

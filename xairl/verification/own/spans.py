@@ -30,6 +30,9 @@ from xairl.verification.own.lexicon import (
     TREND_FITS,
     VIEW_AFTER,
 )
+from xairl.verification.own.lexicon import CHOSEN_LABEL as _CHOSEN_LABEL
+from xairl.verification.own.lexicon import RUNNER_LABEL as _RUNNER_LABEL
+from xairl.verification.own.lexicon import SCORE_NEXT as _SCORE_NEXT
 from xairl.verification.own.parts import Part, is_name, literal, parts
 from xairl.verification.own.truth import MISSING, Truth, number, view_of
 from xairl.verification.result import Claim
@@ -234,29 +237,35 @@ class Sentence:
         )
 
     def _score_role(self, p: Part) -> Claim | None:
-        """A score is the score of the action its words give it to: a 'runner-up' label, a 'chosen' one, else the
-        action right before it in its segment ('turn (score 3.05)'), else the one right after 'for' ('3.99 for B')."""
-        role, before = p.span.fact.role, self.before(p, 60)
-        said = "runner_up" if re.search(r"runner[-_ ]?up|second|next best", before, re.I) else None
-        said = said or ("chosen" if re.search(r"\b(?:chosen|chose|picked|winner|won)\b", before, re.I) else None)
+        """A score is the score of the action its words give it to: a 'runner-up' or 'chosen' label right before it,
+        else the action right before it ('turn (score 3.05)', 'turn | score 3.05'), else the one right after 'for'
+        ('3.99 for B'). Only such adjacency contradicts; an action further back in its block (a binding by position)
+        leaves a mismatch unchecked."""
+        role, before = p.span.fact.role, self.before(p, 40)
+        said = "runner_up" if _RUNNER_LABEL.search(before) else "chosen" if _CHOSEN_LABEL.search(before) else None
+        near = said is not None
         if said is None:
             earlier = [q for q in self.spans if q.end <= p.start]
             later = [q for q in self.spans if q.start >= p.end]
             if earlier and earlier[-1].span.fact.quantity == "action":
                 between = self.text[earlier[-1].end : p.start]
-                if (earlier[-1].block == p.block and SCORE_OF_BEFORE.match(between)) or CELL_SCORE.fullmatch(between):
+                near = bool(_SCORE_NEXT.fullmatch(between) or CELL_SCORE.fullmatch(between))
+                if near or (earlier[-1].block == p.block and SCORE_OF_BEFORE.match(between)):
                     said = earlier[-1].span.fact.role
             if said is None and later and later[0].span.fact.quantity == "action":
                 if SCORE_FOR_AFTER.match(self.text[p.end : later[0].start]):
-                    said = later[0].span.fact.role
-            said = said or self._respective_role(p)
+                    said, near = later[0].span.fact.role, True
+            if said is None:  # (pairing scores with actions in order is a binding by position)
+                said, near = self._respective_role(p), False
         if said is None or said == role:
             return None
         return Claim(
             "number",
             p.span.text,
-            "contradicted",
-            f"{p.span.text} is the {role.replace('_', '-')}'s score, written as the {said.replace('_', '-')}'s",
+            "contradicted" if near else "unchecked",
+            f"{p.span.text} is the {role.replace('_', '-')}'s score, written "
+            + ("as" if near else "after")
+            + f" the {said.replace('_', '-')}'s",
             "tracked.role",
         )
 

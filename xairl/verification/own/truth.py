@@ -145,6 +145,15 @@ def check_fact(span: Span, truth: Truth, after: str = "") -> Claim:
 def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
     f = span.fact
     if getattr(f, "of", None) is not None:  # a declared claim word: its fact says which way, never the word
+        if f.quantity == "direction" and f.of not in PUSHES:
+            return Claim(
+                "direction",
+                span.text,
+                "unchecked",
+                f"a direction word read from the sign of {f.of.replace('_', ' ')}, which pushes nothing: dir reads a "
+                "contribution (f.contribution, q_margin, f.change)",
+                "tracked.fact",
+            )
         want = _claimed(f, truth)
         ok = want is not MISSING and want is not None and str(f.value) == str(want)
         detail = f"{f.quantity} of {f.feature or f.value} = {want if want is not MISSING else 'unknown'}"
@@ -202,6 +211,12 @@ def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
 #: value of its fact ('|replace' keeps the fact) is wrong
 CANONICAL_OF = frozenset({"direction", "direction_high", "direction_low", "level", "trend"})
 CANONICAL = frozenset({"toward", "against", "mixed", "low", "typical", "high", "moderate", "rose", "fell", "steady"})
+
+
+#: the quantities whose sign a direction word may say: pushes on a score or the margin, and a signal's change
+PUSHES = frozenset(
+    {"contribution", "margin", "base_margin", "mean", "value_change", "direction", "direction_high", "direction_low"}
+)
 
 
 def _claimed(f, truth: Truth):
