@@ -46,7 +46,8 @@ def verdict(tmp_path, sentence, exp, **names):
 def test_a_direction_in_the_authors_own_words_is_checked_by_its_fact(tmp_path, robot, words, name):
     """dir takes any two words: identity says which way, so no word list is consulted (issue 65, set B)."""
     up, down = words
-    sentence = MARGIN + "{{ f.label|cap }} {{ f.contribution|dir('%s', '%s') }} {{ f.contribution|abs|num }}." % words
+    said = f"dir('{up}', '{down}')"
+    sentence = MARGIN + "{{ f.label|cap }} {{ f.contribution|" + said + " }} {{ f.contribution|abs|num }}."
     text, v = verdict(tmp_path, sentence, robot, NAME=name)
     assert v.status == "verified", (text, v.problems())
     assert (up if name == "obstacle" else down) in text

@@ -13,7 +13,8 @@ from xairl.templates import prompts
 
 HEAD = "name: t\nkind: decision\noutputs: [actions]\nsentences:\n"
 CHOSE = (
-    "  - [\"{% if runner_up != action %}The policy {{ action|role('chose') }} {{ action }} over {{ runner_up }} by "
+    "  - [\"{% if runner_up != action %}The policy {{ action|role('chose') }} {{ action }} "
+    "{{ runner_up|role('', 'over') }} {{ runner_up }} by "
     "{{ q_margin|num }}.{% else %}The policy {{ action|role('chose') }} {{ action }}, "
     "{{ action|role('', only='the only action') }}.{% endif %}\"]\n"
 )

@@ -206,18 +206,18 @@ def undeclared(tpl: Template, names: Iterable[str] = ()) -> list[str]:
                 for n, (line, literal) in enumerate(_literals(ast))
                 for w in claim_words(literal, names)
             ]
-            line, declared = _runner_up_printed(ast)
-            if line is not None and not declared:
-                where = f"{tpl.path}:{tpl.lines[s][v] + line - 1}"
-                out[(where, "runner_up")] = (
-                    f"{where}: the runner-up is printed without its role; declare it with runner_up|role('', 'over') "
-                    "(the words that say it is the runner-up)"
-                )
             for line, _, _, w in sorted(found, key=lambda x: x[:3]):  # (in the template's order)
                 said = " ".join(w.word.split())
                 where = f"{tpl.path}:{line}"
                 out.setdefault(
                     (where, said.lower()),
                     f"{where}: {said!r} is a claim the template wrote itself; write it with {w.use}",
+                )
+            line, declared = _runner_up_printed(ast)
+            if line is not None and not declared:
+                where = f"{tpl.path}:{tpl.lines[s][v] + line - 1}"
+                out[(where, "runner_up")] = (
+                    f"{where}: the runner-up is printed without its role; declare it with runner_up|role('', 'over') "
+                    "(the words that say it is the runner-up)"
                 )
     return list(out.values())
