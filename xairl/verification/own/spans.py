@@ -57,11 +57,6 @@ class Sentence:
         nxt = [q for q in self.spans if q.start >= p.end]
         return self.text[p.end : min(nxt[0].start if nxt else len(self.text), p.end + n)]
 
-    def feature_fact(self, name: str, view: str | None):
-        views = self.truth.features.get(name, {})
-        return views.get(view_of(view)) or next(iter(views.values()), None)
-
-    # -- rules ------------------------------------------------------------------------------------------------
     def binding(self, p: Part) -> Claim | None:
         """A feature's number said of another feature: the name before it in its block (cut at ; : | and line
         breaks), else the first after it in its block, else (a block naming none) the name before it in the sentence;
@@ -225,16 +220,6 @@ class Sentence:
         if self.truth.output != "actions" or self.truth.actions.get("chosen") == self.truth.actions.get("runner_up"):
             return None
         return self._score_role(p) if p.span.fact.quantity == "score" else None
-
-    @staticmethod
-    def _role_claim(p: Part, role: str, said: str) -> Claim:
-        return Claim(
-            "action",
-            p.span.text,
-            "contradicted",
-            f"{p.span.text} is the {role.replace('_', '-')}, named as the {said.replace('_', '-')}",
-            "tracked.role",
-        )
 
     def _score_role(self, p: Part) -> Claim | None:
         """A score is the score of the action its words give it to: a 'runner-up' or 'chosen' label right before it,
