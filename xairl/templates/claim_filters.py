@@ -12,6 +12,7 @@ then literal text like any other, and a claim word in it leaves its sentence unc
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 
 from jinja2 import pass_context
 
@@ -20,8 +21,11 @@ from xairl.templates.tracking import Fact, TrackedFloat, TrackedInt, TrackedStr
 _DIRECTIONS = ("direction", "direction_high", "direction_low")
 
 
-def _claim(word, fact: Fact | None) -> str:
-    """``word`` printed as the claim ``fact`` (a plain word when there is no fact)."""
+def _claim(word, fact: Fact | None, words=()) -> str:
+    """``word`` printed as the claim ``fact`` (a plain word when there is no fact); ``words``: every word the filter
+    could have printed (one word for every fact declares nothing, and the fact says so)."""
+    if fact is not None and len({" ".join(str(w).lower().split()) for w in words}) == 1:
+        fact = replace(fact, alike=True)
     return str(word) if fact is None else str(TrackedStr(str(word), fact))
 
 
@@ -46,14 +50,15 @@ def direction(x, toward: str = "toward", against: str = "against", mixed: str = 
         value = str.__str__(x)
         word = toward if value == "toward" else against if value == "against" else mixed
         f = x.fact if isinstance(x, TrackedStr) and x.fact.quantity in _DIRECTIONS else None
-        return _claim(word, None if f is None else Fact(f.quantity, f.feature, f.view, f.role, value, of=f.quantity))
+        fact = None if f is None else Fact(f.quantity, f.feature, f.view, f.role, value, of=f.quantity)
+        return _claim(word, fact, (toward, against))
     word = toward if x >= 0 else against
     if not isinstance(x, (TrackedFloat, TrackedInt)) or "abs" in x.transform:
         return str(word)
     flipped = x.transform.split("+").count("neg") % 2 == 1
     value = "toward" if (x >= 0) != flipped else "against"
     f = x.fact
-    return _claim(word, Fact("direction", f.feature, f.view, f.role, value, of=f.quantity))
+    return _claim(word, Fact("direction", f.feature, f.view, f.role, value, of=f.quantity), (toward, against))
 
 
 def level(x, low: str = "low", typical: str = "typical", high: str = "high", unknown: str = "") -> str:
@@ -64,7 +69,9 @@ def level(x, low: str = "low", typical: str = "typical", high: str = "high", unk
     value = str.__str__(x) if isinstance(x, str) else str(x)
     word = {"low": low, "typical": typical, "high": high}.get(value, unknown)
     f = x.fact if isinstance(x, TrackedStr) and x.fact.quantity == "level" else None
-    return _claim(word, None if f is None else Fact("level", f.feature, f.view, value=value, of="level"))
+    return _claim(
+        word, None if f is None else Fact("level", f.feature, f.view, value=value, of="level"), (low, typical, high)
+    )
 
 
 def rank(x, *words: str, other: str = "") -> str:
@@ -77,7 +84,9 @@ def rank(x, *words: str, other: str = "") -> str:
     n = int(x)
     word = words[n - 1] if 1 <= n <= len(words) else other
     f = x.fact if isinstance(x, TrackedInt) and x.fact.quantity in ("rank", "rank_same_way") else None
-    return _claim(word, None if f is None else Fact(f.quantity, f.feature, f.view, value=n, of=f.quantity))
+    return _claim(
+        word, None if f is None else Fact(f.quantity, f.feature, f.view, value=n, of=f.quantity), (*words, other)
+    )
 
 
 def compare(x, other, more: str = "more", less: str = "less", same: str | None = None) -> str:
@@ -92,7 +101,7 @@ def compare(x, other, more: str = "more", less: str = "less", same: str | None =
     fact = (
         Fact("comparison", a.fact.feature, a.fact.view, b.fact.feature, value, of="contribution") if tracked else None
     )
-    return _claim(word, fact)
+    return _claim(word, fact, (more, less))
 
 
 @pass_context

@@ -56,6 +56,8 @@ class Fact:
     role: str | None = None
     value: object = None
     of: str | None = None
+    #: a claim filter's words are the same whatever the fact ('dir("raised", "raised")'): the word declares nothing
+    alike: bool = False
 
 
 @dataclass(frozen=True)

@@ -93,3 +93,5 @@ TREND_BEFORE, SCORE_SUBJECT = _compiled("trend_before"), _compiled("score_subjec
 #: a role's label right before a score ('runner-up: 2.0', 'won with a score of 3.1'), and what may stand between
 #: an action and its own score ('turn (score 3.05)', 'turn: 3.05')
 RUNNER_LABEL, CHOSEN_LABEL, SCORE_NEXT = (_compiled(k) for k in ("runner_label", "chosen_label", "score_next"))
+#: words right after a number that make it the background's average ('0.3 on average over the background')
+BASE_AFTER = _compiled("base_after")

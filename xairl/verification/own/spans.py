@@ -12,6 +12,7 @@ from dataclasses import replace
 from xairl.templates.tracking import Span
 from xairl.verification.own.lexicon import (
     AS_CONTRIBUTION,
+    BASE_AFTER,
     BASE_WORDS,
     CELL_SCORE,
     DIFFERENCE,
@@ -195,6 +196,14 @@ class Sentence:
                     f"written as the {group}, but it is the {q.replace('_', ' ')}",
                     "tracked.label",
                 )
+        if BASE_AFTER.match(self.after(p, 30)) and q not in LABEL_FITS["base"]:
+            return Claim(
+                "number",
+                p.span.text,
+                "contradicted",
+                f"written as the background's average, but it is the {q.replace('_', ' ')}",
+                "tracked.label",
+            )
         if q in ("value", "value_text") and (AS_CONTRIBUTION.match(self.after(p, 30)) or self._sizes_compared(p)):
             return Claim(
                 "number",
@@ -232,7 +241,7 @@ class Sentence:
         if said is None:
             earlier = [q for q in self.spans if q.end <= p.start]
             later = [q for q in self.spans if q.start >= p.end]
-            if earlier and earlier[-1].span.fact.quantity == "action":
+            if earlier and earlier[-1].span.fact.quantity in ("action", "role"):
                 between = self.text[earlier[-1].end : p.start]
                 near = bool(_SCORE_NEXT.fullmatch(between) or CELL_SCORE.fullmatch(between))
                 if near or (earlier[-1].block == p.block and SCORE_OF_BEFORE.match(between)):

@@ -154,6 +154,14 @@ def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
                 "contribution (f.contribution, q_margin, f.change)",
                 "tracked.fact",
             )
+        if getattr(f, "alike", False):
+            return Claim(
+                f.quantity,
+                span.text,
+                "unchecked",
+                "its filter prints this word whatever the fact: it declares nothing (give it one word for each case)",
+                "tracked.fact",
+            )
         want = _claimed(f, truth)
         ok = want is not MISSING and want is not None and str(f.value) == str(want)
         detail = f"{f.quantity} of {f.feature or f.value} = {want if want is not MISSING else 'unknown'}"
