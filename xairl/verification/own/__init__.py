@@ -118,7 +118,8 @@ def _role_declared(spans: Sequence[Part], p: Part, truth: Truth) -> bool:
     is no other action it could be taken for."""
     if truth.actions.get("chosen") == truth.actions.get("runner_up"):
         return True
-    return any(q.span.fact.quantity == "role" and q.span.fact.value == p.span.text for q in spans) or any(
+    name = p.span.fact.value if p.span.fact.value is not None else p.span.text
+    return any(q.span.fact.quantity == "role" and q.span.fact.value in (name, p.span.text) for q in spans) or any(
         q.span.fact.quantity == "role" and q.span.fact.role == "runner_up" for q in spans
     )
 

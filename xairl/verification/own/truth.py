@@ -206,6 +206,8 @@ def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
     ):
         return Claim(kind, span.text, "contradicted", f"{f.quantity} = {expected}", "tracked.fact")
     accepted = [expected]
+    if f.quantity == "action" and truth.policy is not None:  # (an action printed as one of its declared aliases)
+        accepted += list(truth.policy.action_aliases.get(str(expected), ()))
     if f.quantity == "name":  # its name or its label (description)
         accepted += [
             getattr(v, "label", None) or (v.get("label") if isinstance(v, dict) else None)
