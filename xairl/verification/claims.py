@@ -118,7 +118,8 @@ def claim_words(text: str, names: Iterable[str] = ()) -> list[ClaimWord]:
     for m in lex.pattern.finditer(text):
         kind, use = lex.words[normalise(m.group())]
         found.append((m.start(), m.end(), kind, use))
-    pattern = _names(tuple(dict.fromkeys(str(n) for n in names)))
+    key = names if isinstance(names, tuple) else tuple(dict.fromkeys(str(n) for n in names))  # (a tuple: as given)
+    pattern = _names(key)
     if pattern is not None:
         found += [(m.start(), m.end(), "name", NAME_USE) for m in pattern.finditer(text)]
     found += [(m.start(), m.end(), "name", IDENTIFIER_USE) for m in _IDENTIFIER.finditer(text)]
