@@ -1192,3 +1192,54 @@ def test_an_opposite_of_the_label_is_a_wrong_category():
     assert accurate("Being in early lactation, she got a 2.4 boost from the stage feature.")
     assert accurate("Inside the ECA, the zone feature lowered it by 0.3.")
     assert accurate("Early lactation, not late, is what the stage term rewarded with 2.4.")
+
+
+def _turn_over_recharge():
+    """A discrete policy choosing turn (7.2) over recharge (5.66); on the margin battery +5.03, obstacle +2.0, wind
+    -0.8 and speed -3.0 (the hardest push against turning)."""
+    c = np.array([[-1.0, 2.0], [4.0, -1.03], [-0.3, 0.5], [2.5, 0.5]])
+    base = np.array([2.0, 3.69])
+    return xairl.Explanation(
+        values=c[None],
+        base_values=base[None],
+        outputs=(base + c.sum(axis=0))[None],
+        states=np.array([[0.4, 0.3, 0.9, 1.0]]),
+        feature_names=("speed", "battery", "wind", "obstacle"),
+        action_names=("turn", "recharge"),
+        method="given",
+    )
+
+
+@pytest.mark.parametrize(
+    "text,status",
+    [
+        ("The policy did not choose turn.", "contradicted"),
+        ("It is false that the policy chose turn.", "partly checked"),
+        ("Recharge had the higher score (5.66).", "contradicted"),
+        ("Battery raised the margin by 5.03, and so did wind.", "partly checked"),
+        ("The agent turned because of the speed.", "contradicted"),
+        ("Every feature favoured turn.", "contradicted"),
+        # the true statements beside them
+        ("The policy chose turn over recharge.", "verified"),
+        ("The policy did not choose recharge.", "verified"),
+        ("Battery raised the margin by 5.03.", "verified"),
+        ("The agent turned because of the obstacle.", "verified"),
+    ],
+)
+def test_false_sentences_of_a_hostile_round_are_never_verified(text, status):
+    """Issue 65: each false sentence is contradicted (grammar binds it) or leaves its sentence unchecked (a claim no
+    rule read: 'so did wind', a claim under 'it is false that'); appended to a verified text, it still keeps that
+    text from being verified."""
+    exp = _turn_over_recharge()
+    assert xairl.verify(text, exp, 0).status == status
+    if status != "verified":
+        assert xairl.verify("The policy chose turn over recharge. " + text, exp, 0).status == status
+        bad = [c for c in xairl.verify(text, exp, 0).claims if c.status != "verified"]
+        assert bad and all(c.text for c in bad)  # the claim names the word it is about
+
+
+def test_a_sentence_with_no_name_number_nor_claim_word_states_nothing():
+    res = xairl.verify("The policy chose turn over recharge. That was the story of the day.", _turn_over_recharge(), 0)
+    assert [s.status for s in res.sentences] == ["verified", "none"] and res.status == "verified"
+    res = xairl.verify("The policy chose turn over recharge. Most of the push was upward.", _turn_over_recharge(), 0)
+    assert [s.status for s in res.sentences] == ["verified", "unchecked"] and res.status == "partly checked"

@@ -18,6 +18,8 @@ def test_every_rule_has_an_id_a_pattern_a_claim_and_examples():
             "output",
             "net",
             "direction",
+            "every",
+            "action",
             "rank",
             "comparison",
             "category",

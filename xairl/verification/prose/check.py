@@ -13,8 +13,8 @@ from dataclasses import replace
 from xairl.verification.prose.book import FactBook
 from xairl.verification.prose.checks import EITHER, check_direction, over_keys, resolve_action
 from xairl.verification.prose.comparisons import check_comparison
+from xairl.verification.prose.decision import action, every, framed, mention, verb_of
 from xairl.verification.prose.lexicon import lexicon
-from xairl.verification.prose.names import Mention
 from xairl.verification.prose.numbers import matches, percent_reading
 from xairl.verification.prose.parse import Sentence
 from xairl.verification.prose.quantities import feature_number
@@ -29,24 +29,11 @@ def view(s: Sentence, book: FactBook) -> str:
     if not book.runner_up:
         return "chosen"
     actions = [t for t in s.doc if t.ent_type_ == "ACTION"]
-    if any(resolve_action(_mention(t), book) == book.runner_up for t in actions) or any(
+    if any(resolve_action(mention(t), book) == book.runner_up for t in actions) or any(
         t.lower_ in ("rather", "instead", "margin", "lead", "over", "versus", "vs", "vs.") for t in s.doc
     ):
         return "margin"
     return EITHER
-
-
-def _mention(token) -> Mention:
-    kind = {"FEATURE": "feature", "ACTION": "action", "LABEL": "label"}[token.ent_type_]
-    return Mention(token.idx, token.idx + len(token), kind, tuple(token._.keys), token._.label, token._.form)
-
-
-def _verb_of(token):
-    """The nearest verb above a token (its clause's verb)."""
-    head = token.head
-    while head.pos_ not in ("VERB", "AUX") and head.head.i != head.i:
-        head = head.head
-    return head
 
 
 def coordinated(token) -> list:
@@ -81,10 +68,17 @@ def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: f
         made = _category(s.doc[c.name], s.doc[c.anchor], book, known)
     elif c.rule.claim == "invented":
         made = _invented(s.doc[c.name], s.doc[c.anchor], known)
+    elif c.rule.claim == "action":
+        made = action(c, s, book)
+    elif c.rule.claim == "every":
+        made = every(c, s, book, ctx)
     else:
         made = _checked(c, s, book, unit_of, ctx)
     if made is None:
         return None
+    frame = "" if c.rule.claim == "action" else framed(s.doc[c.anchor])  # (an action reads its own frame)
+    if frame and made.status != "unchecked" and not (c.rule.binding == "adjacent" and frame == "under a negation"):
+        made = replace(made, status="unchecked", detail=f"{made.detail} ({frame})")
     if made.status == "contradicted" and c.rule.binding not in ("adjacent", "grammar"):
         made = replace(made, status="unchecked", detail=f"{made.detail} (bound by position only)")
     name = s.doc[c.name]
@@ -101,7 +95,7 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         return Claim("number", anchor.text, "unchecked", "a ratio, a pair or a part of a total")
     together = coordinated(name)
     if c.rule.claim == "number":
-        verb = _verb_of(anchor)
+        verb = verb_of(anchor)
         summed = len(together) > 1 or any(t.lower_ in lexicon()["together"] for t in verb.children)
         if summed and c.rule.binding == "grammar":  # ('A (+0.3) and B (+0.2) raised it': each its own number)
             return Claim("number", anchor.text, "unchecked", "said of several features together")
@@ -120,20 +114,20 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         signed = [  # the verb's own signed number ('lowered it by -0.3'), not one of its subject ('A (+0.3) raised')
             t
             for t in anchor.subtree
-            if t.ent_type_ == "NUM" and t.ent_id_ == "signed" and _verb_of(t) == anchor and t.i not in subjects
+            if t.ent_type_ == "NUM" and t.ent_id_ == "signed" and verb_of(t) == anchor and t.i not in subjects
         ]
         if signed:
             return Claim("direction", word, "unchecked", f"its number's sign ({signed[0].text}) says the way")
         polarity, where = c.polarity, ctx
         target = next((t for t in s.doc[c.anchor].subtree if t.ent_type_ == "ACTION"), None)
         if target is not None and book.runner_up:
-            meant = resolve_action(_mention(target), book)
+            meant = resolve_action(mention(target), book)
             if meant == book.runner_up:  # 'A favoured recharging' when turning was chosen: against the margin
                 polarity, where = -polarity, "margin"
             elif meant != book.chosen:
                 return Claim("direction", word, "unchecked", "toward an action neither chosen nor runner-up")
         named = [t for t in together if t.ent_type_ in ("FEATURE", "LABEL") and t._.keys]
-        checked = check_direction([_mention(t) for t in named], polarity, where, word, book)
+        checked = check_direction([mention(t) for t in named], polarity, where, word, book)
         if not checked:
             return Claim("direction", word, "unchecked", "said of no name")
         return next((x for x in checked if x.status == "contradicted"), checked[0])

@@ -1,0 +1,69 @@
+"""What a sentence says that no rule read: a claim word (a direction, rank, comparison, negation, cause, quantifier,
+denial or choice, from lexicon.yaml) or a name that no claim bound. Each becomes an unchecked claim naming it, so the
+sentence is unchecked and the text at most partly checked: a verified text is one whose every claim was read."""
+
+from __future__ import annotations
+
+import functools
+
+from xairl.verification.prose.check import coordinated
+from xairl.verification.prose.lexicon import lexicon
+from xairl.verification.result import Claim
+
+#: lists of verbs: a claim word only as a verb or an adjective ('the cost', 'a drive' are nouns of the domain)
+_VERBS = ("up", "down", "output_up", "output_down", "outweigh", "choose", "win")
+#: lists whose words claim whatever their part of speech
+_WORDS = ("sign_up", "sign_down", "noun_up", "noun_down", "top", "more", "less", "superlatives", "ordinals")
+#: words a clause's verb takes along with its claim (its negation, its 'because', its particle)
+_TAKEN = ("neg", "aux", "auxpass", "mark", "prt", "agent")
+
+
+@functools.cache
+def _lists() -> tuple[frozenset, frozenset, frozenset]:
+    lex = lexicon()
+    verbs = frozenset(w for k in _VERBS for w in lex[k])
+    words = frozenset(w for k in _WORDS for w in lex[k]) | frozenset(lex["negations"] + lex["cause"] + lex["falsity"])
+    particles = frozenset(lex["particle_up"] + lex["particle_down"])
+    return verbs, words, particles
+
+
+def read_tokens(s, made) -> set[int]:
+    """The tokens the claims made read: each rule's matched words, the names said together with a direction or a
+    number, the action a direction is toward, and the negation, auxiliaries and particle of its verb."""
+    read: set[int] = set()
+    for c, claim in made:
+        anchor, name = s.doc[c.anchor], s.doc[c.name]
+        read |= {*c.tokens, c.anchor, c.name, *([c.other] if c.other >= 0 else [])}
+        read |= {t.i for t in anchor.children if t.dep_ in _TAKEN}
+        if c.rule.claim in ("direction", "number", "every") and claim.kind != "feature":
+            read |= {t.i for t in coordinated(name)}
+            read |= {t.i for t in anchor.subtree if t.ent_type_ == "ACTION"}
+    return read
+
+
+def _claim_word(t) -> bool:
+    verbs, words, particles = _lists()
+    w = t.lower_
+    if w in verbs and t.pos_ in ("VERB", "ADJ"):
+        return True
+    if w in particles and t.dep_ in ("prt", "advmod", "prep") and t.head.pos_ == "VERB":
+        return True
+    if w in lexicon()["every"]:  # 'every feature', 'all three factors'
+        return t.dep_ in ("det", "predet") and t.head.lower_ in lexicon()["rank_nouns"]
+    if w in lexicon()["ordinals"] and t.i == 0 and len(t.doc) > 1 and t.doc[1].text == ",":
+        return False  # 'First, ...': the order of the telling
+    return w in words
+
+
+def unbound(s, read: set[int], book) -> list[Claim]:
+    """An unchecked claim for each claim word and each name of the sentence that no claim read (module doc)."""
+    actions = book.output == "actions" and not book.global_view
+    out = []
+    for t in s.doc:
+        if t.i in read:
+            continue
+        if t.ent_type_ in ("FEATURE", "LABEL") or (t.ent_type_ == "ACTION" and actions):
+            out.append(Claim(t.ent_type_.lower(), t.text, "unchecked", "named, but nothing said of it was read"))
+        elif not t.ent_type_ and _claim_word(t):
+            out.append(Claim("word", t.text, "unchecked", f"'{t.text}' claims something no rule read", "word.unread"))
+    return out
