@@ -19,11 +19,11 @@ from xairl.policies.regions import in_regions
 from xairl.policies.windows import window_of
 from xairl.verification.prose import check, rules
 from xairl.verification.prose.book import add_facts, clean_surface, fact_book
-from xairl.verification.prose.numbers import unit_in_name
 from xairl.verification.prose.parse import Sentence
 from xairl.verification.prose.parse import parse as parse_sentences
 from xairl.verification.prose.resolve import Decision, resolve
 from xairl.verification.prose.unbound import read_tokens, unbound
+from xairl.verification.prose.units import unit_in_name
 from xairl.verification.prose.vocabulary import vocabulary
 from xairl.verification.prose.window import add_window_facts, per_signal
 from xairl.verification.result import Claim, SentenceCheck, Verification

@@ -11,7 +11,8 @@ from dataclasses import dataclass, replace
 
 from xairl.verification.prose.book import FactBook
 from xairl.verification.prose.checks import EITHER, over_keys
-from xairl.verification.prose.numbers import Number, find_numbers, matches, percent_reading, written_scale
+from xairl.verification.prose.numbers import Number, find_numbers, matches, percent_reading
+from xairl.verification.prose.units import written_scale
 from xairl.verification.result import Claim
 
 CONTRIB_BEFORE = re.compile(
