@@ -1212,6 +1212,7 @@ def _turn_over_recharge():
         ("Battery raised the margin by 5.03, and so did wind.", "partly checked"),
         ("The agent turned because of the speed.", "contradicted"),
         ("Every feature favoured turn.", "contradicted"),
+        ("Every feature but speed favoured turn.", "partly checked"),  # (wind was against it too)
         # the true statements beside them
         ("The policy chose turn over recharge.", "verified"),
         ("The policy did not choose recharge.", "verified"),

@@ -123,13 +123,28 @@ def _checked(s: Sentence, decisions: list[Decision], book, unit_of, known) -> tu
         if t.ent_type_ == "NUM":
             read.add(t.i)
             if t.i not in bound:
-                out.append(check.free_number(t, book))
+                name = _nearest_name(s, t)
+                out.append(check.free_number(t, book, name, unit_of, ctx, s.masked))
+                if out[-1].rule == "number.nearest":
+                    read.add(name.i)
         elif t.ent_type_ == "LABEL":
             c = check.label_claim(t, book, named)
             if c is not None:
                 out.append(c)
                 read.add(t.i)
     return out, read
+
+
+def _nearest_name(s: Sentence, number):
+    """The name nearest before a number in its clause (else the nearest after it): a binding by position alone,
+    which may verify a number and never contradicts it."""
+    before = [
+        t
+        for t in s.doc[: number.i]
+        if t.ent_type_ == "FEATURE" and not any(x.text in ";|" for x in s.doc[t.i : number.i])
+    ]
+    after = [t for t in s.doc[number.i + 1 :] if t.ent_type_ == "FEATURE"]
+    return before[-1] if before else (after[0] if after else None)
 
 
 def inputs(text, explanation: Explanation, index: int | None, caller: str = "verify") -> tuple:

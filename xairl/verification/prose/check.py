@@ -110,6 +110,8 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         word = anchor.text
         if c.negated:
             return Claim("direction", word, "unchecked", "a negated or hypothetical direction")
+        if c.rule.polarity == "cause" and not book.runner_up:
+            return Claim("direction", word, "unchecked", "a cause of a one-output value: which way is not read")
         subjects = {t.i for child in anchor.children if child.dep_ in ("nsubj", "csubj") for t in child.subtree}
         signed = [  # the verb's own signed number ('lowered it by -0.3'), not one of its subject ('A (+0.3) raised')
             t
@@ -189,12 +191,17 @@ def _output(n, what: str, book: FactBook) -> Claim:
     )
 
 
-def free_number(token, book: FactBook) -> Claim:
-    """A number no rule bound to a name: verified when it is a decision-level fact, else unchecked."""
+def free_number(token, book: FactBook, name=None, unit_of=None, ctx: str = EITHER, masked: str = "") -> Claim:
+    """A number no rule bound to a name: verified when it is a decision-level fact or a fact of the name nearest it
+    (``name``: a binding by position alone, so never contradicted), else unchecked."""
     n = token._.number
     facts = [*book.decision_numbers, *(v for k, v in book.aggregates.items() if k != "the number of features")]
     if any(matches(n, f, magnitude_ok=False) for f in facts):
         return Claim("number", n.text, "verified", "a decision-level number", "number.decision")
+    if name is not None and name._.keys:
+        near = feature_number(n, tuple(name._.keys), masked, book, ctx, unit_of)
+        if near.status == "verified":
+            return replace(near, rule="number.nearest")
     return Claim("number", n.text, "unchecked", "bound to no name", "number.unbound")
 
 

@@ -89,6 +89,8 @@ def every(c, s, book: FactBook, ctx: str) -> Claim | None:
     word = s.doc[c.anchor]
     if c.negated:
         return Claim("direction", word.text, "unchecked", "a negated or hypothetical direction")
+    if any(t.lower_ in ("but", "except", "save", "bar", "apart", "besides") for t in s.doc[c.name].subtree):
+        return Claim("direction", word.text, "unchecked", "every feature but some: which ones is not read")
     polarity, where = c.polarity, ctx
     target = next((t for t in word.subtree if t.ent_type_ == "ACTION"), None)
     if target is not None and book.runner_up:

@@ -50,6 +50,8 @@ def _claim_word(t) -> bool:
         return True
     if w in lexicon()["every"]:  # 'every feature', 'all three factors'
         return t.dep_ in ("det", "predet") and t.head.lower_ in lexicon()["rank_nouns"]
+    if w in ("thanks", "due", "owing") and (t.i + 1 >= len(t.doc) or t.doc[t.i + 1].lower_ != "to"):
+        return False  # ('thanks for your report'): a cause only with 'to'
     if w in lexicon()["ordinals"] and t.i == 0 and len(t.doc) > 1 and t.doc[1].text == ",":
         return False  # 'First, ...': the order of the telling
     return w in words
