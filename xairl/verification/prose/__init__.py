@@ -22,7 +22,7 @@ from xairl.verification.prose.book import add_facts, clean_surface, fact_book
 from xairl.verification.prose.parse import Sentence
 from xairl.verification.prose.parse import parse as parse_sentences
 from xairl.verification.prose.resolve import Decision, resolve
-from xairl.verification.prose.unbound import read_tokens, unbound
+from xairl.verification.prose.unbound import read_tokens, unbound, unknown_regions
 from xairl.verification.prose.units import unit_in_name
 from xairl.verification.prose.vocabulary import vocabulary
 from xairl.verification.prose.window import add_window_facts, per_signal
@@ -101,7 +101,7 @@ def _claims(s: Sentence, book, unit_of, known) -> tuple[list[Claim], list[Decisi
             for t in s.doc
             if t.ent_type_ == "FEATURE" and t.i in read
         ]
-        return mentions + out + unbound(s, read, book), decisions
+        return mentions + out + unbound(s, read, book) + unknown_regions(s.masked), decisions
     except Exception as e:  # noqa: BLE001 - a reader bug must not take the narration down with it
         return [Claim("internal", s.text.strip(), "unchecked", f"the reader failed ({type(e).__name__}: {e})")], []
 

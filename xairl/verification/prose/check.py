@@ -91,6 +91,8 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
     name = s.doc[c.name]
     keys = tuple(name._.keys)
     anchor = s.doc[c.anchor]
+    if c.rule.id == "skip.span":  # 'over the last 3 frames', 'the past 24 hours': when, not a claim (its kind
+        return Claim("span", anchor.text, "verified", "a span of time, no claim about the decision")  # counts not)
     if c.rule.claim == "skip":
         return Claim("number", anchor.text, "unchecked", "a ratio, a pair or a part of a total")
     together = coordinated(name)
@@ -110,6 +112,9 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         word = anchor.text
         if c.negated:
             return Claim("direction", word, "unchecked", "a negated or hypothetical direction")
+        before = [*_up_to(name, anchor), *s.doc[max(0, name.i - 2) : name.i]]  # ('all but A', 'except for A')
+        if any(t.lower_ in ("but", "except", "excluding", "besides") and t.head.pos_ != "VERB" for t in before):
+            return Claim("direction", word, "unchecked", f"{name.text} is named as an exception")
         if c.rule.polarity == "cause" and not book.runner_up:
             return Claim("direction", word, "unchecked", "a cause of a one-output value: which way is not read")
         subjects = {t.i for child in anchor.children if child.dep_ in ("nsubj", "csubj") for t in child.subtree}
@@ -118,9 +123,12 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
             for t in anchor.subtree
             if t.ent_type_ == "NUM" and t.ent_id_ == "signed" and verb_of(t) == anchor and t.i not in subjects
         ]
-        if signed:
+        if signed and (signed[0]._.number.value > 0) != (c.polarity > 0):  # ('lowered it by +0.3': which is meant?)
             return Claim("direction", word, "unchecked", f"its number's sign ({signed[0].text}) says the way")
         polarity, where = c.polarity, ctx
+        trend = _trend(c, s, book)
+        if trend is not None:
+            return trend
         target = next((t for t in s.doc[c.anchor].subtree if t.ent_type_ == "ACTION"), None)
         if target is not None and book.runner_up:
             meant = resolve_action(mention(target), book)
@@ -139,6 +147,28 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
     sides = set(lex["up"]) | set(lex["down"]) | set(lex["sign_up"]) | set(lex["sign_down"]) | set(lex["side_words"])
     one_side = any(t.lower_ in sides for t in s.doc)  # 'the biggest factor pulling it down': among the negatives
     return _rank(keys, c.rank, anchor.text, book, one_side)
+
+
+def _up_to(token, top) -> list:
+    """The tokens on the way from ``token`` up to ``top`` (not included), or to the root."""
+    out = []
+    while token.i != top.i and token.head.i != token.i:
+        token = token.head
+        out.append(token)
+    return out
+
+
+def _trend(c: Candidate, s: Sentence, book: FactBook) -> Claim | None:
+    """'Patch B6 rose 14.0 over the last 3 frames': an intransitive rise or fall of a windowed signal is its trend
+    (newest value minus oldest), not its push."""
+    verb, keys = s.doc[c.anchor], s.doc[c.name]._.keys
+    changes = {k: book.features[k].change for k in keys if k in book.features}
+    if not changes or any(v is None for v in changes.values()) or any(t.dep_ == "dobj" for t in verb.children):
+        return None
+    ok = [k for k, v in changes.items() if v and (v > 0) == (c.polarity > 0)]
+    k, v = next(iter(changes.items()))
+    status = "verified" if len(ok) == len(changes) else "contradicted" if not ok else "unchecked"
+    return Claim("direction", verb.text, status, f"{k} changed by {v:+.3g} over its window")
 
 
 def _rank(keys: tuple[str, ...], rank: int, word: str, book: FactBook, one_side: bool) -> Claim:

@@ -55,13 +55,17 @@ def mention(token) -> Mention:
 def action(c, s, book: FactBook) -> Claim | None:
     """'chose turn', 'turn was picked', 'the agent turned', 'turn won', 'recharge had the higher score': the named
     action is the chosen one (a negation of the verb says it is not); 'over recharge', 'rather than recharge': it is
-    not (only verified, never contradicted: 'preferred over' may run either way)."""
+    not (only verified, never contradicted: 'preferred over' may run either way); 'toward turn': one of the two
+    weighed (the direction said toward it is another claim's)."""
     if book.output != "actions" or book.global_view or not book.chosen:
         return None
     name, word = s.doc[c.name], s.doc[c.anchor]
     meant = resolve_action(mention(name), book)
     if meant is None:
         return Claim("action", name.text, "unchecked", f"it may mean {' / '.join(name._.keys)}")
+    if c.rule.polarity == "toward":  # 'the push toward turn': which way is the claim's own; it names the choice
+        status = "verified" if meant in (book.chosen, book.runner_up) else "unchecked"
+        return Claim("action", name.text, status, f"the policy chose {book.chosen} over {book.runner_up}")
     if c.rule.polarity == "lost":
         if meant == book.chosen:
             return Claim("action", name.text, "unchecked", f"{meant} was chosen: 'over' may run either way")

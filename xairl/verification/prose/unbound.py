@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import functools
 
+from xairl.policies.region_names import REGION_RE
 from xairl.verification.prose.check import coordinated
 from xairl.verification.prose.lexicon import lexicon
 from xairl.verification.result import Claim
@@ -69,3 +70,20 @@ def unbound(s, read: set[int], book) -> list[Claim]:
         elif not t.ent_type_ and _claim_word(t):
             out.append(Claim("word", t.text, "unchecked", f"'{t.text}' claims something no rule read", "word.unread"))
     return out
+
+
+def unknown_regions(masked: str) -> list[Claim]:
+    """A region phrase left in ``masked`` (the sentence with every known name masked) names no region of the
+    explanation ('patch K9 of frame 2' of a grid of 7 columns): contradicted, its words bind it."""
+    return [
+        Claim(
+            "feature",
+            m.group(0),
+            "contradicted",
+            "no region of this explanation has this name (regions are named by a grid reference, 'patch F6 of frame "
+            "2': column letters from the left, row numbers from the top; or by their pixels, 'the 12x12 patch at rows "
+            "60 to 71, columns 60 to 71 of frame 2', counting rows, columns, channels and frames from 0)",
+            "region.unknown",
+        )
+        for m in REGION_RE.finditer(masked)
+    ]
