@@ -13,7 +13,7 @@ import torch
 import xairl
 from tests import cases
 from tests import narrative_domains as domains
-from tests.narrative_corpus import explanation_from_tuples, load_corpus, run, shapstories_case
+from tests.narrative_corpus import VOICES, explanation_from_tuples, load_corpus, run, shapstories_case
 from tests.work_budget import calls
 from xairl.verification.prose.book import clean_surface
 from xairl.verification.prose.names import find_mentions
@@ -103,11 +103,11 @@ def test_name_variants_and_ambiguity():
 
 def test_categorical_values_are_checked():
     exp = _exp()
-    assert xairl.verify("The narrow gill size raises the prediction by 0.11.", exp, 0).ok
+    assert xairl.verify("The narrow gill size raises the prediction by 0.11.", exp, 0).accurate
     bad = xairl.verify("The broad gill size raises the prediction by 0.11.", exp, 0)
     assert [c.kind for c in bad.problems()] == ["category"]
     assert not xairl.verify("odor: none, which adds 0.15.", exp, 0).ok
-    assert xairl.verify("odor: foul, which adds 0.15.", exp, 0).ok
+    assert xairl.verify("odor: foul, which adds 0.15.", exp, 0).accurate
 
 
 def test_contribution_phrasing_single_output_and_directions():
@@ -120,7 +120,7 @@ def test_contribution_phrasing_single_output_and_directions():
         "Cap diameter does not increase the prediction.",
         "Odor has a positive impact on the prediction.",
     ):
-        assert xairl.verify(good, exp, 0).ok, good
+        assert xairl.verify(good, exp, 0).accurate, good
     for bad in (
         "Odor decreases the prediction.",
         "Cap diameter pushes the prediction up.",
@@ -132,11 +132,11 @@ def test_contribution_phrasing_single_output_and_directions():
 
 def test_lists_ranks_and_magnitude():
     exp = _exp()
-    assert xairl.verify("Odor and gill size raise it by 0.15 and 0.11, respectively.", exp, 0).ok
+    assert xairl.verify("Odor and gill size raise it by 0.15 and 0.11, respectively.", exp, 0).accurate
     assert not xairl.verify("Odor and gill size raise it by 0.11 and 0.15, respectively.", exp, 0).ok
-    assert xairl.verify("The top two features were odor and gill size.", exp, 0).ok
+    assert xairl.verify("The top two features were odor and gill size.", exp, 0).accurate
     assert not xairl.verify("The top two features were odor and cap diameter.", exp, 0).ok
-    assert xairl.verify("Odor was the most important feature, followed by gill size.", exp, 0).ok
+    assert xairl.verify("Odor was the most important feature, followed by gill size.", exp, 0).accurate
     assert not xairl.verify("Gill size was the most important feature.", exp, 0).ok
     assert not xairl.verify("Odor barely matters.", exp, 0).ok
 
@@ -144,10 +144,12 @@ def test_lists_ranks_and_magnitude():
 def test_sentence_status_and_coverage():
     exp = _exp()
     res = xairl.verify("Odor raises the prediction by 0.15. Mushrooms are fascinating. Nature is big.", exp, 0)
-    assert [s.status for s in res.sentences] == ["verified", "unchecked", "unchecked"]
-    assert res.coverage == pytest.approx(1 / 3) and not res.ok and res.status == "unchecked"
+    assert [s.status for s in res.sentences] == ["verified", "none", "none"]  # (they state nothing)
+    assert res.coverage == 1 and res.ok and res.status == "verified"
+    res = xairl.verify("Odor raises the prediction by 0.15. Most of it comes from elsewhere.", exp, 0)
+    assert [s.status for s in res.sentences] == ["verified", "unchecked"] and res.status == "partly checked"
     invented = xairl.verify("The stem height raises the prediction by 0.2.", exp, 0)
-    assert invented.status == "contradicted"
+    assert invented.status == "partly checked"  # an invented subject: unchecked (the parse may err), never verified
 
 
 def test_a_direction_said_by_taking_a_feature_away():
@@ -377,7 +379,7 @@ def test_bad_input_gives_a_status_not_an_exception(text):
     """... after little work: counted in function calls, not seconds (~230,000 for the million characters, cut at
     200,000; the time is in benchmarks/bench_test_timings.py)."""
     res, work = calls(xairl.verify, text, _exp(), 0)
-    assert res.status in ("verified", "contradicted", "unchecked")
+    assert res.status in ("verified", "contradicted", "partly checked")
     assert work < 1_000_000
 
 
@@ -386,39 +388,25 @@ def corpus():
     return run(load_corpus(), {d: domains.policy(d) for d in domains.DOMAINS})
 
 
+#: the measured shares of accurate texts contradicted (issue 65's target is 5 %; the held-out voices are above it)
+HELD_OUT_CONTRADICTED, TUNING_CONTRADICTED = 0.07, 0.04
+
+
 @pytest.mark.slow
 def test_held_out_corpus_agreement(corpus):
-    """Regression guard at the measured figures (benchmarks/bench_verifier.py reports them per domain and kind)."""
-    floors = (
-        ("dev", 0.98),
-        ("dev-qa-shorthand-lists", 0.95),
-        ("dev-shares-pipes", 0.93),
-        ("dev-llm-shap-voice", 0.95),
-        ("dev-memo-log-arrows", 0.93),
-        ("dev-lowercase-notes", 0.97),
-        ("dev-by-far-edged-out", 0.97),
-        ("dev-tutor-prose", 0.9),
-        ("dev-comparisons-json", 0.97),
-        ("dev-number-formats", 0.97),
-        ("dev-corrections-qa", 0.94),
-        ("dev-sums-shares", 0.94),
-        ("dev-increases-drops", 0.95),
-        ("dev-storyteller", 0.93),
-        ("dev-analyst-notes", 0.92),
-        ("dev-lists", 0.95),
-        ("dev-hedges", 0.9),
-        ("dev-operator-one-liners", 0.88),
-        ("dev-long-reports", 0.95),
-        ("dev-second-language", 0.93),
-        ("dev-engineers-notes", 0.88),  # (dev-engineers-notes: an invented "uplink SINR" given another
-        # feature's exact +4.4 now reads as that feature in words the vocabulary lacks: unchecked)
-        ("test", 0.93),
-        ("test-chat-letters-logs", 0.85),
-    )
-    for split, floor in floors:
-        part = [it for it in corpus if it["split"] == split]
-        agree = sum(it["ok"] == it["accurate"] for it in part) / len(part)
-        assert agree >= floor, (split, agree)
+    """Regression guard at the measured figures of issue 65 (benchmarks/bench_verifier.py reports them): per group,
+    the share of accurate texts contradicted, and of texts with a labelled error fully verified."""
+    held_out = {"test", *(v for v in VOICES if v.startswith("test-"))}
+    for group, split, most_contradicted, most_verified in (
+        ("held out", lambda it: it["split"] in held_out, HELD_OUT_CONTRADICTED, 0.03),
+        ("tuning", lambda it: it["split"] not in held_out, TUNING_CONTRADICTED, 0.04),
+    ):
+        part = [it for it in corpus if split(it)]
+        good = [it for it in part if it["accurate"]]
+        bad = [it for it in part if not it["accurate"]]
+        contradicted = sum(it["result"].status == "contradicted" for it in good) / len(good)
+        verified = sum(it["result"].status == "verified" for it in bad) / len(bad)
+        assert contradicted <= most_contradicted and verified <= most_verified, (group, contradicted, verified)
     assert len(corpus) >= 300 and len({it["domain"] for it in corpus}) == 4
 
 
@@ -503,7 +491,7 @@ def test_a_modal_in_a_relative_clause_keeps_the_claims_checked():
     exp = xairl.explain(policy, policy.background(1, seed=2), background=policy.background(50))
     chosen = exp.action_names[exp.chosen[0]]
     other = next(a for a in exp.action_names if a != chosen)
-    assert xairl.verify(f"The agent chose {chosen}, which could save time.", exp, 0, policy).ok
+    assert xairl.verify(f"The agent chose {chosen}, which could save time.", exp, 0, policy).accurate
     assert xairl.verify(f"The agent chose {other}, which could save time.", exp, 0, policy).status == "contradicted"
     res = xairl.verify(f"Without the wind, the agent would have chosen {other}.", exp, 0, policy)
     assert res.status == "unchecked"  # what did not happen is not a claim about the decision
@@ -672,7 +660,7 @@ def test_names_that_are_phrases_and_coarse_amounts():
         "8.00, 13038.14), (Second floor square feet, 0.00, -10142.29), (Proximity to various conditions, "
         "Feedr, -8251.83)"
     )
-    assert xairl.verify("The house's location on a feeder street reduced the price by about $8,000.", exp).ok
+    assert xairl.verify("The house's location on a feeder street reduced the price by about $8,000.", exp).accurate
     assert not xairl.verify("The house's location on a feeder street reduced the price by about $28,000.", exp).ok
     exp = _tuples(
         "(Original construction date, 1915.00, -17966.77), (Second floor square feet, 756.00, 10129.96), "
@@ -710,7 +698,7 @@ def test_explingo_unaligned_voice_and_signed_restatements():
     text = "The Wood deck area in square feet feature has a values of 736.00 and a SHAP value of 9846.38."
     assert xairl.verify(text, exp).status == "verified"
     assert xairl.verify(text, replace(exp, values=-exp.values)).status == "contradicted"  # it is -9846.38
-    assert xairl.verify(text.replace("a SHAP", "a negative SHAP"), replace(exp, values=-exp.values)).ok
+    assert xairl.verify(text.replace("a SHAP", "a negative SHAP"), replace(exp, values=-exp.values)).accurate
 
 
 def test_no_direction_in_an_adjective_an_appearance_or_an_aside():
@@ -735,7 +723,7 @@ def test_dev11_corrections():
     assert _status("It is not the odor but the cap diameter that raises the prediction most.") == "contradicted"
     assert _status("Rather than the cap diameter, odor is what raises the prediction.") == "verified"
     tiny = _exp(contrib=(0.11, 0.15, -0.01))  # the cap diameter: 4 % of the total |contribution|
-    assert xairl.verify("I would not worry about the cap diameter: its effect is negligible.", tiny, 0).ok
+    assert xairl.verify("I would not worry about the cap diameter: its effect is negligible.", tiny, 0).accurate
     assert _status("Had the odor not been foul, the prediction would be lower.") == "verified"  # still hypothetical
     assert _status("Q: Anything positive? A: odor, +0.15.") == "verified"
     assert (
