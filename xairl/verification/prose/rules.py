@@ -112,7 +112,13 @@ def candidates(doc) -> list[Candidate]:
             continue
         anchor = next(roles[k] for k in ("num", "dir", "rank", "word") if k in roles)
         out.append(replace(_reading(rule, doc, roles["name"], anchor, roles), tokens=tuple(ids)))
-    return [c for c in out if not (_dir_is_led(c.rule) and _own_subject(doc, c))]
+    return [c for c in out if not (_dir_is_led(c.rule) and _own_subject(doc, c)) and not _across_cells(doc, c)]
+
+
+def _across_cells(doc, c: Candidate) -> bool:
+    """Does a reading bind a name to a word in another cell of a table or item of a list ('A 2.4 | B +6.9')?"""
+    a, b = sorted((c.name, c.anchor))
+    return any(t.text in ("|", ";") for t in doc[a:b])
 
 
 def _clause_between(doc, top: int, below: int) -> bool:
