@@ -23,7 +23,9 @@ _TAKEN = ("neg", "aux", "auxpass", "mark", "prt", "agent")
 def _lists() -> tuple[frozenset, frozenset, frozenset]:
     lex = lexicon()
     verbs = frozenset(w for k in _VERBS for w in lex[k])
-    words = frozenset(w for k in _WORDS for w in lex[k]) | frozenset(lex["negations"] + lex["cause"] + lex["falsity"])
+    words = frozenset(w for k in _WORDS for w in lex[k]) | frozenset(
+        lex["negations"] + lex["cause"] + lex["falsity"] + lex["measure"]
+    )
     particles = frozenset(lex["particle_up"] + lex["particle_down"])
     return verbs, words, particles
 
