@@ -41,6 +41,10 @@ def read_tokens(s, made) -> set[int]:
         if c.rule.claim in ("direction", "number", "every") and claim.kind != "feature":
             read |= {t.i for t in coordinated(name)}
             read |= {t.i for t in anchor.subtree if t.ent_type_ == "ACTION"}
+    directed = {c.name for c, claim in made if claim.kind == "direction" and claim.status != "unchecked"}
+    for t in s.doc:  # 'because of A, which raised it': the cause is A's direction, checked
+        if t.lower_ in lexicon()["cause"] and any(x.i in directed for x in t.subtree):
+            read.add(t.i)
     return read
 
 
@@ -68,7 +72,8 @@ def unbound(s, read: set[int], book) -> list[Claim]:
         if t.i in read:
             continue
         if t.ent_type_ in ("FEATURE", "LABEL") or (t.ent_type_ == "ACTION" and actions):
-            out.append(Claim(t.ent_type_.lower(), t.text, "unchecked", "named, but nothing said of it was read"))
+            # (kind 'name': a mention no rule read; own narratives judge their literal names themselves)
+            out.append(Claim("name", t.text, "unchecked", "named, but nothing said of it was read", "name.unread"))
         elif not t.ent_type_ and _claim_word(t):
             out.append(Claim("word", t.text, "unchecked", f"'{t.text}' claims something no rule read", "word.unread"))
     return out
