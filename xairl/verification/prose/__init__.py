@@ -122,7 +122,9 @@ def _checked(s: Sentence, decisions: list[Decision], book, unit_of, known) -> tu
     for t in s.doc:
         if t.ent_type_ == "NUM":
             read.add(t.i)
-            if t.i not in bound:
+            if t.i not in bound and (score := check.action_score(s, t, book)) is not None:
+                out.append(score)
+            elif t.i not in bound:
                 name = _nearest_name(s, t)
                 out.append(check.free_number(t, book, name, unit_of, ctx, s.masked))
                 if out[-1].rule == "number.nearest":

@@ -79,6 +79,11 @@ def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: f
     frame = "" if c.rule.claim == "action" else framed(s.doc[c.anchor])  # (an action reads its own frame)
     if frame and made.status != "unchecked" and not (c.rule.binding == "adjacent" and frame == "under a negation"):
         made = replace(made, status="unchecked", detail=f"{made.detail} ({frame})")
+    if made.status == "contradicted" and c.rule.claim == "number" and c.rule.binding == "grammar":
+        a, b = sorted((c.name, c.anchor))  # ('A gave it +3.58, then B, +0.83 and C, +0.02': +0.02 is C's, not A's)
+        between = [t for t in s.doc[a + 1 : b] if t.ent_type_ == "FEATURE" and t.i not in {x.i for x in together(c, s)}]
+        if between:
+            made = replace(made, status="unchecked", detail=f"{made.detail} ('{between[-1].text}' stands between)")
     if made.status == "contradicted" and c.rule.binding not in ("adjacent", "grammar"):
         made = replace(made, status="unchecked", detail=f"{made.detail} (bound by position only)")
     name = s.doc[c.name]
@@ -87,13 +92,21 @@ def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: f
     return replace(made, rule=c.rule.id)
 
 
+def together(c: Candidate, s: Sentence) -> list:
+    """The names said together with a reading's name (itself first)."""
+    return coordinated(s.doc[c.name])
+
+
 def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Claim:
     name = s.doc[c.name]
     keys = tuple(name._.keys)
     anchor = s.doc[c.anchor]
     if c.rule.id == "skip.span":  # 'over the last 3 frames', 'the past 24 hours': when, not a claim (its kind
         return Claim("span", anchor.text, "verified", "a span of time, no claim about the decision")  # counts not)
-    if c.rule.claim == "skip":
+    if c.rule.claim == "skip":  # (one of the decision's own numbers, exactly: 'stayed at 0 of its 100 decisions')
+        decided = free_number(anchor, book)
+        if decided.status == "verified":
+            return decided
         return Claim("number", anchor.text, "unchecked", "a ratio, a pair or a part of a total")
     together = coordinated(name)
     if c.rule.claim == "number":
@@ -219,6 +232,21 @@ def _output(n, what: str, book: FactBook) -> Claim:
         "verified" if ok else "contradicted",
         f"the {'net change' if what == 'net' else 'output'}: {told}",
     )
+
+
+def action_score(s: Sentence, token, book: FactBook) -> Claim | None:
+    """'stay, the only available action (score 31.0)': a number right after 'score' (or 'Q') in a sentence that
+    names one action is that action's score (adjacency binds it)."""
+    before = [t for t in s.doc[max(0, token.i - 3) : token.i] if t.text not in "(:=[,"]
+    actions = {resolve_action(mention(t), book) for t in s.doc if t.ent_type_ == "ACTION"}
+    if not before or before[-1].lower_ not in ("score", "q", "q-value") or len(actions) != 1 or None in actions:
+        return None
+    (action,) = actions
+    if action not in book.scores or book.output != "actions":
+        return None
+    ok = matches(token._.number, book.scores[action], magnitude_ok=False)
+    status = "verified" if ok else "contradicted"
+    return Claim("number", token.text, status, f"{action}'s score is {book.scores[action]:.4g}", "number.score-of")
 
 
 def free_number(token, book: FactBook, name=None, unit_of=None, ctx: str = EITHER, masked: str = "") -> Claim:

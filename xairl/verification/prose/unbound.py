@@ -5,6 +5,7 @@ sentence is unchecked and the text at most partly checked: a verified text is on
 from __future__ import annotations
 
 import functools
+import re
 
 from xairl.policies.region_names import REGION_RE
 from xairl.verification.prose.check import coordinated
@@ -15,6 +16,27 @@ from xairl.verification.result import Claim
 _VERBS = ("up", "down", "output_up", "output_down", "outweigh", "choose", "win")
 #: lists whose words claim whatever their part of speech
 _WORDS = ("sign_up", "sign_down", "noun_up", "noun_down", "top", "more", "less", "superlatives", "ordinals")
+#: a snake_case identifier ('battery_temperature'): a name in any text, so one the vocabulary lacks names nothing
+_IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9]*_[A-Za-z0-9_]*[A-Za-z0-9]")
+_UNKNOWN = "identifier.unknown"
+_AFTER_TIMES = frozenset(
+    {
+        "as",
+        "more",
+        "less",
+        "the",
+        "that",
+        "what",
+        "larger",
+        "bigger",
+        "smaller",
+        "greater",
+        "higher",
+        "lower",
+        "stronger",
+        "weaker",
+    }
+)
 #: words a clause's verb takes along with its claim (its negation, its 'because', its particle)
 _TAKEN = ("neg", "aux", "auxpass", "mark", "prt", "agent")
 
@@ -53,6 +75,10 @@ def _claim_word(t) -> bool:
     w = t.lower_
     if w in verbs and t.pos_ in ("VERB", "ADJ"):
         return True
+    if w == "times" and (t.i + 1 >= len(t.doc) or t.doc[t.i + 1].lower_ not in _AFTER_TIMES):
+        return False  # 'handed over 100 times': a count ('3 times as much', 'twice the push' compare)
+    if w in ("against", "versus") and any(x.ent_type_ == "NUM" for x in t.doc[t.i + 1 : t.i + 4]):
+        return False  # 'set to 0.79, against 0.64 on average': two numbers compared, no direction
     if w in particles and t.dep_ in ("prt", "advmod", "prep") and t.head.pos_ == "VERB":
         return True
     if w in lexicon()["every"]:  # 'every feature', 'all three factors'
@@ -74,6 +100,8 @@ def unbound(s, read: set[int], book) -> list[Claim]:
         if t.ent_type_ in ("FEATURE", "LABEL") or (t.ent_type_ == "ACTION" and actions):
             # (kind 'name': a mention no rule read; own narratives judge their literal names themselves)
             out.append(Claim("name", t.text, "unchecked", "named, but nothing said of it was read", "name.unread"))
+        elif not t.ent_type_ and _IDENTIFIER.fullmatch(t.text):  # 'battery_temperature 41' of no such input
+            out.append(Claim("name", t.text, "unchecked", "an identifier no input of the explanation has", _UNKNOWN))
         elif not t.ent_type_ and _claim_word(t):
             out.append(Claim("word", t.text, "unchecked", f"'{t.text}' claims something no rule read", "word.unread"))
     return out
