@@ -116,9 +116,14 @@ def candidates(doc) -> list[Candidate]:
 
 
 def _across_cells(doc, c: Candidate) -> bool:
-    """Does a reading bind a name to a word in another cell of a table or item of a list ('A 2.4 | B +6.9')?"""
+    """Does a reading bind a name to a word in another item of a list ('A 2.4 +7.2 | lag reading 48.2 +14.7'): an
+    item with words of its own before the anchor? (A table's row, '| season | winter | -1.0 |', is one item.)"""
     a, b = sorted((c.name, c.anchor))
-    return any(t.text in ("|", ";") for t in doc[a:b])
+    cuts = [t.i for t in doc[a:b] if t.text in ("|", ";")]
+    if not cuts:
+        return False
+    own = doc[cuts[-1] + 1 : b] if b == c.anchor else doc[a + 1 : cuts[0]]
+    return any(t.is_alpha and t.ent_type_ != "LABEL" for t in own)
 
 
 def _clause_between(doc, top: int, below: int) -> bool:
