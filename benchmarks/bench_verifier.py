@@ -103,6 +103,33 @@ def report(items: list[dict], show: str | None) -> None:
     print(f"\nspeed: {1000 * per_sentence:.2f} ms per sentence (mean over {len(items)} narratives)")
 
 
+def figures(items: list[dict], title: str) -> None:
+    """Issue 65's figures: accurate texts contradicted (target <= 5 %), texts with a labelled error fully verified
+    (target <= 5 %), coverage on the accurate texts (target >= 60 %)."""
+    good = [it for it in items if it["accurate"]]
+    bad = [it for it in items if not it["accurate"]]
+
+    def share(part, status):
+        n = sum(it["result"].status == status for it in part)
+        return f"{n}/{len(part)} = {100 * n / max(1, len(part)):.1f} %"
+
+    print(
+        f"\n# {title}: accurate texts contradicted {share(good, 'contradicted')}, verified {share(good, 'verified')}; "
+        f"labelled errors fully verified {share(bad, 'verified')} (contradicted {share(bad, 'contradicted')}); "
+        f"coverage on accurate texts {np.mean([it['result'].coverage for it in good]):.2f}"
+    )
+
+
+def speed(items: list[dict]) -> None:
+    """Issue 65's speed targets for outside text: <= 100 ms per 1,000 words, no text over 1 s."""
+    words = sum(max(1, len(it["text"].split())) for it in items)
+    slowest = max(items, key=lambda it: it["seconds"])
+    print(
+        f"\nspeed: {1e6 * sum(it['seconds'] for it in items) / words:.0f} ms per 1,000 words over {len(items)} texts; "
+        f"slowest {slowest['seconds']:.3f} s ({len(slowest['text'].split())} words)"
+    )
+
+
 def explingo_items(path: str) -> list[dict]:
     """Explingo's labelled narratives, each with a one-output Explanation rebuilt from its tuples."""
     out = []
@@ -175,12 +202,9 @@ def main() -> None:
     ap.add_argument("--show", choices=(*SPLITS, "outside"), help="list the disagreements of a split")
     ap.add_argument("--explingo", help="path of Explingo's full-experiment/accuracy_tests.json")
     ap.add_argument("--shapstories", help="path of SHAPnarrative-agents' data/baseline_narratives.json")
-    ap.add_argument("--reader", choices=("old", "new"), default="old", help="xairl.verify (old) or xairl.verify.read")
     args = ap.parse_args()
     if args.explingo or args.shapstories:
-        items = run(
-            explingo_items(args.explingo) if args.explingo else shapstories_items(args.shapstories), {}, args.reader
-        )
+        items = run(explingo_items(args.explingo) if args.explingo else shapstories_items(args.shapstories), {})
         name = (
             f"Explingo {pathlib.Path(args.explingo).stem}"
             if args.explingo
@@ -208,7 +232,12 @@ def main() -> None:
                 print(f"- [{it['case']}: {it['error']}] {it['text']!r}\n    -> {probs or 'no problem found'}")
         return
     policies = {d: domains.policy(d) for d in domains.DOMAINS}
-    report(run(load_corpus(), policies, args.reader), args.show)
+    items = run(load_corpus(), policies)
+    report(items, args.show)
+    held_out = [it for it in items if it["split"].startswith("test")]
+    figures(held_out, "held out (test, " + ", ".join(sorted({it["split"] for it in held_out} - {"test"})) + ")")
+    figures([it for it in items if it["split"] not in {it["split"] for it in held_out}], "tuning (dev, voices/dev-*)")
+    speed(items)
 
 
 if __name__ == "__main__":

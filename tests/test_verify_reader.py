@@ -18,13 +18,15 @@ def test_every_rule_has_an_id_a_pattern_a_claim_and_examples():
             "output",
             "net",
             "direction",
+            "every",
+            "action",
             "rank",
             "comparison",
             "category",
             "class",
             "invented",
             "skip",
-        ) and r.binding in ("adjacent", "grammar")
+        ) and r.binding in ("adjacent", "grammar", "position")
         assert r.pattern and r.fires, r.id
         if r.kind == "dependency":
             roles = {node["RIGHT_ID"] for node in r.pattern}

@@ -247,4 +247,4 @@ def test_the_serving_bs_is_bound_by_its_words_and_another_bs_is_not():
     exp = xairl.explain(policy, bg[:1], background=bg[4:])
     bs = int(exp.states[0][4])
     assert xairl.verify(f"The DQN handed the UAV over from BS {bs} to BS {bs + 7}.", exp, 0, policy).accurate
-    assert not xairl.verify(f"While on BS {bs + 1}, the DQN decided.", exp, 0, policy).accurate
+    assert not xairl.verify(f"While on BS {bs + 1}, the DQN decided.", exp, 0, policy).ok  # (not read: unchecked)

@@ -19,10 +19,11 @@ from xairl.policies.regions import in_regions
 from xairl.policies.windows import window_of
 from xairl.verification.prose import check, rules
 from xairl.verification.prose.book import add_facts, clean_surface, fact_book
-from xairl.verification.prose.numbers import unit_in_name
 from xairl.verification.prose.parse import Sentence
 from xairl.verification.prose.parse import parse as parse_sentences
 from xairl.verification.prose.resolve import Decision, resolve
+from xairl.verification.prose.unbound import read_tokens, unbound, unknown_regions
+from xairl.verification.prose.units import unit_in_name
 from xairl.verification.prose.vocabulary import vocabulary
 from xairl.verification.prose.window import add_window_facts, per_signal
 from xairl.verification.result import Claim, SentenceCheck, Verification
@@ -87,39 +88,65 @@ def _prepare(text, explanation, index, policy, facts=None):
 
 
 def _claims(s: Sentence, book, unit_of, known) -> tuple[list[Claim], list[Decision]]:
-    """A sentence's claims (a name alone claims nothing checkable), and the decisions the trace shows. A failure of
-    the reader leaves the sentence unchecked with the reason: never an exception to the caller."""
-    names = [t for t in s.doc if t.ent_type_ == "FEATURE"]
-    out = [Claim("feature", t.text, "verified", " / ".join(t._.keys), "names.mention") for t in names]
-    if s.text.rstrip().endswith("?") or not any(t.ent_type_ for t in s.doc):
-        return out, []  # a question asserts nothing; a sentence with no name nor number gives no rule a hold
+    """A sentence's claims, and the decisions the trace shows: what the rules read, checked, then an unchecked claim
+    for each claim word or name no rule read (unbound.py). A question asserts nothing. A failure of the reader leaves
+    the sentence unchecked with the reason: never an exception to the caller."""
+    if s.text.rstrip().endswith("?"):
+        return [], []
     try:
         decisions = resolve(rules.candidates(s.doc))
-        return out + _checked(s, decisions, names, book, unit_of, known), decisions
+        out, read = _checked(s, decisions, book, unit_of, known)
+        mentions = [
+            Claim("feature", t.text, "verified", " / ".join(t._.keys), "names.mention")
+            for t in s.doc
+            if t.ent_type_ == "FEATURE" and t.i in read
+        ]
+        return mentions + out + unbound(s, read, book) + unknown_regions(s.masked), decisions
     except Exception as e:  # noqa: BLE001 - a reader bug must not take the narration down with it
-        return out + [
-            Claim("internal", s.text.strip(), "unchecked", f"the reader failed ({type(e).__name__}: {e})")
-        ], []
+        return [Claim("internal", s.text.strip(), "unchecked", f"the reader failed ({type(e).__name__}: {e})")], []
 
 
-def _checked(s: Sentence, decisions: list[Decision], names, book, unit_of, known) -> list[Claim]:
+def _checked(s: Sentence, decisions: list[Decision], book, unit_of, known) -> tuple[list[Claim], set[int]]:
+    """The claims the resolved readings make, each number and label of the sentence checked, and the tokens read."""
     ctx = check.view(s, book)
-    out, bound = [], set()
+    out, bound, made = [], set(), []
     for d in decisions:
-        made = check.claim(d.winner, s, book, unit_of, ctx, known)
-        if made is not None:
-            out.append(made)
+        claim = check.claim(d.winner, s, book, unit_of, ctx, known)
+        if claim is not None:
+            out.append(claim)
+            made.append((d.winner, claim))
         if d.winner.rule.claim in ("number", "output", "net", "skip"):
             bound.add(d.winner.anchor)
-    named = {k for t in names for k in t._.keys} | {k for d in decisions for k in s.doc[d.winner.name]._.keys}
+    read = read_tokens(s, made)
+    named = {k for t in s.doc if t.i in read and t.ent_type_ == "FEATURE" for k in t._.keys}
     for t in s.doc:
-        if t.ent_type_ == "NUM" and t.i not in bound:
-            out.append(check.free_number(t, book))
+        if t.ent_type_ == "NUM":
+            read.add(t.i)
+            if t.i not in bound and (score := check.action_score(s, t, book)) is not None:
+                out.append(score)
+            elif t.i not in bound:
+                name = _nearest_name(s, t)
+                out.append(check.free_number(t, book, name, unit_of, ctx, s.masked))
+                if out[-1].rule == "number.nearest":
+                    read.add(name.i)
         elif t.ent_type_ == "LABEL":
             c = check.label_claim(t, book, named)
             if c is not None:
                 out.append(c)
-    return out
+                read.add(t.i)
+    return out, read
+
+
+def _nearest_name(s: Sentence, number):
+    """The name nearest before a number in its clause (else the nearest after it): a binding by position alone,
+    which may verify a number and never contradicts it."""
+    before = [
+        t
+        for t in s.doc[: number.i]
+        if t.ent_type_ == "FEATURE" and not any(x.text in ";|" for x in s.doc[t.i : number.i])
+    ]
+    after = [t for t in s.doc[number.i + 1 :] if t.ent_type_ == "FEATURE"]
+    return before[-1] if before else (after[0] if after else None)
 
 
 def inputs(text, explanation: Explanation, index: int | None, caller: str = "verify") -> tuple:

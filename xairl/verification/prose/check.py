@@ -13,8 +13,8 @@ from dataclasses import replace
 from xairl.verification.prose.book import FactBook
 from xairl.verification.prose.checks import EITHER, check_direction, over_keys, resolve_action
 from xairl.verification.prose.comparisons import check_comparison
+from xairl.verification.prose.decision import action, every, framed, mention, verb_of
 from xairl.verification.prose.lexicon import lexicon
-from xairl.verification.prose.names import Mention
 from xairl.verification.prose.numbers import matches, percent_reading
 from xairl.verification.prose.parse import Sentence
 from xairl.verification.prose.quantities import feature_number
@@ -29,24 +29,11 @@ def view(s: Sentence, book: FactBook) -> str:
     if not book.runner_up:
         return "chosen"
     actions = [t for t in s.doc if t.ent_type_ == "ACTION"]
-    if any(resolve_action(_mention(t), book) == book.runner_up for t in actions) or any(
+    if any(resolve_action(mention(t), book) == book.runner_up for t in actions) or any(
         t.lower_ in ("rather", "instead", "margin", "lead", "over", "versus", "vs", "vs.") for t in s.doc
     ):
         return "margin"
     return EITHER
-
-
-def _mention(token) -> Mention:
-    kind = {"FEATURE": "feature", "ACTION": "action", "LABEL": "label"}[token.ent_type_]
-    return Mention(token.idx, token.idx + len(token), kind, tuple(token._.keys), token._.label, token._.form)
-
-
-def _verb_of(token):
-    """The nearest verb above a token (its clause's verb)."""
-    head = token.head
-    while head.pos_ not in ("VERB", "AUX") and head.head.i != head.i:
-        head = head.head
-    return head
 
 
 def coordinated(token) -> list:
@@ -81,10 +68,22 @@ def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: f
         made = _category(s.doc[c.name], s.doc[c.anchor], book, known)
     elif c.rule.claim == "invented":
         made = _invented(s.doc[c.name], s.doc[c.anchor], known)
+    elif c.rule.claim == "action":
+        made = action(c, s, book)
+    elif c.rule.claim == "every":
+        made = every(c, s, book, ctx)
     else:
         made = _checked(c, s, book, unit_of, ctx)
     if made is None:
         return None
+    frame = "" if c.rule.claim == "action" else framed(s.doc[c.anchor])  # (an action reads its own frame)
+    if frame and made.status != "unchecked" and not (c.rule.binding == "adjacent" and frame == "under a negation"):
+        made = replace(made, status="unchecked", detail=f"{made.detail} ({frame})")
+    if made.status == "contradicted" and c.rule.claim == "number" and c.rule.binding == "grammar":
+        a, b = sorted((c.name, c.anchor))  # ('A gave it +3.58, then B, +0.83 and C, +0.02': +0.02 is C's, not A's)
+        between = [t for t in s.doc[a + 1 : b] if t.ent_type_ == "FEATURE" and t.i not in {x.i for x in together(c, s)}]
+        if between:
+            made = replace(made, status="unchecked", detail=f"{made.detail} ('{between[-1].text}' stands between)")
     if made.status == "contradicted" and c.rule.binding not in ("adjacent", "grammar"):
         made = replace(made, status="unchecked", detail=f"{made.detail} (bound by position only)")
     name = s.doc[c.name]
@@ -93,15 +92,25 @@ def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: f
     return replace(made, rule=c.rule.id)
 
 
+def together(c: Candidate, s: Sentence) -> list:
+    """The names said together with a reading's name (itself first)."""
+    return coordinated(s.doc[c.name])
+
+
 def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Claim:
     name = s.doc[c.name]
     keys = tuple(name._.keys)
     anchor = s.doc[c.anchor]
-    if c.rule.claim == "skip":
+    if c.rule.id == "skip.span":  # 'over the last 3 frames', 'the past 24 hours': when, not a claim (its kind
+        return Claim("span", anchor.text, "verified", "a span of time, no claim about the decision")  # counts not)
+    if c.rule.claim == "skip":  # (one of the decision's own numbers, exactly: 'stayed at 0 of its 100 decisions')
+        decided = free_number(anchor, book)
+        if decided.status == "verified":
+            return decided
         return Claim("number", anchor.text, "unchecked", "a ratio, a pair or a part of a total")
     together = coordinated(name)
     if c.rule.claim == "number":
-        verb = _verb_of(anchor)
+        verb = verb_of(anchor)
         summed = len(together) > 1 or any(t.lower_ in lexicon()["together"] for t in verb.children)
         if summed and c.rule.binding == "grammar":  # ('A (+0.3) and B (+0.2) raised it': each its own number)
             return Claim("number", anchor.text, "unchecked", "said of several features together")
@@ -116,24 +125,32 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         word = anchor.text
         if c.negated:
             return Claim("direction", word, "unchecked", "a negated or hypothetical direction")
+        before = [*_up_to(name, anchor), *s.doc[max(0, name.i - 2) : name.i]]  # ('all but A', 'except for A')
+        if any(t.lower_ in ("but", "except", "excluding", "besides") and t.head.pos_ != "VERB" for t in before):
+            return Claim("direction", word, "unchecked", f"{name.text} is named as an exception")
+        if c.rule.polarity == "cause" and not book.runner_up:
+            return Claim("direction", word, "unchecked", "a cause of a one-output value: which way is not read")
         subjects = {t.i for child in anchor.children if child.dep_ in ("nsubj", "csubj") for t in child.subtree}
         signed = [  # the verb's own signed number ('lowered it by -0.3'), not one of its subject ('A (+0.3) raised')
             t
             for t in anchor.subtree
-            if t.ent_type_ == "NUM" and t.ent_id_ == "signed" and _verb_of(t) == anchor and t.i not in subjects
+            if t.ent_type_ == "NUM" and t.ent_id_ == "signed" and verb_of(t) == anchor and t.i not in subjects
         ]
-        if signed:
+        if signed and (signed[0]._.number.value > 0) != (c.polarity > 0):  # ('lowered it by +0.3': which is meant?)
             return Claim("direction", word, "unchecked", f"its number's sign ({signed[0].text}) says the way")
         polarity, where = c.polarity, ctx
+        trend = _trend(c, s, book)
+        if trend is not None:
+            return trend
         target = next((t for t in s.doc[c.anchor].subtree if t.ent_type_ == "ACTION"), None)
         if target is not None and book.runner_up:
-            meant = resolve_action(_mention(target), book)
+            meant = resolve_action(mention(target), book)
             if meant == book.runner_up:  # 'A favoured recharging' when turning was chosen: against the margin
                 polarity, where = -polarity, "margin"
             elif meant != book.chosen:
                 return Claim("direction", word, "unchecked", "toward an action neither chosen nor runner-up")
         named = [t for t in together if t.ent_type_ in ("FEATURE", "LABEL") and t._.keys]
-        checked = check_direction([_mention(t) for t in named], polarity, where, word, book)
+        checked = check_direction([mention(t) for t in named], polarity, where, word, book)
         if not checked:
             return Claim("direction", word, "unchecked", "said of no name")
         return next((x for x in checked if x.status == "contradicted"), checked[0])
@@ -143,6 +160,28 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
     sides = set(lex["up"]) | set(lex["down"]) | set(lex["sign_up"]) | set(lex["sign_down"]) | set(lex["side_words"])
     one_side = any(t.lower_ in sides for t in s.doc)  # 'the biggest factor pulling it down': among the negatives
     return _rank(keys, c.rank, anchor.text, book, one_side)
+
+
+def _up_to(token, top) -> list:
+    """The tokens on the way from ``token`` up to ``top`` (not included), or to the root."""
+    out = []
+    while token.i != top.i and token.head.i != token.i:
+        token = token.head
+        out.append(token)
+    return out
+
+
+def _trend(c: Candidate, s: Sentence, book: FactBook) -> Claim | None:
+    """'Patch B6 rose 14.0 over the last 3 frames': an intransitive rise or fall of a windowed signal is its trend
+    (newest value minus oldest), not its push."""
+    verb, keys = s.doc[c.anchor], s.doc[c.name]._.keys
+    changes = {k: book.features[k].change for k in keys if k in book.features}
+    if not changes or any(v is None for v in changes.values()) or any(t.dep_ == "dobj" for t in verb.children):
+        return None
+    ok = [k for k, v in changes.items() if v and (v > 0) == (c.polarity > 0)]
+    k, v = next(iter(changes.items()))
+    status = "verified" if len(ok) == len(changes) else "contradicted" if not ok else "unchecked"
+    return Claim("direction", verb.text, status, f"{k} changed by {v:+.3g} over its window")
 
 
 def _rank(keys: tuple[str, ...], rank: int, word: str, book: FactBook, one_side: bool) -> Claim:
@@ -195,12 +234,32 @@ def _output(n, what: str, book: FactBook) -> Claim:
     )
 
 
-def free_number(token, book: FactBook) -> Claim:
-    """A number no rule bound to a name: verified when it is a decision-level fact, else unchecked."""
+def action_score(s: Sentence, token, book: FactBook) -> Claim | None:
+    """'stay, the only available action (score 31.0)': a number right after 'score' (or 'Q') in a sentence that
+    names one action is that action's score (adjacency binds it)."""
+    before = [t for t in s.doc[max(0, token.i - 3) : token.i] if t.text not in "(:=[,"]
+    actions = {resolve_action(mention(t), book) for t in s.doc if t.ent_type_ == "ACTION"}
+    if not before or before[-1].lower_ not in ("score", "q", "q-value") or len(actions) != 1 or None in actions:
+        return None
+    (action,) = actions
+    if action not in book.scores or book.output != "actions":
+        return None
+    ok = matches(token._.number, book.scores[action], magnitude_ok=False)
+    status = "verified" if ok else "contradicted"
+    return Claim("number", token.text, status, f"{action}'s score is {book.scores[action]:.4g}", "number.score-of")
+
+
+def free_number(token, book: FactBook, name=None, unit_of=None, ctx: str = EITHER, masked: str = "") -> Claim:
+    """A number no rule bound to a name: verified when it is a decision-level fact or a fact of the name nearest it
+    (``name``: a binding by position alone, so never contradicted), else unchecked."""
     n = token._.number
     facts = [*book.decision_numbers, *(v for k, v in book.aggregates.items() if k != "the number of features")]
     if any(matches(n, f, magnitude_ok=False) for f in facts):
         return Claim("number", n.text, "verified", "a decision-level number", "number.decision")
+    if name is not None and name._.keys:
+        near = feature_number(n, tuple(name._.keys), masked, book, ctx, unit_of)
+        if near.status == "verified":
+            return replace(near, rule="number.nearest")
     return Claim("number", n.text, "unchecked", "bound to no name", "number.unbound")
 
 

@@ -10,7 +10,7 @@ import yaml
 
 #: the one lexicon of the verification package (xairl/verification/lexicon.yaml)
 LEXICON = Path(__file__).parent.parent / "lexicon.yaml"
-_VERB_LISTS = ("up", "down", "phrasal", "output_up", "output_down", "outweigh", "give")
+_VERB_LISTS = ("up", "down", "phrasal", "output_up", "output_down", "outweigh", "give", "choose", "win")
 
 
 def forms(word: str) -> set[str]:

@@ -11,7 +11,8 @@ from dataclasses import dataclass, replace
 
 from xairl.verification.prose.book import FactBook
 from xairl.verification.prose.checks import EITHER, over_keys
-from xairl.verification.prose.numbers import Number, find_numbers, matches, percent_reading, written_scale
+from xairl.verification.prose.numbers import Number, find_numbers, matches, percent_reading
+from xairl.verification.prose.units import written_scale
 from xairl.verification.result import Claim
 
 CONTRIB_BEFORE = re.compile(
@@ -238,143 +239,7 @@ def _code_meaning(n: Number, e) -> tuple[bool, str] | None:
     )
 
 
-def other_reading(n: Number, keys: set[str], book: FactBook, ctx: str | None, signed: bool = False) -> str | None:
-    """Another fact the number states exactly when the words bound it to the wrong one: the value, share or
-    contribution (in the sentence's view when it names one, else any) of a feature named in the same sentence. The
-    binding was a guess, so the number is not called wrong; only unhedged numbers of two significant digits or more
-    qualify ('0.06' or 'about 0.1' may match by chance). ``signed``: a contribution only with its sign."""
-    if n.hedge or abs(n.value) < 10 * n.unit:
-        return None
-    views = book.contexts if ctx in (None, EITHER) else (ctx,)
-    for key in sorted(keys):
-        e = book.features[key]
-        if n.percent and not n.points:  # a percentage is a share (or a fill the binding already tried), or a value
-            facts = [(f"share ({c})", e.shares.get(c), True) for c in views] + [("value", e.value, False)]  # ('12 %')
-        else:  # a value as written, sign included; a contribution may be its size
-            facts = [
-                ("value", e.value, False),
-                *((f"contribution ({c})", e.contribs.get(c), not signed) for c in views),
-            ]
-        for what, v, size_ok in facts:
-            if v is not None and (
-                matches(replace(n, percent=False), v, magnitude_ok=size_ok, truncated_ok=False)
-                or (n.points and percent_reading(n, abs(v) if size_ok and not n.sign else v))
-            ):  # '12.3 pp'
-                return f"{key}'s {what}"
-    return None
-
-
 def comparison(n: Number, after: str, book: FactBook) -> bool:
     unit = re.match(r"\s*([A-Za-z]+)", after)
     values = book.by_unit.get(unit.group(1).lower(), []) if unit else []
     return any(matches(n, v) for v in values)
-
-
-def contribution_owners(n: Number, book: FactBook) -> list[str]:
-    """The features whose contribution (in any view) the number states: the one it states as written rounds ('about
-    $8,300' for -8,251.83) when only one does, else all it states within its hedge."""
-    found = []
-    for strict in (True, False):
-        m = replace(n, hedge="") if strict else n
-        found = [
-            f
-            for f, e in book.features.items()
-            if any(matches(m, c) or (m.percent and percent_reading(m, c)) for c in e.contribs.values())
-        ]
-        if len(found) == 1:
-            return found
-    return found
-
-
-def any_fact(
-    n: Number,
-    book: FactBook,
-    keys,
-    ctx: str | None,
-    strict: bool = False,
-    contribution: bool = False,
-    signed: bool = False,
-) -> str | None:
-    """Another fact of the sentence the number states: a value, contribution (either view, its size) or share of a
-    feature named in it (``keys``); a decision-level number; an action's score. ``None``
-    when it states none (then it is wrong wherever it is bound). A feature the sentence does not name is no
-    candidate: with a dozen features, some fact would match any rounded number by chance. ``strict``: any feature
-    may be meant, so only an unhedged number of two significant digits or more may match.
-    ``contribution``: the words say the number is a push ('by -0.22'): no decision-level number or score.
-    ``signed``: the words name a signed quantity ('a SHAP value of 0.3'): a contribution only with its sign.
-    ``ctx``: the sentence's view (contributions and shares in it only), or None / either view."""
-    if strict and (n.hedge or abs(n.value) < 10 * n.unit):
-        return None  # ('0.06' or 'about 0.1' may match by chance)
-
-    def states(v: float | None, size_ok: bool = True) -> bool:
-        return v is not None and (
-            matches(n, v, magnitude_ok=size_ok)
-            or (n.percent and percent_reading(n, v))
-            or (n.points and percent_reading(n, abs(v)))
-        )
-
-    views = book.contexts if ctx in (None, EITHER) else (ctx,)
-    for key, e in ((k, book.features[k]) for k in sorted(keys) if k in book.features):
-        shares = (
-            [
-                ("fill", e.fill),
-                *((f"share ({c})", e.shares.get(c)) for c in views),
-                *((f"share of its side ({c})", e.side_shares.get(c)) for c in views),
-            ]
-            if n.percent and not n.points
-            else []
-        )  # (a share is a percentage)
-        for what, v in (("value", e.value), *shares):
-            if states(v, size_ok=False):
-                return f"{key}'s {what}"
-        for c, x in ((c, e.contribs.get(c)) for c in views):
-            if states(x, size_ok=not signed):
-                return f"{key}'s contribution ({c})"
-    if contribution:
-        return None
-    for what, v in (
-        *(("a decision-level fact", x) for x in book.decision_numbers),
-        *((f"{a}'s score", x) for a, x in book.scores.items()),
-    ):  # (a sum needs its cue words)
-        if states(v):
-            return what
-    return None
-
-
-#: a count of things a name after it holds: 'three robots in the charger queue', 'seven cars waiting at the junction'
-_COUNTED_IN = re.compile(
-    r"^\s+(?:[a-z\0]+\s+){1,2}(?:(?:already|still|now|waiting|queued|parked)\s+)?"
-    r"(?:in|on|at|inside)\s+(?:the\s+|a\s+|its\s+)?$",
-    re.IGNORECASE,
-)
-
-
-def owned_by_unit_or_place(n: Number, masked: str, mentions, book: FactBook, unit_of) -> Claim | None:
-    """A number first read as another name's and contradicted, that states exactly the value of the one feature its
-    unit belongs to ('parked barely 4 m from a charger' of dist_to_charger_m, 4.2) or of the name that holds the things
-    it counts ('three robots in the charger queue' of charger_queue_len, 3): verified as that value; else None."""
-    unit = re.match(r"\s*([A-Za-zµ°/%]+)\b", masked[n.end :])
-    owners = [f for f in book.features if unit and unit_of(f) and unit_of(f).lower() == unit.group(1).lower()]
-    nxt = next(
-        (
-            m
-            for m in mentions
-            if m.kind == "feature"
-            and m.start >= n.end
-            and len(m.keys) == 1
-            and _COUNTED_IN.match(masked[n.end : m.start])
-        ),
-        None,
-    )  # (past the counted noun's own mention)
-    if nxt is not None:
-        owners, rule = list(nxt.keys), "number.counted-in"
-    elif len(owners) == 1:
-        rule = "number.unit-owner"
-    else:
-        return None
-    e = book.features.get(owners[0])
-    if n.hedge not in ("", "approx"):  # ('under 0.6 km', 'over 1000 DM': a bound, not this value)
-        return None
-    if e is None or e.value is None or not matches(replace(n, hedge=""), e.value, magnitude_ok=False):
-        return None
-    return Claim("number", n.text, "verified", f"{owners[0]}: value", rule)

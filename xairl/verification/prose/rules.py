@@ -9,7 +9,7 @@ wins is decided by resolve.py, never by the order of the table.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import yaml
@@ -21,7 +21,7 @@ from xairl.verification.prose.lexicon import lexicon
 @dataclass(frozen=True, eq=False)
 class Rule:
     id: str
-    claim: str  # number | output | net | direction | rank | comparison | category | class | invented | skip
+    claim: str  # number | output | net | direction | every | rank | comparison | category | class | invented | action | skip
     binding: str  # adjacent | grammar
     priority: int
     pattern: list
@@ -44,6 +44,7 @@ class Candidate:
     rank: int = 0
     negated: bool = False
     other: int = -1  # a comparison's second name
+    tokens: tuple[int, ...] = ()  # every token the rule's pattern matched (the words it read)
 
 
 def _expand(node):
@@ -100,18 +101,29 @@ def candidates(doc) -> list[Candidate]:
     out = []
     for match_id, start, end in token(doc):
         rule = by_id()[doc.vocab.strings[match_id]]
-        out += _token_reading(rule, doc, start, end)
+        out += [replace(c, tokens=tuple(range(start, end))) for c in _token_reading(rule, doc, start, end)]
     for match_id, ids in dependency(doc):
         rule = by_id()[doc.vocab.strings[match_id]]
         roles = {node["RIGHT_ID"]: i for node, i in zip(rule.pattern, ids)}
         if rule.claim == "comparison":  # 'A outweighed B'
-            out.append(Candidate(rule, roles["name"], roles["way"], 1, other=roles["other"]))
+            out.append(Candidate(rule, roles["name"], roles["way"], 1, other=roles["other"], tokens=tuple(ids)))
             continue
         if rule.same_clause and _clause_between(doc, *(roles[k] for k in rule.same_clause)):
             continue
         anchor = next(roles[k] for k in ("num", "dir", "rank", "word") if k in roles)
-        out.append(_reading(rule, doc, roles["name"], anchor, roles))
-    return [c for c in out if not (_dir_is_led(c.rule) and _own_subject(doc, c))]
+        out.append(replace(_reading(rule, doc, roles["name"], anchor, roles), tokens=tuple(ids)))
+    return [c for c in out if not (_dir_is_led(c.rule) and _own_subject(doc, c)) and not _across_cells(doc, c)]
+
+
+def _across_cells(doc, c: Candidate) -> bool:
+    """Does a reading bind a name to a word in another item of a list ('A 2.4 +7.2 | lag reading 48.2 +14.7'): an
+    item with words of its own before the anchor? (A table's row, '| season | winter | -1.0 |', is one item.)"""
+    a, b = sorted((c.name, c.anchor))
+    cuts = [t.i for t in doc[a:b] if t.text in ("|", ";")]
+    if not cuts:
+        return False
+    own = doc[cuts[-1] + 1 : b] if b == c.anchor else doc[a + 1 : cuts[0]]
+    return any(t.is_alpha and t.ent_type_ != "LABEL" for t in own)
 
 
 def _clause_between(doc, top: int, below: int) -> bool:
@@ -150,6 +162,9 @@ def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
         return [Candidate(rule, nums[-1], nums[-1])]
     if rule.claim == "class":  # its name is found by its value's class, in check.py
         return [Candidate(rule, start, start)]
+    if rule.claim == "action":  # 'rather than recharge': the action named last
+        acts = [i for i in span if doc[i].ent_type_ == "ACTION"]
+        return [Candidate(rule, acts[-1], acts[-1])] if acts else []
     if not names:
         return []
     if rule.claim == "number":
@@ -175,9 +190,11 @@ def _token_reading(rule: Rule, doc, start: int, end: int) -> list[Candidate]:
 def _reading(rule: Rule, doc, name: int, anchor: int, roles: dict) -> Candidate:
     lex = lexicon()
     polarity = rank = 0
-    if rule.claim == "direction":
+    if rule.claim in ("direction", "every"):
         word = doc[anchor].lower_
-        if rule.polarity == "particle":
+        if rule.polarity == "cause":  # 'turned because of A': A favoured what was done
+            polarity = 1
+        elif rule.polarity == "particle":
             way = doc[roles["way"]].lower_
             polarity = 1 if way in lex["particle_up"] else -1
         elif rule.polarity == "sign":
