@@ -347,7 +347,7 @@ def test_without_provenance_the_reader_reads_as_before(toy):
         for given in (None, ()):
             v = xairl.verify(n.text, exp, i, policy, provenance=given)
             plain = read_prose(n.text, exp, i, policy)
-            assert v == plain
+            assert v.sentences == plain.sentences and v.status == plain.status
             assert [(c.kind, c.text, c.status, c.rule) for c in v.claims] == [
                 (c.kind, c.text, c.status, c.rule) for c in plain.claims
             ]

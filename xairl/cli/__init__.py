@@ -133,7 +133,11 @@ def cmd_verify(args) -> int:
         BY_ID = by_id()
 
         fired = sorted({c.rule for c in result.claims if c.rule in BY_ID})
-        print("rules:" if fired else "rules: none fired", *(f"  {r}: {BY_ID[r].reads}" for r in fired), sep="\n")
+        print(
+            "rules:" if fired else "rules: none fired",
+            *(f"  {r}: a {BY_ID[r].claim} bound by {BY_ID[r].binding}" for r in fired),
+            sep="\n",
+        )
     print(f"verdict: {verdict_text(result.status, result.coverage)}{'; ' + result.note if result.note else ''}")
     if result.account:
         print(f"account: {result.account}")

@@ -150,6 +150,8 @@ def _literals(node: nodes.Node) -> Iterable[tuple[int, str]]:
             todo += [n.node] if n.node is not None else []  # ('{% filter dir(...) %}' has none)
         elif isinstance(n, (nodes.Compare, nodes.Test)):
             continue
+        elif isinstance(n, nodes.Filter) and n.name == "replace":  # (the text it replaces is not printed)
+            todo += [x for x in (n.node, *n.args[1:]) if x is not None]
         elif isinstance(n, nodes.Getitem):
             todo.append(n.node)
         else:
@@ -172,18 +174,23 @@ def _prints_counterfactual(ast: nodes.Template) -> bool:
     return any(x.name in tainted for o in ast.find_all(nodes.Output) for x in o.find_all(nodes.Name))
 
 
-def _runner_up_printed(node: nodes.Node) -> tuple[int | None, bool]:
-    """(the line of the first place a phrasing prints ``runner_up`` itself, whether a ``role`` filter declares the
-    runner-up's role in it): a runner-up named without its role may read as the chosen action."""
+def _runner_up_printed(node: nodes.Template) -> tuple[int | None, bool]:
+    """(the line of the first place a phrasing prints ``runner_up`` itself, or a name set from it, whether a ``role``
+    filter declares the runner-up's role in it): a runner-up named without its role may read as the chosen action."""
+    named = {"runner_up"} | {
+        n.target.name
+        for n in node.find_all(nodes.Assign)
+        if isinstance(n.target, nodes.Name) and any(x.name == "runner_up" for x in n.node.find_all(nodes.Name))
+    }
     first, declared, todo = None, False, [node]
     while todo:
         n = todo.pop()
         if isinstance(n, nodes.Filter) and n.name == "role":
             declared |= isinstance(n.node, nodes.Name) and n.node.name == "runner_up"
             continue
-        if isinstance(n, (nodes.Compare, nodes.Test)):
+        if isinstance(n, (nodes.Compare, nodes.Test, nodes.Assign)):
             continue
-        if isinstance(n, nodes.Name) and n.name == "runner_up" and n.ctx == "load":
+        if isinstance(n, nodes.Name) and n.name in named and n.ctx == "load":
             first = n.lineno if first is None else min(first, n.lineno)
             continue
         tests = [getattr(n, "test", None)] if isinstance(n, (nodes.If, nodes.CondExpr, nodes.For)) else []
