@@ -70,9 +70,9 @@ def test_level_words_come_from_capacity_and_thresholds_not_degenerate_quartiles(
 def test_the_verifier_checks_each_view_against_its_own_quantity(case):
     p, exp = case
     ok = "The policy chose go over wait. The biggest push toward go over wait came from the speed, by +6.00."
-    assert xairl.verify(ok, exp, 0, p).ok
+    assert xairl.verify(ok, exp, 0, p).accurate  # (outside prose: nothing false, whatever is left unread)
     # the speed's contribution to go's own score is also +6 here, so use the position (+1 to the margin)
-    assert xairl.verify("The position favoured go over wait by +1.00.", exp, 0, p).ok
+    assert xairl.verify("The position favoured go over wait by +1.00.", exp, 0, p).accurate
     assert not xairl.verify("The position favoured go over wait by +3.00.", exp, 0, p).ok
     assert not xairl.verify("The biggest push toward go over wait came from the queue.", exp, 0, p).ok
     assert xairl.verify("The queue was 0.5 % full.", exp, 0, p).ok
@@ -159,5 +159,5 @@ def test_declared_groups_are_narrated_as_one_without_a_group_description():
     n = xairl.narrate(exp, 0, policy=plain, robustness=False)
     assert n.verified and "position" in n.text.lower() and "nan" not in n.text, n.text
     assert not {"x", "y"} & set(n.text.replace(".", " ").replace(",", " ").split()), n.text
-    assert xairl.verify("The position favoured action_0 over action_1 by +1.00.", exp, 0, plain).ok
+    assert xairl.verify("The position favoured action_0 over action_1 by +1.00.", exp, 0, plain).accurate
     assert not xairl.verify("The position favoured action_0 over action_1 by +3.00.", exp, 0, plain).ok

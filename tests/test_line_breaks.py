@@ -25,7 +25,7 @@ LISTED = """\
 name: listed
 kind: decision
 sentences:
-  - ["The policy {{ action|role('chose') }} {{ action }} over {{ runner_up }}."]
+  - ["The policy {{ action|role('chose') }} {{ action }} {{ runner_up|role('', 'over') }} {{ runner_up }}."]
   - - |
       Reasons <why> & how:
       {% for f in margin_top %}

@@ -56,10 +56,11 @@ RULES = {
 def _claimy(span: Span) -> bool:
     """A name that carries claims of its own ('speed, the most important feature, pushing toward go by +9.99' as a
     description): not trusted as a name, its words are literal words like any other."""
+    text = re.sub(r"\[[^\]]*\]", "", span.text)  # (an index is part of a name: 'obs[0,5,7]', 'patch[1,0]')
     return (
         span.fact.quantity in ("name", "action")
-        and bool(re.search(r"[,;]", span.text))
-        and bool(re.search(r"\d", span.text) or any(w.kind != "name" for w in claim_words(span.text)))
+        and bool(re.search(r"[,;]", text))
+        and bool(re.search(r"\d", text) or any(w.kind != "name" for w in claim_words(text)))
     )
 
 

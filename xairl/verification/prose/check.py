@@ -190,7 +190,9 @@ def _rank(keys: tuple[str, ...], rank: int, word: str, book: FactBook, one_side:
 
     def test(key):
         e = book.features[key]
-        said = {r for r in (*e.ranks.values(), *(e.signed_ranks.values() if one_side else ())) if r}
+        said = {r for r in e.ranks.values() if r}
+        if one_side and rank not in said and rank in set(e.signed_ranks.values()):
+            return None  # (its rank among its own side's: which side the words say is not read, so not verified)
         if not said:
             return None
         return rank in said, f"{key} ranks {', '.join(map(str, sorted(said)))}"
@@ -253,7 +255,11 @@ def free_number(token, book: FactBook, name=None, unit_of=None, ctx: str = EITHE
     """A number no rule bound to a name: verified when it is a decision-level fact or a fact of the name nearest it
     (``name``: a binding by position alone, so never contradicted), else unchecked."""
     n = token._.number
-    facts = [*book.decision_numbers, *(v for k, v in book.aggregates.items() if k != "the number of features")]
+    summed = bool(_words(masked) & _SUMS)  # (a sum is cited only where the words say one: 'in total', 'together')
+    facts = [
+        *book.decision_numbers,
+        *(v for k, v in book.aggregates.items() if k != "the number of features" and summed),
+    ]
     if any(matches(n, f, magnitude_ok=False) for f in facts):
         return Claim("number", n.text, "verified", "a decision-level number", "number.decision")
     if name is not None and name._.keys:
@@ -261,6 +267,9 @@ def free_number(token, book: FactBook, name=None, unit_of=None, ctx: str = EITHE
         if near.status == "verified":
             return replace(near, rule="number.nearest")
     return Claim("number", n.text, "unchecked", "bound to no name", "number.unbound")
+
+
+_SUMS = frozenset({*lexicon()["together"], "sum", "sums", "total", "totals", "summed", "net", "overall"})
 
 
 def _words(text: str) -> set[str]:
