@@ -152,8 +152,8 @@ def test_a_feature_that_pushes_against_is_said_so_and_a_swap_is_contradicted():
     exp = xairl.explain(policy, states, background=np.zeros((5, 3)), method="exact")
     n = xairl.narrate(exp, None, policy=policy, robustness=False)
     assert n.verified, n.text
-    assert "gain pushed toward the chosen action" in n.text and "drag pushed against it" in n.text, n.text
-    swapped = n.text.replace("drag pushed against", "drag pushed toward")
+    assert "gain raised the margin" in n.text and "drag lowered it" in n.text, n.text
+    swapped = n.text.replace("drag lowered it", "drag raised it")
     assert xairl.verify(swapped, exp, None, policy).status == "contradicted"
 
 

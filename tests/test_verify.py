@@ -23,10 +23,11 @@ def test_mutation_corpus_all_caught_no_paraphrase_rejected(toy):
     cases = corpus(exp, policy, ("explain_action", "why_not"), range(25))
     results = collections.Counter()
     wrongly = []
-    for c in cases:
-        ok = xairl.verify(c.text, exp, c.index, policy).ok
-        results[(c.kind, ok == c.should_pass)] += 1
-        if ok != c.should_pass:
+    for c in cases:  # (read as outside prose: a mutant never verified, a right phrasing never contradicted)
+        v = xairl.verify(c.text, exp, c.index, policy)
+        right = v.accurate if c.should_pass else not v.ok
+        results[(c.kind, right)] += 1
+        if not right:
             wrongly.append((c.kind, c.text))
     kinds = {k for k, _ in results}
     assert {
@@ -59,20 +60,20 @@ def test_reads_any_text_not_just_ours(toy):
     j = int(np.argmax(np.abs(exp.values[i, :, c])))
     f, v = exp.feature_names[j], exp.values[i, j, c]
     good = f"Mostly {f} mattered: it pushed {'toward' if v > 0 else 'against'} {exp.action_names[c]} by {abs(v):.2f}."
-    assert xairl.verify(good, exp, i, policy).ok
+    assert xairl.verify(good, exp, i, policy).accurate
     bad = good.replace("toward", "@").replace("against", "toward").replace("@", "against")
-    assert not xairl.verify(bad, exp, i, policy).ok
+    assert not xairl.verify(bad, exp, i, policy).ok  # (contradicted, or left unchecked: never verified)
     res = xairl.verify("The policy chose nothing in particular.", exp, i, policy)
-    # nothing to contradict, but nothing checked either: a vacuous text is not ok
-    assert not res.ok and res.status == "unchecked" and res.coverage == 0.0
+    # nothing to contradict, but nothing checked either: a vacuous text is not verified
+    assert not res.ok and res.status == "partly checked" and res.coverage == 0.0
 
 
 def test_global_summary_verifies(toy):
     policy, exp = toy
     n = xairl.narrate(exp, None, policy=policy)
     assert n.verified and n.template == "global_summary" and "25 states" in n.text
-    assert "pushed toward" in n.text  # the toy's top features raise the margin over the runner-up on average
-    swapped = n.text.replace("pushed toward", "pushed against")
+    assert " raised the margin" in n.text  # the toy's top feature raises the margin over the runner-up on average
+    swapped = n.text.replace(" raised the margin", " lowered the margin", 1)
     problems = xairl.verify(swapped, exp, None, policy).problems()
     assert problems and all(c.kind == "direction" and c.status == "contradicted" for c in problems)
 
@@ -121,5 +122,5 @@ def test_names_and_descriptions_cannot_smuggle_claims():
     n = xairl.narrate(exp, 0, policy=policy)
     assert not n.verified and n.confidence == 0.0
     text = "The policy chose stop. speed, the most important feature, pushing toward go by +9.99."
-    problems = xairl.verify(text, exp, 0, policy).problems()
-    assert any(c.kind == "number" for c in problems) and any(c.kind == "rank" for c in problems)
+    v = xairl.verify(text, exp, 0, policy)
+    assert v.status == "contradicted" and any(c.kind == "number" for c in v.problems()), v.claims

@@ -34,7 +34,8 @@ KINDS = {
     "direction": "direction",
     "direction_high": "direction",
     "direction_low": "direction",
-    "comparison": "number",
+    "comparison": "comparison",
+    "rank_same_way": "rank",
     "extra": "number",
 }
 SAID_OF_FEATURE = {

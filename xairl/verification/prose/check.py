@@ -79,11 +79,17 @@ def claim(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str, known: f
     frame = "" if c.rule.claim == "action" else framed(s.doc[c.anchor])  # (an action reads its own frame)
     if frame and made.status != "unchecked" and not (c.rule.binding == "adjacent" and frame == "under a negation"):
         made = replace(made, status="unchecked", detail=f"{made.detail} ({frame})")
-    if made.status == "contradicted" and c.rule.claim == "number" and c.rule.binding == "grammar":
+    if made.status == "contradicted" and c.rule.binding == "grammar":
         a, b = sorted((c.name, c.anchor))  # ('A gave it +3.58, then B, +0.83 and C, +0.02': +0.02 is C's, not A's)
         between = [t for t in s.doc[a + 1 : b] if t.ent_type_ == "FEATURE" and t.i not in {x.i for x in together(c, s)}]
-        if between:
+        if c.rule.claim == "number" and between:
             made = replace(made, status="unchecked", detail=f"{made.detail} ('{between[-1].text}' stands between)")
+        elif any(t.text in (";", "|") for t in s.doc[a + 1 : b]):  # (a list's items: no binding across them)
+            made = replace(made, status="unchecked", detail=f"{made.detail} (across a list's items)")
+        elif (
+            c.rule.claim == "number" and c.name > c.anchor and any(t.ent_type_ == "FEATURE" for t in s.doc[: c.anchor])
+        ):  # ('came from A (-1.25), by +3.00, then B': a name before the number may be the one it is said of)
+            made = replace(made, status="unchecked", detail=f"{made.detail} (a name before it may be its own)")
     if made.status == "contradicted" and c.rule.binding not in ("adjacent", "grammar"):
         made = replace(made, status="unchecked", detail=f"{made.detail} (bound by position only)")
     name = s.doc[c.name]
@@ -142,7 +148,10 @@ def _checked(c: Candidate, s: Sentence, book: FactBook, unit_of, ctx: str) -> Cl
         trend = _trend(c, s, book)
         if trend is not None:
             return trend
-        target = next((t for t in s.doc[c.anchor].subtree if t.ent_type_ == "ACTION"), None)
+        target = next(  # (the action it is for, not the one it is weighed against: 'gave A the push over B')
+            (t for t in s.doc[c.anchor].subtree if t.ent_type_ == "ACTION" and t.head.lower_ not in _AGAINST_OTHER),
+            None,
+        )
         if target is not None and book.runner_up:
             meant = resolve_action(mention(target), book)
             if meant == book.runner_up:  # 'A favoured recharging' when turning was chosen: against the margin
@@ -269,6 +278,7 @@ def free_number(token, book: FactBook, name=None, unit_of=None, ctx: str = EITHE
     return Claim("number", n.text, "unchecked", "bound to no name", "number.unbound")
 
 
+_AGAINST_OTHER = frozenset({"over", "than", "versus", "vs", "vs.", "instead"})
 _SUMS = frozenset({*lexicon()["together"], "sum", "sums", "total", "totals", "summed", "net", "overall"})
 
 

@@ -56,8 +56,15 @@ def read_tokens(s, made) -> set[int]:
     """The tokens the claims made read: each rule's matched words, the names said together with a direction or a
     number, the action a direction is toward, and the negation, auxiliaries and particle of its verb."""
     read: set[int] = set()
+    lex = lexicon()
+    choosing = {*lex["choose"], *lex["win"], *lex["top"]}
     for c, claim in made:
         anchor, name = s.doc[c.anchor], s.doc[c.name]
+        if c.rule.claim == "action":  # (it reads the choice, not a feature's push toward it: 'A pushed toward turn')
+            words = (*c.tokens, c.anchor, c.name)
+            read |= {i for i in words if s.doc[i].ent_type_ == "ACTION" or s.doc[i].lower_ in choosing}
+            read |= {t.i for t in anchor.children if t.dep_ in _TAKEN}  # ('did not choose': its negation)
+            continue
         read |= {*c.tokens, c.anchor, c.name, *([c.other] if c.other >= 0 else [])}
         read |= {t.i for t in anchor.children if t.dep_ in _TAKEN}
         if c.rule.claim in ("direction", "number", "every") and claim.kind != "feature":
