@@ -159,5 +159,6 @@ def test_my_plugin_installs_and_registers(tmp_path):
         env,
     )
     assert out.count("[verified") == 2 and out.count("; shortest]") == 2
-    for line in out.splitlines()[1::2]:  # one sentence per narrative
+    rows = [line for line in out.splitlines() if not line.startswith("    account: ")]
+    for line in rows[1::2]:  # one sentence per narrative
         assert line.strip().count(". ") == 0 and line.strip().endswith(".")

@@ -178,7 +178,8 @@ def verified_and_caught(policy, exp):
     """Decision 0 narrated, every claim verified, and the same words with the first signed number changed caught."""
     n = xairl.narrate(exp, 0, policy=policy, robustness=False)
     assert n.verified and "over the last 4 observations" in n.text, n.text
-    assert xairl.verify(n.text, exp, 0, policy).ok
+    assert xairl.verify(n.text, exp, 0, policy).accurate  # (read again as outside prose: nothing false)
+    assert xairl.verify(n.text, exp, 0, policy, provenance=n.provenance).ok
     first = next(c for c in n.claims if c.kind == "number" and "+" in c.text)
     assert not xairl.verify(n.text.replace(first.text, "+9.99", 1), exp, 0, policy).ok
     return n

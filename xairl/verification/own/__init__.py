@@ -110,7 +110,7 @@ def check_sentence(sentence: str, spans: Sequence[Span], truth: Truth, names: Se
                 )
             )
         claims += [c for c in extra if c is not None]
-    claims += undeclared(sentence, s.spans, len(truth.features), names, numbers_only=bool(counterfactual))
+    claims += undeclared(sentence, s.spans, names, numbers_only=bool(counterfactual))
     return claims
 
 
@@ -126,10 +126,10 @@ def _role_declared(spans: Sequence[Part], p: Part, truth: Truth) -> bool:
 
 
 def undeclared(
-    sentence: str, spans: Sequence[Part], n_features: int, names: Sequence[str] = (), numbers_only: bool = False
+    sentence: str, spans: Sequence[Part], names: Sequence[str] = (), numbers_only: bool = False
 ) -> list[Claim]:
     """The claims a template wrote itself, outside every tracked span: claim words, names and identifiers
-    (:func:`~xairl.verification.claims.claim_words`), and numbers other than a small count ('the top 3'). Of a
+    (:func:`~xairl.verification.claims.claim_words`), and numbers other than a small count (up to 3). Of a
     counterfactual sentence (``numbers_only``) only the numbers: its words are its re-run's to judge."""
     blank = list(sentence)
     for p in spans:
@@ -141,8 +141,8 @@ def undeclared(
     ]
     for m in NUMBER.finditer(words):
         x = number(m.group())
-        if x is not None and x == int(x) and 0 < x <= max(n_features, 3) and "." not in m.group():
-            continue  # a count or a list's number
+        if x is not None and x == int(x) and 0 < x <= 3 and "." not in m.group():
+            continue  # a small count or a list's number ('the top 3'); a larger one may be an id ('BS 12')
         out.append(
             Claim(
                 "number",
