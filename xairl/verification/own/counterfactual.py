@@ -1,38 +1,17 @@
-"""The check of a counterfactual sentence (issue 56) by reading its structure and running the policy on what it states.
+"""The check of a counterfactual sentence (issue 56): read its structure, then run the policy on what it states.
 
 'Had the uplink buffer been below 37.6 % full (it was 100 % full), the DQN would have chosen to hand over to
-candidate 2 (margin 4.2)' is read from its *words*, not from what each tracked span was printed from (a template may
-print a fact anywhere): every value in it (a tracked value of the counterfactual fact, or a number the template wrote
-itself) takes the slot the words before it give it:
+candidate 2 (margin 4.2)' is read from its words: each value takes the slot the words before it give it, the
+*hypothetical* one ('had X been [below] V', 'if X were V', 'with X at V') or the *actual* one ('it was V'), and is
+the value of the feature named last before it. A sentence with no counterfactual form states facts of the state.
 
-- the *hypothetical* value, the one the sentence puts under the counterfactual: 'had X been [below] V', 'if X were
-  V', 'with X at V' (also '... to V');
-- the *actual* one: 'it was V', 'X was/is V'.
-
-A sentence with no counterfactual form ('had ... been', 'if ... were', 'would have') states facts of the state: every
-value in it is read as actual ('The queue was 19.9 % full' while the state says 80 % is contradicted). Each value is
-of the feature named last before it: a feature's name, description or alias, or a window's past slot by its own
-words ('the speed 2 steps ago'); words that name several features name none.
-
-The state with every hypothetical value set, the others as they were, is run through the policy (its action mask
-honoured), after the constraints of the world (:func:`xairl.counterfactual_facts.broken`: no immutable feature
-changed, the declared bounds, the policy's ``feasible``), and:
-
-- the hypothetical values are verified when that state is allowed and the policy decides otherwise there;
-- what it says the policy would have done, its *consequent*, is read in one of these forms only: 'would have
-  chosen/taken/picked/selected (to) X', 'would have handed over to X' (the action 'hand over to X'), 'would
-  choose/take (to) X', where X, up to the next punctuation, is an action's name or alias, whole (tracked from any
-  field, or written). X must be the action the policy takes there, and not the one it took. Negated ('would not
-  have chosen X'), it is contradicted when X is the one it takes there, else unchecked. Any other 'would' in the
-  sentence ('would likely have picked', 'would, in that case, have', 'would the policy have', 'would have avoided', 'would have chosen X rather than Y') is not read: the sentence is left unchecked, never
-  verified (its claims that would be verified become unchecked; a wrong value still contradicts it). So is one that
-  names an action anywhere else, unless as the one it took in a clause without 'would' ('it chose stay', checked);
-- the stated margin is the stated action's score minus the best other available one's, as written;
-- a direction word points from the state's value to the hypothetical one, and an actual value is the state's.
-
-Without the policy, or without the state as its input (an image narrated in regions), nothing of it is checked: its
-claims are 'unchecked', never 'verified'. A sentence that nothing within the bounds would have changed the decision
-states a search's miss, which is no proof (the search tries a grid of changes): unchecked.
+The state with every hypothetical value set is run through the policy (its mask honoured), after the world's
+constraints (:func:`xairl.counterfactual_facts.broken`): the values are verified when the policy then decides
+otherwise; the consequent, read only as 'would have chosen/taken/picked/selected (to) X', 'would have handed over
+to X' or 'would choose/take X', must be the action it takes there (negated, contradicted only when it is); the
+stated margin is that action's lead; a direction word points from the state's value to the hypothetical one. Any
+other 'would' leaves the sentence unchecked, never verified. Without the policy or the state as its input nothing
+is checked; a sentence that nothing would have changed the decision states a search's miss: unchecked.
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ NUMERIC = {
     "n_states",
     "index",
 }
-#: the kind of claim a tracked span makes (a checked kind, :data:`xairl.verification.prose.checks.CHECKED`, or a name)
+#: the kind of claim a tracked span makes (a checked kind, :data:`xairl.verification.result.CHECKED`, or a name)
 KINDS = {
     "action": "action",
     "level": "magnitude",

@@ -82,23 +82,8 @@ class FactBook:
         score = self.scores[self.chosen]
         return bool(_PROBABILITY.search(self.chosen or "")) and 0 <= self.base <= 100 and 1 < score <= 100
 
-    @property
-    def log_odds(self) -> bool:
-        """One output in log-odds ('log-odds of default'): a text may give it, and its baseline, as the probability
-        it stands for ('-0.27, roughly 43 %')."""
-        return self.output != "actions" and bool(_LOG_ODDS.search(self.chosen or ""))
-
-    @property
-    def outcome_sign(self) -> int:
-        """Where one output went from the baseline: +1 up, -1 down, 0 unknown or several actions ('the primary
-        reasons for the model's prediction' are the features that moved it that way)."""
-        if self.output == "actions" or self.base is None or self.chosen not in self.scores:
-            return 0
-        return int(np.sign(self.scores[self.chosen] - self.base))
-
 
 _PROBABILITY = re.compile(r"\b(?:probab\w*|chances?|risk|likelihood|share|percent\w*)\b|%", re.IGNORECASE)
-_LOG_ODDS = re.compile(r"\blog[- ]?odds\b|\blogits?\b", re.IGNORECASE)
 _LEGEND_ENTRY = re.compile(r"^\s*(\d+)\s*[:=]?\s+(\S.*?)\s*$")
 
 

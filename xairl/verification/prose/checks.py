@@ -3,35 +3,13 @@ a direction said of names."""
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 
 from xairl.verification.prose.book import FactBook
 from xairl.verification.prose.names import Mention
 from xairl.verification.result import Claim
 
-CHECKED = {"number", "direction", "rank", "action", "category", "magnitude"}
 EITHER = "either"  # a sentence's view when its words weigh two options without naming the view (margin or score)
-
-_POS = (
-    r"rais\w*|increas\w*|boost\w*|lift\w*|add(?:s|ed|ing)?|supports?|supported|supporting|favou?r(?:s|ed|ing)?|"
-    r"in favou?r of|toward|towards|push(?:es|ed|ing)? (?:\w+ ){0,2}up|pull(?:s|ed|ing)? (?:\w+ ){0,2}up|"
-    r"nudg\w* (?:\w+ )?up|drives?|driven by|driving|tipped|tips|argu\w* for|counted for|counts for|"
-    r"positive(?:ly)?|more likely|up by|help(?:s|ed|ing)?|more high|less low"
-)
-_NEG = (
-    r"lower\w*|decreas\w*|reduc\w*|cut(?:s|ting)?|drag\w*|pull(?:s|ed|ing)? (?:\w+ ){0,2}down|"
-    r"push(?:es|ed|ing)? (?:\w+ ){0,2}down|nudg\w* (?:\w+ )?down|subtract\w*|"
-    r"tak(?:es|ing|e) (?:[\w.,$€£]+ ){0,4}(?:off|away)|"
-    r"took (?:[\w.,$€£]+ ){0,4}(?:off|away)|cost(?:s|ing)?|knock\w*|against|away from|oppos(?:e|es|ed|ing)|"
-    r"negative(?:ly)?|"
-    r"less likely|more low|less high|"
-    r"less attractive|weigh\w* against|argu\w* against|drops?|down by|works? against|worked against|loses?|"
-    r"los(?:t|ing)|diminish\w*|penali[sz]\w*|hurt(?:s|ing)?|h[eo]ld(?:s|ing)? (?:\w+ ){0,2}back(?: from)?|"
-    r"discourag\w*"
-)
-DIRECTION_RE = re.compile(rf"\b(?:(?P<pos>{_POS})|(?P<neg>{_NEG}))\b", re.IGNORECASE)
 
 
 def over_keys(keys: tuple[str, ...], test, what: str, text: str, kind: str) -> Claim:

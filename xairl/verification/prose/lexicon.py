@@ -30,7 +30,7 @@ def forms(word: str) -> set[str]:
 
 
 #: the lexicon's sections that are not the reader's (provenance's words, the claim words of templates)
-OTHER_SECTIONS = ("own", "claims")
+OTHER_SECTIONS = ("names", "own", "claims")
 
 
 @functools.cache

@@ -41,11 +41,6 @@ _ASSIGNED = re.compile(
 )
 
 
-def named_features(mentions: list[Mention]) -> list[Mention]:
-    """The mentions a claim can be about: features and categorical values (not actions)."""
-    return [m for m in mentions if m.kind in ("feature", "label")]
-
-
 def find_mentions(text: str, vocab: Vocabulary) -> tuple[list[Mention], str]:
     """Mentions in ``text`` (longest surface first, no overlaps) and the text with them masked by NUL characters,
     so that digits inside names ('rsrp_1', 'candidate 2') are not read as numbers."""
