@@ -194,13 +194,15 @@ def test_fill_a_try_that_fails_verification_is_rejected_and_the_next_one_shown(t
     policy, exp = toy
     ctx, variants = _rendered(exp, 0, policy)
     good = first_phrasings(variants)
-    s = good.spans[0]
-    assert s.fact.quantity == "action" and s.fact.role == "chosen"
+    k = next(k for k, x in enumerate(good.spans) if x.fact.quantity == "action")
+    s = good.spans[k]
+    assert s.fact.role == "chosen"
     other = ctx["runner_up"]
     bad = Rendered(
         good[: s.start] + other + good[s.end :],
-        (dataclasses.replace(s, end=s.start + len(other), text=other),)
-        + tuple(x.shifted(len(other) - len(s.text)) for x in good.spans[1:]),
+        good.spans[:k]
+        + (dataclasses.replace(s, end=s.start + len(other), text=other),)
+        + tuple(x.shifted(len(other) - len(s.text)) for x in good.spans[k + 1 :]),
     )
     tries = iter([bad, None, good])
     monkeypatch.setattr(fill, "fill", lambda *a: next(tries))

@@ -14,6 +14,7 @@ contribution is (numerically) zero pushed neither way and is not listed.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 
 import numpy as np
@@ -35,6 +36,8 @@ def features_named(claims: Iterable[Claim], spans: Iterable = ()) -> set[str]:
             out.add(fact.feature)
         if c.kind == "feature" and c.detail:
             out |= {c.detail, *c.detail.split(" / ")}
+        elif c.rule == "name.unread" and (m := re.search(r"\(([^)]*)\)", c.detail)):  # (named, nothing read of it)
+            out |= set(m.group(1).split(" / "))
     return out
 
 

@@ -19,6 +19,8 @@ _WORDS = ("sign_up", "sign_down", "noun_up", "noun_down", "top", "more", "less",
 #: a snake_case identifier ('battery_temperature'): a name in any text, so one the vocabulary lacks names nothing
 _IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9]*_[A-Za-z0-9_]*[A-Za-z0-9]")
 _UNKNOWN = "identifier.unknown"
+#: the rule of a name no claim bound (its detail says the keys it names, in brackets, for the margin account)
+UNREAD = "name.unread"
 _AFTER_TIMES = frozenset(
     {
         "as",
@@ -106,7 +108,8 @@ def unbound(s, read: set[int], book) -> list[Claim]:
             continue
         if t.ent_type_ in ("FEATURE", "LABEL") or (t.ent_type_ == "ACTION" and actions):
             # (kind 'name': a mention no rule read; own narratives judge their literal names themselves)
-            out.append(Claim("name", t.text, "unchecked", "named, but nothing said of it was read", "name.unread"))
+            keys = " / ".join(t._.keys) or t.text
+            out.append(Claim("name", t.text, "unchecked", f"named ({keys}), but nothing said of it was read", UNREAD))
         elif not t.ent_type_ and _IDENTIFIER.fullmatch(t.text):  # 'battery_temperature 41' of no such input
             out.append(Claim("name", t.text, "unchecked", "an identifier no input of the explanation has", _UNKNOWN))
         elif not t.ent_type_ and _claim_word(t):
