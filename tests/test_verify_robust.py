@@ -116,14 +116,14 @@ def _no_failure(result) -> None:
 
 
 @pytest.mark.slow
-@settings(max_examples=2600, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
+@settings(max_examples=1300, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 @given(text=st.text(max_size=300), index=st.integers(0, len(POOL) - 1))
 def test_any_unicode_text(text, index):
     _no_failure(verify(text, POOL[index], 0))
 
 
 @pytest.mark.slow
-@settings(max_examples=2340, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
+@settings(max_examples=1170, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 @given(parts=st.lists(st.sampled_from(FRAGMENTS), max_size=30), index=st.integers(0, len(POOL) - 1))
 def test_sentences_of_names_numbers_and_hostile_fragments(parts, index):
     _no_failure(verify(" ".join(parts), POOL[index], 0))
