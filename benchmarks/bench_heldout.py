@@ -37,7 +37,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-from tests.narrative_corpus import HELDOUT, load  # noqa: E402
+from tests.narrative_corpus import HELDOUT, load, share  # noqa: E402
 from xairl.verification.prose import parse  # noqa: E402
 from xairl.verification.prose import read as reader  # noqa: E402
 
@@ -56,10 +56,6 @@ def figures(items: list[dict], title: str) -> None:
     good = [it for it in items if it["accurate"]]
     corrupted = [it for it in items if it["wrong_facts"]]
     labelled = [it for it in items if not it["accurate"] and not it["wrong_facts"]]
-
-    def share(part, status):
-        n = sum(it["result"].status == status for it in part)
-        return f"{n}/{len(part)} = {100 * n / max(1, len(part)):.1f} %"
 
     print(
         f"\n# {title}: accurate texts contradicted {share(good, 'contradicted')}, verified {share(good, 'verified')}; "

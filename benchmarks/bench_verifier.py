@@ -55,6 +55,7 @@ from tests.narrative_corpus import (  # noqa: E402
     run,
     shapstories_case,
     shapstories_cases,
+    share,
 )
 
 
@@ -108,10 +109,6 @@ def figures(items: list[dict], title: str) -> None:
     (target <= 5 %), coverage on the accurate texts (target >= 60 %)."""
     good = [it for it in items if it["accurate"]]
     bad = [it for it in items if not it["accurate"]]
-
-    def share(part, status):
-        n = sum(it["result"].status == status for it in part)
-        return f"{n}/{len(part)} = {100 * n / max(1, len(part)):.1f} %"
 
     print(
         f"\n# {title}: accurate texts contradicted {share(good, 'contradicted')}, verified {share(good, 'verified')}; "

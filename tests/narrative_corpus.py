@@ -210,3 +210,9 @@ def load(path: pathlib.Path) -> list[dict]:
 
 def _name(path: pathlib.Path) -> str:
     return f"{'tuning' if path.parent.name == 'tuning' else 'held out'}: {path.stem}"
+
+
+def share(items: list[dict], status: str) -> str:
+    """How many of the verified ``items`` have ``status``, as 'n/N = x %' (the benchmarks' figures of issue 65)."""
+    n = sum(it["result"].status == status for it in items)
+    return f"{n}/{len(items)} = {100 * n / max(1, len(items)):.1f} %"
