@@ -167,8 +167,8 @@ def _names(truth: Truth, policy: Policy | None) -> tuple[str, ...]:
         for f in views.values():
             label = getattr(f, "label", None) or (f.get("label") if isinstance(f, dict) else None)
             out += [label] if label else []
-    if policy is not None:
-        out += list(policy.action_names or ()) + list(policy.feature_names or ())
+    if policy is not None:  # (its features are those of the facts: an image's regions, not its 12,288 pixels)
+        out += list(policy.action_names or ())
     return tuple(dict.fromkeys(str(n) for n in out))
 
 
