@@ -36,20 +36,11 @@ from pathlib import Path
 
 import numpy as np
 import torch
-import yaml
 
 import xairl
 from xairl.errors import XairlError
 from xairl.templates import prompts as xprompts
 from xairl.toy import toy_background, toy_policy
-
-HERE = Path(__file__).resolve().parent
-DATA = HERE / "data" / "templates"
-KINDS = ("flat", "dict", "image", "continuous", "value", "uav")
-OUTPUT_OF = {"flat": "actions", "dict": "actions", "image": "actions", "uav": "actions"} | {
-    "continuous": "continuous",
-    "value": "value",
-}
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from benchmarks.template_mutations import mutants, write_spec  # noqa: E402
@@ -60,6 +51,7 @@ from benchmarks.template_report import (  # noqa: E402
     summarise_mutations,
     summarise_set,
 )
+from benchmarks.template_sets import KINDS, builtin_templates, set_templates  # noqa: E402
 
 # ---------------------------------------------------------------------------------------------------------------
 # The six policy kinds (small seeded torch nets; nothing imported from tests/)
@@ -199,67 +191,6 @@ def run_jobs(jobs, workers):
     with ctx.Pool(workers) as pool:
         for key, kind, index, res in pool.imap_unordered(render, jobs, chunksize=8):
             out[(key, kind, index)] = res
-    return out
-
-
-# ---------------------------------------------------------------------------------------------------------------
-# Templates
-
-
-def read_template(path: Path) -> dict:
-    return yaml.safe_load(path.read_text())
-
-
-def template_kinds(spec: dict, kinds) -> list[str]:
-    outs = spec.get("outputs") or ["actions", "continuous", "value"]
-    return [k for k in kinds if OUTPUT_OF[k] in outs]
-
-
-def builtin_templates(kinds) -> list[dict]:
-    """The built-ins (prompts/*.yaml) and the UAV plugin's handover (on the UAV kind only)."""
-    found = []
-    for path in sorted(xprompts.builtin_dir().glob("*.yaml")):
-        spec = read_template(path)
-        found.append({"name": spec["name"], "path": path, "spec": spec, "kinds": template_kinds(spec, kinds)})
-    from xairl.registry.plugins import prompt_dirs
-
-    for _, folder in prompt_dirs():
-        for path in sorted(Path(folder).glob("*.yaml")):
-            spec = read_template(path)
-            if spec["name"] == "handover":
-                found.append(
-                    {"name": "handover", "path": path, "spec": spec, "kinds": [k for k in kinds if k == "uav"]}
-                )
-    return found
-
-
-def flagged(path: Path) -> list[str]:
-    """What `xairl prompts check` says of the template's literal claim words (file:line, word, filter to use)."""
-    from xairl.narrators.battery import undeclared
-
-    return undeclared(xprompts.load(path))
-
-
-def set_templates(name: str, kinds) -> list[dict]:
-    folder = DATA / name
-    manifest = yaml.safe_load((folder / "MANIFEST.yaml").read_text())
-    out = []
-    for t in manifest["templates"]:
-        path = folder / t["file"]
-        spec = read_template(path)
-        twin = DATA / "twins" / name / t["file"]
-        out.append(
-            {
-                "name": spec["name"],
-                "path": path,
-                "spec": spec,
-                "flagged": flagged(path),
-                "correct": bool(t["correct"]),
-                "kinds": template_kinds(spec, kinds),
-                "twin": twin if not t["correct"] else None,
-                "error": t.get("error"),
-            }
-        )
     return out
 
 

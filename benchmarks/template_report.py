@@ -80,11 +80,24 @@ def summarise_set(set_name, templates, results, twins, n, kinds):
             rows.append(row)
             if not t["correct"]:
                 twin_rows.append(trow)
+    summary = _set_summary(rows, twin_rows, templates)
+    return {
+        "rows": rows,
+        "twins": twin_rows,
+        "summary": summary,
+        "false_rejections": false_rejections,
+        "misses": misses,
+    }
+
+
+def _set_summary(rows: list[dict], twin_rows: list[dict], templates: list[dict]) -> dict:
+    """A set's totals: issue 65's figures (correct renderings contradicted, wrong ones verified, correct templates
+    neither verified nor flagged by prompts check), then verified, caught and the twins'."""
     correct = [r for r in rows if r["correct"]]
     wrong = [r for r in rows if not r["correct"]]
     flagged = {t["name"] for t in templates if t.get("flagged")}
     failing = sorted({r["template"] for r in correct if r["verified"] < r["rendered"]})
-    summary = {
+    return {
         "correct_contradicted": sum(r["contradicted"] for r in correct),
         "wrong_verified": sum(r["verified"] for r in wrong),
         # issue 65: every correct template verifies every rendering, or `xairl prompts check` flags it
@@ -101,13 +114,6 @@ def summarise_set(set_name, templates, results, twins, n, kinds):
         "failing_correct_templates": failing,
         "templates_with_missed_wrong": sorted({r["template"] for r in wrong if r["caught"] < r["wrong"]}),
         "twins_not_verified": sorted({r["template"] for r in twin_rows if r["verified"] < r["rendered"]}),
-    }
-    return {
-        "rows": rows,
-        "twins": twin_rows,
-        "summary": summary,
-        "false_rejections": false_rejections,
-        "misses": misses,
     }
 
 

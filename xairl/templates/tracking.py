@@ -34,14 +34,8 @@ class Fact:
         'direction', 'action', 'score', 'margin', 'base_value', 'base_margin', 'gap', 'comparison' (a domain fact's
         text; 'comparison_value' its number), 'extra' (a plugin's named value), 'mean_abs', 'mean' (a global
         summary's), 'n_states', 'method', 'index', 'unit', 'kind', 'target'; a counterfactual's 'cf_<field>'
-        (:func:`track_counterfactual`). A *claim word* printed by a claim filter (:mod:`xairl.templates.claim_filters`)
-        is the author's word, and its fact has ``of`` set: 'direction' (``dir``: value 'toward' or 'against', the sign
-        of the quantity ``of`` of the feature, view and role; 'direction_high' / 'direction_low' keep theirs), 'level'
-        (``level``: value 'low', 'typical', 'high' or 'unknown'), 'rank' (``rank``: value the rank; 'rank_same_way' of
-        ``f.rank_same_way|rank(...)``, the rank among the pushes of the feature's sign), 'comparison'
-        (``cmp``: value 'more', 'less' or 'same', the feature's |contribution| against that of the feature named in
-        ``role``; a domain comparison's fact has ``of`` None), 'role' (``role``: value the action's name, ``role``
-        'chosen', 'runner_up', 'only' or 'counterfactual').
+        (:func:`track_counterfactual`); a claim word's 'direction', 'level', 'rank', 'rank_same_way', 'comparison' or
+        'role', with ``of`` set (each filter of :mod:`xairl.templates.claim_filters` says its fact's shape).
     :param feature: the feature (or group) it is about; for 'extra' the key; else None.
     :param view: 'score' (the chosen action's score, or the output), 'margin' (over the runner-up) or None.
     :param role: for an action and its score: 'chosen' or 'runner_up'; for a claim word, see ``quantity``.

@@ -144,30 +144,8 @@ def check_fact(span: Span, truth: Truth, after: str = "") -> Claim:
 
 def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
     f = span.fact
-    if getattr(f, "of", None) is not None:  # a declared claim word: its fact says which way, never the word
-        if f.quantity == "direction" and f.of not in PUSHES:
-            return Claim(
-                "direction",
-                span.text,
-                "unchecked",
-                f"a direction word read from the sign of {f.of.replace('_', ' ')}, which pushes nothing: dir reads a "
-                "contribution (f.contribution, q_margin, f.change)",
-                "tracked.fact",
-            )
-        if getattr(f, "alike", False):
-            return Claim(
-                f.quantity,
-                span.text,
-                "unchecked",
-                "its filter prints this word whatever the fact: it declares nothing (give it one word for each case)",
-                "tracked.fact",
-            )
-        want = _claimed(f, truth)
-        ok = want is not MISSING and want is not None and str(f.value) == str(want)
-        detail = f"{f.quantity} of {f.feature or f.value} = {want if want is not MISSING else 'unknown'}"
-        return Claim(
-            KINDS.get(f.quantity, f.quantity), span.text, "verified" if ok else "contradicted", detail, "tracked.fact"
-        )
+    if f.of is not None:  # a declared claim word: its fact says which way, never the word
+        return _check_claim(span, truth)
     expected = truth.get(span)
     kind = KINDS.get(f.quantity, "number" if f.quantity in NUMERIC else "feature")
     if f.quantity == "value_text":
@@ -221,6 +199,36 @@ def _check_fact(span: Span, truth: Truth, percent: bool = False) -> Claim:
 #: value of its fact ('|replace' keeps the fact) is wrong
 CANONICAL_OF = frozenset({"direction", "direction_high", "direction_low", "level", "trend"})
 CANONICAL = frozenset({"toward", "against", "mixed", "low", "typical", "high", "moderate", "rose", "fell", "steady"})
+
+
+def _check_claim(span: Span, truth: Truth) -> Claim:
+    """A claim word a claim filter printed (:mod:`xairl.templates.claim_filters`), by its fact: the word is the
+    author's, so nothing reads it; a direction read from a non-push, or the same word for every case, declares
+    nothing."""
+    f = span.fact
+    if f.quantity == "direction" and f.of not in PUSHES:
+        return Claim(
+            "direction",
+            span.text,
+            "unchecked",
+            f"a direction word read from the sign of {f.of.replace('_', ' ')}, which pushes nothing: dir reads a "
+            "contribution (f.contribution, q_margin, f.change)",
+            "tracked.fact",
+        )
+    if f.alike:
+        return Claim(
+            f.quantity,
+            span.text,
+            "unchecked",
+            "its filter prints this word whatever the fact: it declares nothing (give it one word for each case)",
+            "tracked.fact",
+        )
+    want = _claimed(f, truth)
+    ok = want is not MISSING and want is not None and str(f.value) == str(want)
+    detail = f"{f.quantity} of {f.feature or f.value} = {want if want is not MISSING else 'unknown'}"
+    return Claim(
+        KINDS.get(f.quantity, f.quantity), span.text, "verified" if ok else "contradicted", detail, "tracked.fact"
+    )
 
 
 #: the quantities whose sign a direction word may say: pushes on a score or the margin, and a signal's change
