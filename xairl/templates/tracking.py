@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 #: start of a marker, its id (hex digits as private-use characters), end of the id, end of the span
 _OPEN, _MID, _CLOSE, _DIGIT = "\ue000", "\ue001", "\ue002", 0xE010
 _MARK = re.compile(f"{_OPEN}([\ue010-\ue01f]+){_MID}([^{_OPEN}{_MID}{_CLOSE}]*){_CLOSE}")
-_STRAY = re.compile(f"[{_OPEN}{_MID}{_CLOSE}\ue010-\ue01f]")
+_STRAY = re.compile(f"[{_OPEN}-\ue004\ue010-\ue01f]")  # (a choice point's too: xairl.templates.choices)
 _RECORD: contextvars.ContextVar[list | None] = contextvars.ContextVar("xairl_tracking", default=None)
 
 
@@ -261,6 +261,9 @@ class Rendered(str):
     """A rendered phrasing: its clean text, with the :class:`Span` of every tracked value it printed."""
 
     spans: tuple[Span, ...]
+    #: the rendering with its choice points (:class:`xairl.templates.choices.Draft`) when its template offers
+    #: wordings; this text is its first wordings
+    draft = None
 
     def __new__(cls, text: str, spans: tuple[Span, ...] = ()):
         obj = super().__new__(cls, text)
