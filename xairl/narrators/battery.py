@@ -13,6 +13,7 @@ sentence and the claim."""
 from __future__ import annotations
 
 import itertools
+import re
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
@@ -103,6 +104,7 @@ def run(tpl: Template) -> Report:
     report.problems += undeclared(tpl, names(report.cases))
     failed: dict[str, list[tuple[str, bool]]] = {}  # one line per error: its cases, and whether each lacked extras
     extras = _uses_extras(tpl)
+    bad: dict[tuple[str, str], str] = {}
     for case in report.cases:
         context, domain = _facts(case)
         try:
@@ -110,9 +112,18 @@ def run(tpl: Template) -> Report:
         except TemplateError as exc:
             failed.setdefault(str(exc), []).append((case.label, extras and not context.get("extras")))
             continue
-        for v in range(max(map(len, variants), default=0)):
-            report.renderings += 1
-            report.problems += _contradictions(tpl, case, variants, domain, v)
+        # every variant, and within each every wording a pick() offers (the c-th of each choice point, or its last)
+        for c in range(max((r.draft.wordings for vs in variants for r in vs if r.draft), default=1)):
+            worded = [[r.draft.render(c) if r.draft else r for r in vs] for vs in variants]
+            for s, vs in enumerate(worded):
+                for v, r in enumerate(vs):
+                    if r and (why := malformed(r)):  # (once per line and fault)
+                        where = f"{tpl.path}:{tpl.lines[s][v]}"
+                        bad.setdefault((where, why), f"{where}: malformed on {case.label}: {why}: {str(r)!r}")
+            for v in range(max(map(len, variants), default=0)):
+                report.renderings += 1
+                report.problems += _contradictions(tpl, case, worded, domain, v)
+    report.problems = list(dict.fromkeys(report.problems)) + list(bad.values())  # (a line found twice, once)
     for message, labels in failed.items():
         more = f" and {len(labels) - 1} more case(s)" if len(labels) > 1 else ""
         line = f"{message.rstrip('.')} (on {labels[0][0]}{more})"
@@ -122,6 +133,28 @@ def run(tpl: Template) -> Report:
             report.problems.append(line)
     report.seconds = time.perf_counter() - t0
     return report
+
+
+#: text a rendering should never hold: a space doubled or before punctuation, punctuation doubled or not followed
+#: by a space, empty brackets, a word written twice
+_FORM = (
+    (re.compile(r"(?<=\S) {2,}(?=\S)"), "a double space"),
+    (re.compile(r" [,.;:!?)]"), "a space before punctuation"),
+    (re.compile(r"[,;:](?=[^\W\d])"), "no space after punctuation"),
+    (re.compile(r"[,;:]\s*[,;:.]|(?<!\.)\.\s*[,;:.](?!\.)"), "punctuation doubled"),
+    (re.compile(r"\(\s*\)"), "empty brackets"),
+    (re.compile(r"\b(\w+) \1\b", re.IGNORECASE), "a word written twice"),
+)
+
+
+def malformed(text) -> str | None:
+    """What is wrong with the form of a rendered sentence, or None: a tracked value glued to a letter or digit on
+    either side (a lost space: 'overhand_over'), or a pattern of :data:`_FORM`."""
+    for span in getattr(text, "spans", ()):
+        before, after = text[span.start - 1 : span.start], text[span.end : span.end + 1]
+        if (before.isalnum() and span.text[:1].isalnum()) or (after.isalnum() and span.text[-1:].isalnum()):
+            return f"{span.text!r} is glued to the words beside it"
+    return next((why for pattern, why in _FORM if pattern.search(str(text))), None)
 
 
 def names(cases: Iterable[Case]) -> list[str]:

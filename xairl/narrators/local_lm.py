@@ -178,11 +178,12 @@ class LocalLMNarrator(Narrator):
         super().__init__(options)
         self.model, self.tok = load_model(self.options.model)
 
-    def prompt(self) -> list[int]:
-        """The token ids the narrative follows: the system words with the audience, the operators' examples, and
-        the request, in the model's chat format."""
+    def prompt(self, audience: str | None = "asked") -> list[int]:
+        """The token ids the narrative follows: the system words with the audience (the one asked for, or another),
+        the operators' examples, and the request, in the model's chat format."""
         o = self.options
-        msgs = [{"role": "system", "content": f"{SYSTEM} {AUDIENCES[o.audience]}"}]
+        audience = o.audience if audience == "asked" else audience
+        msgs = [{"role": "system", "content": f"{SYSTEM} {AUDIENCES[audience]}"}]
         for ex in o.examples[-3:]:
             msgs += [{"role": "user", "content": ASK["medium"]}, {"role": "assistant", "content": ex}]
         msgs.append({"role": "user", "content": ASK[o.length]})
@@ -198,5 +199,6 @@ class LocalLMNarrator(Narrator):
             prompt = self.prompt()
             key = (id(self.model), tuple(prompt), self.options.length)
             if key not in _CHOOSERS:
-                _CHOOSERS[key] = Chooser(self.model, self.tok, prompt, self.options.length)
+                plain = None if self.options.audience is None else self.prompt(None)
+                _CHOOSERS[key] = Chooser(self.model, self.tok, prompt, self.options.length, plain)
             return _CHOOSERS[key].choose(variants)

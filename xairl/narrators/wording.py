@@ -26,6 +26,15 @@ from dataclasses import dataclass
 
 from xairl.templates.tracking import Rendered
 
+#: the tokens of the fixed words after a wording that its score reads (how the wording joins them); the rest are
+#: scored with the next choice
+LOOKAHEAD = 8
+#: the tokens of a sentence's variant that its score reads (where the phrasings differ most: their start)
+OPENING = 16
+#: fixed words longer than this go into the cache on their own before a choice (once, not once per wording)
+SHARED = 12
+#: the weight of a wording's fit to the reader the prompt names (:meth:`Chooser.fit`) in its score
+FIT = 1.0
 #: the score added per token of a wording (its mean token log-probability is the score): against or for length
 LENGTH_BONUS = {"short": -0.25, "medium": 0.0, "long": 0.25}
 
@@ -47,16 +56,38 @@ class Chooser:
     """Chooses a template's wordings with a causal language model after a prompt (one per process, model, prompt
     and length; :func:`chooser`)."""
 
-    def __init__(self, model, tok, prompt: list[int], length: str = "medium"):
-        import torch
-
+    def __init__(self, model, tok, prompt: list[int], length: str = "medium", plain: list[int] | None = None):
         self.model, self.tok, self.bonus = model, tok, LENGTH_BONUS[length]
         params = inspect.signature(model.forward).parameters
         self._cache_arg = "cache" if "cache" in params else "past_key_values"  # (transformers 5 renamed it)
         self._ids: dict[str, list[int]] = {}
+        self._prompt = self._start(prompt)
+        self._plain = None if plain is None else self._start(plain)
+        self._fit: dict[str, float] = {}
+
+    def _start(self, prompt: list[int]) -> _State:
+        import torch
+
         with torch.no_grad():
             out = self._forward(torch.tensor([prompt]), torch.ones(1, len(prompt), dtype=torch.long), None)
-        self._prompt = _State(self._cache_of(out), torch.log_softmax(out.logits[0, -1].float(), -1))
+        return _State(self._cache_of(out), torch.log_softmax(out.logits[0, -1].float(), -1))
+
+    def fit(self, wordings: list[str]) -> list[float]:
+        """How much likelier the model finds each wording for the prompt's reader than for none: the mean token
+        log-probability of the wording right after the prompt, less the same after the plain prompt (0 without an
+        audience). Cached per wording: a template's wordings recur on every decision."""
+        if self._plain is None:
+            return [0.0] * len(wordings)
+        new = [w for w in dict.fromkeys(wordings) if w not in self._fit]
+        if new:
+            rows = [self.ids(w.strip()) or [self.tok.eos_token_id] for w in new]
+            asked, plain = (
+                self._score(_State(copy.deepcopy(s.cache), s.last), rows, 0)[0] for s in (self._prompt, self._plain)
+            )
+            if len(self._fit) > 4096:  # (openings carry a decision's names: bounded)
+                self._fit.clear()
+            self._fit.update({w: a - b for w, a, b in zip(new, asked, plain)})
+        return [self._fit[w] for w in wordings]
 
     def _forward(self, ids, mask, cache):
         from transformers import DynamicCache
@@ -103,11 +134,12 @@ class Chooser:
                 for words, after in zip(points, fixed[1:]):
                     path = path + self.ids(words[0]) + self.ids(after)
                 paths.append(path)
-            best, kept = self._pick(state, [pending + p for p in paths], len(pending))
+            fit = self.fit([_pieces(o)[0][0].strip() for o in options])
+            best, kept = self._pick(state, [pending + p[:OPENING] for p in paths], len(pending), fit)
             v = options[best]
-            kept_len = len(pending) + len(self.ids(sep + _pieces(v)[0][0]))
-            self._keep(state, best, kept_len, kept)
-            pending, chose = [], True
+            opening = self.ids(sep + _pieces(v)[0][0])
+            self._keep(state, best, len(pending) + min(len(opening), OPENING), kept)
+            pending, chose = opening[OPENING:], True
         else:
             v = options[0]
             pending = pending + self.ids(sep + _pieces(v)[0][0])
@@ -118,16 +150,38 @@ class Chooser:
                 choices.append(0)
                 pending = pending + self.ids(words[0]) + self.ids(after)
                 continue
-            rows = [pending + self.ids(w) + self.ids(after) for w in words]
-            best, kept = self._pick(state, rows, len(pending))
+            rows = [pending + self.ids(w) + self.ids(after)[:LOOKAHEAD] for w in words]
+            best, kept = self._pick(state, rows, len(pending), self.fit(list(words)))
             self._keep(state, best, len(rows[best]), kept)
             choices.append(best)
-            pending, chose = [], True
+            pending, chose = self.ids(after)[LOOKAHEAD:], True
         return (v.draft.render(choices) if v.draft is not None else v), pending, chose
 
-    def _pick(self, state: _State, rows: list[list[int]], skip: int):
-        """(the row whose tokens after the first ``skip`` have the highest mean log-probability plus the length
-        bonus, the batched forward pass's (cache, log-probabilities)); rows share ``state`` as their prefix."""
+    def _pick(self, state: _State, rows: list[list[int]], skip: int, fit: list[float]):
+        """(the best row, what :meth:`_keep` takes): the row whose tokens after the first ``skip`` the model finds
+        most probable on average, plus the length bonus per token and :data:`FIT` times its fit to the reader. Long
+        fixed words before the choice are put in the cache once, not once per row."""
+        shared = skip if skip > SHARED else 0
+        if shared:
+            self._extend(state, rows[0][:shared])
+        means, kept = self._score(state, [r[shared:] for r in rows], skip - shared)
+        scores = [m + self.bonus * (len(r) - skip) + FIT * f for m, r, f in zip(means, rows, fit)]
+        return max(range(len(rows)), key=scores.__getitem__), (*kept, shared)
+
+    def _extend(self, state: _State, tokens: list[int]) -> None:
+        """``state`` after ``tokens``."""
+        import torch
+
+        past = state.cache.get_seq_length()
+        with torch.no_grad():
+            out = self._forward(
+                torch.tensor([tokens]), torch.ones(1, past + len(tokens), dtype=torch.long), state.cache
+            )
+        state.cache, state.last = self._cache_of(out), torch.log_softmax(out.logits[0, -1].float(), -1)
+
+    def _score(self, state: _State, rows: list[list[int]], skip: int):
+        """(each row's mean log-probability of its tokens after the first ``skip``, the batched forward pass's
+        (cache, log-probabilities)); the rows follow ``state``, whose cache the pass takes."""
         import torch
 
         if any(len(r) == skip for r in rows):  # an empty wording at the very end: judged by the end of the text
@@ -147,13 +201,14 @@ class Chooser:
         for i, r in enumerate(rows):
             before = torch.cat([state.last[None], logp[i, : len(r) - 1]])  # the distribution each token is drawn from
             lp = before[torch.arange(skip, len(r)), torch.tensor(r[skip:], dtype=torch.long)]
-            scores.append(float(lp.mean()) + self.bonus * (len(r) - skip))
-        return max(range(len(rows)), key=scores.__getitem__), (self._cache_of(out), logp)
+            scores.append(float(lp.mean()))
+        return scores, (self._cache_of(out), logp)
 
     @staticmethod
     def _keep(state: _State, row: int, length: int, kept) -> None:
         """The state after ``row``'s first ``length`` tokens of the batched pass ``kept``."""
-        cache, logp = kept
+        cache, logp, shared = kept
+        length -= shared
         base = cache.get_seq_length() - logp.shape[1]
         cache.batch_select_indices([row])
         if cache.get_seq_length() > base + length:  # (a negative count removes from the end, in transformers 4 and 5)

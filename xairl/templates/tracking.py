@@ -261,9 +261,7 @@ class Rendered(str):
     """A rendered phrasing: its clean text, with the :class:`Span` of every tracked value it printed."""
 
     spans: tuple[Span, ...]
-    #: the rendering with its choice points (:class:`xairl.templates.choices.Draft`) when its template offers
-    #: wordings; this text is its first wordings
-    draft = None
+    draft = None  #: its choice points (xairl.templates.choices.Draft) when the template offers wordings
 
     def __new__(cls, text: str, spans: tuple[Span, ...] = ()):
         obj = super().__new__(cls, text)
