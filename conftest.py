@@ -1,6 +1,7 @@
 """Fixtures for every test folder (core and plugins)."""
 
 import os
+from pathlib import Path
 
 import pytest
 
@@ -26,8 +27,10 @@ def fresh_plugins():
 
 @pytest.fixture(autouse=True, scope="session")
 def model_cache(tmp_path_factory):
-    """One converted copy of the local language model per test session (the conversion takes ~15 s)."""
-    path = tmp_path_factory.mktemp("models")
+    """One converted copy of the local language model per test session (the conversion takes ~15 s), or the one
+    `make test`'s set-up made ($XAIRL_TEST_MODEL_CACHE)."""
+    given = os.environ.get("XAIRL_TEST_MODEL_CACHE")
+    path = Path(given) if given else tmp_path_factory.mktemp("models")
     old = os.environ.get("XAIRL_MODEL_CACHE")
     os.environ["XAIRL_MODEL_CACHE"] = str(path)
     yield path

@@ -120,10 +120,10 @@ def test_version_and_examples(capsys):
         # -n is --narrator-option: `-n 3` once explained the default 5 states, and with --narrate named -o
         (
             ["explain", "-n", "3"],
-            "-n/--narrator-option: '3' is not key=value; write e.g. -n mode=rewrite; to explain 3",
+            "-n/--narrator-option: '3' is not key=value; write e.g. -n audience=operator; to explain 3",
         ),
         (["explain", "-n", "3", "--narrate"], "to explain 3 states, write --n 3"),
-        (["explain", "--narrate", "-n", "rewrite"], "'rewrite' is not key=value; write e.g. -n mode=rewrite;"),
+        (["explain", "--narrate", "-n", "operator"], "'operator' is not key=value; write e.g. -n audience=operator;"),
     ],
 )
 def test_user_errors_are_one_line_exit_2(capsys, argv, match):

@@ -158,10 +158,10 @@ def narration_arguments(p: argparse.ArgumentParser) -> None:
         "-n",
         "--narrator-option",
         action="append",
-        type=key_value("-n", "mode=rewrite"),
+        type=key_value("-n", "audience=operator"),
         default=[],
         metavar="KEY=VALUE",
-        help="a narrator option, e.g. -n mode=rewrite or -n model=PATH",
+        help="a narrator option, e.g. -n audience=operator (local_lm) or -n model=PATH",
     )
     p.add_argument(
         "--no-robustness",

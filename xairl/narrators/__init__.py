@@ -25,7 +25,7 @@ def narrate(
     """Words for decision ``index`` (``None``: a global summary over all states), checked against the numbers.
 
     :param narrator: a registered narrator ('template', 'local_lm', or a plugin's).
-    :param options: the narrator's options (e.g. ``{"mode": "rewrite"}`` for local_lm), validated.
+    :param options: the narrator's options (e.g. ``{"audience": "operator"}`` for local_lm), validated.
     :param store: a :class:`xairl.outputs.feedback.FeedbackStore` that records the shown narrative, with its evidence
         (the state, the margin's contributions, the sentences' statuses) for the review page.
     :param narration: how to narrate (:class:`NarrationOptions`); its fields may be given as keyword arguments

@@ -1,0 +1,121 @@
+"""local_lm (issue 66, "Done when"): the language model chooses the template's wordings. For the toy policy
+(``explain_action``) and the reference UAV policy (``uav-dqn``, ``handover``), on ``--states`` decisions each:
+
+- **first try, every sentence chosen**: the narrative's source is ``local_lm`` (not the template's fallback) and the
+  model chose the wording of every sentence (``extras["chosen"]``: sentences it chose, sentences offering a choice,
+  sentences); also the share where it chose every sentence that offers a choice;
+- **false**: narratives shown with a status other than verified (a choice the verifier did not pass);
+- **garbled**: narratives whose text has a form fault (:func:`xairl.narrators.battery.malformed`: a tracked value
+  glued to a word, a doubled space, a space before punctuation, ...);
+- **audiences**: the share of decisions worded differently for ``operator`` and ``researcher``, each verified;
+- **latency**: warm seconds a sentence on one thread (median, 90th percentile); **cold start**: a fresh process's
+  first narrative less its second (import of transformers, the model's load, the prompt's encoding), after the
+  model's cached copy exists.
+
+``--out`` writes every decision's texts for each audience beside the template's, for reading by hand.
+
+Run (about 3 minutes on 2 cores; nothing is downloaded):
+    HF_HUB_OFFLINE=1 .venv/bin/python benchmarks/bench_lm.py [--states 40] [--out /tmp/lm.md]
+"""
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+import xairl  # noqa: E402
+from xairl.narrators.battery import malformed  # noqa: E402
+from xairl.templates.tracking import Rendered  # noqa: E402
+
+POLICIES = (("toy", "explain_action"), ("uav-dqn", "handover"))
+AUDIENCES = (None, "operator", "researcher")
+
+COLD = """
+import time, xairl
+p = xairl.get_policy('toy')
+e = xairl.explain(p, p.background(2, seed=5), background=p.background(20))
+kw = dict(narrator='local_lm', policy=p, robustness=False, options={'threads': 1})
+t0 = time.perf_counter(); xairl.narrate(e, 0, **kw); t1 = time.perf_counter(); xairl.narrate(e, 1, **kw)
+print(t1 - t0 - (time.perf_counter() - t1))
+"""
+
+
+def run(name: str, template: str, states: int, pages: list[str]) -> dict:
+    policy = xairl.get_policy(name)
+    exp = xairl.explain(policy, policy.background(states, seed=7), background=policy.background(60))
+    kw = {"narrator": "local_lm", "policy": policy, "template": template, "robustness": False}
+    for audience in AUDIENCES:  # (each audience's prompt is encoded once, before the timed runs)
+        xairl.narrate(exp, 0, **kw, options={"threads": 1, "audience": audience})
+    every = offered = false = garbled = differ = 0
+    per_sentence = []
+    for i in range(states):
+        texts = {}
+        for audience in AUDIENCES:
+            t = time.perf_counter()
+            n = xairl.narrate(exp, i, **kw, options={"threads": 1, "audience": audience})
+            seconds = time.perf_counter() - t
+            chose, choosing, sentences = n.extras.get("chosen", (0, 0, 0))
+            false += n.status != "verified"
+            garbled += malformed(Rendered(n.text, n.provenance)) is not None
+            texts[audience] = n.text
+            if audience is None:
+                per_sentence.append(seconds / max(sentences, 1))
+                every += n.source == "local_lm" and chose == sentences
+                offered += n.source == "local_lm" and chose == choosing
+        differ += texts["operator"] != texts["researcher"]
+        plain = xairl.narrate(exp, i, policy=policy, template=template, robustness=False).text
+        pages.append(
+            f"### {name}, decision {i}\n\n**template:** {plain}\n\n"
+            + "\n\n".join(f"**{a or 'no audience'}:** {t}" for a, t in texts.items())
+            + "\n"
+        )
+    per_sentence.sort()
+    return {
+        "policy": name,
+        "states": states,
+        "every": every,
+        "offered": offered,
+        "false": false,
+        "garbled": garbled,
+        "differ": differ,
+        "median": statistics.median(per_sentence),
+        "p90": per_sentence[int(0.9 * (len(per_sentence) - 1))],
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--states", type=int, default=40)
+    ap.add_argument("--out", default=None, help="Markdown file with every text, for reading by hand")
+    args = ap.parse_args()
+    pages: list[str] = []
+    rows = [run(name, template, args.states, pages) for name, template in POLICIES]
+    cold = [float(subprocess.run([sys.executable, "-c", COLD], capture_output=True, text=True, check=True).stdout)]
+    cold.append(float(subprocess.run([sys.executable, "-c", COLD], capture_output=True, text=True, check=True).stdout))
+    print(
+        "| policy | decisions | first try, every sentence chosen | every offered choice | false | garbled "
+        "| operator != researcher | s a sentence (median, p90) |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        n = r["states"]
+        print(
+            f"| {r['policy']} | {n} | {r['every']}/{n} ({100 * r['every'] / n:.0f} %) | {r['offered']}/{n} "
+            f"| {r['false']}/{3 * n} | {r['garbled']}/{3 * n} | {r['differ']}/{n} | {r['median']:.2f}, {r['p90']:.2f} |"
+        )
+    print(
+        f"cold start (first narrative less the second, fresh process, cached model): {min(cold):.2f} s "
+        f"(runs: {', '.join(f'{c:.2f}' for c in cold)})"
+    )
+    if args.out:
+        with open(args.out, "w") as fh:
+            fh.write("# local_lm wordings by audience\n\n" + "\n".join(pages))
+        print(f"texts: {args.out}")
+
+
+if __name__ == "__main__":
+    main()
