@@ -298,3 +298,21 @@ def test_verify_names_a_file_of_narratives_for_what_it_is(tmp_path, capsys):
     (tmp_path / "o.jsonl").write_text(out)
     rc, _, err = run(capsys, "verify", "x", "--explanation", str(tmp_path / "o.jsonl"), "--index", "0")
     one_line_error(rc, err, "holds narratives", "explanations.jsonl")
+
+
+@pytest.mark.slow
+def test_a_reader_that_stops_early_gets_no_error(tmp_path):
+    """`xairl explain ... | head -2`: the pipe closes early; xairl stops quietly (141, as other tools), no
+    'internal error: BrokenPipeError'."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "xairl.cli", "explain", "--n", "300", "--no-robustness"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    proc.stdout.readline()
+    proc.stdout.close()
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141 and "error" not in err, err

@@ -225,6 +225,18 @@ def test_an_installed_plugins_policy_is_in_the_battery(uav_plugin, tmp_path):
     assert any("contradicted on uav-dqn, state 0" in p for p in problems), problems
 
 
+@pytest.mark.slow
+def test_the_uav_template_reports_nothing_with_every_wording(uav_plugin):
+    """Issue 66: every gap of the plugin's template, in every wording pick() offers, verified and well formed on the
+    UAV DQN's decisions (the built-ins: test_builtin_templates_report_nothing)."""
+    from xairl_uav_handover import __file__ as plugin
+
+    path = plugins_path = __import__("pathlib").Path(plugin).parent / "prompts" / "handover.yaml"
+    report = battery.run(prompts.parse(path))
+    assert report.problems == [] and plugins_path.is_file()
+    assert report.renderings >= 4 * 3  # (four UAV decisions, three wordings at most of a choice)
+
+
 def test_a_plugin_policy_that_fails_to_load_is_one_line_and_the_battery_goes_on(monkeypatch):
     monkeypatch.setattr(battery_cases, "plugin_policies", lambda: (("broken", None, "RuntimeError: no checkpoint"),))
     decisions, left_out = battery.cases(("actions",))
@@ -271,6 +283,10 @@ def test_a_template_in_its_authors_own_words_passes(tmp_path):
     assert check_template(write(tmp_path, body)) == []
 
 
+def _wordings(r) -> int:
+    return r.draft.wordings if r.draft else 1
+
+
 @pytest.mark.parametrize("path", sorted(prompts.builtin_dir().glob("*.yaml")), ids=lambda p: p.stem)
 def test_a_builtins_renderings_hold_no_literal_claim_word(path):
     """What the static pass promises holds at render time: with every tracked span blanked, the words left over in
@@ -283,7 +299,8 @@ def test_a_builtins_renderings_hold_no_literal_claim_word(path):
     for case in battery.cases(outputs, tpl.spec.kind)[0]:
         context, _ = battery._facts(case)
         names = battery.names([case])
-        for r in (r for variants in tpl.render_variants(context) for r in variants if r):
+        firsts = [r for variants in tpl.render_variants(context) for r in variants if r]
+        for r in (f.draft.render(c) if f.draft else f for f in firsts for c in range(_wordings(f))):
             if checked_by_counterfactual(r.spans):
                 continue
             text = list(str(r))

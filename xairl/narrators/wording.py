@@ -110,6 +110,8 @@ class Chooser:
         from xairl.narrators.base import join_sentences
 
         state = _State(copy.deepcopy(self._prompt.cache), self._prompt.last)
+        # every wording's fit to the reader, in one batch (most are cached after the first decision)
+        self.fit([w for options in variants for o in options if o for p in _pieces(o)[1] for w in p])
         out, pending, counts = [], [], [0, 0, 0]
         for options in variants:
             options = [o for o in options if o]
