@@ -4,7 +4,7 @@
    (one core each, Ray's start-up included); target: Ray <= 1.5 x local. Values compared bit for bit.
 2. kernel_shap and exact Shapley on M states: Ray with 1 worker and with 2 workers; the speed-up per added worker
    (target: close to 2 on 2 cores), and the local engine beside them.
-3. local_lm narration (mode choose, one torch thread per worker) of K states: in this process, and with
+3. local_lm narration (the model choosing the wordings, one torch thread per worker) of K states: in this process, and with
    xairl.runs.scale.narrate_on_ray on 1 and 2 workers (each loads the model once; Ray's start-up included).
 
 Run: .venv/bin/python benchmarks/bench_ray.py [--states 200000] [--kernel-states 1000] [--exact-states 1000]
@@ -111,7 +111,7 @@ def per_worker(policy, bg, tmp: Path, method: str, m: int, rng) -> None:
 
 
 def narrations(k: int) -> None:
-    """local_lm (choose) narratives of k toy states: here, then on Ray with 1 and 2 workers; the same texts."""
+    """local_lm narratives of k toy states: here, then on Ray with 1 and 2 workers; the same texts."""
     from xairl.toy import toy_policy
 
     policy = toy_policy()

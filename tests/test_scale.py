@@ -32,13 +32,13 @@ def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ra
     from xairl.runs.scale import explain_on_ray
 
     states = tmp_path / "s.npy"
-    np.save(states, POLICY.background(6_000, seed=4))
+    np.save(states, POLICY.background(1_200, seed=4))  # six chunks of 200
     bg = POLICY.background(30)
-    explain_to_parquet(POLICY, states, tmp_path / "local", background=bg, chunk_size=1000, progress=False)
-    summary = explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=1000, workers=2)
+    explain_to_parquet(POLICY, states, tmp_path / "local", background=bg, chunk_size=200, progress=False)
+    summary = explain_on_ray(POLICY, states, tmp_path / "ray", background=bg, chunk_size=200, workers=2)
     local, distributed = (read_parquet(tmp_path / d / "explanations.parquet") for d in ("local", "ray"))
     assert np.array_equal(local.values, distributed.values) and np.array_equal(local.outputs, distributed.outputs)
-    assert summary.n == 6_000 and ray.is_initialized()  # a running Ray is used, and left running
+    assert summary.n == 1_200 and ray.is_initialized()  # a running Ray is used, and left running
     assert (tmp_path / "local" / "summary.json").read_text() == (tmp_path / "ray" / "summary.json").read_text()
     parts = sorted((tmp_path / "ray" / "explanations.parquet").glob("part-*.parquet"))
     for part in parts[2:4]:  # as if the run had been killed before these chunks were written
@@ -61,7 +61,7 @@ def test_ray_engine_writes_the_local_engines_bits_and_resumes(tmp_path, local_ra
         "--workers",
         "2",
         "--chunk-size",
-        "1000",
+        "200",
         "--resume",
     ]
     capsys.readouterr()

@@ -141,9 +141,10 @@ _FORM = (
     (re.compile(r"(?<=\S) {2,}(?=\S)"), "a double space"),
     (re.compile(r" [,.;:!?)]"), "a space before punctuation"),
     (re.compile(r"[,;:](?=[^\W\d])"), "no space after punctuation"),
-    (re.compile(r"[,;:]\s*[,;:.]|(?<!\.)\.\s*[,;:.](?!\.)"), "punctuation doubled"),
+    # (',,' ', .' '. .' '..', and '.,' but after an abbreviation: 'e.g.,' 'etc.,')
+    (re.compile(r"[,;:]\s*[,;:.]|(?<!\.)\.\s*\.(?!\.)|(?<!\b[^\W\d_])(?<!etc)\.\s*[,;:]"), "punctuation doubled"),
     (re.compile(r"\(\s*\)"), "empty brackets"),
-    (re.compile(r"\b(\w+) \1\b", re.IGNORECASE), "a word written twice"),
+    (re.compile(r"\b([^\W\d_]+) \1\b", re.IGNORECASE), "a word written twice"),
 )
 
 

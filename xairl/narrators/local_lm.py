@@ -220,6 +220,8 @@ class LocalLMNarrator(Narrator):
             prompt = self.prompt()
             key = (id(self.model), tuple(prompt), self.options.length)
             if key not in _CHOOSERS:
+                if len(_CHOOSERS) >= 8:  # (each holds its prompts' caches: the oldest goes)
+                    _CHOOSERS.pop(next(iter(_CHOOSERS)))
                 plain = None if self.options.audience is None else self.prompt(None)
                 _CHOOSERS[key] = Chooser(self.model, self.tok, prompt, self.options.length, plain)
             return _CHOOSERS[key].choose(variants)

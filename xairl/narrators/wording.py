@@ -3,8 +3,9 @@
 A template offers wordings in two places: a sentence's variants (phrasings that say the same facts) and, inside a
 sentence, ``pick('came from', 'was due to')`` between its tracked values (:mod:`xairl.templates.choices`). The text
 is decoded under that grammar: left to right, at each place where the template offers a choice, every wording is
-scored by the model after the text chosen so far, each followed by the fixed words up to the next choice (so the
-model judges how it joins), and the wording whose tokens it finds most probable on average is kept. What can come
+scored by the model after the text chosen so far, each followed by the first fixed words after it (so the model
+judges how it joins them), and the wording whose tokens it finds most probable on average is kept, give or take its
+fit to the reader the prompt names (:meth:`Chooser.fit`) and the length asked for. What can come
 out is exactly the set of sentences the template can write, each tracked value in its place; so the text verifies
 by its facts like the template's, and a choice is never a claim of the model's.
 
@@ -53,8 +54,9 @@ def _pieces(sentence: Rendered) -> tuple[list[str], list[tuple[str, ...]]]:
 
 
 class Chooser:
-    """Chooses a template's wordings with a causal language model after a prompt (one per process, model, prompt
-    and length; :func:`chooser`)."""
+    """Chooses a template's wordings with a causal language model after a prompt; ``plain`` is the prompt without a
+    reader, for the wordings' fit to the one ``prompt`` names. The local_lm narrator keeps one per model, prompt and
+    length in its process."""
 
     def __init__(self, model, tok, prompt: list[int], length: str = "medium", plain: list[int] | None = None):
         self.model, self.tok, self.bonus = model, tok, LENGTH_BONUS[length]
@@ -99,8 +101,11 @@ class Chooser:
         return getattr(out, self._cache_arg)
 
     def ids(self, text: str) -> list[int]:
-        """The tokens of ``text`` (cached: a template's wordings recur on every decision)."""
+        """The tokens of ``text`` (cached: a template's wordings recur on every decision; bounded, as its fixed
+        words carry each decision's names and numbers)."""
         if text not in self._ids:
+            if len(self._ids) > 16384:
+                self._ids.clear()
             self._ids[text] = self.tok.encode(text, add_special_tokens=False) if text else []
         return self._ids[text]
 
@@ -128,7 +133,7 @@ class Chooser:
     def _sentence(self, state: _State, options: list[Rendered], sep: str, pending: list[int]):
         """(the chosen rendering of one sentence, the tokens not yet in the cache, whether the model chose)."""
         chose = False
-        if len(options) > 1:  # the variant first: each scored on its first wordings, whole
+        if len(options) > 1:  # the variant first: each scored on its opening, with its first wordings
             paths = []
             for o in options:
                 fixed, points = _pieces(o)
