@@ -7,6 +7,9 @@
 - **false**: narratives shown with a status other than verified (a choice the verifier did not pass);
 - **garbled**: narratives whose text has a form fault (:func:`xairl.narrators.battery.malformed`: a tracked value
   glued to a word, a doubled space, a space before punctuation, ...);
+- **worded together**: 16 decisions narrated alone, then prepared 8 at a time as the CLI does
+  (:func:`xairl.narrators.prepare`: each step's choices of all 8 in one batched forward pass); the ratio of times,
+  and whether the texts are the same;
 - **audiences**: the share of decisions worded differently for ``operator`` and ``researcher``, each verified;
 - **latency**: warm seconds a sentence on one thread (median, 90th percentile); **cold start**: a fresh process's
   first narrative less its second of the same decision, after a template narrative (so: the import of
@@ -99,6 +102,25 @@ def run(name: str, template: str, states: int, pages: list[str]) -> dict:
     }
 
 
+def together(name: str, template: str, n: int = 16, batch: int = 8) -> tuple[float, bool]:
+    """(time alone / time prepared `batch` at a time, the same texts) on ``n`` decisions."""
+    from xairl.narrators import prepare
+
+    policy = xairl.get_policy(name)
+    exp = xairl.explain(policy, policy.background(n, seed=3), background=policy.background(60))
+    kw = {"narrator": "local_lm", "options": {"threads": 1}}
+    how = {"policy": policy, "robustness": False, "template": template}
+    xairl.narrate(exp, 0, **kw, **how)
+    t = time.perf_counter()
+    alone = [xairl.narrate(exp, i, **kw, **how).text for i in range(n)]
+    seconds = time.perf_counter() - t
+    t, texts = time.perf_counter(), []
+    for start in range(0, n, batch):
+        prepare(exp, [(i, how) for i in range(start, min(start + batch, n))], **kw)
+        texts += [xairl.narrate(exp, i, **kw, **how).text for i in range(start, min(start + batch, n))]
+    return seconds / (time.perf_counter() - t), texts == alone
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--states", type=int, default=40)
@@ -106,6 +128,7 @@ def main() -> None:
     args = ap.parse_args()
     pages: list[str] = []
     rows = [run(name, template, args.states, pages) for name, template in POLICIES]
+    batched = {name: together(name, template) for name, template in POLICIES}
     cold, imports = [fresh(COLD) for _ in range(3)], [fresh(IMPORT) for _ in range(3)]
     print(
         "| policy | decisions | first try, every sentence chosen | every offered choice | false | garbled "
@@ -118,6 +141,8 @@ def main() -> None:
             f"| {r['policy']} | {n} | {r['every']}/{n} ({100 * r['every'] / n:.0f} %) | {r['offered']}/{n} "
             f"| {r['false']}/{3 * n} | {r['garbled']}/{3 * n} | {r['differ']}/{n} | {r['median']:.2f}, {r['p90']:.2f} |"
         )
+    for name, (ratio, same) in batched.items():
+        print(f"{name}: 16 decisions worded 8 at a time {ratio:.2f}x as fast as alone; the same texts: {same}")
     print(
         f"cold start (a fresh process's first narrative less its second of the same decision, cached model): "
         f"{statistics.median(cold):.2f} s median of {', '.join(f'{c:.2f}' for c in cold)}; of which importing "

@@ -104,32 +104,51 @@ def test_length_leans_to_shorter_or_fuller_wordings(toy):
     assert size["short"] < size["long"], size
 
 
-def test_a_choice_scores_what_a_whole_forward_pass_scores(toy):
-    """The key-value cache bookkeeping (a batched pass per choice, the chosen row kept, the rest cut) gives each
-    wording the mean log-probability that one pass over the whole text gives it."""
-    model, tok = local_lm.load_model()
-    prompt = tok.encode("The decision:", add_special_tokens=False)
-    chooser = wording.Chooser(model, tok, prompt)
-    state = wording._State(chooser._prompt.cache, chooser._prompt.last)
-    state.cache = __import__("copy").deepcopy(state.cache)
-    before = tok.encode(" The policy chose turn over recharge, a margin", add_special_tokens=False)
-    chooser._extend(state, before)
-    words = [" of 2.80.", " worth 2.80 in score.", " 2.80."]
-    rows = [tok.encode(w, add_special_tokens=False) for w in words]
-    means, kept = chooser._score(state, rows, 0)
-    chooser._keep(state, 1, len(rows[1]), (*kept, 0))
-    for row, mean in zip(rows, means):
-        ids = torch.tensor([prompt + before + row])
-        with torch.no_grad():
-            logp = torch.log_softmax(model(input_ids=ids).logits[0].float(), -1)
-        start = len(prompt) + len(before)
-        whole = logp[torch.arange(start - 1, start + len(row) - 1), torch.tensor(row)].mean()
-        assert abs(float(whole) - mean) < 1e-3
-    assert state.cache.get_seq_length() == len(prompt) + len(before) + len(rows[1])
-    ids = torch.tensor([prompt + before + rows[1]])
+def _whole(model, ids: list[int]):
+    """Log-probabilities after each token of ``ids``, from one forward pass over all of them."""
     with torch.no_grad():
-        after = torch.log_softmax(model(input_ids=ids).logits[0, -1].float(), -1)
-    assert torch.allclose(after, state.last, atol=1e-3)
+        return torch.log_softmax(model(input_ids=torch.tensor([ids])).logits[0].float(), -1)
+
+
+def test_a_batched_choice_scores_what_a_whole_forward_pass_scores():
+    """The key-value bookkeeping (two texts of different lengths left-padded into one batched pass, the chosen
+    row kept, the rest cut) gives each wording the mean log-probability, and the kept text the next-token
+    distribution, that one plain pass over the whole text gives."""
+    model, tok = local_lm.load_model()
+
+    def enc(text):
+        return tok.encode(text, add_special_tokens=False)
+
+    prompt = enc("The decision:")
+    chooser = wording.Chooser(model, tok, prompt)
+    texts = [enc(" The policy chose turn over recharge, a margin"), enc(" It turned")]
+    states = [chooser._extend(chooser._prompt, t) for t in texts]
+    rows = [[enc(w) for w in (" of 2.80.", " worth 2.80 in score.", " 2.80.")], [enc(" left."), enc(" right.")]]
+    answers = chooser._score([wording._Ask(st, rs, 0) for st, rs in zip(states, rows)])
+    for text, rs, (means, kept) in zip(texts, rows, answers):
+        for row, mean in zip(rs, means):
+            logp = _whole(model, prompt + text + row)
+            start = len(prompt) + len(text)
+            whole = logp[torch.arange(start - 1, start + len(row) - 1), torch.tensor(row)].mean()
+            assert abs(float(whole) - mean) < 1e-3
+        after = kept(1, len(rs[1]))
+        assert after.length == len(prompt) + len(text) + len(rs[1])
+        assert torch.allclose(_whole(model, prompt + text + rs[1])[-1], after.last, atol=1e-3)
+        assert kept(0, 0) is kept.before
+
+
+def test_decisions_worded_together_are_worded_as_alone(toy):
+    policy, exp = toy
+    narrator = local_lm.LocalLMNarrator({"threads": 1})
+    variants = [
+        prompts.load("explain_action").render_variants(track_decision(decision_facts(exp, i, policy).context()))
+        for i in range(len(exp.values))
+    ]
+    chooser = wording.Chooser(narrator.model, narrator.tok, narrator.prompt())
+    together = chooser.choose_many(variants)
+    alone = [chooser.choose(v) for v in variants]
+    assert [str(t) for t in together] == [str(t) for t in alone]
+    assert [t.spans for t in together] == [t.spans for t in alone]
 
 
 def test_examples_and_repeated_runs_are_deterministic(toy):

@@ -223,9 +223,13 @@ def _stream(args, policy, states, bg, options: dict) -> int:
     return 0
 
 
+#: decisions the CLI words together (a narrator that batches them, local_lm, scores their choices in one pass)
+BATCH = 8
+
+
 def _print_narratives(args, exp, policy, bg, raw=None) -> int:
     from xairl.explanations.evidence import verdict_text
-    from xairl.narrators import narrate
+    from xairl.narrators import narrate, prepare
     from xairl.outputs.feedback import FeedbackStore
 
     store = None if args.no_record else FeedbackStore(args.feedback_db)
@@ -233,17 +237,18 @@ def _print_narratives(args, exp, policy, bg, raw=None) -> int:
     if args.examples_from_feedback and store is not None:
         options.setdefault("examples", store.examples())
     found = summaries(raw, policy)
+    how = {"template": args.template, "policy": policy, "background": bg, "robustness": not args.no_robustness}
+    how["prompt_dirs"] = tuple(args.prompts)
     for i in range(len(exp.values)):
+        if i % BATCH == 0:  # the next decisions worded together (local_lm: one forward pass per step for all)
+            batch = range(i, min(i + BATCH, len(exp.values)))
+            prepare(exp, [(j, how | said(raw, j)) for j in batch], narrator=args.narrator, options=options)
         n = narrate(
             exp,
             i,
             narrator=args.narrator,
-            template=args.template,
-            policy=policy,
-            background=bg,
-            robustness=not args.no_robustness,
             options=options,
-            prompt_dirs=args.prompts,
+            **how,
             **said(raw, i),  # the template's counterfactual sentence, checked by a re-run
         )
         if found is not None and n.evidence is not None:  # the review page shows it beside the narrative

@@ -41,6 +41,23 @@ def narrate(
     return narrative
 
 
+def prepare(
+    explanation: Explanation,
+    requests: list[tuple[int, NarrationOptions | dict]],
+    *,
+    narrator: str = "template",
+    options: dict | None = None,
+) -> None:
+    """Let ``narrator`` word several decisions together before :func:`narrate` shows them one by one:
+    ``requests`` holds (index, how to narrate it) pairs, as :func:`narrate` takes them. ``local_lm`` scores each
+    step's choices of all of them in one batched forward pass; the texts are those :func:`narrate` gives alone.
+    The template narrator does nothing here."""
+    from xairl.registry.plugins import registry
+
+    asked = [(i, NarrationOptions.of(None, **dict(how))) for i, how in requests]
+    registry("narrator").load(narrator)(options).prepare(explanation, asked)
+
+
 def check_template(path: str | Path, *, notes: bool = False, verbose=None) -> list[str]:
     """Problems of a template file, one line each: the static checks of :func:`xairl.templates.prompts.check` with a trial
     rendering on sample facts, then the battery (:mod:`xairl.narrators.battery`): each claim word the template writes
@@ -74,5 +91,6 @@ __all__ = [
     "check_template",
     "confidence",
     "narrate",
+    "prepare",
     "verify",
 ]

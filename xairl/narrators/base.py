@@ -141,6 +141,46 @@ def _template(explanation: Explanation, index: int | None, template: str | None,
     return tpl
 
 
+def _plan(explanation: Explanation, index: int | None, o: NarrationOptions):
+    """(the template, the explanation narrated, its views, the counterfactual said) of one narration."""
+    tpl = _template(explanation, index, o.template, o.prompt_dirs)
+    # an image is narrated in regions, not pixels (the confidence's robustness still reads the pixels); a
+    # continuous action: each dimension is its own output, narrated and verified on its own
+    narrated = in_regions(explanation)
+    views = (
+        [narrated.output_slice(j) for j in range(narrated.values.shape[2])]
+        if index is not None and explanation.output == "continuous"
+        else [narrated]
+    )
+    return tpl, narrated, views, said_counterfactual(explanation, index, o.policy, o.counterfactual, o.background)
+
+
+def _variants(explanation: Explanation, index: int | None, tpl, policy: Policy | None, k: int, history, said):
+    """(every variant of every sentence rendered with tracked facts, the template variables, the domain facts the
+    words are made from) of one view."""
+    facts = (
+        global_facts(explanation, policy, k=max(k, 3))
+        if index is None
+        else replace(decision_facts(explanation, index, policy, k, history), counterfactual=said)
+    )
+    context = facts.context()
+    variants = tpl.render_variants(track_global(context) if index is None else track_decision(context))
+    # the domain facts the words were made from (a facts hook given the episode's history states more)
+    domain = DomainFacts(facts.extras, facts.comparisons) if index is not None else None
+    return variants, context, domain
+
+
+def variants_of(explanation: Explanation, requests: Iterable[tuple[int, NarrationOptions]]) -> list[list[list]]:
+    """The rendered variants of every view of each requested narration, as :meth:`Narrator.narrate` renders them
+    (for :meth:`Narrator.prepare`)."""
+    out = []
+    for index, o in requests:
+        index = explanation.check_index(index)
+        tpl, _, views, said = _plan(explanation, index, o)
+        out += [_variants(view, index, tpl, o.policy, o.k, o.history, said)[0] for view in views]
+    return out
+
+
 class Narrator:
     """Turns an Explanation into words that are checked against its numbers.
 
@@ -167,16 +207,7 @@ class Narrator:
         """
         o = NarrationOptions.of(narration, **given)
         index = None if index is None else explanation.check_index(index)
-        tpl = _template(explanation, index, o.template, o.prompt_dirs)
-        # an image is narrated in regions, not pixels (the confidence's robustness still reads the pixels); a
-        # continuous action: each dimension is its own output, narrated and verified on its own
-        narrated = in_regions(explanation)
-        views = (
-            [narrated.output_slice(j) for j in range(narrated.values.shape[2])]
-            if index is not None and explanation.output == "continuous"
-            else [narrated]
-        )
-        said = said_counterfactual(explanation, index, o.policy, o.counterfactual, o.background)
+        tpl, narrated, views, said = _plan(explanation, index, o)
         words = [self._words(view, index, tpl, o.policy, o.k, o.history, said) for view in views]
         scores, comps = zip(
             *(confidence(explanation, index, c.ok, o, output=j, coverage=c.coverage) for j, c in _checks(words))
@@ -216,15 +247,7 @@ class Narrator:
     ):
         """(text, verification, source, rejected text) for one explanation: the subclass's words, verified, or the
         template's first phrasings when they fail."""
-        facts = (
-            global_facts(explanation, policy, k=max(k, 3))
-            if index is None
-            else replace(decision_facts(explanation, index, policy, k, history), counterfactual=said)
-        )
-        context = facts.context()
-        variants = tpl.render_variants(track_global(context) if index is None else track_decision(context))
-        # the domain facts the words were made from (a facts hook given the episode's history states more)
-        domain = DomainFacts(facts.extras, facts.comparisons) if index is not None else None
+        variants, context, domain = _variants(explanation, index, tpl, policy, k, history, said)
         first = None
         for tries, text in enumerate(self._tries(variants, context), 1):
             if text is None:  # refused by the narrator itself (its words lost a fact)
@@ -242,6 +265,10 @@ class Narrator:
         if rejected is None:
             source = f"template (fallback: {self.name}: {problem.detail})"
         return text, check, source, None if rejected is None else str(rejected), tries
+
+    def prepare(self, explanation: Explanation, requests: Iterable[tuple[int, NarrationOptions]]) -> None:
+        """Get ready to narrate these decisions ((index, how) each): a narrator that words several decisions
+        together does it here, and :meth:`narrate` then shows each as it would have alone. Default: nothing."""
 
     def _tries(self, variants: list[list[Rendered]], context: dict[str, Any]) -> Iterator[str | None]:
         """The subclass's words, try after try: the first that verifies is shown, and the template's when none does

@@ -175,6 +175,8 @@ def _load_model(spec: str | None):
         folder = path
     else:
         raise InputError(f"{path}: not a transformers model folder (no config.json) nor a .gguf file.")
+    bars = tf.utils.logging.is_progress_bar_enabled()
+    tf.utils.logging.disable_progress_bar()  # ('Loading weights: 100%' on every CLI run; set back below)
     try:  # safetensors only: pickled weights (pytorch_model.bin) can run code when loaded
         tok = tf.AutoTokenizer.from_pretrained(str(folder), local_files_only=True)
         model = tf.AutoModelForCausalLM.from_pretrained(str(folder), local_files_only=True, use_safetensors=True).eval()
@@ -183,6 +185,9 @@ def _load_model(spec: str | None):
             f"{folder}: cannot load the model ({' '.join(str(exc).split())[:200]}); give a folder with "
             "config.json and .safetensors weights, or a .gguf file."
         ) from None
+    finally:
+        if bars:
+            tf.utils.logging.enable_progress_bar()
     if tok.pad_token is None:
         tok.pad_token = tok.eos_token
     _LOADED[key] = (model, tok)
@@ -213,15 +218,39 @@ class LocalLMNarrator(Narrator):
             return list(ids["input_ids"] if isinstance(ids, dict) or hasattr(ids, "keys") else ids)
         return self.tok("\n".join(m["content"] for m in msgs) + "\n")["input_ids"]
 
-    def _compose(self, variants: list[list[Rendered]], context: dict) -> Rendered:
+    def _chooser(self):
+        """This narrator's :class:`xairl.narrators.wording.Chooser` (one per model, prompt and length in the
+        process: the prompt is encoded once)."""
         from xairl.narrators.wording import Chooser
 
+        prompt = self.prompt()
+        key = (id(self.model), tuple(prompt), self.options.length)
+        if key not in _CHOOSERS:
+            if len(_CHOOSERS) >= 8:  # (each holds its prompts' caches: the oldest goes)
+                _CHOOSERS.pop(next(iter(_CHOOSERS)))
+            plain = None if self.options.audience is None else self.prompt(None)
+            _CHOOSERS[key] = Chooser(self.model, self.tok, prompt, self.options.length, plain)
+        return _CHOOSERS[key]
+
+    def prepare(self, explanation, requests) -> None:
+        """Word these decisions together: each step's choices of all of them in one batched forward pass; narrate
+        then shows each (the same text as alone)."""
+        from xairl.narrators.base import variants_of
+
         with torch_threads(self.options.threads or default_threads()):
-            prompt = self.prompt()
-            key = (id(self.model), tuple(prompt), self.options.length)
-            if key not in _CHOOSERS:
-                if len(_CHOOSERS) >= 8:  # (each holds its prompts' caches: the oldest goes)
-                    _CHOOSERS.pop(next(iter(_CHOOSERS)))
-                plain = None if self.options.audience is None else self.prompt(None)
-                _CHOOSERS[key] = Chooser(self.model, self.tok, prompt, self.options.length, plain)
-            return _CHOOSERS[key].choose(variants)
+            chooser = self._chooser()
+            many = variants_of(explanation, requests)
+            if len(chooser.ready) > 1024:  # (prepared and never narrated: bounded)
+                chooser.ready.clear()
+            for variants, text in zip(many, chooser.choose_many(many)):
+                chooser.ready[_key(variants)] = text
+
+    def _compose(self, variants: list[list[Rendered]], context: dict) -> Rendered:
+        with torch_threads(self.options.threads or default_threads()):
+            chooser = self._chooser()
+            return chooser.ready.pop(_key(variants), None) or chooser.choose(variants)
+
+
+def _key(variants: list[list[Rendered]]) -> str:
+    """A decision's rendering, every variant's text: the same text, the same choices."""
+    return "\x00".join(str(r) for options in variants for r in options)
