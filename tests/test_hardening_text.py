@@ -276,3 +276,19 @@ def test_a_contradicted_direction_word_is_said_once_by_prompts_check(tmp_path):
     ), lines[:2]
     assert sum("'opposing'" in line for line in lines) == 1, lines[:3]
     assert not [line for line in lines if "'opposing' 'opposing'" in line], lines[:2]
+
+
+def test_the_clock_is_the_renderings_cpu_time_not_a_busy_machines(monkeypatch, tmp_path):
+    """A rendering waiting on a loaded machine (here: a value that sleeps as it prints) is not refused by the clock;
+    one that computes past it is (test_a_rendering_past_the_clock_is_refused)."""
+    import time
+
+    class Slow(str):
+        def __str__(self):
+            time.sleep(0.3)
+            return "slow"
+
+    monkeypatch.setattr(sandbox, "MAX_SECONDS", 0.2)
+    path = _template(tmp_path, '  - ["The action was {{ slow }}."]\n')
+    tpl = prompts.parse(path)
+    assert str(tpl.render_variants({**sample_context("decision"), "slow": Slow("x")})[0][0]) == "The action was slow."

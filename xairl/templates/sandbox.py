@@ -28,7 +28,7 @@ MAX_STEPS = 10_000  # loop iterations and macro calls in one rendering: the buil
 MAX_WORK = 1_000_000  # characters and items built, read by calls or output in one rendering: a few MB, well under 1 s
 MAX_INT_BITS = 10_000  # an integer built by * or ** (3,000 digits): larger ones are slow to build and cannot be printed
 MAX_NESTING = 64  # depth of a variant's syntax tree: deeper ones would overflow Python's stack while compiling
-MAX_SECONDS = 2.0  # one rendering of a whole template, compiling included: the built-ins take milliseconds
+MAX_SECONDS = 2.0  # CPU seconds of one rendering of a whole template, compiling included: the built-ins take ms
 RESERVED = "xairl_"  # names of the sandbox's own helpers, which the rewritten template calls
 
 
@@ -113,7 +113,7 @@ class _Budget:
     """What one rendering may still spend: steps (loop iterations, macro calls) and work (sizes built or read)."""
 
     def __init__(self):
-        self.steps, self.work, self.deadline = MAX_STEPS, MAX_WORK, time.monotonic() + MAX_SECONDS
+        self.steps, self.work, self.deadline = MAX_STEPS, MAX_WORK, time.thread_time() + MAX_SECONDS
 
     def step(self, work: int = 0) -> None:
         self.steps -= 1
@@ -125,7 +125,7 @@ class _Budget:
         self.work -= work
         if self.work < 0:
             raise SecurityError(f"more than {MAX_WORK} characters and items built in one rendering")
-        if time.monotonic() > self.deadline:  # work within the bounds can still be slow: a clock bounds it too
+        if time.thread_time() > self.deadline:  # slow work within the bounds: its CPU time (a busy machine is not)
             raise SecurityError(f"rendering took over {MAX_SECONDS:g} s: loop over fewer items, write fewer sentences")
 
     def checked(self, value):
