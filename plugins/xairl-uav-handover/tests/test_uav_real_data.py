@@ -157,7 +157,7 @@ def sim_report(tmp_path_factory):
     every, display.EVERY = display.EVERY, 0.01  # each step is long at this scale: each is said
     try:
         with contextlib.redirect_stderr(io.StringIO()) as err:
-            argv = ["report", "--plugin", "uav-handover", "--n", "40", "-o", "flights=20", "--narrate"]
+            argv = ["report", "--plugin", "uav-handover", "--n", "24", "-o", "flights=8", "--narrate"]
             assert main([*argv, "--out", str(out)]) == 0
     finally:
         display.EVERY = every
@@ -173,9 +173,9 @@ def test_the_report_says_what_it_is_doing(sim_report):
     starts = [line[len("xairl: ") : -len(" ...")] for line in said if line.endswith(" ...")]
     steps = [
         "building the uav-handover report's content",
-        "Table I: CHM, SA-MRO and the DQN on 20 simulated flights",
+        "Table I: CHM, SA-MRO and the DQN on 8 simulated flights",
         "simulating and explaining the flights at a glance",
-        "explaining (deep_shap) 40 simulated states",  # a fraction of a second: said when the thread is in time
+        "explaining (deep_shap) 24 simulated states",  # a fraction of a second: said when the thread is in time
         "drawing the figures",
         "narrating 6 decisions",
     ]
@@ -191,7 +191,7 @@ def test_report_without_real_data(sim_report):
     assert "Table I" in html and html.count("data:image/png;base64,") >= 3
     assert "&#10003; verified" in html and "confidence" in html
     lines = (out / "explanations.jsonl").read_text().splitlines()
-    assert len(lines) == 40
+    assert len(lines) == 24
     rec = StateRecord.model_validate_json(lines[0])
     assert rec.dataset == "simulated" and set(rec.values) >= {"buffer_queue_size", "rsrp_0"}
     schema = json.loads((out / "explanations.schema.json").read_text())
