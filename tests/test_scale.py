@@ -82,19 +82,19 @@ def test_ray_reads_parquet_by_row_group_and_csv_once_rewritten(tmp_path, local_r
     from xairl.runs.scale import STAGED, explain_on_ray
     from xairl.toy import FEATURES
 
-    states, bg = POLICY.background(2_500, seed=5), POLICY.background(20)
+    states, bg = POLICY.background(1_000, seed=5), POLICY.background(20)
     pq.write_table(
-        pa.table({f: states[:, j] for j, f in enumerate(FEATURES)}), tmp_path / "s.parquet", row_group_size=300
+        pa.table({f: states[:, j] for j, f in enumerate(FEATURES)}), tmp_path / "s.parquet", row_group_size=120
     )  # row groups that do not fall on the chunks' bounds
     (tmp_path / "s.csv").write_text(
         ",".join(FEATURES) + "\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in states)
     )
-    local = explain_to_parquet(POLICY, states, tmp_path / "local", background=bg, chunk_size=1000, progress=False)
+    local = explain_to_parquet(POLICY, states, tmp_path / "local", background=bg, chunk_size=400, progress=False)
     for name in ("s.parquet", "s.csv"):
         summary = explain_on_ray(
-            POLICY, tmp_path / name, tmp_path / name.replace(".", "_"), background=bg, chunk_size=1000, workers=2
+            POLICY, tmp_path / name, tmp_path / name.replace(".", "_"), background=bg, chunk_size=400, workers=2
         )
-        assert summary.n == local.n == 2_500
+        assert summary.n == local.n == 1_000
         assert np.array_equal(
             read_parquet(tmp_path / name.replace(".", "_") / "explanations.parquet").values,
             read_parquet(tmp_path / "local" / "explanations.parquet").values,

@@ -146,15 +146,24 @@ def _hidden_widths(path: Path, meta: dict, tensors: dict) -> tuple[int, ...]:
     return widths
 
 
+_BACKGROUND: dict[tuple, np.ndarray] = {}  # (n, seed, settings) -> the states: simulating them takes seconds
+
+
 def background_states(n: int, seed: int = 0, config: SimConfig | None = None) -> np.ndarray:
-    """``n`` states the policy meets in flight: ``n`` simulated UAVs after 10 s under conventional handover."""
-    env = HandoverVecEnv(config, n_flights=n, decision_every=1)
-    obs, _ = env.reset(seed=seed)
-    chm = CHM()
-    chm.reset(env)
-    for _ in range(int(round(10.0 / env.sim.dt))):
-        obs = env.step(chm(env))[0]
-    return obs
+    """``n`` states the policy meets in flight: ``n`` simulated UAVs after 10 s under conventional handover (the
+    same for the same ``n``, seed and settings: kept in the process, a fresh copy each call)."""
+    key = (n, seed, (config or SimConfig()).model_dump_json())
+    if key not in _BACKGROUND:
+        env = HandoverVecEnv(config, n_flights=n, decision_every=1)
+        obs, _ = env.reset(seed=seed)
+        chm = CHM()
+        chm.reset(env)
+        for _ in range(int(round(10.0 / env.sim.dt))):
+            obs = env.step(chm(env))[0]
+        if len(_BACKGROUND) >= 16:  # (bounded: the oldest goes)
+            _BACKGROUND.pop(next(iter(_BACKGROUND)))
+        _BACKGROUND[key] = obs
+    return _BACKGROUND[key].copy()
 
 
 def uav_policy(checkpoint: Checkpoint | str | Path | None = None) -> Policy:
