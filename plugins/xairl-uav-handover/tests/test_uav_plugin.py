@@ -135,6 +135,8 @@ def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
                 "1",
                 "--pretrain-updates",
                 "5",
+                "--standardise-states",
+                "64",
                 "--no-progress",
                 "--out",
                 str(ckpt),
@@ -146,6 +148,7 @@ def test_train_and_evaluate_commands_tiny_budget(tmp_path, capsys):
     assert meta["seed"] == 4 and meta["train_config"]["episodes"] == 1 and len(meta["history"]) == 1
     assert meta["train_config"]["demonstrations"] == 1 and meta["train_config"]["pretrain_updates"] == 5
     assert "--demonstrations 1 --pretrain-updates 5 --eps-start 0.2 --reward paper --seed 4" in meta["command"]
+    assert meta["command"].endswith("--standardise-states 64") and meta["train_config"]["standardise_states"] == 64
     capsys.readouterr()
     assert (
         main(

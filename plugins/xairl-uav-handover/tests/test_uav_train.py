@@ -65,6 +65,7 @@ def test_pretraining_on_demonstrations_imitates_the_rule():
         eps_end=0.0,
         learning_starts=10**6,
         seed=3,
+        standardise_states=256,
     )
     env = HandoverVecEnv(sim, tc.n_flights)
     rb = ReplayBuffer(

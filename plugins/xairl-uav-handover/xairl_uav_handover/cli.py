@@ -37,6 +37,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         default="paper",
         help="the paper's reward (default), or the operator-priced one that also prices lost data and ping-pongs",
     )
+    p.add_argument(
+        "--standardise-states",
+        type=int,
+        default=None,
+        help="flights simulated for the statistics that standardise the network's inputs (default: 2048)",
+    )
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", default="uav-dqn.safetensors", help="checkpoint path (metadata holds the configs)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -83,6 +89,7 @@ _TRAIN_FLAGS = {
     "demonstrations": "--demonstrations",
     "pretrain_updates": "--pretrain-updates",
     "eps_start": "--eps-start",
+    "standardise_states": "--standardise-states",
 }
 
 

@@ -64,6 +64,12 @@ class TrainConfig(xairl.plugin.Options, frozen=True):
     pretrain_updates: int = Field(
         3000, ge=0, description="gradient steps on the demonstrations alone before the DQN flies"
     )
+    standardise_states: int = Field(
+        2048,
+        ge=16,
+        description="flights simulated (10 s each, under CHM) for the mean and spread that standardise the "
+        "network's inputs; simulating them is most of a tiny run's time",
+    )
     expert_margin: float = Field(
         5.0,
         ge=0,
@@ -162,9 +168,9 @@ def _networks(tc: TrainConfig, sim_cfg: SimConfig):
     if tc.memory:
         from .memory import background
 
-        bg = background(2048, seed=tc.seed + 10_000, config=sim_cfg)
+        bg = background(tc.standardise_states, seed=tc.seed + 10_000, config=sim_cfg)
     else:
-        bg = background_states(2048, seed=tc.seed + 10_000, config=sim_cfg)
+        bg = background_states(tc.standardise_states, seed=tc.seed + 10_000, config=sim_cfg)
     mean, std = bg.mean(axis=0), np.maximum(bg.std(axis=0), 1e-3)
     q, target = build_qnet(mean, std, tc.hidden), build_qnet(mean, std, tc.hidden)
     target.load_state_dict(q.state_dict())
@@ -337,6 +343,7 @@ def train_checkpoint(tc: TrainConfig, sim_cfg: SimConfig, out, progress: bool = 
             f"{tc.n_flights} --demonstrations {tc.demonstrations} "
             f"--pretrain-updates {tc.pretrain_updates} --eps-start "
             f"{tc.eps_start:g} --reward {reward_name(sim_cfg)} --seed {tc.seed}"
+            + (f" --standardise-states {tc.standardise_states}" if tc.standardise_states != 2048 else "")
             + (
                 " (a custom reward: the sim_config above holds its weights)" if reward_name(sim_cfg) == "custom" else ""
             ),
