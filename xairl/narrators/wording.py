@@ -152,7 +152,8 @@ class Chooser:
             sep = ("\n" if "\n" in out[-1] + options[0] else " ") if out else ""
             sentence, state, pending, chose = yield from self._sentence(state, options, sep, pending)
             out.append(sentence)
-            counts = [counts[0] + chose, counts[1] + (len(options) > 1 or bool(_pieces(options[0])[1])), counts[2] + 1]
+            offers = len(options) > 1 or any(len(words) > 1 for words in _pieces(options[0])[1])
+            counts = [counts[0] + chose, counts[1] + offers, counts[2] + 1]
         text = join_sentences(out)
         text.chosen = tuple(counts)
         return text
