@@ -157,7 +157,18 @@ def sim_report(tmp_path_factory):
     every, display.EVERY = display.EVERY, 0.01  # each step is long at this scale: each is said
     try:
         with contextlib.redirect_stderr(io.StringIO()) as err:
-            argv = ["report", "--plugin", "uav-handover", "--n", "24", "-o", "flights=8", "--narrate"]
+            argv = [
+                "report",
+                "--plugin",
+                "uav-handover",
+                "--n",
+                "24",
+                "-o",
+                "flights=8",
+                "-o",
+                "timelines=1",
+                "--narrate",
+            ]
             assert main([*argv, "--out", str(out)]) == 0
     finally:
         display.EVERY = every
