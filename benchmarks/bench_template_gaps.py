@@ -1,22 +1,24 @@
 """How much of a template the language model may choose (issue 66: "at least two wordings in most gaps").
 
 A gap is the literal text between two tracked values of a rendering (or before the first, after the last) that holds
-a word. For each built-in template and the UAV plugin's, rendered on `xairl prompts check`'s battery of decisions
-(the UAV template on the UAV DQN's): the share of gaps inside a ``pick(...)`` (with two or more wordings), and the
-share where the sentence offers another phrasing or a pick.
+a word. For each template (the built-ins, or the files given), rendered on `xairl prompts check`'s battery of
+decisions (a template that reads a plugin's ``extras`` on the plugin policies' decisions only): the share of gaps
+inside a ``pick(...)`` (with two or more wordings), and the share where the sentence offers another phrasing or a
+pick.
 
-Run: .venv/bin/python benchmarks/bench_template_gaps.py
+Run: .venv/bin/python benchmarks/bench_template_gaps.py [TEMPLATE.yaml ...]
+The UAV plugin's template: .venv/bin/python benchmarks/bench_template_gaps.py \
+    plugins/xairl-uav-handover/xairl_uav_handover/prompts/handover.yaml
 """
 
 import re
+import sys
 from pathlib import Path
 
 from xairl.facts import decision_facts, global_facts
-from xairl.narrators.battery import cases
+from xairl.narrators.battery import cases, uses_extras
 from xairl.templates import prompts
 from xairl.templates.tracking import track_decision, track_global, untangle
-
-UAV = Path(__file__).parents[1] / "plugins/xairl-uav-handover/xairl_uav_handover/prompts/handover.yaml"
 
 
 def gaps(rendered, phrasings: int) -> list[tuple[bool, bool]]:
@@ -39,12 +41,13 @@ def gaps(rendered, phrasings: int) -> list[tuple[bool, bool]]:
 def main() -> None:
     print("| template | gaps with a word | in a pick | in a pick or a sentence with another phrasing |")
     print("|---|---|---|---|")
-    for path in [*sorted(prompts.builtin_dir().glob("*.yaml")), UAV]:
+    paths = [Path(p) for p in sys.argv[1:]] or sorted(prompts.builtin_dir().glob("*.yaml"))
+    for path in paths:
         tpl = prompts.parse(path)
         outputs = tpl.spec.outputs if tpl.spec.kind == "decision" else ("actions", "continuous", "value")
-        found = []
+        plugin, found = uses_extras(tpl), []
         for case in cases(outputs, tpl.spec.kind)[0]:
-            if (case.kind == "uav-dqn") != (path == UAV):
+            if plugin and case.policy.facts_hook is None:  # (it reads a plugin's extras: its policies' decisions)
                 continue
             if case.index is None:
                 context = track_global(global_facts(case.explanation, case.policy, k=3).context())

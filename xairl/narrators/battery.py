@@ -85,7 +85,7 @@ def _contradictions(tpl: Template, case: Case, variants, domain, v: int) -> list
     return list(lines.values())
 
 
-def _uses_extras(tpl: Template) -> bool:
+def uses_extras(tpl: Template) -> bool:
     """Whether the template reads a plugin's ``extras`` (it cannot render where a policy has none)."""
     env = environment()
     return any(
@@ -103,7 +103,7 @@ def run(tpl: Template) -> Report:
     report.notes += left_out
     report.problems += undeclared(tpl, names(report.cases))
     failed: dict[str, list[tuple[str, bool]]] = {}  # one line per error: its cases, and whether each lacked extras
-    extras = _uses_extras(tpl)
+    extras = uses_extras(tpl)
     bad: dict[tuple[str, str], str] = {}
     for case in report.cases:
         context, domain = _facts(case)

@@ -15,11 +15,10 @@ from __future__ import annotations
 
 import contextvars
 import re
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from dataclasses import dataclass
 
-from xairl.templates.tracking import Rendered, strip_markers, untangle
+from xairl.templates.tracking import Rendered, collecting, strip_markers, untangle
 
 #: start and end of a choice point's marker; its number is written as tracking writes a span's id
 _OPEN, _CLOSE, _DIGIT = "\ue003", "\ue004", 0xE010
@@ -65,15 +64,9 @@ def capitalised(text: str, cap) -> str | None:
     return text
 
 
-@contextmanager
-def choosing() -> Iterator[list]:
+def choosing():
     """Within it, ``pick`` leaves a choice point; yields the list of each point's wordings."""
-    record: list = []
-    token = _CHOICES.set(record)
-    try:
-        yield record
-    finally:
-        _CHOICES.reset(token)
+    return collecting(_CHOICES)
 
 
 def _number(digits: str) -> int:

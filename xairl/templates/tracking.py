@@ -1,12 +1,11 @@
 """Tracked rendering: every value a template takes from the facts keeps the fact it came from.
 
-The facts a template sees are wrapped (:func:`track`): a name, an action or a label is a :class:`TrackedStr`, a
-number a :class:`TrackedFloat` or :class:`TrackedInt`, each holding its :class:`Fact`. Compared, tested or computed
-with, they are the plain values. Printed while a rendering records (:func:`recording`), they write their text
-between invisible markers (characters of Unicode's private use area) that say which fact they are; the markers
-survive any string the template builds around them. :func:`untangle` takes them out again: the clean text and a
-:class:`Span` per printed value, with its fact and the transformation the template applied (``neg``, ``abs``,
-``round``, ``scale``). The verifier checks a tracked span by its fact, never by its position in the sentence.
+The facts a template sees are wrapped (:func:`track`): a name, an action or a label is a :class:`TrackedStr`, a number
+a :class:`TrackedFloat` or :class:`TrackedInt`, each holding its :class:`Fact`; compared, tested or computed with,
+they are the plain values. Printed while a rendering records (:func:`recording`), they write their text between
+invisible markers (Unicode's private use area) saying which fact they are, which survive any string built around
+them. :func:`untangle` takes them out: the clean text and a :class:`Span` per printed value, with its fact and the
+template's transformation (``neg``, ``abs``, ``round``, ``scale``). The verifier checks a span by its fact.
 """
 
 from __future__ import annotations
@@ -223,15 +222,18 @@ def tracked(value, fact: Fact):
 
 
 @contextmanager
-def recording() -> Iterator[list]:
-    """Within it, tracked values print with their markers; yields the list of (fact, transform) the markers point
-    into (pass it to :func:`untangle`)."""
-    record: list = []
-    token = _RECORD.set(record)
+def collecting(var: contextvars.ContextVar) -> Iterator[list]:
+    """Within it, ``var`` holds a fresh list (what a rendering collects); yields that list."""
+    token = var.set(record := [])
     try:
         yield record
     finally:
-        _RECORD.reset(token)
+        var.reset(token)
+
+
+def recording():
+    """Within it, tracked values print with their markers; yields the (fact, transform) list for :func:`untangle`."""
+    return collecting(_RECORD)
 
 
 def untangle(marked: str, record: list) -> tuple[str, tuple[Span, ...]]:
