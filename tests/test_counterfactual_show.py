@@ -48,6 +48,7 @@ def test_notebook_card_names_the_change_and_the_new_action(uav):
         assert "None found" in miss._repr_html_() and miss.reason in repr(miss)
 
 
+@pytest.mark.slow
 def test_summary_writes_values_as_the_narratives_do(uav):
     from xairl.outputs.report_counterfactuals import writer
 

@@ -56,6 +56,7 @@ class _Slow(torch.nn.Module):
         return self.net(x)
 
 
+@pytest.mark.slow
 def test_a_report_says_each_of_its_long_steps(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(display, "EVERY", 0.01)  # every step is long at this scale
     policy = xairl.Policy(_Slow(), FEATURES, ACTIONS)

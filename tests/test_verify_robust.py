@@ -174,6 +174,7 @@ def test_bytes_are_refused_with_what_to_do():
         verify(b"Speed raised it by 0.4.", POOL[0], 0)
 
 
+@pytest.mark.slow
 def test_work_is_linear_in_the_text():
     """Work counted in function calls, not seconds (the times: benchmarks/bench_test_timings.py); a pattern's own
     backtracking, inside one call, is bounded by the fuzz tests of tests/test_verify_robust.py."""

@@ -1,11 +1,14 @@
 """The reference plugin's tests run with this plugin selected and no other. ``real_report``: the one report with real
 flights that the report's tests read (a report costs a minute: built once per session)."""
 
+import contextlib
+import io
 import shutil
 from pathlib import Path
 
 import pytest
 
+from xairl.explanations import display
 from xairl.registry import plugins
 
 DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
@@ -22,7 +25,7 @@ def only_this_plugin(monkeypatch):
 def real_report(tmp_path_factory) -> tuple[Path, Path]:
     """(report folder, real-flights folder): two UKM flights with the Baltaci events beside them, few simulated
     flights (Table I's SA-MRO then never updates: its columns equal CHM's) and 16 calibration flights, narrated
-    without robustness."""
+    without robustness. What it said on stderr is kept beside the report folder, in stderr.txt."""
     from xairl.cli import main
 
     if not UKM.is_dir():
@@ -37,7 +40,9 @@ def real_report(tmp_path_factory) -> tuple[Path, Path]:
     out = root / "rep"
     argv = ["report", "--plugin", "uav-handover", "--n", "30", "-o", f"real={real}", "-o", "flights=4"]
     argv += ["-o", "timelines=0", "-o", "calibration_flights=16", "--narrate", "--no-robustness", "--out", str(out)]
-    with pytest.MonkeyPatch.context() as mp:
+    with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stderr(io.StringIO()) as err:
         mp.setenv(plugins.LOAD_ENV, "uav-handover")
+        mp.setattr(display, "EVERY", 0.01)  # each step is long at this scale: each is said
         assert main(argv) == 0
+    (root / "stderr.txt").write_text(err.getvalue())
     return out, real

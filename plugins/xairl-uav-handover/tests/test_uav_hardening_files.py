@@ -101,6 +101,7 @@ needs_special_files = pytest.mark.skipif(
 )
 
 
+@pytest.mark.slow
 @needs_special_files
 def test_report_refuses_a_folder_of_a_fifo_and_a_link_to_dev_zero_quickly(tmp_path):
     """Run as a subprocess, bounded in time and memory: the loader used to block on the FIFO for ever, and read

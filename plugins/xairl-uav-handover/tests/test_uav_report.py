@@ -5,6 +5,8 @@ reason where SA-MRO's figures equal CHM's, and the main findings first. All read
 import html as htmllib
 import json
 import re
+import shutil
+import subprocess
 
 import pytest
 
@@ -112,6 +114,46 @@ def test_report_with_real_data(real_report):
     assert "finding (buffer first, position second)" in html
     datasets = {json.loads(x)["dataset"] for x in (out / "explanations.jsonl").read_text().splitlines()}
     assert datasets == {"simulated", "real"}
+
+
+def test_the_report_says_what_it_is_doing(real_report):
+    """`make demo` printed nothing for 97 s, then for 124 s: each long step is said (every 10 s while it runs:
+    tests/test_progress.py), the plugin's own steps inside the command's."""
+    out, _ = real_report
+    lines = (out.parent / "stderr.txt").read_text().splitlines()
+    said = [line for line in lines if line.startswith("xairl: ") and not line.startswith("xairl: still ")]
+    starts = [line[len("xairl: ") : -len(" ...")] for line in said if line.endswith(" ...")]
+    steps = [
+        "reading the real flights",
+        "building the uav-handover report's content",
+        "Table I: CHM, SA-MRO and the DQN on 4 simulated flights",
+        "comparing with the real flights (calibration, agreement)",
+        "simulating 16 flights: the states the real ones are compared with",
+        "simulating handovers per altitude band (calibration)",
+        "replaying the real flights open-loop (agreement)",
+        "simulating handovers by altitude (the figure)",
+        "simulating and explaining the flights at a glance",
+        "explaining (deep_shap) 30 simulated states",
+        "explaining (deep_shap) 30 real states",
+        "drawing the figures",
+        "narrating 6 decisions",
+    ]
+    quick = {"reading the real flights", "replaying the real flights open-loop (agreement)"}  # a fraction of a
+    quick |= {s for s in steps if s.startswith(("explaining", "simulating and"))}  # second: said when in time
+    assert starts == [s for s in steps if s in starts], said  # in this order, each once
+    assert set(steps) - set(starts) <= quick, said  # every step of a second or more is said
+    assert all(any(line.startswith(f"xairl: {s}: done in ") for line in said) for s in starts), said
+
+
+@pytest.mark.skipif(not shutil.which("chromium"), reason="chromium is not installed")
+def test_report_renders_in_headless_chromium(real_report, tmp_path):
+    out, _ = real_report
+    shot = tmp_path / "shot.png"
+    browser = ["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run"]
+    browser += ["--disable-background-networking", "--disable-component-update", "--disable-sync"]
+    browser += [f"--user-data-dir={tmp_path / 'profile'}", f"--screenshot={shot}", "--window-size=1200,2000"]
+    subprocess.run([*browser, (out / "report.html").as_uri()], check=True, capture_output=True, timeout=120)
+    assert shot.stat().st_size > 20_000
 
 
 @pytest.mark.parametrize(

@@ -16,7 +16,7 @@ import numpy as np
 
 from xairl import InputError
 
-from .buffer import buffer_step
+from .buffer import buffer_steps
 from .config import SimConfig
 from .exports import RealFlight
 from .features import FEATURES, N_CANDIDATES, checked_actions, state_rows
@@ -87,12 +87,12 @@ class UplinkBuffer:
         b, dt = self.cfg.buffer, self.cfg.flight.dt_s
         rate = float(capacity_bps(self.cfg, self.sinr_db(rsrp_dbm, cell)))
         interrupt = self.cfg.handover.interruption_s if handed else 0.0
-        for k in range(int(round(seconds / dt))):
-            arrivals = self.rng.poisson(b.packet_rate_hz * dt) * b.data_packet_bits
-            arrivals += b.control_packet_bits if handed and k == 0 else 0.0
-            served = rate * dt if k * dt >= interrupt else 0.0
-            q, lost = buffer_step(self.q, arrivals, served, b.q_max_bits)
-            self.q, self.lost = float(q), self.lost + float(lost)
+        steps = int(round(seconds / dt))
+        arrivals = (self.rng.poisson(b.packet_rate_hz * dt, size=steps) * b.data_packet_bits).tolist()
+        if handed and steps:
+            arrivals[0] += b.control_packet_bits
+        served = [rate * dt if k * dt >= interrupt else 0.0 for k in range(steps)]
+        self.q, self.lost = buffer_steps(self.q, self.lost, arrivals, served, b.q_max_bits)
 
 
 def _candidates(cells: dict, serving, cfg: SimConfig) -> list:

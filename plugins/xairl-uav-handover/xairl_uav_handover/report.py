@@ -136,11 +136,12 @@ class UAVReport(xairl.plugin.Report):
         ckpt = load_checkpoint(self.options.checkpoint)
         cfg = ckpt.sim_config
         policy = uav_policy(ckpt)
+        sampled = min(64, max(req.n_states, 8))  # flights to draw the states from: about one a state, at most 64
         content = xairl.plugin.ReportContent(
             title="xairl report: UAV handover DQN (Meer et al.), calibrated reproduction",
             policy=policy,
             background=policy.background(100, seed=req.seed + 7),
-            datasets=[("simulated", dqn_decision_states(ckpt, req.n_states, seed=req.seed + 1))],
+            datasets=[("simulated", dqn_decision_states(ckpt, req.n_states, seed=req.seed + 1, n_flights=sampled))],
             tables=[],  # Table I is put first below, computed after the states are drawn (the steps said in order)
             settings={
                 "checkpoint": ckpt.path.name,
