@@ -118,7 +118,7 @@ def test_a_folder_holding_a_run_is_not_overwritten_and_resume_checks_it_is_the_s
 @pytest.mark.slow
 def test_kill_9_then_resume_explains_every_state_exactly_once(tmp_path):
     states = tmp_path / "s.npy"
-    np.save(states, POLICY.background(16_000, seed=9))
+    np.save(states, POLICY.background(6_400, seed=9))  # 32 chunks of 200
     out = tmp_path / "out"
     argv = [
         sys.executable,
@@ -132,7 +132,7 @@ def test_kill_9_then_resume_explains_every_state_exactly_once(tmp_path):
         "--format",
         "parquet",
         "--chunk-size",
-        "500",
+        "200",
         "--method",
         "integrated_gradients",
         "-o",
@@ -154,7 +154,7 @@ def test_kill_9_then_resume_explains_every_state_exactly_once(tmp_path):
     rerun = subprocess.run(argv + ["--resume"], capture_output=True, text=True)
     assert rerun.returncode == 0, rerun.stderr
     index = pq.read_table(parts, columns=["index"]).column("index").to_numpy()
-    assert len(index) == 16_000 and np.array_equal(np.sort(index), np.arange(16_000))  # each exactly once
+    assert len(index) == 6_400 and np.array_equal(np.sort(index), np.arange(6_400))  # each exactly once
     for junk in parts.glob(".*.part"):  # what the kill left: hidden, never under a final name
         junk.unlink()
     again = tmp_path / "again"
@@ -165,7 +165,7 @@ def test_kill_9_then_resume_explains_every_state_exactly_once(tmp_path):
         background=POLICY.background(20, seed=0),
         method="integrated_gradients",
         options={"n_steps": 8},
-        chunk_size=500,
+        chunk_size=200,
         progress=False,
     )
     assert np.array_equal(read_parquet(parts).values, read_parquet(again / "explanations.parquet").values)
