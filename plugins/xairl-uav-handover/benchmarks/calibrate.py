@@ -6,6 +6,9 @@ Targets: simulated / real CHM within 2x in every band; buffer full in < 20 % of 
 with any feature outside the simulated range.
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/calibrate.py [--real DIR] [--checkpoint PATH]
      [--set observation.l3_filter_k=4 ...]   (overrides of the checkpoint's simulator settings)
+     [--calibrated]   (network_check.CALIBRATED over the checkpoint's network, before --set)
+     [--table]   (issue 67's calibration table instead, network_check.py: serving SINR, replayed failures, an A3
+                  grid at the logs' cadence, ring convergence; fit and check halves; a few minutes on 2 cores)
 """
 
 import argparse
@@ -21,6 +24,7 @@ from xairl_uav_handover.calibration import band_rows, link_loss_fit, outside, qu
 from xairl_uav_handover.config import SimConfig
 from xairl_uav_handover.env import HandoverVecEnv
 from xairl_uav_handover.exports import load_folder
+from xairl_uav_handover.network_check import calibrated
 from xairl_uav_handover.policy import dqn_decision_states, load_checkpoint
 from xairl_uav_handover.real_data import chm_handovers, walk
 from xairl_uav_handover.uplink import capacity_bps
@@ -78,17 +82,36 @@ def spread_report(cfg: SimConfig, walks, seed: int = 3) -> None:
     )
 
 
+def calibration_table(cfg: SimConfig, flights) -> None:
+    """Issue 67's table: each quantity simulated against real on the fit and the check half."""
+    from xairl_uav_handover import network_check as nc
+
+    grid = [(o, t) for o in (2.0, 4.0, 6.0) for t in (0.16, 0.64, 1.28)]
+    print("| quantity | half | simulated | real | target | met |\n|---|---|---|---|---|---|")
+    for part in (nc.sinr_rows, nc.failure_rows, lambda c, f: nc.a3_rows(c, f, grid), nc.ring_rows):
+        for r in part(cfg, flights):
+            print(
+                f"| {r.quantity} | {r.half} | {r.simulated:.3g} | {r.real:.3g} | {r.target} | {'yes' if r.met else 'no'} |"
+            )
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--real", default=str(ROOT.parent / "shared/data/ukm-uav-lte/raw"))
     ap.add_argument("--checkpoint", default=None)
     ap.add_argument("--set", nargs="*", default=[], help="simulator overrides section.field=JSON")
+    ap.add_argument("--table", action="store_true", help="issue 67's calibration table (network_check.py)")
+    ap.add_argument("--calibrated", action="store_true", help="network_check.CALIBRATED over the checkpoint's network")
     args = ap.parse_args()
     ckpt = load_checkpoint(args.checkpoint)
-    cfg = overridden(ckpt.sim_config, args.set)
+    cfg = overridden(calibrated(ckpt.sim_config) if args.calibrated else ckpt.sim_config, args.set)
     ckpt = dataclasses.replace(ckpt, sim_config=cfg)
     t0 = time.time()
     flights, _ = load_folder(args.real)
+    if args.table:
+        calibration_table(cfg, flights)
+        print(f"({time.time() - t0:.0f} s)")
+        return
     walks = [walk(f, cfg) for f in flights]
     chm_real = [chm_handovers(f, sim_config=cfg) for f in flights]
     print(

@@ -3,6 +3,7 @@ bootstrap 95 % interval (xairl_uav_handover.table), and the targets of the issue
 A3 rule on what operators pay for" checked one by one.
 
 Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/table_one.py [--flights 200] [--seeds 0 1 2]
+     [--calibrated]   (every policy on the network calibrated to the real flights, network_check.CALIBRATED)
      [--checkpoint PATH ...]   (default: the committed checkpoint; several: one DQN column each, and one pooled
     column whose intervals resample training seeds, then flights)
 Each per-flight figure as mean and median; the paper's medians beside ours (table.format_paper).
@@ -12,6 +13,7 @@ import argparse
 import json
 
 from xairl_uav_handover.baselines import CHM, SAMRO
+from xairl_uav_handover.network_check import calibrated
 from xairl_uav_handover.policy import DQNController, load_checkpoint
 from xairl_uav_handover.table import flights, format_paper, format_rows, pooled_seeds, with_intervals
 
@@ -74,9 +76,10 @@ def main():
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="evaluation seeds (flights pooled)")
     ap.add_argument("--checkpoint", nargs="+", default=[None], help="DQN checkpoints (default: the committed one)")
     ap.add_argument("--json", default=None, help="also write the figures here")
+    ap.add_argument("--calibrated", action="store_true", help="on network_check.CALIBRATED's network (issue 67)")
     args = ap.parse_args()
     ckpts = [load_checkpoint(p) for p in args.checkpoint]
-    cfg = ckpts[0].sim_config
+    cfg = calibrated(ckpts[0].sim_config) if args.calibrated else ckpts[0].sim_config
     n = args.flights * len(args.seeds)
     res = {
         c.name: with_intervals(flights(c, cfg, args.flights, args.seeds))

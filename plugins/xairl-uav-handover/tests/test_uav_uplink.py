@@ -109,7 +109,7 @@ def test_real_flight_cells_take_levels_of_one_drop():
 
 
 def test_settings_retired_by_issue_53_are_dropped_from_old_checkpoints():
-    from xairl_uav_handover.config import without_retired
+    from xairl_uav_handover.policy import without_retired
 
     old = SimConfig().model_dump()
     old["radio"].update(ul_activity=0.06, ul_interference_spread_db=9.0)

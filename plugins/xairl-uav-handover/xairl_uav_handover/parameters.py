@@ -29,10 +29,16 @@ def rows(model: BaseModel, prefix: str = "") -> list[tuple[str, str, str]]:
 
 
 def table() -> str:
-    """The markdown table of the simulator's, CHM's and SA-MRO's settings."""
-    lines = [BEGIN, "| setting | value | source |", "|---|---|---|"]
+    """The markdown table of the simulator's, CHM's and SA-MRO's settings, with the value of the network calibrated
+    to the real flights where it differs (network_check.CALIBRATED)."""
+    from .network_check import calibrated
+
+    tuned = {n: v for n, v, _ in rows(calibrated())}
+    lines = [BEGIN, "| setting | value | calibrated network | source |", "|---|---|---|---|"]
     for model, prefix in ((SimConfig(), ""), (CHMConfig(), "chm."), (SAMROConfig(), "sa_mro.")):
-        lines += [f"| `{n}` | {v} | {s.replace('|', '/')} |" for n, v, s in rows(model, prefix)]
+        for n, v, s in rows(model, prefix):
+            other = tuned.get(n, v) if not prefix else v
+            lines.append(f"| `{n}` | {v} | {other if other != v else ''} | {s.replace('|', '/')} |")
     return "\n".join([*lines, END])
 
 

@@ -20,7 +20,7 @@ from xairl import Policy
 from .acting import DQNController as DQNController  # (callers import the controller from here too)
 from .acting import greedy, memory_of, random_available
 from .baselines import CHM, CHMConfig
-from .config import SimConfig, without_retired
+from .config import SimConfig
 from .env import HandoverVecEnv
 from .features import (
     ACTION_ALIASES,
@@ -39,6 +39,25 @@ from .features import (
 from .memory import Memory, memory_policy
 
 DEFAULT_CHECKPOINT = Path(__file__).parent / "checkpoints" / "uav-dqn.safetensors"
+
+
+#: settings issue 53 retired (the uplink spread, the random walk's turns, the fixed resource blocks, the constant
+#: antenna gain and its per-flight spread, the fitted fading): a checkpoint
+#: trained before it still loads, its simulator read without them
+RETIRED = {
+    "channel": ("fading_db",),
+    "radio": ("ul_activity", "ul_interference_spread_db", "bs_antenna_gain_db", "gain_spread_db"),
+    "flight": ("turn_every_s",),
+    "buffer": ("rb_per_uav",),
+}
+
+
+def without_retired(data: dict) -> dict:
+    """``data`` (a SimConfig as a dict) without the :data:`RETIRED` settings."""
+    return {
+        k: ({f: x for f, x in v.items() if f not in RETIRED.get(k, ())} if isinstance(v, dict) else v)
+        for k, v in data.items()
+    }
 
 
 def build_qnet(mean: np.ndarray, std: np.ndarray, hidden=(64, 64)) -> torch.nn.Sequential:

@@ -105,7 +105,7 @@ class Simulator:
         n_site = len(self.sites_xy)
         self.dt = cfg.flight.dt_s
         self.n_steps = cfg.flight.n_steps
-        self.radius = (cfg.layout.rings + 0.5) * cfg.layout.isd_m * np.sqrt(3) / 2  # inside the outer ring
+        self.radius = cfg.layout.flight_radius_m  # the flights' disc (LayoutConfig.area_radius_m)
         self.route = Waypoints(cfg.flight, self.radius, rng, n_uavs)  # flights through waypoints (trajectory.py)
         self.pos = self.route.start.copy()
         # one link per UAV and site: the three cells of a site share its path, differing by their antennas
