@@ -90,9 +90,9 @@ def calibration_table(cfg: SimConfig, flights) -> None:
     print("| quantity | half | simulated | real | target | met |\n|---|---|---|---|---|---|")
     for part in (nc.sinr_rows, nc.failure_rows, lambda c, f: nc.a3_rows(c, f, grid), nc.ring_rows):
         for r in part(cfg, flights):
-            print(
-                f"| {r.quantity} | {r.half} | {r.simulated:.3g} | {r.real:.3g} | {r.target} | {'yes' if r.met else 'no'} |"
-            )
+            real = "" if np.isnan(r.real) else f"{r.real:.3g}"
+            met = ("yes" if r.met else "no") if r.target else ""
+            print(f"| {r.quantity} | {r.half} | {r.simulated:.3g} | {real} | {r.target} | {met} |")
 
 
 def main():

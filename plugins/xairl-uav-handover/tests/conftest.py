@@ -43,6 +43,7 @@ def real_report(tmp_path_factory) -> tuple[Path, Path]:
     with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stderr(io.StringIO()) as err:
         mp.setenv(plugins.LOAD_ENV, "uav-handover")
         mp.setattr(display, "EVERY", 0.01)  # each step is long at this scale: each is said
-        assert main(argv) == 0
+        code = main(argv)
+    assert code == 0, err.getvalue()[-2000:]
     (root / "stderr.txt").write_text(err.getvalue())
     return out, real

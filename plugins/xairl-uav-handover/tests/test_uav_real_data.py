@@ -1,5 +1,7 @@
 """Real flight data (../shared/data, never committed) and the report. Skips cleanly where the data is absent."""
 
+import contextlib
+import io
 import json
 import shutil
 from pathlib import Path
@@ -9,6 +11,7 @@ import pytest
 
 from xairl import InputError
 from xairl.cli import main
+from xairl.explanations import display
 from xairl.plugin import StateRecord
 from xairl_uav_handover.baselines import CHMConfig
 from xairl_uav_handover.calibration import agreement_rows, outside
@@ -152,8 +155,24 @@ def sim_report(tmp_path_factory):
     other tests read one report with real flights (conftest's ``real_report``)."""
     out = tmp_path_factory.mktemp("sim") / "rep"
     argv = ["report", "--plugin", "uav-handover", "--n", "6", "-o", "flights=1", "-o", "timelines=0", "--narrate"]
-    assert main([*argv, "--no-robustness", "--out", str(out)]) == 0
+    with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stderr(io.StringIO()) as err:
+        mp.setattr(display, "EVERY", 0.01)  # each step is said, however short
+        code = main([*argv, "--no-robustness", "--out", str(out)])
+    assert code == 0, err.getvalue()[-2000:]
+    (out.parent / "stderr.txt").write_text(err.getvalue())
     return out
+
+
+@pytest.mark.slow
+def test_a_report_without_real_data_says_its_steps(sim_report):
+    """The report's steps without the real flights, each said once and in order (with them: test_uav_report.py)."""
+    said = (sim_report.parent / "stderr.txt").read_text().splitlines()
+    starts = [
+        line[len("xairl: ") : -len(" ...")] for line in said if line.startswith("xairl: ") and line.endswith(" ...")
+    ]
+    steps = ["building the uav-handover report's content", "Table I: CHM, SA-MRO and the DQN on 1 simulated flight"]
+    steps += ["simulating and explaining the flights at a glance", "drawing the figures", "narrating 6 decisions"]
+    assert [s for s in starts if not s.startswith("explaining")] == steps, starts
 
 
 @pytest.mark.slow

@@ -147,7 +147,7 @@ class LayoutConfig(Strict):
         description="inter-site distance of the hexagonal grid (TR 36.777 Table A.1-1, UMa: 500 m)",
     )
     rings: int = Field(
-        2, ge=1, le=6, description="rings around the centre site (2 -> 19 sites, 57 cells: TR 36.777 Table A.1-1)"
+        2, ge=1, le=8, description="rings around the centre site (2 -> 19 sites, 57 cells: TR 36.777 Table A.1-1)"
     )
     area_radius_m: float | None = Field(
         None,
@@ -336,19 +336,20 @@ class HandoverConfig(Strict):
 
 class RewardConfig(Strict):
     """r = w_buffer / (1 + q) - w_handover*[handover] - w_rsrp*[RSRP<thr] - w_rsrq*[RSRQ<thr] - w_lost*lost
-    - w_pingpong*[ping-pong] per decision, q and lost in Mbit. The defaults are the paper's reward (its four terms;
-    w_lost = w_pingpong = 0). :data:`PRICED_REWARD` is the operator-priced variant (lost data and ping-pongs
-    priced too), an option reported apart (``xairl uav train --reward priced``)."""
+    - w_pingpong*[ping-pong] per decision, q and lost in Mbit. The defaults are the paper's four terms (w_lost =
+    w_pingpong = 0) with weights of ours: the paper names the terms, not their weights. :data:`PRICED_REWARD` is the
+    operator-priced variant (lost data and ping-pongs priced too), an option reported apart (``xairl uav train
+    --reward priced``)."""
 
-    w_handover: float = Field(20.0, ge=0, description="the paper's handover weight")
+    w_handover: float = Field(20.0, ge=0, description="weight of the paper's handover term (ours)")
     w_buffer: float = Field(
         2.0,
         ge=0,
         description="weight of the paper's buffer term omega1 / (1 + q); 2 measured before issue 53 (40 episodes, "
         "100 held-out flights, seeds 0 and 1): 1 left the DQN losing 7-10 % more data than CHM, 2 as much",
     )
-    w_rsrp: float = Field(0.5, ge=0, description="the paper's RSRP-violation weight")
-    w_rsrq: float = Field(0.5, ge=0, description="the paper's RSRQ-violation weight")
+    w_rsrp: float = Field(0.5, ge=0, description="weight of the paper's RSRP term (ours)")
+    w_rsrq: float = Field(0.5, ge=0, description="weight of the paper's RSRQ term (ours)")
     w_lost: float = Field(0.0, ge=0, description="per Mbit of uplink data lost to buffer overflow (not in the paper)")
     w_pingpong: float = Field(
         0.0,

@@ -40,6 +40,8 @@ GROUND_RADIUS_M = 30.0
 LIVE_CHANGES_PER_MIN = 0.83
 #: the SINR 3GPP mobility studies take for Qout (HandoverConfig.qout_db's default)
 QOUT_3GPP_DB = -8.0
+#: a logged sample stands for at most this long (s): the logs have gaps of minutes, with no measurement in them
+HOLD_S = 5.0
 #: the network calibrated on the fit half (docs/uav-reference.md, "The network against the flights"): the flights'
 #: disc as far as the real ones reach, the inter-site distance and the downlink load fitted to the logged SINR (KS)
 #: and the A3 grid's rates (scanned: 500, 400 and 300 m; load from 0.1, 0.3, 0.5 or 0.7), rings enough that one more
@@ -66,8 +68,8 @@ class Row:
     quantity: str
     half: str  # "fit" or "check"
     simulated: float
-    real: float
-    target: str  # what "agrees" means, in words
+    real: float  # NaN: none (a statistic of both)
+    target: str  # what "agrees" means, in words ("": a figure shown beside the others, with no target)
     met: bool
 
 
@@ -77,29 +79,33 @@ def airborne(f) -> np.ndarray:
 
 
 def airborne_minutes(f) -> float:
-    """Minutes of ``f`` spent aloft: each airborne sample counts until the next one."""
-    gaps = np.diff(f.t, append=f.t[-1])
+    """Minutes of ``f`` spent aloft: each airborne sample counts until the next one, for at most HOLD_S."""
+    gaps = np.minimum(np.diff(f.t, append=f.t[-1]), HOLD_S)
     return float(gaps[airborne(f)].sum() / 60.0)
 
 
 def replayed_failures(flights, handover: HandoverConfig, dt: float) -> np.ndarray:
     """(len(flights),) radio link failures the simulator's rule declares on each real flight's logged SINR, each
-    sample held until the next one on a grid of ``dt``; all flights replayed at once, a flight that has ended held in
-    sync. After a failure the rule starts again on the same link, as a re-established one would."""
-    grids = [np.arange(0.0, f.t[-1], dt) for f in flights]
+    sample held until the next one (for at most HOLD_S: in a longer gap nothing is judged, the link held in sync) on a
+    grid of ``dt``. All flights are replayed at once; a failure counts only within its flight. After a failure the
+    rule starts again on the same link, as a re-established one would."""
+    grids = [np.arange(f.t[0], f.t[-1], dt) for f in flights]
     sinr = np.full((len(flights), max(map(len, grids))), np.inf)
+    inside = np.zeros(sinr.shape, dtype=bool)
     for k, (f, grid) in enumerate(zip(flights, grids)):
-        sinr[k, : len(grid)] = f.snr[np.searchsorted(f.t, grid, side="right") - 1]
+        i = np.searchsorted(f.t, grid, side="right") - 1
+        sinr[k, : len(grid)] = np.where(grid - f.t[i] <= HOLD_S, f.snr[i], np.inf)
+        inside[k, : len(grid)] = True
     monitor, failures = LinkMonitor(handover, len(flights), dt), np.zeros(len(flights), dtype=np.int64)
-    for step in sinr.T:
+    for step, live in zip(sinr.T, inside.T):
         avg = monitor.average_db(step[:, None])
-        failures += monitor.radio_link_fails(avg[:, 0])
+        failures += monitor.radio_link_fails(avg[:, 0]) & live
     return failures
 
 
 def simulated_sinr(cfg: SimConfig, heights, weights, n_flights: int = 16, seconds: float = 60.0, seed: int = 0):
     """Serving downlink SINR (dB) of simulated CHM flights held at each of ``heights``, sampled every LOG_INTERVAL_S;
-    the heights mixed in proportion to ``weights`` (20,000 samples drawn with replacement, a height of weight 0 left
+    the heights mixed in proportion to ``weights`` (about 20,000 samples drawn with replacement, a height of weight 0 left
     out)."""
     every = max(1, int(round(LOG_INTERVAL_S / cfg.flight.dt_s)))
     share = np.asarray(weights, float) / np.sum(weights)
@@ -123,7 +129,8 @@ def simulated_cell_changes(
     cfg: SimConfig, rule: CHMConfig, heights, weights, n_flights: int = 16, seconds: float = 60.0, seed: int = 0
 ) -> float:
     """Changes of serving cell a minute (handovers and re-establishments on another cell) of A3 ``rule`` seeing the
-    measurements every LOG_INTERVAL_S, flights held at ``heights`` and averaged with ``weights``."""
+    measurements every LOG_INTERVAL_S, flights held at ``heights`` and averaged with ``weights``. Counted from one
+    decision to the next: a change and back within one period is not seen, as in the logs."""
     every = max(1, int(round(LOG_INTERVAL_S / cfg.flight.dt_s)))
     rates, used = [], []
     for h, w in zip(heights, weights):
@@ -163,12 +170,12 @@ def sinr_rows(cfg: SimConfig, flights, seed: int = 0) -> list[Row]:
         real = np.concatenate([f.snr[airborne(f)] for f in part])
         sim = simulated_sinr(cfg, *heights_of(part), seed=seed)
         ks = float(ks_2samp(sim, real).statistic)
-        rows.append(Row("serving SINR, KS statistic", half, ks, 0.0, "<= 0.15", ks <= 0.15))
+        rows.append(Row("serving SINR, KS statistic", half, ks, float("nan"), "<= 0.15", ks <= 0.15))
         for qout in sorted({cfg.handover.qout_db, QOUT_3GPP_DB}):  # the rule's, and the SINR 3GPP names
             below_sim, below_real = 100 * np.mean(sim < qout), 100 * np.mean(real < qout)
             met = abs(below_sim - below_real) <= 3
             rows.append(Row(f"time below {qout:g} dB, %", half, below_sim, below_real, "within 3 points", met))
-        rows.append(Row("serving SINR median, dB", half, float(np.median(sim)), float(np.median(real)), "", True))
+        rows.append(Row("serving SINR median, dB", half, float(np.median(sim)), float(np.median(real)), "", False))
     return rows
 
 
@@ -184,8 +191,8 @@ def failure_rows(cfg: SimConfig, flights) -> list[Row]:
                 half,
                 rate,
                 live,
-                f"<= {LIVE_CHANGES_PER_MIN}",
-                rate <= LIVE_CHANGES_PER_MIN,
+                f"<= {LIVE_CHANGES_PER_MIN} and <= the half's live changes",
+                rate <= min(live, LIVE_CHANGES_PER_MIN),
             )
         )
     return rows
@@ -206,19 +213,22 @@ def a3_rows(cfg: SimConfig, flights, grid, seed: int = 0) -> list[Row]:
                     sim,
                     real,
                     "within 25 %",
-                    abs(sim / max(real, 1e-9) - 1) <= 0.25,
+                    abs(sim - real) <= 0.25 * real,
                 )
             )
     return rows
 
 
-def ring_rows(cfg: SimConfig, flights, seed: int = 0) -> list[Row]:
-    """The median serving SINR at the layout's rings and at one ring more (fit half's heights)."""
+def ring_rows(cfg: SimConfig, flights, seeds=(0, 1, 2, 3), n_flights: int = 32) -> list[Row]:
+    """The median serving SINR at the layout's rings and at one ring more, the flights' area kept (fit half's heights,
+    ``seeds`` pooled: one seed's median moves by about 1 dB from seed to seed at 16 flights a height)."""
     heights, weights = heights_of(split_flights(flights)[0])
     data = cfg.model_dump()
-    data["layout"]["rings"] = cfg.layout.rings + 1
+    data["layout"].update(rings=cfg.layout.rings + 1, area_radius_m=cfg.layout.flight_radius_m)
     wider = SimConfig.model_validate(data)
-    now, more = (float(np.median(simulated_sinr(c, heights, weights, seed=seed))) for c in (cfg, wider))
+    now, more = (
+        float(np.median([simulated_sinr(c, heights, weights, n_flights, seed=s) for s in seeds])) for c in (cfg, wider)
+    )
     return [
         Row(
             f"median serving SINR, {cfg.layout.rings} rings (real: {cfg.layout.rings + 1} rings), dB",
