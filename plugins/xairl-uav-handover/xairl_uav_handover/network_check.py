@@ -13,8 +13,8 @@ fit half and a check half of the flights (calibration.split_flights).
   closed-loop on the real logs (real_data.chm_handovers), per airborne minute.
 - **Ring convergence.** The median serving SINR with one ring of sites more: the layout's edge must not move it.
 
-Real samples within ``GROUND_RADIUS_M`` of the flight's first position are its take-off and landings (the logs have
-no per-sample height; the UAV lands there to change batteries): 19 % of the UKM samples, with a median RS SNR of
+Real samples within ``GROUND_RADIUS_M`` of the flight's first position are taken where the drone stands before,
+after and between its legs (the logs have no per-sample height): 19 % of the UKM samples, with a median RS SNR of
 15 dB against -6 dB aloft. The simulator flies aloft only, so they are left out of every comparison here.
 
 Run the whole table with ``benchmarks/calibrate.py --table``.
