@@ -172,7 +172,9 @@ def test_a_report_without_real_data_says_its_steps(sim_report):
     ]
     steps = ["building the uav-handover report's content", "Table I: CHM, SA-MRO and the DQN on 1 simulated flight"]
     steps += ["simulating and explaining the flights at a glance", "drawing the figures", "narrating 6 decisions"]
-    assert [s for s in starts if not s.startswith("explaining")] == steps, starts
+    quick = {steps[2]}  # no flight at a glance here: said only when the heartbeat's thread is in time
+    assert [s for s in starts if not s.startswith("explaining")] == [s for s in steps if s in starts], starts
+    assert set(steps) - set(starts) <= quick, starts
 
 
 @pytest.mark.slow
