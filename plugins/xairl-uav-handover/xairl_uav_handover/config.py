@@ -169,6 +169,7 @@ class LayoutConfig(Strict):
 
     @property
     def flight_radius_m(self) -> float:
+        """Radius of the disc the flights cover: ``area_radius_m``, else the grid's."""
         return self.area_radius_m or self.grid_radius_m
 
 
