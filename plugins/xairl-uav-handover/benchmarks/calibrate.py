@@ -8,7 +8,7 @@ Run: .venv/bin/python plugins/xairl-uav-handover/benchmarks/calibrate.py [--real
      [--set observation.l3_filter_k=4 ...]   (overrides of the checkpoint's simulator settings)
      [--calibrated]   (network_check.CALIBRATED over the checkpoint's network, before --set)
      [--table]   (issue 67's calibration table instead, network_check.py: serving SINR, replayed failures, an A3
-                  grid at the logs' cadence, ring convergence; fit and check halves; a few minutes on 2 cores)
+                  grid at the logs' cadence, ring convergence; fit and check halves; about 45 minutes at 5 rings)
 """
 
 import argparse
