@@ -6,9 +6,8 @@ decisions (a template that reads a plugin's ``extras`` on the plugin policies' d
 inside a ``pick(...)`` (with two or more wordings), and the share where the sentence offers another phrasing or a
 pick.
 
-Run: .venv/bin/python benchmarks/bench_template_gaps.py [TEMPLATE.yaml ...]
-The UAV plugin's template: .venv/bin/python benchmarks/bench_template_gaps.py \
-    plugins/xairl-uav-handover/xairl_uav_handover/prompts/handover.yaml
+Run: .venv/bin/python benchmarks/bench_template_gaps.py [TEMPLATE.yaml ...]   (any template file: a plugin's too,
+rendered on the decisions of the policies that plugin registers)
 """
 
 import re
