@@ -44,69 +44,54 @@ def main():
         tmp = Path(tmp)
         rng = np.random.default_rng(0)
         np.save(tmp / "bg.npy", rng.normal(size=(100, 8)).astype(np.float32))
-        common = ["--policy", f"{POLICY}:make_policy", "--background", str(tmp / "bg.npy")]
-        peaks = {}
-        for n in sorted({args.states, args.states * args.scale}):
-            states = np.lib.format.open_memmap(tmp / f"s{n}.npy", mode="w+", dtype=np.float32, shape=(n, 8))
-            for a in range(0, n, 1_000_000):  # written in pieces: the benchmark itself stays small too
-                states[a : a + 1_000_000] = rng.normal(size=(min(1_000_000, n - a), 8))
-            states.flush()
-            del states
-            out = tmp / f"out{n}"
-            secs, rss = run(
-                [
-                    xairl,
-                    "explain",
-                    *common,
-                    "--states",
-                    str(tmp / f"s{n}.npy"),
-                    "--out",
-                    str(out),
-                    "--format",
-                    "parquet",
-                    "--chunk-size",
-                    str(args.chunk_size),
-                ]
-            )
-            peaks[n] = rss
-            disk = sum(p.stat().st_size for p in (out / "explanations.parquet").glob("part-*.parquet"))
-            print(
-                f"{n} states: {secs:.1f} s, {n / secs:,.0f} states/s (target 50,000: {n / secs / 50_000:.2f}x), "
-                f"peak RSS {rss:.0f} MB (target 1024: {rss / 1024:.2f}x), Parquet {disk / n:.1f} bytes/state"
-            )
-            (tmp / f"s{n}.npy").unlink()
+        common = [xairl, "explain", "--policy", f"{POLICY}:make_policy", "--background", str(tmp / "bg.npy")]
+        peaks = {
+            n: throughput(common, tmp, n, args.chunk_size, rng) for n in sorted({args.states, args.states * args.scale})
+        }
         small = min(peaks)
         if len(peaks) > 1:
             big = max(peaks)
             print(f"peak RSS at {big} states / at {small}: {peaks[big] / peaks[small]:.3f} (target <= 1.10)")
-        sample = 10_000  # JSON lines of the same explanations, on fewer states (bytes per state do not depend on n)
-        np.save(tmp / "few.npy", rng.normal(size=(sample, 8)).astype(np.float32))
-        jsonl = subprocess.run(
-            [xairl, "explain", *common, "--states", str(tmp / "few.npy"), "--format", "jsonl"],
-            capture_output=True,
-            check=True,
-        ).stdout
-        subprocess.run(
-            [
-                xairl,
-                "explain",
-                *common,
-                "--states",
-                str(tmp / "few.npy"),
-                "--out",
-                str(tmp / "few"),
-                "--format",
-                "parquet",
-            ],
-            capture_output=True,
-            check=True,
-        )
-        pq = sum(p.stat().st_size for p in (tmp / "few" / "explanations.parquet").glob("part-*.parquet")) / sample
-        print(
-            f"bytes per state, {sample} states: JSON lines {len(jsonl) / sample:.0f}, Parquet {pq:.0f}: "
-            f"Parquet / JSON lines = {pq / (len(jsonl) / sample):.3f} (target <= 0.333)"
-        )
+        bytes_per_state(common, tmp, rng)
     print(f"(this process's own peak: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB)")
+
+
+def throughput(common: list[str], tmp: Path, n: int, chunk_size: int, rng) -> float:
+    """States a second, peak RSS and Parquet bytes a state of ``xairl explain`` on ``n`` states, printed; the RSS."""
+    import numpy as np
+
+    states = np.lib.format.open_memmap(tmp / f"s{n}.npy", mode="w+", dtype=np.float32, shape=(n, 8))
+    for a in range(0, n, 1_000_000):  # written in pieces: the benchmark itself stays small too
+        states[a : a + 1_000_000] = rng.normal(size=(min(1_000_000, n - a), 8))
+    states.flush()
+    del states
+    out = tmp / f"out{n}"
+    secs, rss = run(
+        [*common, "--states", str(tmp / f"s{n}.npy"), "--out", str(out), "--format", "parquet"]
+        + ["--chunk-size", str(chunk_size)]
+    )
+    disk = sum(p.stat().st_size for p in (out / "explanations.parquet").glob("part-*.parquet"))
+    print(
+        f"{n} states: {secs:.1f} s, {n / secs:,.0f} states/s (target 50,000: {n / secs / 50_000:.2f}x), "
+        f"peak RSS {rss:.0f} MB (target 1024: {rss / 1024:.2f}x), Parquet {disk / n:.1f} bytes/state"
+    )
+    (tmp / f"s{n}.npy").unlink()
+    return rss
+
+
+def bytes_per_state(common: list[str], tmp: Path, rng, sample: int = 10_000) -> None:
+    """JSON lines against Parquet of the same explanations, on ``sample`` states (bytes a state do not depend on n)."""
+    import numpy as np
+
+    np.save(tmp / "few.npy", rng.normal(size=(sample, 8)).astype(np.float32))
+    few = [*common, "--states", str(tmp / "few.npy")]
+    jsonl = subprocess.run([*few, "--format", "jsonl"], capture_output=True, check=True).stdout
+    subprocess.run([*few, "--out", str(tmp / "few"), "--format", "parquet"], capture_output=True, check=True)
+    pq = sum(p.stat().st_size for p in (tmp / "few" / "explanations.parquet").glob("part-*.parquet")) / sample
+    print(
+        f"bytes per state, {sample} states: JSON lines {len(jsonl) / sample:.0f}, Parquet {pq:.0f}: "
+        f"Parquet / JSON lines = {pq / (len(jsonl) / sample):.3f} (target <= 0.333)"
+    )
 
 
 if __name__ == "__main__":

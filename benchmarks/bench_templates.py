@@ -306,34 +306,11 @@ def main():
         timed = [t for t in tsets.get("custom", []) if t["correct"]] + builtins
         report["timing"] = timing(kinds, timed, n)
 
-    # Jobs: every template of the sets, the twins, the built-ins
-    jobs = []
-    for s, templates in tsets.items():
-        for t in templates:
-            for kind in t["kinds"]:
-                for i in decisions_of(t["spec"], n):
-                    jobs.append(((s, t["name"]), str(t["path"].parent), t["name"], kind, i))
-                    if t["twin"] is not None:
-                        jobs.append(((s + "-twin", t["name"]), str(t["twin"].parent), t["name"], kind, i))
-    for t in builtins:
-        for kind in t["kinds"]:
-            for i in decisions_of(t["spec"], n):
-                jobs.append((("builtin", t["name"]), None, t["name"], kind, i))
-
+    jobs = template_jobs(tsets, builtins, n)
     tmp = Path(tempfile.mkdtemp(prefix="bench_templates_"))
     mutant_meta = {}  # key -> (source, template, category, label)
     if not args.no_mutations:
-        sources = [("custom", t) for t in tsets.get("custom", []) if t["correct"]] + [("builtin", t) for t in builtins]
-        for src, t in sources:
-            for cat, items in mutants(t["spec"], args.max_mutants).items():
-                for j, (label, spec) in enumerate(items):
-                    key = ("mutant", src, t["name"], cat, j)
-                    folder = tmp / f"{src}-{t['name']}-{cat}-{j}"
-                    write_spec(spec, folder)
-                    mutant_meta[key] = (src, t, cat, label)
-                    for kind in t["kinds"]:
-                        for i in decisions_of(t["spec"], n):
-                            jobs.append((key, str(folder), t["name"], kind, i))
+        jobs += mutant_jobs(tsets, builtins, args.max_mutants, n, tmp, mutant_meta)
     print(f"renderings: {len(jobs)} ({len(mutant_meta)} mutated templates)", flush=True)
     t0 = time.perf_counter()
     results = run_jobs(jobs, args.workers)
@@ -355,6 +332,41 @@ def main():
     print_report(report, tsets)
     Path(args.out).write_text(json.dumps(report, indent=1, default=str))
     print(f"\nJSON: {args.out}; {report['seconds']['total']:.0f} s in all ({render_s:.0f} s rendering)")
+
+
+def template_jobs(tsets: dict, builtins: list, n: int) -> list:
+    """A rendering job for every template of the sets (and its twin), and every built-in, on each decision."""
+    jobs = []
+    for s, templates in tsets.items():
+        for t in templates:
+            for kind in t["kinds"]:
+                for i in decisions_of(t["spec"], n):
+                    jobs.append(((s, t["name"]), str(t["path"].parent), t["name"], kind, i))
+                    if t["twin"] is not None:
+                        jobs.append(((s + "-twin", t["name"]), str(t["twin"].parent), t["name"], kind, i))
+    for t in builtins:
+        for kind in t["kinds"]:
+            for i in decisions_of(t["spec"], n):
+                jobs.append((("builtin", t["name"]), None, t["name"], kind, i))
+    return jobs
+
+
+def mutant_jobs(tsets: dict, builtins: list, max_mutants: int, n: int, tmp: Path, meta: dict) -> list:
+    """The mutants of every correct custom template and every built-in, written under ``tmp``, a rendering job for
+    each on each decision; ``meta`` gets each mutant's (source, template, category, label)."""
+    jobs = []
+    sources = [("custom", t) for t in tsets.get("custom", []) if t["correct"]] + [("builtin", t) for t in builtins]
+    for src, t in sources:
+        for cat, items in mutants(t["spec"], max_mutants).items():
+            for j, (label, spec) in enumerate(items):
+                key = ("mutant", src, t["name"], cat, j)
+                folder = tmp / f"{src}-{t['name']}-{cat}-{j}"
+                write_spec(spec, folder)
+                meta[key] = (src, t, cat, label)
+                for kind in t["kinds"]:
+                    for i in decisions_of(t["spec"], n):
+                        jobs.append((key, str(folder), t["name"], kind, i))
+    return jobs
 
 
 if __name__ == "__main__":

@@ -144,6 +144,15 @@ def summarise_builtins(templates, results, n, kinds):
     }
 
 
+def _count_mutant(tally: dict, per_template: list, label: str, verified: bool) -> None:
+    """One rendering of a mutated template: counted, and caught unless it verified (per operator, per template)."""
+    tally["mutated"] += 1
+    tally["caught"] += not verified
+    for counts in (tally.setdefault("by_operator", {}).setdefault(_operator(label), [0, 0]), per_template):
+        counts[0] += not verified
+        counts[1] += 1
+
+
 def summarise_mutations(meta, results, n):
     cats = {c: {"mutated": 0, "caught": 0, "templates": 0, "unchanged": 0, "na": 0} for c in CATEGORIES}
     para = {"rendered": 0, "rejected": 0, "templates": 0, "unchanged": 0, "na": 0, "original_not_verified": 0}
@@ -174,28 +183,11 @@ def summarise_mutations(meta, results, n):
                 if cat == "signs" and not orig.get("negative_value"):
                     tally["unchanged"] += 1
                     continue
-                tally["mutated"] += 1
-                tally["caught"] += not res["verified"]
-                op = tally.setdefault("by_operator", {}).setdefault(_operator(label), [0, 0])
-                op[0] += not res["verified"]
-                op[1] += 1
-                pt = per_template[f"{src}:{t['name']}"][cat]
-                pt[0] += not res["verified"]
-                pt[1] += 1
+                _count_mutant(tally, per_template[f"{src}:{t['name']}"][cat], label, res["verified"])
                 if res["verified"]:
+                    extra = {"mutation": label, "source": src, "original": orig["text"]}
                     misses[cat].append(
-                        _example(
-                            t["name"],
-                            kind,
-                            i,
-                            res,
-                            {
-                                "mutation": label,
-                                "source": src,
-                                "original": orig["text"],
-                                "claims": _changed_claims(res, orig),
-                            },
-                        )
+                        _example(t["name"], kind, i, res, {**extra, "claims": _changed_claims(res, orig)})
                     )
     return {
         "categories": cats,

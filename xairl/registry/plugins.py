@@ -208,16 +208,24 @@ def load_policy(spec: str, kwargs: dict | None = None, observation=None):
     (``xairl explain --policy-arg key=value``). A bare torch module becomes a Policy whose observation is
     ``observation`` (the shape of one state, taken from the states file by the CLI).
     """
-    import importlib
-    import importlib.util
-    from pathlib import Path
-
     kwargs = dict(kwargs or {})
     if ":" not in spec:
         if kwargs:
             raise InputError(f"--policy-arg is for a module:attr policy; '{spec}' is a registered name.")
         return get_policy(spec)
     where, _, attr = spec.rpartition(":")
+    module = _user_module(where)
+    if not hasattr(module, attr):
+        raise UnknownNameError(f"'{where}' has no attribute '{attr}'.")
+    return _as_policy(spec, getattr(module, attr), attr, kwargs, observation)
+
+
+def _user_module(where: str):
+    """The user's module ``where``: a .py file's path or a dotted name; one line, no traceback, when it fails."""
+    import importlib
+    import importlib.util
+    from pathlib import Path
+
     try:
         if where.endswith(".py"):
             path = Path(where)
@@ -232,9 +240,11 @@ def load_policy(spec: str, kwargs: dict | None = None, observation=None):
         raise
     except Exception as exc:  # the user's module: one line, no traceback
         raise InputError(f"cannot import '{where}' ({one_line(exc, 200)}).") from None
-    if not hasattr(module, attr):
-        raise UnknownNameError(f"'{where}' has no attribute '{attr}'.")
-    obj = getattr(module, attr)
+    return module
+
+
+def _as_policy(spec: str, obj, attr: str, kwargs: dict, observation):
+    """``obj`` (a Policy, a torch module, or a callable building either with ``kwargs``) as a Policy."""
     import torch
 
     from xairl.policies.policy import Policy

@@ -171,35 +171,9 @@ def explain_on_ray(
         todo = [first for first in range(0, total, chunk_size) if first not in run.done]
         started = _start(ray, address, workers)
         ref = ray.put(source) if not isinstance(source, str) else source
-        if todo:
-            with _unwrapped(ray):
-                ray.data.DataContext.get_current().enable_progress_bars = False
-                chunks = ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo)).map_batches(
-                    _ChunkWorker,
-                    batch_size=1,
-                    num_cpus=1,
-                    compute=ray.data.ActorPoolStrategy(size=_usable(ray, workers)),
-                    fn_constructor_kwargs={
-                        "policy": policy,
-                        "states": ref,
-                        "background": run.background,
-                        "method": method,
-                        "options": run.options,
-                        "chunk_size": chunk_size,
-                        "parts": str(run.parts),
-                        "meta": run.meta,
-                        "threads": 1,
-                    },
-                )
-                rows = []
-                for row in chunks.iter_rows():  # streamed: each part in run.json as it arrives, so that an
-                    rows.append(row)  # interrupted run resumes from every part it wrote
-                    if not row["error"]:
-                        run.done[int(row["first"])] = row["sha256"]
-                        run.save()
-            failed = [row["error"] for row in rows if row["error"]]
-            if failed:  # the chunks written so far stay: fix the states and --resume
-                raise InputError(failed[0])
+        failed = _explain_chunks(ray, run, policy, ref, method, chunk_size, todo, workers) if todo else []
+        if failed:  # the chunks written so far stay: fix the states and --resume
+            raise InputError(failed[0])
     finally:
         if started:
             ray.shutdown()
@@ -209,6 +183,38 @@ def explain_on_ray(
     for first in bar(range(0, total, chunk_size), desc="summing", unit="chunk", disable=not progress):
         summary.add(first, read_parquet(run.parts / part_name(first)))
     return finish_run(run, summary, states)
+
+
+def _explain_chunks(ray, run, policy: Policy, states, method: str, chunk_size: int, todo, workers: int) -> list[str]:
+    """The chunks starting at ``todo`` explained by a pool of actors, each part recorded in run.json as it arrives
+    (an interrupted run resumes from every part it wrote); the workers' errors, in order."""
+    with _unwrapped(ray):
+        ray.data.DataContext.get_current().enable_progress_bars = False
+        chunks = ray.data.from_items([{"first": f} for f in todo], override_num_blocks=len(todo)).map_batches(
+            _ChunkWorker,
+            batch_size=1,
+            num_cpus=1,
+            compute=ray.data.ActorPoolStrategy(size=_usable(ray, workers)),
+            fn_constructor_kwargs={
+                "policy": policy,
+                "states": states,
+                "background": run.background,
+                "method": method,
+                "options": run.options,
+                "chunk_size": chunk_size,
+                "parts": str(run.parts),
+                "meta": run.meta,
+                "threads": 1,
+            },
+        )
+        failed = []
+        for row in chunks.iter_rows():  # streamed
+            if row["error"]:
+                failed.append(row["error"])
+            else:
+                run.done[int(row["first"])] = row["sha256"]
+                run.save()
+    return failed
 
 
 class _NarrationWorker:
