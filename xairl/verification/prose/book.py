@@ -102,55 +102,15 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     us = narration_units(exp, policy)
     feats = {f: FeatureFacts() for f in exp.feature_names} | {u.name: FeatureFacts() for u in us}
     if index is None:
-        g = global_facts(exp, policy, k=len(exp.feature_names))
-        for r in g.ranking:
-            e = feats[r["name"]]
-            e.value = r["mean_abs"]
-            e.ranks["chosen"] = r["rank"]
-            if r["direction"] != "mixed":  # the direction it pushed on average, in the summary's view
-                e.contribs["chosen"] = 1.0 if r["direction"] == "toward" else -1.0
-        return FactBook(
-            feats, exp.output, None, None, {}, None, None, [float(g.n_states)], global_view=True, n_states=g.n_states
-        )
+        return _global_book(exp, policy, feats)
     d = decision_facts(exp, index, policy, k=len(exp.feature_names))
-    labels = exp.value_labels
     chosen_i, runner_i = int(exp.chosen[index]), int(exp.runner_up[index])
     deciding = exp.output == "actions" and runner_i != chosen_i
     views = {"chosen": exp.values[index, :, chosen_i]}
     if deciding:
         views["margin"] = exp.values[index, :, chosen_i] - exp.values[index, :, runner_i]
-    # ranks and shares among the narration units (groups narrated as one reason, identifiers not ranked); a group's
-    # members are ranked among all features
-    reasons = np.array([u.info.kind != "identifier" for u in us])
-    for ctx, contrib in views.items():
-        for names, c, ok in (
-            ([u.name for u in us], np.array([contrib[list(u.columns)].sum() for u in us]), reasons),
-            (exp.feature_names, contrib, np.ones(len(contrib), bool)),
-        ):
-            rank, signed, share = unit_ranks(c, ok)
-            for j, f in enumerate(names):
-                e = feats[f]
-                if ctx in e.contribs:  # a feature outside any group: its unit's ranks
-                    continue
-                e.contribs[ctx], e.ranks[ctx], e.signed_ranks[ctx], e.shares[ctx] = (
-                    float(c[j]),
-                    int(rank[j]) or None,
-                    int(signed[j]) or None,
-                    float(share[j]),
-                )
-    for j, f in enumerate(exp.feature_names):
-        info = policy.features.get(f) if policy else None
-        if exp.states is not None:
-            feats[f].value = float(exp.states[index, j])
-            if info is not None and info.capacity is not None:
-                feats[f].fill = 100.0 * feats[f].value / info.capacity
-        if labels is not None and labels[index, j] is not None:
-            feats[f].label = str(labels[index, j])
-        if exp.background_quantiles is not None:
-            feats[f].quartiles = tuple(float(q) for q in exp.background_quantiles[:, j])
-        if info is not None:
-            feats[f].legend = legend(info.description)
-            feats[f].identifier = info.kind == "identifier"
+    _add_ranks(feats, views, us, exp.feature_names)
+    _add_values(feats, exp, index, policy)
     scores = {a: float(exp.outputs[index, k]) for k, a in enumerate(exp.action_names)}
     base = float(exp.base_values[index, chosen_i])
     numbers = [d.score, base, d.score - base, d.additivity_gap, *scores.values()]
@@ -172,6 +132,60 @@ def fact_book(exp: Explanation, index: int | None, policy: Policy | None = None)
     book.aggregates["the number of features"] = float(len(exp.feature_names))
     add_facts(book, DomainFacts(d.extras, d.comparisons))
     return book
+
+
+def _global_book(exp: Explanation, policy: Policy | None, feats: dict) -> FactBook:
+    """The book of a global summary: each feature's mean |contribution|, rank and average direction."""
+    g = global_facts(exp, policy, k=len(exp.feature_names))
+    for r in g.ranking:
+        e = feats[r["name"]]
+        e.value = r["mean_abs"]
+        e.ranks["chosen"] = r["rank"]
+        if r["direction"] != "mixed":  # the direction it pushed on average, in the summary's view
+            e.contribs["chosen"] = 1.0 if r["direction"] == "toward" else -1.0
+    return FactBook(
+        feats, exp.output, None, None, {}, None, None, [float(g.n_states)], global_view=True, n_states=g.n_states
+    )
+
+
+def _add_ranks(feats: dict, views: dict, us, feature_names) -> None:
+    """Each feature's contribution, ranks and share in each view, among the narration units (groups narrated as one
+    reason, identifiers not ranked); a group's members are ranked among all features."""
+    reasons = np.array([u.info.kind != "identifier" for u in us])
+    for ctx, contrib in views.items():
+        for names, c, ok in (
+            ([u.name for u in us], np.array([contrib[list(u.columns)].sum() for u in us]), reasons),
+            (feature_names, contrib, np.ones(len(contrib), bool)),
+        ):
+            rank, signed, share = unit_ranks(c, ok)
+            for j, f in enumerate(names):
+                e = feats[f]
+                if ctx in e.contribs:  # a feature outside any group: its unit's ranks
+                    continue
+                e.contribs[ctx], e.ranks[ctx], e.signed_ranks[ctx], e.shares[ctx] = (
+                    float(c[j]),
+                    int(rank[j]) or None,
+                    int(signed[j]) or None,
+                    float(share[j]),
+                )
+
+
+def _add_values(feats: dict, exp: Explanation, index: int, policy: Policy | None) -> None:
+    """Each feature's value at the decision, its fill of a capacity, label, background quartiles, legend and kind."""
+    labels = exp.value_labels
+    for j, f in enumerate(exp.feature_names):
+        info = policy.features.get(f) if policy else None
+        if exp.states is not None:
+            feats[f].value = float(exp.states[index, j])
+            if info is not None and info.capacity is not None:
+                feats[f].fill = 100.0 * feats[f].value / info.capacity
+        if labels is not None and labels[index, j] is not None:
+            feats[f].label = str(labels[index, j])
+        if exp.background_quantiles is not None:
+            feats[f].quartiles = tuple(float(q) for q in exp.background_quantiles[:, j])
+        if info is not None:
+            feats[f].legend = legend(info.description)
+            feats[f].identifier = info.kind == "identifier"
 
 
 def _add_sums(book: FactBook, ctx: str, contrib: np.ndarray, names) -> None:

@@ -93,35 +93,8 @@ class Vocabulary:
 
 
 def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
-    phrases: dict[str, set[str]] = {}
-    exact: dict[str, set[str]] = {}
-    feature_words: dict[str, frozenset[str]] = {}
-    described_words: list[frozenset[str]] = []  # the content words of each description ('mother's job': mother, job)
     groups = [g for g in (policy.reason_groups if policy else {}) if g not in exp.feature_names]
-    for f in [*exp.feature_names, *groups]:
-        info = policy.features.get(f) if policy else None
-        described = (
-            (info.description if clean(info.description) else description_head(info.description)) if info else ""
-        )
-        described_words.append(
-            frozenset(w for w in split_words(description_head(described)) if w not in STOP and len(w) >= 3)
-        )
-        forms = [f, " ".join(split_words(f))] + (
-            [described, description_head(described), *info.aliases] if info else []
-        )
-        feature_words[f] = frozenset(w for form in forms if form for w in split_words(form) if w not in STOP)
-        name_words = split_words(f)
-        if len(name_words) == 2 and not any(w.isdigit() for w in name_words):  # 'year built' -> 'build year'
-            forms.append(" ".join(_BASE_FORM.get(w, w) for w in reversed(name_words)))
-        for form in forms:
-            if form and clean(form):
-                exact.setdefault(_phrase(form), set()).add(f)
-        spelled = _spellings(name_words)
-        feature_words[f] |= frozenset(w for form in spelled for w in form.split() if w not in STOP)
-        for form in [f] + ([description_head(described)] if described else []) + spelled:
-            if clean(form) and not REGION_RE.match(f.removeprefix("the ")):  # a region: only by its whole name
-                for run in _runs(form, f):
-                    phrases.setdefault(run, set()).add(f)
+    phrases, exact, feature_words, described_words = _feature_forms([*exp.feature_names, *groups], policy, clean)
     shared: dict[str, set[str]] = {}
     for f in [*exp.feature_names, *groups]:
         for w in split_words(f):
@@ -170,6 +143,41 @@ def vocabulary(exp: Explanation, policy: Policy | None, clean) -> Vocabulary:
         frozenset(names),
         _region_aliases(exp),
     )
+
+
+def _feature_forms(names, policy: Policy | None, clean):
+    """The ways each feature (or group) in ``names`` is written: (phrases: a run of words naming part of it ->
+    features, exact: a whole name -> features, each feature's words, each description's content words ('mother's
+    job': mother, job))."""
+    phrases: dict[str, set[str]] = {}
+    exact: dict[str, set[str]] = {}
+    feature_words: dict[str, frozenset[str]] = {}
+    described_words: list[frozenset[str]] = []
+    for f in names:
+        info = policy.features.get(f) if policy else None
+        described = (
+            (info.description if clean(info.description) else description_head(info.description)) if info else ""
+        )
+        described_words.append(
+            frozenset(w for w in split_words(description_head(described)) if w not in STOP and len(w) >= 3)
+        )
+        forms = [f, " ".join(split_words(f))] + (
+            [described, description_head(described), *info.aliases] if info else []
+        )
+        feature_words[f] = frozenset(w for form in forms if form for w in split_words(form) if w not in STOP)
+        name_words = split_words(f)
+        if len(name_words) == 2 and not any(w.isdigit() for w in name_words):  # 'year built' -> 'build year'
+            forms.append(" ".join(_BASE_FORM.get(w, w) for w in reversed(name_words)))
+        for form in forms:
+            if form and clean(form):
+                exact.setdefault(_phrase(form), set()).add(f)
+        spelled = _spellings(name_words)
+        feature_words[f] |= frozenset(w for form in spelled for w in form.split() if w not in STOP)
+        for form in [f] + ([description_head(described)] if described else []) + spelled:
+            if clean(form) and not REGION_RE.match(f.removeprefix("the ")):  # a region: only by its whole name
+                for run in _runs(form, f):
+                    phrases.setdefault(run, set()).add(f)
+    return phrases, exact, feature_words, described_words
 
 
 def _regions(exp: Explanation) -> dict[str, str]:
